@@ -1,0 +1,16 @@
+"""skyroute: plan where drones and small robots fly or drive.
+
+The public API is small: :func:`load_map` reads a map into a :class:`Grid`, :func:`plan`
+searches it and returns a :class:`PlanResult`.
+"""
+
+from skyroute.errors import InputFormatError, OptionError, QueryError, SkyrouteError
+from skyroute.planner import plan
+from skyroute.search.result import PlanResult, Status
+from skyroute.world.grid import Grid
+from skyroute.world.load import bundled_maps, load_map
+
+__version__ = "0.1.0"
+
+__all__ = ["Grid", "InputFormatError", "OptionError", "PlanResult", "QueryError",
+           "SkyrouteError", "Status", "bundled_maps", "load_map", "plan"]

@@ -1,0 +1,1 @@
+"""Benchmarks: skyroute's planners against peer libraries on the same queries."""

@@ -1,0 +1,161 @@
+"""``skyroute bench grid``: MovingAI scenarios through skyroute's planners and the peers.
+
+All runners answer the same queries in one process, interleaved (the order rotates each
+query, so drift in machine speed spreads evenly), after one untimed warm-up query each.
+Times are wall clock around one call: ``skyroute.plan`` for ours (validation included),
+the peer's query function for a peer (its one-off set-up is not timed).
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from skyroute.bench.peers import PEERS, available, octile_cost
+from skyroute.errors import InputFormatError, OptionError, check_choice
+from skyroute.planner import plan
+from skyroute.search.grid_plan import GRID_ALGORITHMS
+from skyroute.world.grid import Grid
+from skyroute.world.movingai import Scenario, read_map, read_scen
+
+# Algorithms whose cost must equal the scenario's octile optimum.
+OPTIMAL = ("dijkstra", "astar", "jps")
+
+
+def find_pairs(folder: str | Path, names: Sequence[str] = ()) -> list[tuple[Path, Path]]:
+    """(map, scen) pairs in ``folder``: ``X.map`` with ``X.map.scen`` or ``X-*.scen``."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputFormatError(folder, "not a folder of .map and .scen files")
+    pairs = {}
+    for m in sorted(folder.glob("*.map")):
+        scen = m.with_name(m.name + ".scen")
+        if not scen.exists():
+            alts = sorted(folder.glob(m.stem + "-*.scen"))
+            scen = alts[0] if alts else None
+        if scen is not None:
+            pairs[m.stem] = (m, scen)
+    if names:
+        wanted = [n.removesuffix(".map") for n in names]
+        unknown = [n for n in wanted if n not in pairs]
+        if unknown:
+            raise OptionError(f"--map {', '.join(unknown)} not found in {folder}; "
+                              f"valid: {', '.join(pairs)}")
+        return [pairs[n] for n in wanted]
+    if not pairs:
+        raise InputFormatError(folder, "no .map file with a matching .scen file")
+    return list(pairs.values())
+
+
+@dataclass
+class RunnerStats:
+    """What one runner did on one map."""
+
+    name: str
+    peer: bool
+    times: list = field(default_factory=list)
+    ratios: list = field(default_factory=list)
+    matched: int = 0
+    failed: int = 0
+    expanded: int = 0
+    search_seconds: float = 0.0
+
+    def row(self) -> dict:
+        med = statistics.median(self.times) * 1e3 if self.times else None
+        return {
+            "runner": self.name,
+            "peer": self.peer,
+            "median_ms": med,
+            "expansions_per_s": (self.expanded / self.search_seconds
+                                 if self.search_seconds > 0 and not self.peer else None),
+            "matched": self.matched,
+            "failed": self.failed,
+            "mean_cost_ratio": float(np.mean(self.ratios)) if self.ratios else None,
+            "max_cost_ratio": float(np.max(self.ratios)) if self.ratios else None,
+        }
+
+
+def _ours(grid: Grid, algorithm: str) -> Callable:
+    def run(s, t):
+        r = plan(grid, s, t, algorithm=algorithm)
+        return r.cost if r.found else None, r.expanded, r.seconds
+
+    return run
+
+
+def _peer(grid: Grid, name: str) -> Callable:
+    query = PEERS[name].prepare(grid)
+
+    def run(s, t):
+        cells = query(s, t)
+        return (None if cells is None else octile_cost(cells)), 0, 0.0
+
+    return run
+
+
+def bench_map(map_path: Path, scen_path: Path, *, per_map: int, algorithms: Sequence[str],
+              peers: Sequence[str], seed: int,
+              on_query: Callable[[], None] | None = None) -> dict:
+    """Run one map's sampled queries through every runner; return its report."""
+    grid = read_map(map_path)
+    scen: Scenario = read_scen(scen_path)
+    if (scen.width, scen.height) != (grid.width, grid.height):
+        raise InputFormatError(scen_path, f"scenario is for a {scen.width}x{scen.height} map, "
+                               f"{map_path.name} is {grid.width}x{grid.height}")
+    rng = np.random.default_rng(seed)
+    n = len(scen) if per_map <= 0 else min(per_map, len(scen))
+    idx = np.sort(rng.choice(len(scen), size=n, replace=False))
+    runners = [(RunnerStats(a, False), _ours(grid, a)) for a in algorithms]
+    runners += [(RunnerStats(p, True), _peer(grid, p)) for p in peers]
+    first = idx[0]
+    for _, run in runners:  # warm-up: compile, caches
+        run(tuple(scen.starts[first].tolist()), tuple(scen.goals[first].tolist()))
+    for q, i in enumerate(idx):
+        s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
+        opt = float(scen.optimal[i])
+        for k in range(len(runners)):
+            stats, run = runners[(k + q) % len(runners)]
+            t0 = time.perf_counter()
+            cost, expanded, search_s = run(s, t)
+            stats.times.append(time.perf_counter() - t0)
+            stats.expanded += expanded
+            stats.search_seconds += search_s
+            if cost is None:
+                stats.failed += 1
+                continue
+            stats.ratios.append(cost / opt if opt > 0 else (1.0 if cost == 0 else np.inf))
+            stats.matched += bool(scen.matches(int(i), cost))
+        if on_query:
+            on_query()
+    rows = [s.row() for s, _ in runners]
+    for row in rows:
+        row["speedup_vs"] = {
+            p["runner"]: p["median_ms"] / row["median_ms"]
+            for p in rows if p["peer"] and p["median_ms"] and row["median_ms"]
+            and not row["peer"]}
+    return {"map": map_path.name, "scen": scen_path.name, "size": [grid.width, grid.height],
+            "queries": int(n), "scen_lines": len(scen), "rows": rows}
+
+
+def check_runners(algorithms: Sequence[str], peers: Sequence[str]) -> tuple[list, list, list]:
+    """Validate names; return (algorithms, installed peers, missing peers)."""
+    for a in algorithms:
+        check_choice("algorithm", a, GRID_ALGORITHMS)
+    for p in peers:
+        check_choice("peer", p, tuple(PEERS))
+    have = [p for p in peers if available(p)]
+    return list(algorithms), have, [p for p in peers if p not in have]
+
+
+def count_queries(pairs: list[tuple[Path, Path]], per_map: int) -> int:
+    """How many queries a run will make per runner (for a progress bar)."""
+    total = 0
+    for _, scen in pairs:
+        lines = sum(1 for line in scen.read_text().splitlines()[1:] if line.strip())
+        total += lines if per_map <= 0 else min(per_map, lines)
+    return total

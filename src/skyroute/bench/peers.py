@@ -1,0 +1,113 @@
+"""Peer grid planners a user might otherwise pick, behind one small interface.
+
+Each peer builds what it needs from a Grid once (not timed) and then answers queries
+with a list of (x, y) cells or None. Peers are optional (``skyroute[bench]``); one that
+is not installed is reported, not fatal.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from skyroute.world.grid import Grid
+
+Query = Callable[[tuple[int, int], tuple[int, int]], "np.ndarray | None"]
+
+
+@dataclass(frozen=True)
+class Peer:
+    """A peer: its name, what problem it solves, and how to prepare it for a grid."""
+
+    name: str
+    module: str
+    note: str
+    prepare: Callable[[Grid], Query]
+
+
+def _pyastar2d(grid: Grid) -> Query:
+    import pyastar2d
+
+    weights = np.where(grid.blocked, np.inf, 1.0).astype(np.float32)
+
+    def query(s, t):
+        p = pyastar2d.astar_path(weights, (s[1], s[0]), (t[1], t[0]), allow_diagonal=True)
+        return None if p is None else p[:, ::-1]
+
+    return query
+
+
+def _pathfinding(grid: Grid) -> Query:
+    from pathfinding.core.diagonal_movement import DiagonalMovement
+    from pathfinding.core.grid import Grid as PFGrid
+    from pathfinding.finder.a_star import AStarFinder
+
+    pf = PFGrid(matrix=(~grid.blocked).astype(int).tolist())
+    finder = AStarFinder(diagonal_movement=DiagonalMovement.only_when_no_obstacle)
+
+    def query(s, t):
+        pf.cleanup()
+        path, _ = finder.find_path(pf.node(*s), pf.node(*t), pf)
+        return np.array([(n.x, n.y) for n in path]) if path else None
+
+    return query
+
+
+def _networkx(grid: Grid) -> Query:
+    import networkx as nx
+
+    free = ~grid.blocked
+    G = nx.Graph()
+    ys, xs = np.nonzero(free)
+    G.add_nodes_from(zip(xs.tolist(), ys.tolist(), strict=True))
+    h, w = free.shape
+    for dx, dy, cost in ((1, 0, 1.0), (0, 1, 1.0), (1, 1, math.sqrt(2)), (-1, 1, math.sqrt(2))):
+        ok = np.zeros_like(free)
+        y0, y1 = 0, h - dy
+        x0, x1 = max(0, -dx), w - max(0, dx)
+        ok[y0:y1, x0:x1] = free[y0:y1, x0:x1] & free[y0 + dy:y1 + dy, x0 + dx:x1 + dx]
+        if dx and dy:  # no corner cutting: both side cells free
+            ok[y0:y1, x0:x1] &= free[y0:y1, x0 + dx:x1 + dx] & free[y0 + dy:y1 + dy, x0:x1]
+        yy, xx = np.nonzero(ok)
+        G.add_weighted_edges_from(
+            ((x, y), (x + dx, y + dy), cost) for x, y in zip(xx.tolist(), yy.tolist(),
+                                                             strict=True))
+
+    def octile(a, b):
+        dx, dy = abs(a[0] - b[0]), abs(a[1] - b[1])
+        return max(dx, dy) + (math.sqrt(2) - 1) * min(dx, dy)
+
+    def query(s, t):
+        try:
+            return np.array(nx.astar_path(G, tuple(s), tuple(t), heuristic=octile))
+        except nx.NetworkXNoPath:
+            return None
+
+    return query
+
+
+PEERS = {
+    "pyastar2d": Peer("pyastar2d", "pyastar2d", "C++ A*; cuts corners, diagonal cost 1",
+                      _pyastar2d),
+    "pathfinding": Peer("pathfinding", "pathfinding", "python-pathfinding AStarFinder, "
+                        "no corner cutting", _pathfinding),
+    "networkx": Peer("networkx", "networkx", "networkx astar_path on the move graph "
+                     "(graph build not timed)", _networkx),
+}
+
+
+def available(name: str) -> bool:
+    """True when the peer's package imports."""
+    import importlib.util
+
+    return importlib.util.find_spec(PEERS[name].module) is not None
+
+
+def octile_cost(cells: np.ndarray) -> float:
+    """Length of a chain of cells with orthogonal steps 1 and diagonal steps sqrt 2."""
+    d = np.abs(np.diff(np.asarray(cells, dtype=float), axis=0))
+    return float(np.sum(np.maximum(d[:, 0], d[:, 1]) + (math.sqrt(2) - 1) *
+                        np.minimum(d[:, 0], d[:, 1])))

@@ -1,0 +1,38 @@
+"""The ``skyroute`` Typer application and its entry point."""
+
+from __future__ import annotations
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from skyroute.cli.bench_cmd import bench_app
+from skyroute.cli.errors import run_cli
+from skyroute.cli.plan_cmd import plan_command
+from skyroute.world.load import bundled_maps
+from skyroute.world.movingai import read_map
+
+app = typer.Typer(help="skyroute: plan where drones and small robots fly or drive.",
+                  no_args_is_help=True, add_completion=False, pretty_exceptions_enable=False)
+app.command("plan")(plan_command)
+app.add_typer(bench_app, name="bench")
+
+
+@app.command("maps")
+def maps_command() -> None:
+    """List the MovingAI maps bundled with skyroute (usable by name as MAP)."""
+    table = Table(title="bundled maps (Sturtevant 2012, MovingAI; see CITATION.md)")
+    for col in ("name", "size", "free", "scenario lines", "file"):
+        table.add_column(col)
+    for name, path in bundled_maps().items():
+        grid = read_map(path)
+        scen = path.with_name(path.name + ".scen")
+        lines = len(scen.read_text().splitlines()) - 1 if scen.exists() else 0
+        table.add_row(name, f"{grid.width}x{grid.height}", f"{grid.free_fraction:.0%}",
+                      str(lines), str(path))
+    Console().print(table)
+
+
+def main() -> None:
+    """Console entry point."""
+    run_cli(app)

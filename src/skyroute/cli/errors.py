@@ -1,0 +1,30 @@
+"""Turn expected errors into one line on stderr and exit code 2; never a traceback."""
+
+from __future__ import annotations
+
+import sys
+
+import typer
+from typer.exceptions import TyperException
+
+from skyroute.errors import SkyrouteError
+
+EXIT_BAD_INPUT = 2
+
+
+def run_cli(app: typer.Typer) -> None:
+    """Run a Typer app; expected errors print ``skyroute: error: ...`` and exit 2."""
+    try:
+        code = app(standalone_mode=False)
+    except TyperException as exc:  # usage errors: unknown option, missing argument, ...
+        ctx = getattr(exc, "ctx", None)
+        hint = f" (see '{ctx.command_path} --help')" if ctx is not None else ""
+        print(f"skyroute: error: {exc.format_message()}{hint}", file=sys.stderr)
+        sys.exit(getattr(exc, "exit_code", EXIT_BAD_INPUT) or EXIT_BAD_INPUT)
+    except SkyrouteError as exc:
+        print(f"skyroute: error: {exc}", file=sys.stderr)
+        sys.exit(EXIT_BAD_INPUT)
+    except (typer.Abort, KeyboardInterrupt):
+        print("skyroute: interrupted", file=sys.stderr)
+        sys.exit(130)
+    sys.exit(code if isinstance(code, int) else 0)

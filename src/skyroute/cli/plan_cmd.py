@@ -1,0 +1,93 @@
+"""``skyroute plan``: one query on a grid map, printed and optionally written out."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from skyroute.cli.parse import parse_cell
+from skyroute.io.files import write_atomic
+from skyroute.io.geojson import dumps, grid_path_geojson
+from skyroute.planner import plan
+from skyroute.search.grid_plan import GRID_ALGORITHMS, grid_options
+from skyroute.world.load import load_map
+
+EXIT_NOT_FOUND = 1
+
+
+def plan_command(
+    map_file: Annotated[str, typer.Argument(metavar="MAP", help=(
+        "A .map (MovingAI), .csv (wall segments x1,y1,x2,y2 in metres), image or .npy "
+        "file, or the name of a bundled map (see 'skyroute maps').")) ],
+    start: Annotated[str, typer.Option(help="Start cell X,Y (column,row).")],
+    goal: Annotated[str, typer.Option(help="Goal cell X,Y (column,row).")],
+    algorithm: Annotated[str, typer.Option(
+        help="One of: " + ", ".join(GRID_ALGORITHMS) + ".")] = "astar",
+    connectivity: Annotated[int | None, typer.Option(
+        help="4 or 8 (default 8; 4 for bfs).")] = None,
+    corner_cutting: Annotated[bool, typer.Option(
+        "--corner-cutting", help="Allow a diagonal step past one blocked side cell.")] = False,
+    heuristic: Annotated[str | None, typer.Option(
+        help="octile, euclidean, manhattan or zero (default: the algorithm's own).")] = None,
+    weight: Annotated[float, typer.Option(help="Weighted A*: w >= 1.")] = 1.0,
+    prune: Annotated[str, typer.Option(help="none, collinear or los.")] = "none",
+    clearance: Annotated[float, typer.Option(
+        help="Block cells within this many metres of an obstacle.")] = 0.0,
+    cell_size: Annotated[float, typer.Option(
+        help="Metres per cell (the rasterising resolution for .csv walls).")] = 1.0,
+    max_expansions: Annotated[int | None, typer.Option(
+        help="Give up after this many expansions (status budget_exhausted).")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    plot: Annotated[Path | None, typer.Option(help="Write a PNG picture here.")] = None,
+    geojson: Annotated[Path | None, typer.Option(help="Write the path as GeoJSON here.")] = None,
+) -> None:
+    """Plan a path on a grid map from START to GOAL.
+
+    Exit code 0 when a path is found, 1 when there is none (or the budget ran out),
+    2 for bad input. Output files are written only when a path is found.
+    """
+    s, t = parse_cell(start, "--start"), parse_cell(goal, "--goal")
+    opts = grid_options(algorithm, connectivity=connectivity, corner_cutting=corner_cutting,
+                        heuristic=heuristic, weight=weight, prune=prune,
+                        max_expansions=max_expansions)
+    grid = load_map(map_file, cell_size=cell_size, clearance=clearance)
+    result = plan(grid, s, t, algorithm=opts.algorithm, connectivity=opts.connectivity,
+                  corner_cutting=opts.corner_cutting, heuristic=opts.heuristic,
+                  weight=opts.weight, prune=opts.prune, max_expansions=max_expansions)
+    if result.found:
+        if geojson:
+            write_atomic(geojson, dumps(grid_path_geojson(grid, result)))
+        if plot:
+            from skyroute.io.plot import plot_grid_path
+
+            plot_grid_path(grid, result, s, t, plot)
+    if as_json:
+        typer.echo(json.dumps(result.to_dict()))
+    else:
+        _print_table(grid.name, result, plot if result.found else None,
+                     geojson if result.found else None)
+    if not result.found:
+        raise typer.Exit(EXIT_NOT_FOUND)
+
+
+def _print_table(name, result, plot, geojson) -> None:
+    table = Table(title=f"{name}: {result.algorithm}", show_header=False)
+    table.add_column(style="bold")
+    table.add_column()
+    table.add_row("status", result.status.value)
+    if result.found:
+        table.add_row("cost", f"{result.cost:.6f}")
+        table.add_row("waypoints", str(len(result.path)))
+    table.add_row("expanded", f"{result.expanded:,}")
+    table.add_row("max frontier", f"{result.max_frontier:,}")
+    table.add_row("line-of-sight checks", f"{result.los_checks:,}")
+    table.add_row("search time", f"{result.seconds * 1e3:.3f} ms")
+    for label, path in (("plot", plot), ("geojson", geojson)):
+        if path:
+            table.add_row(label, str(path))
+    Console().print(table)

@@ -1,0 +1,34 @@
+"""A planned path as GeoJSON."""
+
+from __future__ import annotations
+
+import json
+
+from skyroute.search.result import PlanResult
+from skyroute.world.grid import Grid
+
+
+def grid_path_geojson(grid: Grid, result: PlanResult) -> dict:
+    """A FeatureCollection with the path as a LineString in the grid's world frame.
+
+    Coordinates are metres (x, y) of cell centres, not longitude/latitude: a grid has no
+    geodetic anchor, so the file carries planar coordinates in its local frame, as the
+    properties say. Properties repeat the result's status, cost and statistics.
+    """
+    coords = grid.to_world(result.path).tolist() if result.found else []
+    props = {k: v for k, v in result.to_dict().items() if k != "path"}
+    props.update(map=grid.name, frame="grid-local metres", cell_size=grid.cell_size,
+                 cells=result.path.tolist())
+    return {
+        "type": "FeatureCollection",
+        "features": [{
+            "type": "Feature",
+            "geometry": {"type": "LineString", "coordinates": coords},
+            "properties": props,
+        }],
+    }
+
+
+def dumps(obj: dict) -> str:
+    """Compact, stable JSON text."""
+    return json.dumps(obj, separators=(",", ":")) + "\n"

@@ -1,0 +1,61 @@
+"""``plan()``: the one call that covers the common case."""
+
+from __future__ import annotations
+
+from skyroute.errors import OptionError
+from skyroute.search.grid_plan import grid_options, plan_grid
+from skyroute.search.result import PlanResult
+from skyroute.world.grid import Grid
+
+
+def plan(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
+         algorithm: str = "astar", connectivity: int | None = None,
+         corner_cutting: bool = False, heuristic: str | None = None, weight: float = 1.0,
+         prune: str | None = None, max_expansions: int | None = None) -> PlanResult:
+    """Plan a path on ``grid`` from cell ``start`` to cell ``goal``, both (x, y) = (column, row).
+
+    Parameters
+    ----------
+    algorithm : {"astar", "dijkstra", "bfs", "jps", "theta", "lazy_theta"}
+        ``bfs`` is 4-connected with unit steps; ``jps`` is 8-connected without corner
+        cutting; ``theta`` and ``lazy_theta`` return any-angle paths.
+    connectivity : {4, 8}, optional
+        Default 8 (4 for ``bfs``).
+    corner_cutting : bool
+        False (MovingAI's rule): a diagonal step needs both side cells free. True: one
+        free side suffices; squeezing between two diagonal blocked cells is never legal.
+    heuristic : {"octile", "euclidean", "manhattan", "zero"}, optional
+        Default octile (8-connected), Manhattan (4-connected), Euclidean (any-angle).
+    weight : float
+        >= 1; weighted A* returns a cost at most ``weight`` x the optimum.
+    prune : {"none", "collinear", "los"}, optional
+        Drop straight-on points, or also shortcut by line of sight. Never illegal or longer.
+    max_expansions : int, optional
+        Stop with status ``budget_exhausted`` after this many expansions.
+
+    Returns
+    -------
+    PlanResult
+        ``status`` found / no_path / budget_exhausted; ``path`` (K, 2) cells; ``cost``.
+
+    Raises
+    ------
+    QueryError
+        start or goal outside the grid or on a blocked cell.
+    OptionError
+        an unknown or out-of-range option (the message lists the valid ones).
+
+    Examples
+    --------
+    >>> import skyroute
+    >>> grid = skyroute.load_map("den312d")
+    >>> r = skyroute.plan(grid, (12, 7), (40, 70))
+    >>> r.status.value, round(r.cost, 4)
+    ('found', 77.0833)
+    """
+    if not isinstance(grid, Grid):
+        raise OptionError(f"grid must be a skyroute Grid, got {type(grid).__name__}")
+    opts = grid_options(algorithm, connectivity=connectivity, corner_cutting=corner_cutting,
+                        heuristic=heuristic, weight=weight, prune=prune,
+                        max_expansions=max_expansions)
+    return plan_grid(grid, start, goal, opts)

@@ -1,0 +1,154 @@
+"""Plan on a Grid: validate the query and options, run a compiled kernel, build the result."""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from skyroute.errors import OptionError, QueryError, check_choice
+from skyroute.search.astar import HEURISTICS, astar_kernel
+from skyroute.search.bfs import bfs_kernel
+from skyroute.search.jps import fill, jps_kernel
+from skyroute.search.prune import PRUNE_MODES, prune_collinear, prune_los
+from skyroute.search.result import STATUS_OF_CODE, PlanResult, Status, path_length
+from skyroute.search.space import SearchSpace, space_of
+from skyroute.search.theta import theta_kernel
+from skyroute.search.trace import trace
+from skyroute.world.grid import Grid
+
+GRID_ALGORITHMS = ("bfs", "dijkstra", "astar", "jps", "theta", "lazy_theta")
+ANY_ANGLE = ("theta", "lazy_theta")
+NO_BUDGET = np.iinfo(np.int64).max
+
+
+@dataclass(frozen=True)
+class GridOptions:
+    """Validated search options (see :func:`plan_grid`)."""
+
+    algorithm: str
+    connectivity: int
+    corner_cutting: bool
+    heuristic: str
+    weight: float
+    prune: str
+    max_expansions: int
+
+
+def grid_options(algorithm: str = "astar", *, connectivity: int | None = None,
+                 corner_cutting: bool = False, heuristic: str | None = None,
+                 weight: float = 1.0, prune: str | None = None,
+                 max_expansions: int | None = None) -> GridOptions:
+    """Check every option and fill in the algorithm's defaults; raise OptionError."""
+    check_choice("algorithm", algorithm, GRID_ALGORITHMS)
+    if connectivity is None:
+        connectivity = 4 if algorithm == "bfs" else 8
+    check_choice("connectivity", connectivity, (4, 8))
+    if algorithm == "bfs" and connectivity != 4:
+        raise OptionError("algorithm='bfs' is 4-connected; use connectivity=4 or "
+                          "algorithm='dijkstra' for 8-connected unit costs")
+    if algorithm == "jps" and (connectivity != 8 or corner_cutting):
+        raise OptionError("algorithm='jps' needs connectivity=8 and corner_cutting=False")
+    if heuristic is None:
+        heuristic = _default_h(algorithm, connectivity)
+    check_choice("heuristic", heuristic, tuple(HEURISTICS))
+    if algorithm in ("bfs", "dijkstra", "jps") and heuristic != _default_h(algorithm,
+                                                                             connectivity):
+        raise OptionError(f"algorithm={algorithm!r} takes no heuristic option "
+                          f"(it uses {_default_h(algorithm, connectivity)!r})")
+    if not (isinstance(weight, int | float) and math.isfinite(weight) and weight >= 1.0):
+        raise OptionError(f"weight={weight!r} must be a number >= 1")
+    if weight != 1.0 and algorithm in ("bfs", "dijkstra", "jps"):
+        raise OptionError(f"algorithm={algorithm!r} takes no weight; use 'astar'")
+    prune = "none" if prune is None else prune
+    check_choice("prune", prune, PRUNE_MODES)
+    if max_expansions is None:
+        max_expansions = NO_BUDGET
+    elif isinstance(max_expansions, bool) or not isinstance(max_expansions, int | np.integer) \
+            or max_expansions < 0:
+        raise OptionError(f"max_expansions={max_expansions!r} must be an integer >= 0")
+    return GridOptions(algorithm, int(connectivity), bool(corner_cutting), heuristic,
+                       float(weight), prune, int(max_expansions))
+
+
+def _default_h(algorithm: str, connectivity: int) -> str:
+    if algorithm in ANY_ANGLE:
+        return "euclidean"
+    if algorithm == "dijkstra":
+        return "zero"
+    if algorithm == "bfs":
+        return "manhattan"
+    return "octile" if connectivity == 8 else "manhattan"
+
+
+def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
+    """(x, y) as ints, on the grid and free; else QueryError naming ``what``."""
+    try:
+        x, y = cell  # type: ignore[misc]
+        if float(x) != int(x) or float(y) != int(y):
+            raise ValueError
+        x, y = int(x), int(y)
+    except (TypeError, ValueError):
+        raise QueryError(f"{what} {cell!r} must be two integers (x, y)") from None
+    if not grid.in_bounds((x, y)):
+        raise QueryError(f"{what} ({x}, {y}) lies outside the {grid.width}x{grid.height} grid "
+                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})")
+    if grid.blocked[y, x]:
+        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell")
+    return x, y
+
+
+def plan_grid(grid: Grid, start: tuple[int, int], goal: tuple[int, int],
+              opts: GridOptions) -> PlanResult:
+    """Run one validated query; see :func:`skyroute.plan` for the contract."""
+    start = check_cell(grid, start, "start")
+    goal = check_cell(grid, goal, "goal")
+    space = space_of(grid)
+    t0 = time.perf_counter()
+    code, expanded, frontier, los, flat = _search(space, space.index(start),
+                                                  space.index(goal), opts)
+    if code != 0:
+        seconds = time.perf_counter() - t0
+        return PlanResult(STATUS_OF_CODE[code], np.empty((0, 2)), math.inf, expanded,
+                          frontier, los, seconds, opts.algorithm)
+    if opts.prune == "collinear":
+        flat = prune_collinear(flat, space.Wp)
+    elif opts.prune == "los":
+        flat = prune_collinear(flat, space.Wp)
+        flat, checks = prune_los(space.blocked, space.Wp, flat)
+        los += checks
+    seconds = time.perf_counter() - t0
+    path = space.cells(flat)
+    return PlanResult(Status.FOUND, path, path_length(path), expanded, frontier, los,
+                      seconds, opts.algorithm)
+
+
+def _search(space: SearchSpace, s: int, t: int, o: GridOptions):
+    blk, Wp = space.blocked, space.Wp
+    stamp, g, h, parent, mark, pos, hc, hk, hg = space.workspace()
+    los = 0
+    if o.algorithm == "bfs":
+        code, exp, front = bfs_kernel(blk, Wp, s, t, o.max_expansions, stamp, g, parent, mark,
+                                      hc)
+    elif o.algorithm == "jps":
+        code, exp, front = jps_kernel(blk, Wp, s, t, o.max_expansions, stamp, g, h, parent,
+                                      mark, pos, hc, hk, hg)
+    else:
+        moves = space.moves(o.connectivity, o.corner_cutting)
+        hkind = HEURISTICS[o.heuristic]
+        if o.algorithm in ANY_ANGLE:
+            code, exp, front, los = theta_kernel(blk, Wp, s, t, *moves, hkind, o.weight,
+                                                 o.max_expansions, o.algorithm == "lazy_theta",
+                                                 stamp, g, h, parent, mark, pos, hc, hk, hg)
+        else:
+            code, exp, front = astar_kernel(blk, Wp, s, t, *moves, hkind, o.weight,
+                                            o.max_expansions, stamp, g, h, parent, mark, pos,
+                                            hc, hk, hg)
+    if code != 0:
+        return code, exp, front, los, None
+    flat = trace(parent, s, t)
+    if o.algorithm == "jps":
+        flat = fill(flat, Wp)
+    return code, exp, front, los, flat

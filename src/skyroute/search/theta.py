@@ -1,0 +1,108 @@
+"""Theta* and Lazy Theta*: any-angle search on the grid, compiled with numba.
+
+Nash, Daniel, Koenig & Felner, "Theta*: Any-Angle Path Planning on Grids" (JAIR 2010) and
+Nash, Koenig & Tovey, "Lazy Theta*" (AAAI 2010). Nodes are cell centres; a node may take
+its parent's parent as its own parent when the two see each other (see ``los``), so
+path segments run at any angle. With the Euclidean heuristic every node is expanded with
+a g no larger than its octile grid distance, so the cost never exceeds A*'s. Lazy Theta*
+assumes sight when a node is generated and checks it once, on expansion; if the check
+fails and the repaired g makes the node no longer the best, it goes back on the open
+list instead of being expanded, which keeps that same bound.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from skyroute.search import heap
+from skyroute.search.astar import heuristic, move_ok
+from skyroute.search.los import line_of_sight
+from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+
+
+@njit(cache=True)
+def _dist(a, b, Wp):
+    dx = a % Wp - b % Wp
+    dy = a // Wp - b // Wp
+    return math.sqrt(dx * dx + dy * dy)
+
+
+@njit(cache=True)
+def theta_kernel(blk, Wp, start, goal, nmoves, offs, costs, side_a, side_b, rule,
+                 hkind, weight, max_expansions, lazy,
+                 stamp, g, h, parent, mark, pos, hc, hk, hg):
+    """Return (status, expanded, max_frontier, los_checks); ``parent`` holds the path."""
+    mark[start] = stamp
+    g[start] = 0.0
+    h[start] = weight * heuristic(hkind, start, goal, Wp)
+    parent[start] = start
+    pos[start] = -1
+    size = heap.push(hc, hk, hg, pos, 0, start, h[start], 0.0)
+    expanded = 0
+    max_frontier = 1
+    los = 0
+    closed = stamp + 1
+    while size > 0:
+        c, size = heap.pop(hc, hk, hg, pos, size)
+        if lazy and parent[c] != c:
+            p = parent[c]
+            los += 1
+            if not line_of_sight(blk, Wp, p, c):
+                # Repair: best closed grid neighbour becomes the parent.
+                best = math.inf
+                for k in range(nmoves):
+                    n = c + offs[k]
+                    if mark[n] == closed and move_ok(blk, c, k, offs, side_a, side_b, rule) \
+                            and g[n] + costs[k] < best:
+                        best = g[n] + costs[k]
+                        parent[c] = n
+                old = g[c]
+                g[c] = best
+                if best > old and size > 0:
+                    size = heap.push(hc, hk, hg, pos, size, c, best + h[c], best)
+                    top = hc[0]
+                    if top != c:
+                        continue
+                    c, size = heap.pop(hc, hk, hg, pos, size)
+        if c == goal:
+            return FOUND, expanded, max_frontier, los
+        if expanded >= max_expansions:
+            return BUDGET_EXHAUSTED, expanded, max_frontier, los
+        mark[c] = closed
+        expanded += 1
+        pc = parent[c]
+        for k in range(nmoves):
+            if not move_ok(blk, c, k, offs, side_a, side_b, rule):
+                continue
+            n = c + offs[k]
+            m = mark[n]
+            if m == closed:
+                continue
+            if m != stamp:
+                mark[n] = stamp
+                pos[n] = -1
+                h[n] = weight * heuristic(hkind, n, goal, Wp)
+                g[n] = math.inf
+            if lazy:
+                gn = g[pc] + _dist(pc, n, Wp)
+                par = pc
+            else:
+                sight = False
+                if pc != c:
+                    los += 1
+                    sight = line_of_sight(blk, Wp, pc, n)
+                if sight:
+                    gn = g[pc] + _dist(pc, n, Wp)
+                    par = pc
+                else:
+                    gn = g[c] + costs[k]
+                    par = c
+            if gn < g[n]:
+                g[n] = gn
+                parent[n] = par
+                size = heap.push(hc, hk, hg, pos, size, n, gn + h[n], gn)
+        if size > max_frontier:
+            max_frontier = size
+    return NO_PATH, expanded, max_frontier, los

@@ -1,0 +1,23 @@
+"""Read a path back out of a parent array (compiled, shared by every grid search)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def trace(parent, start, goal):
+    """Flat indices from ``start`` to ``goal`` following ``parent`` pointers back."""
+    count = 1
+    c = goal
+    while c != start:
+        c = parent[c]
+        count += 1
+    out = np.empty(count, np.int64)
+    c = goal
+    for i in range(count - 1, -1, -1):
+        out[i] = c
+        if i:
+            c = parent[c]
+    return out

@@ -1,0 +1,165 @@
+"""MovingAI benchmark files: ``.map`` grids and ``.scen`` scenario lists.
+
+Format: https://movingai.com/benchmarks/formats.html (Sturtevant 2012). Terrain:
+``.``, ``G`` and ``S`` are passable; ``@``, ``O``, ``T`` and ``W`` are blocked. Water
+(``W``) is "traversable, but not passable from terrain", and no cost is given for it; a
+ground robot starting on terrain can never enter it, so it is blocked here. LF and CRLF
+line endings are accepted, with or without a final newline.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from skyroute.errors import InputFormatError
+from skyroute.world.grid import Grid
+
+PASSABLE = ".GS"
+BLOCKED = "@OTW"
+
+
+def _lines(path: Path) -> list[str]:
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
+    try:
+        text = raw.decode("ascii")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise InputFormatError(path, "not an ASCII text file", line=line) from None
+    return text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+
+
+def _header_int(path: Path, lines: list[str], index: int, key: str) -> int:
+    parts = lines[index].split() if index < len(lines) else []
+    if len(parts) != 2 or parts[0] != key:
+        got = lines[index].strip() if index < len(lines) else "end of file"
+        raise InputFormatError(path, f"expected '{key} N', got {got!r}", line=index + 1)
+    try:
+        value = int(parts[1])
+    except ValueError:
+        raise InputFormatError(path, f"{key} must be an integer, got {parts[1]!r}",
+                               line=index + 1) from None
+    if value < 1:
+        raise InputFormatError(path, f"{key} must be >= 1, got {value}", line=index + 1)
+    return value
+
+
+def read_map(path: str | Path) -> Grid:
+    """Read a MovingAI ``.map`` file into a :class:`Grid` with 1 m cells.
+
+    Raises :class:`~skyroute.errors.InputFormatError` naming the line of a bad header,
+    a row of the wrong width, an unknown character or a wrong number of rows.
+    """
+    path = Path(path)
+    lines = _lines(path)
+    if not lines or lines[0].strip() != "type octile":
+        got = lines[0].strip() if lines else "an empty file"
+        raise InputFormatError(path, f"expected 'type octile', got {got!r}", line=1)
+    height = _header_int(path, lines, 1, "height")
+    width = _header_int(path, lines, 2, "width")
+    if len(lines) < 4 or lines[3].strip() != "map":
+        got = lines[3].strip() if len(lines) > 3 else "end of file"
+        raise InputFormatError(path, f"expected 'map', got {got!r}", line=4)
+    rows = lines[4:]
+    while rows and rows[-1] == "":
+        rows.pop()
+    if len(rows) != height:
+        raise InputFormatError(
+            path, f"header says height {height} but {len(rows)} map rows follow",
+            line=4 + min(len(rows), height) + (1 if len(rows) > height else 0))
+    table = np.full(256, 2, dtype=np.uint8)  # 2 = unknown character
+    table[np.frombuffer(PASSABLE.encode(), np.uint8)] = 0
+    table[np.frombuffer(BLOCKED.encode(), np.uint8)] = 1
+    blocked = np.empty((height, width), dtype=bool)
+    for r, row in enumerate(rows):
+        if len(row) != width:
+            raise InputFormatError(path, f"row {r} has {len(row)} characters, header says "
+                                   f"width {width}", line=5 + r)
+        codes = table[np.frombuffer(row.encode(), np.uint8)]
+        if (codes == 2).any():
+            col = int(np.argmax(codes == 2))
+            raise InputFormatError(
+                path, f"unknown terrain {row[col]!r} at column {col}; valid: "
+                f"passable {PASSABLE!r}, blocked {BLOCKED!r}", line=5 + r)
+        blocked[r] = codes == 1
+    return Grid(blocked, 1.0, (0.0, 0.0), name=path.name)
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """The queries of one ``.scen`` file, as parallel arrays (one row per line).
+
+    ``starts`` and ``goals`` are (N, 2) int arrays of (x, y) cells; ``optimal`` the
+    octile lengths; ``tolerance`` the rounding of each printed length (half a unit of
+    its last decimal), so a cost matches when ``|cost - optimal| <= tolerance``.
+    """
+
+    path: Path
+    map_name: str
+    width: int
+    height: int
+    buckets: np.ndarray
+    starts: np.ndarray
+    goals: np.ndarray
+    optimal: np.ndarray
+    tolerance: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.optimal)
+
+    def matches(self, index: int, cost: float) -> bool:
+        """True when ``cost`` equals line ``index``'s optimum to its printed precision
+        plus 1e-6 relative: the legacy random512 file carries its generator's float
+        error of up to about 5e-4 on top of its 5-decimal rounding."""
+        opt = self.optimal[index]
+        return abs(cost - opt) <= self.tolerance[index] + 1e-6 * opt
+
+
+def read_scen(path: str | Path) -> Scenario:
+    """Read a MovingAI ``.scen`` file (``version 1``, 9 tab-separated columns)."""
+    path = Path(path)
+    lines = _lines(path)
+    if not lines or lines[0].strip() not in ("version 1", "version 1.0"):
+        got = lines[0].strip() if lines else "an empty file"
+        raise InputFormatError(path, f"expected 'version 1', got {got!r}", line=1)
+    buckets, coords, optimal, tol = [], [], [], []
+    map_name, size = None, None
+    for n, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        cols = line.split("\t")
+        if len(cols) != 9:
+            raise InputFormatError(path, f"expected 9 tab-separated columns, got {len(cols)}",
+                                   line=n)
+        try:
+            nums = [int(c) for c in (cols[0], *cols[2:8])]
+            length = float(cols[8])
+        except ValueError:
+            raise InputFormatError(path, "bucket, width, height, start_x, start_y, goal_x, "
+                                   "goal_y must be integers and length a number", line=n) from None
+        bucket, w, h, sx, sy, gx, gy = nums
+        if size is None:
+            map_name, size = cols[1].strip(), (w, h)
+        elif (w, h) != size:
+            raise InputFormatError(path, f"map size {w}x{h} differs from the first line's "
+                                   f"{size[0]}x{size[1]}", line=n)
+        if not (0 <= sx < w and 0 <= gx < w and 0 <= sy < h and 0 <= gy < h):
+            raise InputFormatError(path, f"start ({sx}, {sy}) or goal ({gx}, {gy}) lies "
+                                   f"outside the {w}x{h} map", line=n)
+        if not np.isfinite(length) or length < 0:
+            raise InputFormatError(path, f"optimal length {cols[8]!r} must be >= 0", line=n)
+        decimals = len(cols[8].strip().partition(".")[2])
+        buckets.append(bucket)
+        coords.append((sx, sy, gx, gy))
+        optimal.append(length)
+        tol.append(0.5 * 10.0 ** -decimals + 1e-9)
+    if size is None:
+        raise InputFormatError(path, "no scenario lines after the version line", line=2)
+    c = np.array(coords, dtype=np.int64).reshape(-1, 4)
+    return Scenario(path, map_name or "", size[0], size[1], np.array(buckets, dtype=np.int64),
+                    c[:, :2].copy(), c[:, 2:].copy(), np.array(optimal), np.array(tol))
