@@ -49,9 +49,11 @@ def plan(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
     --------
     >>> import skyroute
     >>> grid = skyroute.load_map("den312d")
-    >>> r = skyroute.plan(grid, (12, 7), (40, 70))
-    >>> r.status.value, round(r.cost, 4)
-    ('found', 77.0833)
+    >>> r = skyroute.plan(grid, (50, 76), (60, 13))  # den312d.map.scen: 112.55634918
+    >>> r.status.value, round(r.cost, 8), len(r.path)
+    ('found', 112.55634919, 109)
+    >>> skyroute.plan(grid, (50, 76), (60, 13), algorithm="theta").cost < r.cost
+    True
     """
     if not isinstance(grid, Grid):
         raise OptionError(f"grid must be a skyroute Grid, got {type(grid).__name__}")

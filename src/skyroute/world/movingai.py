@@ -26,6 +26,8 @@ def _lines(path: Path) -> list[str]:
         raw = path.read_bytes()
     except OSError as exc:
         raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
+    if not raw.strip():
+        raise InputFormatError(path, "the file is empty", line=1)
     try:
         text = raw.decode("ascii")
     except UnicodeDecodeError as exc:

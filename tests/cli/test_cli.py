@@ -1,0 +1,121 @@
+"""The CLI through its real entry point: output, exit codes, one-line errors, no partial files."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from skyroute.cli.app import main
+
+QUERY = ["den312d", "--start", "50,76", "--goal", "60,13"]
+
+
+def run(monkeypatch, capsys, *args):
+    monkeypatch.setattr(sys, "argv", ["skyroute", *args])
+    with pytest.raises(SystemExit) as exit_info:
+        main()
+    out, err = capsys.readouterr()
+    return exit_info.value.code, out, err
+
+
+def test_plan_json_and_files(monkeypatch, capsys, tmp_path):
+    png, gj = tmp_path / "out" / "p.png", tmp_path / "p.geojson"
+    code, out, err = run(monkeypatch, capsys, "plan", *QUERY, "--json", "--plot", str(png),
+                         "--geojson", str(gj))
+    assert code == 0, err
+    doc = json.loads(out)
+    assert list(doc) == ["status", "cost", "path", "expanded", "max_frontier", "los_checks",
+                         "seconds", "algorithm"]
+    assert doc["status"] == "found" and doc["algorithm"] == "astar"
+    assert doc["cost"] == pytest.approx(112.55634918, abs=1e-8)  # den312d.map.scen, last line
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    feature = json.loads(gj.read_text())["features"][0]
+    assert feature["geometry"]["type"] == "LineString"
+    assert feature["geometry"]["coordinates"][0] == [50.5, 76.5]  # cell centre, metres
+    assert feature["properties"]["cost"] == doc["cost"]
+
+
+def test_plan_table_and_prune(monkeypatch, capsys):
+    code, out, _ = run(monkeypatch, capsys, "plan", *QUERY, "--algorithm", "theta",
+                       "--prune", "los")
+    assert code == 0
+    assert "status" in out and "found" in out and "theta" in out
+
+
+def test_no_path_exits_1_and_writes_nothing(monkeypatch, capsys, tmp_path):
+    np_file = tmp_path / "wall.npy"
+    import numpy as np
+
+    a = np.zeros((3, 5))
+    a[:, 2] = 1
+    np.save(np_file, a)
+    png = tmp_path / "p.png"
+    code, out, _ = run(monkeypatch, capsys, "plan", str(np_file), "--start", "0,0", "--goal",
+                       "4,0", "--json", "--plot", str(png))
+    assert code == 1 and json.loads(out)["status"] == "no_path"
+    assert not png.exists()
+
+
+@pytest.mark.parametrize("args, words", [
+    (["plan", "den312d", "--start", "0,0", "--goal", "60,13"], "start (0, 0) is on a blocked"),
+    (["plan", "den312d", "--start", "50,76", "--goal", "99,9"], "goal (99, 9) lies outside"),
+    (["plan", "nope.map", "--start", "0,0", "--goal", "1,1"], "nope.map: no such file"),
+    (["plan", *QUERY, "--algorithm", "foo"], "algorithm='foo' is not valid"),
+    (["plan", "den312d", "--start", "5;x", "--goal", "1,1"], "--start '5;x' must be"),
+    (["plan", *QUERY, "--bogus"], "No such option: --bogus"),
+    (["plan", *QUERY, "--clearance", "-1"], "clearance=-1.0"),
+    (["bench", "grid", "--map", "nomap", "--peers", ""], "--map nomap not found"),
+    (["bench", "grid", "--algorithms", "astar,zzz", "--peers", ""], "algorithm='zzz'"),
+])
+def test_bad_input_is_one_line_and_exit_2(monkeypatch, capsys, tmp_path, args, words):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(monkeypatch, capsys, *args, "--plot", "x.png") if args[0] == "plan" \
+        else run(monkeypatch, capsys, *args)
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith("skyroute: error: ")
+    assert words in err
+    assert "Traceback" not in err and out == ""
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_malformed_map_names_file_and_line(monkeypatch, capsys, tmp_path):
+    bad = tmp_path / "bad.map"
+    bad.write_text("type octile\nheight 2\nwidth 3\nmap\n...\n.?.\n")
+    code, _, err = run(monkeypatch, capsys, "plan", str(bad), "--start", "0,0", "--goal", "2,0")
+    assert code == 2 and f"{bad}:6: unknown terrain '?' at column 1" in err
+
+
+def test_maps_lists_bundled(monkeypatch, capsys):
+    code, out, _ = run(monkeypatch, capsys, "maps")
+    assert code == 0 and "den312d" in out and "65x81" in out
+
+
+def test_bench_grid_runs_and_reports_missing_peers(monkeypatch, capsys, tmp_path):
+    import skyroute.bench.grid as grid_mod
+
+    real = grid_mod.available
+    monkeypatch.setattr(grid_mod, "available", lambda p: p != "pathfinding" and real(p))
+    out_json = tmp_path / "bench.json"
+    code, out, err = run(monkeypatch, capsys, "bench", "grid", "--map", "den312d",
+                         "--per-map", "4", "--algorithms", "astar,jps,dijkstra",
+                         "--peers", "pathfinding,networkx", "--json", str(out_json))
+    assert code == 0, err
+    assert "peer pathfinding is not installed" in err
+    doc = json.loads(out_json.read_text())
+    rows = {r["runner"]: r for r in doc["maps"][0]["rows"]}
+    for a in ("astar", "jps", "dijkstra"):
+        assert rows[a]["matched"] == 4 and rows[a]["mean_cost_ratio"] == pytest.approx(1.0)
+    if "networkx" in rows:  # installed with skyroute[bench]: same rule, so optimal too
+        assert rows["networkx"]["matched"] == 4
+        assert rows["astar"]["speedup_vs"]["networkx"] > 0
+    assert doc["settings"]["missing_peers"] == ["pathfinding"] + (
+        [] if "networkx" in rows else ["networkx"])
+    assert "den312d" in out
+
+
+def test_module_entry_point_has_no_traceback():
+    p = subprocess.run([sys.executable, "-m", "skyroute", "plan", "den312d", "--start", "0,0",
+                        "--goal", "1,1"], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2
+    assert p.stderr == "skyroute: error: start (0, 0) is on a blocked cell\n"

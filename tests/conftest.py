@@ -1,0 +1,27 @@
+"""Shared test fixtures: where the outside reference data lives."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT.parent / "shared" / "data"
+MOVINGAI = SHARED / "movingai"
+
+
+def movingai_pairs() -> list[tuple[Path, Path]]:
+    """The 18 (map, scen) pairs of ../shared/data/movingai (see its SOURCES.md)."""
+    if not MOVINGAI.is_dir():
+        if os.environ.get("CI"):
+            raise RuntimeError(f"CI needs the reference data at {MOVINGAI}")
+        return []
+    from skyroute.bench.grid import find_pairs
+
+    return find_pairs(MOVINGAI)
+
+
+needs_shared = pytest.mark.skipif(not MOVINGAI.is_dir() and not os.environ.get("CI"),
+                                  reason=f"reference data not found at {MOVINGAI}")

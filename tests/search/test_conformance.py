@@ -1,0 +1,132 @@
+"""Every algorithm through the same battery of cases (as OMPL runs its planners)."""
+
+import numpy as np
+import pytest
+
+import skyroute
+from skyroute import OptionError, QueryError, Status
+from skyroute.search import GRID_ALGORITHMS
+
+ALGS = GRID_ALGORITHMS
+
+
+def open_grid(h, w):
+    return skyroute.Grid(np.zeros((h, w), bool))
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+def test_start_equals_goal(algorithm):
+    r = skyroute.plan(open_grid(5, 5), (2, 3), (2, 3), algorithm=algorithm)
+    assert r.status is Status.FOUND and r.cost == 0.0
+    np.testing.assert_array_equal(r.path, [[2, 3]])
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+def test_one_by_one_grid(algorithm):
+    r = skyroute.plan(open_grid(1, 1), (0, 0), (0, 0), algorithm=algorithm)
+    assert r.found and r.cost == 0.0 and r.path.shape == (1, 2)
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+@pytest.mark.parametrize("shape", [(1, 9), (9, 1)])
+def test_one_by_n_grids(algorithm, shape):
+    grid = open_grid(*shape)
+    goal = (shape[1] - 1, shape[0] - 1)
+    r = skyroute.plan(grid, (0, 0), goal, algorithm=algorithm)
+    assert r.found and r.cost == pytest.approx(8.0)
+    np.testing.assert_array_equal(r.path[0], [0, 0])
+    np.testing.assert_array_equal(r.path[-1], goal)
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+def test_unreachable_goal_is_a_status(algorithm):
+    b = np.zeros((5, 7), bool)
+    b[:, 3] = True
+    r = skyroute.plan(skyroute.Grid(b), (0, 2), (6, 2), algorithm=algorithm)
+    assert r.status is Status.NO_PATH and not r.found
+    assert r.path.shape == (0, 2) and np.isinf(r.cost)
+    if algorithm == "jps":  # expands jump points only
+        assert 1 <= r.expanded <= 15
+    else:
+        assert r.expanded == 15  # every reachable cell, once
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+def test_diagonal_gap_is_closed_without_corner_cutting(algorithm):
+    b = np.array([[0, 1], [1, 0]], bool)
+    r = skyroute.plan(skyroute.Grid(b), (0, 0), (1, 1), algorithm=algorithm)
+    assert r.status is Status.NO_PATH
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+def test_budget_exhausted(algorithm):
+    b = np.zeros((30, 30), bool)  # a serpentine: walls with gaps at alternate ends
+    for k, x in enumerate(range(2, 28, 3)):
+        b[:, x] = True
+        b[29 if k % 2 == 0 else 0, x] = False
+    grid = skyroute.Grid(b)
+    assert skyroute.plan(grid, (0, 0), (29, 29), algorithm=algorithm).expanded > 3
+    r = skyroute.plan(grid, (0, 0), (29, 29), algorithm=algorithm, max_expansions=3)
+    assert r.status is Status.BUDGET_EXHAUSTED and r.expanded == 3 and not r.found
+    assert r.path.shape == (0, 2)
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+@pytest.mark.parametrize("start, goal, words", [
+    ((1, 1), (4, 4), "start (1, 1) is on a blocked cell"),
+    ((0, 0), (1, 1), "goal (1, 1) is on a blocked cell"),
+    ((-1, 0), (4, 4), "start (-1, 0) lies outside the 5x5 grid"),
+    ((0, 0), (5, 4), "goal (5, 4) lies outside the 5x5 grid"),
+    ((0.5, 0), (4, 4), "two integers"),
+    ("ab", (4, 4), "two integers"),
+])
+def test_bad_queries_raise(algorithm, start, goal, words):
+    b = np.zeros((5, 5), bool)
+    b[1, 1] = True
+    with pytest.raises(QueryError, match=words.replace("(", r"\(").replace(")", r"\)")):
+        skyroute.plan(skyroute.Grid(b), start, goal, algorithm=algorithm)
+
+
+@pytest.mark.parametrize("options, words", [
+    ({"algorithm": "dstar"}, "choose one of 'bfs', 'dijkstra', 'astar', 'jps'"),
+    ({"connectivity": 6}, "connectivity=6 is not valid; choose one of 4, 8"),
+    ({"heuristic": "chebyshev"}, "heuristic='chebyshev'"),
+    ({"weight": 0.5}, "weight=0.5 must be a number >= 1"),
+    ({"prune": "all"}, "choose one of 'none', 'collinear', 'los'"),
+    ({"max_expansions": -1}, "max_expansions=-1"),
+    ({"algorithm": "bfs", "connectivity": 8}, "bfs' is 4-connected"),
+    ({"algorithm": "jps", "corner_cutting": True}, "jps' needs"),
+    ({"algorithm": "dijkstra", "heuristic": "octile"}, "takes no heuristic"),
+])
+def test_bad_options_raise_listing_valid_ones(options, words):
+    with pytest.raises(OptionError, match=words.replace("(", r"\(")):
+        skyroute.plan(open_grid(3, 3), (0, 0), (2, 2), **options)
+
+
+def test_options_are_keyword_only():
+    with pytest.raises(TypeError):
+        skyroute.plan(open_grid(3, 3), (0, 0), (2, 2), "astar")
+
+
+def test_repeated_queries_reuse_state_without_leaking():
+    rng = np.random.default_rng(3)
+    b = rng.random((40, 40)) < 0.3
+    b[0, 0] = b[39, 39] = b[0, 39] = False
+    grid = skyroute.Grid(b)
+    first = [skyroute.plan(grid, s, t, algorithm=a) for a in ALGS
+             for s, t in (((0, 0), (39, 39)), ((0, 39), (0, 0)))]
+    again = [skyroute.plan(grid, s, t, algorithm=a) for a in ALGS
+             for s, t in (((0, 0), (39, 39)), ((0, 39), (0, 0)))]
+    for x, y in zip(first, again, strict=True):
+        assert x.status is y.status and x.cost == y.cost and x.expanded == y.expanded
+        np.testing.assert_array_equal(x.path, y.path)
+
+
+def test_result_is_frozen_and_serialisable():
+    r = skyroute.plan(open_grid(3, 3), (0, 0), (2, 2))
+    with pytest.raises(AttributeError):
+        r.cost = 1.0
+    d = r.to_dict()
+    assert list(d) == ["status", "cost", "path", "expanded", "max_frontier", "los_checks",
+                       "seconds", "algorithm"]
+    assert d["status"] == "found" and d["path"] == [[0, 0], [1, 1], [2, 2]]

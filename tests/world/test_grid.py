@@ -1,0 +1,111 @@
+import numpy as np
+import pytest
+from PIL import Image
+
+from skyroute import Grid, InputFormatError, OptionError, load_map
+from skyroute.world.segments import rasterize_segments
+
+
+def test_grid_is_immutable_and_copies_its_input():
+    a = np.zeros((2, 3), dtype=bool)
+    g = Grid(a)
+    a[0, 0] = True
+    assert not g.blocked[0, 0]
+    with pytest.raises(ValueError):
+        g.blocked[0, 0] = True
+
+
+def test_cell_world_round_trip():
+    g = Grid(np.zeros((4, 5), bool), cell_size=0.5, origin=(10.0, -2.0))
+    cells = np.array([[0, 0], [4, 3], [2, 1]])
+    np.testing.assert_allclose(g.to_world(cells), [[10.25, -1.75], [12.25, -0.25],
+                                                   [11.25, -1.25]])
+    np.testing.assert_array_equal(g.to_cell(g.to_world(cells)), cells)
+    np.testing.assert_array_equal(g.to_cell([[9.99, -2.0]]), [[-1, 0]])
+
+
+@pytest.mark.parametrize("bad", [np.zeros((0, 3)), np.zeros(3), np.zeros((2, 2, 2))])
+def test_bad_shapes_raise(bad):
+    with pytest.raises(OptionError):
+        Grid(bad)
+
+
+def test_inflate_point_robot_seed_case():
+    # A point robot with 0.3 m padding on a 0.1 m grid: one blocked cell grows into the
+    # disc of cells whose centres lie within 0.3 m of its centre (3 cells).
+    a = np.zeros((9, 9), bool)
+    a[4, 4] = True
+    g = Grid(a, cell_size=0.1).inflate(0.3)
+    yy, xx = np.mgrid[0:9, 0:9]
+    expected = (xx - 4) ** 2 + (yy - 4) ** 2 <= 9
+    np.testing.assert_array_equal(g.blocked, expected)
+    assert g.blocked.sum() == 29
+    assert Grid(a).inflate(0.0).blocked.sum() == 1
+
+
+def test_inflate_rejects_negative():
+    with pytest.raises(OptionError, match="clearance"):
+        Grid(np.zeros((2, 2), bool)).inflate(-1)
+
+
+def test_segments_rasterise_cells_they_cross():
+    # A wall from (0, 0) to (4, 2) metres on a 1 m grid with bounds 0..5 x 0..3. It
+    # crosses cells (0,0) (1,0) (2,1) (3,1) and touches closed squares at the vertex
+    # (2, 1): cells (2,0), (1,1); and at its end (4, 2): cells (4,1), (3,2), (4,2).
+    g = rasterize_segments(np.array([[0.0, 0.0, 4.0, 2.0]]), resolution=1.0,
+                           bounds=(0, 0, 5, 3))
+    expected = np.array([
+        [1, 1, 1, 0, 0],
+        [0, 1, 1, 1, 1],
+        [0, 0, 0, 1, 1],
+    ], dtype=bool)
+    np.testing.assert_array_equal(g.blocked, expected)
+
+
+def test_segment_clearance_is_exact_distance_to_the_wall():
+    seg = np.array([[0.0, 2.5, 10.0, 2.5]])
+    g = rasterize_segments(seg, resolution=0.5, clearance=1.0, bounds=(0, 0, 10, 5))
+    centres_y = g.to_world(np.c_[np.zeros(g.height), np.arange(g.height)])[:, 1]
+    rows_blocked = g.blocked.all(axis=1)
+    np.testing.assert_array_equal(rows_blocked, np.abs(centres_y - 2.5) <= 1.0)
+
+
+def test_segment_file_and_errors(tmp_path):
+    p = tmp_path / "walls.csv"
+    p.write_text("x1,y1,x2,y2\n0,0,2,0\n2,0,2,2\n")
+    g = load_map(p, cell_size=0.5, clearance=0.25)
+    assert g.cell_size == 0.5 and g.blocked.any() and not g.blocked.all()
+    p.write_text("x1,y1,x2,y2\n0,0,2,0\n1,2,three,4\n")
+    with pytest.raises(InputFormatError, match=r"walls.csv:3: .*numbers"):
+        load_map(p)
+    p.write_text("0,0,2\n")
+    with pytest.raises(InputFormatError, match=r"walls.csv:1: expected 4 columns"):
+        load_map(p)
+
+
+def test_png_dark_pixels_are_blocked(tmp_path):
+    img = np.full((3, 4), 255, np.uint8)
+    img[1, 2] = 0
+    img[2, 0] = 100
+    Image.fromarray(img).save(tmp_path / "m.png")
+    g = load_map(tmp_path / "m.png", cell_size=0.2)
+    expected = np.zeros((3, 4), bool)
+    expected[1, 2] = expected[2, 0] = True
+    np.testing.assert_array_equal(g.blocked, expected)
+    assert g.cell_size == 0.2
+
+
+def test_npy_and_unknown_suffix(tmp_path):
+    np.save(tmp_path / "m.npy", np.eye(3))
+    np.testing.assert_array_equal(load_map(tmp_path / "m.npy").blocked, np.eye(3, dtype=bool))
+    (tmp_path / "m.txt").write_text("x")
+    with pytest.raises(InputFormatError, match="unknown map type"):
+        load_map(tmp_path / "m.txt")
+    (tmp_path / "bad.png").write_text("not an image")
+    with pytest.raises(InputFormatError, match="bad.png: cannot read as an image"):
+        load_map(tmp_path / "bad.png")
+
+
+def test_missing_file_lists_bundled_maps(tmp_path):
+    with pytest.raises(InputFormatError, match="no such file.*den312d"):
+        load_map(tmp_path / "nothing.map")

@@ -1,0 +1,113 @@
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from skyroute import InputFormatError, load_map
+from skyroute.world.movingai import read_map, read_scen
+from tests.conftest import MOVINGAI, movingai_pairs, needs_shared
+
+SMALL = "type octile\nheight 3\nwidth 4\nmap\n.@..\nGTS.\n..OW\n"
+
+
+def write(tmp_path: Path, text: str | bytes, name: str = "m.map") -> Path:
+    p = tmp_path / name
+    p.write_bytes(text.encode() if isinstance(text, str) else text)
+    return p
+
+
+def test_terrain_characters_and_cell_order(tmp_path):
+    g = read_map(write(tmp_path, SMALL))
+    assert (g.width, g.height) == (4, 3)
+    expected = np.array([[0, 1, 0, 0], [0, 1, 0, 0], [0, 0, 1, 1]], dtype=bool)
+    np.testing.assert_array_equal(g.blocked, expected)
+    assert g.is_free((0, 0)) and not g.is_free((1, 0))  # (x, y) = (column, row)
+    assert not g.is_free((3, 2))  # water is blocked
+
+
+@pytest.mark.parametrize("variant", ["crlf", "no-final-newline", "crlf-no-final"])
+def test_line_endings(tmp_path, variant):
+    text = SMALL
+    if "crlf" in variant:
+        text = text.replace("\n", "\r\n")
+    if "final" in variant:
+        text = text.rstrip("\r\n")
+    g = read_map(write(tmp_path, text))
+    np.testing.assert_array_equal(g.blocked, read_map(write(tmp_path, SMALL, "b.map")).blocked)
+
+
+@pytest.mark.parametrize("text, line, words", [
+    ("type foo\nheight 1\nwidth 1\nmap\n.\n", 1, "type octile"),
+    ("type octile\nheight x\nwidth 1\nmap\n.\n", 2, "integer"),
+    ("type octile\nheight 1\nwidt 1\nmap\n.\n", 3, "width"),
+    ("type octile\nheight 1\nwidth 1\nmop\n.\n", 4, "'map'"),
+    ("type octile\nheight 2\nwidth 2\nmap\n..\n.\n", 6, "width 2"),
+    ("type octile\nheight 2\nwidth 2\nmap\n..\n", 5, "height 2 but 1"),
+    ("type octile\nheight 1\nwidth 2\nmap\n..\n..\n", 6, "height 1 but 2"),
+    ("type octile\nheight 1\nwidth 3\nmap\n.x.\n", 5, "unknown terrain 'x' at column 1"),
+    ("", 1, "empty"),
+])
+def test_malformed_maps_name_the_line(tmp_path, text, line, words):
+    p = write(tmp_path, text)
+    with pytest.raises(InputFormatError) as err:
+        read_map(p)
+    assert err.value.line == line
+    assert str(err.value).startswith(f"{p}:{line}: ")
+    assert words in str(err.value)
+
+
+def test_binary_file_is_a_format_error(tmp_path):
+    with pytest.raises(InputFormatError, match="ASCII"):
+        read_map(write(tmp_path, b"type octile\n\xff\xfe"))
+
+
+SCEN = "version 1\n0\tm.map\t4\t3\t0\t0\t3\t0\t3.00000000\n1\tm.map\t4\t3\t0\t2\t2\t1\t2.41421\n"
+
+
+def test_scen_columns_and_tolerance(tmp_path):
+    sc = read_scen(write(tmp_path, SCEN, "m.map.scen"))
+    assert len(sc) == 2 and sc.map_name == "m.map" and (sc.width, sc.height) == (4, 3)
+    np.testing.assert_array_equal(sc.starts, [[0, 0], [0, 2]])
+    np.testing.assert_array_equal(sc.goals, [[3, 0], [2, 1]])
+    assert sc.matches(0, 3.0) and not sc.matches(0, 3.0001)
+    assert sc.matches(1, 1 + 2 ** 0.5)  # 5 printed decimals: rounding allowed
+    assert not sc.matches(1, 2.4143)
+
+
+@pytest.mark.parametrize("text, line, words", [
+    ("version 2\n", 1, "version 1"),
+    ("version 1\n0\tm.map\t4\t3\t0\t0\t3\t0\n", 2, "9 tab-separated"),
+    ("version 1\n0 m.map 4 3 0 0 3 0 3.0\n", 2, "9 tab-separated"),
+    ("version 1\n0\tm.map\t4\t3\ta\t0\t3\t0\t3.0\n", 2, "integers"),
+    ("version 1\n0\tm.map\t4\t3\t0\t0\t4\t0\t3.0\n", 2, "outside"),
+    ("version 1\n0\tm.map\t4\t3\t0\t0\t3\t0\t3.0\n0\tm.map\t5\t3\t0\t0\t3\t0\t3.0\n", 3,
+     "differs"),
+    ("version 1\n", 2, "no scenario lines"),
+])
+def test_malformed_scen_name_the_line(tmp_path, text, line, words):
+    p = write(tmp_path, text, "bad.scen")
+    with pytest.raises(InputFormatError) as err:
+        read_scen(p)
+    assert err.value.line == line and words in str(err.value)
+
+
+@needs_shared
+def test_every_shared_map_and_scen_parses():
+    pairs = movingai_pairs()
+    assert len(pairs) == 18
+    for map_path, scen_path in pairs:
+        g, sc = read_map(map_path), read_scen(scen_path)
+        assert (sc.width, sc.height) == (g.width, g.height), map_path.name
+        assert not g.blocked[sc.starts[:, 1], sc.starts[:, 0]].any()
+        assert not g.blocked[sc.goals[:, 1], sc.goals[:, 0]].any()
+
+
+@needs_shared
+def test_bundled_maps_are_the_reference_bytes():
+    from skyroute import bundled_maps
+
+    maps = bundled_maps()
+    assert set(maps) >= {"den312d", "Berlin_1_256", "Paris_1_512"}
+    for name, path in maps.items():
+        assert path.read_bytes() == (MOVINGAI / path.name).read_bytes()
+    assert load_map("den312d").blocked.shape == (81, 65)
