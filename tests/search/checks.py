@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
+from itertools import pairwise
 
 import numpy as np
 
@@ -22,7 +23,7 @@ def assert_grid_path_legal(blocked: np.ndarray, path: np.ndarray, *, connectivit
     for x, y in p:
         assert 0 <= x < w and 0 <= y < h, f"cell {(x, y)} off the grid"
         assert not blocked[y, x], f"cell {(x, y)} is blocked"
-    for (x0, y0), (x1, y1) in zip(p[:-1], p[1:], strict=True):
+    for (x0, y0), (x1, y1) in pairwise(p):
         dx, dy = x1 - x0, y1 - y0
         assert max(abs(dx), abs(dy)) == 1, f"step {(x0, y0)}->{(x1, y1)} is not one move"
         if dx and dy:
@@ -42,7 +43,6 @@ def segment_legal(blocked: np.ndarray, a, b) -> bool:
     Illegal when it meets the open interior of a blocked cell, or passes through a grid
     vertex whose two cells on either side of the segment are both blocked.
     """
-    h, w = blocked.shape
     ax, ay = Fraction(2 * int(a[0]) + 1, 2), Fraction(2 * int(a[1]) + 1, 2)
     bx, by = Fraction(2 * int(b[0]) + 1, 2), Fraction(2 * int(b[1]) + 1, 2)
     dx, dy = bx - ax, by - ay
@@ -84,7 +84,7 @@ def assert_any_angle_path_legal(blocked: np.ndarray, path: np.ndarray) -> float:
     p = np.asarray(path).astype(int)
     for x, y in p:
         assert not blocked[y, x], f"vertex {(x, y)} is blocked"
-    for a, b in zip(p[:-1], p[1:], strict=True):
+    for a, b in pairwise(p):
         assert segment_legal(blocked, a, b), f"segment {tuple(a)}->{tuple(b)} is illegal"
     return float(np.hypot(*np.diff(p, axis=0).T).sum()) if len(p) > 1 else 0.0
 

@@ -76,10 +76,10 @@ def test_segment_file_and_errors(tmp_path):
     g = load_map(p, cell_size=0.5, clearance=0.25)
     assert g.cell_size == 0.5 and g.blocked.any() and not g.blocked.all()
     p.write_text("x1,y1,x2,y2\n0,0,2,0\n1,2,three,4\n")
-    with pytest.raises(InputFormatError, match=r"walls.csv:3: .*numbers"):
+    with pytest.raises(InputFormatError, match=r"walls\.csv:3: .*numbers"):
         load_map(p)
     p.write_text("0,0,2\n")
-    with pytest.raises(InputFormatError, match=r"walls.csv:1: expected 4 columns"):
+    with pytest.raises(InputFormatError, match=r"walls\.csv:1: expected 4 columns"):
         load_map(p)
 
 
@@ -102,10 +102,10 @@ def test_npy_and_unknown_suffix(tmp_path):
     with pytest.raises(InputFormatError, match="unknown map type"):
         load_map(tmp_path / "m.txt")
     (tmp_path / "bad.png").write_text("not an image")
-    with pytest.raises(InputFormatError, match="bad.png: cannot read as an image"):
+    with pytest.raises(InputFormatError, match=r"bad\.png: cannot read as an image"):
         load_map(tmp_path / "bad.png")
 
 
 def test_missing_file_lists_bundled_maps(tmp_path):
-    with pytest.raises(InputFormatError, match="no such file.*den312d"):
+    with pytest.raises(InputFormatError, match=r"no such file.*den312d"):
         load_map(tmp_path / "nothing.map")

@@ -108,6 +108,6 @@ def test_bundled_maps_are_the_reference_bytes():
 
     maps = bundled_maps()
     assert set(maps) >= {"den312d", "Berlin_1_256", "Paris_1_512"}
-    for name, path in maps.items():
+    for path in maps.values():
         assert path.read_bytes() == (MOVINGAI / path.name).read_bytes()
     assert load_map("den312d").blocked.shape == (81, 65)
