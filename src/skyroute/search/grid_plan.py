@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import math
+import operator
 import time
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -13,8 +15,8 @@ from skyroute.search.astar import HEURISTICS, astar_kernel
 from skyroute.search.bfs import bfs_kernel
 from skyroute.search.jps import fill, jps_kernel
 from skyroute.search.prune import PRUNE_MODES, prune_collinear, prune_los
-from skyroute.search.result import STATUS_OF_CODE, PlanResult, Status, path_length
-from skyroute.search.space import SearchSpace, space_of
+from skyroute.search.result import STATUS_OF_CODE, PlanResult, Status
+from skyroute.search.space import COSTS, MDX, MDY, SearchSpace, space_of, to_cells
 from skyroute.search.theta import theta_kernel
 from skyroute.search.trace import trace
 from skyroute.world.grid import Grid
@@ -42,6 +44,17 @@ def grid_options(algorithm: str = "astar", *, connectivity: int | None = None,
                  weight: float = 1.0, prune: str | None = None,
                  max_expansions: int | None = None) -> GridOptions:
     """Check every option and fill in the algorithm's defaults; raise OptionError."""
+    try:
+        return _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, prune,
+                             max_expansions)
+    except TypeError:  # unhashable values: validate uncached for the error message
+        return _grid_options.__wrapped__(algorithm, connectivity, corner_cutting, heuristic,
+                                         weight, prune, max_expansions)
+
+
+@lru_cache(maxsize=256)
+def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, prune,
+                  max_expansions) -> GridOptions:
     check_choice("algorithm", algorithm, GRID_ALGORITHMS)
     if connectivity is None:
         connectivity = 4 if algorithm == "bfs" else 8
@@ -87,9 +100,7 @@ def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
     """(x, y) as ints, on the grid and free; else QueryError naming ``what``."""
     try:
         x, y = cell  # type: ignore[misc]
-        if float(x) != int(x) or float(y) != int(y):
-            raise ValueError
-        x, y = int(x), int(y)
+        x, y = operator.index(x), operator.index(y)
     except (TypeError, ValueError):
         raise QueryError(f"{what} {cell!r} must be two integers (x, y)") from None
     if not grid.in_bounds((x, y)):
@@ -120,32 +131,34 @@ def plan_grid(grid: Grid, start: tuple[int, int], goal: tuple[int, int],
         flat, checks = prune_los(space.blocked, space.Wp, flat)
         los += checks
     seconds = time.perf_counter() - t0
-    path = space.cells(flat)
-    return PlanResult(Status.FOUND, path, path_length(path), expanded, frontier, los,
-                      seconds, opts.algorithm)
+    path, length = to_cells(flat, space.Wp)
+    return PlanResult(Status.FOUND, path, length, expanded, frontier, los, seconds,
+                      opts.algorithm)
 
 
 def _search(space: SearchSpace, s: int, t: int, o: GridOptions):
     blk, Wp = space.blocked, space.Wp
-    stamp, g, h, parent, mark, pos, hc, hk, hg = space.workspace()
+    stamp, g, h, parent, mark, pos, hc, hk = space.workspace()
     los = 0
     if o.algorithm == "bfs":
         code, exp, front = bfs_kernel(blk, Wp, s, t, o.max_expansions, stamp, g, parent, mark,
                                       hc)
     elif o.algorithm == "jps":
         code, exp, front = jps_kernel(blk, Wp, s, t, o.max_expansions, stamp, g, h, parent,
-                                      mark, pos, hc, hk, hg)
+                                      mark, pos, hc, hk)
     else:
-        moves = space.moves(o.connectivity, o.corner_cutting)
+        mask = space.move_mask(o.connectivity, o.corner_cutting)
         hkind = HEURISTICS[o.heuristic]
         if o.algorithm in ANY_ANGLE:
-            code, exp, front, los = theta_kernel(blk, Wp, s, t, *moves, hkind, o.weight,
+            code, exp, front, los = theta_kernel(blk, mask, Wp, s, t, o.connectivity,
+                                                 space.offsets, COSTS, hkind, o.weight,
                                                  o.max_expansions, o.algorithm == "lazy_theta",
-                                                 stamp, g, h, parent, mark, pos, hc, hk, hg)
+                                                 stamp, g, h, parent, mark, pos, hc, hk)
         else:
-            code, exp, front = astar_kernel(blk, Wp, s, t, *moves, hkind, o.weight,
-                                            o.max_expansions, stamp, g, h, parent, mark, pos,
-                                            hc, hk, hg)
+            code, exp, front = astar_kernel(mask, Wp, s, t, o.connectivity, space.offsets,
+                                            COSTS, MDX, MDY, hkind, o.weight,
+                                            o.max_expansions, stamp, g, parent, mark, pos,
+                                            hc, hk)
     if code != 0:
         return code, exp, front, los, None
     flat = trace(parent, s, t)

@@ -48,7 +48,7 @@ def _jump_diagonal(blk, c, dx, dy, Wp, goal):
 
 
 @njit(cache=True)
-def _relax(n, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, hg, size):
+def _relax(n, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size):
     closed = stamp + 1
     m = mark[n]
     if m == closed:
@@ -64,7 +64,7 @@ def _relax(n, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, hg, size):
         return size
     g[n] = gn
     parent[n] = c
-    return heap.push(hc, hk, hg, pos, size, n, gn + h[n], gn)
+    return heap.push(hc, hk, pos, size, n, heap.key(gn + h[n], gn))
 
 
 @njit(cache=True)
@@ -74,7 +74,7 @@ def _sign(v):
 
 @njit(cache=True)
 def jps_kernel(blk, Wp, start, goal, max_expansions,
-               stamp, g, h, parent, mark, pos, hc, hk, hg):
+               stamp, g, h, parent, mark, pos, hc, hk):
     """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier).
 
     ``parent`` links jump points; :func:`fill` expands them to every cell.
@@ -84,11 +84,11 @@ def jps_kernel(blk, Wp, start, goal, max_expansions,
     h[start] = heuristic(1, start, goal, Wp)
     parent[start] = start
     pos[start] = -1
-    size = heap.push(hc, hk, hg, pos, 0, start, h[start], 0.0)
+    size = heap.push(hc, hk, pos, 0, start, heap.key(h[start], 0.0))
     expanded = 0
     max_frontier = 1
     while size > 0:
-        c, size = heap.pop(hc, hk, hg, pos, size)
+        c, size = heap.pop(hc, hk, pos, size)
         if c == goal:
             return FOUND, expanded, max_frontier
         if expanded >= max_expansions:
@@ -102,42 +102,42 @@ def jps_kernel(blk, Wp, start, goal, max_expansions,
             for d, side in ((1, Wp), (-1, Wp), (Wp, 1), (-Wp, 1)):
                 j = _jump_straight(blk, c, d, side, goal)
                 if j >= 0:
-                    size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, hg, size)
+                    size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size)
             for dx in (1, -1):
                 for dy in (Wp, -Wp):
                     j = _jump_diagonal(blk, c, dx, dy, Wp, goal)
                     if j >= 0:
                         size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk,
-                                      hg, size)
+                                      size)
         elif sx != 0 and sy != 0:
             j = _jump_straight(blk, c, sx, Wp, goal)
             if j >= 0:
-                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, hg, size)
+                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size)
             j = _jump_straight(blk, c, sy, 1, goal)
             if j >= 0:
-                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, hg, size)
+                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size)
             j = _jump_diagonal(blk, c, sx, sy, Wp, goal)
             if j >= 0:
-                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, hg, size)
+                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size)
         else:
             d = sx + sy
             side = 1 if sx == 0 else Wp
             j = _jump_straight(blk, c, d, side, goal)
             if j >= 0:
-                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, hg, size)
+                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size)
             for s in (side, -side):
                 if blk[c + s] == 0 and blk[c - d + s] != 0:  # forced
                     j = _jump_straight(blk, c, s, abs(d), goal)
                     if j >= 0:
                         size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk,
-                                      hg, size)
+                                      size)
                     if d == 1 or d == -1:
                         j = _jump_diagonal(blk, c, d, s, Wp, goal)
                     else:
                         j = _jump_diagonal(blk, c, s, d, Wp, goal)
                     if j >= 0:
                         size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk,
-                                      hg, size)
+                                      size)
         if size > max_frontier:
             max_frontier = size
     return NO_PATH, expanded, max_frontier

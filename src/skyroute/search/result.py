@@ -61,10 +61,3 @@ class PlanResult:
             "algorithm": self.algorithm,
         }
 
-
-def path_length(path: np.ndarray) -> float:
-    """Euclidean length of a (K, 2) polyline."""
-    p = np.asarray(path, dtype=float)
-    if len(p) < 2:
-        return 0.0
-    return float(np.hypot(*np.diff(p, axis=0).T).sum())

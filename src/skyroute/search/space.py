@@ -1,10 +1,12 @@
-"""The compiled searches' view of a Grid: a padded flat array, move tables, workspace.
+"""The compiled searches' view of a Grid: a padded flat array, move masks, workspace.
 
 The grid is copied once into a flat ``uint8`` array with a one-cell blocked border, so
 kernels never test bounds. Cell (x, y) sits at flat index ``(y + 1) * Wp + (x + 1)``
-with ``Wp = width + 2``. Per-cell search arrays are allocated once per grid and reused:
-a query stamp marks which entries belong to the current query, so nothing is reset
-between queries (plan once, query many).
+with ``Wp = width + 2``. Built once per grid and cached (plan once, query many):
+
+- a move mask per move rule: bit k of ``mask[c]`` is set when move k is legal from c;
+- per-cell search arrays, reused between queries: a query stamp marks which entries
+  belong to the current query, so nothing is cleared between queries.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import math
 import weakref
 
 import numpy as np
+from numba import njit
 
 from skyroute.world.grid import Grid
 
@@ -20,10 +23,13 @@ SQRT2 = math.sqrt(2.0)
 
 # Moves: 4 orthogonal first, then 4 diagonal. (dx, dy) in cells.
 MOVES = ((1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, 1), (1, -1), (-1, -1))
+MDX = np.array([dx for dx, _ in MOVES], dtype=np.int64)
+MDY = np.array([dy for _, dy in MOVES], dtype=np.int64)
+COSTS = np.array([1.0] * 4 + [SQRT2] * 4)
 
 
 class SearchSpace:
-    """Padded occupancy and reusable workspace for one Grid (see module docstring)."""
+    """Padded occupancy, move masks and reusable workspace for one Grid."""
 
     def __init__(self, grid: Grid) -> None:
         self.width, self.height = grid.width, grid.height
@@ -32,6 +38,8 @@ class SearchSpace:
         padded[1:-1, 1:-1] = grid.blocked
         self.blocked = padded.ravel()
         self.n = self.blocked.size
+        self.offsets = MDY * self.Wp + MDX
+        self._masks: dict[tuple[int, bool], np.ndarray] = {}
         self._ws: tuple | None = None
         self._stamp = 0
 
@@ -39,41 +47,57 @@ class SearchSpace:
         """Flat index of cell (x, y)."""
         return (int(cell[1]) + 1) * self.Wp + int(cell[0]) + 1
 
-    def cells(self, flat: np.ndarray) -> np.ndarray:
-        """(K, 2) float (x, y) cells of flat indices."""
-        flat = np.asarray(flat, dtype=np.int64)
-        out = np.empty((len(flat), 2))
-        out[:, 0] = flat % self.Wp - 1
-        out[:, 1] = flat // self.Wp - 1
-        return out
+    def move_mask(self, connectivity: int, corner_cutting: bool) -> np.ndarray:
+        """Per-cell legal-move bits for a move rule (built on first use, then cached).
 
-    def moves(self, connectivity: int, corner_cutting: bool) -> tuple:
-        """Move tables for the kernels: (count, offsets, costs, side_a, side_b, rule).
-
-        A diagonal move's two orthogonal side cells are at ``here + side_a`` and
-        ``here + side_b``. ``rule`` 0: both sides must be free (MovingAI, no corner
-        cutting); 1: at least one side free (corners may be cut, but never a squeeze
-        between two blocked cells that touch only at a corner).
+        Corner rule: without corner cutting a diagonal needs both side cells free
+        (MovingAI); with it, one free side suffices (never a squeeze between two).
         """
-        count = 4 if connectivity == 4 else 8
-        offs = np.array([dy * self.Wp + dx for dx, dy in MOVES], dtype=np.int64)
-        costs = np.array([1.0] * 4 + [SQRT2] * 4)
-        side_a = np.array([0] * 4 + [dx for dx, _ in MOVES[4:]], dtype=np.int64)
-        side_b = np.array([0] * 4 + [dy * self.Wp for _, dy in MOVES[4:]], dtype=np.int64)
-        return count, offs, costs, side_a, side_b, 1 if corner_cutting else 0
+        key = (connectivity, corner_cutting)
+        mask = self._masks.get(key)
+        if mask is None:
+            free = self.blocked == 0
+            mask = np.zeros(self.n, np.uint8)
+            inner = slice(self.Wp + 1, self.n - self.Wp - 1)  # border cells never move
+            for k in range(connectivity):
+                ok = free[inner] & np.roll(free, -self.offsets[k])[inner]
+                if k >= 4:
+                    a = np.roll(free, -MDX[k])[inner]
+                    b = np.roll(free, -MDY[k] * self.Wp)[inner]
+                    ok &= (a | b) if corner_cutting else (a & b)
+                mask[inner] |= ok.astype(np.uint8) << k
+            mask.setflags(write=False)
+            self._masks[key] = mask
+        return mask
 
     def workspace(self) -> tuple:
-        """(stamp, g, h, parent, mark, pos, heap_cell, heap_key, heap_g) for one query.
+        """(stamp, g, h, parent, mark, pos, heap_cell, heap_key) for one query.
 
         ``mark[c] == stamp`` means c was seen this query, ``stamp + 1`` that it is closed.
         """
-        if self._ws is None:
+        if self._ws is None or self._stamp > 2**31 - 8:
             n = self.n
             self._ws = (np.empty(n), np.empty(n), np.empty(n, np.int32),
                         np.zeros(n, np.int32), np.full(n, -1, np.int32),
-                        np.empty(n, np.int32), np.empty(n, np.int64), np.empty(n))
+                        np.empty(n, np.int32), np.empty(n, np.int64))
+            self._stamp = 0
         self._stamp += 2
         return (self._stamp, *self._ws)
+
+
+@njit(cache=True)
+def to_cells(flat, Wp):
+    """(K, 2) float (x, y) cells of flat indices, and the polyline's Euclidean length."""
+    out = np.empty((len(flat), 2))
+    length = 0.0
+    for i in range(len(flat)):
+        out[i, 0] = flat[i] % Wp - 1
+        out[i, 1] = flat[i] // Wp - 1
+        if i:
+            dx = out[i, 0] - out[i - 1, 0]
+            dy = out[i, 1] - out[i - 1, 1]
+            length += math.sqrt(dx * dx + dy * dy)
+    return out, length
 
 
 _SPACES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

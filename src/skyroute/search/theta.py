@@ -30,22 +30,21 @@ def _dist(a, b, Wp):
 
 
 @njit(cache=True)
-def theta_kernel(blk, Wp, start, goal, nmoves, offs, costs, side_a, side_b, rule,
-                 hkind, weight, max_expansions, lazy,
-                 stamp, g, h, parent, mark, pos, hc, hk, hg):
+def theta_kernel(blk, mask, Wp, start, goal, nmoves, offs, costs, hkind, weight,
+                 max_expansions, lazy, stamp, g, h, parent, mark, pos, hc, hk):
     """Return (status, expanded, max_frontier, los_checks); ``parent`` holds the path."""
     mark[start] = stamp
     g[start] = 0.0
     h[start] = weight * heuristic(hkind, start, goal, Wp)
     parent[start] = start
     pos[start] = -1
-    size = heap.push(hc, hk, hg, pos, 0, start, h[start], 0.0)
+    size = heap.push(hc, hk, pos, 0, start, heap.key(h[start], 0.0))
     expanded = 0
     max_frontier = 1
     los = 0
     closed = stamp + 1
     while size > 0:
-        c, size = heap.pop(hc, hk, hg, pos, size)
+        c, size = heap.pop(hc, hk, pos, size)
         if lazy and parent[c] != c:
             p = parent[c]
             los += 1
@@ -54,18 +53,18 @@ def theta_kernel(blk, Wp, start, goal, nmoves, offs, costs, side_a, side_b, rule
                 best = math.inf
                 for k in range(nmoves):
                     n = c + offs[k]
-                    if mark[n] == closed and move_ok(blk, c, k, offs, side_a, side_b, rule) \
+                    if mark[n] == closed and move_ok(mask, c, k) \
                             and g[n] + costs[k] < best:
                         best = g[n] + costs[k]
                         parent[c] = n
                 old = g[c]
                 g[c] = best
                 if best > old and size > 0:
-                    size = heap.push(hc, hk, hg, pos, size, c, best + h[c], best)
+                    size = heap.push(hc, hk, pos, size, c, heap.key(best + h[c], best))
                     top = hc[0]
                     if top != c:
                         continue
-                    c, size = heap.pop(hc, hk, hg, pos, size)
+                    c, size = heap.pop(hc, hk, pos, size)
         if c == goal:
             return FOUND, expanded, max_frontier, los
         if expanded >= max_expansions:
@@ -74,7 +73,7 @@ def theta_kernel(blk, Wp, start, goal, nmoves, offs, costs, side_a, side_b, rule
         expanded += 1
         pc = parent[c]
         for k in range(nmoves):
-            if not move_ok(blk, c, k, offs, side_a, side_b, rule):
+            if not move_ok(mask, c, k):
                 continue
             n = c + offs[k]
             m = mark[n]
@@ -102,7 +101,7 @@ def theta_kernel(blk, Wp, start, goal, nmoves, offs, costs, side_a, side_b, rule
             if gn < g[n]:
                 g[n] = gn
                 parent[n] = par
-                size = heap.push(hc, hk, hg, pos, size, n, gn + h[n], gn)
+                size = heap.push(hc, hk, pos, size, n, heap.key(gn + h[n], gn))
         if size > max_frontier:
             max_frontier = size
     return NO_PATH, expanded, max_frontier, los
