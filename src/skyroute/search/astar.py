@@ -13,10 +13,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from skyroute.search import heap
 from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search.trace import trace
 
 HEURISTICS = {"zero": 0, "octile": 1, "euclidean": 2, "manhattan": 3}
 _SQRT2_M1 = math.sqrt(2.0) - 1.0
@@ -49,7 +51,7 @@ def move_ok(mask, c, k):
 @njit(cache=True)
 def astar_kernel(mask, Wp, start, goal, nmoves, offs, costs, mdx, mdy,
                  hkind, weight, max_expansions, stamp, g, parent, mark, pos, hc, hk):
-    """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier)."""
+    """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier, path)."""
     gx, gy = goal % Wp, goal // Wp
     mark[start] = stamp
     g[start] = 0.0
@@ -63,9 +65,9 @@ def astar_kernel(mask, Wp, start, goal, nmoves, offs, costs, mdx, mdy,
     while size > 0:
         c, size = heap.pop(hc, hk, pos, size)
         if c == goal:
-            return FOUND, expanded, max_frontier
+            return FOUND, expanded, max_frontier, trace(parent, start, goal)
         if expanded >= max_expansions:
-            return BUDGET_EXHAUSTED, expanded, max_frontier
+            return BUDGET_EXHAUSTED, expanded, max_frontier, np.empty(0, np.int64)
         mark[c] = closed
         expanded += 1
         gc = g[c]
@@ -97,4 +99,4 @@ def astar_kernel(mask, Wp, start, goal, nmoves, offs, costs, mdx, mdy,
             size = heap.push(hc, hk, pos, size, n, heap.key(fn, gn))
         if size > max_frontier:
             max_frontier = size
-    return NO_PATH, expanded, max_frontier
+    return NO_PATH, expanded, max_frontier, np.empty(0, np.int64)

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search.trace import trace
 
 
 @njit(cache=True)
 def bfs_kernel(blk, Wp, start, goal, max_expansions, stamp, g, parent, mark, queue):
-    """FIFO search over the 4 orthogonal moves; return (status, expanded, max_frontier).
+    """FIFO search over the 4 orthogonal moves; return (status, expanded, max_frontier, path).
 
     ``queue`` needs one slot per cell; ``g`` receives step counts.
     """
@@ -25,9 +27,9 @@ def bfs_kernel(blk, Wp, start, goal, max_expansions, stamp, g, parent, mark, que
         c = queue[head]
         head += 1
         if c == goal:
-            return FOUND, expanded, max_frontier
+            return FOUND, expanded, max_frontier, trace(parent, start, goal)
         if expanded >= max_expansions:
-            return BUDGET_EXHAUSTED, expanded, max_frontier
+            return BUDGET_EXHAUSTED, expanded, max_frontier, np.empty(0, np.int64)
         expanded += 1
         for k in range(4):
             n = c + offs[k]
@@ -40,4 +42,4 @@ def bfs_kernel(blk, Wp, start, goal, max_expansions, stamp, g, parent, mark, que
             tail += 1
         if tail - head > max_frontier:
             max_frontier = tail - head
-    return NO_PATH, expanded, max_frontier
+    return NO_PATH, expanded, max_frontier, np.empty(0, np.int64)

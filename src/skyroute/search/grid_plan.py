@@ -13,12 +13,11 @@ import numpy as np
 from skyroute.errors import OptionError, QueryError, check_choice
 from skyroute.search.astar import HEURISTICS, astar_kernel
 from skyroute.search.bfs import bfs_kernel
-from skyroute.search.jps import fill, jps_kernel
+from skyroute.search.jps import jps_kernel
 from skyroute.search.prune import PRUNE_MODES, prune_collinear, prune_los
 from skyroute.search.result import STATUS_OF_CODE, PlanResult, Status
 from skyroute.search.space import COSTS, MDX, MDY, SearchSpace, space_of, to_cells
 from skyroute.search.theta import theta_kernel
-from skyroute.search.trace import trace
 from skyroute.world.grid import Grid
 
 GRID_ALGORITHMS = ("bfs", "dijkstra", "astar", "jps", "theta", "lazy_theta")
@@ -141,27 +140,21 @@ def _search(space: SearchSpace, s: int, t: int, o: GridOptions):
     stamp, g, h, parent, mark, pos, hc, hk = space.workspace()
     los = 0
     if o.algorithm == "bfs":
-        code, exp, front = bfs_kernel(blk, Wp, s, t, o.max_expansions, stamp, g, parent, mark,
-                                      hc)
+        code, exp, front, flat = bfs_kernel(blk, Wp, s, t, o.max_expansions, stamp, g, parent,
+                                            mark, hc)
     elif o.algorithm == "jps":
-        code, exp, front = jps_kernel(blk, Wp, s, t, o.max_expansions, stamp, g, h, parent,
-                                      mark, pos, hc, hk)
+        code, exp, front, flat = jps_kernel(blk, space.jump_table(), Wp, s, t,
+                                            o.max_expansions, stamp, g, parent, mark, pos, hc, hk)
     else:
         mask = space.move_mask(o.connectivity, o.corner_cutting)
         hkind = HEURISTICS[o.heuristic]
         if o.algorithm in ANY_ANGLE:
-            code, exp, front, los = theta_kernel(blk, mask, Wp, s, t, o.connectivity,
-                                                 space.offsets, COSTS, hkind, o.weight,
-                                                 o.max_expansions, o.algorithm == "lazy_theta",
-                                                 stamp, g, h, parent, mark, pos, hc, hk)
+            lazy = o.algorithm == "lazy_theta"
+            code, exp, front, los, flat = theta_kernel(
+                blk, mask, Wp, s, t, o.connectivity, space.offsets, COSTS, hkind, o.weight,
+                o.max_expansions, lazy, stamp, g, h, parent, mark, pos, hc, hk)
         else:
-            code, exp, front = astar_kernel(mask, Wp, s, t, o.connectivity, space.offsets,
-                                            COSTS, MDX, MDY, hkind, o.weight,
-                                            o.max_expansions, stamp, g, parent, mark, pos,
-                                            hc, hk)
-    if code != 0:
-        return code, exp, front, los, None
-    flat = trace(parent, s, t)
-    if o.algorithm == "jps":
-        flat = fill(flat, Wp)
+            code, exp, front, flat = astar_kernel(
+                mask, Wp, s, t, o.connectivity, space.offsets, COSTS, MDX, MDY, hkind, o.weight,
+                o.max_expansions, stamp, g, parent, mark, pos, hc, hk)
     return code, exp, front, los, flat

@@ -4,8 +4,13 @@ Harabor & Grastien's pruning for the no-corner-cutting model ("Improving Jump Po
 Search", ICAPS 2014): a diagonal move has no forced neighbours and stops where one of
 its two straight scans finds a jump point; a straight move stops at the goal or where
 a side cell is free while the cell behind it is blocked, which forces the perpendicular
-step and the diagonal beside it. Costs are octile, equal to A*'s; the path returned is
-every cell, as for A*.
+step and the diagonal beside it.
+
+Straight scans are answered in O(1) from a table built once per grid (the JPS+ idea):
+for each cell and each of the 4 straight directions, the steps to the first cell with a
+forced neighbour, or minus the free steps to the wall when none comes first. Only the
+goal depends on the query: a scan also stops on it when it lies on the ray within
+reach. Costs are octile, equal to A*'s; the path returned is every cell, as for A*.
 """
 
 from __future__ import annotations
@@ -14,57 +19,101 @@ import numpy as np
 from numba import njit
 
 from skyroute.search import heap
-from skyroute.search.astar import heuristic
+from skyroute.search.astar import h_of
 from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search.trace import trace
+
+# Straight directions: 0 east (+x), 1 west (-x), 2 south (+y), 3 north (-y).
 
 
 @njit(cache=True)
-def _jump_straight(blk, c, d, side, goal):
-    """Scan from c in step d; return the first jump point or -1."""
-    while True:
-        n = c + d
-        if blk[n]:
-            return -1
-        c = n
-        if c == goal:
-            return c
-        if (blk[c + side] == 0 and blk[c - d + side] != 0) or \
-                (blk[c - side] == 0 and blk[c - d - side] != 0):
-            return c
+def jump_tables(blk, Wp):
+    """An (n, 4) int32 table for the padded grid ``blk``: for each cell and straight
+    direction, the steps to the first cell with a forced neighbour if one comes before
+    the wall, else minus the free steps to the wall (0: blocked at once)."""
+    n = blk.size
+    table = np.zeros((n, 4), np.int32)
+    for dirn in range(4):
+        d = (1, -1, Wp, -Wp)[dirn]
+        side = Wp if dirn < 2 else 1
+        # visit cells so that c + d is done before c
+        first, step = (n - 1, -1) if dirn == 0 or dirn == 2 else (0, 1)
+        for i in range(n):
+            c = first + step * i
+            nb = c + d
+            if nb < 0 or nb >= n or blk[c] or blk[nb]:
+                continue
+            if (blk[nb + side] == 0 and blk[nb - d + side] != 0) or \
+                    (blk[nb - side] == 0 and blk[nb - d - side] != 0):
+                table[c, dirn] = 1
+            elif table[nb, dirn] > 0:
+                table[c, dirn] = table[nb, dirn] + 1
+            else:
+                table[c, dirn] = table[nb, dirn] - 1
+    return table
 
 
 @njit(cache=True)
-def _jump_diagonal(blk, c, dx, dy, Wp, goal):
-    """Scan from c diagonally by (dx, dy) = (+-1, +-Wp); return a jump point or -1."""
+def _straight(table, c, cx, cy, dirn, gx, gy, goal, Wp):
+    """Jump point (or the goal) reached from c in straight direction ``dirn``, or -1."""
+    v = table[c, dirn]
+    reach = v if v > 0 else -v
+    if reach == 0:
+        return -1
+    if dirn == 0:
+        if cy == gy and 0 < gx - cx <= reach:
+            return goal
+    elif dirn == 1:
+        if cy == gy and 0 < cx - gx <= reach:
+            return goal
+    elif dirn == 2:
+        if cx == gx and 0 < gy - cy <= reach:
+            return goal
+    elif cx == gx and 0 < cy - gy <= reach:
+        return goal
+    if v > 0:
+        return c + v * (1, -1, Wp, -Wp)[dirn]
+    return -1
+
+
+@njit(cache=True)
+def _diagonal(blk, table, c, cx, cy, sx, sy, gx, gy, goal, Wp):
+    """Scan from c diagonally by (sx, sy) in {-1, 1}^2; return a jump point or -1."""
+    dx = sx
+    dy = sy * Wp
+    hdir = 0 if sx > 0 else 1
+    vdir = 2 if sy > 0 else 3
     while True:
         if blk[c + dx] or blk[c + dy] or blk[c + dx + dy]:
             return -1
-        c = c + dx + dy
+        c += dx + dy
+        cx += sx
+        cy += sy
         if c == goal:
             return c
-        if _jump_straight(blk, c, dx, Wp, goal) >= 0 or \
-                _jump_straight(blk, c, dy, 1, goal) >= 0:
+        if _straight(table, c, cx, cy, hdir, gx, gy, goal, Wp) >= 0 or \
+                _straight(table, c, cx, cy, vdir, gx, gy, goal, Wp) >= 0:
             return c
 
 
 @njit(cache=True)
-def _relax(n, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size):
+def _relax(n, c, Wp, gx, gy, stamp, g, parent, mark, pos, hc, hk, size):
     closed = stamp + 1
     m = mark[n]
     if m == closed:
         return size
     dx = abs(n % Wp - c % Wp)
     dy = abs(n // Wp - c // Wp)
-    gn = g[c] + max(dx, dy) + 0.41421356237309515 * min(dx, dy)
+    gn = g[c] + h_of(1, dx, dy)
     if m != stamp:
         mark[n] = stamp
         pos[n] = -1
-        h[n] = heuristic(1, n, goal, Wp)
     elif gn >= g[n]:
         return size
     g[n] = gn
     parent[n] = c
-    return heap.push(hc, hk, pos, size, n, heap.key(gn + h[n], gn))
+    fn = gn + h_of(1, abs(n % Wp - gx), abs(n // Wp - gy))
+    return heap.push(hc, hk, pos, size, n, heap.key(fn, gn))
 
 
 @njit(cache=True)
@@ -73,74 +122,73 @@ def _sign(v):
 
 
 @njit(cache=True)
-def jps_kernel(blk, Wp, start, goal, max_expansions,
-               stamp, g, h, parent, mark, pos, hc, hk):
-    """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier).
+def jps_kernel(blk, table, Wp, start, goal, max_expansions,
+               stamp, g, parent, mark, pos, hc, hk):
+    """Search from flat ``start`` to ``goal``.
 
-    ``parent`` links jump points; :func:`fill` expands them to every cell.
+    Returns (status, expanded, max_frontier, path) with ``path`` every flat cell.
     """
+    gx, gy = goal % Wp, goal // Wp
     mark[start] = stamp
     g[start] = 0.0
-    h[start] = heuristic(1, start, goal, Wp)
     parent[start] = start
     pos[start] = -1
-    size = heap.push(hc, hk, pos, 0, start, heap.key(h[start], 0.0))
+    f0 = h_of(1, abs(start % Wp - gx), abs(start // Wp - gy))
+    size = heap.push(hc, hk, pos, 0, start, heap.key(f0, 0.0))
     expanded = 0
     max_frontier = 1
     while size > 0:
         c, size = heap.pop(hc, hk, pos, size)
         if c == goal:
-            return FOUND, expanded, max_frontier
+            return FOUND, expanded, max_frontier, fill(trace(parent, start, goal), Wp)
         if expanded >= max_expansions:
-            return BUDGET_EXHAUSTED, expanded, max_frontier
+            return BUDGET_EXHAUSTED, expanded, max_frontier, np.empty(0, np.int64)
         mark[c] = stamp + 1
         expanded += 1
+        cx, cy = c % Wp, c // Wp
         p = parent[c]
-        sx = _sign(c % Wp - p % Wp)
-        sy = _sign(c // Wp - p // Wp) * Wp
-        if p == c:  # the start: every direction
-            for d, side in ((1, Wp), (-1, Wp), (Wp, 1), (-Wp, 1)):
-                j = _jump_straight(blk, c, d, side, goal)
-                if j >= 0:
-                    size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size)
-            for dx in (1, -1):
-                for dy in (Wp, -Wp):
-                    j = _jump_diagonal(blk, c, dx, dy, Wp, goal)
-                    if j >= 0:
-                        size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk,
-                                      size)
-        elif sx != 0 and sy != 0:
-            j = _jump_straight(blk, c, sx, Wp, goal)
-            if j >= 0:
-                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size)
-            j = _jump_straight(blk, c, sy, 1, goal)
-            if j >= 0:
-                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size)
-            j = _jump_diagonal(blk, c, sx, sy, Wp, goal)
-            if j >= 0:
-                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size)
-        else:
-            d = sx + sy
-            side = 1 if sx == 0 else Wp
-            j = _jump_straight(blk, c, d, side, goal)
-            if j >= 0:
-                size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk, size)
-            for s in (side, -side):
-                if blk[c + s] == 0 and blk[c - d + s] != 0:  # forced
-                    j = _jump_straight(blk, c, s, abs(d), goal)
-                    if j >= 0:
-                        size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk,
-                                      size)
-                    if d == 1 or d == -1:
-                        j = _jump_diagonal(blk, c, d, s, Wp, goal)
+        sx = _sign(cx - p % Wp)
+        sy = _sign(cy - p // Wp)
+        for k in range(8):
+            # successor directions allowed by the pruning rules
+            if k < 4:
+                dirn = k
+                if p != c:
+                    if sx != 0 and sy != 0:  # diagonal arrival: its two straight parts
+                        ok = (dirn == (0 if sx > 0 else 1)) or (dirn == (2 if sy > 0 else 3))
+                    elif sy == 0:  # horizontal arrival
+                        if dirn < 2:
+                            ok = dirn == (0 if sx > 0 else 1)
+                        else:  # perpendicular: only when forced
+                            s = Wp if dirn == 2 else -Wp
+                            ok = blk[c + s] == 0 and blk[c - sx + s] != 0
+                    elif dirn >= 2:  # vertical arrival
+                        ok = dirn == (2 if sy > 0 else 3)
                     else:
-                        j = _jump_diagonal(blk, c, s, d, Wp, goal)
-                    if j >= 0:
-                        size = _relax(j, c, Wp, goal, stamp, g, h, parent, mark, pos, hc, hk,
-                                      size)
+                        s = 1 if dirn == 0 else -1
+                        ok = blk[c + s] == 0 and blk[c - sy * Wp + s] != 0
+                    if not ok:
+                        continue
+                j = _straight(table, c, cx, cy, dirn, gx, gy, goal, Wp)
+            else:
+                ddx = 1 if k == 4 or k == 6 else -1
+                ddy = 1 if k < 6 else -1
+                if p != c:
+                    if sx != 0 and sy != 0:
+                        ok = ddx == sx and ddy == sy
+                    elif sy == 0:  # horizontal: the diagonal beside a forced side
+                        ok = ddx == sx and blk[c + ddy * Wp] == 0 and \
+                            blk[c - sx + ddy * Wp] != 0
+                    else:
+                        ok = ddy == sy and blk[c + ddx] == 0 and blk[c - sy * Wp + ddx] != 0
+                    if not ok:
+                        continue
+                j = _diagonal(blk, table, c, cx, cy, ddx, ddy, gx, gy, goal, Wp)
+            if j >= 0:
+                size = _relax(j, c, Wp, gx, gy, stamp, g, parent, mark, pos, hc, hk, size)
         if size > max_frontier:
             max_frontier = size
-    return NO_PATH, expanded, max_frontier
+    return NO_PATH, expanded, max_frontier, np.empty(0, np.int64)
 
 
 @njit(cache=True)

@@ -40,6 +40,7 @@ class SearchSpace:
         self.n = self.blocked.size
         self.offsets = MDY * self.Wp + MDX
         self._masks: dict[tuple[int, bool], np.ndarray] = {}
+        self._jumps: np.ndarray | None = None
         self._ws: tuple | None = None
         self._stamp = 0
 
@@ -69,6 +70,14 @@ class SearchSpace:
             mask.setflags(write=False)
             self._masks[key] = mask
         return mask
+
+    def jump_table(self) -> np.ndarray:
+        """JPS's straight-scan table, built on first use (see ``search.jps``)."""
+        if self._jumps is None:
+            from skyroute.search.jps import jump_tables
+
+            self._jumps = jump_tables(self.blocked, self.Wp)
+        return self._jumps
 
     def workspace(self) -> tuple:
         """(stamp, g, h, parent, mark, pos, heap_cell, heap_key) for one query.

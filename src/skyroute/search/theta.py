@@ -14,12 +14,14 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from skyroute.search import heap
 from skyroute.search.astar import heuristic, move_ok
 from skyroute.search.los import line_of_sight
 from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search.trace import trace
 
 
 @njit(cache=True)
@@ -32,7 +34,7 @@ def _dist(a, b, Wp):
 @njit(cache=True)
 def theta_kernel(blk, mask, Wp, start, goal, nmoves, offs, costs, hkind, weight,
                  max_expansions, lazy, stamp, g, h, parent, mark, pos, hc, hk):
-    """Return (status, expanded, max_frontier, los_checks); ``parent`` holds the path."""
+    """Return (status, expanded, max_frontier, los_checks, path of flat cells)."""
     mark[start] = stamp
     g[start] = 0.0
     h[start] = weight * heuristic(hkind, start, goal, Wp)
@@ -66,9 +68,9 @@ def theta_kernel(blk, mask, Wp, start, goal, nmoves, offs, costs, hkind, weight,
                         continue
                     c, size = heap.pop(hc, hk, pos, size)
         if c == goal:
-            return FOUND, expanded, max_frontier, los
+            return FOUND, expanded, max_frontier, los, trace(parent, start, goal)
         if expanded >= max_expansions:
-            return BUDGET_EXHAUSTED, expanded, max_frontier, los
+            return BUDGET_EXHAUSTED, expanded, max_frontier, los, np.empty(0, np.int64)
         mark[c] = closed
         expanded += 1
         pc = parent[c]
@@ -104,4 +106,4 @@ def theta_kernel(blk, mask, Wp, start, goal, nmoves, offs, costs, hkind, weight,
                 size = heap.push(hc, hk, pos, size, n, heap.key(gn + h[n], gn))
         if size > max_frontier:
             max_frontier = size
-    return NO_PATH, expanded, max_frontier, los
+    return NO_PATH, expanded, max_frontier, los, np.empty(0, np.int64)
