@@ -130,3 +130,26 @@ def test_result_is_frozen_and_serialisable():
     assert list(d) == ["status", "cost", "path", "expanded", "max_frontier", "los_checks",
                        "seconds", "algorithm"]
     assert d["status"] == "found" and d["path"] == [[0, 0], [1, 1], [2, 2]]
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+def test_search_state_is_clean_after_every_ending(algorithm):
+    # Kernels share per-grid arrays between queries and must leave `state` all zeros,
+    # whether they found a path, found none or ran out of budget.
+    from skyroute.search.space import space_of
+
+    b = np.zeros((12, 12), bool)
+    b[:, 6] = True
+    b[3, 6] = False
+    grid = skyroute.Grid(b)
+    state = space_of(grid).workspace()[1][1]
+    ends = [((0, 0), (11, 11), None), ((0, 0), (11, 11), 2)]
+    b2 = b.copy()
+    b2[3, 6] = True
+    closed = skyroute.Grid(b2)
+    for s, t, budget in ends:
+        skyroute.plan(grid, s, t, algorithm=algorithm, max_expansions=budget)
+        assert not state.any()
+    r = skyroute.plan(closed, (0, 0), (11, 11), algorithm=algorithm)
+    assert r.status is Status.NO_PATH
+    assert not space_of(closed).workspace()[1][1].any()

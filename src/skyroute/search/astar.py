@@ -18,6 +18,7 @@ from numba import njit
 
 from skyroute.search import heap
 from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search.space import COSTS, MDX, MDY, offsets
 from skyroute.search.trace import trace
 
 HEURISTICS = {"zero": 0, "octile": 1, "euclidean": 2, "manhattan": 3}
@@ -49,54 +50,112 @@ def move_ok(mask, c, k):
 
 
 @njit(cache=True)
-def astar_kernel(mask, Wp, start, goal, nmoves, offs, costs, mdx, mdy,
-                 hkind, weight, max_expansions, stamp, g, parent, mark, pos, hc, hk):
-    """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier, path)."""
+def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, ints,
+                 keys):
+    """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier, path).
+
+    floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`; its ``state``
+    row must be all zeros on entry and is all zeros again on return. The heap
+    operations of :mod:`skyroute.search.heap` are written out in this loop: numba does
+    not inline them here, and the calls cost 1.2-1.8x in time (docs/architecture.md).
+    """
+    g = floats[0]
+    parent, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
+    hk = keys
+    offs = offsets(Wp)
     gx, gy = goal % Wp, goal // Wp
-    mark[start] = stamp
     g[start] = 0.0
     parent[start] = start
-    pos[start] = -1
+    touched[0] = start
+    nt = 1
     f0 = weight * h_of(hkind, abs(start % Wp - gx), abs(start // Wp - gy))
-    size = heap.push(hc, hk, pos, 0, start, heap.key(f0, 0.0))
+    hc[0] = start
+    keys[0] = heap.key(f0, 0.0)
+    state[start] = 1
+    size = 1
     expanded = 0
     max_frontier = 1
-    closed = stamp + 1
+    code = NO_PATH
     while size > 0:
-        c, size = heap.pop(hc, hk, pos, size)
+        # pop the minimum (hole sifts down) and close it
+        c = hc[0]
+        size -= 1
+        if size > 0:
+            last = hc[size]
+            lk = hk[size]
+            i = 0
+            while True:
+                b = 2 * i + 1
+                if b >= size:
+                    break
+                if b + 1 < size and hk[b + 1] < hk[b]:
+                    b += 1
+                if hk[b] >= lk:
+                    break
+                moved = hc[b]
+                hc[i] = moved
+                hk[i] = hk[b]
+                state[moved] = i + 1
+                i = b
+            hc[i] = last
+            hk[i] = lk
+            state[last] = i + 1
+        state[c] = -1
         if c == goal:
-            return FOUND, expanded, max_frontier, trace(parent, start, goal)
+            code = FOUND
+            break
         if expanded >= max_expansions:
-            return BUDGET_EXHAUSTED, expanded, max_frontier, np.empty(0, np.int64)
-        mark[c] = closed
+            code = BUDGET_EXHAUSTED
+            break
         expanded += 1
         gc = g[c]
         m = mask[c]
         cx = c % Wp - gx
         cy = c // Wp - gy
-        for k in range(nmoves):
+        for k in range(8):  # the mask holds the connectivity: no diagonal bits when 4
             if not (m >> k) & 1:
                 continue
             n = c + offs[k]
-            state = mark[n]
-            if state == closed:
+            st = state[n]
+            if st < 0:
                 continue
-            gn = gc + costs[k]
-            if state != stamp:
-                mark[n] = stamp
-                pos[n] = -1
+            gn = gc + COSTS[k]
+            if st == 0:
+                touched[nt] = n
+                nt += 1
+                i = size
+                size += 1
             elif gn >= g[n]:
                 continue
+            else:
+                i = st - 1
             g[n] = gn
             parent[n] = c
-            dx = abs(cx + mdx[k])
-            dy = abs(cy + mdy[k])
-            if hkind == 1:  # octile, written out: the common case in the hot loop
+            dx = abs(cx + MDX[k])
+            dy = abs(cy + MDY[k])
+            if hkind == 1:  # octile, written out: the common case
                 hn = max(dx, dy) + _SQRT2_M1 * min(dx, dy)
             else:
                 hn = h_of(hkind, dx, dy)
-            fn = gn + weight * hn
-            size = heap.push(hc, hk, pos, size, n, heap.key(fn, gn))
+            key = (int((gn + weight * hn) * heap.F_SCALE + 0.5) << heap.TIE_BITS) | \
+                (heap.TIE_MAX - min(int(gn * 4.0), heap.TIE_MAX))
+            # push or decrease-key (hole sifts up)
+            while i > 0:
+                p = (i - 1) >> 1
+                kp = hk[p]
+                if key >= kp:
+                    break
+                moved = hc[p]
+                hc[i] = moved
+                hk[i] = kp
+                state[moved] = i + 1
+                i = p
+            hc[i] = n
+            hk[i] = key
+            state[n] = i + 1
         if size > max_frontier:
             max_frontier = size
-    return NO_PATH, expanded, max_frontier, np.empty(0, np.int64)
+    heap.reset(state, touched, nt)
+    if code == FOUND:
+        return code, expanded, max_frontier, trace(parent, start, goal)
+    return code, expanded, max_frontier, np.empty(0, np.int64)

@@ -5,41 +5,52 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from skyroute.search.heap import reset
 from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search.trace import trace
 
 
 @njit(cache=True)
-def bfs_kernel(blk, Wp, start, goal, max_expansions, stamp, g, parent, mark, queue):
+def bfs_kernel(blk, Wp, start, goal, max_expansions, floats, ints):
     """FIFO search over the 4 orthogonal moves; return (status, expanded, max_frontier, path).
 
-    ``queue`` needs one slot per cell; ``g`` receives step counts.
+    floats, ints: the workspace of :meth:`SearchSpace.workspace` (its ``state`` row all
+    zeros on entry and on return). The queue doubles as the list of touched cells; ``g``
+    receives step counts.
     """
+    g = floats[0]
+    parent, state, queue = ints[0], ints[1], ints[2]
     offs = (1, -1, Wp, -Wp)
-    mark[start] = stamp
+    state[start] = -1
     parent[start] = start
     g[start] = 0.0
     head, tail = 0, 1
     queue[0] = start
     expanded = 0
     max_frontier = 1
+    code = NO_PATH
     while head < tail:
         c = queue[head]
         head += 1
         if c == goal:
-            return FOUND, expanded, max_frontier, trace(parent, start, goal)
+            code = FOUND
+            break
         if expanded >= max_expansions:
-            return BUDGET_EXHAUSTED, expanded, max_frontier, np.empty(0, np.int64)
+            code = BUDGET_EXHAUSTED
+            break
         expanded += 1
         for k in range(4):
             n = c + offs[k]
-            if blk[n] or mark[n] == stamp:
+            if blk[n] or state[n] != 0:
                 continue
-            mark[n] = stamp
+            state[n] = -1
             parent[n] = c
             g[n] = g[c] + 1.0
             queue[tail] = n
             tail += 1
         if tail - head > max_frontier:
             max_frontier = tail - head
-    return NO_PATH, expanded, max_frontier, np.empty(0, np.int64)
+    reset(state, queue, tail)
+    if code == FOUND:
+        return code, expanded, max_frontier, trace(parent, start, goal)
+    return code, expanded, max_frontier, np.empty(0, np.int64)

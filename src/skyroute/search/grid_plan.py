@@ -16,7 +16,7 @@ from skyroute.search.bfs import bfs_kernel
 from skyroute.search.jps import jps_kernel
 from skyroute.search.prune import PRUNE_MODES, prune_collinear, prune_los
 from skyroute.search.result import STATUS_OF_CODE, PlanResult, Status
-from skyroute.search.space import COSTS, MDX, MDY, SearchSpace, space_of, to_cells
+from skyroute.search.space import SearchSpace, space_of, to_cells
 from skyroute.search.theta import theta_kernel
 from skyroute.world.grid import Grid
 
@@ -137,24 +137,21 @@ def plan_grid(grid: Grid, start: tuple[int, int], goal: tuple[int, int],
 
 def _search(space: SearchSpace, s: int, t: int, o: GridOptions):
     blk, Wp = space.blocked, space.Wp
-    stamp, g, h, parent, mark, pos, hc, hk = space.workspace()
+    floats, ints, keys = space.workspace()
     los = 0
     if o.algorithm == "bfs":
-        code, exp, front, flat = bfs_kernel(blk, Wp, s, t, o.max_expansions, stamp, g, parent,
-                                            mark, hc)
+        code, exp, front, flat = bfs_kernel(blk, Wp, s, t, o.max_expansions, floats, ints)
     elif o.algorithm == "jps":
         code, exp, front, flat = jps_kernel(blk, space.jump_table(), Wp, s, t,
-                                            o.max_expansions, stamp, g, parent, mark, pos, hc, hk)
+                                            o.max_expansions, floats, ints, keys)
     else:
         mask = space.move_mask(o.connectivity, o.corner_cutting)
         hkind = HEURISTICS[o.heuristic]
         if o.algorithm in ANY_ANGLE:
-            lazy = o.algorithm == "lazy_theta"
             code, exp, front, los, flat = theta_kernel(
-                blk, mask, Wp, s, t, o.connectivity, space.offsets, COSTS, hkind, o.weight,
-                o.max_expansions, lazy, stamp, g, h, parent, mark, pos, hc, hk)
+                blk, mask, Wp, s, t, hkind, o.weight, o.max_expansions,
+                o.algorithm == "lazy_theta", floats, ints, keys)
         else:
-            code, exp, front, flat = astar_kernel(
-                mask, Wp, s, t, o.connectivity, space.offsets, COSTS, MDX, MDY, hkind, o.weight,
-                o.max_expansions, stamp, g, parent, mark, pos, hc, hk)
+            code, exp, front, flat = astar_kernel(mask, Wp, s, t, hkind, o.weight,
+                                                  o.max_expansions, floats, ints, keys)
     return code, exp, front, los, flat

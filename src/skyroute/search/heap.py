@@ -4,8 +4,11 @@ One int64 key per entry packs ``f`` (in units of 2**-20, so float noise in g + h
 breaks ties) above a tie-break that prefers the larger ``g`` (in quarter cells): among
 equally promising nodes the one nearest the goal is expanded first, which on open grids
 cuts expansions several-fold. f must stay below 2**23 (8 million cells of path).
-``pos[c]`` holds the cell's heap slot (-1 when not in the heap), so improving a node is
-a decrease-key, not a duplicate entry. Sifting moves a hole, writing each level once.
+
+The heap shares the searches' per-cell ``state`` array: ``state[c] = i + 1`` while c sits
+in heap slot i, so improving a node is a decrease-key, not a duplicate entry; 0 means
+never seen and -1 closed (``pop`` closes what it returns). Sifting moves a hole, writing
+each level once.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from numba import njit
 F_SCALE = 1048576.0  # 2**20
 TIE_BITS = 20
 TIE_MAX = (1 << TIE_BITS) - 1
+CLOSED = -1
 
 
 @njit(cache=True)
@@ -25,9 +29,9 @@ def key(f, g):
 
 
 @njit(cache=True)
-def push(hc, hk, pos, size, cell, k):
+def push(hc, hk, state, size, cell, k):
     """Insert ``cell`` with key ``k`` (or lower its key if present); return the new size."""
-    i = pos[cell]
+    i = state[cell] - 1
     if i < 0:
         i = size
         size += 1
@@ -38,21 +42,21 @@ def push(hc, hk, pos, size, cell, k):
             moved = hc[p]
             hc[i] = moved
             hk[i] = kp
-            pos[moved] = i
+            state[moved] = i + 1
             i = p
         else:
             break
     hc[i] = cell
     hk[i] = k
-    pos[cell] = i
+    state[cell] = i + 1
     return size
 
 
 @njit(cache=True)
-def pop(hc, hk, pos, size):
-    """Remove the minimum; return (cell, new size)."""
+def pop(hc, hk, state, size):
+    """Remove the minimum and mark it closed; return (cell, new size)."""
     top = hc[0]
-    pos[top] = -1
+    state[top] = CLOSED
     size -= 1
     if size > 0:
         last = hc[size]
@@ -69,11 +73,18 @@ def pop(hc, hk, pos, size):
                 moved = hc[b]
                 hc[i] = moved
                 hk[i] = hk[b]
-                pos[moved] = i
+                state[moved] = i + 1
                 i = b
             else:
                 break
         hc[i] = last
         hk[i] = lk
-        pos[last] = i
+        state[last] = i + 1
     return int(top), size
+
+
+@njit(cache=True)
+def reset(state, touched, count):
+    """Return ``state`` to all zeros by clearing the ``count`` cells a search touched."""
+    for j in range(count):
+        state[touched[j]] = 0

@@ -97,23 +97,21 @@ def _diagonal(blk, table, c, cx, cy, sx, sy, gx, gy, goal, Wp):
 
 
 @njit(cache=True)
-def _relax(n, c, Wp, gx, gy, stamp, g, parent, mark, pos, hc, hk, size):
-    closed = stamp + 1
-    m = mark[n]
-    if m == closed:
-        return size
-    dx = abs(n % Wp - c % Wp)
-    dy = abs(n // Wp - c // Wp)
-    gn = g[c] + h_of(1, dx, dy)
-    if m != stamp:
-        mark[n] = stamp
-        pos[n] = -1
+def _relax(n, c, Wp, gx, gy, g, parent, state, touched, nt, hc, hk, size):
+    """Offer jump point n reached from c; return (heap size, touched count)."""
+    st = state[n]
+    if st < 0:
+        return size, nt
+    gn = g[c] + h_of(1, abs(n % Wp - c % Wp), abs(n // Wp - c // Wp))
+    if st == 0:
+        touched[nt] = n
+        nt += 1
     elif gn >= g[n]:
-        return size
+        return size, nt
     g[n] = gn
     parent[n] = c
     fn = gn + h_of(1, abs(n % Wp - gx), abs(n // Wp - gy))
-    return heap.push(hc, hk, pos, size, n, heap.key(fn, gn))
+    return heap.push(hc, hk, state, size, n, heap.key(fn, gn)), nt
 
 
 @njit(cache=True)
@@ -122,28 +120,34 @@ def _sign(v):
 
 
 @njit(cache=True)
-def jps_kernel(blk, table, Wp, start, goal, max_expansions,
-               stamp, g, parent, mark, pos, hc, hk):
+def jps_kernel(blk, table, Wp, start, goal, max_expansions, floats, ints, keys):
     """Search from flat ``start`` to ``goal``.
 
     Returns (status, expanded, max_frontier, path) with ``path`` every flat cell.
+    floats, ints, keys: the workspace of :meth:`SearchSpace.workspace` (its ``state`` row all
+    zeros on entry and on return).
     """
+    g = floats[0]
+    parent, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
+    hk = keys
     gx, gy = goal % Wp, goal // Wp
-    mark[start] = stamp
     g[start] = 0.0
     parent[start] = start
-    pos[start] = -1
+    touched[0] = start
+    nt = 1
     f0 = h_of(1, abs(start % Wp - gx), abs(start // Wp - gy))
-    size = heap.push(hc, hk, pos, 0, start, heap.key(f0, 0.0))
+    size = heap.push(hc, hk, state, 0, start, heap.key(f0, 0.0))
     expanded = 0
     max_frontier = 1
+    code = NO_PATH
     while size > 0:
-        c, size = heap.pop(hc, hk, pos, size)
+        c, size = heap.pop(hc, hk, state, size)
         if c == goal:
-            return FOUND, expanded, max_frontier, fill(trace(parent, start, goal), Wp)
+            code = FOUND
+            break
         if expanded >= max_expansions:
-            return BUDGET_EXHAUSTED, expanded, max_frontier, np.empty(0, np.int64)
-        mark[c] = stamp + 1
+            code = BUDGET_EXHAUSTED
+            break
         expanded += 1
         cx, cy = c % Wp, c // Wp
         p = parent[c]
@@ -185,10 +189,14 @@ def jps_kernel(blk, table, Wp, start, goal, max_expansions,
                         continue
                 j = _diagonal(blk, table, c, cx, cy, ddx, ddy, gx, gy, goal, Wp)
             if j >= 0:
-                size = _relax(j, c, Wp, gx, gy, stamp, g, parent, mark, pos, hc, hk, size)
+                size, nt = _relax(j, c, Wp, gx, gy, g, parent, state, touched, nt, hc, hk,
+                                  size)
         if size > max_frontier:
             max_frontier = size
-    return NO_PATH, expanded, max_frontier, np.empty(0, np.int64)
+    heap.reset(state, touched, nt)
+    if code == FOUND:
+        return code, expanded, max_frontier, fill(trace(parent, start, goal), Wp)
+    return code, expanded, max_frontier, np.empty(0, np.int64)
 
 
 @njit(cache=True)

@@ -5,8 +5,8 @@ kernels never test bounds. Cell (x, y) sits at flat index ``(y + 1) * Wp + (x + 
 with ``Wp = width + 2``. Built once per grid and cached (plan once, query many):
 
 - a move mask per move rule: bit k of ``mask[c]`` is set when move k is legal from c;
-- per-cell search arrays, reused between queries: a query stamp marks which entries
-  belong to the current query, so nothing is cleared between queries.
+- per-cell search arrays, reused between queries; each search clears only the cells it
+  touched.
 """
 
 from __future__ import annotations
@@ -42,7 +42,6 @@ class SearchSpace:
         self._masks: dict[tuple[int, bool], np.ndarray] = {}
         self._jumps: np.ndarray | None = None
         self._ws: tuple | None = None
-        self._stamp = 0
 
     def index(self, cell: tuple[int, int]) -> int:
         """Flat index of cell (x, y)."""
@@ -79,19 +78,26 @@ class SearchSpace:
             self._jumps = jump_tables(self.blocked, self.Wp)
         return self._jumps
 
-    def workspace(self) -> tuple:
-        """(stamp, g, h, parent, mark, pos, heap_cell, heap_key) for one query.
+    def workspace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(floats, ints, keys), allocated once: F rows g, h (float64); I rows parent, state,
+        touched, heap cell (int32); K heap keys (int64). Few arrays, because numba's
+        dispatch costs about a microsecond per array argument.
 
-        ``mark[c] == stamp`` means c was seen this query, ``stamp + 1`` that it is closed.
+        ``state`` (``ints[1]``) is all zeros between queries: every kernel clears the cells
+        it touched (listed in ``ints[2]``) before it returns, so no query pays for the grid.
         """
-        if self._ws is None or self._stamp > 2**31 - 8:
+        if self._ws is None:
             n = self.n
-            self._ws = (np.empty(n), np.empty(n), np.empty(n, np.int32),
-                        np.zeros(n, np.int32), np.full(n, -1, np.int32),
-                        np.empty(n, np.int32), np.empty(n, np.int64))
-            self._stamp = 0
-        self._stamp += 2
-        return (self._stamp, *self._ws)
+            ints = np.empty((4, n), np.int32)
+            ints[1] = 0
+            self._ws = (np.empty((2, n)), ints, np.empty(n, np.int64))
+        return self._ws
+
+
+@njit(cache=True)
+def offsets(Wp):
+    """Flat offsets of the 8 moves, in MOVES order."""
+    return (1, -1, Wp, -Wp, Wp + 1, Wp - 1, 1 - Wp, -1 - Wp)
 
 
 @njit(cache=True)

@@ -21,6 +21,7 @@ from skyroute.search import heap
 from skyroute.search.astar import heuristic, move_ok
 from skyroute.search.los import line_of_sight
 from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search.space import COSTS, offsets
 from skyroute.search.trace import trace
 
 
@@ -32,58 +33,65 @@ def _dist(a, b, Wp):
 
 
 @njit(cache=True)
-def theta_kernel(blk, mask, Wp, start, goal, nmoves, offs, costs, hkind, weight,
-                 max_expansions, lazy, stamp, g, h, parent, mark, pos, hc, hk):
-    """Return (status, expanded, max_frontier, los_checks, path of flat cells)."""
-    mark[start] = stamp
+def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy,
+                 floats, ints, keys):
+    """Return (status, expanded, max_frontier, los_checks, path of flat cells).
+
+    floats, ints, keys: the workspace of :meth:`SearchSpace.workspace` (its ``state`` row all
+    zeros on entry and on return).
+    """
+    g, h = floats[0], floats[1]
+    parent, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
+    hk = keys
+    offs = offsets(Wp)
     g[start] = 0.0
     h[start] = weight * heuristic(hkind, start, goal, Wp)
     parent[start] = start
-    pos[start] = -1
-    size = heap.push(hc, hk, pos, 0, start, heap.key(h[start], 0.0))
+    touched[0] = start
+    nt = 1
+    size = heap.push(hc, hk, state, 0, start, heap.key(h[start], 0.0))
     expanded = 0
     max_frontier = 1
     los = 0
-    closed = stamp + 1
+    code = NO_PATH
     while size > 0:
-        c, size = heap.pop(hc, hk, pos, size)
+        c, size = heap.pop(hc, hk, state, size)
         if lazy and parent[c] != c:
             p = parent[c]
             los += 1
             if not line_of_sight(blk, Wp, p, c):
-                # Repair: best closed grid neighbour becomes the parent.
+                # Repair: the best closed grid neighbour becomes the parent.
                 best = math.inf
-                for k in range(nmoves):
+                for k in range(8):  # the mask holds the connectivity
                     n = c + offs[k]
-                    if mark[n] == closed and move_ok(mask, c, k) \
-                            and g[n] + costs[k] < best:
-                        best = g[n] + costs[k]
+                    if state[n] < 0 and move_ok(mask, c, k) and g[n] + COSTS[k] < best:
+                        best = g[n] + COSTS[k]
                         parent[c] = n
                 old = g[c]
                 g[c] = best
-                if best > old and size > 0:
-                    size = heap.push(hc, hk, pos, size, c, heap.key(best + h[c], best))
-                    top = hc[0]
-                    if top != c:
+                if best > old and size > 0:  # no longer surely the best: queue it again
+                    size = heap.push(hc, hk, state, size, c, heap.key(best + h[c], best))
+                    if hc[0] != c:
                         continue
-                    c, size = heap.pop(hc, hk, pos, size)
+                    c, size = heap.pop(hc, hk, state, size)
         if c == goal:
-            return FOUND, expanded, max_frontier, los, trace(parent, start, goal)
+            code = FOUND
+            break
         if expanded >= max_expansions:
-            return BUDGET_EXHAUSTED, expanded, max_frontier, los, np.empty(0, np.int64)
-        mark[c] = closed
+            code = BUDGET_EXHAUSTED
+            break
         expanded += 1
         pc = parent[c]
-        for k in range(nmoves):
+        for k in range(8):  # the mask holds the connectivity
             if not move_ok(mask, c, k):
                 continue
             n = c + offs[k]
-            m = mark[n]
-            if m == closed:
+            st = state[n]
+            if st < 0:
                 continue
-            if m != stamp:
-                mark[n] = stamp
-                pos[n] = -1
+            if st == 0:
+                touched[nt] = n
+                nt += 1
                 h[n] = weight * heuristic(hkind, n, goal, Wp)
                 g[n] = math.inf
             if lazy:
@@ -98,12 +106,15 @@ def theta_kernel(blk, mask, Wp, start, goal, nmoves, offs, costs, hkind, weight,
                     gn = g[pc] + _dist(pc, n, Wp)
                     par = pc
                 else:
-                    gn = g[c] + costs[k]
+                    gn = g[c] + COSTS[k]
                     par = c
             if gn < g[n]:
                 g[n] = gn
                 parent[n] = par
-                size = heap.push(hc, hk, pos, size, n, heap.key(gn + h[n], gn))
+                size = heap.push(hc, hk, state, size, n, heap.key(gn + h[n], gn))
         if size > max_frontier:
             max_frontier = size
-    return NO_PATH, expanded, max_frontier, los, np.empty(0, np.int64)
+    heap.reset(state, touched, nt)
+    if code == FOUND:
+        return code, expanded, max_frontier, los, trace(parent, start, goal)
+    return code, expanded, max_frontier, los, np.empty(0, np.int64)
