@@ -12,3 +12,36 @@ MODULES = ["skyroute.world.grid", "skyroute.world.load", "skyroute.planner"]
 def test_docstring_examples(name):
     result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_readme_python_example():
+    from tests.conftest import ROOT
+
+    result = doctest.testfile(str(ROOT / "README.md"), module_relative=False,
+                              optionflags=doctest.ELLIPSIS)
+    assert result.attempted >= 6 and result.failed == 0
+
+
+def readme_cli_examples() -> list[str]:
+    from tests.conftest import ROOT
+
+    text = (ROOT / "README.md").read_text()
+    usage = text[text.index("## Usage"):]
+    block = usage[usage.index("```sh") + 5:]
+    block = block[:block.index("```")]
+    return [line.split("#")[0].strip() for line in block.splitlines()
+            if line.strip().startswith("skyroute ")]
+
+
+@pytest.mark.parametrize("command", readme_cli_examples())
+def test_readme_cli_examples_run(command, monkeypatch, capsys, tmp_path):
+    import shlex
+    import sys
+
+    from skyroute.cli.app import main
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", shlex.split(command))
+    with pytest.raises(SystemExit) as exit_info:
+        main()
+    assert exit_info.value.code == 0, capsys.readouterr().err

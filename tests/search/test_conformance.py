@@ -153,3 +153,16 @@ def test_search_state_is_clean_after_every_ending(algorithm):
     r = skyroute.plan(closed, (0, 0), (11, 11), algorithm=algorithm)
     assert r.status is Status.NO_PATH
     assert not space_of(closed).workspace()[1][1].any()
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+def test_setup_is_timed_apart_from_the_search(algorithm):
+    rng = np.random.default_rng(5)
+    grid = skyroute.Grid(rng.random((60, 60)) < 0.2)
+    free = np.argwhere(~grid.blocked)
+    s, t = tuple(free[0][::-1]), tuple(free[-1][::-1])
+    first = skyroute.plan(grid, s, t, algorithm=algorithm)
+    again = skyroute.plan(grid, s, t, algorithm=algorithm)
+    assert first.extra["setup_seconds"] > 0  # masks, tables, workspace for a new grid
+    assert "setup_seconds" not in again.extra
+    assert first.cost == again.cost and first.expanded == again.expanded

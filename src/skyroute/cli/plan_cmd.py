@@ -87,6 +87,9 @@ def _print_table(name, result, plot, geojson) -> None:
     table.add_row("max frontier", f"{result.max_frontier:,}")
     table.add_row("line-of-sight checks", f"{result.los_checks:,}")
     table.add_row("search time", f"{result.seconds * 1e3:.3f} ms")
+    if "setup_seconds" in result.extra:
+        table.add_row("set-up time", f"{result.extra['setup_seconds'] * 1e3:.3f} ms "
+                      "(first query: masks, tables, compiled kernels)")
     for label, path in (("plot", plot), ("geojson", geojson)):
         if path:
             table.add_row(label, str(path))

@@ -42,6 +42,7 @@ class SearchSpace:
         self._masks: dict[tuple[int, bool], np.ndarray] = {}
         self._jumps: np.ndarray | None = None
         self._ws: tuple | None = None
+        self.prepared: set = set()  # option sets whose set-up ran (see grid_plan)
 
     def index(self, cell: tuple[int, int]) -> int:
         """Flat index of cell (x, y)."""
