@@ -119,3 +119,15 @@ def test_module_entry_point_has_no_traceback():
                         "--goal", "1,1"], capture_output=True, text=True, timeout=120)
     assert p.returncode == 2
     assert p.stderr == "skyroute: error: start (0, 0) is on a blocked cell\n"
+
+
+def test_bench_malformed_scen_names_file_and_line(monkeypatch, capsys, tmp_path):
+    (tmp_path / "tiny.map").write_text("type octile\nheight 2\nwidth 3\nmap\n...\n...\n")
+    scen = tmp_path / "tiny.map.scen"
+    scen.write_text("version 1\n0\ttiny.map\t3\t2\t0\t0\t2\t1\t2.41421356\n"
+                    "0\ttiny.map\t3\t2\t0\t0\t2\n")
+    out_json = tmp_path / "out.json"
+    code, out, err = run(monkeypatch, capsys, "bench", "grid", "--maps", str(tmp_path),
+                         "--peers", "", "--json", str(out_json))
+    assert code == 2 and f"{scen}:3: expected 9 tab-separated columns, got 7" in err
+    assert err.count("\n") == 1 and not out_json.exists() and out == ""

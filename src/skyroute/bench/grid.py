@@ -153,9 +153,11 @@ def check_runners(algorithms: Sequence[str], peers: Sequence[str]) -> tuple[list
 
 
 def count_queries(pairs: list[tuple[Path, Path]], per_map: int) -> int:
-    """How many queries a run will make per runner (for a progress bar)."""
+    """Read every map and scenario (so bad input fails before a long run starts) and
+    return how many queries the run will make per runner, for a progress bar."""
     total = 0
-    for _, scen in pairs:
-        lines = sum(1 for line in scen.read_text().splitlines()[1:] if line.strip())
+    for map_path, scen_path in pairs:
+        read_map(map_path)
+        lines = len(read_scen(scen_path))
         total += lines if per_map <= 0 else min(per_map, lines)
     return total

@@ -41,6 +41,7 @@ def bench_grid(
     folder = maps or next(iter(bundled_maps().values())).parent
     algs, have, missing = check_runners(parse_list(algorithms), parse_list(peers))
     pairs = find_pairs(folder, map_names or ())
+    total = count_queries(pairs, per_map)
     console = Console(stderr=True)
     for p in missing:
         console.print(f"[yellow]peer {p} is not installed; skipped "
@@ -49,7 +50,7 @@ def bench_grid(
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                TimeRemainingColumn())
     with Progress(*columns, console=console, transient=True) as progress:
-        task = progress.add_task("queries", total=count_queries(pairs, per_map))
+        task = progress.add_task("queries", total=total)
         for map_path, scen_path in pairs:
             progress.update(task, description=map_path.stem)
             reports.append(bench_map(map_path, scen_path, per_map=per_map, algorithms=algs,
