@@ -6,7 +6,7 @@ import numpy as np
 from numba import njit
 
 from skyroute.search.heap import reset
-from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search.result import FOUND, NO_PATH, stop_code
 from skyroute.search.trace import trace
 
 
@@ -28,15 +28,12 @@ def bfs_kernel(blk, Wp, start, goal, max_expansions, floats, ints):
     queue[0] = start
     expanded = 0
     max_frontier = 1
-    code = NO_PATH
+    code = -1
     while head < tail:
         c = queue[head]
         head += 1
-        if c == goal:
-            code = FOUND
-            break
-        if expanded >= max_expansions:
-            code = BUDGET_EXHAUSTED
+        code = stop_code(c, goal, expanded, max_expansions)
+        if code >= 0:
             break
         expanded += 1
         for k in range(4):
@@ -50,6 +47,8 @@ def bfs_kernel(blk, Wp, start, goal, max_expansions, floats, ints):
             tail += 1
         if tail - head > max_frontier:
             max_frontier = tail - head
+    if code < 0:  # the open list ran dry
+        code = NO_PATH
     reset(state, queue, tail)
     if code == FOUND:
         return code, expanded, max_frontier, trace(parent, start, goal)

@@ -20,7 +20,7 @@ from numba import njit
 
 from skyroute.search import heap
 from skyroute.search.astar import h_of
-from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search.result import FOUND, NO_PATH, stop_code
 from skyroute.search.trace import trace
 
 # Straight directions: 0 east (+x), 1 west (-x), 2 south (+y), 3 north (-y).
@@ -139,14 +139,11 @@ def jps_kernel(blk, table, Wp, start, goal, max_expansions, floats, ints, keys):
     size = heap.push(hc, hk, state, 0, start, heap.key(f0, 0.0))
     expanded = 0
     max_frontier = 1
-    code = NO_PATH
+    code = -1
     while size > 0:
         c, size = heap.pop(hc, hk, state, size)
-        if c == goal:
-            code = FOUND
-            break
-        if expanded >= max_expansions:
-            code = BUDGET_EXHAUSTED
+        code = stop_code(c, goal, expanded, max_expansions)
+        if code >= 0:
             break
         expanded += 1
         cx, cy = c % Wp, c // Wp
@@ -193,6 +190,8 @@ def jps_kernel(blk, table, Wp, start, goal, max_expansions, floats, ints, keys):
                                   size)
         if size > max_frontier:
             max_frontier = size
+    if code < 0:  # the open list ran dry
+        code = NO_PATH
     heap.reset(state, touched, nt)
     if code == FOUND:
         return code, expanded, max_frontier, fill(trace(parent, start, goal), Wp)

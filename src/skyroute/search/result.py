@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 
 import numpy as np
+from numba import njit
 
 
 class Status(StrEnum):
@@ -19,6 +20,16 @@ class Status(StrEnum):
 # Kernel status codes, shared by every compiled search.
 FOUND, NO_PATH, BUDGET_EXHAUSTED = 0, 1, 2
 STATUS_OF_CODE = (Status.FOUND, Status.NO_PATH, Status.BUDGET_EXHAUSTED)
+
+
+@njit(cache=True)
+def stop_code(c, goal, expanded, max_expansions):
+    """A kernel's stop test when it takes node c: FOUND, BUDGET_EXHAUSTED, or -1 (go on)."""
+    if c == goal:
+        return FOUND
+    if expanded >= max_expansions:
+        return BUDGET_EXHAUSTED
+    return -1
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ from numba import njit
 from skyroute.search import heap
 from skyroute.search.astar import heuristic, move_ok
 from skyroute.search.los import line_of_sight
-from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search.result import FOUND, NO_PATH, stop_code
 from skyroute.search.space import COSTS, offsets
 from skyroute.search.trace import trace
 
@@ -53,7 +53,7 @@ def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy
     expanded = 0
     max_frontier = 1
     los = 0
-    code = NO_PATH
+    code = -1
     while size > 0:
         c, size = heap.pop(hc, hk, state, size)
         if lazy and parent[c] != c:
@@ -74,11 +74,8 @@ def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy
                     if hc[0] != c:
                         continue
                     c, size = heap.pop(hc, hk, state, size)
-        if c == goal:
-            code = FOUND
-            break
-        if expanded >= max_expansions:
-            code = BUDGET_EXHAUSTED
+        code = stop_code(c, goal, expanded, max_expansions)
+        if code >= 0:
             break
         expanded += 1
         pc = parent[c]
@@ -114,6 +111,8 @@ def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy
                 size = heap.push(hc, hk, state, size, n, heap.key(gn + h[n], gn))
         if size > max_frontier:
             max_frontier = size
+    if code < 0:  # the open list ran dry
+        code = NO_PATH
     heap.reset(state, touched, nt)
     if code == FOUND:
         return code, expanded, max_frontier, los, trace(parent, start, goal)
