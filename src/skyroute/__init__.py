@@ -8,9 +8,11 @@ from skyroute.errors import InputFormatError, OptionError, QueryError, SkyrouteE
 from skyroute.planner import plan
 from skyroute.search.result import PlanResult, Status
 from skyroute.world.grid import Grid
-from skyroute.world.load import bundled_maps, load_map
+from skyroute.world.load import bundled_maps, load_map, load_world
+from skyroute.world.world import World
 
 __version__ = "0.1.0"
 
 __all__ = ["Grid", "InputFormatError", "OptionError", "PlanResult", "QueryError",
-           "SkyrouteError", "Status", "bundled_maps", "load_map", "plan"]
+           "SkyrouteError", "Status", "World", "bundled_maps", "load_map", "load_world",
+           "plan"]

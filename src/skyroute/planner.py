@@ -6,13 +6,23 @@ from skyroute.errors import OptionError
 from skyroute.search.grid_plan import grid_options, plan_grid
 from skyroute.search.result import PlanResult
 from skyroute.world.grid import Grid
+from skyroute.world.world import World
 
 
-def plan(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
-         algorithm: str = "astar", connectivity: int | None = None,
-         corner_cutting: bool = False, heuristic: str | None = None, weight: float = 1.0,
-         prune: str | None = None, max_expansions: int | None = None) -> PlanResult:
-    """Plan a path on ``grid`` from cell ``start`` to cell ``goal``, both (x, y) = (column, row).
+def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
+         connectivity: int | None = None, corner_cutting: bool = False,
+         heuristic: str | None = None, weight: float = 1.0, prune: str | None = None,
+         max_expansions: int | None = None, resolution: float | None = None,
+         samples: int = 1000, neighbours: int = 10, prm_star: bool = False,
+         seed: int = 0) -> PlanResult:
+    """Plan a path on a Grid from cell ``start`` to cell ``goal``, both (x, y) = (column,
+    row), or on a World between two world points.
+
+    On a World (see :func:`skyroute.load_world`), ``algorithm`` is "visibility" (the
+    default: the exact shortest path), "prm" (``samples``, ``neighbours``, ``prm_star``,
+    ``seed``), or any grid algorithm on the world rasterised at ``resolution`` (default:
+    1000 cells along the longer side); the path is in world coordinates and its cost in
+    world units.
 
     Parameters
     ----------
@@ -55,8 +65,22 @@ def plan(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
     >>> skyroute.plan(grid, (50, 76), (60, 13), algorithm="theta").cost < r.cost
     True
     """
+    if isinstance(grid, World):
+        from skyroute.world_plan import plan_world
+
+        extra = {k: v for k, v in (("connectivity", connectivity), ("heuristic", heuristic),
+                                   ("prune", prune)) if v is not None}
+        if corner_cutting:
+            extra["corner_cutting"] = True
+        if weight != 1.0:
+            extra["weight"] = weight
+        return plan_world(grid, start, goal, algorithm=algorithm or "visibility",
+                          resolution=resolution, samples=samples, neighbours=neighbours,
+                          prm_star=prm_star, seed=seed, max_expansions=max_expansions,
+                          **extra)
     if not isinstance(grid, Grid):
-        raise OptionError(f"grid must be a skyroute Grid, got {type(grid).__name__}")
+        raise OptionError(f"grid must be a skyroute Grid or World, got {type(grid).__name__}")
+    algorithm = algorithm or "astar"
     opts = grid_options(algorithm, connectivity=connectivity, corner_cutting=corner_cutting,
                         heuristic=heuristic, weight=weight, prune=prune,
                         max_expansions=max_expansions)

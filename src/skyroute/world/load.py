@@ -5,11 +5,14 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
-from skyroute.errors import InputFormatError
+import numpy as np
+
+from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.world.grid import Grid
 from skyroute.world.image import read_image, read_npy
 from skyroute.world.movingai import read_map
 from skyroute.world.segments import rasterize_segments, read_segments
+from skyroute.world.world import World
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".pgm", ".tif", ".tiff")
 
@@ -65,3 +68,49 @@ def load_map(path: str | Path, *, cell_size: float = 1.0, clearance: float = 0.0
         raise InputFormatError(p, f"unknown map type {suffix!r}; valid: .map, .csv, .npy, "
                                + ", ".join(IMAGE_SUFFIXES))
     return grid.inflate(clearance)
+
+
+def load_world(path: str | Path, *, altitude: float | None = None, safety: float = 0.0,
+               boundary: str | Path | None = None, frame: str = "lonlat") -> World:
+    """Read a continuous world: a ``colliders.csv`` city or a GeoJSON file of zones.
+
+    ``frame``: "lonlat" and "local" give geometry in metres around home (they differ
+    only in how a CLI reads starts and goals); "degrees" keeps (lon, lat) as a plane,
+    which is how the ILP rules measure. ``altitude`` keeps the obstacles that count
+    there; ``safety`` grows every obstacle (metres, or degrees in the degrees frame).
+    """
+    from skyroute.world.colliders import read_colliders
+    from skyroute.world.geojson_world import parse_boundary, read_geojson_world
+
+    check_choice("frame", frame, ("lonlat", "local", "degrees"))
+    if not (np.isfinite(safety) and safety >= 0):
+        raise OptionError(f"safety={safety!r} must be a number >= 0")
+    p = Path(path)
+    if not p.exists():
+        raise InputFormatError(p, "no such file")
+    if p.suffix.lower() == ".csv":
+        if frame == "degrees":
+            raise OptionError("a colliders.csv city is in metres; use frame 'lonlat' or 'local'")
+        world = read_colliders(p, safety=safety)
+        if boundary is not None:
+            world = _with_boundary(world, parse_boundary(boundary))
+    elif p.suffix.lower() in (".geojson", ".json"):
+        world = read_geojson_world(p, boundary=boundary, safety=safety,
+                                   frame="degrees" if frame == "degrees" else "metres")
+    else:
+        raise InputFormatError(p, f"unknown world type {p.suffix!r}; valid: .csv (colliders), "
+                               ".geojson")
+    return world.at(altitude)
+
+
+def _with_boundary(world: World, lonlat_box) -> World:
+    """Attach a lon/lat boundary to a metres world (projected around its home)."""
+    import shapely
+
+    from skyroute.geo import lonlat_to_enu
+
+    def project(coords):
+        return lonlat_to_enu(coords[:, 0], coords[:, 1], 0.0, world.home)[:, :2]
+
+    return World(world.obstacles, world.floors, world.ceilings, world.names,
+                 shapely.transform(lonlat_box, project), world.frame, world.home, world.name)

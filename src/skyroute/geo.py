@@ -1,0 +1,84 @@
+"""Geodetic coordinates and local frames around a home point, and heading conventions.
+
+Local frames are the ellipsoid's tangent plane at home (WGS84), computed exactly by PROJ's
+``cart`` + ``topocentric`` pipeline: ENU = (east, north, up) and NED = (north, east, down)
+in metres. This is the "local" frame of PX4, ROS and ArduPilot; unlike a map projection
+(UTM, as the FCND course used) it has no scale distortion at home and round-trips to the
+millimetre and better within tens of kilometres.
+
+Headings:
+
+- NED heading: 0 = north, clockwise, radians (the waypoint format [north, east, alt, heading]).
+- ILP angle: 0 = east, anticlockwise, degrees (the lunch-drone rules; -999 means hover).
+
+Angles in the "degrees" frame (the ILP rules) are measured on the (lon, lat) plane as if
+it were flat, which is what those rules define.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Home:
+    """The origin of a local frame: longitude and latitude in degrees, altitude in metres."""
+
+    lon: float
+    lat: float
+    alt: float = 0.0
+
+
+@lru_cache(maxsize=32)
+def _transformer(home: Home):
+    from pyproj import Transformer
+
+    pipeline = ("+proj=pipeline +step +proj=cart +ellps=WGS84 "
+                f"+step +proj=topocentric +ellps=WGS84 +lon_0={home.lon!r} "
+                f"+lat_0={home.lat!r} +h_0={home.alt!r}")
+    return Transformer.from_pipeline(pipeline)
+
+
+def lonlat_to_enu(lon, lat, alt, home: Home) -> np.ndarray:
+    """(N, 3) east, north, up in metres for arrays of lon, lat (degrees) and alt (m)."""
+    lon, lat, alt = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (lon, lat, alt)))
+    e, n, u = _transformer(home).transform(lon.ravel(), lat.ravel(), alt.ravel())
+    return np.column_stack([e, n, u])
+
+
+def enu_to_lonlat(east, north, up, home: Home) -> np.ndarray:
+    """(N, 3) lon, lat (degrees), alt (m) for arrays of east, north, up in metres."""
+    e, n, u = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (east, north, up)))
+    lon, lat, alt = _transformer(home).transform(e.ravel(), n.ravel(), u.ravel(),
+                                                  direction="INVERSE")
+    return np.column_stack([lon, lat, alt])
+
+
+def lonlat_to_ned(lon, lat, alt, home: Home) -> np.ndarray:
+    """(N, 3) north, east, down in metres."""
+    enu = lonlat_to_enu(lon, lat, alt, home)
+    return np.column_stack([enu[:, 1], enu[:, 0], -enu[:, 2]])
+
+
+def ned_to_lonlat(north, east, down, home: Home) -> np.ndarray:
+    """(N, 3) lon, lat (degrees), alt (m) for NED metres."""
+    return enu_to_lonlat(east, north, -np.asarray(down, dtype=float), home)
+
+
+def ned_heading_to_ilp(heading) -> np.ndarray:
+    """NED heading (radians, 0 north, clockwise) -> ILP angle (degrees, 0 east, anticlockwise)."""
+    return np.mod(90.0 - np.degrees(heading), 360.0)
+
+
+def ilp_to_ned_heading(angle) -> np.ndarray:
+    """ILP angle (degrees, 0 east, anticlockwise) -> NED heading in radians in [0, 2 pi)."""
+    return np.mod(np.radians(90.0 - np.asarray(angle, dtype=float)), 2 * math.pi)
+
+
+def heading_of(dx, dy) -> np.ndarray:
+    """NED heading (radians) of a move of (dx east, dy north)."""
+    return np.mod(np.arctan2(dx, dy), 2 * math.pi)

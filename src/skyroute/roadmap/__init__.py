@@ -1,0 +1,1 @@
+"""Roadmaps over continuous worlds: built once, queried many times."""

@@ -1,0 +1,96 @@
+"""Probabilistic roadmap (Kavraki et al. 1996): free samples joined to their k nearest
+neighbours when the segment between them is free; k-PRM* (Karaman & Frazzoli 2011) sets
+k = ceil(e (1 + 1/d) log n) with d = 2. Built once per world; each query joins start
+and goal to their nearest visible samples, runs Dijkstra (scipy) on the roadmap, and
+shortcuts the result by the exact segment test.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
+from scipy.spatial import cKDTree
+
+from skyroute.errors import OptionError
+from skyroute.search.result import PlanResult, Status
+from skyroute.world.world import World
+
+
+class PRM:
+    """A roadmap over a world's free space (see module docstring)."""
+
+    def __init__(self, world: World, *, samples: int = 1000, neighbours: int = 10,
+                 prm_star: bool = False, rng: np.random.Generator | None = None) -> None:
+        if samples < 2 or neighbours < 1:
+            raise OptionError(f"samples={samples} must be >= 2 and neighbours={neighbours} >= 1")
+        rng = np.random.default_rng() if rng is None else rng
+        t0 = time.perf_counter()
+        self.world = world.merged()
+        xmin, ymin, xmax, ymax = self.world.bounds
+        pts = np.empty((0, 2))
+        for _ in range(100):
+            batch = rng.uniform([xmin, ymin], [xmax, ymax], size=(2 * samples, 2))
+            pts = np.vstack([pts, batch[self.world.is_free(batch)]])
+            if len(pts) >= samples:
+                break
+        self.points = pts[:samples]
+        n = len(self.points)
+        self.k = math.ceil(math.e * 1.5 * math.log(n)) if prm_star else neighbours
+        self.tree = cKDTree(self.points)
+        _, nb = self.tree.query(self.points, k=min(self.k + 1, n))
+        i = np.repeat(np.arange(n), nb.shape[1] - 1)
+        j = nb[:, 1:].ravel()
+        a, b = np.minimum(i, j), np.maximum(i, j)
+        pairs = np.unique(np.c_[a, b], axis=0)
+        free = self.world.segments_free(self.points[pairs[:, 0]], self.points[pairs[:, 1]])
+        self.edges = pairs[free]
+        self.edge_checks = len(pairs)
+        self.build_seconds = time.perf_counter() - t0
+
+    def plan(self, start, goal, *, max_expansions: int | None = None) -> PlanResult:
+        """Shortest roadmap path from ``start`` to ``goal``, shortcut; world coordinates."""
+        from skyroute.world_plan import shortcut
+
+        w = self.world
+        s = w.check_point(start, "start")
+        t = w.check_point(goal, "goal")
+        t0 = time.perf_counter()
+        n = len(self.points)
+        pts = np.vstack([self.points, s, t])
+        rows, cols = [self.edges[:, 0]], [self.edges[:, 1]]
+        checks = 0
+        for node, p in ((n, s), (n + 1, t)):
+            _, nb = self.tree.query(p, k=min(self.k, n))
+            nb = np.atleast_1d(nb)
+            ok = w.segments_free(np.broadcast_to(p, (len(nb), 2)), self.points[nb])
+            checks += len(nb)
+            rows.append(np.full(int(ok.sum()), node))
+            cols.append(nb[ok])
+        direct = w.segment_free(s, t)
+        checks += 1
+        if direct:
+            rows.append(np.array([n]))
+            cols.append(np.array([n + 1]))
+        r, c = np.concatenate(rows), np.concatenate(cols)
+        lengths = np.hypot(*(pts[r] - pts[c]).T)
+        graph = coo_matrix((lengths + 1e-300, (r, c)), shape=(n + 2, n + 2)).tocsr()
+        dist, pred = dijkstra(graph, directed=False, indices=n, return_predecessors=True)
+        if not np.isfinite(dist[n + 1]):
+            return PlanResult(Status.NO_PATH, np.empty((0, 2)), math.inf, n, 0, checks,
+                              time.perf_counter() - t0, "prm",
+                              {"samples": n, "edges": len(self.edges)})
+        path = [n + 1]
+        while path[-1] != n:
+            path.append(int(pred[path[-1]]))
+        raw = pts[path[::-1]]
+        short, tests = shortcut(w, raw)
+        cost = float(np.hypot(*np.diff(short, axis=0).T).sum())
+        return PlanResult(Status.FOUND, short, cost, n, 0, checks + tests,
+                          time.perf_counter() - t0, "prm",
+                          {"samples": n, "edges": len(self.edges), "k": self.k,
+                           "raw_cost": float(dist[n + 1]),
+                           "build_seconds": self.build_seconds})

@@ -1,0 +1,65 @@
+"""FCND city maps: ``colliders.csv`` boxes around a home point (a 2.5D world in metres).
+
+Line 1 is ``lat0 <deg>, lon0 <deg>``; line 2 the header
+``posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ``; then one box per row: centre north,
+east and height above ground, and half extents along north, east and up (metres). Each
+box grows by ``safety`` on every side and at its top; it counts at an altitude below
+its top + safety.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from skyroute.errors import InputFormatError
+from skyroute.geo import Home
+from skyroute.world.world import World
+
+HEADER = "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ"
+_HOME = re.compile(r"^\s*lat0\s+(-?[\d.]+)\s*,\s*lon0\s+(-?[\d.]+)\s*$")
+
+
+def read_colliders(path: str | Path, *, safety: float = 0.0) -> World:
+    """Read a colliders file into a metres-frame World with home at (lon0, lat0)."""
+    path = Path(path)
+    try:
+        lines = path.read_text().splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputFormatError(path, f"cannot read: {exc}") from None
+    m = _HOME.match(lines[0]) if lines else None
+    if m is None:
+        got = lines[0][:60] if lines else "an empty file"
+        raise InputFormatError(path, f"expected 'lat0 <deg>, lon0 <deg>', got {got!r}", line=1)
+    lat0, lon0 = float(m.group(1)), float(m.group(2))
+    if not (-90 <= lat0 <= 90 and -180 <= lon0 <= 180):
+        raise InputFormatError(path, f"home lat0 {lat0}, lon0 {lon0} is not a place", line=1)
+    if len(lines) < 2 or lines[1].replace(" ", "") != HEADER:
+        raise InputFormatError(path, f"expected the header {HEADER!r}", line=2)
+    rows = []
+    for n, line in enumerate(lines[2:], start=3):
+        if not line.strip():
+            continue
+        parts = line.split(",")
+        try:
+            if len(parts) != 6:
+                raise ValueError
+            vals = [float(v) for v in parts]
+        except ValueError:
+            raise InputFormatError(path, f"expected 6 numbers ({HEADER}), got {line[:60]!r}",
+                                   line=n) from None
+        if not all(np.isfinite(vals)) or min(vals[3:]) <= 0:
+            raise InputFormatError(path, "values must be finite and half sizes > 0", line=n)
+        rows.append(vals)
+    if not rows:
+        raise InputFormatError(path, "no boxes after the header", line=3)
+    b = np.array(rows)
+    north, east, up, hn, he, hu = b.T
+    s = float(safety)
+    boxes = shapely.box(east - he - s, north - hn - s, east + he + s, north + hn + s)
+    names = tuple(f"box at line {n}" for n in range(3, 3 + len(rows)))
+    return World(boxes, up - hu - s, up + hu + s, names, None, "metres",
+                 Home(lon0, lat0, 0.0), name=path.name)
