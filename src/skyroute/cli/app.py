@@ -9,12 +9,14 @@ from rich.table import Table
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.errors import run_cli
 from skyroute.cli.plan_cmd import plan_command
+from skyroute.cli.world_cmd import plan_world_command
 from skyroute.world.load import bundled_maps
 from skyroute.world.movingai import read_map
 
 app = typer.Typer(help="skyroute: plan where drones and small robots fly or drive.",
                   no_args_is_help=True, add_completion=False, pretty_exceptions_enable=False)
 app.command("plan")(plan_command)
+app.command("plan-world")(plan_world_command)
 app.add_typer(bench_app, name="bench")
 
 

@@ -1,8 +1,9 @@
 """Probabilistic roadmap (Kavraki et al. 1996): free samples joined to their k nearest
 neighbours when the segment between them is free; k-PRM* (Karaman & Frazzoli 2011) sets
 k = ceil(e (1 + 1/d) log n) with d = 2. Built once per world; each query joins start
-and goal to their nearest visible samples, runs Dijkstra (scipy) on the roadmap, and
-shortcuts the result by the exact segment test.
+and goal to their nearest visible samples, runs Dijkstra (scipy) on the roadmap, then
+shortcuts the result by the exact segment test: greedy vertex shortcuts, random
+sub-segment shortcuts (as OMPL's path simplifier), and greedy again.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ class PRM:
         if samples < 2 or neighbours < 1:
             raise OptionError(f"samples={samples} must be >= 2 and neighbours={neighbours} >= 1")
         rng = np.random.default_rng() if rng is None else rng
+        self.rng = rng
         t0 = time.perf_counter()
         self.world = world.merged()
         xmin, ymin, xmax, ymax = self.world.bounds
@@ -53,7 +55,7 @@ class PRM:
 
     def plan(self, start, goal, *, max_expansions: int | None = None) -> PlanResult:
         """Shortest roadmap path from ``start`` to ``goal``, shortcut; world coordinates."""
-        from skyroute.world_plan import shortcut
+        from skyroute.world_plan import shortcut, smooth
 
         w = self.world
         s = w.check_point(start, "start")
@@ -88,6 +90,9 @@ class PRM:
             path.append(int(pred[path[-1]]))
         raw = pts[path[::-1]]
         short, tests = shortcut(w, raw)
+        short, more = smooth(w, short, self.rng)
+        short, again = shortcut(w, short)
+        tests += more + again
         cost = float(np.hypot(*np.diff(short, axis=0).T).sum())
         return PlanResult(Status.FOUND, short, cost, n, 0, checks + tests,
                           time.perf_counter() - t0, "prm",

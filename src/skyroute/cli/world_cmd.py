@@ -1,0 +1,122 @@
+"""``skyroute plan-world``: plan on a city (colliders.csv) or on zones (GeoJSON)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from skyroute.errors import OptionError
+from skyroute.geo import lonlat_to_enu
+from skyroute.io.files import write_atomic
+from skyroute.io.geojson import dumps
+from skyroute.io.world_out import (
+    path_lonlat,
+    path_north_east,
+    plot_world_path,
+    waypoints,
+    world_path_geojson,
+)
+from skyroute.planner import plan
+from skyroute.world.load import load_world
+from skyroute.world_plan import WORLD_ALGORITHMS
+
+EXIT_NOT_FOUND = 1
+
+
+def parse_pair(text: str, option: str, names: str) -> tuple[float, float]:
+    """``"A,B"`` -> two finite floats."""
+    parts = text.replace(" ", "").split(",")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        a, b = float(parts[0]), float(parts[1])
+        if not (np.isfinite(a) and np.isfinite(b)):
+            raise ValueError
+    except ValueError:
+        raise OptionError(f"{option} {text!r} must be two numbers {names}") from None
+    return a, b
+
+
+def plan_world_command(
+    world_file: Annotated[Path, typer.Argument(metavar="WORLD", help=(
+        "A colliders.csv city (metres around lat0/lon0) or a GeoJSON file of zones."))],
+    start: Annotated[str, typer.Option(help="LON,LAT (lonlat, degrees) or NORTH,EAST "
+                                       "(local).")],
+    goal: Annotated[str, typer.Option(help="Same form as --start.")],
+    frame: Annotated[str, typer.Option(help="lonlat, local or degrees.")] = "lonlat",
+    altitude: Annotated[float | None, typer.Option(
+        help="Keep the obstacles that count at this altitude (m).")] = None,
+    safety: Annotated[float, typer.Option(
+        help="Grow obstacles by this distance (m; degrees in the degrees frame).")] = 0.0,
+    boundary: Annotated[str | None, typer.Option(
+        help="A GeoJSON file or MINLON,MINLAT,MAXLON,MAXLAT to stay strictly inside.")] = None,
+    algorithm: Annotated[str, typer.Option(help="One of: " + ", ".join(WORLD_ALGORITHMS))] =
+        "visibility",
+    resolution: Annotated[float | None, typer.Option(
+        help="Grid algorithms: cell size in world units (default: 1000 cells across).")] =
+        None,
+    samples: Annotated[int, typer.Option(help="PRM samples.")] = 1000,
+    seed: Annotated[int, typer.Option(help="PRM random seed.")] = 0,
+    waypoints_out: Annotated[Path | None, typer.Option(
+        "--waypoints", help="Write [[north, east, altitude, heading], ...] JSON here.")] = None,
+    geojson: Annotated[Path | None, typer.Option(help="Write the path as lon/lat GeoJSON.")] =
+        None,
+    plot: Annotated[Path | None, typer.Option(help="Write a PNG map here.")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Plan between two points of a continuous world.
+
+    Exit code 0 when a path is found, 1 when there is none, 2 for bad input; output
+    files are written only when a path is found.
+    """
+    names = "NORTH,EAST" if frame == "local" else "LON,LAT"
+    a = parse_pair(start, "--start", names)
+    b = parse_pair(goal, "--goal", names)
+    world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
+                       frame=frame)
+    s, t = (_to_world(world, p, frame) for p in (a, b))
+    result = plan(world, s, t, algorithm=algorithm, resolution=resolution, samples=samples,
+                  seed=seed)
+    alt = 0.0 if altitude is None else altitude
+    if result.found:
+        if waypoints_out:
+            write_atomic(waypoints_out, json.dumps(waypoints(world, result.path, alt)))
+        if geojson:
+            write_atomic(geojson, dumps(world_path_geojson(world, result)))
+        if plot:
+            plot_world_path(world, result, s, t, plot)
+    local = (result.path if frame == "degrees" else path_north_east(world, result.path))
+    doc = {"status": result.status.value,
+           "cost": float(result.cost) if result.found else None,
+           "path_local": local.tolist(),
+           "path_lonlat": path_lonlat(world, result.path).tolist(),
+           "seconds": result.seconds, "algorithm": result.algorithm}
+    if as_json:
+        typer.echo(json.dumps(doc))
+    else:
+        table = Table(title=f"{world.name}: {result.algorithm}", show_header=False)
+        unit = "deg" if world.frame == "degrees" else "m"
+        table.add_row("status", result.status.value)
+        if result.found:
+            table.add_row("length", f"{result.cost:.6g} {unit}")
+            table.add_row("waypoints", str(len(result.path)))
+        table.add_row("expanded", f"{result.expanded:,}")
+        table.add_row("segment tests", f"{result.los_checks:,}")
+        table.add_row("time", f"{result.seconds * 1e3:.1f} ms")
+        Console().print(table)
+    if not result.found:
+        raise typer.Exit(EXIT_NOT_FOUND)
+
+
+def _to_world(world, p: tuple[float, float], frame: str) -> np.ndarray:
+    if frame == "degrees":
+        return np.array(p)
+    if frame == "local":
+        return np.array([p[1], p[0]])  # (north, east) -> (x = east, y = north)
+    return lonlat_to_enu(p[0], p[1], 0.0, world.home)[0, :2]

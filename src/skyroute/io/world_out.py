@@ -1,0 +1,98 @@
+"""A path planned on a World as FCND waypoints, lon/lat GeoJSON, and a PNG map."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+
+from skyroute.geo import enu_to_lonlat, heading_of, lonlat_to_enu
+from skyroute.io.files import write_atomic
+from skyroute.search.result import PlanResult
+from skyroute.world.world import World
+
+
+def path_lonlat(world: World, path: np.ndarray) -> np.ndarray:
+    """(K, 2) lon, lat of a world path."""
+    p = np.asarray(path, dtype=float).reshape(-1, 2)
+    if world.frame == "degrees" or len(p) == 0:
+        return p.copy()
+    return enu_to_lonlat(p[:, 0], p[:, 1], 0.0, world.home)[:, :2]
+
+
+def path_north_east(world: World, path: np.ndarray) -> np.ndarray:
+    """(K, 2) north, east metres from home of a world path."""
+    p = np.asarray(path, dtype=float).reshape(-1, 2)
+    if world.frame == "degrees" and len(p):
+        enu = lonlat_to_enu(p[:, 0], p[:, 1], 0.0, world.home)
+        return np.c_[enu[:, 1], enu[:, 0]]
+    return np.c_[p[:, 1], p[:, 0]]
+
+
+def waypoints(world: World, path: np.ndarray, altitude: float) -> list[list[float]]:
+    """[[north, east, altitude, heading], ...] relative to home; heading (radians, 0 north,
+    clockwise) along the track into each point, the first taking the first leg's."""
+    ne = path_north_east(world, path)
+    if len(ne) == 0:
+        return []
+    d = np.diff(ne, axis=0)
+    legs = heading_of(d[:, 1], d[:, 0]) if len(d) else np.zeros(0)
+    headings = np.concatenate([legs[:1] if len(legs) else [0.0], legs])
+    return [[float(n), float(e), float(altitude), float(h)]
+            for (n, e), h in zip(ne, headings, strict=True)]
+
+
+def world_path_geojson(world: World, result: PlanResult) -> dict:
+    """A FeatureCollection with the path as a LineString in lon/lat (RFC 7946)."""
+    props = {k: v for k, v in result.to_dict().items() if k != "path"}
+    props.update(world=world.name, frame=world.frame)
+    return {"type": "FeatureCollection", "features": [{
+        "type": "Feature",
+        "geometry": {"type": "LineString",
+                     "coordinates": path_lonlat(world, result.path).tolist()},
+        "properties": props}]}
+
+
+def plot_world_path(world: World, result: PlanResult, start, goal, path: str | Path, *,
+                    edges: np.ndarray | None = None, dpi: int = 150) -> Path:
+    """Draw obstacles (grey), the boundary (dashed), roadmap edges (thin), the path."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import shapely
+
+    fig, ax = plt.subplots(figsize=(8, 8))
+    for poly in world.obstacles:
+        for part in getattr(poly, "geoms", [poly]):
+            x, y = part.exterior.xy
+            ax.fill(x, y, color="0.45", lw=0)
+            for hole in part.interiors:
+                hx, hy = hole.xy
+                ax.fill(hx, hy, color="white", lw=0)
+    if world.boundary is not None:
+        x, y = shapely.Polygon(world.boundary).exterior.xy
+        ax.plot(x, y, "--", color="tab:orange", lw=1.2, label="boundary")
+    if edges is not None and len(edges):
+        from matplotlib.collections import LineCollection
+
+        ax.add_collection(LineCollection(edges, colors="tab:cyan", linewidths=0.3, alpha=0.5))
+    if result.found:
+        p = np.asarray(result.path)
+        ax.plot(p[:, 0], p[:, 1], "-o", color="tab:blue", lw=1.8, ms=3, label="path")
+    ax.plot(*start, "o", color="tab:green", ms=9, label="start")
+    ax.plot(*goal, "*", color="tab:red", ms=13, label="goal")
+    unit = "deg" if world.frame == "degrees" else "m"
+    cost = f"{result.cost:.6g} {unit}" if result.found else result.status.value
+    ax.set_title(f"{world.name}: {result.algorithm}, {cost}", fontsize=10)
+    ax.set_xlabel("longitude" if world.frame == "degrees" else "east (m)")
+    ax.set_ylabel("latitude" if world.frame == "degrees" else "north (m)")
+    ax.set_aspect("equal" if world.frame == "metres" else
+                  1 / np.cos(np.radians(np.mean(ax.get_ylim()))))
+    ax.legend(loc="best", fontsize=8, framealpha=0.9)
+    buf = io.BytesIO()
+    fig.tight_layout()
+    fig.savefig(buf, format="png", dpi=dpi)
+    plt.close(fig)
+    return write_atomic(path, buf.getvalue())
