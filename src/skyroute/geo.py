@@ -32,14 +32,18 @@ class Home:
     lat: float
     alt: float = 0.0
 
+    def __post_init__(self) -> None:
+        for name in ("lon", "lat", "alt"):
+            object.__setattr__(self, name, float(getattr(self, name)))
+
 
 @lru_cache(maxsize=32)
 def _transformer(home: Home):
     from pyproj import Transformer
 
     pipeline = ("+proj=pipeline +step +proj=cart +ellps=WGS84 "
-                f"+step +proj=topocentric +ellps=WGS84 +lon_0={home.lon!r} "
-                f"+lat_0={home.lat!r} +h_0={home.alt!r}")
+                f"+step +proj=topocentric +ellps=WGS84 +lon_0={home.lon:.12f} "
+                f"+lat_0={home.lat:.12f} +h_0={home.alt:.6f}")
     return Transformer.from_pipeline(pipeline)
 
 

@@ -38,6 +38,8 @@ def plan_world(world: World, start, goal, *, algorithm: str = "visibility",
                **grid_kwargs) -> PlanResult:
     """See :func:`skyroute.plan`; ``start`` and ``goal`` are world (x, y) points."""
     check_choice("algorithm", algorithm, WORLD_ALGORITHMS)
+    world.check_point(start, "start")  # errors name the obstacles as loaded
+    world.check_point(goal, "goal")
     if algorithm == "visibility":
         from skyroute.roadmap.visibility import VisibilityGraph
 

@@ -80,9 +80,14 @@ class World:
         parts = np.array(list(getattr(union, "geoms", [union])), dtype=object)
         parts = parts[shapely.get_type_id(parts) == 3]  # polygons only
         n = len(parts)
-        return World(parts, np.full(n, -np.inf), np.full(n, np.inf),
-                     tuple(f"block {i}" for i in range(n)), self.boundary, self.frame,
-                     self.home, self.name)
+        ip, io = self.tree.query(parts, predicate="intersects")
+        names = []
+        for i in range(n):
+            members = np.sort(io[ip == i])
+            first = self.names[members[0]] if len(members) else f"block {i}"
+            names.append(first if len(members) <= 1 else f"{first} and {len(members) - 1} more")
+        return World(parts, np.full(n, -np.inf), np.full(n, np.inf), tuple(names),
+                     self.boundary, self.frame, self.home, self.name)
 
     @cached_property
     def _prepared_boundary(self):

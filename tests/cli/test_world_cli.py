@@ -1,0 +1,66 @@
+"""``skyroute plan-world`` end to end: outputs and one-line errors."""
+
+import json
+
+import pytest
+
+from tests.cli.test_cli import run
+from tests.conftest import SHARED
+
+FCND = str(SHARED / "fcnd" / "colliders.csv")
+ZONES = str(SHARED / "ilp2021" / "website" / "buildings" / "no-fly-zones.geojson")
+BOX = str(SHARED / "ilp2021" / "testing" / "confinement-zone.geojson")
+
+
+def test_fcnd_json_waypoints_geojson_plot(monkeypatch, capsys, tmp_path):
+    wp, gj, png = tmp_path / "wp.json", tmp_path / "p.geojson", tmp_path / "p.png"
+    code, out, err = run(monkeypatch, capsys, "plan-world", FCND, "--start=-122.397450,37.792480",
+                         "--goal=-122.396428,37.795232", "--altitude", "5", "--safety", "5",
+                         "--json", "--waypoints", str(wp), "--geojson", str(gj), "--plot",
+                         str(png))
+    assert code == 0, err
+    doc = json.loads(out)
+    assert list(doc) == ["status", "cost", "path_local", "path_lonlat", "seconds", "algorithm"]
+    assert doc["status"] == "found" and doc["path_local"][0] == pytest.approx([0, 0], abs=1e-6)
+    assert doc["path_lonlat"][-1] == pytest.approx([-122.396428, 37.795232], abs=1e-9)
+    waypoints = json.loads(wp.read_text())
+    assert waypoints[0][:3] == pytest.approx([0, 0, 5], abs=1e-6) and len(waypoints[0]) == 4
+    assert json.loads(gj.read_text())["features"][0]["geometry"]["coordinates"][0] == \
+        pytest.approx([-122.397450, 37.792480], abs=1e-9)
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_local_frame_and_degrees_frame(monkeypatch, capsys):
+    code, out, _ = run(monkeypatch, capsys, "plan-world", FCND, "--frame", "local",
+                       "--start", "0,0", "--goal", "305.45,90.01", "--altitude", "5",
+                       "--safety", "5", "--json")
+    assert code == 0 and json.loads(out)["path_local"][-1] == pytest.approx([305.45, 90.01])
+    code, out, _ = run(monkeypatch, capsys, "plan-world", ZONES, "--frame", "degrees",
+                       "--boundary", BOX, "--start=-3.186874,55.944494",
+                       "--goal=-3.1913,55.9455", "--json")
+    doc = json.loads(out)
+    assert code == 0 and doc["path_local"] == doc["path_lonlat"] and doc["cost"] < 0.01
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--start=-3.1950,55.944", "--goal=-3.1913,55.9455"], "start (-3.195000, 55.944000) lies "
+     "outside the map"),
+    (["--start=-3.1885,55.9450", "--goal=-3.1913,55.9455"], "lies inside obstacle"),
+    (["--start=abc", "--goal=-3.1913,55.9455"], "--start 'abc' must be two numbers LON,LAT"),
+    (["--start=-3.186874,55.944494", "--goal=-3.1913,55.9455", "--algorithm", "rrt"],
+     "algorithm='rrt' is not valid"),
+])
+def test_bad_queries_are_one_line_exit_2(monkeypatch, capsys, tmp_path, args, words):
+    png = tmp_path / "p.png"
+    code, out, err = run(monkeypatch, capsys, "plan-world", ZONES, "--frame", "degrees",
+                         "--boundary", BOX, *args, "--plot", str(png))
+    assert code == 2 and err.count("\n") == 1 and words in err and not png.exists()
+    assert out == ""
+
+
+def test_missing_home_line_is_one_line_exit_2(monkeypatch, capsys, tmp_path):
+    bad = tmp_path / "c.csv"
+    bad.write_text("posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n1,2,3,4,5,6\n")
+    code, _, err = run(monkeypatch, capsys, "plan-world", str(bad), "--start=0,0",
+                       "--goal=1,1")
+    assert code == 2 and f"{bad}:1: expected 'lat0 <deg>, lon0 <deg>'" in err

@@ -1,0 +1,120 @@
+"""Visibility graph: closed-form lengths, an independent brute force, exact freedom."""
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
+
+import skyroute
+from skyroute import QueryError, Status, World
+
+
+def rect_world(boxes, boundary=None, frame="metres"):
+    polys = shapely.box(*np.asarray(boxes, dtype=float).T)
+    n = len(polys)
+    return World(polys, np.full(n, -np.inf), np.full(n, np.inf), (), boundary, frame)
+
+
+def brute_force(boxes, s, t):
+    """All vertices of the union, every pair tested with shapely's DE-9IM directly,
+    Dijkstra by scipy: nothing of skyroute's geometry code."""
+    union = shapely.unary_union(shapely.box(*np.asarray(boxes, dtype=float).T))
+    verts = [np.asarray(r.coords)[:-1] for p in getattr(union, "geoms", [union])
+             for r in (p.exterior, *p.interiors)]
+    pts = np.vstack([s, t, *verts])
+    n = len(pts)
+    rows, cols, w = [], [], []
+    for i in range(n):
+        for j in range(i + 1, n):
+            line = shapely.LineString([pts[i], pts[j]])
+            if not union.relate_pattern(line, "T********"):
+                rows.append(i)
+                cols.append(j)
+                w.append(math.dist(pts[i], pts[j]) + 1e-300)
+    g = coo_matrix((w, (rows, cols)), shape=(n, n)).tocsr()
+    return dijkstra(g, directed=False, indices=0)[1]
+
+
+def assert_free(boxes, path):
+    union = shapely.unary_union(shapely.box(*np.asarray(boxes, dtype=float).T))
+    for a, b in itertools.pairwise(path):
+        assert not union.relate_pattern(shapely.LineString([a, b]), "T********"), (a, b)
+
+
+@pytest.mark.parametrize("boxes, s, t, expected", [
+    ([(1, 1, 3, 3)], (0, 2), (4, 2), 2 + 2 * math.sqrt(2)),                   # one square
+    ([(1, -1, 3, 1), (5, -1, 7, 1)], (0, 0), (8, 0), 6 + 2 * math.sqrt(2)),   # two squares
+    ([(2, -5, 3, -0.5), (2, 0.5, 3, 5)], (0, 3), (5, -3),                    # a slit
+     2 * math.hypot(2, 2.5) + math.sqrt(2)),
+    ([(1, 1, 3, 3)], (0, 0), (4, 0), 4.0),                  # along an edge: touching is free
+])
+def test_closed_form_lengths(boxes, s, t, expected):
+    r = skyroute.plan(rect_world(boxes), s, t)
+    assert r.status is Status.FOUND
+    assert r.cost == pytest.approx(expected, rel=1e-12)
+    assert_free(boxes, r.path)
+    np.testing.assert_allclose(r.path[[0, -1]], [s, t])
+
+
+@st.composite
+def rect_worlds(draw):
+    k = draw(st.integers(1, 7))
+    boxes = []
+    for _ in range(k):
+        x, y = draw(st.integers(0, 18)), draw(st.integers(0, 18))
+        w, h = draw(st.integers(1, 6)), draw(st.integers(1, 6))
+        boxes.append((x, y, x + w, y + h))
+    coords = st.floats(-2, 26, allow_nan=False).map(lambda v: round(v, 3))
+    s = (draw(coords), draw(coords))
+    t = (draw(coords), draw(coords))
+    return boxes, s, t
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@given(rect_worlds())
+def test_matches_brute_force_on_random_rectangle_worlds(case):
+    boxes, s, t = case
+    world = rect_world(boxes)
+    union = shapely.unary_union(world.obstacles)
+    if union.contains(shapely.Point(s)) or union.contains(shapely.Point(t)):
+        with pytest.raises(QueryError):
+            skyroute.plan(world, s, t)
+        return
+    expected = brute_force(boxes, s, t)
+    r = skyroute.plan(world, s, t)
+    if np.isinf(expected):
+        assert r.status is Status.NO_PATH
+    else:
+        assert r.found and r.cost == pytest.approx(expected, rel=1e-9, abs=1e-9)
+        assert_free(boxes, r.path)
+
+
+def test_boundary_is_strict_and_corners_outside_are_ignored():
+    boundary = shapely.box(0, 0, 10, 10)
+    world = rect_world([(4, -5, 6, 9)], boundary)  # a wall from below, gap at the top
+    r = skyroute.plan(world, (2, 5), (8, 5))
+    assert r.found and r.cost == pytest.approx(2 * math.hypot(2, 4) + 2, rel=1e-12)
+    closed = rect_world([(4, -5, 6, 10)], boundary)  # the wall reaches the boundary
+    assert skyroute.plan(closed, (2, 5), (8, 5)).status is Status.NO_PATH
+    with pytest.raises(QueryError, match=r"outside the map \(x in \(0, 10\)"):
+        skyroute.plan(world, (10, 5), (8, 5))  # on the boundary counts as outside
+
+
+def test_start_inside_an_obstacle_names_it_and_a_free_point():
+    world = rect_world([(1, 1, 3, 3)])
+    with pytest.raises(QueryError, match=r"start \(2.00, 1.50\) lies inside obstacle "
+                       r"'obstacle 0'; nearest free point \(2.00, 1.00\)"):
+        skyroute.plan(world, (2, 1.5), (5, 5))
+
+
+def test_repeated_queries_reuse_the_graph():
+    world = rect_world([(1, 1, 3, 3), (5, 0, 6, 8)])
+    first = skyroute.plan(world, (0, 0), (8, 4))
+    again = skyroute.plan(world, (0, 0), (8, 4))
+    assert first.cost == again.cost and again.los_checks <= first.los_checks

@@ -1,0 +1,144 @@
+"""Worlds: loaders (colliders.csv, GeoJSON), exact queries, the FCND city, bad input."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+import shapely
+
+import skyroute
+from skyroute import InputFormatError, OptionError, QueryError
+from skyroute.geo import lonlat_to_enu
+from tests.conftest import SHARED
+
+FCND = SHARED / "fcnd" / "colliders.csv"
+ILP = SHARED / "ilp2021"
+needs_fcnd = pytest.mark.skipif(not FCND.exists(), reason="FCND data not beside the repo")
+
+
+def write(path, text):
+    path.write_text(text)
+    return path
+
+
+COLLIDERS = ("lat0 37.792480, lon0 -122.397450\nposX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n"
+             "10,0,5,2,3,5\n-20,20,40,5,5,40\n")
+
+
+def test_colliders_boxes_heights_and_safety(tmp_path):
+    w = skyroute.load_world(write(tmp_path / "c.csv", COLLIDERS), safety=1.0)
+    assert len(w.obstacles) == 2 and w.home.lat == 37.79248 and w.home.lon == -122.39745
+    # box 0: north 10 +- 2, east 0 +- 3, grown by 1: x = east in [-4, 4], y = north in [7, 13]
+    assert w.obstacles[0].bounds == (-4.0, 7.0, 4.0, 13.0)
+    np.testing.assert_allclose(w.ceilings, [11.0, 81.0])
+    assert len(skyroute.load_world(tmp_path / "c.csv", safety=1.0, altitude=20).obstacles) == 1
+    assert len(skyroute.load_world(tmp_path / "c.csv", altitude=10).obstacles) == 1  # top 10
+
+
+@pytest.mark.parametrize("text, line, words", [
+    ("lat0 x\nposX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n1,2,3,4,5,6\n", 1, "lat0"),
+    ("lat0 37.0, lon0 -122.0\nposX,posY\n1,2,3,4,5,6\n", 2, "header"),
+    ("lat0 37.0, lon0 -122.0\nposX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n1,2,3,4,5\n", 3,
+     "expected 6 numbers"),
+    ("lat0 37.0, lon0 -122.0\nposX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n1,2,3,4,5,6\n"
+     "1,2,x,4,5,6\n", 4, "expected 6 numbers"),
+])
+def test_bad_colliders_name_the_line(tmp_path, text, line, words):
+    p = write(tmp_path / "bad.csv", text)
+    with pytest.raises(InputFormatError) as err:
+        skyroute.load_world(p)
+    assert err.value.line == line and words in str(err.value)
+
+
+def fc(*features):
+    return json.dumps({"type": "FeatureCollection", "features": list(features)})
+
+
+def feature(geom, **props):
+    return {"type": "Feature", "geometry": geom, "properties": props}
+
+
+SQUARE = {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]}
+
+
+@pytest.mark.parametrize("text, words", [
+    (fc(feature({"type": "Point", "coordinates": [0, 0]}, name="pin")),
+     "feature 0 ('pin') is a Point; only Polygon and MultiPolygon"),
+    (fc(feature({"type": "Polygon", "coordinates": [[[0, 0], [2, 2], [2, 0], [0, 2], [0, 0]]]},
+                name="bow")), "feature 0 ('bow') is not a valid polygon: Self-intersection"),
+    ('{"type": "Feature"}', "expected a GeoJSON FeatureCollection"),
+    ("{not json", "not JSON"),
+])
+def test_bad_geojson_names_the_feature(tmp_path, text, words):
+    p = write(tmp_path / "z.geojson", text)
+    with pytest.raises(InputFormatError, match=None) as err:
+        skyroute.load_world(p, frame="degrees")
+    assert words in str(err.value) and str(p) in str(err.value)
+
+
+def test_geojson_boundary_from_feature_bbox_or_file(tmp_path):
+    box = {"type": "Polygon", "coordinates": [[[-1, -1], [3, -1], [3, 3], [-1, 3], [-1, -1]]]}
+    p = write(tmp_path / "z.geojson", fc(feature(SQUARE, name="zone"),
+                                         feature(box, name="Drone confinement zone")))
+    w = skyroute.load_world(p, frame="degrees")
+    assert len(w.obstacles) == 1 and w.boundary.bounds == (-1, -1, 3, 3)
+    w2 = skyroute.load_world(p, frame="degrees", boundary="-2,-2,4,4")
+    assert w2.boundary.bounds == (-2, -2, 4, 4)
+    with pytest.raises(OptionError, match="min must be below max"):
+        skyroute.load_world(p, frame="degrees", boundary="4,4,-2,-2")
+
+
+def test_exact_point_and_segment_queries():
+    w = skyroute.World(shapely.box(np.array([0.0]), 0, 1, 1), [-np.inf], [np.inf], ("sq",),
+                       shapely.box(-5, -5, 5, 5))
+    assert w.is_free([[1, 0.5], [0.5, 0.5], [5, 0], [2, 2]]).tolist() == [True, False, False,
+                                                                          True]
+    assert w.segment_free((-1, 1), (2, 1))        # along the top edge: touching
+    assert not w.segment_free((-1, 0.5), (2, 0.5))  # through the interior
+    assert not w.segment_free((-1, -1), (6, -1))    # leaves the boundary
+    assert w.segment_free((-1, 0), (0, 1)) and w.clearance([[3, 0.5]])[0] == 2.0
+
+
+def test_ilp_zones_in_degrees_and_metres():
+    w = skyroute.load_world(ILP / "website/buildings/no-fly-zones.geojson", frame="degrees",
+                            boundary=ILP / "testing/confinement-zone.geojson")
+    assert len(w.obstacles) == 5 and w.boundary.bounds == (-3.192473, 55.942617, -3.184319,
+                                                           55.946233)
+    at = (-3.186874, 55.944494)  # Appleton Tower
+    r = skyroute.plan(w, at, (-3.1913, 55.9455))
+    assert r.found and all(w.segment_free(a, b) for a, b in zip(r.path[:-1], r.path[1:],
+                                                                strict=True))
+    m = skyroute.load_world(ILP / "website/buildings/no-fly-zones.geojson", frame="lonlat")
+    # the zones span 0.00326 degrees of longitude: about 203 m at 55.94 N
+    assert m.frame == "metres" and 200 < m.bounds[2] - m.bounds[0] < 206
+
+
+@needs_fcnd
+def test_fcnd_home_to_goal_is_free_and_theta_within_one_percent():
+    w = skyroute.load_world(FCND, altitude=5, safety=5)
+    goal = lonlat_to_enu(-122.396428, 37.795232, 0.0, w.home)[0, :2]
+    exact = skyroute.plan(w, (0, 0), goal)
+    assert exact.found
+    for a, b in zip(exact.path[:-1], exact.path[1:], strict=True):
+        assert w.segment_free(a, b)
+    theta = skyroute.plan(w, (0, 0), goal, algorithm="theta", resolution=1.0)
+    assert theta.found and exact.cost <= theta.cost <= 1.01 * exact.cost
+    for a, b in zip(theta.path[:-1], theta.path[1:], strict=True):
+        assert w.segment_free(a, b)
+    # straight-line distance is a lower bound, the rasterised A* path an upper one
+    assert math.dist((0, 0), goal) <= exact.cost
+
+
+@needs_fcnd
+def test_fcnd_prm_and_grid_paths_are_free():
+    w = skyroute.load_world(FCND, altitude=5, safety=5)
+    goal = lonlat_to_enu(-122.396428, 37.795232, 0.0, w.home)[0, :2]
+    exact = skyroute.plan(w, (0, 0), goal).cost
+    for algorithm, kw in (("prm", {"samples": 1500, "seed": 3}), ("jps", {"resolution": 2.0})):
+        r = skyroute.plan(w, (0, 0), goal, algorithm=algorithm, **kw)
+        assert r.found and r.cost >= exact - 1e-9
+        for a, b in zip(r.path[:-1], r.path[1:], strict=True):
+            assert w.segment_free(a, b)
+    with pytest.raises(QueryError, match="lies inside obstacle 'box at line"):
+        skyroute.plan(w, (-310.2, -439.2)[::-1], goal)
