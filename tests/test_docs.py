@@ -33,15 +33,18 @@ def readme_cli_examples() -> list[str]:
             if line.strip().startswith("skyroute ")]
 
 
-@pytest.mark.parametrize("command", readme_cli_examples())
-def test_readme_cli_examples_run(command, monkeypatch, capsys, tmp_path):
+def test_readme_cli_examples_run_in_order(monkeypatch, capsys, tmp_path):
     import shlex
     import sys
 
     from skyroute.cli.app import main
 
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(sys, "argv", shlex.split(command))
-    with pytest.raises(SystemExit) as exit_info:
-        main()
-    assert exit_info.value.code == 0, capsys.readouterr().err
+    commands = readme_cli_examples()
+    assert len(commands) >= 8
+    monkeypatch.chdir(tmp_path)  # one folder: later examples read earlier outputs
+    for command in commands:
+        monkeypatch.setattr(sys, "argv", shlex.split(command))
+        with pytest.raises(SystemExit) as exit_info:
+            main()
+        assert exit_info.value.code == 0, (command, capsys.readouterr().err)
+    assert (tmp_path / "city.png").exists() and (tmp_path / "city-waypoints.json").exists()

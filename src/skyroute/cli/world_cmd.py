@@ -120,3 +120,17 @@ def _to_world(world, p: tuple[float, float], frame: str) -> np.ndarray:
     if frame == "local":
         return np.array([p[1], p[0]])  # (north, east) -> (x = east, y = north)
     return lonlat_to_enu(p[0], p[1], 0.0, world.home)[0, :2]
+
+
+def synth_city_command(
+    out: Annotated[Path, typer.Argument(help="The colliders.csv file to write.")],
+    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    blocks: Annotated[int, typer.Option(help="Blocks along each side.")] = 6,
+) -> None:
+    """Write a synthetic city (random box buildings in street blocks) as colliders.csv."""
+    from skyroute.world.synth import synth_city
+
+    if blocks < 1:
+        raise OptionError(f"--blocks {blocks} must be >= 1")
+    write_atomic(out, synth_city(np.random.default_rng(seed), blocks=blocks))
+    typer.echo(f"wrote {out}: {blocks}x{blocks} blocks, home (0, 0) on a street crossing")

@@ -1,0 +1,167 @@
+"""``skyroute bench world``: continuous planners against OMPL on the same worlds.
+
+Worlds: seeded random rectangle worlds and, when given, a colliders.csv city at an
+altitude. Each query runs skyroute's visibility graph (first query on a fresh graph,
+build included, then the same query again), PRM and Theta* on a raster, and OMPL's
+PRM, PRM*, RRT*, RRTConnect and InformedRRT* (PyPI ``ompl``, a bench extra) with a time
+budget, each in a fresh SimpleSetup. OMPL checks states with a Python callback on the
+prepared union of the obstacles and checks motions at its default resolution; every
+returned path, ours and OMPL's, is re-checked with the exact segment test.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+import shapely
+
+from skyroute.world.world import World
+
+OMPL_PLANNERS = ("PRM", "PRMstar", "RRTstar", "RRTConnect", "InformedRRTstar")
+
+
+def random_rect_world(seed: int, *, count: int = 20, size: float = 100.0) -> World:
+    """``count`` axis-aligned rectangles (sides 5-20% of ``size``) in a square boundary."""
+    rng = np.random.default_rng(seed)
+    lo = rng.uniform(0, size * 0.9, size=(count, 2))
+    wh = rng.uniform(size * 0.05, size * 0.2, size=(count, 2))
+    hi = np.minimum(lo + wh, size)
+    boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
+    return World(boxes, np.full(count, -np.inf), np.full(count, np.inf), (),
+                 shapely.box(0, 0, size, size), "metres", name=f"random-rects-{seed}")
+
+
+def free_pair(world: World, rng: np.random.Generator, min_dist: float) -> tuple:
+    """Two free points at least ``min_dist`` apart with a path between them."""
+    from skyroute.planner import plan
+
+    xmin, ymin, xmax, ymax = world.bounds
+    for _ in range(1000):
+        p = rng.uniform([xmin, ymin], [xmax, ymax], size=(2, 2))
+        if world.is_free(p).all() and math.dist(*p) >= min_dist and \
+                plan(world, p[0], p[1]).found:
+            return p[0], p[1]
+    raise RuntimeError(f"no connected free pair found in {world.name}")
+
+
+def path_exactly_free(world: World, path: np.ndarray) -> bool:
+    """Every segment of ``path`` free under the exact test."""
+    p = np.asarray(path)
+    return bool(len(p) >= 2 and world.segments_free(p[:-1], p[1:]).all())
+
+
+def ompl_available() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("ompl") is not None
+
+
+def run_ompl(world: World, start, goal, planner: str, budget: float) -> dict:
+    """One OMPL solve: raw and simplified lengths, time, exact validity."""
+    from ompl import base as ob
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    ou.setLogLevel(ou.LOG_NONE)
+    union = shapely.unary_union(world.obstacles)
+    shapely.prepare(union)
+    inside = world.boundary
+    if inside is not None:
+        inside = shapely.Polygon(inside)
+        shapely.prepare(inside)
+    xmin, ymin, xmax, ymax = world.bounds
+    space = ob.RealVectorStateSpace(2)
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0, xmin)
+    bounds.setLow(1, ymin)
+    bounds.setHigh(0, xmax)
+    bounds.setHigh(1, ymax)
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+
+    def valid(state) -> bool:
+        x, y = state[0], state[1]
+        if inside is not None and not shapely.contains_xy(inside, x, y):
+            return False
+        return not shapely.contains_xy(union, x, y)
+
+    ss.setStateValidityChecker(valid)
+    s, g = space.allocState(), space.allocState()
+    s[0], s[1] = float(start[0]), float(start[1])
+    g[0], g[1] = float(goal[0]), float(goal[1])
+    ss.setStartAndGoalStates(s, g)
+    si = ss.getSpaceInformation()
+    ss.setPlanner(getattr(og, planner)(si))
+    t0 = time.perf_counter()
+    solved = ss.solve(budget)
+    seconds = time.perf_counter() - t0
+    out = {"runner": f"ompl {planner}", "seconds": seconds, "exact": str(solved) ==
+           "Exact solution"}
+    if not out["exact"]:
+        return {**out, "raw": None, "simplified": None, "valid": None}
+    path = ss.getSolutionPath()
+    raw = path.length()
+    raw_pts = np.array([(path.getState(i)[0], path.getState(i)[1])
+                        for i in range(path.getStateCount())])
+    ss.simplifySolution()
+    path = ss.getSolutionPath()
+    pts = np.array([(path.getState(i)[0], path.getState(i)[1])
+                    for i in range(path.getStateCount())])
+    return {**out, "raw": raw, "simplified": path.length(),
+            "valid": path_exactly_free(world, pts),
+            "raw_valid": path_exactly_free(world, raw_pts)}
+
+
+def run_ours(world: World, start, goal) -> list[dict]:
+    """skyroute's planners on one query (fresh caches: the build is timed)."""
+    from skyroute.planner import plan
+
+    fresh = World(world.obstacles, world.floors, world.ceilings, world.names,
+                  world.boundary, world.frame, world.home, world.name)
+    rows = []
+    t0 = time.perf_counter()
+    r = plan(fresh, start, goal)
+    rows.append({"runner": "visibility (1st, with build)",
+                 "seconds": time.perf_counter() - t0, "length": r.cost,
+                 "valid": path_exactly_free(world, r.path)})
+    t0 = time.perf_counter()
+    r = plan(fresh, start, goal)
+    rows.append({"runner": "visibility (again)",
+                 "seconds": time.perf_counter() - t0, "length": r.cost,
+                 "valid": path_exactly_free(world, r.path)})
+    for label, kw in (("prm, shortcut", {"algorithm": "prm"}),
+                      ("theta* on raster", {"algorithm": "theta"})):
+        t0 = time.perf_counter()
+        r = plan(fresh, start, goal, **kw)
+        rows.append({"runner": label, "seconds": time.perf_counter() - t0,
+                     "length": r.cost if r.found else None,
+                     "valid": path_exactly_free(world, r.path) if r.found else None})
+    return rows
+
+
+def bench_query(world: World, start, goal, *, budget: float, planners: tuple,
+                rrt_budgets: tuple, on_step: Callable[[], None] | None = None) -> dict:
+    """All runners on one query; lengths relative to the visibility optimum."""
+    rows = run_ours(world, start, goal)
+    optimum = rows[1]["length"]
+    if ompl_available():
+        for planner in planners:
+            rows.append(run_ompl(world, start, goal, planner, budget))
+            if on_step:
+                on_step()
+        reached = None
+        for b in rrt_budgets:
+            r = run_ompl(world, start, goal, "RRTstar", b)
+            if r["raw"] is not None and r["raw"] <= 1.01 * optimum:
+                reached = b
+                break
+    for row in rows:
+        for k in ("length", "raw", "simplified"):
+            if row.get(k) is not None:
+                row[k + "_ratio"] = row[k] / optimum
+    return {"world": world.name, "start": list(map(float, start)),
+            "goal": list(map(float, goal)), "optimum": optimum, "rows": rows,
+            "rrtstar_budget_within_1pct": reached if ompl_available() else None}

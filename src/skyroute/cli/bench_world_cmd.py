@@ -1,0 +1,89 @@
+"""``skyroute bench world``: skyroute's continuous planners against OMPL."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import Progress
+from rich.table import Table
+
+from skyroute.bench.world import (
+    OMPL_PLANNERS,
+    bench_query,
+    free_pair,
+    ompl_available,
+    random_rect_world,
+)
+from skyroute.cli.bench_cmd import bench_app
+from skyroute.cli.parse import parse_list
+from skyroute.errors import check_choice
+from skyroute.io.files import write_atomic
+from skyroute.world.load import load_world
+
+
+@bench_app.command("world")
+def bench_world(
+    worlds: Annotated[int, typer.Option(help="Random 20-rectangle worlds.")] = 5,
+    seed: Annotated[int, typer.Option(help="Seed of the first world and its query.")] = 0,
+    city: Annotated[Path | None, typer.Option(
+        help="Also a colliders.csv city (at --altitude, with --safety).")] = None,
+    altitude: Annotated[float, typer.Option(help="City altitude (m).")] = 5.0,
+    safety: Annotated[float, typer.Option(help="City safety margin (m).")] = 5.0,
+    budget: Annotated[float, typer.Option(help="Seconds per OMPL solve.")] = 1.0,
+    planners: Annotated[str, typer.Option(help="OMPL planners, comma-separated.")] =
+        ",".join(OMPL_PLANNERS),
+    json_out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] =
+        None,
+) -> None:
+    """Path length relative to the visibility-graph optimum, and time, against OMPL."""
+    chosen = tuple(parse_list(planners))
+    for p in chosen:
+        check_choice("planner", p, OMPL_PLANNERS)
+    console = Console(stderr=True)
+    if not ompl_available():
+        console.print("[yellow]OMPL is not installed; skyroute only "
+                      "(pip install 'skyroute[bench]')[/yellow]")
+    cases = [random_rect_world(seed + i) for i in range(worlds)]
+    if city is not None:
+        cases.append(load_world(city, altitude=altitude, safety=safety))
+    reports = []
+    with Progress(console=console, transient=True) as progress:
+        task = progress.add_task("worlds", total=len(cases))
+        for i, world in enumerate(cases):
+            rng = np.random.default_rng(seed + i)
+            size = max(world.bounds[2] - world.bounds[0], world.bounds[3] - world.bounds[1])
+            s, g = free_pair(world, rng, 0.6 * size)
+            reports.append(bench_query(world, s, g, budget=budget, planners=chosen,
+                                       rrt_budgets=(0.1, 0.3, 1.0, 3.0)))
+            progress.advance(task)
+    out = Console()
+    for rep in reports:
+        t = Table(title=f"{rep['world']}: optimum {rep['optimum']:.3f}; RRT* within 1% "
+                        f"after {rep['rrtstar_budget_within_1pct'] or 'more than 3'} s")
+        for col in ("runner", "seconds", "length / optimum", "simplified / optimum",
+                    "exactly free"):
+            t.add_column(col, justify="left" if col == "runner" else "right")
+        for row in rep["rows"]:
+            ratio = row.get("length_ratio", row.get("raw_ratio"))
+            t.add_row(row["runner"], f"{row['seconds']:.4f}",
+                      "-" if ratio is None else f"{ratio:.4f}",
+                      "-" if row.get("simplified_ratio") is None else
+                      f"{row['simplified_ratio']:.4f}",
+                      {True: "yes", False: "no", None: "-"}[row.get("valid")])
+        out.print(t)
+    if json_out:
+        write_atomic(json_out, json.dumps({"budget": budget, "seed": seed, "worlds": reports},
+                                          indent=1, default=float))
+    if "ompl" in sys.modules:
+        # OMPL's nanobind bindings print a reference-leak report at interpreter exit;
+        # everything is written and flushed, so leave without running finalisers.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(0)

@@ -1,0 +1,43 @@
+"""The synthetic city generator and the OMPL world benchmark."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+
+import skyroute
+from skyroute.bench.world import ompl_available, random_rect_world
+from skyroute.world.synth import synth_city
+
+
+def test_synth_city_is_seeded_and_home_is_free(tmp_path):
+    a = synth_city(np.random.default_rng(3))
+    assert a == synth_city(np.random.default_rng(3)) != synth_city(np.random.default_rng(4))
+    p = tmp_path / "c.csv"
+    p.write_text(a)
+    world = skyroute.load_world(p, altitude=10, safety=2)
+    assert world.is_free([[0, 0]])[0] and len(world.obstacles) > 36
+    r = skyroute.plan(world, (0, 0), (-180, 120))
+    assert r.found and world.segments_free(r.path[:-1], r.path[1:]).all()
+
+
+def test_random_rect_worlds_are_seeded():
+    a, b = random_rect_world(5), random_rect_world(5)
+    assert len(a.obstacles) == 20
+    assert all(x.equals(y) for x, y in zip(a.obstacles, b.obstacles, strict=True))
+
+
+def test_bench_world_runs_end_to_end(tmp_path):
+    out = tmp_path / "bw.json"
+    p = subprocess.run([sys.executable, "-m", "skyroute", "bench", "world", "--worlds", "1",
+                        "--budget", "0.05", "--planners", "RRTConnect,PRM", "--json",
+                        str(out)], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    doc = json.loads(out.read_text())
+    rows = {r["runner"]: r for r in doc["worlds"][0]["rows"]}
+    assert rows["visibility (again)"]["length_ratio"] == 1.0
+    assert rows["prm, shortcut"]["length_ratio"] >= 1.0 - 1e-9
+    if ompl_available():
+        assert rows["ompl RRTConnect"]["exact"] and rows["ompl RRTConnect"]["raw_ratio"] >= 1.0
+    assert "leaked" not in p.stderr
