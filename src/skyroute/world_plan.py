@@ -149,3 +149,19 @@ def smooth(world: World, pts: np.ndarray, rng: np.random.Generator,
             pts = np.vstack([pts[: i + 1], pa, pb, pts[j + 1:]])
     keep = np.r_[True, np.any(np.diff(pts, axis=0) != 0, axis=1)]
     return pts[keep], tests
+
+
+def roadmap_edges(world: World, algorithm: str, *, samples: int = 1000,
+                  neighbours: int = 10, prm_star: bool = False, seed: int = 0):
+    """(E, 2, 2) segments of the roadmap a planner built on ``world`` (for plots): the
+    edges a visibility graph has checked and found free, or a PRM's edges; None else."""
+    per_world = _CACHE.get(world, {})
+    if algorithm == "visibility" and ("visibility",) in per_world:
+        g = per_world[("visibility",)]
+        pairs = np.array([k for k, ok in g._verdicts.items() if ok], dtype=np.int64)
+        return g.corners[pairs] if len(pairs) else None
+    key = ("prm", samples, neighbours, prm_star, seed)
+    if algorithm == "prm" and key in per_world:
+        rm = per_world[key]
+        return rm.points[rm.edges]
+    return None

@@ -43,7 +43,7 @@ def test_local_frame_and_degrees_frame(monkeypatch, capsys):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--start=-3.1950,55.944", "--goal=-3.1913,55.9455"], "start (-3.195000, 55.944000) lies "
+    (["--start=-3.1950,55.944", "--goal=-3.1913,55.9455"], "start (-3.1950000, 55.9440000) lies "
      "outside the map"),
     (["--start=-3.1885,55.9450", "--goal=-3.1913,55.9455"], "lies inside obstacle"),
     (["--start=abc", "--goal=-3.1913,55.9455"], "--start 'abc' must be two numbers LON,LAT"),

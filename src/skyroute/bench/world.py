@@ -115,8 +115,9 @@ def run_ompl(world: World, start, goal, planner: str, budget: float) -> dict:
             "raw_valid": path_exactly_free(world, raw_pts)}
 
 
-def run_ours(world: World, start, goal) -> list[dict]:
-    """skyroute's planners on one query (fresh caches: the build is timed)."""
+def run_ours(world: World, start, goal, other: tuple | None = None) -> list[dict]:
+    """skyroute's planners on one query (fresh caches: the build is timed); ``other``, a
+    second query timed on the graph the first one built."""
     from skyroute.planner import plan
 
     fresh = World(world.obstacles, world.floors, world.ceilings, world.names,
@@ -132,6 +133,12 @@ def run_ours(world: World, start, goal) -> list[dict]:
     rows.append({"runner": "visibility (again)",
                  "seconds": time.perf_counter() - t0, "length": r.cost,
                  "valid": path_exactly_free(world, r.path)})
+    if other is not None:
+        t0 = time.perf_counter()
+        r2 = plan(fresh, *other)
+        rows.append({"runner": "visibility (other query)",
+                     "seconds": time.perf_counter() - t0, "length": None,
+                     "valid": path_exactly_free(world, r2.path) if r2.found else None})
     for label, kw in (("prm, shortcut", {"algorithm": "prm"}),
                       ("theta* on raster", {"algorithm": "theta"})):
         t0 = time.perf_counter()
@@ -143,9 +150,10 @@ def run_ours(world: World, start, goal) -> list[dict]:
 
 
 def bench_query(world: World, start, goal, *, budget: float, planners: tuple,
-                rrt_budgets: tuple, on_step: Callable[[], None] | None = None) -> dict:
+                rrt_budgets: tuple, other: tuple | None = None,
+                on_step: Callable[[], None] | None = None) -> dict:
     """All runners on one query; lengths relative to the visibility optimum."""
-    rows = run_ours(world, start, goal)
+    rows = run_ours(world, start, goal, other)
     optimum = rows[1]["length"]
     if ompl_available():
         for planner in planners:

@@ -60,8 +60,9 @@ def bench_world(
             rng = np.random.default_rng(seed + i)
             size = max(world.bounds[2] - world.bounds[0], world.bounds[3] - world.bounds[1])
             s, g = free_pair(world, rng, 0.6 * size)
+            other = free_pair(world, rng, 0.6 * size)
             reports.append(bench_query(world, s, g, budget=budget, planners=chosen,
-                                       rrt_budgets=(0.1, 0.3, 1.0, 3.0)))
+                                       rrt_budgets=(0.1, 0.3, 1.0, 3.0), other=other))
             progress.advance(task)
     out = Console()
     for rep in reports:

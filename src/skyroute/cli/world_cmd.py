@@ -11,8 +11,8 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from skyroute.errors import OptionError
-from skyroute.geo import lonlat_to_enu
+from skyroute.errors import OptionError, QueryError
+from skyroute.geo import enu_to_lonlat, lonlat_to_enu
 from skyroute.io.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
@@ -24,7 +24,7 @@ from skyroute.io.world_out import (
 )
 from skyroute.planner import plan
 from skyroute.world.load import load_world
-from skyroute.world_plan import WORLD_ALGORITHMS
+from skyroute.world_plan import WORLD_ALGORITHMS, roadmap_edges
 
 EXIT_NOT_FOUND = 1
 
@@ -81,6 +81,8 @@ def plan_world_command(
     world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
                        frame=frame)
     s, t = (_to_world(world, p, frame) for p in (a, b))
+    _check_in_user_frame(world, s, a, "start", frame)
+    _check_in_user_frame(world, t, b, "goal", frame)
     result = plan(world, s, t, algorithm=algorithm, resolution=resolution, samples=samples,
                   seed=seed)
     alt = 0.0 if altitude is None else altitude
@@ -90,7 +92,8 @@ def plan_world_command(
         if geojson:
             write_atomic(geojson, dumps(world_path_geojson(world, result)))
         if plot:
-            plot_world_path(world, result, s, t, plot)
+            plot_world_path(world, result, s, t, plot,
+                            edges=roadmap_edges(world, algorithm, samples=samples, seed=seed))
     local = (result.path if frame == "degrees" else path_north_east(world, result.path))
     doc = {"status": result.status.value,
            "cost": float(result.cost) if result.found else None,
@@ -112,6 +115,37 @@ def plan_world_command(
         Console().print(table)
     if not result.found:
         raise typer.Exit(EXIT_NOT_FOUND)
+
+
+def _user(world, p: np.ndarray, frame: str) -> tuple[float, float]:
+    """A world point in the frame the user typed: (lon, lat) or (north, east)."""
+    if frame == "local":
+        return float(p[1]), float(p[0])
+    if frame == "degrees":
+        return float(p[0]), float(p[1])
+    lon, lat, _ = enu_to_lonlat(p[0], p[1], 0.0, world.home)[0]
+    return float(lon), float(lat)
+
+
+def _check_in_user_frame(world, p: np.ndarray, typed, what: str, frame: str) -> None:
+    """Raise the world's start/goal errors with coordinates in the user's frame."""
+    names = ("north", "east") if frame == "local" else ("lon", "lat")
+    fmt = "{:.2f}" if frame == "local" else "{:.7f}"  # 1e-7 degree is about 1 cm
+    here = f"({fmt.format(typed[0])}, {fmt.format(typed[1])})"
+    if not world.inside([p])[0]:
+        xmin, ymin, xmax, ymax = world.bounds
+        lo = _user(world, np.array([xmin, ymin]), frame)
+        hi = _user(world, np.array([xmax, ymax]), frame)
+        a0, a1 = sorted((lo[0], hi[0]))
+        b0, b1 = sorted((lo[1], hi[1]))
+        raise QueryError(f"{what} {here} lies outside the map ({names[0]} in "
+                         f"({fmt.format(a0)}, {fmt.format(a1)}), {names[1]} in "
+                         f"({fmt.format(b0)}, {fmt.format(b1)}))")
+    j = int(world.blocking([p])[0])
+    if j >= 0:
+        near = _user(world, world.nearest_free(p, j), frame)
+        raise QueryError(f"{what} {here} lies inside obstacle {world.names[j]!r}; nearest "
+                         f"free point ({fmt.format(near[0])}, {fmt.format(near[1])})")
 
 
 def _to_world(world, p: tuple[float, float], frame: str) -> np.ndarray:

@@ -17,13 +17,14 @@ import numpy as np
 
 
 def lazy_astar(points: np.ndarray, start: int, goal: int,
-               candidates: Callable[[int], tuple[np.ndarray, np.ndarray]],
+               candidates: Callable[[int, int], tuple[np.ndarray, np.ndarray]],
                valid: Callable[[int, int], bool], max_expansions: int | None = None):
     """Euclidean A* from node ``start`` to ``goal``.
 
-    ``candidates(u)`` returns (node ids, edge lengths) that may be edges; ``valid(u, v)``
-    decides. Returns (status code, node path, cost, expanded, max_frontier, checks) with
-    codes 0 found, 1 no path, 2 budget exhausted.
+    ``candidates(u, parent)`` returns (node ids, edge lengths) that may be edges out of
+    u, reached from ``parent`` (u itself for the start); ``valid(u, v)`` decides.
+    Returns (status code, node path, cost, expanded, max_frontier, checks) with codes
+    0 found, 1 no path, 2 budget exhausted.
     """
     gx, gy = points[goal]
 
@@ -55,7 +56,7 @@ def lazy_astar(points: np.ndarray, start: int, goal: int,
             return 2, [], math.inf, expanded, frontier, checks
         closed.add(v)
         expanded += 1
-        ids, lengths = candidates(v)
+        ids, lengths = candidates(v, u)
         for w, d in zip(ids.tolist(), lengths.tolist(), strict=True):
             if w not in closed:
                 gw = gv + d

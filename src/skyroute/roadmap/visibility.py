@@ -74,13 +74,32 @@ class VisibilityGraph:
         s2 = d[:, 0] * b[:, 1] - d[:, 1] * b[:, 0]
         return ids[s1 * s2 >= 0]
 
-    def _corner_candidates(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+    def _corner_candidates(self, i: int) -> np.ndarray:
+        """Corners that may follow corner i on a shortest path: the edge must be tangent
+        at both ends (a bitangent)."""
         c = self._candidates.get(i)
         if c is None:
-            p = self.corners[i]
-            ids = self._tangent_ids(p, exclude=i)
-            c = self._candidates[i] = (ids, np.hypot(*(self.corners[ids] - p).T))
+            u = self.corners[i]
+            ids = self._tangent_ids(u, exclude=i)
+            d = self.corners[ids] - u
+            a, b = self._prev[i] - u, self._next[i] - u
+            s1 = d[:, 0] * a[1] - d[:, 1] * a[0]
+            s2 = d[:, 0] * b[1] - d[:, 1] * b[0]
+            c = self._candidates[i] = ids[s1 * s2 >= 0]
         return c
+
+    def _taut(self, i: int, p: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """Keep targets v for which the path p -> corner i -> v bends around i's obstacle
+        (turns towards the obstacle's side) or goes straight on: a shortest path never
+        bends away from the corner it touches."""
+        u = self.corners[i]
+        inward = (self._prev[i] - u) / np.hypot(*(self._prev[i] - u)) + \
+            (self._next[i] - u) / np.hypot(*(self._next[i] - u))
+        din = u - p
+        side = din[0] * inward[1] - din[1] * inward[0]
+        d = targets - u
+        turn = din[0] * d[:, 1] - din[1] * d[:, 0]
+        return turn * side >= 0
 
     def plan(self, start, goal, *, max_expansions: int | None = None) -> PlanResult:
         """Exact shortest path from ``start`` to ``goal`` (world coordinates)."""
@@ -95,13 +114,14 @@ class VisibilityGraph:
         to_goal = set(self._tangent_ids(t).tolist())
         tests = 0
 
-        def candidates(u: int):
+        def candidates(u: int, parent: int):
             if u == S:
                 ids = np.append(from_start, T)
             else:
-                ids, _ = self._corner_candidates(u)
+                ids = self._corner_candidates(u)
                 if u in to_goal:
                     ids = np.append(ids, T)
+                ids = ids[self._taut(u, points[parent], points[ids])]
             return ids, np.hypot(*(points[ids] - points[u]).T)
 
         def valid(u: int, v: int) -> bool:
