@@ -173,3 +173,27 @@ def bench_query(world: World, start, goal, *, budget: float, planners: tuple,
     return {"world": world.name, "start": list(map(float, start)),
             "goal": list(map(float, goal)), "optimum": optimum, "rows": rows,
             "rrtstar_budget_within_1pct": reached if ompl_available() else None}
+
+
+def repeated_queries(world: World, count: int, rng: np.random.Generator) -> dict:
+    """Build the visibility graph, then time ``count`` queries between random free
+    points (any distance): the plan-once, query-many case."""
+    from skyroute.roadmap.visibility import VisibilityGraph
+
+    t0 = time.perf_counter()
+    graph = VisibilityGraph(world)
+    build = time.perf_counter() - t0
+    xmin, ymin, xmax, ymax = world.bounds
+    times, found = [], 0
+    while len(times) < count:
+        p = rng.uniform([xmin, ymin], [xmax, ymax], size=(2, 2))
+        if not graph.world.is_free(p).all():
+            continue
+        t0 = time.perf_counter()
+        r = graph.plan(p[0], p[1])
+        times.append(time.perf_counter() - t0)
+        found += r.found
+    t = np.array(times)
+    return {"build_seconds": build, "first_seconds": float(t[0]), "queries": count,
+            "found": found, "median_ms": float(np.median(t[1:]) * 1e3),
+            "p90_ms": float(np.percentile(t[1:], 90) * 1e3), "max_ms": float(t[1:].max() * 1e3)}

@@ -20,6 +20,7 @@ from skyroute.bench.world import (
     free_pair,
     ompl_available,
     random_rect_world,
+    repeated_queries,
 )
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_list
@@ -36,6 +37,8 @@ def bench_world(
         help="Also a colliders.csv city (at --altitude, with --safety).")] = None,
     altitude: Annotated[float, typer.Option(help="City altitude (m).")] = 5.0,
     safety: Annotated[float, typer.Option(help="City safety margin (m).")] = 5.0,
+    city_queries: Annotated[int, typer.Option(
+        help="Random queries timed on the city's graph once built.")] = 30,
     budget: Annotated[float, typer.Option(help="Seconds per OMPL solve.")] = 1.0,
     planners: Annotated[str, typer.Option(help="OMPL planners, comma-separated.")] =
         ",".join(OMPL_PLANNERS),
@@ -79,8 +82,18 @@ def bench_world(
                       f"{row['simplified_ratio']:.4f}",
                       {True: "yes", False: "no", None: "-"}[row.get("valid")])
         out.print(t)
+    city_timing = None
+    if city is not None and city_queries > 1:
+        city_timing = repeated_queries(cases[-1], city_queries, np.random.default_rng(seed))
+        out.print(f"{cases[-1].name}: visibility graph built in "
+                  f"{city_timing['build_seconds']:.3f} s; first query "
+                  f"{city_timing['first_seconds'] * 1e3:.1f} ms; {city_queries - 1} more: "
+                  f"median {city_timing['median_ms']:.1f} ms, 90th percentile "
+                  f"{city_timing['p90_ms']:.1f} ms, max {city_timing['max_ms']:.1f} ms "
+                  f"({city_timing['found']} of {city_queries} found a path)")
     if json_out:
-        write_atomic(json_out, json.dumps({"budget": budget, "seed": seed, "worlds": reports},
+        write_atomic(json_out, json.dumps({"budget": budget, "seed": seed, "worlds": reports,
+                                           "city_queries": city_timing},
                                           indent=1, default=float))
     if "ompl" in sys.modules:
         # OMPL's nanobind bindings print a reference-leak report at interpreter exit;
