@@ -8,9 +8,9 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.table import Table
 
 from skyroute.cli.parse import parse_cell
+from skyroute.cli.tables import result_table
 from skyroute.io.files import write_atomic
 from skyroute.io.geojson import dumps, grid_path_geojson
 from skyroute.planner import plan
@@ -69,28 +69,7 @@ def plan_command(
     if as_json:
         typer.echo(json.dumps(result.to_dict()))
     else:
-        _print_table(grid.name, result, plot if result.found else None,
-                     geojson if result.found else None)
+        files = (("plot", plot), ("geojson", geojson)) if result.found else ()
+        Console().print(result_table(f"{grid.name}: {result.algorithm}", result, files=files))
     if not result.found:
         raise typer.Exit(EXIT_NOT_FOUND)
-
-
-def _print_table(name, result, plot, geojson) -> None:
-    table = Table(title=f"{name}: {result.algorithm}", show_header=False)
-    table.add_column(style="bold")
-    table.add_column()
-    table.add_row("status", result.status.value)
-    if result.found:
-        table.add_row("cost", f"{result.cost:.6f}")
-        table.add_row("waypoints", str(len(result.path)))
-    table.add_row("expanded", f"{result.expanded:,}")
-    table.add_row("max frontier", f"{result.max_frontier:,}")
-    table.add_row("line-of-sight checks", f"{result.los_checks:,}")
-    table.add_row("search time", f"{result.seconds * 1e3:.3f} ms")
-    if "setup_seconds" in result.extra:
-        table.add_row("set-up time", f"{result.extra['setup_seconds'] * 1e3:.3f} ms "
-                      "(first query: masks, tables, compiled kernels)")
-    for label, path in (("plot", plot), ("geojson", geojson)):
-        if path:
-            table.add_row(label, str(path))
-    Console().print(table)

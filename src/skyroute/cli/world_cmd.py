@@ -9,8 +9,8 @@ from typing import Annotated
 import numpy as np
 import typer
 from rich.console import Console
-from rich.table import Table
 
+from skyroute.cli.tables import result_table
 from skyroute.errors import OptionError, QueryError
 from skyroute.geo import enu_to_lonlat, lonlat_to_enu
 from skyroute.io.files import write_atomic
@@ -103,16 +103,11 @@ def plan_world_command(
     if as_json:
         typer.echo(json.dumps(doc))
     else:
-        table = Table(title=f"{world.name}: {result.algorithm}", show_header=False)
-        unit = "deg" if world.frame == "degrees" else "m"
-        table.add_row("status", result.status.value)
-        if result.found:
-            table.add_row("length", f"{result.cost:.6g} {unit}")
-            table.add_row("waypoints", str(len(result.path)))
-        table.add_row("expanded", f"{result.expanded:,}")
-        table.add_row("segment tests", f"{result.los_checks:,}")
-        table.add_row("time", f"{result.seconds * 1e3:.1f} ms")
-        Console().print(table)
+        files = (("waypoints file", waypoints_out), ("geojson", geojson), ("plot", plot)) \
+            if result.found else ()
+        Console().print(result_table(f"{world.name}: {result.algorithm}", result,
+                                     unit="deg" if world.frame == "degrees" else "m",
+                                     files=files))
     if not result.found:
         raise typer.Exit(EXIT_NOT_FOUND)
 

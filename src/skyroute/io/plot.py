@@ -41,6 +41,13 @@ def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
     ax.set_xlabel("x (column)")
     ax.set_ylabel("y (row)")
     ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    return save_figure(fig, path, dpi=dpi)
+
+
+def save_figure(fig, path: str | Path, *, dpi: int = 150) -> Path:
+    """Render a matplotlib figure to PNG, close it, and write the file whole."""
+    import matplotlib.pyplot as plt
+
     buf = io.BytesIO()
     fig.tight_layout()
     fig.savefig(buf, format="png", dpi=dpi)

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
 
 from skyroute.geo import enu_to_lonlat, heading_of, lonlat_to_enu
-from skyroute.io.files import write_atomic
+from skyroute.io.plot import save_figure
 from skyroute.search.result import PlanResult
 from skyroute.world.world import World
 
@@ -91,8 +90,4 @@ def plot_world_path(world: World, result: PlanResult, start, goal, path: str | P
     ax.set_aspect("equal" if world.frame == "metres" else
                   1 / np.cos(np.radians(np.mean(ax.get_ylim()))))
     ax.legend(loc="best", fontsize=8, framealpha=0.9)
-    buf = io.BytesIO()
-    fig.tight_layout()
-    fig.savefig(buf, format="png", dpi=dpi)
-    plt.close(fig)
-    return write_atomic(path, buf.getvalue())
+    return save_figure(fig, path, dpi=dpi)
