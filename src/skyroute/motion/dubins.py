@@ -1,0 +1,285 @@
+"""Dubins paths: the shortest way between two poses for a vehicle that only drives
+forward and turns no tighter than a radius r (Dubins 1957).
+
+Poses are (x, y, heading) with heading in radians from the x axis, anticlockwise. The
+shortest path is one of six words of left (L), straight (S) and right (R) pieces:
+LSL, RSR, LSR, RSL, RLR, LRL; their lengths have closed forms (Shkel & Lumelsky 2001,
+as in A. Walker's reference implementation). :func:`lengths` evaluates all six for N
+queries at once with numpy.
+
+>>> p = shortest_path((0, 0, 0), (10, 0, 0), 1.0)
+>>> p.word, round(p.length, 12)
+('LSL', 10.0)
+>>> q = shortest_path((0, 0, math.pi / 2), (1, 0, -math.pi / 2), 1.0)
+>>> q.word, round(q.length, 6)
+('LRL', 6.03253)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit, prange
+
+from skyroute.errors import OptionError
+
+WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
+TWO_PI = 2 * math.pi
+
+
+def _mod2pi(a):
+    return np.mod(a, TWO_PI)
+
+
+def _check_radius(radius) -> None:
+    if not (np.all(np.isfinite(radius)) and np.all(np.asarray(radius) > 0)):
+        raise OptionError(f"radius={radius!r} must be a positive number")
+
+
+def _words(starts: np.ndarray, goals: np.ndarray, radius: float) -> np.ndarray:
+    """(N, 6, 3) normalised segment lengths (t, p, q) of every word; NaN where a word
+    does not exist."""
+    s = np.asarray(starts, dtype=float).reshape(-1, 3)
+    g = np.asarray(goals, dtype=float).reshape(-1, 3)
+    dx, dy = g[:, 0] - s[:, 0], g[:, 1] - s[:, 1]
+    d = np.hypot(dx, dy) / radius
+    phi = np.arctan2(dy, dx)
+    a = _mod2pi(s[:, 2] - phi)
+    b = _mod2pi(g[:, 2] - phi)
+    sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+    cab = np.cos(a - b)
+    out = np.full((len(s), 6, 3), np.nan)
+    with np.errstate(invalid="ignore"):
+        # LSL
+        p2 = 2 + d * d - 2 * cab + 2 * d * (sa - sb)
+        tmp = np.arctan2(cb - ca, d + sa - sb)
+        ok = p2 >= 0
+        out[ok, 0] = np.c_[_mod2pi(-a + tmp), np.sqrt(p2), _mod2pi(b - tmp)][ok]
+        # RSR
+        p2 = 2 + d * d - 2 * cab + 2 * d * (sb - sa)
+        tmp = np.arctan2(ca - cb, d - sa + sb)
+        ok = p2 >= 0
+        out[ok, 1] = np.c_[_mod2pi(a - tmp), np.sqrt(p2), _mod2pi(-b + tmp)][ok]
+        # LSR
+        p2 = -2 + d * d + 2 * cab + 2 * d * (sa + sb)
+        p = np.sqrt(p2)
+        tmp = np.arctan2(-ca - cb, d + sa + sb) - np.arctan2(-2.0, p)
+        ok = p2 >= 0
+        out[ok, 2] = np.c_[_mod2pi(-a + tmp), p, _mod2pi(-_mod2pi(b) + tmp)][ok]
+        # RSL
+        p2 = d * d - 2 + 2 * cab - 2 * d * (sa + sb)
+        p = np.sqrt(p2)
+        tmp = np.arctan2(ca + cb, d - sa - sb) - np.arctan2(2.0, p)
+        ok = p2 >= 0
+        out[ok, 3] = np.c_[_mod2pi(a - tmp), p, _mod2pi(b - tmp)][ok]
+        # RLR
+        c = (6.0 - d * d + 2 * cab + 2 * d * (sa - sb)) / 8.0
+        ok = np.abs(c) <= 1
+        p = _mod2pi(TWO_PI - np.arccos(np.clip(c, -1, 1)))
+        t = _mod2pi(a - np.arctan2(ca - cb, d - sa + sb) + p / 2)
+        out[ok, 4] = np.c_[t, p, _mod2pi(a - b - t + p)][ok]
+        # LRL
+        c = (6.0 - d * d + 2 * cab + 2 * d * (sb - sa)) / 8.0
+        ok = np.abs(c) <= 1
+        p = _mod2pi(TWO_PI - np.arccos(np.clip(c, -1, 1)))
+        t = _mod2pi(-a - np.arctan2(ca - cb, d + sa - sb) + p / 2)
+        out[ok, 5] = np.c_[t, p, _mod2pi(_mod2pi(b) - a - t + p)][ok]
+    return out
+
+
+def lengths(starts, goals, radius: float) -> np.ndarray:
+    """Shortest Dubins lengths for (N, 3) arrays of start and goal poses (compiled)."""
+    _check_radius(radius)
+    s = np.ascontiguousarray(starts, dtype=np.float64).reshape(-1, 3)
+    g = np.ascontiguousarray(goals, dtype=np.float64).reshape(-1, 3)
+    if s.shape != g.shape:
+        raise OptionError(f"starts {s.shape} and goals {g.shape} must have the same shape")
+    return _lengths_kernel(s, g, float(radius))
+
+
+@njit(cache=True)
+def _m2p(a):
+    return a - TWO_PI * math.floor(a / TWO_PI)
+
+
+@njit(cache=True, parallel=True)
+def _lengths_kernel(s, g, r):
+    """The six closed forms of :func:`_words`, one query per iteration, across cores;
+    atan2 terms shared between words (LRL's is LSL's negated, RLR's is RSR's)."""
+    n = s.shape[0]
+    out = np.empty(n)
+    for i in prange(n):
+        dx = g[i, 0] - s[i, 0]
+        dy = g[i, 1] - s[i, 1]
+        d = math.sqrt(dx * dx + dy * dy) / r
+        phi = math.atan2(dy, dx)
+        a = _m2p(s[i, 2] - phi)
+        b = _m2p(g[i, 2] - phi)
+        sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
+        cab = math.cos(a - b)
+        dd = d * d
+        t_lsl = math.atan2(cb - ca, d + sa - sb)  # LRL uses -t_lsl
+        t_rsr = math.atan2(ca - cb, d - sa + sb)  # RLR uses it too
+        best = math.inf
+        p2 = 2 + dd - 2 * cab + 2 * d * (sa - sb)  # LSL
+        if p2 >= 0:
+            best = min(best, _m2p(t_lsl - a) + math.sqrt(p2) + _m2p(b - t_lsl))
+        p2 = 2 + dd - 2 * cab + 2 * d * (sb - sa)  # RSR
+        if p2 >= 0:
+            best = min(best, _m2p(a - t_rsr) + math.sqrt(p2) + _m2p(t_rsr - b))
+        p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
+        if p2 >= 0:
+            p = math.sqrt(p2)
+            tmp = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
+            best = min(best, _m2p(tmp - a) + p + _m2p(tmp - b))
+        p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
+        if p2 >= 0:
+            p = math.sqrt(p2)
+            tmp = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
+            best = min(best, _m2p(a - tmp) + p + _m2p(b - tmp))
+        c = (6.0 - dd + 2 * cab + 2 * d * (sa - sb)) / 8.0  # RLR
+        if abs(c) <= 1:
+            p = _m2p(TWO_PI - math.acos(c))
+            t = _m2p(a - t_rsr + p / 2)
+            best = min(best, t + p + _m2p(a - b - t + p))
+        c = (6.0 - dd + 2 * cab + 2 * d * (sb - sa)) / 8.0  # LRL
+        if abs(c) <= 1:
+            p = _m2p(TWO_PI - math.acos(c))
+            t = _m2p(-a + t_lsl + p / 2)
+            best = min(best, t + p + _m2p(b - a - t + p))
+        out[i] = best * r
+    return out
+
+
+@dataclass(frozen=True)
+class DubinsPath:
+    """One shortest path: its word, the lengths of its three pieces (metres), and poses."""
+
+    start: tuple[float, float, float]
+    goal: tuple[float, float, float]
+    radius: float
+    word: str
+    segments: tuple[float, float, float]
+
+    @property
+    def length(self) -> float:
+        """Total length."""
+        return float(sum(self.segments))
+
+    def pose_at(self, s: float) -> np.ndarray:
+        """(x, y, heading) after travelling ``s`` along the path (0 <= s <= length)."""
+        return self.sample_at(np.array([s]))[0]
+
+    def sample_at(self, s: np.ndarray) -> np.ndarray:
+        """(K, 3) poses at arc lengths ``s`` (clipped to [0, length])."""
+        s = np.clip(np.asarray(s, dtype=float), 0.0, self.length)
+        out = np.empty((len(s), 3))
+        x, y, th = self.start
+        r = self.radius
+        done = np.zeros(len(s))
+        cur = np.tile([x, y, th], (len(s), 1))
+        for kind, seg in zip(self.word, self.segments, strict=True):
+            step = np.clip(s - done, 0.0, seg)
+            cur = _advance(cur, kind, step, r)
+            done = done + seg
+        out[:] = cur
+        out[:, 2] = _mod2pi(out[:, 2])
+        return out
+
+    def sample(self, step: float) -> np.ndarray:
+        """Poses every ``step`` metres; the first sample is exactly the start and the last
+        exactly the goal."""
+        if not (math.isfinite(step) and step > 0):
+            raise OptionError(f"step={step!r} must be a positive number")
+        n = math.floor(self.length / step + 1e-12)
+        s = np.arange(n + 1) * step
+        if s[-1] < self.length - 1e-12:
+            s = np.append(s, self.length)
+        poses = self.sample_at(s)
+        poses[0] = [self.start[0], self.start[1], self.start[2] % TWO_PI]
+        poses[-1] = [self.goal[0], self.goal[1], self.goal[2] % TWO_PI]
+        return poses
+
+
+def _advance(pose: np.ndarray, kind: str, s: np.ndarray, r: float) -> np.ndarray:
+    x, y, th = pose[:, 0], pose[:, 1], pose[:, 2]
+    if kind == "S":
+        return np.c_[x + s * np.cos(th), y + s * np.sin(th), th]
+    turn = s / r if kind == "L" else -s / r
+    sign = 1.0 if kind == "L" else -1.0
+    nx = x + sign * r * (np.sin(th + turn) - np.sin(th))
+    ny = y - sign * r * (np.cos(th + turn) - np.cos(th))
+    return np.c_[nx, ny, th + turn]
+
+
+def shortest_path(start, goal, radius: float) -> DubinsPath:
+    """The shortest Dubins path from pose ``start`` to pose ``goal`` with turning ``radius``."""
+    _check_radius(radius)
+    s = tuple(float(v) for v in np.asarray(start, dtype=float).reshape(3))
+    g = tuple(float(v) for v in np.asarray(goal, dtype=float).reshape(3))
+    if not all(map(math.isfinite, s + g)):
+        raise OptionError(f"poses must be finite, got {start!r} and {goal!r}")
+    w = _words([s], [g], radius)[0]
+    k = int(np.nanargmin(w.sum(axis=1)))
+    return DubinsPath(s, g, float(radius), WORDS[k], tuple(float(v) * radius for v in w[k]))
+
+
+def through(points, radius: float, *, start_heading: float | None = None,
+            end_heading: float | None = None, headings: int = 36) -> list[DubinsPath]:
+    """Dubins paths through (x, y) ``points``, choosing each free heading among
+    ``headings`` candidates so the total is shortest (dynamic programming over the
+    candidates, each stage one vectorised :func:`lengths` call)."""
+    _check_radius(radius)
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    if len(pts) < 2:
+        raise OptionError("through() needs at least two points")
+    cand = np.arange(headings) * TWO_PI / headings
+    options = [np.array([h]) if h is not None else cand
+               for h in ([start_heading] + [None] * (len(pts) - 2) + [end_heading])]
+    cost = np.zeros(len(options[0]))
+    back = []
+    for i in range(1, len(pts)):
+        prev, cur = options[i - 1], options[i]
+        pa = np.repeat(np.c_[np.tile(pts[i - 1], (len(prev), 1)), prev], len(cur), axis=0)
+        pb = np.tile(np.c_[np.tile(pts[i], (len(cur), 1)), cur], (len(prev), 1))
+        total = cost[:, None] + lengths(pa, pb, radius).reshape(len(prev), len(cur))
+        back.append(np.argmin(total, axis=0))
+        cost = total.min(axis=0)
+    k = int(np.argmin(cost))
+    chosen = [k]
+    for b in reversed(back):
+        chosen.append(int(b[chosen[-1]]))
+    chosen.reverse()
+    heads = [options[i][c] for i, c in enumerate(chosen)]
+    return [shortest_path((*pts[i], heads[i]), (*pts[i + 1], heads[i + 1]), radius)
+            for i in range(len(pts) - 1)]
+
+
+def runway_approach(start, threshold, runway_heading: float, radius: float, *,
+                    final: float | None = None) -> list[DubinsPath]:
+    """Fly from pose ``start`` onto a straight final approach of length ``final``
+    (default 3 r) that crosses the runway ``threshold`` (x, y) on ``runway_heading``."""
+    final = 3 * radius if final is None else float(final)
+    if final < 0:
+        raise OptionError(f"final={final!r} must be >= 0")
+    tx, ty = np.asarray(threshold, dtype=float).reshape(2)
+    gate = (tx - final * math.cos(runway_heading), ty - final * math.sin(runway_heading),
+            runway_heading)
+    legs = [shortest_path(start, gate, radius)]
+    if final > 0:
+        legs.append(shortest_path(gate, (tx, ty, runway_heading), radius))
+    return legs
+
+
+def loiter(center, radius: float, *, start_angle: float = 0.0, turns: float = 1.0,
+           step: float = 1.0, clockwise: bool = False) -> np.ndarray:
+    """(K, 3) poses around a holding circle, ``turns`` times, every ``step`` metres."""
+    _check_radius(radius)
+    cx, cy = np.asarray(center, dtype=float).reshape(2)
+    total = TWO_PI * radius * turns
+    s = np.append(np.arange(0.0, total, step), total)
+    ang = start_angle + (-1 if clockwise else 1) * s / radius
+    heading = ang + (-math.pi / 2 if clockwise else math.pi / 2)
+    return np.c_[cx + radius * np.cos(ang), cy + radius * np.sin(ang), _mod2pi(heading)]

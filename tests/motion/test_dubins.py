@@ -1,0 +1,98 @@
+"""Dubins paths against OMPL's DubinsStateSpace and published cases."""
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from skyroute import OptionError
+from skyroute.motion import dubins as D  # noqa: N812
+
+ob = pytest.importorskip("ompl.base")
+
+
+def ompl_lengths(starts, goals, r):
+    space = ob.DubinsStateSpace(r)
+    a, b = space.allocState(), space.allocState()
+    out = np.empty(len(starts))
+    for i, (s, g) in enumerate(zip(starts, goals, strict=True)):
+        a.setX(s[0]), a.setY(s[1]), a.setYaw(s[2])
+        b.setX(g[0]), b.setY(g[1]), b.setYaw(g[2])
+        out[i] = space.distance(a, b)
+    return out
+
+
+@pytest.mark.parametrize("radius", [0.5, 1.0, 3.7])
+def test_agrees_with_ompl_on_10000_random_queries(radius):
+    rng = np.random.default_rng(42)
+    n = 10_000
+    s = np.c_[rng.uniform(-10, 10, (n, 2)), rng.uniform(-math.pi, math.pi, n)]
+    g = np.c_[rng.uniform(-10, 10, (n, 2)), rng.uniform(-math.pi, math.pi, n)]
+    np.testing.assert_allclose(D.lengths(s, g, radius), ompl_lengths(s, g, radius),
+                               rtol=0, atol=1e-9)
+
+
+def test_published_cases():
+    p = D.shortest_path((0, 0, math.pi / 2), (1, 0, -math.pi / 2), 1.0)
+    assert p.word == "LRL"
+    assert D.shortest_path((0, 0, 0), (10, 0, 0), 2.0).length == pytest.approx(10.0, abs=1e-12)
+    half = D.shortest_path((0, 0, 0), (0, 2 * 1.5, math.pi), 1.5)  # a half loop
+    assert half.length == pytest.approx(math.pi * 1.5, abs=1e-12) and half.word in ("LSL",
+                                                                                      "LRL")
+    assert D.shortest_path((3, 4, 1.0), (3, 4, 1.0), 1.0).length == pytest.approx(0, abs=1e-12)
+    with pytest.raises(OptionError, match="radius"):
+        D.shortest_path((0, 0, 0), (1, 1, 0), -1.0)
+    with pytest.raises(OptionError, match="radius"):
+        D.lengths([[0, 0, 0]], [[1, 1, 0]], 0.0)
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.floats(0.2, 5.0), st.floats(0.1, 10.0), st.integers(0, 2**31))
+def test_length_scales_with_radius(r, k, seed):
+    rng = np.random.default_rng(seed)
+    s = np.c_[rng.uniform(-5, 5, (20, 2)), rng.uniform(-3, 3, 20)]
+    g = np.c_[rng.uniform(-5, 5, (20, 2)), rng.uniform(-3, 3, 20)]
+    scale = np.array([k, k, 1.0])
+    np.testing.assert_allclose(D.lengths(s * scale, g * scale, r * k), k * D.lengths(s, g, r),
+                               rtol=1e-9, atol=1e-9)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.tuples(*[st.floats(-20, 20)] * 2, st.floats(-4, 4)),
+       st.tuples(*[st.floats(-20, 20)] * 2, st.floats(-4, 4)), st.floats(0.3, 4.0))
+def test_pieces_fly_to_the_goal_and_samples_end_there(s, g, r):
+    p = D.shortest_path(s, g, r)
+    end = p.pose_at(p.length)  # integrate the three pieces: independent of the formulas
+    assert end[:2] == pytest.approx(g[:2], abs=1e-7)
+    assert math.cos(end[2] - g[2]) == pytest.approx(1.0, abs=1e-9)
+    assert p.length == pytest.approx(D.lengths([s], [g], r)[0], abs=1e-9)
+    step = max(p.length / 50, 0.05)
+    poses = p.sample(step)
+    np.testing.assert_array_equal(poses[-1], [g[0], g[1], g[2] % (2 * math.pi)])
+    np.testing.assert_array_equal(poses[0][:2], s[:2])
+    assert np.all(np.hypot(*np.diff(poses[:, :2], axis=0).T) <= step + 1e-9)
+
+
+def test_through_waypoints_chains_and_beats_fixed_headings():
+    pts = [(0, 0), (10, 0), (10, 10), (0, 10)]
+    legs = D.through(pts, 2.0, start_heading=0.0)
+    assert len(legs) == 3
+    for a, b in itertools.pairwise(legs):
+        assert a.goal == b.start
+    fixed = sum(D.shortest_path((*pts[i], 0.0), (*pts[i + 1], 0.0), 2.0).length
+                for i in range(3))
+    assert sum(leg.length for leg in legs) <= fixed
+
+
+def test_runway_approach_and_loiter():
+    legs = D.runway_approach((0, 0, 0), (50, 20), math.pi / 2, 5.0, final=15.0)
+    assert legs[-1].goal == (50.0, 20.0, math.pi / 2)
+    assert legs[-1].length == pytest.approx(15.0, abs=1e-9)  # straight final approach
+    circle = D.loiter((3, 4), 10.0, turns=1.0, step=2.0)
+    np.testing.assert_allclose(np.hypot(circle[:, 0] - 3, circle[:, 1] - 4), 10.0)
+    # anticlockwise: heading is the radius direction plus 90 degrees
+    ang = np.arctan2(circle[:, 1] - 4, circle[:, 0] - 3)
+    np.testing.assert_allclose(np.cos(circle[:, 2] - ang - math.pi / 2), 1.0, atol=1e-9)
