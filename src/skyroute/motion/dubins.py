@@ -195,7 +195,7 @@ class DubinsPath:
             raise OptionError(f"step={step!r} must be a positive number")
         n = math.floor(self.length / step + 1e-12)
         s = np.arange(n + 1) * step
-        if s[-1] < self.length - 1e-12:
+        if s[-1] < self.length - 1e-12 or (len(s) == 1 and self.start != self.goal):
             s = np.append(s, self.length)
         poses = self.sample_at(s)
         poses[0] = [self.start[0], self.start[1], self.start[2] % TWO_PI]
