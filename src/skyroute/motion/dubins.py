@@ -30,7 +30,10 @@ TWO_PI = 2 * math.pi
 
 
 def _mod2pi(a):
-    return np.mod(a, TWO_PI)
+    """Angle in [0, 2 pi), with float noise around 0 and 2 pi snapped to 0 (as OMPL does:
+    a piece of -1e-17 is no turn, not a full circle)."""
+    m = np.mod(a, TWO_PI)
+    return np.where((TWO_PI - m < 5e-7) | ((a < 0) & (a > -1e-15)), 0.0, m)
 
 
 def _check_radius(radius) -> None:
@@ -101,7 +104,11 @@ def lengths(starts, goals, radius: float) -> np.ndarray:
 
 @njit(cache=True)
 def _m2p(a):
-    return a - TWO_PI * math.floor(a / TWO_PI)
+    """:func:`_mod2pi` for one angle."""
+    if a < 0 and a > -1e-15:
+        return 0.0
+    m = a - TWO_PI * math.floor(a / TWO_PI)
+    return 0.0 if TWO_PI - m < 5e-7 else m
 
 
 @njit(cache=True, parallel=True)
