@@ -158,6 +158,20 @@ class World:
             ok[idx] &= shapely.contains_properly(self._prepared_boundary, lines)
         return ok
 
+    def segments_clear(self, a, b) -> np.ndarray:
+        """Stricter than :meth:`segments_free`: the segment may not even touch an obstacle
+        (closed polygons), and lies strictly inside the boundary. The ILP rules' test."""
+        a = np.asarray(a, dtype=float).reshape(-1, 2)
+        b = np.asarray(b, dtype=float).reshape(-1, 2)
+        lines = shapely.linestrings(np.stack([a, b], axis=1))
+        ok = np.ones(len(a), bool)
+        if len(self.obstacles):
+            il, _ = self.tree.query(lines, predicate="intersects")
+            ok[il] = False
+        if self.boundary is not None:
+            ok &= shapely.contains_properly(self._prepared_boundary, lines)
+        return ok
+
     def segment_free(self, a, b) -> bool:
         """:meth:`segments_free` for one segment (a leaner path: 70 us, not 120, here)."""
         a = np.asarray(a, dtype=float)

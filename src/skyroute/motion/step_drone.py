@@ -1,0 +1,262 @@
+"""The ILP lunch drone: fixed steps at headings that are multiples of 10 degrees.
+
+Rules (shared/data/ilp2021/SPEC.md 4.1-4.3): positions are (lon, lat) on a flat plane; a
+move flies exactly ``step`` = 0.00015 degrees at an angle in {0, 10, ..., 350} (0 east,
+anticlockwise) or hovers (angle -999); every move ends strictly inside the confinement
+area, and no move may end in, cross or touch a no-fly zone; two points are close when
+strictly less than ``step`` apart.
+
+- :func:`plan_moves`: A* in move space, the fewest moves from a point to close to a target.
+- :func:`follow`: fly a planned path by rounding headings, trying the nearest other
+  headings when the rounded one is blocked (what the course's students did), never
+  returning to a spot it has flown through.
+
+Known limit: plan_moves is exact but slow where a leg detours around a building (its
+bound misses the moves that 10-degree headings and the no-touching rule add, and equal-f
+states multiply): most ILP legs take 5-60 ms, a few exhaust a 200,000-expansion budget.
+
+Both return a :class:`Flight`: plain arrays of (from, angle, to), hovers included.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+import time
+import weakref
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from skyroute.errors import OptionError, QueryError
+from skyroute.search.result import Status
+from skyroute.world.world import World
+
+STEP = 0.00015
+HOVER = -999
+ANGLES = np.arange(0, 360, 10)
+MERGE = 1e-9  # positions this close are one state
+_CORNER_GRAPHS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+@dataclass(frozen=True, eq=False)
+class Flight:
+    """Moves as data: ``frm`` and ``to`` (N, 2) lon/lat, ``angle`` (N,) ints, -999 = hover."""
+
+    frm: np.ndarray
+    angle: np.ndarray
+    to: np.ndarray
+    status: Status = Status.FOUND
+    expanded: int = 0
+    seconds: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def moves(self) -> int:
+        """Number of moves, hovers included."""
+        return len(self.angle)
+
+    @property
+    def end(self) -> np.ndarray:
+        """Where the flight ends."""
+        return self.to[-1] if len(self.to) else np.full(2, np.nan)
+
+    def rows(self) -> list[list[float]]:
+        """[[from_lon, from_lat, angle, to_lon, to_lat], ...]."""
+        return [[float(f[0]), float(f[1]), int(a), float(t[0]), float(t[1])]
+                for f, a, t in zip(self.frm, self.angle, self.to, strict=True)]
+
+    def then(self, other: Flight) -> Flight:
+        """This flight followed by ``other``."""
+        return Flight(np.vstack([self.frm, other.frm]), np.concatenate([self.angle,
+                                                                         other.angle]),
+                      np.vstack([self.to, other.to]), other.status,
+                      self.expanded + other.expanded, self.seconds + other.seconds)
+
+    def hover(self, at=None) -> Flight:
+        """This flight followed by one hover (at its end, or at ``at``)."""
+        p = np.asarray(self.end if at is None else at, dtype=float).reshape(1, 2)
+        return self.then(Flight(p, np.array([HOVER]), p.copy()))
+
+
+def _check_world(world: World) -> None:
+    if world.frame != "degrees":
+        raise OptionError("the step drone flies in the 'degrees' frame (lon/lat as a plane); "
+                          "load the world with frame='degrees'")
+
+
+def legal(world: World, p, step: float = STEP) -> np.ndarray:
+    """(36,) bool: which of the 36 headings are legal moves from ``p``."""
+    p = np.asarray(p, dtype=float).reshape(2)
+    rad = np.radians(ANGLES)
+    to = p + step * np.c_[np.cos(rad), np.sin(rad)]
+    return world.segments_clear(np.broadcast_to(p, to.shape), to)
+
+
+class DistanceBound:
+    """A lower bound on the obstacle-avoiding distance to one target, for A*'s heuristic.
+
+    Built once per world (visibility among the zones' convex corners) and once per target
+    (exact corner-to-target distances by Dijkstra). For a point q it is |q - t| when q
+    sees t, else min over all corners v of |q - v| + D(v): the shortest path from q bends
+    first at a corner q sees, so minimising over every corner can only under-estimate.
+    """
+
+    def __init__(self, world: World, target: np.ndarray) -> None:
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import dijkstra
+
+        from skyroute.roadmap.visibility import convex_corners
+
+        self.world = world
+        self.target = np.asarray(target, dtype=float)
+        if world not in _CORNER_GRAPHS:
+            corners = convex_corners(world.merged())[0]
+            n = len(corners)
+            i, j = np.triu_indices(n, 1)
+            ok = world.segments_free(corners[i], corners[j]) if n else np.zeros(0, bool)
+            _CORNER_GRAPHS[world] = (corners, i[ok], j[ok])
+        self.corners, i, j = _CORNER_GRAPHS[world]
+        n = len(self.corners)
+        sees = world.segments_free(np.broadcast_to(self.target, (n, 2)), self.corners) \
+            if n else np.zeros(0, bool)
+        rows = np.concatenate([i, np.full(int(sees.sum()), n)])
+        cols = np.concatenate([j, np.flatnonzero(sees)])
+        w = np.hypot(*(np.vstack([self.corners, self.target])[rows] -
+                       np.vstack([self.corners, self.target])[cols]).T) + 1e-300
+        graph = coo_matrix((w, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
+        self.dist = dijkstra(graph, directed=False, indices=n)[:n] if n else np.zeros(0)
+
+    def __call__(self, q: np.ndarray, sees_target: np.ndarray) -> np.ndarray:
+        """Bounds for (K, 2) points ``q`` given whether each sees the target."""
+        direct = np.hypot(*(q - self.target).T)
+        if len(self.corners) == 0:
+            return direct
+        via = np.min(np.hypot(q[:, None, 0] - self.corners[None, :, 0],
+                              q[:, None, 1] - self.corners[None, :, 1]) + self.dist[None, :],
+                     axis=1)
+        return np.where(sees_target, direct, np.maximum(direct, via))
+
+
+def _coarse(p: np.ndarray) -> tuple[int, int]:
+    """A spot a third of a step wide, for follow()'s loop detection."""
+    return round(p[0] / (STEP / 3)), round(p[1] / (STEP / 3))
+
+
+def _key(p: np.ndarray) -> tuple[int, int]:
+    return round(p[0] / MERGE), round(p[1] / MERGE)
+
+
+def plan_moves(world: World, start, target, *, step: float = STEP,
+               max_expansions: int = 200_000) -> Flight:
+    """The fewest moves from ``start`` to a position strictly closer than ``step`` to
+    ``target`` (A* over positions reachable by steps, merged within 1e-9 degrees).
+
+    h = max(0, ceil(d / step - 1)) where d is a lower bound on the obstacle-avoiding
+    distance to the target (:class:`DistanceBound`): admissible, since each move covers
+    at most ``step`` and the flight may stop within ``step`` of the target. Ties go to
+    the deeper node. No path is a status, not an exception.
+    """
+    _check_world(world)
+    t0 = time.perf_counter()
+    s = np.asarray(start, dtype=float).reshape(2)
+    t = np.asarray(target, dtype=float).reshape(2)
+    if not world.is_free([s])[0] or world.blocking([s])[0] >= 0:
+        raise QueryError(f"start ({s[0]:.6f}, {s[1]:.6f}) is not strictly inside the area "
+                         "and outside every zone")
+    rad = np.radians(ANGLES)
+    deltas = step * np.c_[np.cos(rad), np.sin(rad)]
+    bound = DistanceBound(world, t)
+
+    def h(d):
+        return np.maximum(0, np.ceil(d / step - 1 - 1e-12)).astype(int)
+
+    h0 = int(h(bound(s[None, :], world.segments_free([s], [t])))[0])
+    pos = [s]
+    parent = [-1]
+    angle = [HOVER]
+    g = [0]
+    seen = {_key(s): 0}
+    heap = [(h0, 0, 0)]
+    expanded = 0
+    while heap:
+        i = heapq.heappop(heap)[2]
+        p = pos[i]
+        if math.hypot(*(t - p)) < step:
+            return _trace(pos, parent, angle, i, expanded, time.perf_counter() - t0)
+        if expanded >= max_expansions:
+            return _empty(s, Status.BUDGET_EXHAUSTED, expanded, time.perf_counter() - t0)
+        expanded += 1
+        nxt = p + deltas
+        ok = world.segments_clear(np.broadcast_to(p, nxt.shape), nxt)
+        fresh = [k for k in np.flatnonzero(ok) if _key(nxt[k]) not in seen]
+        if not fresh:
+            continue
+        q = nxt[fresh]
+        hq = h(bound(q, world.segments_free(q, np.broadcast_to(t, q.shape))))
+        for k, qk, hk in zip(fresh, q, hq, strict=True):
+            j = len(pos)
+            seen[_key(qk)] = j
+            pos.append(qk)
+            parent.append(i)
+            angle.append(int(ANGLES[k]))
+            g.append(g[i] + 1)
+            heapq.heappush(heap, (g[j] + int(hk), -g[j], j))
+    return _empty(s, Status.NO_PATH, expanded, time.perf_counter() - t0)
+
+
+def _trace(pos, parent, angle, i, expanded, seconds) -> Flight:
+    chain = []
+    while parent[i] >= 0:
+        chain.append(i)
+        i = parent[i]
+    chain.reverse()
+    frm = np.array([pos[parent[j]] for j in chain]).reshape(-1, 2)
+    to = np.array([pos[j] for j in chain]).reshape(-1, 2)
+    ang = np.array([angle[j] for j in chain], dtype=int)
+    return Flight(frm, ang, to, Status.FOUND, expanded, seconds)
+
+
+def _empty(s, status, expanded, seconds) -> Flight:
+    e = np.empty((0, 2))
+    return Flight(e, np.empty(0, int), e.copy(), status, expanded, seconds)
+
+
+def follow(world: World, path, *, step: float = STEP, max_moves: int = 1500) -> Flight:
+    """Fly the polyline ``path`` (lon/lat) waypoint by waypoint: each move takes the
+    heading to the current waypoint rounded to 10 degrees, or the nearest legal one to
+    it; a waypoint counts as reached when the drone is closer than ``step``."""
+    _check_world(world)
+    t0 = time.perf_counter()
+    pts = np.asarray(path, dtype=float).reshape(-1, 2)
+    p = pts[0].copy()
+    frm, ang, to = [], [], []
+    target = 1
+    rad = np.radians(ANGLES)
+    deltas = step * np.c_[np.cos(rad), np.sin(rad)]
+    visited = {_coarse(p)}
+    stuck = False
+    while target < len(pts) and len(ang) < max_moves:
+        if math.hypot(*(pts[target] - p)) < step:
+            target += 1
+            continue
+        want = math.degrees(math.atan2(*(pts[target] - p)[::-1])) % 360
+        ok = legal(world, p, step)
+        diff = np.abs((ANGLES - want + 180) % 360 - 180)
+        order = np.argsort(diff, kind="stable")
+        # nearest legal heading that does not return to a spot already flown through
+        k = next((int(k) for k in order if ok[k] and _coarse(p + deltas[k]) not in visited),
+                 None)
+        if k is None:
+            stuck = True
+            break
+        q = p + deltas[k]
+        frm.append(p)
+        ang.append(int(ANGLES[k]))
+        to.append(q)
+        p = q
+        visited.add(_coarse(p))
+    status = Status.FOUND if target >= len(pts) else \
+        Status.NO_PATH if stuck else Status.BUDGET_EXHAUSTED
+    return Flight(np.array(frm).reshape(-1, 2), np.array(ang, dtype=int),
+                  np.array(to).reshape(-1, 2), status, len(ang), time.perf_counter() - t0)

@@ -1,0 +1,112 @@
+"""The ILP step drone: every move legal under an independent re-check; fewest moves."""
+
+import json
+import math
+from collections import deque
+
+import numpy as np
+import pytest
+import shapely
+
+import skyroute
+from skyroute.motion.step_drone import HOVER, STEP, Flight, follow, plan_moves
+from tests.conftest import SHARED
+
+ILP = SHARED / "ilp2021"
+pytestmark = pytest.mark.skipif(not ILP.exists(), reason="ILP data not beside the repo")
+AT = (-3.186874, 55.944494)
+AREA = (-3.192473, 55.942617, -3.184319, 55.946233)
+
+
+@pytest.fixture(scope="module")
+def world():
+    return skyroute.load_world(ILP / "website/buildings/no-fly-zones.geojson", frame="degrees",
+                               boundary=ILP / "testing/confinement-zone.geojson")
+
+
+@pytest.fixture(scope="module")
+def places():
+    d = json.loads((ILP / "testing/all.geojson").read_text())
+    return {f["properties"]["name"]: tuple(f["geometry"]["coordinates"])
+            for f in d["features"] if f["geometry"]["type"] == "Point"}
+
+
+def zones():
+    d = json.loads((ILP / "website/buildings/no-fly-zones.geojson").read_text())
+    return [shapely.geometry.shape(f["geometry"]) for f in d["features"]]
+
+
+def assert_legal(flight: Flight, start):
+    """SPEC 4.2-4.3, checked from the raw rows with shapely and nothing of skyroute's."""
+    polys = zones()
+    prev = np.asarray(start, dtype=float)
+    for f_lon, f_lat, angle, t_lon, t_lat in flight.rows():
+        assert (f_lon, f_lat) == tuple(prev), "moves must chain"
+        if angle == HOVER:
+            assert (t_lon, t_lat) == (f_lon, f_lat)
+        else:
+            assert angle % 10 == 0 and 0 <= angle <= 350
+            assert math.hypot(t_lon - f_lon, t_lat - f_lat) == pytest.approx(STEP, abs=1e-12)
+            expect = (f_lon + STEP * math.cos(math.radians(angle)),
+                      f_lat + STEP * math.sin(math.radians(angle)))
+            assert (t_lon, t_lat) == pytest.approx(expect, abs=1e-15)
+        assert AREA[0] < t_lon < AREA[2] and AREA[1] < t_lat < AREA[3]
+        line = shapely.LineString([(f_lon, f_lat), (t_lon, t_lat)]) if angle != HOVER \
+            else shapely.Point(t_lon, t_lat)
+        assert not any(p.intersects(line) for p in polys)
+        prev = np.array([t_lon, t_lat])
+
+
+@pytest.mark.parametrize("name", ["Soderberg Cafe", "Bing Tea", "The Nile Valley",
+                                  "Beirut Restaurant"])
+def test_plan_moves_from_appleton_tower_is_legal_and_arrives(world, places, name):
+    flight = plan_moves(world, AT, places[name])
+    assert flight.status is skyroute.Status.FOUND
+    assert_legal(flight.hover(), AT)
+    assert math.dist(flight.end, places[name]) < STEP
+    theta = skyroute.plan(world, AT, places[name], algorithm="theta")
+    flown = follow(world, theta.path)
+    assert flown.status is skyroute.Status.FOUND
+    assert_legal(flown, AT)
+    assert flight.moves <= flown.moves
+
+
+def bfs_moves(world, start, target, limit):
+    """Fewest moves by breadth-first search in move space (no heuristic)."""
+    angles = np.radians(np.arange(0, 360, 10))
+    deltas = STEP * np.c_[np.cos(angles), np.sin(angles)]
+    start = np.asarray(start, dtype=float)
+    seen = {(round(start[0] / 1e-9), round(start[1] / 1e-9))}
+    frontier = deque([(start, 0)])
+    while frontier:
+        p, d = frontier.popleft()
+        if math.dist(p, target) < STEP:
+            return d
+        if d >= limit:
+            continue
+        nxt = p + deltas
+        ok = world.segments_clear(np.broadcast_to(p, nxt.shape), nxt)
+        for q in nxt[ok]:
+            key = (round(q[0] / 1e-9), round(q[1] / 1e-9))
+            if key not in seen:
+                seen.add(key)
+                frontier.append((q, d + 1))
+    return None
+
+
+def test_plan_moves_is_fewest_moves(world):
+    target = (AT[0] - 2.6 * STEP, AT[1] + 1.3 * STEP)
+    flight = plan_moves(world, AT, target)
+    assert flight.moves == bfs_moves(world, AT, target, 4) == 2
+
+
+def test_statuses_and_bad_frame(world):
+    inside_zone = (-3.188896, 55.944913)  # Teviot's centroid
+    assert world.blocking([inside_zone])[0] >= 0
+    with pytest.raises(skyroute.QueryError):
+        plan_moves(world, inside_zone, AT)
+    budget = plan_moves(world, AT, (-3.1913, 55.9455), max_expansions=3)
+    assert budget.status is skyroute.Status.BUDGET_EXHAUSTED and budget.moves == 0
+    metres = skyroute.load_world(ILP / "website/buildings/no-fly-zones.geojson")
+    with pytest.raises(skyroute.OptionError, match="degrees"):
+        plan_moves(metres, (0, 0), (1, 1))
