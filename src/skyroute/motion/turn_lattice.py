@@ -1,0 +1,177 @@
+"""Turn-aware planning: time, not distance, on a (cell, heading) lattice.
+
+A vehicle at a cell faces one of 8 or 16 headings. It may drive forward to the next
+cell along its heading (cost distance / speed; 8 headings: the 8 neighbours, no corner
+cutting; 16: also the knight moves (2, 1), legal by exact line of sight) or turn in
+place to a neighbouring heading (cost angle / turn_rate). A* with the heuristic
+(straight-line distance) / speed finds the fastest route; :func:`travel_time` prices any
+cell path under the same model, so a distance-optimal path can be compared fairly.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from skyroute.errors import OptionError, check_choice
+from skyroute.search import heap
+from skyroute.search.los import line_of_sight
+from skyroute.search.space import space_of
+from skyroute.world.grid import Grid
+
+_DIRS = {
+    8: [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)],
+    16: [(1, 0), (2, 1), (1, 1), (1, 2), (0, 1), (-1, 2), (-1, 1), (-2, 1), (-1, 0),
+         (-2, -1), (-1, -1), (-1, -2), (0, -1), (1, -2), (1, -1), (2, -1)],
+}
+
+
+@dataclass(frozen=True)
+class LatticeResult:
+    """The fastest route: cells (K, 2) as (x, y), headings (K,) in radians, and times."""
+
+    cells: np.ndarray
+    headings: np.ndarray
+    time: float
+    distance: float
+    expanded: int
+    seconds: float
+
+    @property
+    def found(self) -> bool:
+        return len(self.cells) > 0
+
+
+def _tables(headings: int, Wp: int):
+    dirs = np.array(_DIRS[headings], dtype=np.int64)
+    offs = dirs[:, 1] * Wp + dirs[:, 0]
+    lens = np.hypot(dirs[:, 0], dirs[:, 1])
+    ang = np.arctan2(dirs[:, 1], dirs[:, 0])
+    turn = np.abs((np.roll(ang, -1) - ang + np.pi) % (2 * np.pi) - np.pi)  # h -> h + 1
+    return dirs, offs, lens, ang, turn
+
+
+@njit(cache=True)
+def _forward_ok(blk, Wp, c, dx, dy, off):
+    n = c + off
+    if blk[n]:
+        return False
+    if abs(dx) + abs(dy) == 1:
+        return True
+    if abs(dx) == 1 and abs(dy) == 1:  # diagonal: both side cells free
+        return blk[c + dx] == 0 and blk[c + dy * Wp] == 0
+    return line_of_sight(blk, Wp, c, n)
+
+
+@njit(cache=True)
+def _lattice_kernel(blk, Wp, start, start_h, goal, H, dirs, offs, lens, turn, speed, rate,
+                    max_expansions):
+    n = blk.size * H
+    g = np.full(n, np.inf)
+    parent = np.full(n, -1, np.int64)
+    state = np.zeros(n, np.int32)
+    hc = np.empty(n, np.int32)
+    hk = np.empty(n, np.int64)
+    gx, gy = goal % Wp, goal // Wp
+    size = 0
+    for h in range(H):
+        if start_h >= 0 and h != start_h:
+            continue
+        s = start * H + h
+        g[s] = 0.0
+        d = math.hypot(start % Wp - gx, start // Wp - gy)
+        size = heap.push(hc, hk, state, size, s, heap.key(d / speed, 0.0))
+    expanded = 0
+    while size > 0:
+        u, size = heap.pop(hc, hk, state, size)
+        c, h = u // H, u % H
+        if c == goal:
+            return u, g, parent, expanded
+        if expanded >= max_expansions:
+            return -2, g, parent, expanded
+        expanded += 1
+        # forward, turn left, turn right
+        for k in range(3):
+            if k == 0:
+                if not _forward_ok(blk, Wp, c, dirs[h, 0], dirs[h, 1], offs[h]):
+                    continue
+                v = (c + offs[h]) * H + h
+                cost = lens[h] / speed
+            elif k == 1:
+                v = c * H + (h + 1) % H
+                cost = turn[h] / rate
+            else:
+                v = c * H + (h - 1) % H
+                cost = turn[(h - 1) % H] / rate
+            if state[v] < 0:
+                continue
+            gv = g[u] + cost
+            if gv < g[v]:
+                g[v] = gv
+                parent[v] = u
+                vc = v // H
+                d = math.hypot(vc % Wp - gx, vc // Wp - gy)
+                size = heap.push(hc, hk, state, size, v, heap.key(gv + d / speed, gv))
+    return -1, g, parent, expanded
+
+
+def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
+               headings: int = 8, speed: float = 1.0, turn_rate: float = math.pi / 2,
+               start_heading: float | None = None,
+               max_expansions: int | None = None) -> LatticeResult:
+    """Fastest route from cell ``start`` to cell ``goal`` (any final heading).
+
+    ``speed`` in cells per second, ``turn_rate`` in radians per second; ``start_heading``
+    (radians, from the x axis towards +y) snaps to the nearest lattice heading, or any.
+    """
+    from skyroute.search.grid_plan import check_cell
+
+    check_choice("headings", headings, (8, 16))
+    if not (speed > 0 and turn_rate > 0):
+        raise OptionError(f"speed={speed!r} and turn_rate={turn_rate!r} must be positive")
+    s = check_cell(grid, start, "start")
+    t = check_cell(grid, goal, "goal")
+    space = space_of(grid)
+    dirs, offs, lens, ang, turn = _tables(headings, space.Wp)
+    sh = -1
+    if start_heading is not None:
+        sh = int(np.argmin(np.abs((ang - start_heading + np.pi) % (2 * np.pi) - np.pi)))
+    budget = np.iinfo(np.int64).max if max_expansions is None else int(max_expansions)
+    t0 = time.perf_counter()
+    end, g, parent, expanded = _lattice_kernel(
+        space.blocked, space.Wp, space.index(s), sh, space.index(t), headings, dirs, offs,
+        lens, turn, float(speed), float(turn_rate), budget)
+    seconds = time.perf_counter() - t0
+    if end < 0:
+        return LatticeResult(np.empty((0, 2)), np.empty(0), math.inf, math.inf, expanded,
+                             seconds)
+    chain = [end]
+    while parent[chain[-1]] >= 0:
+        chain.append(parent[chain[-1]])
+    chain.reverse()
+    cells_flat = np.array([u // headings for u in chain])
+    heads = ang[np.array([u % headings for u in chain])]
+    keep = np.r_[True, (cells_flat[1:] != cells_flat[:-1]) | (heads[1:] != heads[:-1])]
+    cells = np.c_[cells_flat % space.Wp - 1, cells_flat // space.Wp - 1][keep].astype(float)
+    dist = float(np.hypot(*np.diff(cells, axis=0).T).sum()) if len(cells) > 1 else 0.0
+    return LatticeResult(cells, heads[keep], float(g[end]), dist, expanded, seconds)
+
+
+def travel_time(cells, *, speed: float = 1.0, turn_rate: float = math.pi / 2,
+                start_heading: float | None = None) -> float:
+    """Time to drive a cell path: its length / speed plus every heading change / turn rate
+    (the first move's turn counted from ``start_heading`` when given)."""
+    c = np.asarray(cells, dtype=float).reshape(-1, 2)
+    if len(c) < 2:
+        return 0.0
+    d = np.diff(c, axis=0)
+    d = d[np.any(d != 0, axis=1)]
+    ang = np.arctan2(d[:, 1], d[:, 0])
+    turns = np.abs((np.diff(ang) + np.pi) % (2 * np.pi) - np.pi).sum()
+    if start_heading is not None:
+        turns += abs((ang[0] - start_heading + np.pi) % (2 * np.pi) - np.pi)
+    return float(np.hypot(*d.T).sum() / speed + turns / turn_rate)
