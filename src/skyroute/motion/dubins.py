@@ -30,10 +30,11 @@ TWO_PI = 2 * math.pi
 
 
 def _mod2pi(a):
-    """Angle in [0, 2 pi), with float noise around 0 and 2 pi snapped to 0 (as OMPL does:
-    a piece of -1e-17 is no turn, not a full circle)."""
+    """Angle in [0, 2 pi), with float noise around 0 and 2 pi (within 1e-12) snapped to 0:
+    a piece of -1e-17 is no turn, not a full circle. OMPL snaps within 5e-7, which also
+    erases real turns of that size; 1e-12 only absorbs rounding."""
     m = np.mod(a, TWO_PI)
-    return np.where((TWO_PI - m < 5e-7) | ((a < 0) & (a > -1e-15)), 0.0, m)
+    return np.where((TWO_PI - m < 1e-12) | ((a < 0) & (a > -1e-12)), 0.0, m)
 
 
 def _check_radius(radius) -> None:
@@ -105,10 +106,10 @@ def lengths(starts, goals, radius: float) -> np.ndarray:
 @njit(cache=True)
 def _m2p(a):
     """:func:`_mod2pi` for one angle."""
-    if a < 0 and a > -1e-15:
+    if a < 0 and a > -1e-12:
         return 0.0
     m = a - TWO_PI * math.floor(a / TWO_PI)
-    return 0.0 if TWO_PI - m < 5e-7 else m
+    return 0.0 if TWO_PI - m < 1e-12 else m
 
 
 @njit(cache=True, parallel=True)
