@@ -70,8 +70,10 @@ def _plan_on_raster(world, start, goal, algorithm, resolution, max_expansions, k
         raise OptionError(f"resolution={resolution!r} must be a positive number")
     opts = grid_options(algorithm, max_expansions=max_expansions, **kwargs)
     t0 = time.perf_counter()
-    grid = _cached(world, ("raster", r),
-                   lambda: world.merged().rasterize(r, clearance=r / math.sqrt(2) * 1.0001))
+    box = world.extent_with([s, t], margin=4 * r)
+    grid = _cached(world, ("raster", r, box),
+                   lambda: world.merged().rasterize(r, clearance=r / math.sqrt(2) * 1.0001,
+                                                    bounds=box))
     setup = time.perf_counter() - t0
     cs, ct = _entry_cell(world, grid, s, "start"), _entry_cell(world, grid, t, "goal")
     res = plan_grid(grid, cs, ct, opts)

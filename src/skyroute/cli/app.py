@@ -9,6 +9,7 @@ from rich.table import Table
 from skyroute.cli import bench_world_cmd  # noqa: F401  (registers 'bench world')
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.errors import run_cli
+from skyroute.cli.fly_cmd import fly_command
 from skyroute.cli.plan_cmd import plan_command
 from skyroute.cli.world_cmd import plan_world_command, synth_city_command
 from skyroute.world.load import bundled_maps
@@ -19,6 +20,7 @@ app = typer.Typer(help="skyroute: plan where drones and small robots fly or driv
 app.command("plan")(plan_command)
 app.command("plan-world")(plan_world_command)
 app.command("synth-city")(synth_city_command)
+app.command("fly")(fly_command)
 app.add_typer(bench_app, name="bench")
 
 

@@ -198,6 +198,17 @@ class World:
         out[ip] = shapely.distance(pts[ip], self.obstacles[io])
         return out
 
+    def extent_with(self, points, margin: float = 0.0) -> tuple[float, float, float, float]:
+        """The world's bounds grown to hold ``points`` (and ``margin`` around them) when
+        there is no boundary: planners must be able to reach points beyond the obstacles."""
+        if self.boundary is not None:
+            return self.bounds
+        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        x0, y0, x1, y1 = self.bounds if len(self.obstacles) else (*p.min(0), *p.max(0))
+        lo = np.minimum([x0, y0], p.min(0) - margin)
+        hi = np.maximum([x1, y1], p.max(0) + margin)
+        return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+
     def check_point(self, point, what: str) -> np.ndarray:
         """``point`` as a float (2,) array when it is free, else a QueryError that says why."""
         p = np.asarray(point, dtype=float).reshape(2)
@@ -234,7 +245,8 @@ class World:
     # -- rasterising -----------------------------------------------------------------
 
     def rasterize(self, resolution: float, altitude: float | None = None, *,
-                  clearance: float = 0.0) -> Grid:
+                  clearance: float = 0.0,
+                  bounds: tuple[float, float, float, float] | None = None) -> Grid:
         """A Grid over the world's bounds: a cell is blocked when its centre lies within
         ``clearance`` of an obstacle (0: in the closed obstacle) or is not that far inside
         the boundary. World point (x, y) maps to cell ((x - xmin) / r, (y - ymin) / r):
@@ -243,13 +255,14 @@ class World:
         The distance is to the obstacle itself, not between cell centres as in
         :meth:`Grid.inflate`, which would leave a free centre up to half a cell from an
         obstacle's edge. Obstacles are buffered with 32-gon circles enlarged by
-        1/cos(pi/32), so the test never under-blocks."""
+        1/cos(pi/32), so the test never under-blocks. ``bounds`` (xmin, ymin, xmax, ymax)
+        overrides the world's extent."""
         if not (np.isfinite(resolution) and resolution > 0):
             raise OptionError(f"resolution={resolution!r} must be a positive number")
         if not (np.isfinite(clearance) and clearance >= 0):
             raise OptionError(f"clearance={clearance!r} must be a number >= 0")
         w = self.at(altitude)
-        xmin, ymin, xmax, ymax = self.bounds
+        xmin, ymin, xmax, ymax = self.bounds if bounds is None else bounds
         width = max(1, int(np.ceil((xmax - xmin) / resolution)))
         height = max(1, int(np.ceil((ymax - ymin) / resolution)))
         xs = xmin + (np.arange(width) + 0.5) * resolution

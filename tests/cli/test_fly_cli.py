@@ -1,0 +1,69 @@
+"""``skyroute fly``: the step drone, Dubins and the turn lattice from the command line."""
+
+import csv
+import json
+
+import pytest
+
+import skyroute
+from tests.cli.test_cli import run
+from tests.conftest import SHARED
+
+ZONES = str(SHARED / "ilp2021" / "website" / "buildings" / "no-fly-zones.geojson")
+BOX = str(SHARED / "ilp2021" / "testing" / "confinement-zone.geojson")
+AT, SODERBERG = "--start=-3.186874,55.944494", "--goal=-3.191594,55.943658"
+
+
+@pytest.fixture
+def city(tmp_path, monkeypatch, capsys):
+    p = tmp_path / "city.csv"
+    assert run(monkeypatch, capsys, "synth-city", str(p), "--seed", "7")[0] == 0
+    return str(p)
+
+
+def test_step_drone_moves_and_follow(monkeypatch, capsys, tmp_path):
+    out = tmp_path / "moves.csv"
+    code, text, err = run(monkeypatch, capsys, "fly", ZONES, "--boundary", BOX, AT, SODERBERG,
+                          "--json", "--out", str(out))
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["reached"] and doc["metrics"]["moves"] == 31 == len(doc["moves"])
+    rows = list(csv.reader(out.open()))
+    assert rows[0] == ["from_lon", "from_lat", "angle", "to_lon", "to_lat"] and len(rows) == 32
+    code, text, _ = run(monkeypatch, capsys, "fly", ZONES, "--boundary", BOX, AT, SODERBERG,
+                        "--planner", "follow", "--json")
+    assert code == 0 and json.loads(text)["metrics"]["moves"] >= 31
+
+
+def test_dubins_and_lattice(monkeypatch, capsys, tmp_path, city):
+    code, text, err = run(monkeypatch, capsys, "fly", city, "--frame", "local", "--vehicle",
+                          "dubins", "--radius", "8", "--start", "0,0", "--goal", "120,-180",
+                          "--altitude", "10", "--safety", "2", "--json")
+    assert code == 0, err
+    m = json.loads(text)["metrics"]
+    assert m["length"] > 0 and isinstance(m["free"], bool) and len(m["words"].split()) >= 1
+    gj = tmp_path / "lattice.geojson"
+    code, text, err = run(monkeypatch, capsys, "fly", city, "--frame", "local", "--vehicle",
+                          "lattice", "--start", "0,0", "--goal", "120,-180", "--altitude",
+                          "10", "--safety", "2", "--resolution", "2", "--json", "--out",
+                          str(gj))
+    assert code == 0, err
+    assert json.loads(text)["metrics"]["time"] > 0
+    assert json.loads(gj.read_text())["features"][0]["geometry"]["type"] == "LineString"
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--vehicle", "field"], "vehicle='field' is not valid"),
+    (["--planner", "greedy"], "planner='greedy' is not valid"),
+    (["--out", "x.txt"], "--out x.txt: the suffix must be"),
+])
+def test_bad_options(monkeypatch, capsys, args, words):
+    code, _, err = run(monkeypatch, capsys, "fly", ZONES, "--boundary", BOX, AT, SODERBERG,
+                       *args)
+    assert code == 2 and words in err and err.count("\n") == 1
+
+
+def test_grid_planners_reach_goals_beyond_the_obstacles(city):
+    world = skyroute.load_world(city, frame="local", altitude=10, safety=2)
+    r = skyroute.plan(world, (0, 0), (-180, 120), algorithm="astar")
+    assert r.found and world.segments_free(r.path[:-1], r.path[1:]).all()
