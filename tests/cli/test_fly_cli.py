@@ -53,7 +53,7 @@ def test_dubins_and_lattice(monkeypatch, capsys, tmp_path, city):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--vehicle", "field"], "vehicle='field' is not valid"),
+    (["--vehicle", "boat"], "vehicle='boat' is not valid"),
     (["--planner", "greedy"], "planner='greedy' is not valid"),
     (["--out", "x.txt"], "--out x.txt: the suffix must be"),
 ])

@@ -22,7 +22,7 @@ from skyroute.io.world_out import path_lonlat
 from skyroute.planner import plan
 from skyroute.world.load import load_world
 
-VEHICLES = ("step", "dubins", "lattice")
+VEHICLES = ("step", "dubins", "lattice", "field")
 EXIT_NOT_REACHED = 1
 
 
@@ -31,7 +31,7 @@ def fly_command(
         "A colliders.csv city or a GeoJSON file of zones, as for plan-world."))],
     start: Annotated[str, typer.Option(help="LON,LAT or NORTH,EAST (--frame local).")],
     goal: Annotated[str, typer.Option(help="Same form as --start.")],
-    vehicle: Annotated[str, typer.Option(help="step, dubins or lattice.")] = "step",
+    vehicle: Annotated[str, typer.Option(help="step, dubins, lattice or field.")] = "step",
     frame: Annotated[str, typer.Option(help="lonlat, local or degrees.")] = "degrees",
     altitude: Annotated[float | None, typer.Option(help="Altitude filter (m).")] = None,
     safety: Annotated[float, typer.Option(help="Grow obstacles by this distance.")] = 0.0,
@@ -49,7 +49,12 @@ def fly_command(
     speed: Annotated[float, typer.Option(help="lattice: cells per second.")] = 1.0,
     turn_rate: Annotated[float, typer.Option(help="lattice: degrees per second.")] = 90.0,
     resolution: Annotated[float | None, typer.Option(help="lattice: cell size.")] = None,
-    step: Annotated[float, typer.Option(help="dubins: sampling step.")] = 1.0,
+    step: Annotated[float, typer.Option(help="dubins: sampling step; field: move length.")] =
+        1.0,
+    escape: Annotated[bool, typer.Option(
+        help="field: follow a navigation function out of local minima.")] = True,
+    sensor_range: Annotated[float, typer.Option(help="field: sensor range.")] = 6.0,
+    sensor_rays: Annotated[int, typer.Option(help="field: sensor rays (density).")] = 36,
     out: Annotated[Path | None, typer.Option(help="Write moves or samples (.json, .csv, "
                                              ".geojson).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
@@ -72,9 +77,11 @@ def fly_command(
         doc, rows, xy = _fly_dubins(world, s, t, radius, math.radians(start_heading),
                                     None if goal_heading is None else
                                     math.radians(goal_heading), step)
-    else:
+    elif vehicle == "lattice":
         doc, rows, xy = _fly_lattice(world, s, t, headings, speed, math.radians(turn_rate),
                                      math.radians(start_heading), resolution)
+    else:
+        doc, rows, xy = _fly_field(world, s, t, step, escape, sensor_range, sensor_rays)
     if out is not None and doc["reached"]:
         write_atomic(out, _render(out, rows, doc["columns"], path_lonlat(world, xy)))
     if as_json:
@@ -82,7 +89,8 @@ def fly_command(
     else:
         table = Table(title=f"{world.name}: {vehicle}", show_header=False)
         for k, v in doc["metrics"].items():
-            table.add_row(k, f"{v:.6g}" if isinstance(v, float) else str(v))
+            if k != "reached":
+                table.add_row(k, f"{v:.6g}" if isinstance(v, float) else str(v))
         table.add_row("reached", str(doc["reached"]))
         Console().print(table)
     if not doc["reached"]:
@@ -152,6 +160,16 @@ def _fly_lattice(world, s, t, headings, speed, rate, h0, resolution):
     rows = poses.tolist()
     return ({"reached": True, "trajectory": rows, "metrics": metrics,
              "columns": ["x", "y", "heading"]}, rows, xy)
+
+
+def _fly_field(world, s, t, step, escape, sensor_range, sensor_rays):
+    from skyroute.motion.potential import run_field
+
+    run = run_field(world, s, t, step=step, escape=escape, sensor_range=sensor_range,
+                    sensor_rays=sensor_rays, tolerance=step)
+    rows = run.path.tolist()
+    return ({"reached": run.reached, "trajectory": rows, "metrics": run.metrics(),
+             "columns": ["x", "y"]}, rows, run.path)
 
 
 def _not_reached(why: str) -> dict:

@@ -1,0 +1,198 @@
+"""Potential-field robots: attraction to the goal, repulsion from what a sensor sees.
+
+Each move senses ``sensor_rays`` rays out to ``sensor_range``, sums a conic attraction
+(unit vector to the goal) and the classic repulsion ``k (1/d - 1/range) / d^2`` from each
+hit (Khatib 1986), and steps ``step`` along the resulting direction (steepest descent).
+The plain field stalls in local minima: a C-shaped obstacle opening towards the robot
+traps it. The escape follows a navigation function instead: the wavefront distance to
+the goal over the rasterised free space (scipy Dijkstra on the 8-connected free cells),
+which has no local minima (Barraquand & Latombe 1991), until the robot is clear, then
+hands back to the field.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+
+from skyroute.errors import OptionError, check_choice
+from skyroute.world.world import World
+
+COURSES = ("easy", "medium", "hard")
+
+
+@dataclass(frozen=True)
+class FieldRun:
+    """A run: poses (K, 2), whether the goal was reached, and how."""
+
+    path: np.ndarray
+    reached: bool
+    escaped: int  # moves taken on the navigation function
+
+    @property
+    def moves(self) -> int:
+        return max(0, len(self.path) - 1)
+
+    @property
+    def distance(self) -> float:
+        return float(np.hypot(*np.diff(self.path, axis=0).T).sum()) if self.moves else 0.0
+
+    @property
+    def smoothness(self) -> float:
+        """Mean absolute heading change per move, radians (0 = dead straight)."""
+        d = np.diff(self.path, axis=0)
+        if len(d) < 2:
+            return 0.0
+        a = np.arctan2(d[:, 1], d[:, 0])
+        return float(np.abs((np.diff(a) + math.pi) % (2 * math.pi) - math.pi).mean())
+
+    def metrics(self) -> dict:
+        return {"distance": self.distance, "moves": self.moves,
+                "smoothness": self.smoothness, "reached": self.reached,
+                "escape_moves": self.escaped}
+
+
+def course(name: str) -> tuple[World, np.ndarray, np.ndarray]:
+    """A built-in course: (world, start, goal) in a 60 x 60 m box."""
+    check_choice("course", name, COURSES)
+    if name == "easy":
+        boxes = [shapely.box(25, 22, 33, 30)]
+    elif name == "medium":
+        # boxes alternating above and below the straight line: a slalom, no trap
+        boxes = [shapely.box(x, y, x + 5, y + 5) for x, y in
+                 ((12, 32), (20, 23), (28, 33), (36, 22), (44, 32))]
+    else:  # a C opening towards the start, the goal behind it
+        boxes = [shapely.box(30, 15, 34, 45), shapely.box(18, 41, 34, 45),
+                 shapely.box(18, 15, 34, 19)]
+    n = len(boxes)
+    world = World(np.array(boxes, dtype=object), np.full(n, -np.inf), np.full(n, np.inf),
+                  (), shapely.box(0, 0, 60, 60), "metres", name=f"{name} course")
+    return world, np.array([5.0, 30.0]), np.array([52.0, 30.0])
+
+
+def _sense(world: World, p: np.ndarray, sensor_range: float, rays: int) -> np.ndarray:
+    """(K, 2) nearest hit point along each ray that meets an obstacle within range."""
+    ang = np.arange(rays) * 2 * math.pi / rays
+    ends = p + sensor_range * np.c_[np.cos(ang), np.sin(ang)]
+    lines = shapely.linestrings(np.stack([np.broadcast_to(p, ends.shape), ends], axis=1))
+    edges = _edges(world)
+    hit = shapely.intersection(lines, edges)
+    d = shapely.distance(shapely.Point(p), hit)
+    ok = ~shapely.is_empty(hit) & np.isfinite(d)
+    return p + (d[ok] / sensor_range)[:, None] * (ends[ok] - p)
+
+
+_EDGE_CACHE: dict = {}
+
+
+def _edges(world: World):
+    key = id(world)
+    if key not in _EDGE_CACHE or _EDGE_CACHE[key][0] is not world:
+        geoms = list(world.obstacles)
+        if world.boundary is not None:
+            geoms.append(shapely.Polygon(world.boundary).exterior)
+        e = shapely.unary_union([shapely.boundary(g) if g.geom_type != "LinearRing" else g
+                                 for g in geoms])
+        shapely.prepare(e)
+        _EDGE_CACHE[key] = (world, e)
+    return _EDGE_CACHE[key][1]
+
+
+def _navigation(world: World, goal: np.ndarray, resolution: float):
+    """Wavefront distance to the goal per free cell (inf where unreachable), and the grid."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    grid = world.merged().rasterize(resolution, clearance=resolution / math.sqrt(2))
+    free = ~grid.blocked
+    h, w = free.shape
+    idx = np.arange(h * w).reshape(h, w)
+    rows, cols, lens = [], [], []
+    for dx, dy in ((1, 0), (0, 1), (1, 1), (1, -1)):
+        a = free[max(0, -dy):h - max(0, dy), :w - dx]
+        b = free[max(0, dy):h - max(0, -dy) or None, dx:]
+        ok = a & b
+        if dx and dy:  # no corner cutting
+            ok &= free[max(0, -dy):h - max(0, dy), dx:] & free[max(0, dy):h - max(0, -dy)
+                                                                  or None, :w - dx]
+        ia = idx[max(0, -dy):h - max(0, dy), :w - dx][ok]
+        ib = idx[max(0, dy):h - max(0, -dy) or None, dx:][ok]
+        rows.append(ia)
+        cols.append(ib)
+        lens.append(np.full(len(ia), math.hypot(dx, dy) * resolution))
+    g = coo_matrix((np.concatenate(lens), (np.concatenate(rows), np.concatenate(cols))),
+                   shape=(h * w, h * w)).tocsr()
+    gx, gy = grid.to_cell([goal])[0]
+    dist = dijkstra(g, directed=False, indices=int(idx[gy, gx])).reshape(h, w)
+    return grid, dist
+
+
+def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 1.0,
+              repulse: float = 60.0, sensor_range: float = 6.0, sensor_rays: int = 36,
+              tolerance: float = 0.5, max_moves: int = 2000, escape: bool = True,
+              window: int = 40) -> FieldRun:
+    """Descend the field from ``start``; when ``escape`` and the last ``window`` moves
+    made less than two steps of net progress, follow the navigation function instead."""
+    if not (step > 0 and sensor_range > 0 and sensor_rays >= 4 and tolerance > 0):
+        raise OptionError("step, sensor_range and tolerance must be > 0 and sensor_rays >= 4")
+    p = world.check_point(start, "start")
+    t = world.check_point(goal, "goal")
+    path = [p.copy()]
+    nav = None
+    escaped = 0
+    on_nav = 0
+    while len(path) <= max_moves:
+        if math.dist(p, t) < tolerance:
+            return FieldRun(np.array(path), True, escaped)
+        stalled = len(path) > window and math.dist(path[-1], path[-window]) < 2 * step
+        if escape and (stalled or on_nav > 0):
+            if nav is None:
+                nav = _navigation(world, t, step)
+            q = _descend(world, nav, p)
+            if q is None:
+                break
+            escaped += 1
+            on_nav = on_nav - 1 if on_nav > 0 else int(4 * sensor_range / step)
+        else:
+            if stalled:
+                break
+            to_goal = t - p
+            force = attract * to_goal / np.linalg.norm(to_goal)
+            hits = _sense(world, p, sensor_range, sensor_rays)
+            if len(hits):
+                away = p - hits
+                d = np.maximum(np.hypot(*away.T), 1e-9)
+                mag = repulse * (1 / d - 1 / sensor_range) / d ** 2 / sensor_rays
+                force = force + (mag[:, None] * away / d[:, None]).sum(axis=0)
+            norm = np.linalg.norm(force)
+            if norm < 1e-12:
+                break
+            q = p + step * force / norm
+            if math.dist(q, t) < step:
+                q = t.copy()
+            if not world.segment_free(p, q):
+                q = p + 0.5 * step * force / norm
+                if not world.segment_free(p, q):
+                    break
+        path.append(q)
+        p = q
+    return FieldRun(np.array(path), math.dist(p, t) < tolerance, escaped)
+
+
+def _descend(world: World, nav, p: np.ndarray) -> np.ndarray | None:
+    """One step to the neighbouring free cell centre with the lowest wavefront value."""
+    grid, dist = nav
+    cx, cy = grid.to_cell([p])[0]
+    best, where = np.inf, None
+    for dx in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            x, y = cx + dx, cy + dy
+            inside = 0 <= x < grid.width and 0 <= y < grid.height
+            if (dx or dy) and inside and dist[y, x] < best:
+                q = grid.to_world([(x, y)])[0]
+                if world.segment_free(p, q):
+                    best, where = dist[y, x], q
+    return where

@@ -1,0 +1,40 @@
+"""Potential fields: the plain field on easy and medium, the escape on the C shape."""
+
+import math
+
+import pytest
+
+from skyroute import OptionError
+from skyroute.motion.potential import course, run_field
+
+
+@pytest.mark.parametrize("name", ["easy", "medium"])
+def test_plain_field_reaches_easy_and_medium(name):
+    world, start, goal = course(name)
+    run = run_field(world, start, goal, escape=False)
+    assert run.reached and run.escaped == 0
+    assert world.segments_free(run.path[:-1], run.path[1:]).all()
+    m = run.metrics()
+    assert m["moves"] == run.moves and m["distance"] >= math.dist(start, goal) - 0.5
+    assert 0 <= m["smoothness"] < 0.2  # nearly straight
+
+
+def test_c_shape_traps_the_plain_field_and_the_escape_gets_out():
+    world, start, goal = course("hard")
+    plain = run_field(world, start, goal, escape=False)
+    assert not plain.reached  # stalls inside the C
+    assert plain.path[-1][0] < 34  # it never got past the C's back wall
+    out = run_field(world, start, goal, escape=True)
+    assert out.reached and out.escaped > 0
+    assert world.segments_free(out.path[:-1], out.path[1:]).all()
+
+
+def test_sensor_parameters_matter_and_are_checked():
+    world, start, goal = course("medium")
+    near = run_field(world, start, goal, escape=False, sensor_range=1.0)
+    far = run_field(world, start, goal, escape=False, sensor_range=6.0)
+    assert near.reached and far.reached and near.path.shape != far.path.shape
+    with pytest.raises(OptionError):
+        run_field(world, start, goal, sensor_rays=2)
+    with pytest.raises(OptionError):
+        course("impossible")
