@@ -57,6 +57,7 @@ def fly_command(
     sensor_rays: Annotated[int, typer.Option(help="field: sensor rays (density).")] = 36,
     out: Annotated[Path | None, typer.Option(help="Write moves or samples (.json, .csv, "
                                              ".geojson).")] = None,
+    plot: Annotated[Path | None, typer.Option(help="Write a PNG map of the flight.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Fly from START to GOAL with a vehicle model; exit 1 when the goal is not reached."""
@@ -84,6 +85,13 @@ def fly_command(
         doc, rows, xy = _fly_field(world, s, t, step, escape, sensor_range, sensor_rays)
     if out is not None and doc["reached"]:
         write_atomic(out, _render(out, rows, doc["columns"], path_lonlat(world, xy)))
+    if plot is not None and doc["reached"]:
+        from skyroute.io.world_out import plot_world_path
+        from skyroute.search.result import PlanResult, Status
+
+        length = float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
+        shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)
+        plot_world_path(world, shown, s, t, plot)
     if as_json:
         typer.echo(json.dumps({k: v for k, v in doc.items() if k != "columns"}))
     else:

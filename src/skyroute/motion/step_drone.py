@@ -143,12 +143,8 @@ def _coarse(p: np.ndarray) -> tuple[int, int]:
     return round(p[0] / (STEP / 3)), round(p[1] / (STEP / 3))
 
 
-def _key(p: np.ndarray) -> tuple[int, int]:
-    return round(p[0] / MERGE), round(p[1] / MERGE)
-
-
 def plan_moves(world: World, start, target, *, step: float = STEP,
-               max_expansions: int = 200_000) -> Flight:
+               max_expansions: int = 200_000, merge: float = MERGE) -> Flight:
     """The fewest moves from ``start`` to a position strictly closer than ``step`` to
     ``target`` (A* over positions reachable by steps, merged within 1e-9 degrees).
 
@@ -176,7 +172,13 @@ def plan_moves(world: World, start, target, *, step: float = STEP,
     parent = [-1]
     angle = [HOVER]
     g = [0]
-    seen = {_key(s): 0}
+    if not merge > 0:
+        raise OptionError(f"merge={merge!r} must be a positive number")
+
+    def key(p: np.ndarray) -> tuple[int, int]:
+        return round(p[0] / merge), round(p[1] / merge)
+
+    seen = {key(s): 0}
     heap = [(h0, 0, 0)]
     expanded = 0
     while heap:
@@ -189,14 +191,14 @@ def plan_moves(world: World, start, target, *, step: float = STEP,
         expanded += 1
         nxt = p + deltas
         ok = world.segments_clear(np.broadcast_to(p, nxt.shape), nxt)
-        fresh = [k for k in np.flatnonzero(ok) if _key(nxt[k]) not in seen]
+        fresh = [k for k in np.flatnonzero(ok) if key(nxt[k]) not in seen]
         if not fresh:
             continue
         q = nxt[fresh]
         hq = h(bound(q, world.segments_free(q, np.broadcast_to(t, q.shape))))
         for k, qk, hk in zip(fresh, q, hq, strict=True):
             j = len(pos)
-            seen[_key(qk)] = j
+            seen[key(qk)] = j
             pos.append(qk)
             parent.append(i)
             angle.append(int(ANGLES[k]))
