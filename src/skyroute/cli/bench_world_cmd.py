@@ -101,3 +101,39 @@ def bench_world(
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(0)
+
+
+@bench_app.command("motion")
+def bench_motion(
+    data: Annotated[Path, typer.Option(help="The ILP data folder (website/, testing/).")],
+    budget: Annotated[int, typer.Option(help="plan_moves expansions per leg.")] = 20_000,
+    merge: Annotated[float, typer.Option(help="plan_moves merge lattice (degrees).")] =
+        1e-9,
+    json_out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] =
+        None,
+) -> None:
+    """Dubins batch speed vs OMPL; step-drone fewest moves vs following a Theta* path."""
+    from skyroute.bench.motion import dubins_speed, step_drone_pairs
+
+    out = Console()
+    d = dubins_speed()
+    out.print(f"Dubins: {d['skyroute_us']:.3f} us per query for {d['queries']:,} queries "
+              "(compiled batch)" + (f"; OMPL distance() from Python {d['ompl_us']:.3f} us "
+                                    "per call" if "ompl_us" in d else ""))
+    with Progress(console=Console(stderr=True), transient=True) as progress:
+        task = progress.add_task("pairs", total=14 * 13)
+        r = step_drone_pairs(data, budget=budget, merge=merge,
+                             on_pair=lambda: progress.advance(task))
+    both = sum(1 for x in r["rows"] if x["moves"] is not None and x["follow"] is not None)
+    out.print(f"step drone over {r['pairs']} ordered pairs: plan_moves solved "
+              f"{r['solved']} (budget {budget:,}, merge {merge:g}), follow "
+              f"{r['follow_solved']}; on the {both} both solved: {r['moves_total']} moves vs "
+              f"{r['follow_total']} "
+              f"(ratio {r['ratio']:.4f}); plan_moves per leg median {r['median_ms']:.1f} ms, "
+              f"p90 {r['p90_ms']:.1f} ms, max {r['max_ms']:.1f} ms")
+    if json_out:
+        write_atomic(json_out, json.dumps({"dubins": d, "step_drone": r}, indent=1))
+    if "ompl" in sys.modules:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(0)
