@@ -110,3 +110,27 @@ def test_statuses_and_bad_frame(world):
     metres = skyroute.load_world(ILP / "website/buildings/no-fly-zones.geojson")
     with pytest.raises(skyroute.OptionError, match="degrees"):
         plan_moves(metres, (0, 0), (1, 1))
+
+
+def test_compiled_move_test_is_never_more_permissive_than_shapely(world):
+    from skyroute.motion.step_drone import ANGLES, _zones
+    from skyroute.motion.zone_kernels import expand
+
+    rad = np.radians(ANGLES)
+    deltas = STEP * np.c_[np.cos(rad), np.sin(rad)]
+    rng = np.random.default_rng(9)
+    points = []
+    for poly in world.obstacles:  # near every zone, where the edge cases are
+        ring = poly.buffer(STEP * 0.7).exterior
+        for f in rng.uniform(0, 1, 60):
+            q = np.array(ring.interpolate(f, normalized=True).coords[0]) + \
+                rng.normal(0, STEP * 0.3, 2)
+            if world.is_free([q])[0]:
+                points.append(q)
+    assert len(points) > 100
+    for p in points:
+        clear, _ = expand(p[0], p[1], deltas, AT[0], AT[1], *_zones(world), 1e-12)
+        nxt = p + deltas
+        ref = world.segments_clear(np.broadcast_to(p, nxt.shape), nxt)
+        assert not np.any(clear & ~ref)
+        assert np.array_equal(clear, ref)
