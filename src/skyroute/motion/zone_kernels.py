@@ -14,6 +14,7 @@ import numpy as np
 import shapely
 from numba import njit
 
+from skyroute.world.segments import point_segment_dist2
 from skyroute.world.world import World
 
 
@@ -41,17 +42,6 @@ def _orient(ax, ay, bx, by, cx, cy):
 
 
 @njit(cache=True)
-def _seg_dist2(px, py, ax, ay, bx, by):
-    dx, dy = bx - ax, by - ay
-    L = dx * dx + dy * dy
-    t = 0.0
-    if L > 0:
-        t = min(1.0, max(0.0, ((px - ax) * dx + (py - ay) * dy) / L))
-    qx, qy = ax + t * dx - px, ay + t * dy - py
-    return qx * qx + qy * qy
-
-
-@njit(cache=True)
 def _touch(ax, ay, bx, by, cx, cy, dx, dy, eps):
     """Segments ab and cd intersect or come within eps of each other."""
     o1 = _orient(ax, ay, bx, by, cx, cy)
@@ -62,9 +52,10 @@ def _touch(ax, ay, bx, by, cx, cy, dx, dy, eps):
             and o3 != 0 and o4 != 0:
         return True
     e2 = eps * eps
-    return (_seg_dist2(ax, ay, cx, cy, dx, dy) <= e2 or _seg_dist2(bx, by, cx, cy, dx, dy)
-            <= e2 or _seg_dist2(cx, cy, ax, ay, bx, by) <= e2
-            or _seg_dist2(dx, dy, ax, ay, bx, by) <= e2)
+    return (point_segment_dist2(ax, ay, cx, cy, dx, dy) <= e2
+            or point_segment_dist2(bx, by, cx, cy, dx, dy) <= e2
+            or point_segment_dist2(cx, cy, ax, ay, bx, by) <= e2
+            or point_segment_dist2(dx, dy, ax, ay, bx, by) <= e2)
 
 
 @njit(cache=True)
@@ -100,7 +91,7 @@ def _near(px, py, edges, reach):
     k = 0
     r2 = reach * reach
     for i in range(edges.shape[0]):
-        if _seg_dist2(px, py, edges[i, 0], edges[i, 1], edges[i, 2], edges[i, 3]) <= r2:
+        if point_segment_dist2(px, py, edges[i, 0], edges[i, 1], edges[i, 2], edges[i, 3]) <= r2:
             out[k] = i
             k += 1
     return out[:k]

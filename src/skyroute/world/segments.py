@@ -72,7 +72,8 @@ def rasterize_segments(segments: np.ndarray, *, resolution: float, clearance: fl
 
 
 @njit(cache=True)
-def _point_segment_dist2(px, py, ax, ay, bx, by):
+def point_segment_dist2(px, py, ax, ay, bx, by):
+    """Squared distance from point p to segment ab (compiled; shared with motion)."""
     dx, dy = bx - ax, by - ay
     L2 = dx * dx + dy * dy
     t = 0.0
@@ -119,6 +120,6 @@ def _rasterize(seg, xmin, ymin, s, clearance, blocked):
                 if blocked[r, c]:
                     continue
                 cx0 = xmin + c * s
-                near = _point_segment_dist2(cx0 + 0.5 * s, cy0 + 0.5 * s, ax, ay, bx, by) <= r2
+                near = point_segment_dist2(cx0 + 0.5 * s, cy0 + 0.5 * s, ax, ay, bx, by) <= r2
                 if near or _segment_hits_box(ax, ay, bx, by, cx0, cy0, cx0 + s, cy0 + s):
                     blocked[r, c] = True
