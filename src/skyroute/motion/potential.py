@@ -13,6 +13,7 @@ hands back to the field.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,20 +86,20 @@ def _sense(world: World, p: np.ndarray, sensor_range: float, rays: int) -> np.nd
     return p + (d[ok] / sensor_range)[:, None] * (ends[ok] - p)
 
 
-_EDGE_CACHE: dict = {}
+_EDGE_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _edges(world: World):
-    key = id(world)
-    if key not in _EDGE_CACHE or _EDGE_CACHE[key][0] is not world:
+    """Obstacle and boundary edges as one prepared geometry (cached per world)."""
+    if world not in _EDGE_CACHE:
         geoms = list(world.obstacles)
         if world.boundary is not None:
             geoms.append(shapely.Polygon(world.boundary).exterior)
         e = shapely.unary_union([shapely.boundary(g) if g.geom_type != "LinearRing" else g
                                  for g in geoms])
         shapely.prepare(e)
-        _EDGE_CACHE[key] = (world, e)
-    return _EDGE_CACHE[key][1]
+        _EDGE_CACHE[world] = e
+    return _EDGE_CACHE[world]
 
 
 def _navigation(world: World, goal: np.ndarray, resolution: float):
