@@ -7,6 +7,8 @@ from collections import deque
 import numpy as np
 import pytest
 import shapely
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 import skyroute
 from skyroute.motion.step_drone import HOVER, STEP, Flight, follow, plan_moves
@@ -98,6 +100,48 @@ def test_plan_moves_is_fewest_moves(world):
     target = (AT[0] - 2.6 * STEP, AT[1] + 1.3 * STEP)
     flight = plan_moves(world, AT, target)
     assert flight.moves == bfs_moves(world, AT, target, 4) == 2
+
+
+@pytest.mark.parametrize("leg", [("Soderberg Cafe", "Appleton Tower"), ("Bing Tea", "Rudis"),
+                                 ("Rudis", "The Nile Valley")])
+def test_default_merge_loses_no_move_against_exact_search(world, places, leg):
+    """On these legs a 1e-5 lattice flies one move more; the default must not."""
+    exact = plan_moves(world, places[leg[0]], places[leg[1]], merge=1e-9)
+    assert exact.status is skyroute.Status.FOUND
+    assert plan_moves(world, places[leg[0]], places[leg[1]]).moves == exact.moves
+
+
+def shortest_distance(polys, a, b):
+    """Obstacle-avoiding distance by networkx over a shapely visibility graph of every
+    zone vertex (lines may touch zones, not enter them)."""
+    import networkx as nx
+
+    pts = [tuple(a), tuple(b)] + [c for p in polys for c in p.exterior.coords[:-1]]
+    g = nx.Graph()
+    for i, p in enumerate(pts):
+        for j in range(i + 1, len(pts)):
+            line = shapely.LineString([p, pts[j]])
+            if not any(line.relate_pattern(z, "T********") for z in polys):
+                g.add_edge(i, j, weight=math.dist(p, pts[j]))
+    return nx.dijkstra_path_length(g, 0, 1)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.floats(0.02, 0.98), st.floats(0.02, 0.98), st.sampled_from(range(14)))
+def test_heuristic_never_exceeds_the_moves_left(world, places, u, v, k):
+    """A*'s bound stays at or below ceil(D / step - 1), D the true shortest distance."""
+    from skyroute.motion import move_search
+    from skyroute.motion.step_drone import DistanceBound, _zones
+
+    q = np.array([AREA[0] + u * (AREA[2] - AREA[0]), AREA[1] + v * (AREA[3] - AREA[1])])
+    assume(world.blocking([q])[0] < 0)
+    t = np.array(list(places.values())[k])
+    table = DistanceBound(world, t)
+    sees = bool(world.segments_free([q], [t])[0])
+    h = move_search.bound(q[0], q[1], sees, t[0], t[1], table.corners, table.dist,
+                          _zones(world)[0], STEP)
+    d = shortest_distance(zones(), q, t)
+    assert h <= max(0, math.ceil(d / STEP - 1 + 1e-9))
 
 
 def test_statuses_and_bad_frame(world):

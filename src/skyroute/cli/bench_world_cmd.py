@@ -27,6 +27,7 @@ from skyroute.cli.parse import parse_list
 from skyroute.errors import check_choice
 from skyroute.io.files import write_atomic
 from skyroute.world.load import load_world
+from skyroute.motion.step_drone import MERGE
 
 
 @bench_app.command("world")
@@ -106,9 +107,9 @@ def bench_world(
 @bench_app.command("motion")
 def bench_motion(
     data: Annotated[Path, typer.Option(help="The ILP data folder (website/, testing/).")],
-    budget: Annotated[int, typer.Option(help="plan_moves expansions per leg.")] = 20_000,
+    budget: Annotated[int, typer.Option(help="plan_moves expansions per leg.")] = 200_000,
     merge: Annotated[float, typer.Option(help="plan_moves merge lattice (degrees).")] =
-        1e-9,
+        MERGE,
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] =
         None,
 ) -> None:

@@ -19,7 +19,6 @@ Both return a :class:`Flight`: plain arrays of (from, angle, to), hovers include
 
 from __future__ import annotations
 
-import heapq
 import math
 import time
 import weakref
@@ -28,14 +27,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from skyroute.errors import OptionError, QueryError
-from skyroute.motion.zone_kernels import expand, zone_arrays
+from skyroute.motion import move_search
+from skyroute.motion.zone_kernels import zone_arrays
 from skyroute.search.result import Status
 from skyroute.world.world import World
 
 STEP = 0.00015
 HOVER = -999
 ANGLES = np.arange(0, 360, 10)
-MERGE = 1e-9  # positions this close are one state
+MERGE = 5e-6  # positions in one lattice cell this wide (1/30 step) are one state
 _CORNER_GRAPHS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _ZONES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
@@ -95,12 +95,12 @@ def legal(world: World, p, step: float = STEP) -> np.ndarray:
 
 
 class DistanceBound:
-    """A lower bound on the obstacle-avoiding distance to one target, for A*'s heuristic.
+    """The table behind A*'s heuristic: the zones' convex corners and each one's shortest
+    obstacle-avoiding distance D(v) to one target.
 
-    Built once per world (visibility among the zones' convex corners) and once per target
-    (exact corner-to-target distances by Dijkstra). For a point q it is |q - t| when q
-    sees t, else min over all corners v of |q - v| + D(v): the shortest path from q bends
-    first at a corner q sees, so minimising over every corner can only under-estimate.
+    Built once per world (visibility among the corners) and once per target (Dijkstra).
+    The compiled search bounds a point q's distance by |q - t| when q sees t, else by
+    min over the corners v that q sees of |q - v| + D(v) (:func:`move_search.bound`).
     """
 
     def __init__(self, world: World, target: np.ndarray) -> None:
@@ -128,16 +128,6 @@ class DistanceBound:
         graph = coo_matrix((w, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
         self.dist = dijkstra(graph, directed=False, indices=n)[:n] if n else np.zeros(0)
 
-    def __call__(self, q: np.ndarray, sees_target: np.ndarray) -> np.ndarray:
-        """Bounds for (K, 2) points ``q`` given whether each sees the target."""
-        direct = np.hypot(*(q - self.target).T)
-        if len(self.corners) == 0:
-            return direct
-        via = np.min(np.hypot(q[:, None, 0] - self.corners[None, :, 0],
-                              q[:, None, 1] - self.corners[None, :, 1]) + self.dist[None, :],
-                     axis=1)
-        return np.where(sees_target, direct, np.maximum(direct, via))
-
 
 def _zones(world: World) -> tuple:
     """The compiled kernels' view of the zones (cached per world)."""
@@ -156,12 +146,15 @@ def _coarse(p: np.ndarray) -> tuple[int, int]:
 def plan_moves(world: World, start, target, *, step: float = STEP,
                max_expansions: int = 200_000, merge: float = MERGE) -> Flight:
     """The fewest moves from ``start`` to a position strictly closer than ``step`` to
-    ``target`` (A* over positions reachable by steps, merged within 1e-9 degrees).
+    ``target`` (A* over positions reachable by steps; positions in one ``merge``-wide
+    lattice cell are one state, which on the ILP map gives the same move counts as
+    merging 2.5x finer, see docs/benchmarks.md).
 
     h = max(0, ceil(d / step - 1)) where d is a lower bound on the obstacle-avoiding
     distance to the target (:class:`DistanceBound`): admissible, since each move covers
     at most ``step`` and the flight may stop within ``step`` of the target. Ties go to
-    the deeper node. No path is a status, not an exception.
+    the deeper node. No path is a status, not an exception. The whole search is one
+    compiled call (:mod:`skyroute.motion.move_search`).
     """
     _check_world(world)
     t0 = time.perf_counter()
@@ -170,64 +163,28 @@ def plan_moves(world: World, start, target, *, step: float = STEP,
     if not world.is_free([s])[0] or world.blocking([s])[0] >= 0:
         raise QueryError(f"start ({s[0]:.6f}, {s[1]:.6f}) is not strictly inside the area "
                          "and outside every zone")
+    if not merge > 0:
+        raise OptionError(f"merge={merge!r} must be a positive number")
     rad = np.radians(ANGLES)
     deltas = step * np.c_[np.cos(rad), np.sin(rad)]
     bound = DistanceBound(world, t)
-    zones = _zones(world)
-
-    def h(d):
-        return np.maximum(0, np.ceil(d / step - 1 - 1e-12)).astype(int)
-
-    h0 = int(h(bound(s[None, :], world.segments_free([s], [t])))[0])
-    pos = [s]
-    parent = [-1]
-    angle = [HOVER]
-    g = [0]
-    if not merge > 0:
-        raise OptionError(f"merge={merge!r} must be a positive number")
-
-    def key(p: np.ndarray) -> tuple[int, int]:
-        return round(p[0] / merge), round(p[1] / merge)
-
-    seen = {key(s): 0}
-    heap = [(h0, 0, 0)]
-    expanded = 0
-    while heap:
-        i = heapq.heappop(heap)[2]
-        p = pos[i]
-        if math.hypot(*(t - p)) < step:
-            return _trace(pos, parent, angle, i, expanded, time.perf_counter() - t0)
-        if expanded >= max_expansions:
-            return _empty(s, Status.BUDGET_EXHAUSTED, expanded, time.perf_counter() - t0)
-        expanded += 1
-        nxt = p + deltas
-        ok, sees = expand(p[0], p[1], deltas, t[0], t[1], *zones, 1e-12)
-        fresh = [k for k in np.flatnonzero(ok) if key(nxt[k]) not in seen]
-        if not fresh:
-            continue
-        q = nxt[fresh]
-        hq = h(bound(q, sees[fresh]))
-        for k, qk, hk in zip(fresh, q, hq, strict=True):
-            j = len(pos)
-            seen[key(qk)] = j
-            pos.append(qk)
-            parent.append(i)
-            angle.append(int(ANGLES[k]))
-            g.append(g[i] + 1)
-            heapq.heappush(heap, (g[j] + int(hk), -g[j], j))
-    return _empty(s, Status.NO_PATH, expanded, time.perf_counter() - t0)
-
-
-def _trace(pos, parent, angle, i, expanded, seconds) -> Flight:
+    sees0 = bool(world.segments_free([s], [t])[0])
+    status, goal, expanded, x, y, parent, move = move_search.search(
+        s[0], s[1], t[0], t[1], sees0, deltas, *_zones(world), bound.corners,
+        bound.dist, step, merge, max_expansions, 1e-12)
+    seconds = time.perf_counter() - t0
+    if status != move_search.FOUND:
+        return _empty(s, Status.BUDGET_EXHAUSTED if status == move_search.BUDGET
+                      else Status.NO_PATH, expanded, seconds)
     chain = []
+    i = goal
     while parent[i] >= 0:
         chain.append(i)
         i = parent[i]
-    chain.reverse()
-    frm = np.array([pos[parent[j]] for j in chain]).reshape(-1, 2)
-    to = np.array([pos[j] for j in chain]).reshape(-1, 2)
-    ang = np.array([angle[j] for j in chain], dtype=int)
-    return Flight(frm, ang, to, Status.FOUND, expanded, seconds)
+    chain = np.array(chain[::-1], dtype=np.int64)
+    pos = np.c_[x, y]
+    return Flight(pos[parent[chain]].reshape(-1, 2), ANGLES[move[chain]].astype(int),
+                  pos[chain].reshape(-1, 2), Status.FOUND, expanded, seconds)
 
 
 def _empty(s, status, expanded, seconds) -> Flight:

@@ -59,7 +59,7 @@ def _touch(ax, ay, bx, by, cx, cy, dx, dy, eps):
 
 
 @njit(cache=True)
-def _crosses(ax, ay, bx, by, cx, cy, dx, dy):
+def crosses(ax, ay, bx, by, cx, cy, dx, dy):
     """Proper crossing: interiors meet at one point, no collinear or endpoint cases."""
     o1 = _orient(ax, ay, bx, by, cx, cy)
     o2 = _orient(ax, ay, bx, by, dx, dy)
@@ -137,7 +137,7 @@ def expand(px, py, deltas, tx, ty, edges, owner, nzones, bedges, eps):
         if ok:
             s = True
             for i in range(edges.shape[0]):
-                if _crosses(qx, qy, tx, ty, edges[i, 0], edges[i, 1], edges[i, 2],
+                if crosses(qx, qy, tx, ty, edges[i, 0], edges[i, 1], edges[i, 2],
                             edges[i, 3]):
                     s = False
                     break

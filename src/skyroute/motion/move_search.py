@@ -1,0 +1,175 @@
+"""The step drone's A* in move space, compiled whole: plain arrays in, a parent tree out.
+
+States are positions reachable by steps; two positions in the same ``merge``-wide lattice
+cell (relative to the start) are one state. Moves cost 1; ``h`` is the admissible bound
+of :class:`skyroute.motion.step_drone.DistanceBound`, evaluated here from its corner
+table. The open list is a binary heap of packed int64 keys (f above the tie-break "deeper
+first") with lazy deletion; a state not yet expanded takes a shorter route found later
+(its position becomes that route's end), so first discovery never fixes a longer g.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, types
+from numba.typed import Dict
+
+from skyroute.motion.zone_kernels import crosses, expand
+
+FOUND, BUDGET, NO_PATH = 0, 1, 2
+_TIE = (1 << 20) - 1
+_HALF = 1 << 31
+
+
+@njit(cache=True)
+def _sight(qx, qy, vx, vy, edges):
+    """No zone edge properly crosses segment qv (touching counts as sight: a superset)."""
+    for i in range(edges.shape[0]):
+        if crosses(qx, qy, vx, vy, edges[i, 0], edges[i, 1], edges[i, 2], edges[i, 3]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def bound(qx, qy, sees, tx, ty, corners, cdist, edges, step):
+    """Moves still needed at least: max(0, ceil(d / step - 1)).
+
+    d is the straight distance when q sees the target, else min over the corners q sees
+    of |q - v| + D(v), D the corner's shortest distance to the target: every path from q
+    bends first at a corner in sight. Corners are tried cheapest first, so usually the
+    first sight test settles it.
+    """
+    d = math.hypot(qx - tx, qy - ty)
+    if not sees and corners.shape[0]:
+        vals = np.empty(corners.shape[0])
+        for c in range(corners.shape[0]):
+            vals[c] = math.hypot(qx - corners[c, 0], qy - corners[c, 1]) + cdist[c]
+        for _ in range(corners.shape[0]):
+            c = np.argmin(vals)
+            if not vals[c] < np.inf:
+                break
+            if _sight(qx, qy, corners[c, 0], corners[c, 1], edges):
+                d = max(d, vals[c])
+                break
+            vals[c] = np.inf
+    h = math.ceil(d / step - 1.0 - 1e-12)
+    return h if h > 0 else 0
+
+
+@njit(cache=True)
+def _grow(a, n):
+    if n < a.shape[0]:
+        return a
+    b = np.empty(max(2 * a.shape[0], n + 1), a.dtype)
+    b[:a.shape[0]] = a
+    return b
+
+
+@njit(cache=True)
+def _push(hk, hn, size, k, node):
+    i = size
+    while i > 0:
+        p = (i - 1) >> 1
+        if k < hk[p]:
+            hk[i] = hk[p]
+            hn[i] = hn[p]
+            i = p
+        else:
+            break
+    hk[i] = k
+    hn[i] = node
+
+
+@njit(cache=True)
+def _pop(hk, hn, size):
+    """Remove the minimum of a heap of ``size`` entries; return its node."""
+    top = hn[0]
+    size -= 1
+    lk, ln = hk[size], hn[size]
+    i = 0
+    while True:
+        b = 2 * i + 1
+        if b >= size:
+            break
+        if b + 1 < size and hk[b + 1] < hk[b]:
+            b += 1
+        if hk[b] < lk:
+            hk[i] = hk[b]
+            hn[i] = hn[b]
+            i = b
+        else:
+            break
+    if size > 0:
+        hk[i] = lk
+        hn[i] = ln
+    return top
+
+
+@njit(cache=True)
+def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners, cdist,
+           step, merge, max_expansions, eps):
+    """A* from (sx, sy) to closer than ``step`` to (tx, ty).
+
+    Returns (status, goal node, expanded, x, y, parent, move index); parent -1 at the start.
+    """
+    cap = 4096
+    x = np.empty(cap)
+    y = np.empty(cap)
+    parent = np.empty(cap, np.int64)
+    move = np.empty(cap, np.int64)
+    g = np.empty(cap, np.int64)
+    closed = np.zeros(cap, np.bool_)
+    hk = np.empty(cap, np.int64)
+    hn = np.empty(cap, np.int64)
+    seen = Dict.empty(key_type=types.int64, value_type=types.int64)
+    x[0], y[0], parent[0], move[0], g[0] = sx, sy, -1, -1, 0
+    n = 1
+    seen[np.int64(_HALF) * (1 << 32) + _HALF] = 0
+    h0 = bound(sx, sy, sees0, tx, ty, corners, cdist, edges, step)
+    hk[0] = (np.int64(h0) << 20) | _TIE
+    hn[0] = 0
+    size = 1
+    expanded = 0
+    while size > 0:
+        i = _pop(hk, hn, size)
+        size -= 1
+        if closed[i]:
+            continue
+        closed[i] = True
+        if math.hypot(tx - x[i], ty - y[i]) < step:
+            return FOUND, i, expanded, x[:n], y[:n], parent[:n], move[:n]
+        if expanded >= max_expansions:
+            return BUDGET, -1, expanded, x[:n], y[:n], parent[:n], move[:n]
+        expanded += 1
+        ok, sees = expand(x[i], y[i], deltas, tx, ty, edges, owner, nzones, bedges, eps)
+        gi = g[i] + 1
+        for k in range(deltas.shape[0]):
+            if not ok[k]:
+                continue
+            qx, qy = x[i] + deltas[k, 0], y[i] + deltas[k, 1]
+            key = (np.int64(round((qx - sx) / merge)) + _HALF) * (1 << 32) + \
+                np.int64(round((qy - sy) / merge)) + _HALF
+            j = -1
+            if key in seen:
+                j = seen[key]
+            if j >= 0 and (closed[j] or g[j] <= gi):
+                continue
+            if j < 0:
+                j = n
+                n += 1
+                if n > x.shape[0]:
+                    x, y, parent = _grow(x, n), _grow(y, n), _grow(parent, n)
+                    move, g = _grow(move, n), _grow(g, n)
+                    c2 = np.zeros(x.shape[0], np.bool_)
+                    c2[:closed.shape[0]] = closed
+                    closed = c2
+                seen[key] = j
+            x[j], y[j], parent[j], move[j], g[j] = qx, qy, i, k, gi
+            f = gi + bound(qx, qy, sees[k], tx, ty, corners, cdist, edges, step)
+            if size + 1 > hk.shape[0]:
+                hk, hn = _grow(hk, size + 1), _grow(hn, size + 1)
+            _push(hk, hn, size, (np.int64(f) << 20) | (_TIE - min(gi, _TIE)), j)
+            size += 1
+    return NO_PATH, -1, expanded, x[:n], y[:n], parent[:n], move[:n]
