@@ -52,6 +52,19 @@ def test_dubins_and_lattice(monkeypatch, capsys, tmp_path, city):
     assert json.loads(gj.read_text())["features"][0]["geometry"]["type"] == "LineString"
 
 
+def test_field_arc_mode(monkeypatch, capsys, tmp_path, city):
+    args = ["fly", city, "--frame", "local", "--vehicle", "field", "--start", "0,0",
+            "--goal", "60,-40", "--altitude", "10", "--step", "1", "--json"]
+    code, text, err = run(monkeypatch, capsys, *args, "--field-mode", "arc", "--max-turn",
+                          "30")
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["reached"] and doc["metrics"]["moves"] > 0
+    assert len(doc["trajectory"]) > doc["metrics"]["moves"]  # the arcs, sampled
+    code, text, _ = run(monkeypatch, capsys, *args, "--field-mode", "glide")
+    assert code == 2 and "mode='glide' is not valid" in text + _
+
+
 @pytest.mark.parametrize("args, words", [
     (["--vehicle", "boat"], "vehicle='boat' is not valid"),
     (["--planner", "greedy"], "planner='greedy' is not valid"),

@@ -2,6 +2,7 @@
 
 import math
 
+import numpy as np
 import pytest
 
 from skyroute import OptionError
@@ -38,3 +39,29 @@ def test_sensor_parameters_matter_and_are_checked():
         run_field(world, start, goal, sensor_rays=2)
     with pytest.raises(OptionError):
         course("impossible")
+
+
+@pytest.mark.parametrize("name", ["easy", "medium"])
+def test_arc_mode_reaches_with_bounded_turns_and_fractional_steps(name):
+    world, start, goal = course(name)
+    run = run_field(world, start, goal, escape=False, mode="arc", max_turn=math.pi / 6)
+    assert run.reached and run.escaped == 0
+    assert world.segments_free(run.trace[:-1], run.trace[1:]).all()
+    chords = np.diff(run.trace, axis=0)
+    heading = np.arctan2(chords[:, 1], chords[:, 0])
+    turns = np.abs((np.diff(heading) + math.pi) % (2 * math.pi) - math.pi)
+    assert turns.max() <= math.pi / 6 + 1e-9  # never a sharper turn than allowed
+    hops = np.hypot(*np.diff(run.path, axis=0).T)
+    assert hops.max() <= 0.5 + 1e-9 and hops.min() >= 0.5 / 4 * 0.9  # fractional progress
+    assert run.distance == pytest.approx(np.hypot(*chords.T).sum())
+
+
+def test_arc_mode_escapes_the_c_shape_more_smoothly_than_steps():
+    world, start, goal = course("hard")
+    arc = run_field(world, start, goal, mode="arc")
+    step = run_field(world, start, goal, mode="step")
+    assert arc.reached and arc.escaped > 0 and step.reached
+    assert world.segments_free(arc.trace[:-1], arc.trace[1:]).all()
+    assert arc.smoothness < step.smoothness
+    with pytest.raises(OptionError):
+        run_field(world, start, goal, mode="glide")

@@ -26,8 +26,8 @@ from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_list
 from skyroute.errors import check_choice
 from skyroute.io.files import write_atomic
-from skyroute.world.load import load_world
 from skyroute.motion.step_drone import MERGE
+from skyroute.world.load import load_world
 
 
 @bench_app.command("world")

@@ -55,6 +55,11 @@ def fly_command(
         help="field: follow a navigation function out of local minima.")] = True,
     sensor_range: Annotated[float, typer.Option(help="field: sensor range.")] = 6.0,
     sensor_rays: Annotated[int, typer.Option(help="field: sensor rays (density).")] = 36,
+    field_mode: Annotated[str, typer.Option(
+        help="field: step (jump along the force) or arc (turn-limited arcs, slower in "
+             "turns).")] = "step",
+    max_turn: Annotated[float, typer.Option(
+        help="field arc mode: largest heading change per move, degrees.")] = 45.0,
     out: Annotated[Path | None, typer.Option(help="Write moves or samples (.json, .csv, "
                                              ".geojson).")] = None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG map of the flight.")] = None,
@@ -82,7 +87,8 @@ def fly_command(
         doc, rows, xy = _fly_lattice(world, s, t, headings, speed, math.radians(turn_rate),
                                      math.radians(start_heading), resolution)
     else:
-        doc, rows, xy = _fly_field(world, s, t, step, escape, sensor_range, sensor_rays)
+        doc, rows, xy = _fly_field(world, s, t, step, escape, sensor_range, sensor_rays,
+                                   field_mode, math.radians(max_turn))
     if out is not None and doc["reached"]:
         write_atomic(out, _render(out, rows, doc["columns"], path_lonlat(world, xy)))
     if plot is not None and doc["reached"]:
@@ -170,14 +176,15 @@ def _fly_lattice(world, s, t, headings, speed, rate, h0, resolution):
              "columns": ["x", "y", "heading"]}, rows, xy)
 
 
-def _fly_field(world, s, t, step, escape, sensor_range, sensor_rays):
+def _fly_field(world, s, t, step, escape, sensor_range, sensor_rays, mode, max_turn):
     from skyroute.motion.potential import run_field
 
     run = run_field(world, s, t, step=step, escape=escape, sensor_range=sensor_range,
-                    sensor_rays=sensor_rays, tolerance=step)
-    rows = run.path.tolist()
+                    sensor_rays=sensor_rays, tolerance=step, mode=mode, max_turn=max_turn)
+    xy = run.path if run.trace is None else run.trace
+    rows = xy.tolist()
     return ({"reached": run.reached, "trajectory": rows, "metrics": run.metrics(),
-             "columns": ["x", "y"]}, rows, run.path)
+             "columns": ["x", "y"]}, rows, xy)
 
 
 def _not_reached(why: str) -> dict:

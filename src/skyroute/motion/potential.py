@@ -8,6 +8,12 @@ traps it. The escape follows a navigation function instead: the wavefront distan
 the goal over the rasterised free space (scipy Dijkstra on the 8-connected free cells),
 which has no local minima (Barraquand & Latombe 1991), until the robot is clear, then
 hands back to the field.
+
+Two ways to move (``mode``): ``step`` jumps ``step`` along the force; ``arc`` gives the
+robot a heading it cannot change by more than ``max_turn`` per move, drives a circular
+arc that turns towards the force, and makes fractional progress: the arc is ``step``
+long scaled by cos(heading error) (at least a quarter step), so the robot slows into
+sharp turns and speeds up when aligned, as a wheeled robot does.
 """
 
 from __future__ import annotations
@@ -23,6 +29,8 @@ from skyroute.errors import OptionError, check_choice
 from skyroute.world.world import World
 
 COURSES = ("easy", "medium", "hard")
+MODES = ("step", "arc")
+ARC_SAMPLES = 4  # points per arc, for collision checks and the drawn trace
 
 
 @dataclass(frozen=True)
@@ -32,6 +40,7 @@ class FieldRun:
     path: np.ndarray
     reached: bool
     escaped: int  # moves taken on the navigation function
+    trace: np.ndarray | None = None  # arc mode: the arcs sampled, for distance and plots
 
     @property
     def moves(self) -> int:
@@ -39,7 +48,8 @@ class FieldRun:
 
     @property
     def distance(self) -> float:
-        return float(np.hypot(*np.diff(self.path, axis=0).T).sum()) if self.moves else 0.0
+        pts = self.path if self.trace is None else self.trace
+        return float(np.hypot(*np.diff(pts, axis=0).T).sum()) if len(pts) > 1 else 0.0
 
     @property
     def smoothness(self) -> float:
@@ -134,20 +144,27 @@ def _navigation(world: World, goal: np.ndarray, resolution: float):
 def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 1.0,
               repulse: float = 60.0, sensor_range: float = 6.0, sensor_rays: int = 36,
               tolerance: float = 0.5, max_moves: int = 2000, escape: bool = True,
-              window: int = 40) -> FieldRun:
+              window: int = 40, mode: str = "step", max_turn: float = math.pi / 4,
+              heading: float | None = None) -> FieldRun:
     """Descend the field from ``start``; when ``escape`` and the last ``window`` moves
-    made less than two steps of net progress, follow the navigation function instead."""
-    if not (step > 0 and sensor_range > 0 and sensor_rays >= 4 and tolerance > 0):
-        raise OptionError("step, sensor_range and tolerance must be > 0 and sensor_rays >= 4")
+    made less than two steps of net progress, follow the navigation function instead.
+    In ``arc`` mode the robot starts on ``heading`` (radians; default towards the goal)."""
+    check_choice("mode", mode, MODES)
+    if not (step > 0 and sensor_range > 0 and sensor_rays >= 4 and tolerance > 0
+            and 0 < max_turn <= math.pi):
+        raise OptionError("step, sensor_range and tolerance must be > 0, sensor_rays >= 4 "
+                          "and 0 < max_turn <= pi")
     p = world.check_point(start, "start")
     t = world.check_point(goal, "goal")
+    theta = math.atan2(*(t - p)[::-1]) if heading is None else float(heading)
     path = [p.copy()]
+    trace = [p.copy()]
     nav = None
     escaped = 0
     on_nav = 0
     while len(path) <= max_moves:
         if math.dist(p, t) < tolerance:
-            return FieldRun(np.array(path), True, escaped)
+            break
         stalled = len(path) > window and math.dist(path[-1], path[-window]) < 2 * step
         if escape and (stalled or on_nav > 0):
             if nav is None:
@@ -157,30 +174,74 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
                 break
             escaped += 1
             on_nav = on_nav - 1 if on_nav > 0 else int(4 * sensor_range / step)
+            theta = math.atan2(*(q - p)[::-1])
+            arc = np.array([q])
         else:
             if stalled:
                 break
-            to_goal = t - p
-            force = attract * to_goal / np.linalg.norm(to_goal)
-            hits = _sense(world, p, sensor_range, sensor_rays)
-            if len(hits):
-                away = p - hits
-                d = np.maximum(np.hypot(*away.T), 1e-9)
-                mag = repulse * (1 / d - 1 / sensor_range) / d ** 2 / sensor_rays
-                force = force + (mag[:, None] * away / d[:, None]).sum(axis=0)
-            norm = np.linalg.norm(force)
-            if norm < 1e-12:
+            force = _force(world, p, t, attract, repulse, sensor_range, sensor_rays)
+            if force is None:
                 break
-            q = p + step * force / norm
-            if math.dist(q, t) < step:
-                q = t.copy()
-            if not world.segment_free(p, q):
-                q = p + 0.5 * step * force / norm
-                if not world.segment_free(p, q):
-                    break
+            if mode == "step":
+                arc = _straight(world, p, t, step, force)
+            else:
+                arc, theta = _arc(world, p, theta, step, force, max_turn)
+            if arc is None:
+                break
+            q = arc[-1]
         path.append(q)
+        trace.extend(arc)
         p = q
-    return FieldRun(np.array(path), math.dist(p, t) < tolerance, escaped)
+    return FieldRun(np.array(path), math.dist(p, t) < tolerance, escaped,
+                    np.array(trace) if mode == "arc" else None)
+
+
+def _force(world, p, t, attract, repulse, sensor_range, sensor_rays) -> np.ndarray | None:
+    """Unit direction of attraction plus the sensed repulsion, or None where they cancel."""
+    to_goal = t - p
+    force = attract * to_goal / np.linalg.norm(to_goal)
+    hits = _sense(world, p, sensor_range, sensor_rays)
+    if len(hits):
+        away = p - hits
+        d = np.maximum(np.hypot(*away.T), 1e-9)
+        mag = repulse * (1 / d - 1 / sensor_range) / d ** 2 / sensor_rays
+        force = force + (mag[:, None] * away / d[:, None]).sum(axis=0)
+    norm = np.linalg.norm(force)
+    return None if norm < 1e-12 else force / norm
+
+
+def _straight(world, p, t, step, u) -> np.ndarray | None:
+    """A full step along u (landing on the goal when within a step), else half of one."""
+    q = p + step * u
+    if math.dist(q, t) < step:
+        q = t.copy()
+    if not world.segment_free(p, q):
+        q = p + 0.5 * step * u
+        if not world.segment_free(p, q):
+            return None
+    return q[None, :]
+
+
+def _arc(world, p, theta, step, u, max_turn):
+    """Turn towards u by at most ``max_turn`` along a circular arc whose length is
+    ``step`` x max(cos(heading error), 1/4); halve it once if blocked. Returns the
+    sampled arc (ARC_SAMPLES, 2) and the new heading, or (None, theta)."""
+    err = (math.atan2(u[1], u[0]) - theta + math.pi) % (2 * math.pi) - math.pi
+    turn = max(-max_turn, min(max_turn, err))
+    for scale in (1.0, 0.5):
+        length = scale * step * max(math.cos(err), 0.25)
+        s = np.linspace(length / ARC_SAMPLES, length, ARC_SAMPLES)
+        if abs(turn) < 1e-9:
+            pts = p + s[:, None] * np.array([math.cos(theta), math.sin(theta)])
+        else:
+            r = length / turn  # signed radius: positive turns left
+            a = theta + turn * s / length
+            pts = p + r * np.c_[np.sin(a) - math.sin(theta), math.cos(theta) - np.cos(a)]
+        ok = world.segment_free(p, pts[0]) and all(
+            world.segment_free(pts[i], pts[i + 1]) for i in range(ARC_SAMPLES - 1))
+        if ok:
+            return pts, theta + turn
+    return None, theta
 
 
 def _descend(world: World, nav, p: np.ndarray) -> np.ndarray | None:
