@@ -8,6 +8,8 @@ from rich.table import Table
 
 from skyroute.cli import bench_world_cmd  # noqa: F401  (registers 'bench world')
 from skyroute.cli.bench_cmd import bench_app
+from skyroute.cli.db_cmd import db_app
+from skyroute.cli.deliver_cmd import deliver_command
 from skyroute.cli.errors import run_cli
 from skyroute.cli.fly_cmd import fly_command
 from skyroute.cli.plan_cmd import plan_command
@@ -22,6 +24,8 @@ app.command("plan-world")(plan_world_command)
 app.command("synth-city")(synth_city_command)
 app.command("fly")(fly_command)
 app.add_typer(bench_app, name="bench")
+app.command("deliver")(deliver_command)
+app.add_typer(db_app, name="db")
 
 
 @app.command("maps")

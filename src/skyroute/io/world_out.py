@@ -60,19 +60,9 @@ def plot_world_path(world: World, result: PlanResult, start, goal, path: str | P
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import shapely
 
     fig, ax = plt.subplots(figsize=(8, 8))
-    for poly in world.obstacles:
-        for part in getattr(poly, "geoms", [poly]):
-            x, y = part.exterior.xy
-            ax.fill(x, y, color="0.45", lw=0)
-            for hole in part.interiors:
-                hx, hy = hole.xy
-                ax.fill(hx, hy, color="white", lw=0)
-    if world.boundary is not None:
-        x, y = shapely.Polygon(world.boundary).exterior.xy
-        ax.plot(x, y, "--", color="tab:orange", lw=1.2, label="boundary")
+    draw_world(ax, world)
     if edges is not None and len(edges):
         from matplotlib.collections import LineCollection
 
@@ -85,9 +75,30 @@ def plot_world_path(world: World, result: PlanResult, start, goal, path: str | P
     unit = "deg" if world.frame == "degrees" else "m"
     cost = f"{result.cost:.6g} {unit}" if result.found else result.status.value
     ax.set_title(f"{world.name}: {result.algorithm}, {cost}", fontsize=10)
+    finish_axes(ax, world)
+    return save_figure(fig, path, dpi=dpi)
+
+
+def draw_world(ax, world: World) -> None:
+    """Obstacles filled grey (holes white) and the boundary dashed."""
+    import shapely
+
+    for poly in world.obstacles:
+        for part in getattr(poly, "geoms", [poly]):
+            x, y = part.exterior.xy
+            ax.fill(x, y, color="0.45", lw=0)
+            for hole in part.interiors:
+                hx, hy = hole.xy
+                ax.fill(hx, hy, color="white", lw=0)
+    if world.boundary is not None:
+        x, y = shapely.Polygon(world.boundary).exterior.xy
+        ax.plot(x, y, "--", color="tab:orange", lw=1.2, label="boundary")
+
+
+def finish_axes(ax, world: World) -> None:
+    """Axis names, true proportions (degrees squeezed by cos latitude), a legend."""
     ax.set_xlabel("longitude" if world.frame == "degrees" else "east (m)")
     ax.set_ylabel("latitude" if world.frame == "degrees" else "north (m)")
     ax.set_aspect("equal" if world.frame == "metres" else
                   1 / np.cos(np.radians(np.mean(ax.get_ylim()))))
     ax.legend(loc="best", fontsize=8, framealpha=0.9)
-    return save_figure(fig, path, dpi=dpi)

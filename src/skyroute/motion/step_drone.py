@@ -38,6 +38,7 @@ ANGLES = np.arange(0, 360, 10)
 MERGE = 5e-6  # positions in one lattice cell this wide (1/30 step) are one state
 _CORNER_GRAPHS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _ZONES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_BOUNDS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,6 +130,17 @@ class DistanceBound:
         self.dist = dijkstra(graph, directed=False, indices=n)[:n] if n else np.zeros(0)
 
 
+def _bound(world: World, t: np.ndarray) -> DistanceBound:
+    """The corner table for target ``t`` (kept per world: delivery legs share targets)."""
+    tables = _BOUNDS.setdefault(world, {})
+    key = (float(t[0]), float(t[1]))
+    if key not in tables:
+        if len(tables) > 256:
+            tables.clear()
+        tables[key] = DistanceBound(world, t)
+    return tables[key]
+
+
 def _zones(world: World) -> tuple:
     """The compiled kernels' view of the zones (cached per world)."""
     z = _ZONES.get(world)
@@ -167,7 +179,7 @@ def plan_moves(world: World, start, target, *, step: float = STEP,
         raise OptionError(f"merge={merge!r} must be a positive number")
     rad = np.radians(ANGLES)
     deltas = step * np.c_[np.cos(rad), np.sin(rad)]
-    bound = DistanceBound(world, t)
+    bound = _bound(world, t)
     sees0 = bool(world.segments_free([s], [t])[0])
     status, goal, expanded, x, y, parent, move = move_search.search(
         s[0], s[1], t[0], t[1], sees0, deltas, *_zones(world), bound.corners,

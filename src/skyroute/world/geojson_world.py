@@ -21,9 +21,9 @@ from skyroute.geo import Home, lonlat_to_enu
 from skyroute.world.world import World
 
 
-def _features(path: Path) -> list[dict]:
+def _features(path: Path | str, text: str | None = None) -> list[dict]:
     try:
-        doc = json.loads(path.read_text())
+        doc = json.loads(Path(path).read_text() if text is None else text)
     except (OSError, UnicodeDecodeError) as exc:
         raise InputFormatError(path, f"cannot read: {exc}") from None
     except json.JSONDecodeError as exc:
@@ -80,15 +80,18 @@ def parse_boundary(value: str | Path) -> shapely.Polygon:
 
 
 def read_geojson_world(path: str | Path, *, boundary: str | Path | shapely.Polygon | None = None,
-                       safety: float = 0.0, frame: str = "degrees") -> World:
+                       safety: float = 0.0, frame: str = "degrees",
+                       text: str | None = None) -> World:
     """Read zones (and a boundary) from a FeatureCollection in lon/lat.
 
     ``safety`` grows every zone by that distance in the frame's units (mitred corners,
     so polygons stay polygons; a point at the corner keeps at least that distance).
+    ``text``: the document itself, already fetched; ``path`` then only names it (a URL).
     """
-    path = Path(path)
+    if text is None:
+        path = Path(path)
     zones, names, found = [], [], None
-    for i, feature in enumerate(_features(path)):
+    for i, feature in enumerate(_features(path, text)):
         shape, name = _polygon(path, i, feature)
         if _is_boundary(feature):
             found = shape
@@ -116,7 +119,7 @@ def read_geojson_world(path: str | Path, *, boundary: str | Path | shapely.Polyg
             pnames.append(name)
     n = len(polys)
     return World(np.array(polys, dtype=object), np.full(n, -np.inf), np.full(n, np.inf),
-                 tuple(pnames), found, frame, home, name=path.name)
+                 tuple(pnames), found, frame, home, name=str(path).rstrip("/").rsplit("/")[-1])
 
 
 def _to_metres(shape: shapely.Geometry, home: Home) -> shapely.Geometry:

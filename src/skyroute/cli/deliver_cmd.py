@@ -1,0 +1,158 @@
+"""``skyroute deliver``: one delivery day, or many in parallel, into the SQL store."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import time
+from collections import defaultdict
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from skyroute.delivery.day import METHODS, DayResult
+from skyroute.delivery.store import DEFAULT_DB
+from skyroute.errors import OptionError, SkyrouteError, check_choice
+
+
+def _date(text: str | None, option: str) -> dt.date | None:
+    if text is None:
+        return None
+    try:
+        return dt.date.fromisoformat(text)
+    except ValueError:
+        raise OptionError(f"{option} {text!r}: expected a date YYYY-MM-DD") from None
+
+
+def deliver_command(
+    date: Annotated[str | None, typer.Argument(metavar="[DATE]", help="The day, YYYY-MM-DD.")] =
+        None,
+    first: Annotated[str | None, typer.Option("--from", help="First day of a range.")] = None,
+    last: Annotated[str | None, typer.Option("--to", help="Last day of a range.")] = None,
+    data: Annotated[Path | None, typer.Option(
+        help="Data folder in the ILP layout (website/, database/); its orders are imported "
+             "into the store first.")] = None,
+    source: Annotated[str | None, typer.Option(
+        help="Read website/ from this URL instead (see 'skyroute data serve').")] = None,
+    db: Annotated[str, typer.Option(help="SQLAlchemy URL of the store.")] = DEFAULT_DB,
+    out: Annotated[Path, typer.Option(help="Folder for the GeoJSON, PNG and report files.")] =
+        Path("."),
+    jobs: Annotated[int, typer.Option(help="Worker processes for a range of days.")] = 1,
+    method: Annotated[str, typer.Option(help="milp (exact over the leg table) or greedy.")] =
+        "milp",
+    plot: Annotated[bool | None, typer.Option(
+        help="Draw each day's PNG (default: on for one day, off for a range).")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the report as JSON.")] = False,
+) -> None:
+    """Fly a day's lunch orders: choose, order and fly them for the most money within the
+    battery, store deliveries and flightpath, and write drone-DD-MM-YYYY.geojson."""
+    from skyroute.delivery.days import open_store, prepare_legs, run_days
+    from skyroute.delivery.orders import read_csv_orders
+    from skyroute.delivery.site import load_site
+    from skyroute.delivery.source import open_source
+    from skyroute.delivery.store import import_orders, orders_between
+
+    check_choice("method", method, METHODS)
+    day, d0, d1 = _date(date, "DATE"), _date(first, "--from"), _date(last, "--to")
+    if (day is None) == (d0 is None and d1 is None) or (day is None and (d0 is None or
+                                                                          d1 is None)):
+        raise OptionError("give a DATE, or both --from and --to")
+    if day is not None:
+        d0 = d1 = day
+    if d1 < d0:
+        raise OptionError(f"--to {d1} is before --from {d0}")
+    if jobs < 1:
+        raise OptionError(f"--jobs {jobs} must be at least 1")
+    src = open_source(data, source)
+    site = load_site(src)
+    engine = open_store(db)
+    err = Console(stderr=True)
+    if data is not None:
+        added, _ = import_orders(engine, read_csv_orders(data))
+        if added:
+            err.print(f"imported {added:,} orders from {data / 'database'}")
+    by_date = orders_between(engine, d0, d1)
+    for d in (d0 + dt.timedelta(k) for k in range((d1 - d0).days + 1)):
+        by_date.setdefault(d, [])
+    all_orders = [o for v in by_date.values() for o in v]
+    with _progress(err) as progress:
+        task = progress.add_task("leg table", total=None)
+        prepare_legs(site, all_orders, on_leg=lambda: progress.advance(task),
+                     on_total=lambda n: progress.update(task, total=n))
+        progress.remove_task(task)
+        days = progress.add_task("days", total=len(by_date))
+        t0 = time.perf_counter()
+        results = run_days(site, engine, by_date, out, jobs=jobs, method=method,
+                           plot=(day is not None) if plot is None else plot,
+                           on_day=lambda r: progress.advance(days))
+        wall = time.perf_counter() - t0
+    if day is not None:
+        _one_day(results[0], out, as_json)
+    else:
+        _summary(results, wall, jobs, as_json)
+
+
+def _progress(console: Console) -> Progress:
+    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                    TimeRemainingColumn(), console=console, transient=True)
+
+
+def _one_day(r: DayResult, out: Path, as_json: bool) -> None:
+    rep = r.report()
+    if as_json:
+        typer.echo(json.dumps(rep))
+        return
+    t = Table(title=f"delivery day {r.date}", show_header=False)
+    pct = rep["money_pct"]
+    rows = [("orders placed", rep["orders_placed"]), ("delivered", rep["orders_delivered"]),
+            ("invalid", rep["orders_invalid"]),
+            ("money delivered", f"{rep['money_delivered']:,}p of {rep['money_placed']:,}p"
+             + ("" if pct is None else f" ({pct:.2f}%)")),
+            ("moves", f"{rep['moves']} (battery left {rep['moves_left']})"),
+            ("time", f"{rep['seconds']:.2f} s"),
+            ("files", str(out / f"drone-{r.date:%d-%m-%Y}.geojson"))]
+    for k, v in rows:
+        t.add_row(k, str(v))
+    Console().print(t)
+    for o, reason in r.invalid:
+        Console(stderr=True).print(f"invalid order {o.order_no}: {reason}", markup=False)
+
+
+def summarise(results: list[DayResult]) -> dict:
+    """Mean and minimum money % over the days with orders, and per month."""
+    pcts = [(r.date, r.money_pct) for r in results if r.money_pct is not None]
+    if not pcts:
+        return {"days": len(results), "days_with_orders": 0}
+    months = defaultdict(list)
+    for d, p in pcts:
+        months[f"{d:%Y-%m}"].append(p)
+    worst = min(pcts, key=lambda x: x[1])
+    return {"days": len(results), "days_with_orders": len(pcts),
+            "mean_pct": sum(p for _, p in pcts) / len(pcts), "min_pct": worst[1],
+            "min_date": worst[0].isoformat(),
+            "months": {m: {"mean_pct": sum(v) / len(v), "min_pct": min(v), "days": len(v)}
+                       for m, v in sorted(months.items())},
+            "moves_max": max(r.flight.moves for r in results),
+            "seconds_per_day_mean": sum(r.seconds for r in results) / len(results),
+            "seconds_per_day_max": max(r.seconds for r in results)}
+
+
+def _summary(results: list[DayResult], wall: float, jobs: int, as_json: bool) -> None:
+    s = summarise(results)
+    s["wall_seconds"], s["jobs"] = wall, jobs
+    if as_json:
+        typer.echo(json.dumps(s))
+        return
+    if not s["days_with_orders"]:
+        raise SkyrouteError("no orders on any of these days")
+    t = Table(title=f"{s['days']} days, {wall:.1f} s with {jobs} job(s): money delivered "
+                    f"mean {s['mean_pct']:.2f}%, worst {s['min_pct']:.2f}% on {s['min_date']}")
+    for col in ("month", "days", "mean %", "min %"):
+        t.add_column(col, justify="right")
+    for m, v in s["months"].items():
+        t.add_row(m, str(v["days"]), f"{v['mean_pct']:.2f}", f"{v['min_pct']:.2f}")
+    Console().print(t)

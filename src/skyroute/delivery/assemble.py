@@ -1,0 +1,88 @@
+"""Turn a plan (orders, shop orders) into the day's flight: legal moves from the actual
+position to each stop, a hover at each, and the way home; every leg is ``plan_moves``
+from where the drone really is, so the flight may differ from the leg table by a move
+here and there. The day's loop (:mod:`skyroute.delivery.day`) re-plans with a smaller
+budget when the flight comes out over the battery.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from skyroute.errors import SkyrouteError
+from skyroute.motion.step_drone import HOVER, MERGE, STEP, Flight, plan_moves
+from skyroute.world.world import World
+
+_LEGS: dict = {}  # (start bytes, target) -> (angles, tos): legs recur across days
+# (merge, expansions): the fewest moves when that is quick to find (96% of the legs of
+# Dec 2023), else a coarser lattice, which on the rest flies the same count 9 times in
+# 10 and one move more otherwise, at a twentieth of the time (docs/benchmarks.md).
+LADDER = ((MERGE, 1000), (1e-5, 20_000), (3e-5, 200_000))
+
+
+@dataclass(frozen=True)
+class DayFlight:
+    """Moves of a day with the order each move serves (SPEC.md 4.6)."""
+
+    flight: Flight
+    order_no: tuple[str, ...]
+    stops: tuple[tuple[str, int], ...]  # (order_no, index of the hover), in order
+
+    @property
+    def moves(self) -> int:
+        return self.flight.moves
+
+
+def leg(world: World, start: np.ndarray, target: tuple[float, float]) -> Flight:
+    """The fewest moves from ``start`` to close to ``target`` (none when already close)."""
+    if math.dist(start, target) < STEP:
+        e = np.empty((0, 2))
+        return Flight(e, np.empty(0, int), e.copy())
+    key = (start.tobytes(), target)
+    hit = _LEGS.get(key)
+    if hit is None:
+        for merge, budget in LADDER:
+            f = plan_moves(world, start, target, merge=merge, max_expansions=budget)
+            if f.status.value != "budget_exhausted":
+                break
+        if f.status.value != "found":
+            raise SkyrouteError(f"no flight from ({start[0]:.6f}, {start[1]:.6f}) to "
+                                f"({target[0]:.6f}, {target[1]:.6f}): {f.status.value}")
+        if len(_LEGS) > 200_000:
+            _LEGS.clear()
+        hit = _LEGS[key] = (f.angle, f.frm, f.to)
+    angle, frm, to = hit
+    return Flight(frm, angle, to)
+
+
+def fly_day(world: World, home: tuple[float, float],
+            visits: list[tuple[str, list[tuple[float, float]]]]) -> DayFlight:
+    """Fly ``visits`` = [(order_no, [shop, ..., customer]), ...] from home and back,
+    hovering once at every stop."""
+    pos = np.asarray(home, dtype=float)
+    parts, labels, stops = [], [], []
+    n = 0
+    for order_no, points in visits:
+        for p in points:
+            f = leg(world, pos, p)
+            if f.moves:
+                parts.append(f)
+                pos = f.to[-1]
+            h = Flight(pos[None, :].copy(), np.array([HOVER]), pos[None, :].copy())
+            parts.append(h)
+            labels += [order_no] * (f.moves + 1)
+            n += f.moves + 1
+            stops.append((order_no, n - 1))
+    f = leg(world, pos, home)
+    if f.moves:
+        parts.append(f)
+        labels += [visits[-1][0] if visits else "home"] * f.moves
+    if not parts:
+        e = np.empty((0, 2))
+        return DayFlight(Flight(e, np.empty(0, int), e.copy()), (), ())
+    flight = Flight(np.vstack([p.frm for p in parts]), np.concatenate([p.angle for p in parts]),
+                    np.vstack([p.to for p in parts]))
+    return DayFlight(flight, tuple(labels), tuple(stops))

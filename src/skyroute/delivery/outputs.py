@@ -1,0 +1,97 @@
+"""What a delivery day leaves behind: its rows in the store, ``drone-DD-MM-YYYY.geojson``
+(the flight as one LineString, SPEC.md 4.6), a PNG map of the day and a JSON report.
+
+The store is written first, in one transaction; each file is then written whole or not
+at all.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+from pathlib import Path
+
+import numpy as np
+
+from skyroute.delivery import store
+from skyroute.delivery.day import DayResult
+from skyroute.io.files import write_atomic
+
+
+def stem(date: dt.date) -> str:
+    return f"drone-{date:%d-%m-%Y}"
+
+
+def store_day(engine, result: DayResult) -> None:
+    f = result.flight.flight
+    run = {"started": dt.datetime.fromtimestamp(result.started),
+           "finished": dt.datetime.fromtimestamp(result.started + result.seconds),
+           "moves": f.moves, "orders_placed": len(result.orders),
+           "orders_delivered": len(result.delivered), "orders_invalid": len(result.invalid),
+           "money_delivered": result.money_delivered, "money_placed": result.money_placed,
+           "settings": result.settings}
+    delivered = [{"order_no": p.order.order_no, "delivered_to": p.order.deliver_to,
+                  "cost_in_pence": p.cost} for p in result.delivered]
+    moves = ({"seq": k, "order_no": result.flight.order_no[k],
+              "from_lon": float(f.frm[k, 0]), "from_lat": float(f.frm[k, 1]),
+              "angle": int(f.angle[k]), "to_lon": float(f.to[k, 0]),
+              "to_lat": float(f.to[k, 1])} for k in range(f.moves))
+    store.write_day(engine, result.date, run, delivered, moves)
+
+
+def geojson(result: DayResult, home) -> str:
+    f = result.flight.flight
+    pts = np.vstack([f.frm[:1], f.to]) if f.moves else np.array([home, home], dtype=float)
+    return json.dumps({"type": "FeatureCollection", "features": [{
+        "type": "Feature", "properties": {"date": result.date.isoformat(),
+                                          "moves": f.moves},
+        "geometry": {"type": "LineString", "coordinates": pts.tolist()}}]})
+
+
+def plot_day(site, result: DayResult, path: Path) -> Path:
+    """Zones, area, the flight, shops, customers served (green) or not (red), home."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from skyroute.io.plot import save_figure
+    from skyroute.io.world_out import draw_world, finish_axes
+
+    fig, ax = plt.subplots(figsize=(10, 6))
+    draw_world(ax, site.world)
+    f = result.flight.flight
+    if f.moves:
+        pts = np.vstack([f.frm[:1], f.to])
+        ax.plot(pts[:, 0], pts[:, 1], "-", color="tab:blue", lw=0.8, label="flight")
+    for s in site.shops:
+        ax.plot(*s.lonlat, "s", color="tab:purple", ms=7)
+        ax.annotate(s.name, s.lonlat, fontsize=7, xytext=(4, 4), textcoords="offset points")
+    ax.plot([], [], "s", color="tab:purple", label="shop")
+    served = {p.lonlat for p in result.delivered}
+    missed = {site.locate(o.deliver_to) for o in result.orders
+              if o.order_no not in {p.order.order_no for p in result.delivered}
+              and o not in {q for q, _ in result.invalid}} - served
+    for pts, colour, label in ((served, "tab:green", "customer served"),
+                               (missed, "tab:red", "customer not served")):
+        if pts:
+            a = np.array(sorted(pts))
+            ax.plot(a[:, 0], a[:, 1], "o", color=colour, ms=7, label=label)
+    ax.plot(*site.home, "*", color="black", ms=13, label="home")
+    pct = result.money_pct
+    ax.set_title(f"{result.date:%d %b %Y}: {len(result.delivered)}/{len(result.orders)} "
+                 f"orders, {'no orders' if pct is None else f'{pct:.1f}% of the money'}, "
+                 f"{f.moves} moves", fontsize=10)
+    finish_axes(ax, site.world)
+    return save_figure(fig, path)
+
+
+def write_outputs(site, result: DayResult, out: Path, *, plot: bool = True) -> list[Path]:
+    """The day's GeoJSON, report and (optionally) PNG in ``out``."""
+    base = out / stem(result.date)
+    paths = [write_atomic(base.with_suffix(".geojson"), geojson(result, site.home)),
+             write_atomic(out / f"report-{result.date:%d-%m-%Y}.json",
+                          json.dumps(result.report(), indent=1))]
+    if plot:
+        paths.append(plot_day(site, result, base.with_suffix(".png")))
+    return paths

@@ -1,0 +1,169 @@
+"""The SQL store: orders in, deliveries and flight paths out (SQLAlchemy 2 Core).
+
+Tables (the course's schemas plus the day and order of moves):
+
+- ``orders(order_no, delivery_date, customer, deliver_to)``, ``order_details(order_no,
+  line, item)``
+- ``deliveries(delivery_date, order_no, delivered_to, cost_in_pence)``
+- ``flightpath(delivery_date, seq, order_no, from_lon, from_lat, angle, to_lon, to_lat)``
+- ``runs(delivery_date, started, finished, moves, money_delivered, money_placed, ...)``
+
+A SQLite file by default, PostgreSQL (or any SQLAlchemy URL) by ``--db``. The schema is
+made and upgraded by Alembic migrations shipped in the package (``db init`` runs them).
+A day's results go in one transaction: its old rows are deleted and the new ones
+inserted together, so a run killed midway leaves the previous state of that day.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+from collections.abc import Iterable
+from pathlib import Path
+
+import sqlalchemy as sa
+
+from skyroute.errors import SkyrouteError
+
+DEFAULT_DB = "sqlite:///skyroute.db"
+TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
+_REFLECTED: dict[str, dict[str, sa.Table]] = {}
+
+
+def tables(engine: sa.Engine) -> dict[str, sa.Table]:
+    """The tables as the migrations made them (reflected once per database): the
+    migrations are the one definition of the schema."""
+    key = str(engine.url)
+    if key not in _REFLECTED:
+        if not sa.inspect(engine).has_table("runs"):
+            raise SkyrouteError(f"{_safe(key)}: no skyroute tables; run 'skyroute db init' "
+                                "first")
+        md = sa.MetaData()
+        md.reflect(engine, only=TABLES)
+        _REFLECTED[key] = dict(md.tables)
+    return _REFLECTED[key]
+
+
+def connect(url: str = DEFAULT_DB) -> sa.Engine:
+    """An engine for ``url``; a bad URL or an unreachable server is one clear error."""
+    try:
+        engine = sa.create_engine(url)
+        with engine.connect():
+            pass
+    except sa.exc.ArgumentError:
+        raise SkyrouteError(f"--db {url!r}: not a database URL (e.g. sqlite:///skyroute.db or "
+                            "postgresql+psycopg://user@127.0.0.1:5432/test)") from None
+    except (sa.exc.OperationalError, sa.exc.InterfaceError) as exc:
+        raise SkyrouteError(f"--db {_safe(url)}: cannot connect: "
+                            f"{str(exc.orig).strip().splitlines()[0]}") from None
+    except ModuleNotFoundError as exc:
+        raise SkyrouteError(f"--db {_safe(url)}: driver {exc.name!r} is not installed") from None
+    return engine
+
+
+def _safe(url: str) -> str:
+    return sa.engine.make_url(url).render_as_string(hide_password=True)
+
+
+def init(engine: sa.Engine) -> str:
+    """Create or upgrade the schema to the newest migration; return its revision."""
+    from alembic import command
+    from alembic.config import Config
+    from alembic.runtime.migration import MigrationContext
+
+    cfg = Config()
+    cfg.set_main_option("script_location", str(Path(__file__).parent / "migrations"))
+    with engine.begin() as conn:
+        cfg.attributes["connection"] = conn
+        command.upgrade(cfg, "head")
+    _REFLECTED.pop(str(engine.url), None)
+    with engine.connect() as conn:
+        return MigrationContext.configure(conn).get_current_revision()
+
+
+def import_orders(engine: sa.Engine, all_orders: Iterable) -> tuple[int, int]:
+    """Insert the orders (and their items) not already stored; (added, already there).
+    One transaction: an error leaves the store as it was."""
+    t = tables(engine)
+    orders, order_details = t["orders"], t["order_details"]
+    with engine.begin() as conn:
+        have = set(conn.scalars(sa.select(orders.c.order_no)))
+        new = [o for o in all_orders if o.order_no not in have]
+        if new:
+            conn.execute(orders.insert(), [
+                {"order_no": o.order_no, "delivery_date": o.date, "customer": o.customer,
+                 "deliver_to": o.deliver_to} for o in new])
+            rows = [{"order_no": o.order_no, "line": k, "item": item}
+                    for o in new for k, item in enumerate(o.items)]
+            if rows:
+                conn.execute(order_details.insert(), rows)
+    return len(new), len(have)
+
+
+def orders_between(engine: sa.Engine, first: dt.date, last: dt.date) -> dict[dt.date, list]:
+    """The stored orders of each day from ``first`` to ``last`` (days without orders are
+    absent), items in their original order."""
+    from skyroute.delivery.orders import Order
+
+    t = tables(engine)
+    orders, order_details = t["orders"], t["order_details"]
+    when = orders.c.delivery_date.between(first, last)
+    with engine.connect() as conn:
+        heads = conn.execute(sa.select(orders).where(when).order_by(orders.c.order_no)).all()
+        items: dict[str, list[str]] = {h.order_no: [] for h in heads}
+        q = sa.select(order_details.c.order_no, order_details.c.item) \
+            .join(orders, orders.c.order_no == order_details.c.order_no).where(when) \
+            .order_by(order_details.c.order_no, order_details.c.line)
+        for no, item in conn.execute(q):
+            items[no].append(item)
+    out: dict[dt.date, list] = {}
+    for h in heads:
+        out.setdefault(h.delivery_date, []).append(
+            Order(h.order_no, h.delivery_date, h.customer, h.deliver_to,
+                  tuple(items[h.order_no])))
+    return out
+
+
+def order_dates(engine: sa.Engine) -> list[dt.date]:
+    orders = tables(engine)["orders"]
+    with engine.connect() as conn:
+        return list(conn.scalars(sa.select(orders.c.delivery_date).distinct()
+                                 .order_by(orders.c.delivery_date)))
+
+
+def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[dict],
+              moves: Iterable[dict]) -> None:
+    """Replace one day's results in one transaction (``moves`` may be a generator)."""
+    t_ = tables(engine)
+    flightpath, deliveries, runs = t_["flightpath"], t_["deliveries"], t_["runs"]
+    with engine.begin() as conn:
+        for t in (flightpath, deliveries, runs):
+            conn.execute(t.delete().where(t.c.delivery_date == date))
+        conn.execute(runs.insert(), [{**run, "delivery_date": date,
+                                      "settings": json.dumps(run.get("settings", {}),
+                                                             sort_keys=True)}])
+        rows = [{**d, "delivery_date": date} for d in delivered]
+        if rows:
+            conn.execute(deliveries.insert(), rows)
+        batch = []
+        for m in moves:
+            batch.append({**m, "delivery_date": date})
+            if len(batch) >= 500:
+                conn.execute(flightpath.insert(), batch)
+                batch = []
+        if batch:
+            conn.execute(flightpath.insert(), batch)
+
+
+def day_rows(engine: sa.Engine, date: dt.date) -> dict[str, list[tuple]]:
+    """A day's stored deliveries and flightpath rows (for comparing stores)."""
+    t = tables(engine)
+    flightpath, deliveries = t["flightpath"], t["deliveries"]
+    with engine.connect() as conn:
+        return {
+            "deliveries": [tuple(r) for r in conn.execute(
+                sa.select(deliveries).where(deliveries.c.delivery_date == date)
+                .order_by(deliveries.c.order_no))],
+            "flightpath": [tuple(r) for r in conn.execute(
+                sa.select(flightpath).where(flightpath.c.delivery_date == date)
+                .order_by(flightpath.c.seq))]}
