@@ -25,3 +25,16 @@ def movingai_pairs() -> list[tuple[Path, Path]]:
 
 needs_shared = pytest.mark.skipif(not MOVINGAI.is_dir() and not os.environ.get("CI"),
                                   reason=f"reference data not found at {MOVINGAI}")
+
+
+@pytest.fixture(scope="session", autouse=True)
+def leg_cache(tmp_path_factory):
+    """Delivery leg tables go to one temporary cache for the whole run, not ~/.cache."""
+    path = tmp_path_factory.mktemp("skyroute-cache")
+    old = os.environ.get("SKYROUTE_CACHE")
+    os.environ["SKYROUTE_CACHE"] = str(path)
+    yield path
+    if old is None:
+        os.environ.pop("SKYROUTE_CACHE", None)
+    else:
+        os.environ["SKYROUTE_CACHE"] = old

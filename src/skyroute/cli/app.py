@@ -8,6 +8,7 @@ from rich.table import Table
 
 from skyroute.cli import bench_world_cmd  # noqa: F401  (registers 'bench world')
 from skyroute.cli.bench_cmd import bench_app
+from skyroute.cli.data_cmd import data_app
 from skyroute.cli.db_cmd import db_app
 from skyroute.cli.deliver_cmd import deliver_command
 from skyroute.cli.errors import run_cli
@@ -26,6 +27,7 @@ app.command("fly")(fly_command)
 app.add_typer(bench_app, name="bench")
 app.command("deliver")(deliver_command)
 app.add_typer(db_app, name="db")
+app.add_typer(data_app, name="data")
 
 
 @app.command("maps")

@@ -63,7 +63,7 @@ def order_costs(legs: np.ndarray, origins: list[int], stops: list[tuple[list[int
 
 
 def solve(value: np.ndarray, cost: np.ndarray, back: np.ndarray, cust: np.ndarray,
-          budget: int, *, time_limit: float = 5.0) -> tuple[list[tuple[int, int]], bool]:
+          budget: int, *, time_limit: float = 2.0) -> tuple[list[tuple[int, int]], bool]:
     """Chosen arcs (order, origin index) of the best tour, origin 0 = home, and whether
     HiGHS proved it optimal. ``cost`` (P, n) from :func:`order_costs`, ``back`` (P,) moves
     from each origin home, ``cust[i]`` the origin index order i leaves the drone at."""

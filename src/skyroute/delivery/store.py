@@ -47,6 +47,10 @@ def tables(engine: sa.Engine) -> dict[str, sa.Table]:
 def connect(url: str = DEFAULT_DB) -> sa.Engine:
     """An engine for ``url``; a bad URL or an unreachable server is one clear error."""
     try:
+        parsed = sa.engine.make_url(url)
+        if parsed.drivername.startswith("sqlite") and parsed.database not in (None, "",
+                                                                               ":memory:"):
+            Path(parsed.database).parent.mkdir(parents=True, exist_ok=True)
         engine = sa.create_engine(url)
         with engine.connect():
             pass

@@ -1,0 +1,55 @@
+"""``skyroute data``: write a synthetic data set, or serve one's website over HTTP."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+
+from skyroute.errors import OptionError
+
+data_app = typer.Typer(help="Delivery data sets: synthesise one, serve one over HTTP.",
+                       no_args_is_help=True)
+
+
+@data_app.command("synth")
+def data_synth(
+    folder: Annotated[Path, typer.Argument(metavar="DIR", help="Where to write it.")],
+    days: Annotated[int, typer.Option(help="Days of orders.")] = 7,
+    orders_per_day: Annotated[int, typer.Option(help="Orders each day.")] = 12,
+    customers: Annotated[int, typer.Option(help="Customers' delivery places.")] = 7,
+    start: Annotated[str, typer.Option(help="First day, YYYY-MM-DD.")] = "2024-01-01",
+    seed: Annotated[int, typer.Option(help="Seed: the same seed writes the same files.")] = 1,
+) -> None:
+    """Write a synthetic data set in the ILP layout (website/, database/) in another town."""
+    from skyroute.delivery.synth import synth
+
+    try:
+        first = dt.date.fromisoformat(start)
+    except ValueError:
+        raise OptionError(f"--start {start!r}: expected a date YYYY-MM-DD") from None
+    summary = synth(folder, days=days, orders_per_day=orders_per_day, seed=seed, start=first,
+                    customers=customers)
+    Console().print(json.dumps(summary))
+
+
+@data_app.command("serve")
+def data_serve(
+    folder: Annotated[Path, typer.Argument(metavar="DIR", help="A data folder (website/).")],
+    port: Annotated[int, typer.Option(help="TCP port.")] = 9898,
+    host: Annotated[str, typer.Option(help="Address to listen on.")] = "127.0.0.1",
+) -> None:
+    """Serve DIR/website over HTTP until interrupted (read it with --source URL)."""
+    from skyroute.delivery.serve import make_server
+
+    server = make_server(folder, port, host)
+    Console(stderr=True).print(f"serving {folder / 'website'} at http://{host}:"
+                               f"{server.server_address[1]} (Ctrl-C to stop)")
+    try:
+        server.serve_forever()
+    finally:
+        server.server_close()

@@ -1,0 +1,109 @@
+"""The SQL store: migrations make the issue's tables, import is idempotent, a day is
+written whole (a killed run leaves the previous day) and rerunning replaces it."""
+
+from __future__ import annotations
+
+import datetime as dt
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+import sqlalchemy as sa
+
+from skyroute.delivery import store
+from skyroute.delivery.orders import Order
+from skyroute.errors import SkyrouteError
+
+DAY = dt.date(2024, 1, 1)
+COLUMNS = {
+    "orders": ["order_no", "delivery_date", "customer", "deliver_to"],
+    "order_details": ["order_no", "line", "item"],
+    "deliveries": ["delivery_date", "order_no", "delivered_to", "cost_in_pence"],
+    "flightpath": ["delivery_date", "seq", "order_no", "from_lon", "from_lat", "angle",
+                   "to_lon", "to_lat"],
+    "runs": ["delivery_date", "started", "finished", "moves", "orders_placed",
+             "orders_delivered", "orders_invalid", "money_delivered", "money_placed",
+             "settings"],
+}
+
+
+def run_row(moves: int) -> dict:
+    now = dt.datetime(2024, 1, 1, 12)
+    return {"started": now, "finished": now, "moves": moves, "orders_placed": 1,
+            "orders_delivered": 1, "orders_invalid": 0, "money_delivered": 100,
+            "money_placed": 100, "settings": {"method": "test"}}
+
+
+def moves(n: int, label: str = "aaaaaaaa"):
+    for k in range(n):
+        yield {"seq": k, "order_no": label, "from_lon": -3.0, "from_lat": 55.0,
+               "angle": -999, "to_lon": -3.0, "to_lat": 55.0}
+
+
+@pytest.fixture
+def engine(tmp_path):
+    e = store.connect(f"sqlite:///{tmp_path / 'store.db'}")
+    assert store.init(e) == "0001"
+    return e
+
+
+def test_init_makes_the_issues_tables_and_is_repeatable(engine):
+    insp = sa.inspect(engine)
+    for table, cols in COLUMNS.items():
+        assert [c["name"] for c in insp.get_columns(table)] == cols
+    assert store.init(engine) == "0001"  # again: nothing to do
+
+
+def test_import_is_idempotent(engine):
+    orders = [Order("0000000a", DAY, "s2400001", "a.b.c", ("x", "y", "x")),
+              Order("0000000b", DAY, "s2400002", "a.b.d", ("z",))]
+    assert store.import_orders(engine, orders) == (2, 0)
+    assert store.import_orders(engine, orders) == (0, 2)
+    back = store.orders_between(engine, DAY, DAY)[DAY]
+    assert back == orders  # items, repeats and order kept
+
+
+def test_rerun_replaces_the_day(engine):
+    store.write_day(engine, DAY, run_row(5), [], moves(5))
+    store.write_day(engine, DAY, run_row(3), [], moves(3, "bbbbbbbb"))
+    rows = store.day_rows(engine, DAY)["flightpath"]
+    assert len(rows) == 3 and {r[2] for r in rows} == {"bbbbbbbb"}
+
+
+def test_killed_run_leaves_no_partial_day(engine, tmp_path):
+    store.write_day(engine, DAY, run_row(5), [], moves(5))
+    script = textwrap.dedent(f"""
+        import datetime as dt, sys, time
+        from skyroute.delivery import store
+        from tests.delivery.test_store import moves, run_row
+        e = store.connect({str(engine.url)!r})
+        def slow():
+            for k, m in enumerate(moves(3000, "cccccccc")):
+                if k == 1200:  # two batches inserted, the old rows deleted
+                    print("midway", flush=True)
+                    time.sleep(120)
+                yield m
+        store.write_day(e, dt.date(2024, 1, 1), run_row(3000), [], slow())
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
+                            cwd=str(Path(__file__).parents[2]))
+    assert proc.stdout.readline().strip() == "midway"
+    proc.kill()
+    proc.wait()
+    engine.dispose()
+    rows = store.day_rows(engine, DAY)["flightpath"]
+    assert len(rows) == 5 and {r[2] for r in rows} == {"aaaaaaaa"}
+    with engine.connect() as c:
+        assert c.execute(sa.text("select moves from runs")).scalar_one() == 5
+
+
+def test_bad_urls_are_one_line_errors(tmp_path):
+    with pytest.raises(SkyrouteError, match="not a database URL"):
+        store.connect("nonsense")
+    with pytest.raises(SkyrouteError, match="cannot connect"):
+        store.connect("postgresql+psycopg://nobody@127.0.0.1:1/none")
+    e = store.connect(f"sqlite:///{tmp_path / 'empty.db'}")
+    with pytest.raises(SkyrouteError, match="skyroute db init"):
+        store.orders_between(e, DAY, DAY)

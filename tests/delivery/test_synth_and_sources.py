@@ -1,0 +1,92 @@
+"""The shipped synthetic set is what ``data synth`` writes; a day read over HTTP is the
+day read from the folder; unreachable servers and missing files are clear errors."""
+
+from __future__ import annotations
+
+import filecmp
+import json
+
+import pytest
+
+from skyroute.delivery.day import plan_day
+from skyroute.delivery.orders import read_csv_orders
+from skyroute.delivery.serve import serve_in_thread
+from skyroute.delivery.site import load_site
+from skyroute.delivery.source import DirSource, HttpSource
+from skyroute.errors import InputFormatError, SkyrouteError
+from tests.cli.test_cli import run
+from tests.conftest import ROOT
+from tests.delivery.flight_check import check_day, order_book, website
+
+EXAMPLE = ROOT / "examples" / "lunch"
+
+
+def same_tree(a, b) -> bool:
+    cmp = filecmp.dircmp(a, b)
+    if cmp.left_only or cmp.right_only or cmp.diff_files or cmp.funny_files:
+        return False
+    return all(same_tree(a / d, b / d) for d in cmp.common_dirs)
+
+
+def test_shipped_example_is_what_synth_writes(monkeypatch, capsys, tmp_path):
+    code, out, err = run(monkeypatch, capsys, "data", "synth", str(tmp_path / "lunch"),
+                         "--days", "3", "--orders-per-day", "36")
+    assert code == 0, err
+    assert json.loads(out.replace("\n", ""))["orders"] == 108
+    assert same_tree(EXAMPLE, tmp_path / "lunch")
+
+
+def test_synthetic_days_fly_legal_flights(monkeypatch, capsys, tmp_path):
+    url = f"sqlite:///{tmp_path / 's.db'}"
+    code, out, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
+                         "2024-01-03", "--data", str(EXAMPLE), "--db", url, "--out",
+                         str(tmp_path), "--jobs", "2", "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["days"] == 3 and summary["jobs"] == 2 and summary["moves_max"] <= 1500
+    from tests.delivery.test_ilp_days import rows
+
+    site, book = website(EXAMPLE), order_book(EXAMPLE)
+    for d in ("2024-01-01", "2024-01-02", "2024-01-03"):
+        deliveries, flight = rows(url, d)
+        assert flight and check_day(site, book, d, deliveries, flight) == []
+
+
+def test_http_source_gives_the_same_day(tmp_path):
+    server, url = serve_in_thread(EXAMPLE)
+    try:
+        by_http = load_site(HttpSource(url))
+        by_dir = load_site(DirSource(EXAMPLE))
+        assert by_http.menu == by_dir.menu and by_http.home == by_dir.home
+        orders = [o for o in read_csv_orders(EXAMPLE) if o.date.day == 2]
+        a = plan_day(by_http, orders[0].date, orders)
+        b = plan_day(by_dir, orders[0].date, orders)
+        assert a.flight.flight.rows() == b.flight.flight.rows()
+        with pytest.raises(InputFormatError, match=r"/words/no/such/place/details.json: no "
+                                                   r"such file \(HTTP 404\)"):
+            by_http.locate("no.such.place")
+    finally:
+        server.shutdown()
+        server.server_close()
+    with pytest.raises(SkyrouteError, match="cannot reach the data server"):
+        load_site(HttpSource(url))
+
+
+def test_missing_words_file_makes_the_order_invalid_not_the_day(monkeypatch, capsys, tmp_path):
+    import shutil
+
+    data = tmp_path / "data"
+    shutil.copytree(EXAMPLE, data)
+    p = data / "database" / "orders.csv"
+    lines = p.read_text().splitlines()
+    no = lines[1].split(",")[0]
+    lines[1] = ",".join([*lines[1].split(",")[:3], "gone.missing.place"])
+    p.write_text("\n".join(lines) + "\n")
+    code, out, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", str(data),
+                         "--db", f"sqlite:///{tmp_path / 'x.db'}", "--out", str(tmp_path),
+                         "--json", "--no-plot")
+    assert code == 0, err
+    report = json.loads(out)
+    assert report["orders_invalid"] == 1
+    bad = report["invalid"][0]
+    assert bad["order_no"] == no and "gone/missing/place/details.json" in bad["reason"]
