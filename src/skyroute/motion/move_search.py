@@ -33,11 +33,11 @@ def _sight(qx, qy, vx, vy, edges):
 
 
 @njit(cache=True)
-def bound(qx, qy, sees, tx, ty, corners, cdist, edges, step):
-    """Moves still needed at least: max(0, ceil(d / step - 1)).
+def distance(qx, qy, sees, tx, ty, corners, cdist, edges):
+    """A lower bound on the obstacle-avoiding distance from q to the target.
 
-    d is the straight distance when q sees the target, else min over the corners q sees
-    of |q - v| + D(v), D the corner's shortest distance to the target: every path from q
+    The straight distance when q sees the target, else min over the corners q sees of
+    |q - v| + D(v), D the corner's shortest distance to the target: every path from q
     bends first at a corner in sight. Corners are tried cheapest first, so usually the
     first sight test settles it.
     """
@@ -54,8 +54,21 @@ def bound(qx, qy, sees, tx, ty, corners, cdist, edges, step):
                 d = max(d, vals[c])
                 break
             vals[c] = np.inf
+    return d
+
+
+@njit(cache=True)
+def moves_left(d, step):
+    """At least max(0, ceil(d / step - 1)) moves: each covers ``step``, and the flight
+    may stop anywhere closer than ``step`` to the target."""
     h = math.ceil(d / step - 1.0 - 1e-12)
     return h if h > 0 else 0
+
+
+@njit(cache=True)
+def bound(qx, qy, sees, tx, ty, corners, cdist, edges, step):
+    """:func:`moves_left` of :func:`distance`: A*'s heuristic."""
+    return moves_left(distance(qx, qy, sees, tx, ty, corners, cdist, edges), step)
 
 
 @njit(cache=True)
@@ -112,6 +125,12 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
            step, merge, max_expansions, eps):
     """A* from (sx, sy) to closer than ``step`` to (tx, ty).
 
+    The heuristic is evaluated lazily: a new state gets the cheap bound max(|q - t|,
+    d(parent) - step) (the obstacle-avoiding distance is 1-Lipschitz along a free move),
+    and the exact :func:`distance` only when it reaches the top of the heap; if that
+    raises its f it goes back in. Most generated states are never popped, so most
+    sight tests are never made.
+
     Returns (status, goal node, expanded, x, y, parent, move index); parent -1 at the start.
     """
     cap = 4096
@@ -120,30 +139,45 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
     parent = np.empty(cap, np.int64)
     move = np.empty(cap, np.int64)
     g = np.empty(cap, np.int64)
+    dist = np.empty(cap)
     closed = np.zeros(cap, np.bool_)
+    exact = np.zeros(cap, np.bool_)
     hk = np.empty(cap, np.int64)
     hn = np.empty(cap, np.int64)
     seen = Dict.empty(key_type=types.int64, value_type=types.int64)
     x[0], y[0], parent[0], move[0], g[0] = sx, sy, -1, -1, 0
+    dist[0] = distance(sx, sy, sees0, tx, ty, corners, cdist, edges)
+    exact[0] = True
     n = 1
     seen[np.int64(_HALF) * (1 << 32) + _HALF] = 0
-    h0 = bound(sx, sy, sees0, tx, ty, corners, cdist, edges, step)
-    hk[0] = (np.int64(h0) << 20) | _TIE
+    hk[0] = (np.int64(moves_left(dist[0], step)) << 20) | _TIE
     hn[0] = 0
     size = 1
     expanded = 0
     while size > 0:
+        top = hk[0]
         i = _pop(hk, hn, size)
         size -= 1
         if closed[i]:
             continue
-        closed[i] = True
         if math.hypot(tx - x[i], ty - y[i]) < step:
             return FOUND, i, expanded, x[:n], y[:n], parent[:n], move[:n]
+        if not exact[i]:
+            exact[i] = True
+            sees = _sight(x[i], y[i], tx, ty, edges)
+            dist[i] = max(dist[i], distance(x[i], y[i], sees, tx, ty, corners, cdist, edges))
+            f = g[i] + moves_left(dist[i], step)
+            if f > (top >> 20):
+                if size + 1 > hk.shape[0]:
+                    hk, hn = _grow(hk, size + 1), _grow(hn, size + 1)
+                _push(hk, hn, size, (np.int64(f) << 20) | (_TIE - min(g[i], _TIE)), i)
+                size += 1
+                continue
+        closed[i] = True
         if expanded >= max_expansions:
             return BUDGET, -1, expanded, x[:n], y[:n], parent[:n], move[:n]
         expanded += 1
-        ok, sees = expand(x[i], y[i], deltas, tx, ty, edges, owner, nzones, bedges, eps)
+        ok, _ = expand(x[i], y[i], deltas, tx, ty, edges, owner, nzones, bedges, eps, False)
         gi = g[i] + 1
         for k in range(deltas.shape[0]):
             if not ok[k]:
@@ -161,13 +195,18 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
                 n += 1
                 if n > x.shape[0]:
                     x, y, parent = _grow(x, n), _grow(y, n), _grow(parent, n)
-                    move, g = _grow(move, n), _grow(g, n)
+                    move, g, dist = _grow(move, n), _grow(g, n), _grow(dist, n)
                     c2 = np.zeros(x.shape[0], np.bool_)
                     c2[:closed.shape[0]] = closed
                     closed = c2
+                    e2 = np.zeros(x.shape[0], np.bool_)
+                    e2[:exact.shape[0]] = exact
+                    exact = e2
                 seen[key] = j
             x[j], y[j], parent[j], move[j], g[j] = qx, qy, i, k, gi
-            f = gi + bound(qx, qy, sees[k], tx, ty, corners, cdist, edges, step)
+            dist[j] = max(math.hypot(qx - tx, qy - ty), dist[i] - step)
+            exact[j] = False
+            f = gi + moves_left(dist[j], step)
             if size + 1 > hk.shape[0]:
                 hk, hn = _grow(hk, size + 1), _grow(hn, size + 1)
             _push(hk, hn, size, (np.int64(f) << 20) | (_TIE - min(gi, _TIE)), j)

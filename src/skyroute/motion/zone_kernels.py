@@ -98,8 +98,9 @@ def _near(px, py, edges, reach):
 
 
 @njit(cache=True)
-def expand(px, py, deltas, tx, ty, edges, owner, nzones, bedges, eps):
-    """(clear (36,), sees (36,)) for the moves p + deltas[k] from a free point p.
+def expand(px, py, deltas, tx, ty, edges, owner, nzones, bedges, eps, want_sees=True):
+    """(clear (36,), sees (36,)) for the moves p + deltas[k] from a free point p (sees
+    all False unless ``want_sees``).
 
     Only edges within one move of p are tested for the moves; with none near, no move can
     enter a zone (it would cross an edge), so the point-in-zone test is skipped too.
@@ -134,7 +135,7 @@ def expand(px, py, deltas, tx, ty, edges, owner, nzones, bedges, eps):
         if ok and near.shape[0] and _inside(qx, qy, edges, owner, nzones) >= 0:
             ok = False
         clear[k] = ok
-        if ok:
+        if ok and want_sees:
             s = True
             for i in range(edges.shape[0]):
                 if crosses(qx, qy, tx, ty, edges[i, 0], edges[i, 1], edges[i, 2],
