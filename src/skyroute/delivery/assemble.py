@@ -17,10 +17,12 @@ from skyroute.motion.step_drone import HOVER, MERGE, STEP, Flight, plan_moves
 from skyroute.world.world import World
 
 _LEGS: dict = {}  # (start bytes, target) -> (angles, tos): legs recur across days
-# (merge, expansions): the fewest moves when that is quick to find (96% of the legs of
-# Dec 2023), else a coarser lattice, which on the rest flies the same count 9 times in
-# 10 and one move more otherwise, at a twentieth of the time (docs/benchmarks.md).
-LADDER = ((MERGE, 1000), (1e-5, 20_000), (3e-5, 200_000))
+# (merge, expansions): the fewest moves when that is quick to find (at most 2000
+# expansions, about 95% of the legs of late 2023), else a lattice six times coarser,
+# which flies one move more on about a third of those legs at a twentieth of the time.
+# On 24 of the busiest days this ladder delivered the same money as one ending in a
+# 1e-5 lattice, in three quarters of the time (docs/benchmarks.md, section 7).
+LADDER = ((MERGE, 2000), (3e-5, 200_000))
 
 
 @dataclass(frozen=True)
