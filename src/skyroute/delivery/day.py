@@ -101,14 +101,14 @@ def plan_day(site, date: dt.date, orders: list[Order], *, method: str = "milp",
         rounds += 1
         tried.add(budget)
         tour = plan(budget)
-        if tour == last:
-            break
+        money = sum(value[i] for i, _ in tour)
+        if tour == last or (fit is not None and money <= fit[0]):
+            break  # nothing to gain from flying it
         last = tour
         flight = fly_day(site.world, site.home, [
             (priced[i].order.order_no, [places[s] for s in perm] + [priced[i].lonlat])
             for i, perm in tour])
         if flight.moves <= battery:
-            money = sum(value[i] for i, _ in tour)
             if fit is None or (money, -flight.moves) > (fit[0], -fit[2].moves):
                 fit = (money, tour, flight)
             if len(tour) == len(priced):
