@@ -70,3 +70,24 @@ def test_bad_input_is_one_line(monkeypatch, capsys, tmp_path, args, words):
     code, _out, err = run(monkeypatch, capsys, *args)
     assert code == 2
     assert words in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_source_needs_stored_orders(monkeypatch, capsys, tmp_path):
+    from pathlib import Path
+
+    from skyroute.delivery.serve import serve_in_thread
+
+    server, url = serve_in_thread(Path(EXAMPLE))
+    try:
+        db = f"sqlite:///{tmp_path / 'e.db'}"
+        code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--source", url,
+                           "--db", db, "--out", str(tmp_path))
+        assert code == 2 and "no orders stored" in err and "skyroute db import" in err
+        assert run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", db)[0] == 0
+        code, out, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--source", url,
+                             "--db", db, "--out", str(tmp_path), "--json", "--no-plot")
+        assert code == 0, err
+        assert json.loads(out)["orders_placed"] == 36
+    finally:
+        server.shutdown()
+        server.server_close()

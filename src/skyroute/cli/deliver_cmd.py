@@ -54,7 +54,7 @@ def deliver_command(
     from skyroute.delivery.orders import read_csv_orders
     from skyroute.delivery.site import load_site
     from skyroute.delivery.source import open_source
-    from skyroute.delivery.store import import_orders, orders_between
+    from skyroute.delivery.store import import_orders, order_dates, orders_between
 
     check_choice("method", method, METHODS)
     day, d0, d1 = _date(date, "DATE"), _date(first, "--from"), _date(last, "--to")
@@ -75,6 +75,9 @@ def deliver_command(
         added, _ = import_orders(engine, read_csv_orders(data))
         if added:
             err.print(f"imported {added:,} orders from {data / 'database'}")
+    elif not order_dates(engine):
+        raise SkyrouteError(f"{db}: no orders stored; load them with 'skyroute db import DIR' "
+                            "or give --data DIR")
     by_date = orders_between(engine, d0, d1)
     for d in (d0 + dt.timedelta(k) for k in range((d1 - d0).days + 1)):
         by_date.setdefault(d, [])

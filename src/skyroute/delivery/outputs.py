@@ -64,9 +64,10 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
     if f.moves:
         pts = np.vstack([f.frm[:1], f.to])
         ax.plot(pts[:, 0], pts[:, 1], "-", color="tab:blue", lw=0.8, label="flight")
-    for s in site.shops:
+    for k, s in enumerate(site.shops):  # labels alternate above and below: shops crowd
         ax.plot(*s.lonlat, "s", color="tab:purple", ms=7)
-        ax.annotate(s.name, s.lonlat, fontsize=7, xytext=(4, 4), textcoords="offset points")
+        ax.annotate(s.name, s.lonlat, fontsize=7, xytext=(4, 5 if k % 2 else -10),
+                    textcoords="offset points")
     ax.plot([], [], "s", color="tab:purple", label="shop")
     served = {p.lonlat for p in result.delivered}
     missed = {site.locate(o.deliver_to) for o in result.orders
@@ -83,6 +84,8 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
                  f"orders, {'no orders' if pct is None else f'{pct:.1f}% of the money'}, "
                  f"{f.moves} moves", fontsize=10)
     finish_axes(ax, site.world)
+    ax.ticklabel_format(useOffset=False)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     return save_figure(fig, path)
 
 
