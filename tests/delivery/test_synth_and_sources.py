@@ -90,3 +90,28 @@ def test_missing_words_file_makes_the_order_invalid_not_the_day(monkeypatch, cap
     assert report["orders_invalid"] == 1
     bad = report["invalid"][0]
     assert bad["order_no"] == no and "gone/missing/place/details.json" in bad["reason"]
+
+
+def test_an_order_no_flight_can_reach_is_invalid_with_its_reason(monkeypatch):
+    """As if a customer's place were walled in: every leg into it has no flight."""
+    from skyroute.delivery import day as day_module
+
+    site = load_site(DirSource(EXAMPLE))
+    orders = [o for o in read_csv_orders(EXAMPLE) if o.date.day == 1][:6]
+    walled = site.locate(orders[0].deliver_to)
+    real = day_module.leg_table
+
+    def table(world, places):
+        legs = real(world, places)
+        k = [tuple(p) for p in places].index(walled)
+        legs[:, k] = -1
+        legs[k, k] = 0
+        return legs
+
+    monkeypatch.setattr(day_module, "leg_table", table)
+    r = plan_day(site, orders[0].date, orders)
+    walled_orders = {o.order_no for o in orders if o.deliver_to == orders[0].deliver_to}
+    assert {o.order_no for o, _ in r.invalid} == walled_orders
+    assert all("no legal flight" in why for _, why in r.invalid)
+    assert {p.order.order_no for p in r.delivered} == \
+        {o.order_no for o in orders} - walled_orders

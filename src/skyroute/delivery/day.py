@@ -73,13 +73,19 @@ def plan_day(site, date: dt.date, orders: list[Order], *, method: str = "milp",
     legs = leg_table(site.world, places)
     origins = [0] + [1 + len(shops) + k for k in range(len(custs))]
     org_of = {c: 1 + k for k, c in enumerate(custs)}
+    back = np.array([legs[o, 0] if o else 0 for o in origins], dtype=float)
+    back[back < 0] = np.inf
     stops = [([1 + s for s in p.shops], 1 + len(shops) + custs.index(p.lonlat))
              for p in priced]
     cost, best = mission.order_costs(legs, origins, stops)
-    back = np.array([legs[o, 0] if o else 0 for o in origins], dtype=float)
-    back[back < 0] = np.inf
     cust = np.array([org_of[p.lonlat] for p in priced], dtype=int)
+    unreachable = ~np.isfinite(cost[0]) | ~np.isfinite(back[cust]) if len(priced) else []
+    for i in np.flatnonzero(unreachable):
+        invalid.append((priced[i].order, "no legal flight reaches its shops and customer "
+                                         "from home and back"))
+        cost[:, i] = np.inf  # never chosen
     value = np.array([p.cost for p in priced], dtype=float)
+
     def plan(budget: int) -> list[tuple[int, tuple]]:
         nonlocal proven
         if method == "milp" and len(priced):
