@@ -115,3 +115,19 @@ def test_an_order_no_flight_can_reach_is_invalid_with_its_reason(monkeypatch):
     assert all("no legal flight" in why for _, why in r.invalid)
     assert {p.order.order_no for p in r.delivered} == \
         {o.order_no for o in orders} - walled_orders
+
+
+def test_a_small_battery_is_never_exceeded():
+    """Re-planning lowers the budget until the real flight fits, however tight."""
+    site = load_site(DirSource(EXAMPLE))
+    orders = [o for o in read_csv_orders(EXAMPLE) if o.date.day == 3]
+    book, ref = order_book(EXAMPLE), website(EXAMPLE)
+    for battery in (60, 250):
+        r = plan_day(site, orders[0].date, orders, battery=battery)
+        assert 0 < r.flight.moves <= battery and r.delivered
+        f = r.flight.flight
+        rows = [("2024-01-03", k, r.flight.order_no[k], *map(float, f.frm[k]),
+                 int(f.angle[k]), *map(float, f.to[k])) for k in range(f.moves)]
+        deliveries = [("2024-01-03", p.order.order_no, p.order.deliver_to, p.cost)
+                      for p in r.delivered]
+        assert check_day(ref, book, "2024-01-03", deliveries, rows) == []

@@ -102,24 +102,31 @@ def plan_day(site, date: dt.date, orders: list[Order], *, method: str = "milp",
     # The leg table prices legs from each place exactly, the flight flies them from
     # where the drone really is: re-plan with the budget moved by what the flight
     # over- or under-spent, keep the best flight that fits (a few rounds at most).
-    budget, rounds, proven, fit, tried, last = battery, 0, True, None, set(), None
-    while rounds < MAX_ROUNDS and budget > 0 and budget not in tried:
-        rounds += 1
+    # Past MAX_ROUNDS it only goes on while nothing has fitted yet: every flight over the
+    # battery lowers the budget, so it ends (an empty plan always fits).
+    budget, rounds, proven, fit, tried, last, over = battery, 0, True, None, set(), None, 0
+    flyable = len(priced) - int(np.count_nonzero(unreachable))
+    while budget > 0 and budget not in tried and (rounds < MAX_ROUNDS or fit is None):
         tried.add(budget)
         tour = plan(budget)
         money = sum(value[i] for i, _ in tour)
-        if tour == last or (fit is not None and money <= fit[0]):
+        if fit is not None and (tour == last or money <= fit[0]):
             break  # nothing to gain from flying it
+        if tour == last:  # the same tour, over the battery again: lower the budget more
+            budget -= over
+            continue
+        rounds += 1
         last = tour
         flight = fly_day(site.world, site.home, [
             (priced[i].order.order_no, [places[s] for s in perm] + [priced[i].lonlat])
             for i, perm in tour])
-        if flight.moves <= battery:
+        over = flight.moves - battery
+        if over <= 0:
             if fit is None or (money, -flight.moves) > (fit[0], -fit[2].moves):
                 fit = (money, tour, flight)
-            if len(tour) == len(priced):
-                break  # everything delivered
-        budget += battery - flight.moves
+            if len(tour) == flyable:
+                break  # everything that can be delivered is
+        budget -= over
     if fit is None:  # nothing fitted: fly nothing
         tour, flight = [], fly_day(site.world, site.home, [])
     else:
