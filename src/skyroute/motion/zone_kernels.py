@@ -97,6 +97,16 @@ def _near(px, py, edges, reach):
     return out[:k]
 
 
+@njit(cache=True, inline="always")
+def _touches_any(px, py, qx, qy, idx, edges, eps):
+    """Segment pq touches one of the edges ``edges[idx]``."""
+    for j in range(idx.shape[0]):
+        i = idx[j]
+        if _touch(px, py, qx, qy, edges[i, 0], edges[i, 1], edges[i, 2], edges[i, 3], eps):
+            return True
+    return False
+
+
 @njit(cache=True)
 def expand(px, py, deltas, tx, ty, edges, owner, nzones, bedges, eps, want_sees=True):
     """(clear (36,), sees (36,)) for the moves p + deltas[k] from a free point p (sees
@@ -113,25 +123,13 @@ def expand(px, py, deltas, tx, ty, edges, owner, nzones, bedges, eps, want_sees=
     bnear = _near(px, py, bedges, reach + 2 * eps)
     clear = np.zeros(n, np.bool_)
     sees = np.zeros(n, np.bool_)
+    bowner = np.zeros(bedges.shape[0], np.int64)  # the boundary is one ring
     for k in range(n):
         qx, qy = px + deltas[k, 0], py + deltas[k, 1]
-        ok = True
-        for j in range(bnear.shape[0]):
-            i = bnear[j]
-            if _touch(px, py, qx, qy, bedges[i, 0], bedges[i, 1], bedges[i, 2], bedges[i, 3],
-                      eps):
-                ok = False
-                break
-        if ok and bnear.shape[0] and _inside(qx, qy, bedges, np.zeros(bedges.shape[0],
-                                                                      np.int64), 1) < 0:
+        ok = not _touches_any(px, py, qx, qy, bnear, bedges, eps)
+        if ok and bnear.shape[0] and _inside(qx, qy, bedges, bowner, 1) < 0:
             ok = False
-        if ok:
-            for j in range(near.shape[0]):
-                i = near[j]
-                if _touch(px, py, qx, qy, edges[i, 0], edges[i, 1], edges[i, 2], edges[i, 3],
-                          eps):
-                    ok = False
-                    break
+        ok = ok and not _touches_any(px, py, qx, qy, near, edges, eps)
         if ok and near.shape[0] and _inside(qx, qy, edges, owner, nzones) >= 0:
             ok = False
         clear[k] = ok
