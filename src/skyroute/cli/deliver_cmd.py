@@ -58,8 +58,8 @@ def deliver_command(
 
     check_choice("method", method, METHODS)
     day, d0, d1 = _date(date, "DATE"), _date(first, "--from"), _date(last, "--to")
-    if (day is None) == (d0 is None and d1 is None) or (day is None and (d0 is None or
-                                                                          d1 is None)):
+    one_day, ranged = day is not None, d0 is not None or d1 is not None
+    if one_day == ranged or (ranged and (d0 is None or d1 is None)):
         raise OptionError("give a DATE, or both --from and --to")
     if day is not None:
         d0 = d1 = day
