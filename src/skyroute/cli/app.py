@@ -18,7 +18,8 @@ from skyroute.cli.world_cmd import plan_world_command, synth_city_command
 from skyroute.world.load import bundled_maps
 from skyroute.world.movingai import read_map
 
-app = typer.Typer(help="skyroute: plan where drones and small robots fly or drive.",
+app = typer.Typer(help="skyroute: plan where drones and small robots fly or drive, and what "
+                       "they deliver.",
                   no_args_is_help=True, add_completion=False, pretty_exceptions_enable=False)
 app.command("plan")(plan_command)
 app.command("plan-world")(plan_world_command)

@@ -29,7 +29,7 @@ def _date(text: str | None, option: str) -> dt.date | None:
 
 
 def deliver_command(
-    date: Annotated[str | None, typer.Argument(metavar="[DATE]", help="The day, YYYY-MM-DD.")] =
+    date: Annotated[str | None, typer.Argument(metavar="DATE", help="The day, YYYY-MM-DD.")] =
         None,
     first: Annotated[str | None, typer.Option("--from", help="First day of a range.")] = None,
     last: Annotated[str | None, typer.Option("--to", help="Last day of a range.")] = None,
@@ -48,8 +48,10 @@ def deliver_command(
         help="Draw each day's PNG (default: on for one day, off for a range).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the report as JSON.")] = False,
 ) -> None:
-    """Fly a day's lunch orders: choose, order and fly them for the most money within the
-    battery, store deliveries and flightpath, and write drone-DD-MM-YYYY.geojson."""
+    """Fly a day (or a range) of lunch orders for the most money within the battery.
+
+    Stores deliveries and flightpath; writes drone-DD-MM-YYYY.geojson, a report, a map.
+    """
     from skyroute.delivery.days import open_store, prepare_legs, run_days
     from skyroute.delivery.orders import read_csv_orders
     from skyroute.delivery.site import load_site
