@@ -27,4 +27,6 @@ def run_cli(app: typer.Typer) -> None:
     except (typer.Abort, KeyboardInterrupt):
         print("skyroute: interrupted", file=sys.stderr)
         sys.exit(130)
+    if code == 130:  # Typer turns Ctrl-C into exit code 130, silently
+        print("skyroute: interrupted", file=sys.stderr)
     sys.exit(code if isinstance(code, int) else 0)

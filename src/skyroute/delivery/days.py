@@ -68,11 +68,16 @@ def run_days(site, engine, by_date: dict[dt.date, list], out: Path | None, *,
         for d, orders in sorted(by_date.items()):
             finish(plan_day(site, d, orders, method=method))
     else:
-        with ProcessPoolExecutor(jobs, initializer=_init, initargs=(site.source,)) as pool:
+        pool = ProcessPoolExecutor(jobs, initializer=_init, initargs=(site.source,))
+        try:
             futures = [pool.submit(_plan, d, orders, method)
                        for d, orders in sorted(by_date.items())]
             for f in as_completed(futures):
                 finish(f.result())
+        except BaseException:  # an error or Ctrl-C: stop now, not after every queued day
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+        pool.shutdown()
     return sorted(results, key=lambda r: r.date)
 
 
