@@ -64,10 +64,14 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
     if f.moves:
         pts = np.vstack([f.frm[:1], f.to])
         ax.plot(pts[:, 0], pts[:, 1], "-", color="tab:blue", lw=0.8, label="flight")
-    for k, s in enumerate(site.shops):  # labels alternate above and below: shops crowd
+    placed: list[tuple[float, float]] = []
+    for s in site.shops:  # shops close together get their labels stacked, not piled up
         ax.plot(*s.lonlat, "s", color="tab:purple", ms=7)
-        ax.annotate(s.name, s.lonlat, fontsize=7, xytext=(4, 5 if k % 2 else -10),
-                    textcoords="offset points")
+        near = sum(1 for q in placed if abs(q[0] - s.lonlat[0]) < 0.0012 and
+                   abs(q[1] - s.lonlat[1]) < 0.0003)
+        placed.append(s.lonlat)
+        ax.annotate(s.name, s.lonlat, fontsize=7, textcoords="offset points",
+                    xytext=(5, (6, -12, 18, -24, 30)[near % 5]))
     ax.plot([], [], "s", color="tab:purple", label="shop")
     served = {p.lonlat for p in result.delivered}
     missed = {site.locate(o.deliver_to) for o in result.orders
