@@ -31,7 +31,6 @@ class DayFlight:
 
     flight: Flight
     order_no: tuple[str, ...]
-    stops: tuple[tuple[str, int], ...]  # (order_no, index of the hover), in order
 
     @property
     def moves(self) -> int:
@@ -65,8 +64,7 @@ def fly_day(world: World, home: tuple[float, float],
     """Fly ``visits`` = [(order_no, [shop, ..., customer]), ...] from home and back,
     hovering once at every stop."""
     pos = np.asarray(home, dtype=float)
-    parts, labels, stops = [], [], []
-    n = 0
+    parts, labels = [], []
     for order_no, points in visits:
         for p in points:
             f = leg(world, pos, p)
@@ -76,15 +74,13 @@ def fly_day(world: World, home: tuple[float, float],
             h = Flight(pos[None, :].copy(), np.array([HOVER]), pos[None, :].copy())
             parts.append(h)
             labels += [order_no] * (f.moves + 1)
-            n += f.moves + 1
-            stops.append((order_no, n - 1))
     f = leg(world, pos, home)
     if f.moves:
         parts.append(f)
         labels += [visits[-1][0] if visits else "home"] * f.moves
     if not parts:
         e = np.empty((0, 2))
-        return DayFlight(Flight(e, np.empty(0, int), e.copy()), (), ())
+        return DayFlight(Flight(e, np.empty(0, int), e.copy()), ())
     flight = Flight(np.vstack([p.frm for p in parts]), np.concatenate([p.angle for p in parts]),
                     np.vstack([p.to for p in parts]))
-    return DayFlight(flight, tuple(labels), tuple(stops))
+    return DayFlight(flight, tuple(labels))

@@ -15,7 +15,8 @@ from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
 
-from skyroute.errors import InputFormatError, SkyrouteError
+from skyroute.delivery.site import check_place
+from skyroute.errors import InputFormatError
 
 CHARGE = 50
 MAX_ITEMS = 4
@@ -61,19 +62,10 @@ def price(site, order: Order) -> Priced | str:
         return f"items from {len(shops)} shops (at most {MAX_SHOPS})"
     try:
         p = site.locate(order.deliver_to)
-        from skyroute.delivery.site import check_place
-
         check_place(site, f"deliverTo {order.deliver_to!r}", order.deliver_to, p)
     except InputFormatError as exc:
         return str(exc)
     return Priced(order, cost, tuple(shops), p)
-
-
-def parse_date(text: str, what: str = "date") -> dt.date:
-    try:
-        return dt.date.fromisoformat(text)
-    except (TypeError, ValueError):
-        raise SkyrouteError(f"{what} {text!r}: expected YYYY-MM-DD") from None
 
 
 def _rows(path: Path, header: list[str]):
