@@ -6,7 +6,7 @@ searches it and returns a :class:`PlanResult`.
 
 from skyroute.errors import InputFormatError, OptionError, QueryError, SkyrouteError
 from skyroute.planner import plan
-from skyroute.search.result import PlanResult, Status
+from skyroute.result import PlanResult, Status
 from skyroute.world.grid import Grid
 from skyroute.world.load import bundled_maps, load_map, load_world
 from skyroute.world.world import World

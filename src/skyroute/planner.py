@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from skyroute.errors import OptionError
+from skyroute.result import PlanResult
 from skyroute.search.grid_plan import grid_options, plan_grid
-from skyroute.search.result import PlanResult
 from skyroute.world.grid import Grid
 from skyroute.world.world import World
 

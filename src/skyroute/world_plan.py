@@ -17,8 +17,8 @@ import weakref
 import numpy as np
 
 from skyroute.errors import OptionError, QueryError, check_choice
+from skyroute.result import PlanResult, Status
 from skyroute.search.grid_plan import GRID_ALGORITHMS, grid_options, plan_grid
-from skyroute.search.result import PlanResult, Status
 from skyroute.world.world import World
 
 WORLD_ALGORITHMS = ("visibility", "prm", *GRID_ALGORITHMS)

@@ -93,7 +93,7 @@ def fly_command(
         write_atomic(out, _render(out, rows, doc["columns"], path_lonlat(world, xy)))
     if plot is not None and doc["reached"]:
         from skyroute.io.world_out import plot_world_path
-        from skyroute.search.result import PlanResult, Status
+        from skyroute.result import PlanResult, Status
 
         length = float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
         shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from rich.table import Table
 
-from skyroute.search.result import PlanResult
+from skyroute.result import PlanResult
 
 
 def result_table(title: str, result: PlanResult, *, unit: str = "",

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-HOVER = 1  # moves per hover
+HOVER_MOVES = 1  # a hover costs one move of the battery
 CUT_ROUNDS = 3  # rounds of connectivity cuts before the flow formulation joins in
 
 
@@ -61,7 +61,7 @@ def order_costs(legs: np.ndarray, origins: list[int], stops: list[tuple[list[int
                 legs_ = [legs[a, b] for a, b in itertools.pairwise(seq)]
                 if min(legs_) < 0:
                     continue
-                c = sum(legs_) + HOVER * (len(perm) + 1)
+                c = sum(legs_) + HOVER_MOVES * (len(perm) + 1)
                 if c < cost[p, i]:
                     cost[p, i], best[p][i] = c, perm
     return cost, best

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from skyroute.search.result import PlanResult
+from skyroute.result import PlanResult
 from skyroute.world.grid import Grid
 
 

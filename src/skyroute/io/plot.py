@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.io.files import write_atomic
-from skyroute.search.result import PlanResult
+from skyroute.result import PlanResult
 from skyroute.world.grid import Grid
 
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from skyroute.geo import enu_to_lonlat, heading_of, lonlat_to_enu
 from skyroute.io.plot import save_figure
-from skyroute.search.result import PlanResult
+from skyroute.result import PlanResult
 from skyroute.world.world import World
 
 

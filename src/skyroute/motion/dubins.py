@@ -24,6 +24,7 @@ import numpy as np
 from numba import njit, prange
 
 from skyroute.errors import OptionError
+from skyroute.result import Status
 
 WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
 TWO_PI = 2 * math.pi
@@ -175,6 +176,11 @@ class DubinsPath:
     def length(self) -> float:
         """Total length."""
         return float(sum(self.segments))
+
+    @property
+    def status(self) -> Status:
+        """Always found: without obstacles a Dubins path joins any two poses."""
+        return Status.FOUND
 
     def pose_at(self, s: float) -> np.ndarray:
         """(x, y, heading) after travelling ``s`` along the path (0 <= s <= length)."""

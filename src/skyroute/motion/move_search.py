@@ -17,8 +17,8 @@ from numba import njit, types
 from numba.typed import Dict
 
 from skyroute.motion.zone_kernels import crosses, expand
+from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 
-FOUND, BUDGET, NO_PATH = 0, 1, 2
 _TIE = (1 << 20) - 1
 _HALF = 1 << 31
 
@@ -175,7 +175,7 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
                 continue
         closed[i] = True
         if expanded >= max_expansions:
-            return BUDGET, -1, expanded, x[:n], y[:n], parent[:n], move[:n]
+            return BUDGET_EXHAUSTED, -1, expanded, x[:n], y[:n], parent[:n], move[:n]
         expanded += 1
         ok, _ = expand(x[i], y[i], deltas, tx, ty, edges, owner, nzones, bedges, eps, False)
         gi = g[i] + 1

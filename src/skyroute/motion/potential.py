@@ -26,6 +26,7 @@ import numpy as np
 import shapely
 
 from skyroute.errors import OptionError, check_choice
+from skyroute.result import Status
 from skyroute.world.world import World
 
 COURSES = ("easy", "medium", "hard")
@@ -35,12 +36,18 @@ ARC_SAMPLES = 4  # points per arc, for collision checks and the drawn trace
 
 @dataclass(frozen=True)
 class FieldRun:
-    """A run: poses (K, 2), whether the goal was reached, and how."""
+    """A run: poses (K, 2), how it ended (``status``: found when the goal was reached,
+    budget_exhausted after ``max_moves``, stuck when no move led on), and how."""
 
     path: np.ndarray
-    reached: bool
+    status: Status
     escaped: int  # moves taken on the navigation function
     trace: np.ndarray | None = None  # arc mode: the arcs sampled, for distance and plots
+
+    @property
+    def reached(self) -> bool:
+        """True when the goal was reached."""
+        return self.status is Status.FOUND
 
     @property
     def moves(self) -> int:
@@ -63,6 +70,7 @@ class FieldRun:
     def metrics(self) -> dict:
         return {"distance": self.distance, "moves": self.moves,
                 "smoothness": self.smoothness, "reached": self.reached,
+                "status": self.status.value,
                 "escape_moves": self.escaped}
 
 
@@ -192,7 +200,9 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
         path.append(q)
         trace.extend(arc)
         p = q
-    return FieldRun(np.array(path), math.dist(p, t) < tolerance, escaped,
+    status = Status.FOUND if math.dist(p, t) < tolerance else \
+        Status.BUDGET_EXHAUSTED if len(path) > max_moves else Status.STUCK
+    return FieldRun(np.array(path), status, escaped,
                     np.array(trace) if mode == "arc" else None)
 
 

@@ -29,7 +29,7 @@ import numpy as np
 from skyroute.errors import OptionError, QueryError
 from skyroute.motion import move_search
 from skyroute.motion.zone_kernels import zone_arrays
-from skyroute.search.result import Status
+from skyroute.result import FOUND, STATUS_OF_CODE, Status
 from skyroute.world.world import World
 
 STEP = 0.00015
@@ -185,9 +185,8 @@ def plan_moves(world: World, start, target, *, step: float = STEP,
         s[0], s[1], t[0], t[1], sees0, deltas, *_zones(world), bound.corners,
         bound.dist, step, merge, max_expansions, 1e-12)
     seconds = time.perf_counter() - t0
-    if status != move_search.FOUND:
-        return _empty(s, Status.BUDGET_EXHAUSTED if status == move_search.BUDGET
-                      else Status.NO_PATH, expanded, seconds)
+    if status != FOUND:
+        return _empty(s, STATUS_OF_CODE[status], expanded, seconds)
     chain = []
     i = goal
     while parent[i] >= 0:

@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit
 
 from skyroute.errors import OptionError, check_choice
+from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH, STATUS_OF_CODE, Status
 from skyroute.search import heap
 from skyroute.search.los import line_of_sight
 from skyroute.search.space import space_of
@@ -32,8 +33,10 @@ _DIRS = {
 
 @dataclass(frozen=True)
 class LatticeResult:
-    """The fastest route: cells (K, 2) as (x, y), headings (K,) in radians, and times."""
+    """The fastest route: ``status``, cells (K, 2) as (x, y), headings (K,) in radians,
+    travel time and distance (inf without a route), and search statistics."""
 
+    status: Status
     cells: np.ndarray
     headings: np.ndarray
     time: float
@@ -43,7 +46,8 @@ class LatticeResult:
 
     @property
     def found(self) -> bool:
-        return len(self.cells) > 0
+        """True when a route was found."""
+        return self.status is Status.FOUND
 
 
 def _tables(headings: int, Wp: int):
@@ -90,9 +94,9 @@ def _lattice_kernel(blk, Wp, start, start_h, goal, H, dirs, offs, lens, turn, sp
         u, size = heap.pop(hc, hk, state, size)
         c, h = u // H, u % H
         if c == goal:
-            return u, g, parent, expanded
+            return FOUND, u, g, parent, expanded
         if expanded >= max_expansions:
-            return -2, g, parent, expanded
+            return BUDGET_EXHAUSTED, -1, g, parent, expanded
         expanded += 1
         # forward, turn left, turn right
         for k in range(3):
@@ -116,7 +120,7 @@ def _lattice_kernel(blk, Wp, start, start_h, goal, H, dirs, offs, lens, turn, sp
                 vc = v // H
                 d = math.hypot(vc % Wp - gx, vc // Wp - gy)
                 size = heap.push(hc, hk, state, size, v, heap.key(gv + d / speed, gv))
-    return -1, g, parent, expanded
+    return NO_PATH, -1, g, parent, expanded
 
 
 def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
@@ -142,13 +146,13 @@ def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
         sh = int(np.argmin(np.abs((ang - start_heading + np.pi) % (2 * np.pi) - np.pi)))
     budget = np.iinfo(np.int64).max if max_expansions is None else int(max_expansions)
     t0 = time.perf_counter()
-    end, g, parent, expanded = _lattice_kernel(
+    code, end, g, parent, expanded = _lattice_kernel(
         space.blocked, space.Wp, space.index(s), sh, space.index(t), headings, dirs, offs,
         lens, turn, float(speed), float(turn_rate), budget)
     seconds = time.perf_counter() - t0
-    if end < 0:
-        return LatticeResult(np.empty((0, 2)), np.empty(0), math.inf, math.inf, expanded,
-                             seconds)
+    if code != FOUND:
+        return LatticeResult(STATUS_OF_CODE[code], np.empty((0, 2)), np.empty(0), math.inf,
+                             math.inf, expanded, seconds)
     chain = [end]
     while parent[chain[-1]] >= 0:
         chain.append(parent[chain[-1]])
@@ -158,7 +162,8 @@ def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
     keep = np.r_[True, (cells_flat[1:] != cells_flat[:-1]) | (heads[1:] != heads[:-1])]
     cells = np.c_[cells_flat % space.Wp - 1, cells_flat // space.Wp - 1][keep].astype(float)
     dist = float(np.hypot(*np.diff(cells, axis=0).T).sum()) if len(cells) > 1 else 0.0
-    return LatticeResult(cells, heads[keep], float(g[end]), dist, expanded, seconds)
+    return LatticeResult(Status.FOUND, cells, heads[keep], float(g[end]), dist, expanded,
+                         seconds)
 
 
 def travel_time(cells, *, speed: float = 1.0, turn_rate: float = math.pi / 2,

@@ -17,7 +17,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from skyroute.errors import OptionError
-from skyroute.search.result import PlanResult, Status
+from skyroute.result import PlanResult, Status
 from skyroute.world.world import World
 
 

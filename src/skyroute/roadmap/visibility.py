@@ -17,8 +17,8 @@ import time
 import numpy as np
 import shapely
 
+from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.roadmap.graph_search import lazy_astar
-from skyroute.search.result import STATUS_OF_CODE, PlanResult
 from skyroute.world.world import World
 
 

@@ -11,42 +11,13 @@ inner loop does no division and no corner tests.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
+from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
-from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
-from skyroute.search.space import COSTS, MDX, MDY, offsets
+from skyroute.search.moves import COSTS, MDX, MDY, SQRT2_M1, h_of, offsets
 from skyroute.search.trace import trace
-
-HEURISTICS = {"zero": 0, "octile": 1, "euclidean": 2, "manhattan": 3}
-_SQRT2_M1 = math.sqrt(2.0) - 1.0
-
-
-@njit(cache=True)
-def h_of(kind, dx, dy):
-    """Heuristic for absolute offsets (dx, dy) to the goal."""
-    if kind == 1:
-        return max(dx, dy) + _SQRT2_M1 * min(dx, dy)
-    if kind == 2:
-        return math.sqrt(dx * dx + dy * dy)
-    if kind == 3:
-        return float(dx + dy)
-    return 0.0
-
-
-@njit(cache=True)
-def heuristic(kind, c, goal, Wp):
-    """Heuristic between flat cells ``c`` and ``goal``."""
-    return h_of(kind, abs(c % Wp - goal % Wp), abs(c // Wp - goal // Wp))
-
-
-@njit(cache=True)
-def move_ok(mask, c, k):
-    """True when move k is legal from cell c."""
-    return (mask[c] >> k) & 1
 
 
 @njit(cache=True)
@@ -134,7 +105,7 @@ def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, i
             dx = abs(cx + MDX[k])
             dy = abs(cy + MDY[k])
             if hkind == 1:  # octile, written out: the common case
-                hn = max(dx, dy) + _SQRT2_M1 * min(dx, dy)
+                hn = max(dx, dy) + SQRT2_M1 * min(dx, dy)
             else:
                 hn = h_of(hkind, dx, dy)
             key = (int((gn + weight * hn) * heap.F_SCALE + 0.5) << heap.TIE_BITS) | \

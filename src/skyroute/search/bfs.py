@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from skyroute.result import FOUND, NO_PATH, stop_code
 from skyroute.search.heap import reset
-from skyroute.search.result import FOUND, NO_PATH, stop_code
 from skyroute.search.trace import trace
 
 

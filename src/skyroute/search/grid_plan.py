@@ -11,11 +11,12 @@ from functools import lru_cache
 import numpy as np
 
 from skyroute.errors import OptionError, QueryError, check_choice
-from skyroute.search.astar import HEURISTICS, astar_kernel
+from skyroute.result import STATUS_OF_CODE, PlanResult, Status
+from skyroute.search.astar import astar_kernel
 from skyroute.search.bfs import bfs_kernel
 from skyroute.search.jps import jps_kernel
+from skyroute.search.moves import HEURISTICS
 from skyroute.search.prune import PRUNE_MODES, prune_collinear, prune_los
-from skyroute.search.result import STATUS_OF_CODE, PlanResult, Status
 from skyroute.search.space import SearchSpace, space_of, to_cells
 from skyroute.search.theta import theta_kernel
 from skyroute.world.grid import Grid

@@ -18,9 +18,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from skyroute.result import FOUND, NO_PATH, stop_code
 from skyroute.search import heap
-from skyroute.search.astar import h_of
-from skyroute.search.result import FOUND, NO_PATH, stop_code
+from skyroute.search.moves import h_of
 from skyroute.search.trace import trace
 
 # Straight directions: 0 east (+x), 1 west (-x), 2 south (+y), 3 north (-y).

@@ -1,74 +1,11 @@
-"""The one result type every planner returns."""
+"""Deprecated location of :mod:`skyroute.result` (kept for one release)."""
 
-from __future__ import annotations
-
-from dataclasses import dataclass, field
-from enum import StrEnum
-
-import numpy as np
-from numba import njit
-
-
-class Status(StrEnum):
-    """How a search ended. Finding no path is a status, not an exception."""
-
-    FOUND = "found"
-    NO_PATH = "no_path"
-    BUDGET_EXHAUSTED = "budget_exhausted"
-
-
-# Kernel status codes, shared by every compiled search.
-FOUND, NO_PATH, BUDGET_EXHAUSTED = 0, 1, 2
-STATUS_OF_CODE = (Status.FOUND, Status.NO_PATH, Status.BUDGET_EXHAUSTED)
-
-
-@njit(cache=True)
-def stop_code(c, goal, expanded, max_expansions):
-    """A kernel's stop test when it takes node c: FOUND, BUDGET_EXHAUSTED, or -1 (go on)."""
-    if c == goal:
-        return FOUND
-    if expanded >= max_expansions:
-        return BUDGET_EXHAUSTED
-    return -1
-
-
-@dataclass(frozen=True)
-class PlanResult:
-    """What a planner found and what it cost to find it.
-
-    ``path`` is a (K, 2) float array of (x, y) points: cell coordinates on a grid (cell
-    centres, as MovingAI counts them), empty unless ``status`` is ``found``. ``cost`` is
-    the path's length in the same units (diagonal steps count sqrt 2); ``inf`` when no
-    path was found. ``expanded`` counts nodes taken off the open list and expanded,
-    ``max_frontier`` the largest open list, ``los_checks`` line-of-sight tests, and
-    ``seconds`` the wall time of the search itself.
-    """
-
-    status: Status
-    path: np.ndarray
-    cost: float
-    expanded: int = 0
-    max_frontier: int = 0
-    los_checks: int = 0
-    seconds: float = 0.0
-    algorithm: str = ""
-    extra: dict = field(default_factory=dict, compare=False)
-
-    @property
-    def found(self) -> bool:
-        """True when a path was found."""
-        return self.status is Status.FOUND
-
-    def to_dict(self) -> dict:
-        """Plain JSON-ready data, in the CLI's ``--json`` field order."""
-        return {
-            "status": self.status.value,
-            "cost": float(self.cost) if self.found else None,
-            "path": self.path.tolist(),
-            "expanded": int(self.expanded),
-            "max_frontier": int(self.max_frontier),
-            "los_checks": int(self.los_checks),
-            "seconds": float(self.seconds),
-            "algorithm": self.algorithm,
-        }
-
+from skyroute.result import (  # noqa: F401
+    BUDGET_EXHAUSTED,
+    FOUND,
+    NO_PATH,
+    STATUS_OF_CODE,
+    PlanResult,
+    Status,
+    stop_code,
+)

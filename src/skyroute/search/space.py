@@ -17,15 +17,9 @@ import weakref
 import numpy as np
 from numba import njit
 
+from skyroute.search.jps import jump_tables
+from skyroute.search.moves import MDX, MDY
 from skyroute.world.grid import Grid
-
-SQRT2 = math.sqrt(2.0)
-
-# Moves: 4 orthogonal first, then 4 diagonal. (dx, dy) in cells.
-MOVES = ((1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, 1), (1, -1), (-1, -1))
-MDX = np.array([dx for dx, _ in MOVES], dtype=np.int64)
-MDY = np.array([dy for _, dy in MOVES], dtype=np.int64)
-COSTS = np.array([1.0] * 4 + [SQRT2] * 4)
 
 
 class SearchSpace:
@@ -74,8 +68,6 @@ class SearchSpace:
     def jump_table(self) -> np.ndarray:
         """JPS's straight-scan table, built on first use (see ``search.jps``)."""
         if self._jumps is None:
-            from skyroute.search.jps import jump_tables
-
             self._jumps = jump_tables(self.blocked, self.Wp)
         return self._jumps
 
@@ -93,12 +85,6 @@ class SearchSpace:
             ints[1] = 0
             self._ws = (np.empty((2, n)), ints, np.empty(n, np.int64))
         return self._ws
-
-
-@njit(cache=True)
-def offsets(Wp):
-    """Flat offsets of the 8 moves, in MOVES order."""
-    return (1, -1, Wp, -Wp, Wp + 1, Wp - 1, 1 - Wp, -1 - Wp)
 
 
 @njit(cache=True)

@@ -17,11 +17,10 @@ import math
 import numpy as np
 from numba import njit
 
+from skyroute.result import FOUND, NO_PATH, stop_code
 from skyroute.search import heap
-from skyroute.search.astar import heuristic, move_ok
 from skyroute.search.los import line_of_sight
-from skyroute.search.result import FOUND, NO_PATH, stop_code
-from skyroute.search.space import COSTS, offsets
+from skyroute.search.moves import COSTS, heuristic, move_ok, offsets
 from skyroute.search.trace import trace
 
 
