@@ -6,9 +6,20 @@ so the CLI can print it as one line.
 
 from __future__ import annotations
 
+import warnings
+
 
 class SkyrouteError(Exception):
-    """Root of every error skyroute raises on purpose."""
+    """Root of every error skyroute raises on purpose.
+
+    ``param`` names the parameter (or a tuple of parameters) at fault, when there is
+    one: messages speak of parameters (``safety=-1 must be ...``) and the CLI maps them
+    to its flags.
+    """
+
+    def __init__(self, *args, param: str | tuple[str, ...] | None = None) -> None:
+        super().__init__(*args)
+        self.param = param
 
 
 class InputFormatError(SkyrouteError, ValueError):
@@ -22,7 +33,7 @@ class InputFormatError(SkyrouteError, ValueError):
         self.line = line
         self.reason = message
         where = self.path if line is None else f"{self.path}:{line}"
-        super().__init__(f"{where}: {message}")
+        super().__init__(f"{where}: {message}", param=None)
 
 
 class QueryError(SkyrouteError, ValueError):
@@ -37,4 +48,15 @@ def check_choice(name: str, value: object, choices: tuple) -> None:
     """Raise :class:`OptionError` unless ``value`` is one of ``choices``."""
     if value not in choices:
         valid = ", ".join(repr(c) for c in choices)
-        raise OptionError(f"{name}={value!r} is not valid; choose one of {valid}")
+        raise OptionError(f"{name}={value!r} is not valid; choose one of {valid}", param=name)
+
+
+def renamed(new: str, value: object, old: str, old_value: object) -> object:
+    """The value of a parameter renamed from ``old`` to ``new`` (the old spelling still
+    works for one release, with a DeprecationWarning); both given is an OptionError."""
+    if old_value is None:
+        return value
+    if value is not None:
+        raise OptionError(f"give {new} (or its old name {old}), not both", param=new)
+    warnings.warn(f"{old}= is deprecated; use {new}=", DeprecationWarning, stacklevel=3)
+    return old_value

@@ -6,13 +6,25 @@ in metres. This is the "local" frame of PX4, ROS and ArduPilot; unlike a map pro
 (UTM, as the FCND course used) it has no scale distortion at home and round-trips to the
 millimetre and better within tens of kilometres.
 
-Headings:
+Frames (one meaning everywhere: Python, CLI, files; see docs/architecture.md):
 
-- NED heading: 0 = north, clockwise, radians (the waypoint format [north, east, alt, heading]).
-- ILP angle: 0 = east, anticlockwise, degrees (the lunch-drone rules; -999 means hover).
+====================  ================  ==========================  =====================
+frame                 a point is        plane (geometry)            heading (radians)
+====================  ================  ==========================  =====================
+``lonlat``            (lon, lat) deg    east, north metres at home  clockwise from north
+``ned`` (``local``)   (north, east) m   east, north metres at home  clockwise from north
+``enu``               (east, north) m   east, north metres          anticlockwise from +x
+``degrees``           (lon, lat) deg    lon, lat as a flat plane    anticlockwise from +x
+====================  ================  ==========================  =====================
 
-Angles in the "degrees" frame (the ILP rules) are measured on the (lon, lat) plane as if
-it were flat, which is what those rules define.
+Planners work in the plane, where headings are radians anticlockwise from +x (as
+:mod:`skyroute.motion.dubins` and shapely). :func:`heading_to_plane` and
+:func:`heading_from_plane` are the one place headings change convention. The CLI reads
+and prints headings in degrees, with the same direction as its frame. File formats keep
+their own: FCND waypoints ``[north, east, alt, heading]`` carry a NED heading (radians,
+clockwise from north), ILP flight paths an ILP angle (degrees anticlockwise from east;
+-999 means hover). Angles in the "degrees" frame are measured on the (lon, lat) plane as
+if it were flat, which is what the ILP rules define.
 """
 
 from __future__ import annotations
@@ -81,6 +93,25 @@ def ned_heading_to_ilp(heading) -> np.ndarray:
 def ilp_to_ned_heading(angle) -> np.ndarray:
     """ILP angle (degrees, 0 east, anticlockwise) -> NED heading in radians in [0, 2 pi)."""
     return np.mod(np.radians(90.0 - np.asarray(angle, dtype=float)), 2 * math.pi)
+
+
+FRAMES = ("lonlat", "ned", "enu", "degrees")
+FRAME_ALIASES = {"local": "ned"}
+COMPASS_FRAMES = ("lonlat", "ned")  # headings clockwise from north
+
+
+def heading_to_plane(heading, frame: str):
+    """A heading in ``frame``'s convention (radians) -> the plane's (radians
+    anticlockwise from +x, in [0, 2 pi))."""
+    h = np.asarray(heading, dtype=float)
+    out = (math.pi / 2 - h) if frame in COMPASS_FRAMES else h
+    return np.mod(out, 2 * math.pi)
+
+
+def heading_from_plane(heading, frame: str):
+    """The plane's heading (radians anticlockwise from +x) -> ``frame``'s convention,
+    in [0, 2 pi)."""
+    return heading_to_plane(heading, frame)  # the map x -> pi/2 - x is its own inverse
 
 
 def heading_of(dx, dy) -> np.ndarray:

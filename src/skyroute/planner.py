@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from skyroute.errors import OptionError
 from skyroute.result import PlanResult
+from skyroute.roadmap.world_plan import plan_world
 from skyroute.search.grid_plan import grid_options, plan_grid
 from skyroute.world.grid import Grid
 from skyroute.world.world import World
@@ -16,13 +17,16 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
          samples: int = 1000, neighbours: int = 10, prm_star: bool = False,
          seed: int = 0) -> PlanResult:
     """Plan a path on a Grid from cell ``start`` to cell ``goal``, both (x, y) = (column,
-    row), or on a World between two world points.
+    row), or on a World between two points given in the world's frame.
 
-    On a World (see :func:`skyroute.load_world`), ``algorithm`` is "visibility" (the
-    default: the exact shortest path), "prm" (``samples``, ``neighbours``, ``prm_star``,
-    ``seed``), or any grid algorithm on the world rasterised at ``resolution`` (default:
-    1000 cells along the longer side); the path is in world coordinates and its cost in
-    world units.
+    On a World (see :func:`skyroute.load_world`), ``start`` and ``goal`` are read in the
+    frame the world was loaded in ((lon, lat) for "lonlat" and "degrees", (north, east)
+    for "ned", (east, north) for "enu"), and ``path`` comes back in it, with
+    ``path_lonlat`` beside it where the world has a home. ``algorithm`` is "visibility"
+    (the default: the exact shortest path), "prm" (``samples``, ``neighbours``,
+    ``prm_star``, ``seed``; the same seed gives the same path), or any grid algorithm on
+    the world rasterised at ``resolution`` (default: 1000 cells along the longer side);
+    the cost is in plane units (metres; degrees in the degrees frame).
 
     Parameters
     ----------
@@ -66,8 +70,6 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
     True
     """
     if isinstance(grid, World):
-        from skyroute.world_plan import plan_world
-
         extra = {k: v for k, v in (("connectivity", connectivity), ("heuristic", heuristic),
                                    ("prune", prune)) if v is not None}
         if corner_cutting:

@@ -45,12 +45,15 @@ def stop_code(c, goal, expanded, max_expansions):
 class PlanResult:
     """What a planner found and what it cost to find it.
 
-    ``path`` is a (K, 2) float array of (x, y) points: cell coordinates on a grid (cell
-    centres, as MovingAI counts them), empty unless ``status`` is ``found``. ``cost`` is
-    the path's length in the same units (diagonal steps count sqrt 2); ``inf`` when no
-    path was found. ``expanded`` counts nodes taken off the open list and expanded,
-    ``max_frontier`` the largest open list, ``los_checks`` line-of-sight tests, and
-    ``seconds`` the wall time of the search itself.
+    ``path`` is a (K, 2) float array of points, empty unless ``status`` is ``found``: on
+    a grid, (x, y) cells (cell centres, as MovingAI counts them); on a World, points in
+    the world's frame (``extra["frame"]``), with ``path_lonlat`` the same points as
+    (lon, lat) where the world has a home. ``cost`` is the path's length (cells, with
+    diagonal steps sqrt 2, on a grid; plane units, metres or degrees, on a World);
+    ``inf`` when no path was found. ``expanded`` counts nodes taken off the open list and
+    expanded (for PRM: roadmap nodes Dijkstra settled up to the goal), ``max_frontier``
+    the largest open list, ``los_checks`` line-of-sight (segment) tests, and ``seconds``
+    the wall time of the search itself.
     """
 
     status: Status
@@ -62,6 +65,7 @@ class PlanResult:
     seconds: float = 0.0
     algorithm: str = ""
     extra: dict = field(default_factory=dict, compare=False)
+    path_lonlat: np.ndarray | None = field(default=None, compare=False)
 
     @property
     def found(self) -> bool:
@@ -79,5 +83,7 @@ class PlanResult:
             "los_checks": int(self.los_checks),
             "seconds": float(self.seconds),
             "algorithm": self.algorithm,
+            **({"path_lonlat": self.path_lonlat.tolist()}
+               if self.path_lonlat is not None else {}),
         }
 

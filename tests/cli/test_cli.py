@@ -61,12 +61,12 @@ def test_no_path_exits_1_and_writes_nothing(monkeypatch, capsys, tmp_path):
     (["plan", "den312d", "--start", "0,0", "--goal", "60,13"], "start (0, 0) is on a blocked"),
     (["plan", "den312d", "--start", "50,76", "--goal", "99,9"], "goal (99, 9) lies outside"),
     (["plan", "nope.map", "--start", "0,0", "--goal", "1,1"], "nope.map: no such file"),
-    (["plan", *QUERY, "--algorithm", "foo"], "algorithm='foo' is not valid"),
+    (["plan", *QUERY, "--algorithm", "foo"], "--algorithm 'foo' is not valid"),
     (["plan", "den312d", "--start", "5;x", "--goal", "1,1"], "--start '5;x' must be"),
     (["plan", *QUERY, "--bogus"], "No such option: --bogus"),
-    (["plan", *QUERY, "--clearance", "-1"], "clearance=-1.0"),
+    (["plan", *QUERY, "--clearance", "-1"], "--safety -1.0"),
     (["bench", "grid", "--map", "nomap", "--peers", ""], "--map nomap not found"),
-    (["bench", "grid", "--algorithms", "astar,zzz", "--peers", ""], "algorithm='zzz'"),
+    (["bench", "grid", "--algorithms", "astar,zzz", "--peers", ""], "--algorithm 'zzz'"),
 ])
 def test_bad_input_is_one_line_and_exit_2(monkeypatch, capsys, tmp_path, args, words):
     monkeypatch.chdir(tmp_path)

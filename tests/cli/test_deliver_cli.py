@@ -61,7 +61,7 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
     (["deliver", "2024-01-01"], "give exactly one of --data DIR and --source URL"),
     (["deliver", "2024-01-01", "--source", "ftp://x"], "expected an http:// or https:// URL"),
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--method", "magic"],
-     "method='magic' is not valid"),
+     "--method 'magic' is not valid"),
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "nonsense"], "not a database URL"),
     (["data", "serve", "/nonexistent"], "not a data folder"),
 ])

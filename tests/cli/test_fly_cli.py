@@ -62,12 +62,12 @@ def test_field_arc_mode(monkeypatch, capsys, tmp_path, city):
     assert doc["reached"] and doc["metrics"]["moves"] > 0
     assert len(doc["trajectory"]) > doc["metrics"]["moves"]  # the arcs, sampled
     code, text, _ = run(monkeypatch, capsys, *args, "--field-mode", "glide")
-    assert code == 2 and "mode='glide' is not valid" in text + _
+    assert code == 2 and "--field-mode 'glide' is not valid" in text + _
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--vehicle", "boat"], "vehicle='boat' is not valid"),
-    (["--planner", "greedy"], "planner='greedy' is not valid"),
+    (["--vehicle", "boat"], "--vehicle 'boat' is not valid"),
+    (["--planner", "greedy"], "--planner 'greedy' is not valid"),
     (["--out", "x.txt"], "--out x.txt: the suffix must be"),
 ])
 def test_bad_options(monkeypatch, capsys, args, words):
@@ -77,6 +77,6 @@ def test_bad_options(monkeypatch, capsys, args, words):
 
 
 def test_grid_planners_reach_goals_beyond_the_obstacles(city):
-    world = skyroute.load_world(city, frame="local", altitude=10, safety=2)
+    world = skyroute.load_world(city, frame="enu", altitude=10, safety=2)
     r = skyroute.plan(world, (0, 0), (-180, 120), algorithm="astar")
     assert r.found and world.segments_free(r.path[:-1], r.path[1:]).all()

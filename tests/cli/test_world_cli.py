@@ -20,7 +20,9 @@ def test_fcnd_json_waypoints_geojson_plot(monkeypatch, capsys, tmp_path):
                          str(png))
     assert code == 0, err
     doc = json.loads(out)
-    assert list(doc) == ["status", "cost", "path_local", "path_lonlat", "seconds", "algorithm"]
+    assert list(doc) == ["status", "cost", "frame", "path", "path_local", "path_lonlat",
+                         "expanded", "seconds", "algorithm"]
+    assert doc["frame"] == "lonlat" and doc["path"] == doc["path_lonlat"]
     assert doc["status"] == "found" and doc["path_local"][0] == pytest.approx([0, 0], abs=1e-6)
     assert doc["path_lonlat"][-1] == pytest.approx([-122.396428, 37.795232], abs=1e-9)
     waypoints = json.loads(wp.read_text())
@@ -48,7 +50,7 @@ def test_local_frame_and_degrees_frame(monkeypatch, capsys):
     (["--start=-3.1885,55.9450", "--goal=-3.1913,55.9455"], "lies inside obstacle"),
     (["--start=abc", "--goal=-3.1913,55.9455"], "--start 'abc' must be two numbers LON,LAT"),
     (["--start=-3.186874,55.944494", "--goal=-3.1913,55.9455", "--algorithm", "rrt"],
-     "algorithm='rrt' is not valid"),
+     "--algorithm 'rrt' is not valid"),
 ])
 def test_bad_queries_are_one_line_exit_2(monkeypatch, capsys, tmp_path, args, words):
     png = tmp_path / "p.png"

@@ -15,7 +15,7 @@ import skyroute
 from skyroute import QueryError, Status, World
 
 
-def rect_world(boxes, boundary=None, frame="metres"):
+def rect_world(boxes, boundary=None, frame="enu"):
     polys = shapely.box(*np.asarray(boxes, dtype=float).T)
     n = len(polys)
     return World(polys, np.full(n, -np.inf), np.full(n, np.inf), (), boundary, frame)

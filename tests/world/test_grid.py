@@ -16,7 +16,7 @@ def test_grid_is_immutable_and_copies_its_input():
 
 
 def test_cell_world_round_trip():
-    g = Grid(np.zeros((4, 5), bool), cell_size=0.5, origin=(10.0, -2.0))
+    g = Grid(np.zeros((4, 5), bool), resolution=0.5, origin=(10.0, -2.0))
     cells = np.array([[0, 0], [4, 3], [2, 1]])
     np.testing.assert_allclose(g.to_world(cells), [[10.25, -1.75], [12.25, -0.25],
                                                    [11.25, -1.25]])
@@ -35,7 +35,7 @@ def test_inflate_point_robot_seed_case():
     # disc of cells whose centres lie within 0.3 m of its centre (3 cells).
     a = np.zeros((9, 9), bool)
     a[4, 4] = True
-    g = Grid(a, cell_size=0.1).inflate(0.3)
+    g = Grid(a, resolution=0.1).inflate(0.3)
     yy, xx = np.mgrid[0:9, 0:9]
     expected = (xx - 4) ** 2 + (yy - 4) ** 2 <= 9
     np.testing.assert_array_equal(g.blocked, expected)
@@ -44,8 +44,23 @@ def test_inflate_point_robot_seed_case():
 
 
 def test_inflate_rejects_negative():
-    with pytest.raises(OptionError, match="clearance"):
+    with pytest.raises(OptionError, match="safety=-1"):
         Grid(np.zeros((2, 2), bool)).inflate(-1)
+
+
+def test_old_names_still_work_with_a_deprecation_warning():
+    a = np.zeros((9, 9), bool)
+    a[4, 4] = True
+    with pytest.warns(DeprecationWarning, match="clearance"):
+        old = Grid(a).inflate(clearance=2.0)
+    np.testing.assert_array_equal(old.blocked, Grid(a).inflate(2.0).blocked)
+    with pytest.warns(DeprecationWarning, match="cell_size"):
+        g = Grid(a, cell_size=0.5)
+    assert g.resolution == 0.5
+    with pytest.warns(DeprecationWarning, match="cell_size"):
+        assert g.cell_size == 0.5
+    with pytest.raises(OptionError, match="not both"):
+        Grid(a, 0.5, cell_size=0.5)
 
 
 def test_segments_rasterise_cells_they_cross():
@@ -64,7 +79,7 @@ def test_segments_rasterise_cells_they_cross():
 
 def test_segment_clearance_is_exact_distance_to_the_wall():
     seg = np.array([[0.0, 2.5, 10.0, 2.5]])
-    g = rasterize_segments(seg, resolution=0.5, clearance=1.0, bounds=(0, 0, 10, 5))
+    g = rasterize_segments(seg, resolution=0.5, safety=1.0, bounds=(0, 0, 10, 5))
     centres_y = g.to_world(np.c_[np.zeros(g.height), np.arange(g.height)])[:, 1]
     rows_blocked = g.blocked.all(axis=1)
     np.testing.assert_array_equal(rows_blocked, np.abs(centres_y - 2.5) <= 1.0)
@@ -73,8 +88,8 @@ def test_segment_clearance_is_exact_distance_to_the_wall():
 def test_segment_file_and_errors(tmp_path):
     p = tmp_path / "walls.csv"
     p.write_text("x1,y1,x2,y2\n0,0,2,0\n2,0,2,2\n")
-    g = load_map(p, cell_size=0.5, clearance=0.25)
-    assert g.cell_size == 0.5 and g.blocked.any() and not g.blocked.all()
+    g = load_map(p, resolution=0.5, safety=0.25)
+    assert g.resolution == 0.5 and g.blocked.any() and not g.blocked.all()
     p.write_text("x1,y1,x2,y2\n0,0,2,0\n1,2,three,4\n")
     with pytest.raises(InputFormatError, match=r"walls\.csv:3: .*numbers"):
         load_map(p)
@@ -88,11 +103,11 @@ def test_png_dark_pixels_are_blocked(tmp_path):
     img[1, 2] = 0
     img[2, 0] = 100
     Image.fromarray(img).save(tmp_path / "m.png")
-    g = load_map(tmp_path / "m.png", cell_size=0.2)
+    g = load_map(tmp_path / "m.png", resolution=0.2)
     expected = np.zeros((3, 4), bool)
     expected[1, 2] = expected[2, 0] = True
     np.testing.assert_array_equal(g.blocked, expected)
-    assert g.cell_size == 0.2
+    assert g.resolution == 0.2
 
 
 def test_npy_and_unknown_suffix(tmp_path):

@@ -16,7 +16,7 @@ def test_synth_city_is_seeded_and_home_is_free(tmp_path):
     assert a == synth_city(np.random.default_rng(3)) != synth_city(np.random.default_rng(4))
     p = tmp_path / "c.csv"
     p.write_text(a)
-    world = skyroute.load_world(p, altitude=10, safety=2)
+    world = skyroute.load_world(p, altitude=10, safety=2, frame="enu")
     assert world.is_free([[0, 0]])[0] and len(world.obstacles) > 36
     r = skyroute.plan(world, (0, 0), (-180, 120))
     assert r.found and world.segments_free(r.path[:-1], r.path[1:]).all()

@@ -111,12 +111,12 @@ def test_ilp_zones_in_degrees_and_metres():
                                                                 strict=True))
     m = skyroute.load_world(ILP / "website/buildings/no-fly-zones.geojson", frame="lonlat")
     # the zones span 0.00326 degrees of longitude: about 203 m at 55.94 N
-    assert m.frame == "metres" and 200 < m.bounds[2] - m.bounds[0] < 206
+    assert m.frame == "lonlat" and m.plane == "metres" and 200 < m.bounds[2] - m.bounds[0] < 206
 
 
 @needs_fcnd
 def test_fcnd_home_to_goal_is_free_and_theta_within_one_percent():
-    w = skyroute.load_world(FCND, altitude=5, safety=5)
+    w = skyroute.load_world(FCND, altitude=5, safety=5, frame="enu")
     goal = lonlat_to_enu(-122.396428, 37.795232, 0.0, w.home)[0, :2]
     exact = skyroute.plan(w, (0, 0), goal)
     assert exact.found
@@ -132,7 +132,7 @@ def test_fcnd_home_to_goal_is_free_and_theta_within_one_percent():
 
 @needs_fcnd
 def test_fcnd_prm_and_grid_paths_are_free():
-    w = skyroute.load_world(FCND, altitude=5, safety=5)
+    w = skyroute.load_world(FCND, altitude=5, safety=5, frame="enu")
     goal = lonlat_to_enu(-122.396428, 37.795232, 0.0, w.home)[0, :2]
     exact = skyroute.plan(w, (0, 0), goal).cost
     for algorithm, kw in (("prm", {"samples": 1500, "seed": 3}), ("jps", {"resolution": 2.0})):

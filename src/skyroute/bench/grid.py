@@ -44,8 +44,8 @@ def find_pairs(folder: str | Path, names: Sequence[str] = ()) -> list[tuple[Path
         wanted = [n.removesuffix(".map") for n in names]
         unknown = [n for n in wanted if n not in pairs]
         if unknown:
-            raise OptionError(f"--map {', '.join(unknown)} not found in {folder}; "
-                              f"valid: {', '.join(pairs)}")
+            raise OptionError(f"names={', '.join(unknown)} not found in {folder}; "
+                              f"valid: {', '.join(pairs)}", param="names")
         return [pairs[n] for n in wanted]
     if not pairs:
         raise InputFormatError(folder, "no .map file with a matching .scen file")

@@ -44,7 +44,7 @@ def _timed(fn) -> float:
     return time.perf_counter() - t0
 
 
-def step_drone_pairs(data: Path, *, budget: int, merge: float, on_pair=None) -> dict:
+def step_drone_pairs(data: Path, *, max_expansions: int, merge: float, on_pair=None) -> dict:
     """plan_moves and follow (on a Theta* path) for every ordered pair of ILP places."""
     from skyroute.motion.step_drone import follow, plan_moves
     from skyroute.planner import plan
@@ -58,7 +58,7 @@ def step_drone_pairs(data: Path, *, budget: int, merge: float, on_pair=None) -> 
     rows = []
     for a, b in itertools.permutations(places, 2):
         t0 = time.perf_counter()
-        m = plan_moves(world, places[a], places[b], max_expansions=budget, merge=merge)
+        m = plan_moves(world, places[a], places[b], max_expansions=max_expansions, merge=merge)
         ms = (time.perf_counter() - t0) * 1e3
         route = plan(world, places[a], places[b], algorithm="theta")
         f = follow(world, route.path)

@@ -31,7 +31,7 @@ def random_rect_world(seed: int, *, count: int = 20, size: float = 100.0) -> Wor
     hi = np.minimum(lo + wh, size)
     boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
     return World(boxes, np.full(count, -np.inf), np.full(count, np.inf), (),
-                 shapely.box(0, 0, size, size), "metres", name=f"random-rects-{seed}")
+                 shapely.box(0, 0, size, size), "enu", name=f"random-rects-{seed}")
 
 
 def free_pair(world: World, rng: np.random.Generator, min_dist: float) -> tuple:
@@ -59,7 +59,7 @@ def ompl_available() -> bool:
     return importlib.util.find_spec("ompl") is not None
 
 
-def run_ompl(world: World, start, goal, planner: str, budget: float) -> dict:
+def run_ompl(world: World, start, goal, planner: str, seconds: float) -> dict:
     """One OMPL solve: raw and simplified lengths, time, exact validity."""
     from ompl import base as ob
     from ompl import geometric as og
@@ -96,7 +96,7 @@ def run_ompl(world: World, start, goal, planner: str, budget: float) -> dict:
     si = ss.getSpaceInformation()
     ss.setPlanner(getattr(og, planner)(si))
     t0 = time.perf_counter()
-    solved = ss.solve(budget)
+    solved = ss.solve(seconds)
     seconds = time.perf_counter() - t0
     out = {"runner": f"ompl {planner}", "seconds": seconds, "exact": str(solved) ==
            "Exact solution"}
@@ -149,7 +149,7 @@ def run_ours(world: World, start, goal, other: tuple | None = None) -> list[dict
     return rows
 
 
-def bench_query(world: World, start, goal, *, budget: float, planners: tuple,
+def bench_query(world: World, start, goal, *, seconds: float, planners: tuple,
                 rrt_budgets: tuple, other: tuple | None = None,
                 on_step: Callable[[], None] | None = None) -> dict:
     """All runners on one query; lengths relative to the visibility optimum."""
@@ -157,7 +157,7 @@ def bench_query(world: World, start, goal, *, budget: float, planners: tuple,
     optimum = rows[1]["length"]
     if ompl_available():
         for planner in planners:
-            rows.append(run_ompl(world, start, goal, planner, budget))
+            rows.append(run_ompl(world, start, goal, planner, seconds))
             if on_step:
                 on_step()
         reached = None

@@ -40,7 +40,8 @@ def bench_world(
     safety: Annotated[float, typer.Option(help="City safety margin (m).")] = 5.0,
     city_queries: Annotated[int, typer.Option(
         help="Random queries timed on the city's graph once built.")] = 30,
-    budget: Annotated[float, typer.Option(help="Seconds per OMPL solve.")] = 1.0,
+    seconds: Annotated[float, typer.Option(
+        "--seconds", "--budget", help="Seconds per OMPL solve (--budget: old name).")] = 1.0,
     planners: Annotated[str, typer.Option(help="OMPL planners, comma-separated.")] =
         ",".join(OMPL_PLANNERS),
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] =
@@ -56,7 +57,7 @@ def bench_world(
                       "(pip install 'skyroute[bench]')[/yellow]")
     cases = [random_rect_world(seed + i) for i in range(worlds)]
     if city is not None:
-        cases.append(load_world(city, altitude=altitude, safety=safety))
+        cases.append(load_world(city, altitude=altitude, safety=safety, frame="enu"))
     reports = []
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task("worlds", total=len(cases))
@@ -65,7 +66,7 @@ def bench_world(
             size = max(world.bounds[2] - world.bounds[0], world.bounds[3] - world.bounds[1])
             s, g = free_pair(world, rng, 0.6 * size)
             other = free_pair(world, rng, 0.6 * size)
-            reports.append(bench_query(world, s, g, budget=budget, planners=chosen,
+            reports.append(bench_query(world, s, g, seconds=seconds, planners=chosen,
                                        rrt_budgets=(0.1, 0.3, 1.0, 3.0), other=other))
             progress.advance(task)
     out = Console()
@@ -93,7 +94,7 @@ def bench_world(
                   f"{city_timing['p90_ms']:.1f} ms, max {city_timing['max_ms']:.1f} ms "
                   f"({city_timing['found']} of {city_queries} found a path)")
     if json_out:
-        write_atomic(json_out, json.dumps({"budget": budget, "seed": seed, "worlds": reports,
+        write_atomic(json_out, json.dumps({"seconds": seconds, "seed": seed, "worlds": reports,
                                            "city_queries": city_timing},
                                           indent=1, default=float))
     if "ompl" in sys.modules:
@@ -107,7 +108,9 @@ def bench_world(
 @bench_app.command("motion")
 def bench_motion(
     data: Annotated[Path, typer.Option(help="The ILP data folder (website/, testing/).")],
-    budget: Annotated[int, typer.Option(help="plan_moves expansions per leg.")] = 200_000,
+    max_expansions: Annotated[int, typer.Option(
+        "--max-expansions", "--budget",
+        help="plan_moves expansions per leg (--budget: old name).")] = 200_000,
     merge: Annotated[float, typer.Option(help="plan_moves merge lattice (degrees).")] =
         MERGE,
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] =
@@ -123,11 +126,11 @@ def bench_motion(
                                     "per call" if "ompl_us" in d else ""))
     with Progress(console=Console(stderr=True), transient=True) as progress:
         task = progress.add_task("pairs", total=14 * 13)
-        r = step_drone_pairs(data, budget=budget, merge=merge,
+        r = step_drone_pairs(data, max_expansions=max_expansions, merge=merge,
                              on_pair=lambda: progress.advance(task))
     both = sum(1 for x in r["rows"] if x["moves"] is not None and x["follow"] is not None)
     out.print(f"step drone over {r['pairs']} ordered pairs: plan_moves solved "
-              f"{r['solved']} (budget {budget:,}, merge {merge:g}), follow "
+              f"{r['solved']} (max expansions {max_expansions:,}, merge {merge:g}), follow "
               f"{r['follow_solved']}; on the {both} both solved: {r['moves_total']} moves vs "
               f"{r['follow_total']} "
               f"(ratio {r['ratio']:.4f}); plan_moves per leg median {r['median_ms']:.1f} ms, "

@@ -14,13 +14,14 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from skyroute.cli.world_cmd import _check_in_user_frame, _to_world, parse_pair
+from skyroute.cli.world_cmd import FRAME_HELP, frame_of, parse_pair, point_names
 from skyroute.errors import OptionError, check_choice
 from skyroute.io.files import write_atomic
 from skyroute.io.geojson import dumps
-from skyroute.io.world_out import path_lonlat
 from skyroute.planner import plan
+from skyroute.result import PlanResult, Status
 from skyroute.world.load import load_world
+from skyroute.world.world import AXES
 
 VEHICLES = ("step", "dubins", "lattice", "field")
 EXIT_NOT_REACHED = 1
@@ -29,10 +30,11 @@ EXIT_NOT_REACHED = 1
 def fly_command(
     world_file: Annotated[Path, typer.Argument(metavar="WORLD", help=(
         "A colliders.csv city or a GeoJSON file of zones, as for plan-world."))],
-    start: Annotated[str, typer.Option(help="LON,LAT or NORTH,EAST (--frame local).")],
+    start: Annotated[str, typer.Option(help="A point in --frame: LON,LAT, NORTH,EAST or "
+                                       "EAST,NORTH.")],
     goal: Annotated[str, typer.Option(help="Same form as --start.")],
     vehicle: Annotated[str, typer.Option(help="step, dubins, lattice or field.")] = "step",
-    frame: Annotated[str, typer.Option(help="lonlat, local or degrees.")] = "degrees",
+    frame: Annotated[str | None, typer.Option(help=FRAME_HELP)] = None,
     altitude: Annotated[float | None, typer.Option(help="Altitude filter (m).")] = None,
     safety: Annotated[float, typer.Option(help="Grow obstacles by this distance.")] = 0.0,
     boundary: Annotated[str | None, typer.Option(help="GeoJSON file or a lon/lat bbox.")] =
@@ -42,11 +44,14 @@ def fly_command(
         "moves",
     radius: Annotated[float, typer.Option(help="dubins: turning radius.")] = 10.0,
     start_heading: Annotated[float, typer.Option(
-        help="dubins / lattice: start heading in degrees from the x axis (east).")] = 0.0,
+        help="dubins / lattice: start heading, degrees in the frame's convention "
+             "(clockwise from north in lonlat and ned; anticlockwise from east in enu and "
+             "degrees).")] = 0.0,
     goal_heading: Annotated[float | None, typer.Option(
         help="dubins: heading at the goal (degrees); free when left out.")] = None,
     headings: Annotated[int, typer.Option(help="lattice: 8 or 16 headings.")] = 8,
-    speed: Annotated[float, typer.Option(help="lattice: cells per second.")] = 1.0,
+    speed: Annotated[float, typer.Option(help="lattice: metres (plane units) per second.")] =
+        1.0,
     turn_rate: Annotated[float, typer.Option(help="lattice: degrees per second.")] = 90.0,
     resolution: Annotated[float | None, typer.Option(help="lattice: cell size.")] = None,
     step: Annotated[float, typer.Option(help="dubins: sampling step; field: move length.")] =
@@ -65,39 +70,45 @@ def fly_command(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG map of the flight.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
-    """Fly from START to GOAL with a vehicle model; exit 1 when the goal is not reached."""
+    """Fly from START to GOAL with a vehicle model; exit 1 when the goal is not reached.
+
+    Points, headings and written trajectories are in --frame (headings in degrees); the
+    step drone flies the ILP rules on the lon/lat plane whatever the frame, and writes
+    its moves as ILP rows (from_lon, from_lat, angle, to_lon, to_lat).
+    """
     check_choice("vehicle", vehicle, VEHICLES)
     check_choice("planner", planner, ("moves", "follow"))
     if out is not None and out.suffix.lower() not in (".json", ".csv", ".geojson"):
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
-    names = "NORTH,EAST" if frame == "local" else "LON,LAT"
-    a, b = parse_pair(start, "--start", names), parse_pair(goal, "--goal", names)
+    frame = frame_of(frame)
+    a = parse_pair(start, "--start", point_names(frame))
+    b = parse_pair(goal, "--goal", point_names(frame))
     world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
                        frame=frame)
-    s, t = (_to_world(world, p, frame) for p in (a, b))
-    _check_in_user_frame(world, s, a, "start", frame)
-    _check_in_user_frame(world, t, b, "goal", frame)
+    world.check_point(a, "start")  # one error, in the user's frame, for every vehicle
+    world.check_point(b, "goal")
+    h0 = math.radians(start_heading)
+    h1 = None if goal_heading is None else math.radians(goal_heading)
     if vehicle == "step":
-        doc, rows, xy = _fly_step(world, s, t, planner)
+        world, a, b = world.in_frame("degrees"), world.to_lonlat(a)[0], world.to_lonlat(b)[0]
+        doc, rows, xy = _fly_step(world, a, b, planner)
     elif vehicle == "dubins":
-        doc, rows, xy = _fly_dubins(world, s, t, radius, math.radians(start_heading),
-                                    None if goal_heading is None else
-                                    math.radians(goal_heading), step)
+        doc, rows, xy = _fly_dubins(world, a, b, radius, h0, h1, step)
     elif vehicle == "lattice":
-        doc, rows, xy = _fly_lattice(world, s, t, headings, speed, math.radians(turn_rate),
-                                     math.radians(start_heading), resolution)
+        doc, rows, xy = _fly_lattice(world, a, b, headings, speed, math.radians(turn_rate),
+                                     h0, resolution)
     else:
-        doc, rows, xy = _fly_field(world, s, t, step, escape, sensor_range, sensor_rays,
+        doc, rows, xy = _fly_field(world, a, b, step, escape, sensor_range, sensor_rays,
                                    field_mode, math.radians(max_turn))
     if out is not None and doc["reached"]:
-        write_atomic(out, _render(out, rows, doc["columns"], path_lonlat(world, xy)))
+        write_atomic(out, _render(out, rows, doc["columns"], world.to_lonlat(xy)))
     if plot is not None and doc["reached"]:
         from skyroute.io.world_out import plot_world_path
-        from skyroute.result import PlanResult, Status
 
-        length = float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
+        plane = world.to_plane(xy)
+        length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
         shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)
-        plot_world_path(world, shown, s, t, plot)
+        plot_world_path(world, shown, a, b, plot)
     if as_json:
         typer.echo(json.dumps({k: v for k, v in doc.items() if k != "columns"}))
     else:
@@ -111,30 +122,41 @@ def fly_command(
         raise typer.Exit(EXIT_NOT_REACHED)
 
 
+def _pose_rows(world, xy: np.ndarray, plane_headings: np.ndarray) -> list[list[float]]:
+    """[[a, b, heading_deg], ...]: points in the world's frame, headings in degrees in its
+    convention."""
+    deg = np.degrees(world.heading_from_plane(plane_headings))
+    return np.c_[xy, deg].tolist()
+
+
+def _pose_columns(world) -> list[str]:
+    return [*AXES[world.frame], "heading_deg"]
+
+
 def _fly_step(world, s, t, planner):
-    from skyroute.motion.step_drone import follow, plan_moves
+    from skyroute.motion.step_drone import STEP, follow, plan_moves
 
     if planner == "moves":
         flight = plan_moves(world, s, t)
     else:
         route = plan(world, s, t, algorithm="theta")
         flight = follow(world, route.path if route.found else np.array([s, t]))
-    reached = bool(flight.moves and math.dist(flight.end, t) < 0.00015) or \
-        math.dist(s, t) < 0.00015
+    reached = bool(flight.moves and math.dist(flight.end, t) < STEP) or \
+        math.dist(s, t) < STEP
     rows = flight.rows()
     xy = np.vstack([s, flight.to]) if flight.moves else np.array([s])
-    metrics = {"moves": flight.moves, "length_deg": float(flight.moves * 0.00015),
+    metrics = {"moves": flight.moves, "length_deg": float(flight.moves * STEP),
                "expanded": flight.expanded, "seconds": flight.seconds,
                "status": flight.status.value}
     return ({"reached": reached, "moves": rows, "metrics": metrics,
              "columns": ["from_lon", "from_lat", "angle", "to_lon", "to_lat"]}, rows, xy)
 
 
-def _smoothness(poses: np.ndarray) -> float:
+def _smoothness(plane_headings: np.ndarray) -> float:
     """Mean absolute heading change per sample step (radians)."""
-    if len(poses) < 2:
+    if len(plane_headings) < 2:
         return 0.0
-    d = np.abs((np.diff(poses[:, 2]) + math.pi) % (2 * math.pi) - math.pi)
+    d = np.abs((np.diff(plane_headings) + math.pi) % (2 * math.pi) - math.pi)
     return float(d.mean())
 
 
@@ -144,36 +166,35 @@ def _fly_dubins(world, s, t, radius, h0, h1, step):
     route = plan(world, s, t)
     if not route.found:
         return _not_reached("no route between start and goal"), [], np.array([s])
-    legs = through(route.path, radius, start_heading=h0, end_heading=h1)
+    legs = through(world.to_plane(route.path), radius,
+                   start_heading=float(world.heading_to_plane(h0)),
+                   end_heading=None if h1 is None else float(world.heading_to_plane(h1)))
     poses = np.vstack([leg.sample(step) for leg in legs])
     free = bool(world.segments_free(poses[:-1, :2], poses[1:, :2]).all())
     length = float(sum(leg.length for leg in legs))
-    metrics = {"length": length, "moves": len(poses) - 1, "smoothness": _smoothness(poses),
-               "free": free, "words": " ".join(leg.word for leg in legs)}
-    rows = poses.tolist()
+    metrics = {"length": length, "moves": len(poses) - 1,
+               "smoothness": _smoothness(poses[:, 2]), "free": free,
+               "words": " ".join(leg.word for leg in legs)}
+    xy = world.from_plane(poses[:, :2])
+    rows = _pose_rows(world, xy, poses[:, 2])
     return ({"reached": True, "trajectory": rows, "metrics": metrics,
-             "columns": ["x", "y", "heading"]}, rows, poses[:, :2])
+             "columns": _pose_columns(world)}, rows, xy)
 
 
 def _fly_lattice(world, s, t, headings, speed, rate, h0, resolution):
-    from skyroute.motion.turn_lattice import plan_turns
-    from skyroute.world_plan import default_resolution
+    from skyroute.motion.turn_lattice import plan_turns_world
 
-    r = default_resolution(world) if resolution is None else resolution
-    grid = world.merged().rasterize(r, clearance=r / math.sqrt(2) * 1.0001,
-                                    bounds=world.extent_with([s, t], margin=4 * r))
-    cs, ct = (tuple(int(v) for v in grid.to_cell([p])[0]) for p in (s, t))
-    res = plan_turns(grid, cs, ct, headings=headings, speed=speed, turn_rate=rate,
-                     start_heading=h0)
+    res = plan_turns_world(world, s, t, resolution=resolution, headings=headings,
+                           speed=speed, turn_rate=rate, start_heading=h0)
     if not res.found:
-        return _not_reached("no lattice route"), [], np.array([s])
-    xy = grid.to_world(res.cells)
-    poses = np.c_[xy, res.headings]
-    metrics = {"time": res.time, "length": float(res.distance * r), "moves": len(xy) - 1,
-               "smoothness": _smoothness(poses), "expanded": res.expanded}
-    rows = poses.tolist()
+        return _not_reached(f"no lattice route: {res.status.value}"), [], np.array([s])
+    plane_h = world.heading_to_plane(res.headings)
+    metrics = {"time": res.time, "length": res.distance, "moves": len(res.path) - 1,
+               "smoothness": _smoothness(plane_h), "expanded": res.expanded,
+               "status": res.status.value}
+    rows = _pose_rows(world, res.path, plane_h)
     return ({"reached": True, "trajectory": rows, "metrics": metrics,
-             "columns": ["x", "y", "heading"]}, rows, xy)
+             "columns": _pose_columns(world)}, rows, res.path)
 
 
 def _fly_field(world, s, t, step, escape, sensor_range, sensor_rays, mode, max_turn):
@@ -182,9 +203,9 @@ def _fly_field(world, s, t, step, escape, sensor_range, sensor_rays, mode, max_t
     run = run_field(world, s, t, step=step, escape=escape, sensor_range=sensor_range,
                     sensor_rays=sensor_rays, tolerance=step, mode=mode, max_turn=max_turn)
     xy = run.path if run.trace is None else run.trace
-    rows = xy.tolist()
+    rows = np.asarray(xy).tolist()
     return ({"reached": run.reached, "trajectory": rows, "metrics": run.metrics(),
-             "columns": ["x", "y"]}, rows, xy)
+             "columns": list(AXES[world.frame])}, rows, xy)
 
 
 def _not_reached(why: str) -> dict:

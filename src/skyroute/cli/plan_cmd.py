@@ -36,10 +36,14 @@ def plan_command(
         help="octile, euclidean, manhattan or zero (default: the algorithm's own).")] = None,
     weight: Annotated[float, typer.Option(help="Weighted A*: w >= 1.")] = 1.0,
     prune: Annotated[str, typer.Option(help="none, collinear or los.")] = "none",
-    clearance: Annotated[float, typer.Option(
-        help="Block cells within this many metres of an obstacle.")] = 0.0,
-    cell_size: Annotated[float, typer.Option(
-        help="Metres per cell (the rasterising resolution for .csv walls).")] = 1.0,
+    safety: Annotated[float, typer.Option(
+        "--safety", "--clearance",
+        help="Block cells within this many metres of an obstacle (--clearance: old name).")]
+        = 0.0,
+    resolution: Annotated[float, typer.Option(
+        "--resolution", "--cell-size",
+        help="Metres per cell: the rasterising resolution for .csv walls (--cell-size: old "
+             "name).")] = 1.0,
     max_expansions: Annotated[int | None, typer.Option(
         help="Give up after this many expansions (status budget_exhausted).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
@@ -55,7 +59,7 @@ def plan_command(
     opts = grid_options(algorithm, connectivity=connectivity, corner_cutting=corner_cutting,
                         heuristic=heuristic, weight=weight, prune=prune,
                         max_expansions=max_expansions)
-    grid = load_map(map_file, cell_size=cell_size, clearance=clearance)
+    grid = load_map(map_file, resolution=resolution, safety=safety)
     result = plan(grid, s, t, algorithm=opts.algorithm, connectivity=opts.connectivity,
                   corner_cutting=opts.corner_cutting, heuristic=opts.heuristic,
                   weight=opts.weight, prune=opts.prune, max_expansions=max_expansions)

@@ -11,22 +11,22 @@ import typer
 from rich.console import Console
 
 from skyroute.cli.tables import result_table
-from skyroute.errors import OptionError, QueryError
-from skyroute.geo import enu_to_lonlat, lonlat_to_enu
+from skyroute.errors import OptionError, check_choice
+from skyroute.geo import FRAME_ALIASES, FRAMES
 from skyroute.io.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
-    path_lonlat,
     path_north_east,
     plot_world_path,
     waypoints,
     world_path_geojson,
 )
 from skyroute.planner import plan
+from skyroute.roadmap.world_plan import WORLD_ALGORITHMS, roadmap_edges
 from skyroute.world.load import load_world
-from skyroute.world_plan import WORLD_ALGORITHMS, roadmap_edges
 
 EXIT_NOT_FOUND = 1
+DEFAULT_FRAME = "lonlat"  # a world's own frame, for colliders and GeoJSON files alike
 
 
 def parse_pair(text: str, option: str, names: str) -> tuple[float, float]:
@@ -43,13 +43,31 @@ def parse_pair(text: str, option: str, names: str) -> tuple[float, float]:
     return a, b
 
 
+def frame_of(frame: str | None) -> str:
+    """The frame a command reads points in: ``--frame``, or a world's own (lonlat)."""
+    frame = DEFAULT_FRAME if frame is None else frame
+    check_choice("frame", frame, (*FRAMES, *FRAME_ALIASES))
+    return FRAME_ALIASES.get(frame, frame)
+
+
+def point_names(frame: str) -> str:
+    """How a point is typed in ``frame``: LON,LAT / NORTH,EAST / EAST,NORTH."""
+    return {"lonlat": "LON,LAT", "degrees": "LON,LAT", "ned": "NORTH,EAST",
+            "enu": "EAST,NORTH"}[frame]
+
+
+FRAME_HELP = ("How points are typed and printed: lonlat (LON,LAT; the default, a world's "
+              "own), ned or local (NORTH,EAST metres from home), enu (EAST,NORTH metres) or "
+              "degrees (LON,LAT on a flat plane, the ILP rules; GeoJSON only).")
+
+
 def plan_world_command(
     world_file: Annotated[Path, typer.Argument(metavar="WORLD", help=(
         "A colliders.csv city (metres around lat0/lon0) or a GeoJSON file of zones."))],
-    start: Annotated[str, typer.Option(help="LON,LAT (lonlat, degrees) or NORTH,EAST "
-                                       "(local).")],
+    start: Annotated[str, typer.Option(help="A point in --frame: LON,LAT, NORTH,EAST or "
+                                       "EAST,NORTH.")],
     goal: Annotated[str, typer.Option(help="Same form as --start.")],
-    frame: Annotated[str, typer.Option(help="lonlat, local or degrees.")] = "lonlat",
+    frame: Annotated[str | None, typer.Option(help=FRAME_HELP)] = None,
     altitude: Annotated[float | None, typer.Option(
         help="Keep the obstacles that count at this altitude (m).")] = None,
     safety: Annotated[float, typer.Option(
@@ -72,18 +90,17 @@ def plan_world_command(
 ) -> None:
     """Plan between two points of a continuous world.
 
-    Exit code 0 when a path is found, 1 when there is none, 2 for bad input; output
-    files are written only when a path is found.
+    Points are read and the path printed in --frame, exactly as skyroute.plan() reads
+    and returns them for a world loaded in that frame. Exit code 0 when a path is found,
+    1 when there is none, 2 for bad input; output files are written only when a path is
+    found.
     """
-    names = "NORTH,EAST" if frame == "local" else "LON,LAT"
-    a = parse_pair(start, "--start", names)
-    b = parse_pair(goal, "--goal", names)
+    frame = frame_of(frame)
+    a = parse_pair(start, "--start", point_names(frame))
+    b = parse_pair(goal, "--goal", point_names(frame))
     world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
                        frame=frame)
-    s, t = (_to_world(world, p, frame) for p in (a, b))
-    _check_in_user_frame(world, s, a, "start", frame)
-    _check_in_user_frame(world, t, b, "goal", frame)
-    result = plan(world, s, t, algorithm=algorithm, resolution=resolution, samples=samples,
+    result = plan(world, a, b, algorithm=algorithm, resolution=resolution, samples=samples,
                   seed=seed)
     alt = 0.0 if altitude is None else altitude
     if result.found:
@@ -92,63 +109,33 @@ def plan_world_command(
         if geojson:
             write_atomic(geojson, dumps(world_path_geojson(world, result)))
         if plot:
-            plot_world_path(world, result, s, t, plot,
+            plot_world_path(world, result, a, b, plot,
                             edges=roadmap_edges(world, algorithm, samples=samples, seed=seed))
-    local = (result.path if frame == "degrees" else path_north_east(world, result.path))
-    doc = {"status": result.status.value,
-           "cost": float(result.cost) if result.found else None,
-           "path_local": local.tolist(),
-           "path_lonlat": path_lonlat(world, result.path).tolist(),
-           "seconds": result.seconds, "algorithm": result.algorithm}
     if as_json:
-        typer.echo(json.dumps(doc))
+        typer.echo(json.dumps(world_result_doc(world, result)))
     else:
         files = (("waypoints file", waypoints_out), ("geojson", geojson), ("plot", plot)) \
             if result.found else ()
         Console().print(result_table(f"{world.name}: {result.algorithm}", result,
-                                     unit="deg" if world.frame == "degrees" else "m",
+                                     unit="deg" if world.plane == "degrees" else "m",
                                      files=files))
     if not result.found:
         raise typer.Exit(EXIT_NOT_FOUND)
 
 
-def _user(world, p: np.ndarray, frame: str) -> tuple[float, float]:
-    """A world point in the frame the user typed: (lon, lat) or (north, east)."""
-    if frame == "local":
-        return float(p[1]), float(p[0])
-    if frame == "degrees":
-        return float(p[0]), float(p[1])
-    lon, lat, _ = enu_to_lonlat(p[0], p[1], 0.0, world.home)[0]
-    return float(lon), float(lat)
-
-
-def _check_in_user_frame(world, p: np.ndarray, typed, what: str, frame: str) -> None:
-    """Raise the world's start/goal errors with coordinates in the user's frame."""
-    names = ("north", "east") if frame == "local" else ("lon", "lat")
-    fmt = "{:.2f}" if frame == "local" else "{:.7f}"  # 1e-7 degree is about 1 cm
-    here = f"({fmt.format(typed[0])}, {fmt.format(typed[1])})"
-    if not world.inside([p])[0]:
-        xmin, ymin, xmax, ymax = world.bounds
-        lo = _user(world, np.array([xmin, ymin]), frame)
-        hi = _user(world, np.array([xmax, ymax]), frame)
-        a0, a1 = sorted((lo[0], hi[0]))
-        b0, b1 = sorted((lo[1], hi[1]))
-        raise QueryError(f"{what} {here} lies outside the map ({names[0]} in "
-                         f"({fmt.format(a0)}, {fmt.format(a1)}), {names[1]} in "
-                         f"({fmt.format(b0)}, {fmt.format(b1)}))")
-    j = int(world.blocking([p])[0])
-    if j >= 0:
-        near = _user(world, world.nearest_free(p, j), frame)
-        raise QueryError(f"{what} {here} lies inside obstacle {world.names[j]!r}; nearest "
-                         f"free point ({fmt.format(near[0])}, {fmt.format(near[1])})")
-
-
-def _to_world(world, p: tuple[float, float], frame: str) -> np.ndarray:
-    if frame == "degrees":
-        return np.array(p)
-    if frame == "local":
-        return np.array([p[1], p[0]])  # (north, east) -> (x = east, y = north)
-    return lonlat_to_enu(p[0], p[1], 0.0, world.home)[0, :2]
+def world_result_doc(world, result) -> dict:
+    """The --json object of a world plan: the path in the frame (``path``), as north/east
+    metres (``path_local``; lon/lat in the degrees frame, as before) and as lon/lat."""
+    local = result.path if world.frame == "degrees" else path_north_east(world, result.path)
+    lonlat = result.path_lonlat if result.path_lonlat is not None else np.empty((0, 2))
+    return {"status": result.status.value,
+            "cost": float(result.cost) if result.found else None,
+            "frame": world.frame,
+            "path": result.path.tolist(),
+            "path_local": np.asarray(local).tolist(),
+            "path_lonlat": np.asarray(lonlat).tolist(),
+            "expanded": int(result.expanded),
+            "seconds": result.seconds, "algorithm": result.algorithm}
 
 
 def synth_city_command(

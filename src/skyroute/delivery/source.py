@@ -72,12 +72,14 @@ def _client():
 
 
 def open_source(data: Path | None, source: str | None) -> DirSource | HttpSource:
-    """The one source a command names: ``--data DIR`` or ``--source URL``."""
+    """The one source a caller names: a folder ``data`` or a URL ``source``."""
     if (data is None) == (source is None):
-        raise OptionError("give exactly one of --data DIR and --source URL")
+        raise OptionError("give exactly one of data=DIR and source=URL",
+                          param=("data", "source"))
     if source is not None:
         if not source.startswith(("http://", "https://")):
-            raise OptionError(f"--source {source!r}: expected an http:// or https:// URL")
+            raise OptionError(f"source={source!r}: expected an http:// or https:// URL",
+                              param="source")
         return HttpSource(source)
     if not (data / "website").is_dir():
         raise InputFormatError(data, "not a data folder: no website/ inside (the ILP layout)")

@@ -55,13 +55,14 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
         with engine.connect():
             pass
     except sa.exc.ArgumentError:
-        raise SkyrouteError(f"--db {url!r}: not a database URL (e.g. sqlite:///skyroute.db or "
-                            "postgresql+psycopg://user@127.0.0.1:5432/test)") from None
+        raise SkyrouteError(f"url={url!r}: not a database URL (e.g. sqlite:///skyroute.db or "
+                            "postgresql+psycopg://user@127.0.0.1:5432/test)", param="url") from None
     except (sa.exc.OperationalError, sa.exc.InterfaceError) as exc:
-        raise SkyrouteError(f"--db {_safe(url)}: cannot connect: "
-                            f"{str(exc.orig).strip().splitlines()[0]}") from None
+        raise SkyrouteError(f"url={_safe(url)}: cannot connect: "
+                            f"{str(exc.orig).strip().splitlines()[0]}", param="url") from None
     except ModuleNotFoundError as exc:
-        raise SkyrouteError(f"--db {_safe(url)}: driver {exc.name!r} is not installed") from None
+        raise SkyrouteError(f"url={_safe(url)}: driver {exc.name!r} is not installed",
+                            param="url") from None
     return engine
 
 

@@ -95,7 +95,8 @@ def synth(out: Path, *, days: int = 7, orders_per_day: int = 12, seed: int = 1,
           start: dt.date = dt.date(2024, 1, 1), customers: int = 7) -> dict:
     """Write the data set to ``out``; return a summary of what was written."""
     if days < 1 or orders_per_day < 0 or customers < 1:
-        raise OptionError("--days and --customers must be at least 1, --orders-per-day >= 0")
+        raise OptionError(f"days={days} and customers={customers} must be at least 1, "
+                          f"orders_per_day={orders_per_day} >= 0", param="days")
     rng = np.random.default_rng(seed)
     box = shapely.box(ORIGIN[0], ORIGIN[1], ORIGIN[0] + SIZE[0], ORIGIN[1] + SIZE[1])
     zones = _zones(rng, box)

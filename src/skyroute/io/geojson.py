@@ -17,7 +17,7 @@ def grid_path_geojson(grid: Grid, result: PlanResult) -> dict:
     """
     coords = grid.to_world(result.path).tolist() if result.found else []
     props = {k: v for k, v in result.to_dict().items() if k != "path"}
-    props.update(map=grid.name, frame="grid-local metres", cell_size=grid.cell_size,
+    props.update(map=grid.name, frame="grid-local metres", resolution=grid.resolution,
                  cells=result.path.tolist())
     return {
         "type": "FeatureCollection",

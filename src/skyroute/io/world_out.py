@@ -1,4 +1,7 @@
-"""A path planned on a World as FCND waypoints, lon/lat GeoJSON, and a PNG map."""
+"""A path planned on a World as FCND waypoints, lon/lat GeoJSON, and a PNG map.
+
+Paths and points come in the world's frame (as :func:`skyroute.plan` returns them);
+pictures are drawn in its plane (east/north metres, or lon/lat in degrees)."""
 
 from __future__ import annotations
 
@@ -6,23 +9,20 @@ from pathlib import Path
 
 import numpy as np
 
-from skyroute.geo import enu_to_lonlat, heading_of, lonlat_to_enu
+from skyroute.geo import heading_of, lonlat_to_enu
 from skyroute.io.plot import save_figure
 from skyroute.result import PlanResult
 from skyroute.world.world import World
 
 
 def path_lonlat(world: World, path: np.ndarray) -> np.ndarray:
-    """(K, 2) lon, lat of a world path."""
-    p = np.asarray(path, dtype=float).reshape(-1, 2)
-    if world.frame == "degrees" or len(p) == 0:
-        return p.copy()
-    return enu_to_lonlat(p[:, 0], p[:, 1], 0.0, world.home)[:, :2]
+    """(K, 2) lon, lat of a path in the world's frame."""
+    return world.plane_to_lonlat(world.to_plane(np.reshape(path, (-1, 2)), "path"))
 
 
 def path_north_east(world: World, path: np.ndarray) -> np.ndarray:
-    """(K, 2) north, east metres from home of a world path."""
-    p = np.asarray(path, dtype=float).reshape(-1, 2)
+    """(K, 2) north, east metres from home of a path in the world's frame."""
+    p = world.to_plane(np.reshape(path, (-1, 2)), "path")
     if world.frame == "degrees" and len(p):
         enu = lonlat_to_enu(p[:, 0], p[:, 1], 0.0, world.home)
         return np.c_[enu[:, 1], enu[:, 0]]
@@ -44,18 +44,20 @@ def waypoints(world: World, path: np.ndarray, altitude: float) -> list[list[floa
 
 def world_path_geojson(world: World, result: PlanResult) -> dict:
     """A FeatureCollection with the path as a LineString in lon/lat (RFC 7946)."""
-    props = {k: v for k, v in result.to_dict().items() if k != "path"}
+    props = {k: v for k, v in result.to_dict().items() if k not in ("path", "path_lonlat")}
     props.update(world=world.name, frame=world.frame)
+    lonlat = result.path_lonlat if result.path_lonlat is not None else \
+        path_lonlat(world, result.path)
     return {"type": "FeatureCollection", "features": [{
         "type": "Feature",
-        "geometry": {"type": "LineString",
-                     "coordinates": path_lonlat(world, result.path).tolist()},
+        "geometry": {"type": "LineString", "coordinates": np.asarray(lonlat).tolist()},
         "properties": props}]}
 
 
 def plot_world_path(world: World, result: PlanResult, start, goal, path: str | Path, *,
                     edges: np.ndarray | None = None, dpi: int = 150) -> Path:
-    """Draw obstacles (grey), the boundary (dashed), roadmap edges (thin), the path."""
+    """Draw obstacles (grey), the boundary (dashed), roadmap edges (thin, plane
+    segments), the path; ``result.path``, ``start`` and ``goal`` in the world's frame."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -68,11 +70,11 @@ def plot_world_path(world: World, result: PlanResult, start, goal, path: str | P
 
         ax.add_collection(LineCollection(edges, colors="tab:cyan", linewidths=0.3, alpha=0.5))
     if result.found:
-        p = np.asarray(result.path)
+        p = world.to_plane(result.path, "path")
         ax.plot(p[:, 0], p[:, 1], "-o", color="tab:blue", lw=1.8, ms=3, label="path")
-    ax.plot(*start, "o", color="tab:green", ms=9, label="start")
-    ax.plot(*goal, "*", color="tab:red", ms=13, label="goal")
-    unit = "deg" if world.frame == "degrees" else "m"
+    ax.plot(*world.to_plane(start, "start")[0], "o", color="tab:green", ms=9, label="start")
+    ax.plot(*world.to_plane(goal, "goal")[0], "*", color="tab:red", ms=13, label="goal")
+    unit = "deg" if world.plane == "degrees" else "m"
     cost = f"{result.cost:.6g} {unit}" if result.found else result.status.value
     ax.set_title(f"{world.name}: {result.algorithm}, {cost}", fontsize=10)
     finish_axes(ax, world)
@@ -97,8 +99,8 @@ def draw_world(ax, world: World) -> None:
 
 def finish_axes(ax, world: World) -> None:
     """Axis names, true proportions (degrees squeezed by cos latitude), a legend."""
-    ax.set_xlabel("longitude" if world.frame == "degrees" else "east (m)")
-    ax.set_ylabel("latitude" if world.frame == "degrees" else "north (m)")
-    ax.set_aspect("equal" if world.frame == "metres" else
+    ax.set_xlabel("longitude" if world.plane == "degrees" else "east (m)")
+    ax.set_ylabel("latitude" if world.plane == "degrees" else "north (m)")
+    ax.set_aspect("equal" if world.plane == "metres" else
                   1 / np.cos(np.radians(np.mean(ax.get_ylim()))))
     ax.legend(loc="best", fontsize=8, framealpha=0.9)

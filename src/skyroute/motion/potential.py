@@ -39,10 +39,12 @@ class FieldRun:
     """A run: poses (K, 2), how it ended (``status``: found when the goal was reached,
     budget_exhausted after ``max_moves``, stuck when no move led on), and how."""
 
-    path: np.ndarray
+    path: np.ndarray  # in the world's frame
     status: Status
     escaped: int  # moves taken on the navigation function
-    trace: np.ndarray | None = None  # arc mode: the arcs sampled, for distance and plots
+    trace: np.ndarray | None = None  # arc mode: the arcs sampled (world's frame), for plots
+    distance: float = 0.0  # length flown, plane units (along the arcs in arc mode)
+    smoothness: float = 0.0  # mean absolute heading change per move, radians
 
     @property
     def reached(self) -> bool:
@@ -53,19 +55,6 @@ class FieldRun:
     def moves(self) -> int:
         return max(0, len(self.path) - 1)
 
-    @property
-    def distance(self) -> float:
-        pts = self.path if self.trace is None else self.trace
-        return float(np.hypot(*np.diff(pts, axis=0).T).sum()) if len(pts) > 1 else 0.0
-
-    @property
-    def smoothness(self) -> float:
-        """Mean absolute heading change per move, radians (0 = dead straight)."""
-        d = np.diff(self.path, axis=0)
-        if len(d) < 2:
-            return 0.0
-        a = np.arctan2(d[:, 1], d[:, 0])
-        return float(np.abs((np.diff(a) + math.pi) % (2 * math.pi) - math.pi).mean())
 
     def metrics(self) -> dict:
         return {"distance": self.distance, "moves": self.moves,
@@ -88,7 +77,7 @@ def course(name: str) -> tuple[World, np.ndarray, np.ndarray]:
                  shapely.box(18, 15, 34, 19)]
     n = len(boxes)
     world = World(np.array(boxes, dtype=object), np.full(n, -np.inf), np.full(n, np.inf),
-                  (), shapely.box(0, 0, 60, 60), "metres", name=f"{name} course")
+                  (), shapely.box(0, 0, 60, 60), "enu", name=f"{name} course")
     return world, np.array([5.0, 30.0]), np.array([52.0, 30.0])
 
 
@@ -125,7 +114,7 @@ def _navigation(world: World, goal: np.ndarray, resolution: float):
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 
-    grid = world.merged().rasterize(resolution, clearance=resolution / math.sqrt(2))
+    grid = world.merged().rasterize(resolution, safety=resolution / math.sqrt(2))
     free = ~grid.blocked
     h, w = free.shape
     idx = np.arange(h * w).reshape(h, w)
@@ -156,7 +145,9 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
               heading: float | None = None) -> FieldRun:
     """Descend the field from ``start``; when ``escape`` and the last ``window`` moves
     made less than two steps of net progress, follow the navigation function instead.
-    In ``arc`` mode the robot starts on ``heading`` (radians; default towards the goal)."""
+    In ``arc`` mode the robot starts on ``heading`` (radians in the world's frame's
+    convention; default towards the goal). Points come in and the run's path goes out in
+    the world's frame; distances (``step``, ``sensor_range``) are plane units."""
     check_choice("mode", mode, MODES)
     if not (step > 0 and sensor_range > 0 and sensor_rays >= 4 and tolerance > 0
             and 0 < max_turn <= math.pi):
@@ -164,7 +155,8 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
                           "and 0 < max_turn <= pi")
     p = world.check_point(start, "start")
     t = world.check_point(goal, "goal")
-    theta = math.atan2(*(t - p)[::-1]) if heading is None else float(heading)
+    theta = math.atan2(*(t - p)[::-1]) if heading is None else \
+        float(world.heading_to_plane(heading))
     path = [p.copy()]
     trace = [p.copy()]
     nav = None
@@ -202,8 +194,20 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
         p = q
     status = Status.FOUND if math.dist(p, t) < tolerance else \
         Status.BUDGET_EXHAUSTED if len(path) > max_moves else Status.STUCK
-    return FieldRun(np.array(path), status, escaped,
-                    np.array(trace) if mode == "arc" else None)
+    path, trace = np.array(path), np.array(trace)
+    flown = trace if mode == "arc" else path
+    return FieldRun(world.from_plane(path), status, escaped,
+                    world.from_plane(trace) if mode == "arc" else None,
+                    float(np.hypot(*np.diff(flown, axis=0).T).sum()), _smoothness(path))
+
+
+def _smoothness(path: np.ndarray) -> float:
+    """Mean absolute heading change per move, radians (0 = dead straight)."""
+    d = np.diff(path, axis=0)
+    if len(d) < 2:
+        return 0.0
+    a = np.arctan2(d[:, 1], d[:, 0])
+    return float(np.abs((np.diff(a) + math.pi) % (2 * math.pi) - math.pi).mean())
 
 
 def _force(world, p, t, attract, repulse, sensor_range, sensor_rays) -> np.ndarray | None:

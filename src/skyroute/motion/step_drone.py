@@ -26,10 +26,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skyroute.errors import OptionError, QueryError
+from skyroute.errors import OptionError, renamed
 from skyroute.motion import move_search
 from skyroute.motion.zone_kernels import zone_arrays
 from skyroute.result import FOUND, STATUS_OF_CODE, Status
+from skyroute.world.geometry import convex_corners
 from skyroute.world.world import World
 
 STEP = 0.00015
@@ -108,8 +109,6 @@ class DistanceBound:
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import dijkstra
 
-        from skyroute.roadmap.visibility import convex_corners
-
         self.world = world
         self.target = np.asarray(target, dtype=float)
         if world not in _CORNER_GRAPHS:
@@ -155,40 +154,40 @@ def _coarse(p: np.ndarray) -> tuple[int, int]:
     return round(p[0] / (STEP / 3)), round(p[1] / (STEP / 3))
 
 
-def plan_moves(world: World, start, target, *, step: float = STEP,
-               max_expansions: int = 200_000, merge: float = MERGE) -> Flight:
+def plan_moves(world: World, start, goal=None, *, step: float = STEP,
+               max_expansions: int = 200_000, merge: float = MERGE, target=None) -> Flight:
     """The fewest moves from ``start`` to a position strictly closer than ``step`` to
-    ``target`` (A* over positions reachable by steps; positions in one ``merge``-wide
+    ``goal`` (A* over positions reachable by steps; positions in one ``merge``-wide
     lattice cell are one state, which on the ILP map gives the same move counts as
     merging 2.5x finer, see docs/benchmarks.md).
 
     h = max(0, ceil(d / step - 1)) where d is a lower bound on the obstacle-avoiding
-    distance to the target (:class:`DistanceBound`): admissible, since each move covers
-    at most ``step`` and the flight may stop within ``step`` of the target. Ties go to
+    distance to the goal (:class:`DistanceBound`): admissible, since each move covers
+    at most ``step`` and the flight may stop within ``step`` of the goal. Ties go to
     the deeper node. No path is a status, not an exception. The whole search is one
     compiled call (:mod:`skyroute.motion.move_search`).
     """
     _check_world(world)
+    goal = renamed("goal", goal, "target", target)
+    if goal is None:
+        raise OptionError("plan_moves needs a goal", param="goal")
     t0 = time.perf_counter()
-    s = np.asarray(start, dtype=float).reshape(2)
-    t = np.asarray(target, dtype=float).reshape(2)
-    if not world.is_free([s])[0] or world.blocking([s])[0] >= 0:
-        raise QueryError(f"start ({s[0]:.6f}, {s[1]:.6f}) is not strictly inside the area "
-                         "and outside every zone")
+    s = world.check_point(start, "start")
+    t = world.to_plane(goal, "goal")[0]
     if not merge > 0:
-        raise OptionError(f"merge={merge!r} must be a positive number")
+        raise OptionError(f"merge={merge!r} must be a positive number", param="merge")
     rad = np.radians(ANGLES)
     deltas = step * np.c_[np.cos(rad), np.sin(rad)]
     bound = _bound(world, t)
     sees0 = bool(world.segments_free([s], [t])[0])
-    status, goal, expanded, x, y, parent, move = move_search.search(
+    status, end, expanded, x, y, parent, move = move_search.search(
         s[0], s[1], t[0], t[1], sees0, deltas, *_zones(world), bound.corners,
         bound.dist, step, merge, max_expansions, 1e-12)
     seconds = time.perf_counter() - t0
     if status != FOUND:
         return _empty(s, STATUS_OF_CODE[status], expanded, seconds)
     chain = []
-    i = goal
+    i = end
     while parent[i] >= 0:
         chain.append(i)
         i = parent[i]

@@ -10,6 +10,7 @@ cell path under the same model, so a distance-optimal path can be compared fairl
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -19,10 +20,12 @@ from numba import njit
 
 from skyroute.errors import OptionError, check_choice
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH, STATUS_OF_CODE, Status
+from skyroute.roadmap.raster import entry_cell, world_raster
 from skyroute.search import heap
 from skyroute.search.los import line_of_sight
 from skyroute.search.space import space_of
-from skyroute.world.grid import Grid
+from skyroute.world.grid import Grid, check_cell
+from skyroute.world.world import World
 
 _DIRS = {
     8: [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)],
@@ -43,6 +46,7 @@ class LatticeResult:
     distance: float
     expanded: int
     seconds: float
+    path: np.ndarray | None = None  # planned on a World: the cells' centres in its frame
 
     @property
     def found(self) -> bool:
@@ -132,8 +136,6 @@ def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
     ``speed`` in cells per second, ``turn_rate`` in radians per second; ``start_heading``
     (radians, from the x axis towards +y) snaps to the nearest lattice heading, or any.
     """
-    from skyroute.search.grid_plan import check_cell
-
     check_choice("headings", headings, (8, 16))
     if not (speed > 0 and turn_rate > 0):
         raise OptionError(f"speed={speed!r} and turn_rate={turn_rate!r} must be positive")
@@ -164,6 +166,29 @@ def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
     dist = float(np.hypot(*np.diff(cells, axis=0).T).sum()) if len(cells) > 1 else 0.0
     return LatticeResult(Status.FOUND, cells, heads[keep], float(g[end]), dist, expanded,
                          seconds)
+
+
+def plan_turns_world(world: World, start, goal, *, resolution: float | None = None,
+                     headings: int = 8, speed: float = 1.0, turn_rate: float = math.pi / 2,
+                     start_heading: float | None = None,
+                     max_expansions: int | None = None) -> LatticeResult:
+    """:func:`plan_turns` on a World rasterised at ``resolution`` (as the grid planners
+    on a World do, so every move is exactly free): ``start`` and ``goal`` in the world's
+    frame, ``start_heading`` and the result's ``headings`` in its heading convention,
+    ``path`` the route in its frame; ``speed`` in plane units per second, ``distance``
+    in plane units."""
+    s = world.check_point(start, "start")
+    t = world.check_point(goal, "goal")
+    grid = world_raster(world, s, t, resolution)
+    cs, ct = entry_cell(world, grid, s, "start"), entry_cell(world, grid, t, "goal")
+    h0 = None if start_heading is None else float(world.heading_to_plane(start_heading))
+    res = plan_turns(grid, cs, ct, headings=headings, speed=speed / grid.resolution,
+                     turn_rate=turn_rate, start_heading=h0, max_expansions=max_expansions)
+    if not res.found:
+        return res
+    return dataclasses.replace(res, distance=res.distance * grid.resolution,
+                               headings=world.heading_from_plane(res.headings),
+                               path=world.from_plane(grid.to_world(res.cells)))
 
 
 def travel_time(cells, *, speed: float = 1.0, turn_rate: float = math.pi / 2,

@@ -14,7 +14,7 @@ import numpy as np
 import shapely
 from numba import njit
 
-from skyroute.world.segments import point_segment_dist2
+from skyroute.world.geometry import point_segment_dist2
 from skyroute.world.world import World
 
 

@@ -4,6 +4,12 @@ k = ceil(e (1 + 1/d) log n) with d = 2. Built once per world; each query joins s
 and goal to their nearest visible samples, runs Dijkstra (scipy) on the roadmap, then
 shortcuts the result by the exact segment test: greedy vertex shortcuts, random
 sub-segment shortcuts (as OMPL's path simplifier), and greedy again.
+
+Reproducible: the samples come from ``seed``, and each query's random shortcuts from a
+generator seeded by ``seed`` and the query's own coordinates, so the same world, query,
+options and seed give the same path on every call and in every process. ``expanded``
+counts the roadmap nodes Dijkstra settles up to the goal (those no farther than it).
+scipy's Dijkstra has no expansion budget, so ``max_expansions`` is refused.
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ from scipy.spatial import cKDTree
 
 from skyroute.errors import OptionError
 from skyroute.result import PlanResult, Status
+from skyroute.roadmap.simplify import shortcut, smooth
 from skyroute.world.world import World
 
 
@@ -25,11 +32,14 @@ class PRM:
     """A roadmap over a world's free space (see module docstring)."""
 
     def __init__(self, world: World, *, samples: int = 1000, neighbours: int = 10,
-                 prm_star: bool = False, rng: np.random.Generator | None = None) -> None:
+                 prm_star: bool = False, seed: int = 0) -> None:
         if samples < 2 or neighbours < 1:
-            raise OptionError(f"samples={samples} must be >= 2 and neighbours={neighbours} >= 1")
-        rng = np.random.default_rng() if rng is None else rng
-        self.rng = rng
+            raise OptionError(f"samples={samples} must be >= 2 and neighbours={neighbours} >= 1",
+                              param="samples" if samples < 2 else "neighbours")
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise OptionError(f"seed={seed!r} must be an integer >= 0", param="seed")
+        self.seed = int(seed)
+        rng = np.random.default_rng(self.seed)
         t0 = time.perf_counter()
         self.world = world.merged()
         xmin, ymin, xmax, ymax = self.world.bounds
@@ -54,12 +64,15 @@ class PRM:
         self.build_seconds = time.perf_counter() - t0
 
     def plan(self, start, goal, *, max_expansions: int | None = None) -> PlanResult:
-        """Shortest roadmap path from ``start`` to ``goal``, shortcut; world coordinates."""
-        from skyroute.world_plan import shortcut, smooth
-
+        """Shortest roadmap path from plane point ``start`` to ``goal``, shortcut (the
+        plane is the world's; :func:`skyroute.plan` converts from and to its frame)."""
+        if max_expansions is not None:
+            raise OptionError("max_expansions: PRM searches its roadmap with scipy's "
+                              "Dijkstra, which has no expansion budget; bound the work with "
+                              "samples instead", param="max_expansions")
         w = self.world
-        s = w.check_point(start, "start")
-        t = w.check_point(goal, "goal")
+        s = w.check_plane_point(start, "start")
+        t = w.check_plane_point(goal, "goal")
         t0 = time.perf_counter()
         n = len(self.points)
         pts = np.vstack([self.points, s, t])
@@ -81,8 +94,9 @@ class PRM:
         lengths = np.hypot(*(pts[r] - pts[c]).T)
         graph = coo_matrix((lengths + 1e-300, (r, c)), shape=(n + 2, n + 2)).tocsr()
         dist, pred = dijkstra(graph, directed=False, indices=n, return_predecessors=True)
+        settled = int(np.count_nonzero(np.isfinite(dist) & (dist <= dist[n + 1])))
         if not np.isfinite(dist[n + 1]):
-            return PlanResult(Status.NO_PATH, np.empty((0, 2)), math.inf, n, 0, checks,
+            return PlanResult(Status.NO_PATH, np.empty((0, 2)), math.inf, settled, 0, checks,
                               time.perf_counter() - t0, "prm",
                               {"samples": n, "edges": len(self.edges)})
         path = [n + 1]
@@ -90,12 +104,21 @@ class PRM:
             path.append(int(pred[path[-1]]))
         raw = pts[path[::-1]]
         short, tests = shortcut(w, raw)
-        short, more = smooth(w, short, self.rng)
+        short, more = smooth(w, short, self._query_rng(s, t))
         short, again = shortcut(w, short)
         tests += more + again
         cost = float(np.hypot(*np.diff(short, axis=0).T).sum())
-        return PlanResult(Status.FOUND, short, cost, n, 0, checks + tests,
+        return PlanResult(Status.FOUND, short, cost, settled, 0, checks + tests,
                           time.perf_counter() - t0, "prm",
                           {"samples": n, "edges": len(self.edges), "k": self.k,
                            "raw_cost": float(dist[n + 1]),
                            "build_seconds": self.build_seconds})
+
+    def _query_rng(self, s: np.ndarray, t: np.ndarray) -> np.random.Generator:
+        """The shortcuts' generator for one query: from the seed and the query's bits."""
+        bits = np.concatenate([s, t]).astype(np.float64).view(np.uint64)
+        return np.random.default_rng(np.random.SeedSequence([self.seed, *bits.tolist()]))
+
+    def edge_segments(self) -> np.ndarray:
+        """(E, 2, 2) plane segments of the roadmap's edges (for plots)."""
+        return self.points[self.edges]

@@ -15,36 +15,11 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import shapely
 
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.roadmap.graph_search import lazy_astar
+from skyroute.world.geometry import convex_corners
 from skyroute.world.world import World
-
-
-def convex_corners(world: World) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(corners, previous, next): the convex corners of the union of the obstacles, with
-    their neighbours along the ring (obstacle interior on the left)."""
-    if len(world.obstacles) == 0:
-        e = np.empty((0, 2))
-        return e, e, e
-    merged = shapely.orient_polygons(shapely.unary_union(world.obstacles))
-    corners, prevs, nexts = [], [], []
-    for poly in getattr(merged, "geoms", [merged]):
-        if poly.geom_type != "Polygon":
-            continue
-        for ring in (poly.exterior, *poly.interiors):
-            c = np.asarray(ring.coords)[:-1]
-            # exterior counter-clockwise, holes clockwise: the obstacle is on the left
-            prev, nxt = np.roll(c, 1, axis=0), np.roll(c, -1, axis=0)
-            u, v = c - prev, nxt - c
-            cross = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
-            scale = np.hypot(*u.T) * np.hypot(*v.T)
-            keep = cross > 1e-12 * scale  # convex, not collinear
-            corners.append(c[keep])
-            prevs.append(prev[keep])
-            nexts.append(nxt[keep])
-    return np.concatenate(corners), np.concatenate(prevs), np.concatenate(nexts)
 
 
 class VisibilityGraph:
@@ -101,11 +76,18 @@ class VisibilityGraph:
         turn = din[0] * d[:, 1] - din[1] * d[:, 0]
         return turn * side >= 0
 
+    def checked_edges(self) -> np.ndarray:
+        """(E, 2, 2) plane segments between corners that queries have checked and found
+        free (the part of the graph searched so far, for plots)."""
+        pairs = np.array([k for k, ok in self._verdicts.items() if ok], dtype=np.int64)
+        return self.corners[pairs] if len(pairs) else np.empty((0, 2, 2))
+
     def plan(self, start, goal, *, max_expansions: int | None = None) -> PlanResult:
-        """Exact shortest path from ``start`` to ``goal`` (world coordinates)."""
+        """Exact shortest path from plane point ``start`` to ``goal`` (the plane is the
+        world's; :func:`skyroute.plan` converts from and to the world's frame)."""
         w = self.world
-        s = w.check_point(start, "start")
-        t = w.check_point(goal, "goal")
+        s = w.check_plane_point(start, "start")
+        t = w.check_plane_point(goal, "goal")
         t0 = time.perf_counter()
         n = len(self.corners)
         S, T = n, n + 1

@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import math
-import operator
 import time
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
-from skyroute.errors import OptionError, QueryError, check_choice
+from skyroute.errors import OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult, Status
 from skyroute.search.astar import astar_kernel
 from skyroute.search.bfs import bfs_kernel
@@ -19,7 +18,7 @@ from skyroute.search.moves import HEURISTICS
 from skyroute.search.prune import PRUNE_MODES, prune_collinear, prune_los
 from skyroute.search.space import SearchSpace, space_of, to_cells
 from skyroute.search.theta import theta_kernel
-from skyroute.world.grid import Grid
+from skyroute.world.grid import Grid, check_cell
 
 GRID_ALGORITHMS = ("bfs", "dijkstra", "astar", "jps", "theta", "lazy_theta")
 ANY_ANGLE = ("theta", "lazy_theta")
@@ -94,21 +93,6 @@ def _default_h(algorithm: str, connectivity: int) -> str:
     if algorithm == "bfs":
         return "manhattan"
     return "octile" if connectivity == 8 else "manhattan"
-
-
-def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
-    """(x, y) as ints, on the grid and free; else QueryError naming ``what``."""
-    try:
-        x, y = cell  # type: ignore[misc]
-        x, y = operator.index(x), operator.index(y)
-    except (TypeError, ValueError):
-        raise QueryError(f"{what} {cell!r} must be two integers (x, y)") from None
-    if not grid.in_bounds((x, y)):
-        raise QueryError(f"{what} ({x}, {y}) lies outside the {grid.width}x{grid.height} grid "
-                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})")
-    if grid.blocked[y, x]:
-        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell")
-    return x, y
 
 
 def plan_grid(grid: Grid, start: tuple[int, int], goal: tuple[int, int],

@@ -23,8 +23,9 @@ HEADER = "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ"
 _HOME = re.compile(r"^\s*lat0\s+(-?[\d.]+)\s*,\s*lon0\s+(-?[\d.]+)\s*$")
 
 
-def read_colliders(path: str | Path, *, safety: float = 0.0) -> World:
-    """Read a colliders file into a metres-frame World with home at (lon0, lat0)."""
+def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonlat") -> World:
+    """Read a colliders file into a World in ``frame`` ("lonlat", "ned" or "enu"; the
+    plane is east/north metres around home at (lon0, lat0))."""
     path = Path(path)
     try:
         lines = path.read_text().splitlines()
@@ -61,5 +62,5 @@ def read_colliders(path: str | Path, *, safety: float = 0.0) -> World:
     s = float(safety)
     boxes = shapely.box(east - he - s, north - hn - s, east + he + s, north + hn + s)
     names = tuple(f"box at line {n}" for n in range(3, 3 + len(rows)))
-    return World(boxes, up - hu - s, up + hu + s, names, None, "metres",
+    return World(boxes, up - hu - s, up + hu + s, names, None, frame,
                  Home(lon0, lat0, 0.0), name=path.name)

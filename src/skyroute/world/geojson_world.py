@@ -4,8 +4,8 @@ Every feature must be a Polygon or MultiPolygon (an obstacle), except the bounda
 feature whose properties carry ``"boundary": true`` or whose name mentions
 "confinement". A boundary may also come from another GeoJSON file or a bbox string
 ``MINLON,MINLAT,MAXLON,MAXLAT``. Frames: "degrees" keeps (lon, lat) as a flat plane
-(the ILP rules); "metres" projects to east/north metres around a home at the centre of
-the boundary (or of the zones), see :mod:`skyroute.geo`.
+(the ILP rules); "lonlat" (the default), "ned" and "enu" project to east/north metres
+around a home at the centre of the boundary (or of the zones), see :mod:`skyroute.geo`.
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import shapely
 
-from skyroute.errors import InputFormatError, OptionError
-from skyroute.geo import Home, lonlat_to_enu
+from skyroute.errors import InputFormatError, OptionError, check_choice
+from skyroute.geo import FRAME_ALIASES, FRAMES, Home, lonlat_to_enu
 from skyroute.world.world import World
 
 
@@ -65,10 +65,10 @@ def parse_boundary(value: str | Path) -> shapely.Polygon:
         try:
             x0, y0, x1, y1 = (float(p) for p in parts)
         except ValueError:
-            raise OptionError(f"--boundary {text!r}: expected MINLON,MINLAT,MAXLON,MAXLAT or "
-                              "a GeoJSON file") from None
+            raise OptionError(f"boundary={text!r}: expected MINLON,MINLAT,MAXLON,MAXLAT or "
+                              "a GeoJSON file", param="boundary") from None
         if not (x0 < x1 and y0 < y1):
-            raise OptionError(f"--boundary {text!r}: min must be below max")
+            raise OptionError(f"boundary={text!r}: min must be below max", param="boundary")
         return shapely.box(x0, y0, x1, y1)
     path = Path(text)
     if not path.exists():
@@ -80,7 +80,7 @@ def parse_boundary(value: str | Path) -> shapely.Polygon:
 
 
 def read_geojson_world(path: str | Path, *, boundary: str | Path | shapely.Polygon | None = None,
-                       safety: float = 0.0, frame: str = "degrees",
+                       safety: float = 0.0, frame: str = "lonlat",
                        text: str | None = None) -> World:
     """Read zones (and a boundary) from a FeatureCollection in lon/lat.
 
@@ -105,11 +105,10 @@ def read_geojson_world(path: str | Path, *, boundary: str | Path | shapely.Polyg
     allb = shapely.total_bounds(np.array(zones + ([found] if found is not None else []),
                                          dtype=object))
     home = Home((allb[0] + allb[2]) / 2, (allb[1] + allb[3]) / 2, 0.0)
-    if frame == "metres":
+    check_choice("frame", frame, (*FRAMES, *FRAME_ALIASES))
+    if frame != "degrees":
         zones = [_to_metres(z, home) for z in zones]
         found = _to_metres(found, home) if found is not None else None
-    elif frame != "degrees":
-        raise OptionError(f"frame={frame!r} is not valid; choose one of 'degrees', 'metres'")
     polys, pnames = [], []
     for z, name in zip(zones, names, strict=True):
         if safety:

@@ -8,23 +8,27 @@ cell (x, y) covers ``[ox + x*s, ox + (x+1)*s) x [oy + y*s, oy + (y+1)*s)`` for o
 
 from __future__ import annotations
 
+import operator
+import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 
-from skyroute.errors import OptionError
+from skyroute.errors import OptionError, QueryError, renamed
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class Grid:
-    """Boolean occupancy (True = blocked) with a cell size and origin in metres.
+    """Boolean occupancy (True = blocked) with a resolution (cell size) and origin in
+    metres.
 
     The array is copied and made read-only, so a Grid never changes after creation.
+    ``cell_size`` is the old name of ``resolution`` (deprecated).
 
     Examples
     --------
-    >>> g = Grid(np.array([[0, 1], [0, 0]], dtype=bool), cell_size=0.5)
+    >>> g = Grid(np.array([[0, 1], [0, 0]], dtype=bool), resolution=0.5)
     >>> g.width, g.height, g.is_free((0, 1)), g.is_free((1, 0))
     (2, 2, True, False)
     >>> g.to_world([(1, 1)]).tolist()
@@ -32,20 +36,33 @@ class Grid:
     """
 
     blocked: np.ndarray
-    cell_size: float = 1.0
+    resolution: float = 1.0
     origin: tuple[float, float] = (0.0, 0.0)
     name: str = field(default="grid", compare=False)
 
-    def __post_init__(self) -> None:
-        arr = np.array(self.blocked, dtype=bool, copy=True)
+    def __init__(self, blocked, resolution: float | None = None,
+                 origin: tuple[float, float] = (0.0, 0.0), name: str = "grid", *,
+                 cell_size: float | None = None) -> None:
+        resolution = renamed("resolution", resolution, "cell_size", cell_size)
+        resolution = 1.0 if resolution is None else resolution
+        arr = np.array(blocked, dtype=bool, copy=True)
         if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
             raise OptionError(f"blocked must be a non-empty 2-D array, got shape {arr.shape}")
-        if not (np.isfinite(self.cell_size) and self.cell_size > 0):
-            raise OptionError(f"cell_size={self.cell_size!r} must be a positive number")
+        if not (np.isfinite(resolution) and resolution > 0):
+            raise OptionError(f"resolution={resolution!r} must be a positive number",
+                              param="resolution")
         arr.setflags(write=False)
         object.__setattr__(self, "blocked", arr)
-        object.__setattr__(self, "cell_size", float(self.cell_size))
-        object.__setattr__(self, "origin", (float(self.origin[0]), float(self.origin[1])))
+        object.__setattr__(self, "resolution", float(resolution))
+        object.__setattr__(self, "origin", (float(origin[0]), float(origin[1])))
+        object.__setattr__(self, "name", name)
+
+    @property
+    def cell_size(self) -> float:
+        """Deprecated name of :attr:`resolution`."""
+        warnings.warn("Grid.cell_size is deprecated; use Grid.resolution",
+                      DeprecationWarning, stacklevel=2)
+        return self.resolution
 
     @property
     def width(self) -> int:
@@ -69,32 +86,50 @@ class Grid:
     def to_world(self, cells: np.ndarray) -> np.ndarray:
         """Centres in metres of an (N, 2) array of (x, y) cells (float cells allowed)."""
         c = np.asarray(cells, dtype=float).reshape(-1, 2)
-        return (c + 0.5) * self.cell_size + np.asarray(self.origin)
+        return (c + 0.5) * self.resolution + np.asarray(self.origin)
 
     def to_cell(self, points: np.ndarray) -> np.ndarray:
         """The (x, y) cells containing an (N, 2) array of world points (may be off-grid)."""
         p = np.asarray(points, dtype=float).reshape(-1, 2)
-        return np.floor((p - np.asarray(self.origin)) / self.cell_size).astype(np.int64)
+        return np.floor((p - np.asarray(self.origin)) / self.resolution).astype(np.int64)
 
-    def inflate(self, clearance: float) -> Grid:
-        """Block every cell whose centre lies within ``clearance`` metres of a blocked cell.
+    def inflate(self, safety: float | None = None, *, clearance: float | None = None) -> Grid:
+        """Block every cell whose centre lies within ``safety`` metres of a blocked cell.
 
         Distances are Euclidean between cell centres (scipy's exact distance transform),
-        so a point robot that keeps to free cell centres keeps that clearance from the
-        centres of blocked cells. ``clearance=0`` returns an equal grid.
+        so a point robot that keeps to free cell centres keeps that distance from the
+        centres of blocked cells. ``safety=0`` returns an equal grid. (``clearance`` is
+        the old name, deprecated.)
         """
-        if not (np.isfinite(clearance) and clearance >= 0):
-            raise OptionError(f"clearance={clearance!r} must be a number >= 0")
-        if clearance == 0 or not self.blocked.any():
+        safety = renamed("safety", safety, "clearance", clearance)
+        safety = 0.0 if safety is None else safety
+        if not (np.isfinite(safety) and safety >= 0):
+            raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
+        if safety == 0 or not self.blocked.any():
             return self
         from scipy import ndimage  # imported here: it costs 0.25 s at start-up
 
         free = ~self.blocked
-        dist = ndimage.distance_transform_edt(free, sampling=self.cell_size)
-        inflated = dist <= clearance + 1e-9 * self.cell_size
-        return Grid(inflated, self.cell_size, self.origin, name=self.name)
+        dist = ndimage.distance_transform_edt(free, sampling=self.resolution)
+        inflated = dist <= safety + 1e-9 * self.resolution
+        return Grid(inflated, self.resolution, self.origin, name=self.name)
 
     @cached_property
     def free_fraction(self) -> float:
         """Share of free cells, for reports."""
         return float(1.0 - self.blocked.mean())
+
+
+def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
+    """(x, y) as ints, on the grid and free; else QueryError naming ``what``."""
+    try:
+        x, y = cell  # type: ignore[misc]
+        x, y = operator.index(x), operator.index(y)
+    except (TypeError, ValueError):
+        raise QueryError(f"{what} {cell!r} must be two integers (x, y)") from None
+    if not grid.in_bounds((x, y)):
+        raise QueryError(f"{what} ({x}, {y}) lies outside the {grid.width}x{grid.height} grid "
+                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})")
+    if grid.blocked[y, x]:
+        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell")
+    return x, y

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from skyroute.errors import InputFormatError, OptionError, check_choice
+from skyroute.errors import InputFormatError, OptionError, check_choice, renamed
+from skyroute.geo import FRAME_ALIASES, FRAMES
 from skyroute.world.grid import Grid
 from skyroute.world.image import read_image, read_npy
 from skyroute.world.movingai import read_map
@@ -35,68 +36,80 @@ def resolve_map_path(path: str | Path) -> Path:
     raise InputFormatError(p, "no such file (bundled maps: " + ", ".join(maps) + ")")
 
 
-def load_map(path: str | Path, *, cell_size: float = 1.0, clearance: float = 0.0) -> Grid:
+def load_map(path: str | Path, *, resolution: float | None = None, safety: float | None = None,
+             cell_size: float | None = None, clearance: float | None = None) -> Grid:
     """Read a map into a :class:`Grid`, chosen by the file's suffix.
 
-    - ``.map``: a MovingAI map (1 m cells; ``cell_size`` rescales it);
-    - ``.csv``: wall segments ``x1,y1,x2,y2`` in metres, rasterised at ``cell_size``;
+    - ``.map``: a MovingAI map (1 m cells; ``resolution`` rescales it);
+    - ``.csv``: wall segments ``x1,y1,x2,y2`` in metres, rasterised at ``resolution``;
     - ``.png``, ``.jpg``, ...: an image, dark pixels blocked;
     - ``.npy``: a 2-D array, non-zero blocked.
 
     A bare name such as ``"den312d"`` that is not a file names a bundled map.
-    ``clearance`` (metres) blocks cells near obstacles (exact to the walls for ``.csv``;
-    a Euclidean distance transform, :meth:`Grid.inflate`, for the others).
+    ``resolution`` is the cell size in metres (default 1). ``safety`` (metres) blocks
+    cells near obstacles (exact to the walls for ``.csv``; a Euclidean distance
+    transform, :meth:`Grid.inflate`, for the others). ``cell_size`` and ``clearance``
+    are the old names of ``resolution`` and ``safety`` (deprecated).
 
     >>> grid = load_map("den312d")
     >>> grid.width, grid.height
     (65, 81)
     """
+    resolution = renamed("resolution", resolution, "cell_size", cell_size)
+    resolution = 1.0 if resolution is None else resolution
+    safety = renamed("safety", safety, "clearance", clearance)
+    safety = 0.0 if safety is None else safety
     p = resolve_map_path(path)
     suffix = p.suffix.lower()
     if suffix == ".csv":
-        return rasterize_segments(read_segments(p), resolution=cell_size, clearance=clearance,
+        return rasterize_segments(read_segments(p), resolution=resolution, safety=safety,
                                   name=p.name)
     if suffix == ".map":
         grid = read_map(p)
-        if cell_size != 1.0:
-            grid = Grid(grid.blocked, cell_size, grid.origin, name=grid.name)
+        if resolution != 1.0:
+            grid = Grid(grid.blocked, resolution, grid.origin, name=grid.name)
     elif suffix in IMAGE_SUFFIXES:
-        grid = read_image(p, cell_size=cell_size)
+        grid = read_image(p, resolution=resolution)
     elif suffix == ".npy":
-        grid = read_npy(p, cell_size=cell_size)
+        grid = read_npy(p, resolution=resolution)
     else:
         raise InputFormatError(p, f"unknown map type {suffix!r}; valid: .map, .csv, .npy, "
                                + ", ".join(IMAGE_SUFFIXES))
-    return grid.inflate(clearance)
+    return grid.inflate(safety)
 
 
 def load_world(path: str | Path, *, altitude: float | None = None, safety: float = 0.0,
                boundary: str | Path | None = None, frame: str = "lonlat") -> World:
     """Read a continuous world: a ``colliders.csv`` city or a GeoJSON file of zones.
 
-    ``frame``: "lonlat" and "local" give geometry in metres around home (they differ
-    only in how a CLI reads starts and goals); "degrees" keeps (lon, lat) as a plane,
-    which is how the ILP rules measure. ``altitude`` keeps the obstacles that count
-    there; ``safety`` grows every obstacle (metres, or degrees in the degrees frame).
+    ``frame`` is how points are given to and returned by everything that takes this
+    world (:func:`skyroute.plan`, the motion models, the writers): "lonlat" (the default
+    for both kinds of file: (lon, lat) in, geometry in metres around home), "ned"
+    ((north, east) metres from home, FCND; "local" is an alias), "enu" ((east, north)
+    metres) or "degrees" ((lon, lat) on a flat plane, the ILP rules; GeoJSON only). A
+    colliders file's home is its ``lat0, lon0``; a GeoJSON file's the centre of its
+    zones and boundary. ``altitude`` keeps the obstacles that count there; ``safety``
+    grows every obstacle (metres, or degrees in the degrees frame).
     """
     from skyroute.world.colliders import read_colliders
     from skyroute.world.geojson_world import parse_boundary, read_geojson_world
 
-    check_choice("frame", frame, ("lonlat", "local", "degrees"))
+    check_choice("frame", frame, (*FRAMES, *FRAME_ALIASES))
+    frame = FRAME_ALIASES.get(frame, frame)
     if not (np.isfinite(safety) and safety >= 0):
-        raise OptionError(f"safety={safety!r} must be a number >= 0")
+        raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
     p = Path(path)
     if not p.exists():
         raise InputFormatError(p, "no such file")
     if p.suffix.lower() == ".csv":
         if frame == "degrees":
-            raise OptionError("a colliders.csv city is in metres; use frame 'lonlat' or 'local'")
-        world = read_colliders(p, safety=safety)
+            raise OptionError("frame='degrees': a colliders.csv city is in metres; use "
+                              "'lonlat', 'ned' or 'enu'", param="frame")
+        world = read_colliders(p, safety=safety, frame=frame)
         if boundary is not None:
             world = _with_boundary(world, parse_boundary(boundary))
     elif p.suffix.lower() in (".geojson", ".json"):
-        world = read_geojson_world(p, boundary=boundary, safety=safety,
-                                   frame="degrees" if frame == "degrees" else "metres")
+        world = read_geojson_world(p, boundary=boundary, safety=safety, frame=frame)
     else:
         raise InputFormatError(p, f"unknown world type {p.suffix!r}; valid: .csv (colliders), "
                                ".geojson")
@@ -107,10 +120,6 @@ def _with_boundary(world: World, lonlat_box) -> World:
     """Attach a lon/lat boundary to a metres world (projected around its home)."""
     import shapely
 
-    from skyroute.geo import lonlat_to_enu
-
-    def project(coords):
-        return lonlat_to_enu(coords[:, 0], coords[:, 1], 0.0, world.home)[:, :2]
-
     return World(world.obstacles, world.floors, world.ceilings, world.names,
-                 shapely.transform(lonlat_box, project), world.frame, world.home, world.name)
+                 shapely.transform(lonlat_box, world.plane_from_lonlat), world.frame,
+                 world.home, world.name)

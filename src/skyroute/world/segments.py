@@ -1,7 +1,7 @@
 """Wall maps given as line segments in metres (CSV ``x1,y1,x2,y2``), rasterised to a Grid.
 
 A cell is blocked when a wall passes through it (touching its closed square) or when its
-centre lies within ``clearance`` of a wall, measured exactly to the segment.
+centre lies within ``safety`` of a wall, measured exactly to the segment.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import numpy as np
 from numba import njit
 
 from skyroute.errors import InputFormatError, OptionError
+from skyroute.world.geometry import point_segment_dist2
 from skyroute.world.grid import Grid
 
 
@@ -46,42 +47,29 @@ def read_segments(path: str | Path) -> np.ndarray:
     return np.array(rows, dtype=np.float64)
 
 
-def rasterize_segments(segments: np.ndarray, *, resolution: float, clearance: float = 0.0,
+def rasterize_segments(segments: np.ndarray, *, resolution: float, safety: float = 0.0,
                        bounds: tuple[float, float, float, float] | None = None,
                        name: str = "segments") -> Grid:
     """Rasterise (N, 4) segments at ``resolution`` metres per cell.
 
     ``bounds`` = (xmin, ymin, xmax, ymax) defaults to the segments' extent plus the
-    clearance and one cell on every side.
+    safety margin and one cell on every side.
     """
     if not (math.isfinite(resolution) and resolution > 0):
         raise OptionError(f"resolution={resolution!r} must be a positive number")
-    if not (math.isfinite(clearance) and clearance >= 0):
-        raise OptionError(f"clearance={clearance!r} must be a number >= 0")
+    if not (math.isfinite(safety) and safety >= 0):
+        raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
     seg = np.ascontiguousarray(segments, dtype=np.float64).reshape(-1, 4)
     if bounds is None:
-        pad = clearance + resolution
+        pad = safety + resolution
         xs, ys = seg[:, [0, 2]], seg[:, [1, 3]]
         bounds = (xs.min() - pad, ys.min() - pad, xs.max() + pad, ys.max() + pad)
     xmin, ymin, xmax, ymax = (float(b) for b in bounds)
     width = max(1, math.ceil((xmax - xmin) / resolution))
     height = max(1, math.ceil((ymax - ymin) / resolution))
     blocked = np.zeros((height, width), dtype=np.bool_)
-    _rasterize(seg, xmin, ymin, resolution, clearance, blocked)
+    _rasterize(seg, xmin, ymin, resolution, safety, blocked)
     return Grid(blocked, resolution, (xmin, ymin), name=name)
-
-
-@njit(cache=True)
-def point_segment_dist2(px, py, ax, ay, bx, by):
-    """Squared distance from point p to segment ab (compiled; shared with motion)."""
-    dx, dy = bx - ax, by - ay
-    L2 = dx * dx + dy * dy
-    t = 0.0
-    if L2 > 0.0:
-        t = ((px - ax) * dx + (py - ay) * dy) / L2
-        t = min(1.0, max(0.0, t))
-    qx, qy = ax + t * dx - px, ay + t * dy - py
-    return qx * qx + qy * qy
 
 
 @njit(cache=True)

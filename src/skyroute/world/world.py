@@ -1,16 +1,20 @@
 """A continuous world: polygon obstacles with heights, an optional boundary, a frame.
 
-Coordinates are planar (x, y): east and north in metres around ``home`` (frame
-"metres"), or longitude and latitude read as a flat plane (frame "degrees", the ILP
-rules). Obstacles are shapely polygons with a floor and a ceiling; ``at(altitude)``
-keeps those that count at an altitude. Queries are exact and vectorised (shapely 2 and
-an STRtree): a point is free when it lies in no obstacle's interior and strictly inside
-the boundary; a segment is free when it meets no obstacle's interior and lies strictly
-inside the boundary (touching an obstacle's edge or corner is allowed).
+Geometry lives in a plane: east and north metres around ``home`` (frames "lonlat",
+"ned", "enu"), or longitude and latitude read as a flat plane (frame "degrees", the ILP
+rules). A World remembers the frame it was loaded in: its public queries read points in
+that frame and planners return paths in it; :meth:`World.to_plane` and
+:meth:`World.from_plane` are the one pair of conversions (see :mod:`skyroute.geo` for the
+table of frames). Obstacles are shapely polygons with a floor and a ceiling;
+``at(altitude)`` keeps those that count at an altitude. Queries are exact and vectorised
+(shapely 2 and an STRtree): a point is free when it lies in no obstacle's interior and
+strictly inside the boundary; a segment is free when it meets no obstacle's interior and
+lies strictly inside the boundary (touching an obstacle's edge or corner is allowed).
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -18,30 +22,55 @@ import numpy as np
 import shapely
 from shapely import STRtree
 
-from skyroute.errors import OptionError, QueryError
-from skyroute.geo import Home
+from skyroute.errors import OptionError, QueryError, check_choice, renamed
+from skyroute.geo import (
+    FRAME_ALIASES,
+    FRAMES,
+    Home,
+    enu_to_lonlat,
+    heading_from_plane,
+    heading_to_plane,
+    lonlat_to_enu,
+)
 from skyroute.world.grid import Grid
+from skyroute.world.points import as_points
 
-FRAMES = ("metres", "degrees")
+AXES = {"lonlat": ("lon", "lat"), "degrees": ("lon", "lat"), "ned": ("north", "east"),
+        "enu": ("x", "y")}
 
 
 @dataclass(frozen=True, eq=False)
 class World:
-    """Polygon obstacles (with floors and ceilings), a boundary, a frame and a home."""
+    """Polygon obstacles (with floors and ceilings), a boundary, a frame and a home.
+
+    Obstacles and boundary are given in the plane (shapely x, y: east, north metres, or
+    lon, lat in the "degrees" frame). ``frame`` says how callers give and get points:
+    "enu" (the default: the plane itself), "ned" ("local" is an alias), "lonlat" (needs
+    ``home``) or "degrees".
+    """
 
     obstacles: np.ndarray  # object array of shapely Polygons
     floors: np.ndarray
     ceilings: np.ndarray
     names: tuple[str, ...]
     boundary: shapely.Polygon | None = None
-    frame: str = "metres"
+    frame: str = "enu"
     home: Home | None = None
     name: str = field(default="world", compare=False)
 
     def __post_init__(self) -> None:
         obs = np.asarray(self.obstacles, dtype=object).ravel()
-        if self.frame not in FRAMES:
-            raise OptionError(f"frame={self.frame!r} is not valid; choose one of {FRAMES}")
+        frame = FRAME_ALIASES.get(self.frame, self.frame)
+        if frame == "metres":
+            warnings.warn("frame='metres' is deprecated; use 'enu' (the same plane)",
+                          DeprecationWarning, stacklevel=3)
+            frame = "enu"
+        if frame not in FRAMES:
+            raise OptionError(f"frame={self.frame!r} is not valid; choose one of "
+                              + ", ".join(repr(f) for f in (*FRAMES, *FRAME_ALIASES)))
+        if frame == "lonlat" and self.home is None:
+            raise OptionError("frame='lonlat' needs a home (the origin of the metres plane)")
+        object.__setattr__(self, "frame", frame)
         n = len(obs)
         floors = np.broadcast_to(np.asarray(self.floors, dtype=float), (n,)).copy()
         ceilings = np.broadcast_to(np.asarray(self.ceilings, dtype=float), (n,)).copy()
@@ -52,6 +81,86 @@ class World:
         object.__setattr__(self, "floors", floors)
         object.__setattr__(self, "ceilings", ceilings)
         object.__setattr__(self, "names", names)
+
+    # -- frames ----------------------------------------------------------------------
+
+    @property
+    def plane(self) -> str:
+        """The plane's units: "metres" (east, north) or "degrees" (lon, lat)."""
+        return "degrees" if self.frame == "degrees" else "metres"
+
+    @property
+    def has_lonlat(self) -> bool:
+        """True when plane points can be given as lon/lat (a home, or the degrees frame)."""
+        return self.frame == "degrees" or self.home is not None
+
+    def to_plane(self, points, what: str = "points") -> np.ndarray:
+        """Points in the world's frame -> (N, 2) plane points; a malformed input is a
+        QueryError naming ``what``."""
+        p = as_points(points, what)
+        if self.frame == "ned":
+            return p[:, ::-1].copy()
+        if self.frame == "lonlat":
+            return lonlat_to_enu(p[:, 0], p[:, 1], 0.0, self.home)[:, :2] if len(p) else p
+        return p
+
+    def from_plane(self, points) -> np.ndarray:
+        """(N, 2) plane points -> points in the world's frame."""
+        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        if self.frame == "ned":
+            return p[:, ::-1].copy()
+        if self.frame == "lonlat":
+            return self.plane_to_lonlat(p)
+        return p.copy()
+
+    def plane_to_lonlat(self, points) -> np.ndarray:
+        """(N, 2) plane points -> (lon, lat) degrees."""
+        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        if self.frame == "degrees" or len(p) == 0:
+            return p.copy()
+        if self.home is None:
+            raise OptionError(f"world {self.name!r} has no home, so no lon/lat")
+        return enu_to_lonlat(p[:, 0], p[:, 1], 0.0, self.home)[:, :2]
+
+    def plane_from_lonlat(self, lonlat) -> np.ndarray:
+        """(N, 2) (lon, lat) degrees -> plane points."""
+        p = np.asarray(lonlat, dtype=float).reshape(-1, 2)
+        if self.frame == "degrees" or len(p) == 0:
+            return p.copy()
+        if self.home is None:
+            raise OptionError(f"world {self.name!r} has no home, so no lon/lat")
+        return lonlat_to_enu(p[:, 0], p[:, 1], 0.0, self.home)[:, :2]
+
+    def heading_to_plane(self, heading):
+        """A heading in the world's frame (radians) -> plane radians from +x."""
+        return heading_to_plane(heading, self.frame)
+
+    def heading_from_plane(self, heading):
+        """A plane heading (radians from +x, anticlockwise) -> the world's frame."""
+        return heading_from_plane(heading, self.frame)
+
+    def to_lonlat(self, points) -> np.ndarray:
+        """Points in the world's frame -> (N, 2) (lon, lat) degrees."""
+        return self.plane_to_lonlat(self.to_plane(points))
+
+    def in_frame(self, frame: str) -> World:
+        """The same world read and written in another frame. Between the metres frames
+        only the point interface changes; to or from "degrees" every vertex is carried
+        exactly through lon/lat (edges stay straight in the new plane, which differs from
+        the old by millimetres over hundreds of metres)."""
+        frame = FRAME_ALIASES.get(frame, frame)
+        check_choice("frame", frame, FRAMES)
+        obstacles, boundary = self.obstacles, self.boundary
+        if (frame == "degrees") != (self.frame == "degrees"):
+            if self.home is None:
+                raise OptionError(f"frame={frame!r}: world {self.name!r} has no home, so "
+                                  "no lon/lat", param="frame")
+            to_new = self.plane_to_lonlat if frame == "degrees" else \
+                World([], [], [], (), None, "lonlat", self.home).plane_from_lonlat
+            obstacles = shapely.transform(self.obstacles, to_new)
+            boundary = None if boundary is None else shapely.transform(boundary, to_new)
+        return World(obstacles, self.floors, self.ceilings, self.names, boundary, frame,
+                     self.home, self.name)
 
     # -- views -----------------------------------------------------------------------
 
@@ -210,14 +319,19 @@ class World:
         return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
 
     def check_point(self, point, what: str) -> np.ndarray:
-        """``point`` as a float (2,) array when it is free, else a QueryError that says why."""
-        p = np.asarray(point, dtype=float).reshape(2)
-        if not np.all(np.isfinite(p)):
-            raise QueryError(f"{what} {tuple(p)} must be finite numbers")
+        """One point in the world's frame -> its (2,) plane point when it is free, else a
+        QueryError naming ``what`` that speaks in the world's frame."""
+        p = self.to_plane(point, what)
+        if len(p) != 1:
+            raise QueryError(f"{what} must be one point (a, b), got {len(p)} points")
+        return self.check_plane_point(p[0], what)
+
+    def check_plane_point(self, p: np.ndarray, what: str) -> np.ndarray:
+        """A (2,) plane point when it is free, else a QueryError in the world's frame."""
+        p = np.asarray(p, dtype=float).reshape(2)
         if not self.inside([p])[0]:
-            xmin, ymin, xmax, ymax = self.bounds
-            raise QueryError(f"{what} {self._fmt(p)} lies outside the map (x in "
-                             f"({xmin:.6g}, {xmax:.6g}), y in ({ymin:.6g}, {ymax:.6g}))")
+            raise QueryError(f"{what} {self._fmt(p)} lies outside the map "
+                             f"({self._extent_text()})")
         j = int(self.blocking([p])[0])
         if j >= 0:
             near = self.nearest_free(p, j)
@@ -239,16 +353,29 @@ class World:
         return q
 
     def _fmt(self, p) -> str:
-        return f"({p[0]:.6f}, {p[1]:.6f})" if self.frame == "degrees" else \
-            f"({p[0]:.2f}, {p[1]:.2f})"
+        """A plane point as the caller wrote it: 7 decimals of a degree (about 1 cm) or cm."""
+        a, b = self.from_plane([p])[0]
+        fmt = "{:.7f}" if self.frame in ("lonlat", "degrees") else "{:.2f}"
+        return f"({fmt.format(a)}, {fmt.format(b)})"
+
+    def _extent_text(self) -> str:
+        """'x in (a, b), y in (c, d)' for the map's extent, in the world's frame."""
+        x0, y0, x1, y1 = self.bounds
+        q = self.from_plane([[x0, y0], [x0, y1], [x1, y0], [x1, y1]])
+        lo, hi = q.min(0), q.max(0)
+        fmt = "{:.7f}" if self.frame in ("lonlat", "degrees") else "{:.6g}"
+        a, b = AXES[self.frame]
+        return (f"{a} in ({fmt.format(lo[0])}, {fmt.format(hi[0])}), "
+                f"{b} in ({fmt.format(lo[1])}, {fmt.format(hi[1])})")
 
     # -- rasterising -----------------------------------------------------------------
 
     def rasterize(self, resolution: float, altitude: float | None = None, *,
-                  clearance: float = 0.0,
-                  bounds: tuple[float, float, float, float] | None = None) -> Grid:
+                  safety: float | None = None,
+                  bounds: tuple[float, float, float, float] | None = None,
+                  clearance: float | None = None) -> Grid:
         """A Grid over the world's bounds: a cell is blocked when its centre lies within
-        ``clearance`` of an obstacle (0: in the closed obstacle) or is not that far inside
+        ``safety`` of an obstacle (0: in the closed obstacle) or is not that far inside
         the boundary. World point (x, y) maps to cell ((x - xmin) / r, (y - ymin) / r):
         grid rows grow with y (north).
 
@@ -256,11 +383,13 @@ class World:
         :meth:`Grid.inflate`, which would leave a free centre up to half a cell from an
         obstacle's edge. Obstacles are buffered with 32-gon circles enlarged by
         1/cos(pi/32), so the test never under-blocks. ``bounds`` (xmin, ymin, xmax, ymax)
-        overrides the world's extent."""
+        overrides the world's extent. ``clearance`` is the old name of ``safety``."""
         if not (np.isfinite(resolution) and resolution > 0):
             raise OptionError(f"resolution={resolution!r} must be a positive number")
-        if not (np.isfinite(clearance) and clearance >= 0):
-            raise OptionError(f"clearance={clearance!r} must be a number >= 0")
+        safety = renamed("safety", safety, "clearance", clearance)
+        safety = 0.0 if safety is None else safety
+        if not (np.isfinite(safety) and safety >= 0):
+            raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
         w = self.at(altitude)
         xmin, ymin, xmax, ymax = self.bounds if bounds is None else bounds
         width = max(1, int(np.ceil((xmax - xmin) / resolution)))
@@ -268,7 +397,7 @@ class World:
         xs = xmin + (np.arange(width) + 0.5) * resolution
         ys = ymin + (np.arange(height) + 0.5) * resolution
         blocked = np.zeros((height, width), bool)
-        grow = clearance / np.cos(np.pi / 32) if clearance > 0 else 0.0
+        grow = safety / np.cos(np.pi / 32) if safety > 0 else 0.0
         for poly in w.obstacles:
             if grow:
                 poly = poly.buffer(grow, quad_segs=8)
@@ -281,7 +410,7 @@ class World:
             blocked[r0:r1, c0:c1] |= shapely.intersects_xy(poly, gx, gy)
         if w.boundary is not None:
             inner = shapely.Polygon(w.boundary)
-            if clearance > 0:
+            if safety > 0:
                 inner = inner.buffer(-grow, quad_segs=8)
             gx, gy = np.meshgrid(xs, ys)
             blocked |= ~shapely.contains_xy(inner, gx, gy)

@@ -1,0 +1,48 @@
+"""Plane geometry shared across layers: convex corners of obstacle unions (visibility
+graphs, the step drone's heuristic) and the compiled point-segment distance (rasterising
+walls, the step drone's move test)."""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from numba import njit
+
+
+@njit(cache=True)
+def point_segment_dist2(px, py, ax, ay, bx, by):
+    """Squared distance from point p to segment ab (compiled)."""
+    dx, dy = bx - ax, by - ay
+    L2 = dx * dx + dy * dy
+    t = 0.0
+    if L2 > 0.0:
+        t = ((px - ax) * dx + (py - ay) * dy) / L2
+        t = min(1.0, max(0.0, t))
+    qx, qy = ax + t * dx - px, ay + t * dy - py
+    return qx * qx + qy * qy
+
+
+
+def convex_corners(world) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(corners, previous, next): the convex corners of the union of the obstacles, with
+    their neighbours along the ring (obstacle interior on the left)."""
+    if len(world.obstacles) == 0:
+        e = np.empty((0, 2))
+        return e, e, e
+    merged = shapely.orient_polygons(shapely.unary_union(world.obstacles))
+    corners, prevs, nexts = [], [], []
+    for poly in getattr(merged, "geoms", [merged]):
+        if poly.geom_type != "Polygon":
+            continue
+        for ring in (poly.exterior, *poly.interiors):
+            c = np.asarray(ring.coords)[:-1]
+            # exterior counter-clockwise, holes clockwise: the obstacle is on the left
+            prev, nxt = np.roll(c, 1, axis=0), np.roll(c, -1, axis=0)
+            u, v = c - prev, nxt - c
+            cross = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+            scale = np.hypot(*u.T) * np.hypot(*v.T)
+            keep = cross > 1e-12 * scale  # convex, not collinear
+            corners.append(c[keep])
+            prevs.append(prev[keep])
+            nexts.append(nxt[keep])
+    return np.concatenate(corners), np.concatenate(prevs), np.concatenate(nexts)
