@@ -4,6 +4,7 @@ The public API is small: :func:`load_map` reads a map into a :class:`Grid`, :fun
 searches it and returns a :class:`PlanResult`.
 """
 
+from skyroute.caches import clear_caches
 from skyroute.errors import InputFormatError, OptionError, QueryError, SkyrouteError
 from skyroute.planner import plan
 from skyroute.result import PlanResult, Status
@@ -13,6 +14,18 @@ from skyroute.world.world import World
 
 __version__ = "0.1.0"
 
-__all__ = ["Grid", "InputFormatError", "OptionError", "PlanResult", "QueryError",
-           "SkyrouteError", "Status", "World", "bundled_maps", "load_map", "load_world",
-           "plan"]
+__all__ = [
+           "Grid",
+           "InputFormatError",
+           "OptionError",
+           "PlanResult",
+           "QueryError",
+           "SkyrouteError",
+           "Status",
+           "World",
+           "bundled_maps",
+           "clear_caches",
+           "load_map",
+           "load_world",
+           "plan",
+]

@@ -14,7 +14,7 @@ from rich.table import Table
 
 from skyroute.bench.grid import bench_map, check_runners, count_queries, find_pairs
 from skyroute.cli.parse import parse_list
-from skyroute.io.files import write_atomic
+from skyroute.files import write_atomic
 from skyroute.world.load import bundled_maps
 
 bench_app = typer.Typer(help="Benchmarks against peer libraries.", no_args_is_help=True)

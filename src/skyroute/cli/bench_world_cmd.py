@@ -25,7 +25,7 @@ from skyroute.bench.world import (
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_list
 from skyroute.errors import check_choice
-from skyroute.io.files import write_atomic
+from skyroute.files import write_atomic
 from skyroute.motion.step_drone import MERGE
 from skyroute.world.load import load_world
 

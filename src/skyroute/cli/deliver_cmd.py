@@ -57,6 +57,7 @@ def deliver_command(
     from skyroute.delivery.site import load_site
     from skyroute.delivery.source import open_source
     from skyroute.delivery.store import import_orders, order_dates, orders_between
+    from skyroute.io.day_out import write_outputs
 
     check_choice("method", method, METHODS)
     day, d0, d1 = _date(date, "DATE"), _date(first, "--from"), _date(last, "--to")
@@ -91,9 +92,14 @@ def deliver_command(
         progress.remove_task(task)
         days = progress.add_task("days", total=len(by_date))
         t0 = time.perf_counter()
-        results = run_days(site, engine, by_date, out, jobs=jobs, method=method,
-                           plot=(day is not None) if plot is None else plot,
-                           on_day=lambda r: progress.advance(days))
+        draw = (day is not None) if plot is None else plot
+
+        def finished(r: DayResult) -> None:
+            if out is not None:
+                write_outputs(site, r, out, plot=draw)
+            progress.advance(days)
+
+        results = run_days(site, engine, by_date, jobs=jobs, method=method, on_day=finished)
         wall = time.perf_counter() - t0
     if day is not None:
         _one_day(results[0], out, as_json)

@@ -16,7 +16,7 @@ from rich.table import Table
 
 from skyroute.cli.world_cmd import FRAME_HELP, frame_of, parse_pair, point_names
 from skyroute.errors import OptionError, check_choice
-from skyroute.io.files import write_atomic
+from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.planner import plan
 from skyroute.result import PlanResult, Status

@@ -11,7 +11,7 @@ from rich.console import Console
 
 from skyroute.cli.parse import parse_cell
 from skyroute.cli.tables import result_table
-from skyroute.io.files import write_atomic
+from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps, grid_path_geojson
 from skyroute.planner import plan
 from skyroute.search.grid_plan import GRID_ALGORITHMS, grid_options

@@ -12,8 +12,8 @@ from rich.console import Console
 
 from skyroute.cli.tables import result_table
 from skyroute.errors import OptionError, check_choice
+from skyroute.files import write_atomic
 from skyroute.geo import FRAME_ALIASES, FRAMES
-from skyroute.io.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
     path_north_east,

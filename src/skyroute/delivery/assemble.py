@@ -8,15 +8,19 @@ budget when the flight comes out over the battery.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
 
+from skyroute.caches import register
 from skyroute.errors import SkyrouteError
 from skyroute.motion.step_drone import HOVER, MERGE, STEP, Flight, plan_moves
 from skyroute.world.world import World
 
-_LEGS: dict = {}  # (start bytes, target) -> (angles, tos): legs recur across days
+# world -> {(start bytes, target): (angles, froms, tos)}: legs recur across days
+_LEGS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+register(_LEGS.clear)
 # (merge, expansions): the fewest moves when that is quick to find (at most 2000
 # expansions, about 95% of the legs of late 2023), else a lattice six times coarser,
 # which flies one move more on about a third of those legs at a twentieth of the time.
@@ -42,8 +46,9 @@ def leg(world: World, start: np.ndarray, target: tuple[float, float]) -> Flight:
     if math.dist(start, target) < STEP:
         e = np.empty((0, 2))
         return Flight(e, np.empty(0, int), e.copy())
-    key = (start.tobytes(), target)
-    hit = _LEGS.get(key)
+    legs = _LEGS.setdefault(world, {})
+    key = (start.tobytes(), tuple(target))
+    hit = legs.get(key)
     if hit is None:
         for merge, budget in LADDER:
             f = plan_moves(world, start, target, merge=merge, max_expansions=budget)
@@ -52,9 +57,9 @@ def leg(world: World, start: np.ndarray, target: tuple[float, float]) -> Flight:
         if f.status.value != "found":
             raise SkyrouteError(f"no flight from ({start[0]:.6f}, {start[1]:.6f}) to "
                                 f"({target[0]:.6f}, {target[1]:.6f}): {f.status.value}")
-        if len(_LEGS) > 200_000:
-            _LEGS.clear()
-        hit = _LEGS[key] = (f.angle, f.frm, f.to)
+        if len(legs) > 200_000:
+            legs.clear()
+        hit = legs[key] = (f.angle, f.frm, f.to)
     angle, frm, to = hit
     return Flight(frm, angle, to)
 

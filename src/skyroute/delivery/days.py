@@ -11,13 +11,11 @@ import datetime as dt
 import os
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from pathlib import Path
 
 from skyroute.delivery import store
 from skyroute.delivery.day import DayResult, plan_day
 from skyroute.delivery.legs import leg_table, missing_legs
 from skyroute.delivery.orders import Priced, price
-from skyroute.delivery.outputs import store_day, write_outputs
 from skyroute.delivery.site import load_site
 from skyroute.delivery.source import DirSource, HttpSource
 
@@ -49,17 +47,17 @@ def _plan(date: dt.date, orders, method: str) -> DayResult:
     return plan_day(_SITE, date, orders, method=method)
 
 
-def run_days(site, engine, by_date: dict[dt.date, list], out: Path | None, *,
-             jobs: int = 1, method: str = "milp", plot: bool = False,
+def run_days(site, engine, by_date: dict[dt.date, list], *, jobs: int = 1,
+             method: str = "milp",
              on_day: Callable[[DayResult], None] | None = None) -> list[DayResult]:
-    """Plan, store and write every day of ``by_date``; results in date order."""
+    """Plan and store every day of ``by_date`` (each in one transaction, as it finishes),
+    then hand it to ``on_day`` (the CLI writes its files there); results in date
+    order."""
     jobs = max(1, min(jobs, os.cpu_count() or 1, len(by_date) or 1))
     results = []
 
     def finish(r: DayResult) -> None:
-        store_day(engine, r)
-        if out is not None:
-            write_outputs(site, r, out, plot=plot)
+        store.store_day(engine, r)
         results.append(r)
         if on_day:
             on_day(r)

@@ -17,8 +17,9 @@ from pathlib import Path
 import numpy as np
 import shapely
 
+from skyroute.caches import register
 from skyroute.errors import SkyrouteError
-from skyroute.io.files import write_atomic
+from skyroute.files import write_atomic
 from skyroute.motion.step_drone import MERGE, STEP, plan_moves
 from skyroute.world.world import World
 
@@ -40,6 +41,7 @@ def _world_key(world: World) -> str:
 
 
 _MEMO: dict[Path, dict] = {}
+register(_MEMO.clear)
 
 
 def _known(path: Path) -> dict:

@@ -23,11 +23,13 @@ from pathlib import Path
 
 import sqlalchemy as sa
 
+from skyroute.caches import register
 from skyroute.errors import SkyrouteError
 
 DEFAULT_DB = "sqlite:///skyroute.db"
 TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
 _REFLECTED: dict[str, dict[str, sa.Table]] = {}
+register(_REFLECTED.clear)
 
 
 def tables(engine: sa.Engine) -> dict[str, sa.Table]:
@@ -172,3 +174,22 @@ def day_rows(engine: sa.Engine, date: dt.date) -> dict[str, list[tuple]]:
             "flightpath": [tuple(r) for r in conn.execute(
                 sa.select(flightpath).where(flightpath.c.delivery_date == date)
                 .order_by(flightpath.c.seq))]}
+
+
+def store_day(engine, result) -> None:
+    """Write a :class:`~skyroute.delivery.day.DayResult` (run, deliveries, moves) in
+    one transaction."""
+    f = result.flight.flight
+    run = {"started": dt.datetime.fromtimestamp(result.started),
+           "finished": dt.datetime.fromtimestamp(result.started + result.seconds),
+           "moves": f.moves, "orders_placed": len(result.orders),
+           "orders_delivered": len(result.delivered), "orders_invalid": len(result.invalid),
+           "money_delivered": result.money_delivered, "money_placed": result.money_placed,
+           "settings": result.settings}
+    delivered = [{"order_no": p.order.order_no, "delivered_to": p.order.deliver_to,
+                  "cost_in_pence": p.cost} for p in result.delivered]
+    moves = ({"seq": k, "order_no": result.flight.order_no[k],
+              "from_lon": float(f.frm[k, 0]), "from_lat": float(f.frm[k, 1]),
+              "angle": int(f.angle[k]), "to_lon": float(f.to[k, 0]),
+              "to_lat": float(f.to[k, 1])} for k in range(f.moves))
+    write_day(engine, result.date, run, delivered, moves)

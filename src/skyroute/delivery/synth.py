@@ -17,7 +17,7 @@ import shapely
 from shapely import affinity
 
 from skyroute.errors import OptionError
-from skyroute.io.files import write_atomic
+from skyroute.files import write_atomic
 from skyroute.motion.step_drone import STEP
 
 # A 0.0082 x 0.0036 degree box (the ILP area's size) near Leith Links, Edinburgh.

@@ -1,30 +1,3 @@
-"""Write a file whole or not at all."""
+"""Deprecated location of :mod:`skyroute.files` (kept for one release)."""
 
-from __future__ import annotations
-
-import os
-import tempfile
-from pathlib import Path
-
-from skyroute.errors import SkyrouteError
-
-
-def write_atomic(path: str | Path, data: bytes | str) -> Path:
-    """Write ``data`` to a temporary file beside ``path``, then rename it into place.
-
-    A crash or error midway leaves no half-written file. Parent folders are created.
-    """
-    path = Path(path)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    except OSError as exc:
-        raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data.encode() if isinstance(data, str) else data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+from skyroute.files import write_atomic  # noqa: F401

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from skyroute.io.files import write_atomic
+from skyroute.files import write_atomic
 from skyroute.result import PlanResult
 from skyroute.world.grid import Grid
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
+from skyroute.caches import register
 from skyroute.errors import OptionError, check_choice
 from skyroute.result import Status
 from skyroute.world.world import World
@@ -94,6 +95,7 @@ def _sense(world: World, p: np.ndarray, sensor_range: float, rays: int) -> np.nd
 
 
 _EDGE_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+register(_EDGE_CACHE.clear)
 
 
 def _edges(world: World):

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from skyroute.caches import register
 from skyroute.errors import OptionError, renamed
 from skyroute.motion import move_search
 from skyroute.motion.zone_kernels import zone_arrays
@@ -40,6 +41,8 @@ MERGE = 5e-6  # positions in one lattice cell this wide (1/30 step) are one stat
 _CORNER_GRAPHS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _ZONES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _BOUNDS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+for _cache in (_CORNER_GRAPHS, _ZONES, _BOUNDS):
+    register(_cache.clear)
 
 
 @dataclass(frozen=True, eq=False)

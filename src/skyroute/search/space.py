@@ -17,6 +17,7 @@ import weakref
 import numpy as np
 from numba import njit
 
+from skyroute.caches import register
 from skyroute.search.jps import jump_tables
 from skyroute.search.moves import MDX, MDY
 from skyroute.world.grid import Grid
@@ -103,6 +104,7 @@ def to_cells(flat, Wp):
 
 
 _SPACES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+register(_SPACES.clear)
 
 
 def space_of(grid: Grid) -> SearchSpace:

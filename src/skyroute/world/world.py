@@ -100,6 +100,12 @@ class World:
         p = as_points(points, what)
         if self.frame == "ned":
             return p[:, ::-1].copy()
+        if self.frame in ("lonlat", "degrees"):
+            bad = (np.abs(p[:, 0]) > 180) | (np.abs(p[:, 1]) > 90)
+            if bad.any():
+                q = p[np.argmax(bad)]
+                raise QueryError(f"{what} ({q[0]:.7g}, {q[1]:.7g}) is not a place: expected "
+                                 "(lon, lat) degrees, lon in [-180, 180], lat in [-90, 90]")
         if self.frame == "lonlat":
             return lonlat_to_enu(p[:, 0], p[:, 1], 0.0, self.home)[:, :2] if len(p) else p
         return p

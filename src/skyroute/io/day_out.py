@@ -1,8 +1,7 @@
-"""What a delivery day leaves behind: its rows in the store, ``drone-DD-MM-YYYY.geojson``
-(the flight as one LineString, SPEC.md 4.6), a PNG map of the day and a JSON report.
-
-The store is written first, in one transaction; each file is then written whole or not
-at all.
+"""What a delivery day leaves on disk: ``drone-DD-MM-YYYY.geojson`` (the flight as one
+LineString, SPEC.md 4.6), a PNG map of the day and a JSON report; each file is written
+whole or not at all. (Its rows in the store come first: :func:`skyroute.delivery.store.
+store_day`.)
 """
 
 from __future__ import annotations
@@ -13,30 +12,13 @@ from pathlib import Path
 
 import numpy as np
 
-from skyroute.delivery import store
 from skyroute.delivery.day import DayResult
-from skyroute.io.files import write_atomic
+from skyroute.files import write_atomic
 
 
 def stem(date: dt.date) -> str:
+    """The ILP file name stem of a day: ``drone-DD-MM-YYYY``."""
     return f"drone-{date:%d-%m-%Y}"
-
-
-def store_day(engine, result: DayResult) -> None:
-    f = result.flight.flight
-    run = {"started": dt.datetime.fromtimestamp(result.started),
-           "finished": dt.datetime.fromtimestamp(result.started + result.seconds),
-           "moves": f.moves, "orders_placed": len(result.orders),
-           "orders_delivered": len(result.delivered), "orders_invalid": len(result.invalid),
-           "money_delivered": result.money_delivered, "money_placed": result.money_placed,
-           "settings": result.settings}
-    delivered = [{"order_no": p.order.order_no, "delivered_to": p.order.deliver_to,
-                  "cost_in_pence": p.cost} for p in result.delivered]
-    moves = ({"seq": k, "order_no": result.flight.order_no[k],
-              "from_lon": float(f.frm[k, 0]), "from_lat": float(f.frm[k, 1]),
-              "angle": int(f.angle[k]), "to_lon": float(f.to[k, 0]),
-              "to_lat": float(f.to[k, 1])} for k in range(f.moves))
-    store.write_day(engine, result.date, run, delivered, moves)
 
 
 def geojson(result: DayResult, home) -> str:
