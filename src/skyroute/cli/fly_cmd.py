@@ -14,7 +14,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from skyroute.cli.world_cmd import FRAME_HELP, frame_of, parse_pair, point_names
+from skyroute.cli import world_args as wa
 from skyroute.errors import OptionError, check_choice
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
@@ -28,17 +28,14 @@ EXIT_NOT_REACHED = 1
 
 
 def fly_command(
-    world_file: Annotated[Path, typer.Argument(metavar="WORLD", help=(
-        "A colliders.csv city or a GeoJSON file of zones, as for plan-world."))],
-    start: Annotated[str, typer.Option(help="A point in --frame: LON,LAT, NORTH,EAST or "
-                                       "EAST,NORTH.")],
-    goal: Annotated[str, typer.Option(help="Same form as --start.")],
+    world_file: wa.WorldFile,
+    start: wa.StartPoint,
+    goal: wa.GoalPoint,
     vehicle: Annotated[str, typer.Option(help="step, dubins, lattice or field.")] = "step",
-    frame: Annotated[str | None, typer.Option(help=FRAME_HELP)] = None,
-    altitude: Annotated[float | None, typer.Option(help="Altitude filter (m).")] = None,
-    safety: Annotated[float, typer.Option(help="Grow obstacles by this distance.")] = 0.0,
-    boundary: Annotated[str | None, typer.Option(help="GeoJSON file or a lon/lat bbox.")] =
-        None,
+    frame: wa.Frame = None,
+    altitude: wa.Altitude = None,
+    safety: wa.Safety = 0.0,
+    boundary: wa.Boundary = None,
     planner: Annotated[str, typer.Option(
         help="step drone: moves (fewest moves, A*) or follow (round a Theta* path).")] =
         "moves",
@@ -80,9 +77,9 @@ def fly_command(
     check_choice("planner", planner, ("moves", "follow"))
     if out is not None and out.suffix.lower() not in (".json", ".csv", ".geojson"):
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
-    frame = frame_of(frame)
-    a = parse_pair(start, "--start", point_names(frame))
-    b = parse_pair(goal, "--goal", point_names(frame))
+    frame = wa.frame_of(frame)
+    a = wa.parse_pair(start, "--start", wa.point_names(frame))
+    b = wa.parse_pair(goal, "--goal", wa.point_names(frame))
     world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
                        frame=frame)
     world.check_point(a, "start")  # one error, in the user's frame, for every vehicle

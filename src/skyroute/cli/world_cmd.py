@@ -10,10 +10,10 @@ import numpy as np
 import typer
 from rich.console import Console
 
+from skyroute.cli import world_args as wa
 from skyroute.cli.tables import result_table
-from skyroute.errors import OptionError, check_choice
+from skyroute.errors import OptionError
 from skyroute.files import write_atomic
-from skyroute.geo import FRAME_ALIASES, FRAMES
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
     path_north_east,
@@ -26,54 +26,16 @@ from skyroute.roadmap.world_plan import WORLD_ALGORITHMS, roadmap_edges
 from skyroute.world.load import load_world
 
 EXIT_NOT_FOUND = 1
-DEFAULT_FRAME = "lonlat"  # a world's own frame, for colliders and GeoJSON files alike
-
-
-def parse_pair(text: str, option: str, names: str) -> tuple[float, float]:
-    """``"A,B"`` -> two finite floats."""
-    parts = text.replace(" ", "").split(",")
-    try:
-        if len(parts) != 2:
-            raise ValueError
-        a, b = float(parts[0]), float(parts[1])
-        if not (np.isfinite(a) and np.isfinite(b)):
-            raise ValueError
-    except ValueError:
-        raise OptionError(f"{option} {text!r} must be two numbers {names}") from None
-    return a, b
-
-
-def frame_of(frame: str | None) -> str:
-    """The frame a command reads points in: ``--frame``, or a world's own (lonlat)."""
-    frame = DEFAULT_FRAME if frame is None else frame
-    check_choice("frame", frame, (*FRAMES, *FRAME_ALIASES))
-    return FRAME_ALIASES.get(frame, frame)
-
-
-def point_names(frame: str) -> str:
-    """How a point is typed in ``frame``: LON,LAT / NORTH,EAST / EAST,NORTH."""
-    return {"lonlat": "LON,LAT", "degrees": "LON,LAT", "ned": "NORTH,EAST",
-            "enu": "EAST,NORTH"}[frame]
-
-
-FRAME_HELP = ("How points are typed and printed: lonlat (LON,LAT; the default, a world's "
-              "own), ned or local (NORTH,EAST metres from home), enu (EAST,NORTH metres) or "
-              "degrees (LON,LAT on a flat plane, the ILP rules; GeoJSON only).")
 
 
 def plan_world_command(
-    world_file: Annotated[Path, typer.Argument(metavar="WORLD", help=(
-        "A colliders.csv city (metres around lat0/lon0) or a GeoJSON file of zones."))],
-    start: Annotated[str, typer.Option(help="A point in --frame: LON,LAT, NORTH,EAST or "
-                                       "EAST,NORTH.")],
-    goal: Annotated[str, typer.Option(help="Same form as --start.")],
-    frame: Annotated[str | None, typer.Option(help=FRAME_HELP)] = None,
-    altitude: Annotated[float | None, typer.Option(
-        help="Keep the obstacles that count at this altitude (m).")] = None,
-    safety: Annotated[float, typer.Option(
-        help="Grow obstacles by this distance (m; degrees in the degrees frame).")] = 0.0,
-    boundary: Annotated[str | None, typer.Option(
-        help="A GeoJSON file or MINLON,MINLAT,MAXLON,MAXLAT to stay strictly inside.")] = None,
+    world_file: wa.WorldFile,
+    start: wa.StartPoint,
+    goal: wa.GoalPoint,
+    frame: wa.Frame = None,
+    altitude: wa.Altitude = None,
+    safety: wa.Safety = 0.0,
+    boundary: wa.Boundary = None,
     algorithm: Annotated[str, typer.Option(help="One of: " + ", ".join(WORLD_ALGORITHMS))] =
         "visibility",
     resolution: Annotated[float | None, typer.Option(
@@ -95,9 +57,9 @@ def plan_world_command(
     1 when there is none, 2 for bad input; output files are written only when a path is
     found.
     """
-    frame = frame_of(frame)
-    a = parse_pair(start, "--start", point_names(frame))
-    b = parse_pair(goal, "--goal", point_names(frame))
+    frame = wa.frame_of(frame)
+    a = wa.parse_pair(start, "--start", wa.point_names(frame))
+    b = wa.parse_pair(goal, "--goal", wa.point_names(frame))
     world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
                        frame=frame)
     result = plan(world, a, b, algorithm=algorithm, resolution=resolution, samples=samples,

@@ -18,6 +18,7 @@ from numba.typed import Dict
 
 from skyroute.motion.zone_kernels import crosses, expand
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search import heap
 
 _TIE = (1 << 20) - 1
 _HALF = 1 << 31
@@ -81,46 +82,6 @@ def _grow(a, n):
 
 
 @njit(cache=True)
-def _push(hk, hn, size, k, node):
-    i = size
-    while i > 0:
-        p = (i - 1) >> 1
-        if k < hk[p]:
-            hk[i] = hk[p]
-            hn[i] = hn[p]
-            i = p
-        else:
-            break
-    hk[i] = k
-    hn[i] = node
-
-
-@njit(cache=True)
-def _pop(hk, hn, size):
-    """Remove the minimum of a heap of ``size`` entries; return its node."""
-    top = hn[0]
-    size -= 1
-    lk, ln = hk[size], hn[size]
-    i = 0
-    while True:
-        b = 2 * i + 1
-        if b >= size:
-            break
-        if b + 1 < size and hk[b + 1] < hk[b]:
-            b += 1
-        if hk[b] < lk:
-            hk[i] = hk[b]
-            hn[i] = hn[b]
-            i = b
-        else:
-            break
-    if size > 0:
-        hk[i] = lk
-        hn[i] = ln
-    return top
-
-
-@njit(cache=True)
 def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners, cdist,
            step, merge, max_expansions, eps):
     """A* from (sx, sy) to closer than ``step`` to (tx, ty).
@@ -156,7 +117,7 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
     expanded = 0
     while size > 0:
         top = hk[0]
-        i = _pop(hk, hn, size)
+        i = heap.pop_plain(hk, hn, size)
         size -= 1
         if closed[i]:
             continue
@@ -170,7 +131,7 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
             if f > (top >> 20):
                 if size + 1 > hk.shape[0]:
                     hk, hn = _grow(hk, size + 1), _grow(hn, size + 1)
-                _push(hk, hn, size, (np.int64(f) << 20) | (_TIE - min(g[i], _TIE)), i)
+                heap.push_plain(hk, hn, size, (np.int64(f) << 20) | (_TIE - min(g[i], _TIE)), i)
                 size += 1
                 continue
         closed[i] = True
@@ -209,6 +170,6 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
             f = gi + moves_left(dist[j], step)
             if size + 1 > hk.shape[0]:
                 hk, hn = _grow(hk, size + 1), _grow(hn, size + 1)
-            _push(hk, hn, size, (np.int64(f) << 20) | (_TIE - min(gi, _TIE)), j)
+            heap.push_plain(hk, hn, size, (np.int64(f) << 20) | (_TIE - min(gi, _TIE)), j)
             size += 1
     return NO_PATH, -1, expanded, x[:n], y[:n], parent[:n], move[:n]

@@ -62,16 +62,21 @@ def plan_world(world: World, start, goal, *, algorithm: str = "visibility",
     else:
         opts = grid_options(algorithm, max_expansions=max_expansions, **grid_kwargs)
         res = plan_on_raster(world, s, t, opts, resolution)
-    return in_frame(world, res)
+    return in_frame(world, res, start, goal)
 
 
-def in_frame(world: World, res: PlanResult) -> PlanResult:
-    """A plane result with its path in the world's frame and, where the world has a home
-    (or is in degrees), in lon/lat too."""
+def in_frame(world: World, res: PlanResult, start, goal) -> PlanResult:
+    """A plane result with its path in the world's frame, its ends exactly the caller's
+    ``start`` and ``goal``, and, where the world has a home (or is in degrees), the path
+    in lon/lat too."""
+    path = world.from_plane(res.path)
     lonlat = world.plane_to_lonlat(res.path) if world.has_lonlat else None
+    if len(path):
+        path[0], path[-1] = np.ravel(start).astype(float), np.ravel(goal).astype(float)
+        if lonlat is not None:
+            lonlat[0], lonlat[-1] = world.to_lonlat(start)[0], world.to_lonlat(goal)[0]
     extra = {**res.extra, "frame": world.frame}
-    return dataclasses.replace(res, path=world.from_plane(res.path), path_lonlat=lonlat,
-                               extra=extra)
+    return dataclasses.replace(res, path=path, path_lonlat=lonlat, extra=extra)
 
 
 def roadmap_edges(world: World, algorithm: str, *, samples: int = 1000,

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 from numba import njit
 
+from skyroute.result import NO_PATH
+
 F_SCALE = 1048576.0  # 2**20
 TIE_BITS = 20
 TIE_MAX = (1 << TIE_BITS) - 1
@@ -28,6 +30,14 @@ def key(f, g):
     return (int(f * F_SCALE + 0.5) << TIE_BITS) | tie
 
 
+@njit(cache=True, inline="always")
+def _put(hc, hk, state, i, cell, k):
+    """Write ``cell`` with key ``k`` into heap slot i and note the slot in ``state``."""
+    hc[i] = cell
+    hk[i] = k
+    state[cell] = i + 1
+
+
 @njit(cache=True)
 def push(hc, hk, state, size, cell, k):
     """Insert ``cell`` with key ``k`` (or lower its key if present); return the new size."""
@@ -39,16 +49,11 @@ def push(hc, hk, state, size, cell, k):
         p = (i - 1) >> 1
         kp = hk[p]
         if k < kp:
-            moved = hc[p]
-            hc[i] = moved
-            hk[i] = kp
-            state[moved] = i + 1
+            _put(hc, hk, state, i, hc[p], kp)
             i = p
         else:
             break
-    hc[i] = cell
-    hk[i] = k
-    state[cell] = i + 1
+    _put(hc, hk, state, i, cell, k)
     return size
 
 
@@ -70,16 +75,11 @@ def pop(hc, hk, state, size):
             if r < size and hk[r] < hk[b]:
                 b = r
             if hk[b] < lk:
-                moved = hc[b]
-                hc[i] = moved
-                hk[i] = hk[b]
-                state[moved] = i + 1
+                _put(hc, hk, state, i, hc[b], hk[b])
                 i = b
             else:
                 break
-        hc[i] = last
-        hk[i] = lk
-        state[last] = i + 1
+        _put(hc, hk, state, i, last, lk)
     return int(top), size
 
 
@@ -88,3 +88,54 @@ def reset(state, touched, count):
     """Return ``state`` to all zeros by clearing the ``count`` cells a search touched."""
     for j in range(count):
         state[touched[j]] = 0
+
+
+@njit(cache=True)
+def finish(code, state, touched, count):
+    """A kernel's last step: clear the cells it touched, and turn "still searching" (a
+    negative code: the open list ran dry) into NO_PATH."""
+    reset(state, touched, count)
+    return NO_PATH if code < 0 else code
+
+
+@njit(cache=True)
+def push_plain(hk, hn, size, k, node):
+    """Insert ``node`` with key ``k`` into a plain heap of ``size`` entries (no index: a
+    node may sit in it several times, for searches that re-queue instead of
+    decreasing a key)."""
+    i = size
+    while i > 0:
+        p = (i - 1) >> 1
+        if k < hk[p]:
+            hk[i] = hk[p]
+            hn[i] = hn[p]
+            i = p
+        else:
+            break
+    hk[i] = k
+    hn[i] = node
+
+
+@njit(cache=True)
+def pop_plain(hk, hn, size):
+    """Remove the minimum of a plain heap of ``size`` entries; return its node."""
+    top = hn[0]
+    size -= 1
+    lk, ln = hk[size], hn[size]
+    i = 0
+    while True:
+        b = 2 * i + 1
+        if b >= size:
+            break
+        if b + 1 < size and hk[b + 1] < hk[b]:
+            b += 1
+        if hk[b] < lk:
+            hk[i] = hk[b]
+            hn[i] = hn[b]
+            i = b
+        else:
+            break
+    if size > 0:
+        hk[i] = lk
+        hn[i] = ln
+    return top

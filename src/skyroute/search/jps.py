@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from skyroute.result import FOUND, NO_PATH, stop_code
+from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
 from skyroute.search.moves import h_of
 from skyroute.search.trace import trace
@@ -190,9 +190,7 @@ def jps_kernel(blk, table, Wp, start, goal, max_expansions, floats, ints, keys):
                                   size)
         if size > max_frontier:
             max_frontier = size
-    if code < 0:  # the open list ran dry
-        code = NO_PATH
-    heap.reset(state, touched, nt)
+    code = heap.finish(code, state, touched, nt)
     if code == FOUND:
         return code, expanded, max_frontier, fill(trace(parent, start, goal), Wp)
     return code, expanded, max_frontier, np.empty(0, np.int64)

@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numba import njit
 
-from skyroute.result import FOUND, NO_PATH, stop_code
+from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
 from skyroute.search.los import line_of_sight
 from skyroute.search.moves import COSTS, heuristic, move_ok, offsets
@@ -110,9 +110,7 @@ def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy
                 size = heap.push(hc, hk, state, size, n, heap.key(gn + h[n], gn))
         if size > max_frontier:
             max_frontier = size
-    if code < 0:  # the open list ran dry
-        code = NO_PATH
-    heap.reset(state, touched, nt)
+    code = heap.finish(code, state, touched, nt)
     if code == FOUND:
         return code, expanded, max_frontier, los, trace(parent, start, goal)
     return code, expanded, max_frontier, los, np.empty(0, np.int64)

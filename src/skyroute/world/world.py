@@ -121,21 +121,19 @@ class World:
 
     def plane_to_lonlat(self, points) -> np.ndarray:
         """(N, 2) plane points -> (lon, lat) degrees."""
+        return self._through_home(points, enu_to_lonlat)
+
+    def plane_from_lonlat(self, lonlat) -> np.ndarray:
+        """(N, 2) (lon, lat) degrees -> plane points."""
+        return self._through_home(lonlat, lonlat_to_enu)
+
+    def _through_home(self, points, convert) -> np.ndarray:
         p = np.asarray(points, dtype=float).reshape(-1, 2)
         if self.frame == "degrees" or len(p) == 0:
             return p.copy()
         if self.home is None:
             raise OptionError(f"world {self.name!r} has no home, so no lon/lat")
-        return enu_to_lonlat(p[:, 0], p[:, 1], 0.0, self.home)[:, :2]
-
-    def plane_from_lonlat(self, lonlat) -> np.ndarray:
-        """(N, 2) (lon, lat) degrees -> plane points."""
-        p = np.asarray(lonlat, dtype=float).reshape(-1, 2)
-        if self.frame == "degrees" or len(p) == 0:
-            return p.copy()
-        if self.home is None:
-            raise OptionError(f"world {self.name!r} has no home, so no lon/lat")
-        return lonlat_to_enu(p[:, 0], p[:, 1], 0.0, self.home)[:, :2]
+        return convert(p[:, 0], p[:, 1], 0.0, self.home)[:, :2]
 
     def heading_to_plane(self, heading):
         """A heading in the world's frame (radians) -> plane radians from +x."""
@@ -145,9 +143,13 @@ class World:
         """A plane heading (radians from +x, anticlockwise) -> the world's frame."""
         return heading_from_plane(heading, self.frame)
 
-    def to_lonlat(self, points) -> np.ndarray:
-        """Points in the world's frame -> (N, 2) (lon, lat) degrees."""
-        return self.plane_to_lonlat(self.to_plane(points))
+    def to_lonlat(self, points, what: str = "points") -> np.ndarray:
+        """Points in the world's frame -> (N, 2) (lon, lat) degrees (unchanged, bit for
+        bit, in the frames whose points are lon/lat)."""
+        p = self.to_plane(points, what)
+        if self.frame in ("lonlat", "degrees"):
+            return as_points(points, what)
+        return self.plane_to_lonlat(p)
 
     def in_frame(self, frame: str) -> World:
         """The same world read and written in another frame. Between the metres frames

@@ -1,0 +1,61 @@
+"""How commands that take a world read it and its points: shared arguments and options
+(WORLD, --start, --goal, --frame, --altitude, --safety, --boundary) and their parsing."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from skyroute.errors import OptionError, check_choice
+from skyroute.geo import FRAME_ALIASES, FRAMES
+
+DEFAULT_FRAME = "lonlat"  # a world's own frame, for colliders and GeoJSON files alike
+
+def parse_pair(text: str, option: str, names: str) -> tuple[float, float]:
+    """``"A,B"`` -> two finite floats."""
+    parts = text.replace(" ", "").split(",")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        a, b = float(parts[0]), float(parts[1])
+        if not (np.isfinite(a) and np.isfinite(b)):
+            raise ValueError
+    except ValueError:
+        raise OptionError(f"{option} {text!r} must be two numbers {names}") from None
+    return a, b
+
+
+def frame_of(frame: str | None) -> str:
+    """The frame a command reads points in: ``--frame``, or a world's own (lonlat)."""
+    frame = DEFAULT_FRAME if frame is None else frame
+    check_choice("frame", frame, (*FRAMES, *FRAME_ALIASES))
+    return FRAME_ALIASES.get(frame, frame)
+
+
+def point_names(frame: str) -> str:
+    """How a point is typed in ``frame``: LON,LAT / NORTH,EAST / EAST,NORTH."""
+    return {"lonlat": "LON,LAT", "degrees": "LON,LAT", "ned": "NORTH,EAST",
+            "enu": "EAST,NORTH"}[frame]
+
+
+FRAME_HELP = ("How points are typed and printed: lonlat (LON,LAT; the default, a world's "
+              "own), ned or local (NORTH,EAST metres from home), enu (EAST,NORTH metres) or "
+              "degrees (LON,LAT on a flat plane, the ILP rules; GeoJSON only).")
+
+
+WorldFile = Annotated[Path, typer.Argument(metavar="WORLD", help=(
+    "A colliders.csv city (metres around lat0/lon0) or a GeoJSON file of zones."))]
+StartPoint = Annotated[str, typer.Option(
+    "--start", help="A point in --frame: LON,LAT, NORTH,EAST or EAST,NORTH.")]
+GoalPoint = Annotated[str, typer.Option("--goal", help="Same form as --start.")]
+Frame = Annotated[str | None, typer.Option("--frame", help=FRAME_HELP)]
+Altitude = Annotated[float | None, typer.Option(
+    "--altitude", help="Keep the obstacles that count at this altitude (m).")]
+Safety = Annotated[float, typer.Option(
+    "--safety", help="Grow obstacles by this distance (m; degrees in the degrees frame).")]
+Boundary = Annotated[str | None, typer.Option(
+    "--boundary", help="A GeoJSON file or MINLON,MINLAT,MAXLON,MAXLAT to stay strictly "
+                       "inside.")]
