@@ -48,3 +48,32 @@ def test_readme_cli_examples_run_in_order(monkeypatch, capsys, tmp_path):
             main()
         assert exit_info.value.code == 0, (command, capsys.readouterr().err)
     assert (tmp_path / "city.png").exists() and (tmp_path / "city-waypoints.json").exists()
+
+
+def test_readme_lonlat_city_matches_plan_world(monkeypatch, capsys):
+    """The README's lon/lat city example and its plan-world command agree exactly."""
+    import json
+
+    import skyroute
+    from tests.cli.test_cli import run
+    from tests.conftest import ROOT
+
+    city = str(ROOT / "examples" / "city.csv")
+    world = skyroute.load_world(city, altitude=10, safety=2)
+    r = skyroute.plan(world, (-3.1890, 55.9456), (-3.1850, 55.9432))
+    code, out, err = run(monkeypatch, capsys, "plan-world", city, "--start=-3.1890,55.9456",
+                         "--goal=-3.1850,55.9432", "--altitude", "10", "--safety", "2",
+                         "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["cost"] == r.cost and doc["path"] == r.path.tolist()
+    assert round(doc["cost"], 6) == 367.319524  # the number the README prints
+
+
+def test_shipped_city_is_what_synth_city_writes():
+    import numpy as np
+
+    from skyroute.world.synth import synth_city
+    from tests.conftest import ROOT
+
+    assert (ROOT / "examples" / "city.csv").read_text() == synth_city(np.random.default_rng(7))
