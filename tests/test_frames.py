@@ -158,3 +158,38 @@ def test_local_is_an_alias_of_ned_and_metres_is_deprecated():
         skyroute.load_world(CITY, frame="mercator")
     with pytest.raises(skyroute.OptionError, match="needs a home"):
         skyroute.World([], [], [], (), None, "lonlat")
+
+
+def test_fly_reads_the_same_frames(monkeypatch, capsys, tmp_path):
+    """fly's default frame is the world's own (lonlat), as plan-world's; the step drone
+    flies the same moves whether the points come as lonlat or degrees."""
+    a, b = ZONES_LONLAT
+    common = ["fly", ZONES, "--boundary", BOX, f"--start={a[0]},{a[1]}",
+              f"--goal={b[0]},{b[1]}", "--json"]
+    code, out, err = run(monkeypatch, capsys, *common)
+    assert code == 0, err
+    lonlat = json.loads(out)
+    code, out, err = run(monkeypatch, capsys, *common, "--frame", "degrees")
+    assert code == 0, err
+    degrees = json.loads(out)
+    assert lonlat["moves"] == degrees["moves"] and lonlat["metrics"]["moves"] > 0
+    assert lonlat["moves"][0][:2] == [a[0], a[1]]  # ILP rows start at the typed point
+
+
+def test_fly_lattice_in_ned_matches_python(monkeypatch, capsys):
+    from skyroute.motion.turn_lattice import plan_turns_world
+
+    world = skyroute.load_world(CITY, altitude=10, safety=2, frame="ned")
+    res = plan_turns_world(world, (0, 0), (120, -180), resolution=2.0,
+                           start_heading=math.radians(90))
+    assert res.found and res.path.shape[1] == 2
+    assert np.hypot(*(res.path[0] - (0, 0))) < 2.0 and np.hypot(*(res.path[-1] - (120, -180))) < 2
+    code, out, err = run(monkeypatch, capsys, "fly", CITY, "--frame", "ned", "--vehicle",
+                         "lattice", "--start", "0,0", "--goal", "120,-180", "--altitude", "10",
+                         "--safety", "2", "--resolution", "2", "--start-heading", "90",
+                         "--json")
+    assert code == 0, err
+    traj = np.array(json.loads(out)["trajectory"])
+    np.testing.assert_allclose(traj[:, :2], res.path)
+    np.testing.assert_allclose(traj[:, 2], np.degrees(res.headings))
+    assert traj[0, 2] == pytest.approx(90.0)  # heading east, as asked, in compass degrees
