@@ -34,6 +34,7 @@ from skyroute.world.segments import point_segment_dist2
 from skyroute.world.world import World
 
 TWO_PI = 2 * math.pi
+SUB = 4  # clearance sub-cells per bucket side
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -51,11 +52,12 @@ class EdgeIndex:
     nx: int
     ny: int
     eps: float
+    clear: np.ndarray
 
     def args(self) -> tuple:
         """The arrays and numbers the kernels take, in order."""
         return (self.edges, self.start, self.items, self.x0, self.y0, self.cell, self.nx,
-                self.ny, self.eps)
+                self.ny, self.eps, self.clear)
 
 
 def world_edges(world: World) -> np.ndarray:
@@ -80,7 +82,7 @@ def edge_index(world: World, cell: float) -> EdgeIndex:
 def _build(edges: np.ndarray, cell: float) -> EdgeIndex:
     if len(edges) == 0:
         return EdgeIndex(edges.reshape(0, 4), np.zeros(2, np.int64), np.zeros(0, np.int64),
-                         0.0, 0.0, cell, 1, 1, 1e-9)
+                         0.0, 0.0, cell, 1, 1, 1e-9, np.zeros((1, 1)))
     lo = np.minimum(edges[:, :2], edges[:, 2:]).min(0)
     hi = np.maximum(edges[:, :2], edges[:, 2:]).max(0)
     eps = 1e-9 * max(1.0, float((hi - lo).max()))
@@ -101,7 +103,33 @@ def _build(edges: np.ndarray, cell: float) -> EdgeIndex:
     order = np.argsort(b, kind="stable")
     items = np.concatenate(ids)[order]
     start = np.searchsorted(b[order], np.arange(nx * ny + 1)).astype(np.int64)
-    return EdgeIndex(edges, start, items, float(x0), float(y0), cell, nx, ny, eps)
+    clear = _clearance(edges, start, items, float(x0), float(y0), cell, nx, ny)
+    return EdgeIndex(edges, start, items, float(x0), float(y0), cell, nx, ny, eps, clear)
+
+
+@njit(cache=True)
+def _clearance(edges, start, items, x0, y0, cell, nx, ny):
+    """(SUB ny, SUB nx) distance from each sub-cell centre to the nearest edge, capped at
+    two buckets (edges further away are in no bucket within two of the centre's)."""
+    res = cell / SUB
+    out = np.empty((SUB * ny, SUB * nx))
+    cap = 2 * cell
+    for r in range(SUB * ny):
+        cy = y0 + (r + 0.5) * res
+        by = r // SUB
+        for c in range(SUB * nx):
+            cx = x0 + (c + 0.5) * res
+            bx = c // SUB
+            best = cap * cap
+            for iy in range(max(0, by - 2), min(ny, by + 3)):
+                for ix in range(max(0, bx - 2), min(nx, bx + 3)):
+                    b = iy * nx + ix
+                    for m in range(start[b], start[b + 1]):
+                        i = items[m]
+                        best = min(best, point_segment_dist2(cx, cy, edges[i, 0], edges[i, 1],
+                                                             edges[i, 2], edges[i, 3]))
+            out[r, c] = math.sqrt(best)
+    return out
 
 
 @njit(cache=True)
@@ -170,8 +198,8 @@ def segment_distance(px, py, qx, qy, ax, ay, bx, by):
 
 
 @njit(cache=True)
-def piece_free(x, y, th, k, u, r, edges, start, items, x0, y0, cell, nx, ny, eps, stamp,
-               tick):
+def piece_free(x, y, th, k, u, r, edges, start, items, x0, y0, cell, nx, ny, eps, clear,
+               stamp, tick):
     """True when the piece from pose (x, y, th) (signed length ``u``, turn ``k``, radius
     ``r``) stays more than ``eps`` from every edge. ``stamp`` (E,) int64 and ``tick``
     (1,) int64 are scratch: stamp[i] == tick[0] marks edge i as tested in this chunk."""
@@ -182,8 +210,15 @@ def piece_free(x, y, th, k, u, r, edges, start, items, x0, y0, cell, nx, ny, eps
     n = max(1, math.ceil(length / lc))
     du = u / n
     cx = cy = a0 = sweep = sag = 0.0
+    res = cell / SUB
+    slack = 0.7072 * res + abs(du) + eps  # half a sub-cell's diagonal, the chunk, eps
     for j in range(n):
         px, py, pth = advance(x, y, th, k, du * j, r)
+        # a chunk lies within |du| of its start: far enough from every edge, it is free
+        ci = math.floor((px - x0) / res)
+        cj = math.floor((py - y0) / res)
+        if 0 <= ci < clear.shape[1] and 0 <= cj < clear.shape[0] and clear[cj, ci] > slack:
+            continue
         qx, qy, _ = advance(x, y, th, k, du * (j + 1), r)
         if k != 0:
             cx = px - k * r * math.sin(pth)
@@ -221,12 +256,12 @@ def piece_free(x, y, th, k, u, r, edges, start, items, x0, y0, cell, nx, ny, eps
 
 @njit(cache=True)
 def chain_free(x, y, th, turns, lengths, r, edges, start, items, x0, y0, cell, nx, ny, eps,
-               stamp, tick):
+               clear, stamp, tick):
     """:func:`piece_free` for consecutive pieces (turns (P,) int64, signed lengths (P,))
     from pose (x, y, th)."""
     for p in range(turns.shape[0]):
         if not piece_free(x, y, th, turns[p], lengths[p], r, edges, start, items, x0, y0,
-                          cell, nx, ny, eps, stamp, tick):
+                          cell, nx, ny, eps, clear, stamp, tick):
             return False
         x, y, th = advance(x, y, th, turns[p], lengths[p], r)
     return True

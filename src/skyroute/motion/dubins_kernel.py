@@ -78,9 +78,46 @@ def words(sx, sy, sth, gx, gy, gth, r):
 
 @njit(cache=True)
 def shortest_length(sx, sy, sth, gx, gy, gth, r):
-    """Length of the shortest Dubins path (metres)."""
-    _, total = words(sx, sy, sth, gx, gy, gth, r)
-    return total.min()
+    """Length of the shortest Dubins path (metres): :func:`words` without its arrays
+    (the search calls this for every node it generates)."""
+    dx, dy = gx - sx, gy - sy
+    d = math.sqrt(dx * dx + dy * dy) / r
+    phi = math.atan2(dy, dx)
+    a = _m2p(sth - phi)
+    b = _m2p(gth - phi)
+    sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
+    cab = math.cos(a - b)
+    dd = d * d
+    t_lsl = math.atan2(cb - ca, d + sa - sb)
+    t_rsr = math.atan2(ca - cb, d - sa + sb)
+    best = math.inf
+    p2 = 2 + dd - 2 * cab + 2 * d * (sa - sb)  # LSL
+    if p2 >= 0:
+        best = min(best, _m2p(t_lsl - a) + math.sqrt(p2) + _m2p(b - t_lsl))
+    p2 = 2 + dd - 2 * cab + 2 * d * (sb - sa)  # RSR
+    if p2 >= 0:
+        best = min(best, _m2p(a - t_rsr) + math.sqrt(p2) + _m2p(t_rsr - b))
+    p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
+    if p2 >= 0:
+        p = math.sqrt(p2)
+        tmp = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
+        best = min(best, _m2p(tmp - a) + p + _m2p(tmp - _m2p(b)))
+    p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
+    if p2 >= 0:
+        p = math.sqrt(p2)
+        tmp = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
+        best = min(best, _m2p(a - tmp) + p + _m2p(b - tmp))
+    c = (6.0 - dd + 2 * cab + 2 * d * (sa - sb)) / 8.0  # RLR
+    if abs(c) <= 1:
+        p = _m2p(TWO_PI - math.acos(c))
+        t = _m2p(a - t_rsr + p / 2)
+        best = min(best, t + p + _m2p(a - b - t + p))
+    c = (6.0 - dd + 2 * cab + 2 * d * (sb - sa)) / 8.0  # LRL
+    if abs(c) <= 1:
+        p = _m2p(TWO_PI - math.acos(c))
+        t = _m2p(-a + t_lsl + p / 2)
+        best = min(best, t + p + _m2p(_m2p(b) - a - t + p))
+    return best * r
 
 
 @njit(cache=True)

@@ -16,27 +16,40 @@ is tested exactly against the obstacles' and the boundary's edges
 (:mod:`skyroute.motion.arc_kernels`); the path ends with an analytic Dubins expansion
 and is then shortcut (:mod:`skyroute.motion.smooth`).
 
-Choices, and why:
+Choices, and why (measured on the curvature benchmark's worlds, :mod:`skyroute.bench.
+curvature`; numbers in docs/architecture.md):
 
-- ``step`` (default: the arc that turns 360/18 degrees, r pi / 9, about 1.75 m for r =
-  5) is a whole number of heading bins, so the lattice headings stay exact multiples of
-  the bin width from the start heading; smaller steps multiply expansions without
-  shortening the smoothed paths much (docs/architecture.md, benchmarks).
-- Cell size ``step / sqrt(2)``: a straight primitive always leaves its cell, and an arc's
-  chord (at least 0.98 step here) nearly always does, so one expansion never lands back
-  in its own state.
-- Heuristic max(Dubins ignoring obstacles, exact 2D distance around the obstacles): the
-  2D distance from a per-goal table of each convex corner's shortest distance to the
-  goal (:class:`skyroute.motion.step_drone.DistanceBound`, a Dijkstra over the corner
-  visibility graph) and, per node, the corners it sees. A raster distance field is
-  cheaper per node but is a lower bound only after losing a cell diagonal and the
-  8-connected metric's 8 %, which costs more expansions than the sight tests cost.
+- ``step``: by default the arc that turns 20 degrees (r pi / 9, 1.75 m for r = 5),
+  rounded to whole heading bins so lattice headings stay exact multiples of the bin
+  width from the start heading. Turns of 15 degrees gave the same smoothed lengths (mean
+  within 0.1 %) at up to twice the time on hard queries; 30 degrees was faster still
+  but 1.5 % longer on average, with some detours.
+- Cell size ``step / sqrt(2)``: a straight primitive always leaves its cell (an arc's
+  chord nearly always), so an expansion does not land back in its own state.
+- Heuristic max(Dubins length ignoring obstacles, 2D distance around the obstacles),
+  both lower bounds. The 2D term comes from a per-goal table of every convex corner's
+  exact shortest distance to the goal (:mod:`skyroute.motion.corner_distance`: the
+  corners' bitangent visibility graph once per world, a compiled Dijkstra per goal in
+  well under a millisecond) and, per node, the cheapest corners it sees; after 3 blocked
+  candidates the next candidate's value is taken, still a bound. Evaluated lazily: a new
+  node gets max(|q - goal|, parent's bound - step) and the exact value only when popped.
+  No raster: a grid distance field stays a lower bound only after losing a cell
+  diagonal and the 8-neighbour metric's 8 %, and needs a raster per goal.
+- Analytic expansion (the shortest of up to 3 Dubins words that fits) from every node
+  that sees the goal and every 10th node, when it can still beat the best path found;
+  the search runs on until no open node can (f >= best), then the path is shortcut.
+- Time reversal first: a path driven backwards is a forward path from the goal turned
+  round to the start turned round, so a short (500-expansion) search that way ends at
+  once when the goal cannot be reached (say, facing the boundary), and when it finishes
+  its path is the answer; otherwise the forward search runs.
 - A start without heading seeds every heading bin, measured from the direction towards
-  the goal (so driving straight at it is one of them); a goal without heading is reached
-  by the turn-then-tangent Dubins paths (every heading bin when it lies inside a turning
-  circle).
+  the goal (so driving straight at it is one), and first the two headings that reach a
+  goal circle on a tangent; a goal without heading is reached by the turn-then-tangent
+  Dubins paths (every heading bin when it lies inside a turning circle).
 - Without a boundary, states are kept within the bounding box of the obstacles, start
   and goal grown by 4 r + 2 step, so an enclosed goal ends in ``no_path``.
+- ``no_path`` means no path on this lattice (Hybrid A* is resolution-complete only in
+  the limit): every state reachable by the primitives was expanded.
 """
 
 from __future__ import annotations
@@ -44,7 +57,6 @@ from __future__ import annotations
 import math
 import numbers
 import time
-import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -52,14 +64,20 @@ import numpy as np
 from skyroute.errors import OptionError, QueryError
 from skyroute.motion import hybrid_search
 from skyroute.motion.arc_kernels import chain_free, edge_index
-from skyroute.motion.dubins_kernel import TURNS
+from skyroute.motion.corner_distance import corner_graph
+from skyroute.motion.dubins_kernel import TURNS, tangent_heading, words
 from skyroute.motion.pieces import Piece, chain, merge, sample
 from skyroute.motion.smooth import length, shortcut
-from skyroute.motion.zone_kernels import zone_arrays
-from skyroute.search.result import STATUS_OF_CODE, Status
+from skyroute.search.result import FOUND, NO_PATH, STATUS_OF_CODE, Status
 from skyroute.world.world import World
 
 Pose = tuple[float, float, float]
+_EVERY, _WORDS = 10, 3  # analytic expansion: every 10th node; 3 words
+_SIGHT_TESTS = 3  # corners tried per node by the 2D bound
+_WEIGHT = 1.0  # f = g + weight h; 1 keeps the search best-first on the true bound
+_REVERSE_BUDGET = 500  # expansions of the reversed search that comes first
+_PRIM_K = np.array([1, 0, -1], np.int64)  # left, straight, right
+_PRIM_U = np.ones(3)
 
 
 @dataclass(frozen=True)
@@ -184,53 +202,38 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         if not ok:
             raise QueryError(f"goal: the final approach of {approach:g} m to "
                              f"({threshold[0]:.2f}, {threshold[1]:.2f}) is not free")
-    dth = 2 * math.pi / H
-    ref = sth if sth is not None else (
-        math.atan2(gxy[1] - sxy[1], gxy[0] - sxy[0]) if np.any(gxy != sxy) else 0.0)
-    seeds = np.array([[sxy[0], sxy[1], sth]]) if sth is not None else \
-        np.c_[np.tile(sxy, (H, 1)), ref + np.arange(H) * dth]
-    from skyroute.motion.step_drone import DistanceBound
-
-    table = DistanceBound(world, gxy)
-    sight = _sight_edges(world)
-    cell = step / math.sqrt(2)
-    region = _region(world, sxy, gxy, 4 * r + 2 * step)
-    prim_k = np.array([1, 0, -1], np.int64)
-    prim_u = np.full(3, step)
-    prim_c = np.full(3, step)
-    code, end, end_head, end_word, best, expanded, tries, x, y, th, parent, prim = \
-        hybrid_search.search(
-            seeds, float(gxy[0]), float(gxy[1]), 0.0 if gth is None else float(gth),
-            gth is not None, r, prim_k, prim_u, prim_c, float(ref), dth, H, cell,
-            np.array(region, dtype=float), *index.args(),
-            np.ascontiguousarray(table.corners, dtype=float),
-            np.ascontiguousarray(table.dist, dtype=float), sight, budget, 10, 3)
-    status = STATUS_OF_CODE[code]
-    goal_pose = (float(gxy[0]), float(gxy[1]), float(end_head if gth is None else gth))
-    start_pose = (float(sxy[0]), float(sxy[1]), float(sth if sth is not None else 0.0))
+    lattice = _Lattice(world, index, r, H, step, _region(world, sxy, gxy, 4 * r + 2 * step))
+    # Time reversal: a path from start to goal driven backwards is a forward path from
+    # the goal turned round to the start turned round. A short search that way first
+    # ends at once when the goal is boxed in (facing a wall, or only reachable from
+    # outside the boundary), which the forward search would learn only after exhausting
+    # the whole world; when it finishes it is the answer.
+    first = min(budget, _REVERSE_BUDGET)
+    back = lattice.search(gxy, _turned(gth), sxy, _turned(sth), first)
+    if back.code == NO_PATH or (back.code == FOUND and back.expanded < first):
+        res, expanded = back.reversed(), back.expanded
+    else:
+        res = lattice.search(sxy, sth, gxy, gth, budget - back.expanded)
+        expanded = back.expanded + res.expanded
+    status = STATUS_OF_CODE[res.code]
+    start_pose = (float(sxy[0]), float(sxy[1]), math.nan if sth is None else float(sth))
+    goal_pose = (float(gxy[0]), float(gxy[1]), math.nan if gth is None else float(gth))
     if status is not Status.FOUND:
-        return HybridResult(status, math.inf, (), start_pose, goal_pose if gth is not None
-                            else (goal_pose[0], goal_pose[1], math.nan), r, int(expanded),
-                            time.perf_counter() - t0, {"tries": int(tries)})
-    nodes = [end]
-    while parent[nodes[-1]] >= 0:
-        nodes.append(parent[nodes[-1]])
-    nodes.reverse()
-    root = nodes[0]
-    start_pose = (float(sxy[0]), float(sxy[1]), float(th[root]))
-    turns = [int(prim_k[prim[n]]) for n in nodes[1:]]
-    lens = [float(prim_u[prim[n]]) for n in nodes[1:]]
-    node_end = (float(x[end]), float(y[end]), float(th[end]))
-    from skyroute.motion.dubins_kernel import words
-
-    segs, _ = words(*node_end, *goal_pose, r)
-    pieces = merge(chain(start_pose, turns, lens, r) +
-                   chain(node_end, TURNS[end_word], segs[end_word], r))
+        return HybridResult(status, math.inf, (), start_pose, goal_pose, r, int(expanded),
+                            time.perf_counter() - t0, {"tries": back.tries + res.tries})
+    pieces = res.pieces
+    if pieces:  # exactly the given start (a reversed search ends there within rounding)
+        head = pieces[0].start[2] if sth is None else sth
+        start_pose = (float(sxy[0]), float(sxy[1]), float(head))
+        pieces[0] = Piece(pieces[0].kind, start_pose, pieces[0].length, r)
+        goal_pose = (float(gxy[0]), float(gxy[1]), float(res.goal[2] if gth is None else gth))
+    else:
+        head = sth if sth is not None else (gth if gth is not None else 0.0)
+        start_pose = goal_pose = (float(sxy[0]), float(sxy[1]), float(head))
     raw = length(pieces)
     shortcut_tries = 0
     if smooth:
-        pieces, shortcut_tries = shortcut(pieces, start_pose, r, lambda p: _free(index, p),
-                                          np.random.default_rng(seed))
+        pieces, shortcut_tries = shortcut(pieces, r, index, seed=seed)
         pieces = merge(pieces)
     if final is not None:
         pieces.append(Piece("S", goal_pose, final.length, r))
@@ -238,8 +241,82 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     return HybridResult(Status.FOUND, length(pieces), tuple(pieces), start_pose, goal_pose,
                         r, int(expanded), time.perf_counter() - t0,
                         {"raw_length": raw + (final.length if final else 0.0),
-                         "tries": int(tries), "shortcut_tries": shortcut_tries,
-                         "best": float(best)})
+                         "tries": back.tries + res.tries, "shortcut_tries": shortcut_tries,
+                         "reversed": res.flipped})
+
+
+@dataclass
+class _Found:
+    """One direction's outcome: kernel code, expansions, analytic tries, and the pieces
+    and goal pose when found."""
+
+    code: int
+    expanded: int
+    tries: int
+    pieces: list = field(default_factory=list)
+    goal: Pose | None = None
+    flipped: bool = False
+
+    def reversed(self) -> _Found:
+        """The same path driven the other way (each piece turned round, L and R swapped)."""
+        if self.code != FOUND:
+            return _Found(self.code, self.expanded, self.tries)
+        out = []
+        for p in reversed(self.pieces):
+            x, y, th = p.end
+            out.append(Piece({"L": "R", "R": "L", "S": "S"}[p.kind], (x, y, th + math.pi),
+                             p.length, p.radius, p.reverse))
+        start = self.pieces[0].start if self.pieces else self.goal
+        return _Found(self.code, self.expanded, self.tries, out,
+                      (start[0], start[1], start[2] + math.pi), True)
+
+
+class _Lattice:
+    """The search's fixed inputs for one query: edges, lattice sizes, region."""
+
+    def __init__(self, world, index, r, H, step, region):
+        self.world, self.index, self.r, self.H, self.step = world, index, r, H, step
+        self.region = np.array(region, dtype=float)
+        self.graph = corner_graph(world)
+
+    def search(self, sxy, sth, gxy, gth, budget) -> _Found:
+        r, H, step = self.r, self.H, self.step
+        dth = 2 * math.pi / H
+        ref = sth if sth is not None else (
+            math.atan2(gxy[1] - sxy[1], gxy[0] - sxy[0]) if np.any(gxy != sxy) else 0.0)
+        if sth is not None:
+            seeds = np.array([[sxy[0], sxy[1], sth]])
+        else:
+            heads = ref + np.arange(H) * dth
+            if gth is not None:  # first the headings that leave straight on a tangent
+                # of a goal circle: the best ones without obstacles (time-reversed
+                # turn-then-tangent paths from the goal turned round)
+                tang = [tangent_heading(gxy[0], gxy[1], gth + math.pi, sxy[0], sxy[1], r,
+                                        side) + math.pi for side in (1, -1)]
+                heads = np.r_[[h for h in tang if math.isfinite(h)], heads]
+            seeds = np.c_[np.tile(sxy, (len(heads), 1)), heads]
+        g = self.graph
+        code, end, end_head, end_word, _, expanded, tries, x, y, th, parent, prim = \
+            hybrid_search.search(
+                seeds, float(gxy[0]), float(gxy[1]), 0.0 if gth is None else float(gth),
+                gth is not None, r, _PRIM_K, _PRIM_U * step, _PRIM_U * step, float(ref),
+                dth, H, step / math.sqrt(2), self.region, *self.index.args(), g.corners,
+                g.to(gxy), g.edges, _SIGHT_TESTS, _WEIGHT, budget, _EVERY,
+                _WORDS)
+        if code != FOUND:
+            return _Found(int(code), int(expanded), int(tries))
+        nodes = [end]
+        while parent[nodes[-1]] >= 0:
+            nodes.append(parent[nodes[-1]])
+        nodes.reverse()
+        start_pose = (float(sxy[0]), float(sxy[1]), float(th[nodes[0]]))
+        goal_pose = (float(gxy[0]), float(gxy[1]), float(end_head if gth is None else gth))
+        turns = [int(_PRIM_K[prim[n]]) for n in nodes[1:]]
+        node_end = (float(x[end]), float(y[end]), float(th[end]))
+        segs, _ = words(*node_end, *goal_pose, r)
+        pieces = merge(chain(start_pose, turns, [step] * len(turns), r) +
+                       chain(node_end, TURNS[end_word], segs[end_word], r))
+        return _Found(int(code), int(expanded), int(tries), pieces, goal_pose)
 
 
 def path_free(world: World, pieces) -> bool:
@@ -269,14 +346,8 @@ def _bucket(world: World) -> float:
     return max(xmax - xmin, ymax - ymin) / 64.0
 
 
-_SIGHT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
-def _sight_edges(world: World) -> np.ndarray:
-    """Obstacle edges (not the boundary: the 2D bound ignores it, so stays a bound)."""
-    if world not in _SIGHT:
-        _SIGHT[world] = np.ascontiguousarray(zone_arrays(world.merged())[0], dtype=float)
-    return _SIGHT[world]
+def _turned(h: float | None) -> float | None:
+    return None if h is None else h + math.pi
 
 
 def _region(world: World, s, g, margin: float) -> tuple[float, float, float, float]:

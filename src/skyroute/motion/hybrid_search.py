@@ -7,8 +7,9 @@ the primitives (turn k, signed length u, cost c) that :func:`piece_free` passes.
 
 Heuristic: h = max(Dubins length to the goal ignoring obstacles (to the goal pose, or
 to the goal point with any heading), the obstacle-avoiding 2D distance). Both are lower
-bounds of the remaining length. The 2D term (:func:`move_search.distance`, from a
-per-goal corner table) costs a sight test, so a new node first gets the cheap bound
+bounds of the remaining length; ``weight`` > 1 turns the search into weighted A*
+(default 1). The 2D term (:func:`corner_distance.lower_bound`, from a per-goal corner
+table) costs sight tests, so a new node first gets the cheap bound
 max(|q - goal|, d2(parent) - |u|) (the 2D distance is 1-Lipschitz and a primitive moves
 at most |u|) and the exact one when it reaches the top of the heap; if that raises its
 f it goes back in.
@@ -30,6 +31,7 @@ from numba import njit, types
 from numba.typed import Dict
 
 from skyroute.motion.arc_kernels import advance, chain_free, piece_free
+from skyroute.motion.corner_distance import lower_bound
 from skyroute.motion.dubins_kernel import (
     TURNS,
     free_heading_bound,
@@ -37,7 +39,7 @@ from skyroute.motion.dubins_kernel import (
     tangent_heading,
     words,
 )
-from skyroute.motion.move_search import _sight, distance
+from skyroute.motion.move_search import _sight
 from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 
 TWO_PI = 2 * math.pi
@@ -103,7 +105,7 @@ def dubins_bound(x, y, th, gx, gy, gth, has_heading, r):
 
 @njit(cache=True)
 def _analytic(x, y, th, g, best, gx, gy, gth, has_heading, r, ref, dth, H, max_words,
-              ed, st, it, x0, y0, cell, nx, ny, eps, stamp, tick):
+              ed, st, it, x0, y0, cell, nx, ny, eps, clear, stamp, tick):
     """The shortest free Dubins connection from pose (x, y, th) at cost g that beats
     ``best``: (total cost or inf, goal heading, word index)."""
     n = 1 if has_heading else 2 + H
@@ -148,15 +150,15 @@ def _analytic(x, y, th, g, best, gx, gy, gth, has_heading, r, ref, dth, H, max_w
             turns[p] = TURNS[w, p]
             lens[p] = segs[w, p]
         if chain_free(x, y, th, turns, lens, r, ed, st, it, x0, y0, cell, nx, ny, eps,
-                      stamp, tick):
+                      clear, stamp, tick):
             return g + cand_len[c], cand_head[c], w
     return math.inf, 0.0, -1
 
 
 @njit(cache=True)
 def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth, H, cell,
-           region, ed, st, it, x0, y0, bcell, nx, ny, eps, corners, cdist, sight_edges,
-           max_expansions, every, max_words):
+           region, ed, st, it, x0, y0, bcell, nx, ny, eps, clear, corners, cdist,
+           sight_edges, sight_tests, weight, max_expansions, every, max_words):
     """Hybrid A* from the poses ``seeds`` (S, 3) to the goal.
 
     ``region`` (xmin, ymin, xmax, ymax): nodes outside it are dropped (states are keyed
@@ -180,6 +182,7 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
     seen = Dict.empty(key_type=types.int64, value_type=types.int64)
     stamp = np.zeros(ed.shape[0], np.int64)
     tick = np.zeros(1, np.int64)
+    scratch = np.empty(corners.shape[0])
     ny_cells = np.int64(math.floor((region[3] - region[1]) / cell)) + 1
     n = 0
     size = 0
@@ -195,7 +198,7 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
         parent[n], prim[n] = -1, -1
         hd[n] = dubins_bound(sx, sy, sth, gx, gy, gth, has_heading, r)
         d2[n] = math.hypot(gx - sx, gy - sy)
-        fq[n] = max(hd[n], d2[n])
+        fq[n] = weight * max(hd[n], d2[n])
         _push(hf, hn, size, fq[n], n)
         size += 1
         n += 1
@@ -214,9 +217,9 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
         if not exact[i]:
             exact[i] = True
             sees = _sight(x[i], y[i], gx, gy, sight_edges)
-            d2[i] = max(d2[i], distance(x[i], y[i], sees, gx, gy, corners, cdist,
-                                        sight_edges))
-            f2 = g[i] + max(hd[i], d2[i])
+            d2[i] = max(d2[i], lower_bound(x[i], y[i], gx, gy, sees, corners, cdist,
+                                           sight_edges, scratch, sight_tests))
+            f2 = g[i] + weight * max(hd[i], d2[i])
             if f2 > f:
                 if size + 1 > hf.shape[0]:
                     hf, hn = _grow(hf, size + 1), _grow(hn, size + 1)
@@ -230,17 +233,17 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
             break
         closed[i] = True
         expanded += 1
-        if sees or expanded % every == 1 or every == 1:
+        if (sees or expanded % every == 1 or every == 1) and g[i] + hd[i] < best:
             tries += 1
             c, h, w = _analytic(x[i], y[i], th[i], g[i], best, gx, gy, gth, has_heading,
                                 r, ref, dth, H, max_words, ed, st, it, x0, y0, bcell, nx,
-                                ny, eps, stamp, tick)
+                                ny, eps, clear, stamp, tick)
             if c < best:
                 best, end, end_head, end_word = c, i, h, w
         for p in range(prim_k.shape[0]):
             k, u = prim_k[p], prim_u[p]
             if not piece_free(x[i], y[i], th[i], k, u, r, ed, st, it, x0, y0, bcell, nx,
-                              ny, eps, stamp, tick):
+                              ny, eps, clear, stamp, tick):
                 continue
             qx, qy, qth = advance(x[i], y[i], th[i], k, u, r)
             if not (region[0] <= qx <= region[2] and region[1] <= qy <= region[3]):
@@ -274,7 +277,7 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
             hd[j] = dubins_bound(qx, qy, qth, gx, gy, gth, has_heading, r)
             d2[j] = max(math.hypot(gx - qx, gy - qy), d2[i] - abs(u))
             exact[j] = False
-            fq[j] = gq + max(hd[j], d2[j])
+            fq[j] = gq + weight * max(hd[j], d2[j])
             if fq[j] >= best:
                 continue
             if size + 1 > hf.shape[0]:
