@@ -320,3 +320,51 @@ def test_path_free_is_exact_at_a_corner():
         rad = 10 + dr
         p = Piece("L", (50 - rad, 70, -math.pi / 2), rad * math.pi, rad)
         assert path_free(world, [p]) is ok
+
+
+# -- smaller contracts --------------------------------------------------------------------
+
+def test_docstring_examples():
+    import doctest
+
+    from skyroute.motion import hybrid, pieces
+
+    for module in (hybrid, pieces):
+        result = doctest.testmod(module)
+        assert result.attempted > 0 and result.failed == 0
+
+
+def test_same_start_and_goal():
+    world = make_world([(40, 40, 60, 60)])
+    res = plan(world, (10, 10, 1.0), (10, 10, 1.0), R)
+    assert res.found and res.length == 0 and res.segments == ()
+    assert res.sample(1.0).tolist() == [[10, 10, 1.0]]
+    res = plan(world, (10, 10, 0.0), (10, 10, math.pi), R)  # turn round: a loop
+    check_path(world, res, (10, 10, 0.0), (10, 10, math.pi), R)
+
+
+def test_a_boxed_in_goal_ends_at_once():
+    # the goal faces the boundary 1 m ahead: no forward path can arrive there
+    world = make_world([(40, 40, 60, 60)])
+    res = plan(world, (10, 10, 0.0), (99, 50, math.pi), R)
+    assert res.status is Status.NO_PATH and res.expanded < 20
+    # the start faces the boundary: the forward search ends at once too
+    res = plan(world, (1, 50, math.pi), (90, 90, 0.0), R)
+    assert res.status is Status.NO_PATH and res.expanded < 600
+
+
+def test_result_pieces_describe_arcs():
+    world = make_world([(48, 0, 52, 45), (48, 57, 52, 100)])
+    res = plan(world, (20, 80, -math.pi / 2), (80, 20, 0.0), R)
+    assert {p.kind for p in res.segments} <= {"L", "S", "R"}
+    for p in res.segments:
+        assert p.length > 0 and not p.reverse
+        if p.kind == "S":
+            assert p.centre is None and p.turn == 0
+        else:
+            cx, cy = p.centre
+            assert math.dist((cx, cy), p.start[:2]) == pytest.approx(R)
+            assert math.dist((cx, cy), p.end[:2]) == pytest.approx(R)
+            assert p.turn == pytest.approx((1 if p.kind == "L" else -1) * p.length / R)
+            a = p.start_angle
+            assert (cx + R * math.cos(a), cy + R * math.sin(a)) == pytest.approx(p.start[:2])
