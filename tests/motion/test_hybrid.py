@@ -32,7 +32,7 @@ def wrap(a):
     return (np.asarray(a) + math.pi) % (2 * math.pi) - math.pi
 
 
-def check_path(world: World, res, start, goal, radius, *, ds=0.05):
+def check_path(world: World, res, start, goal, radius, *, ds=0.05, reverse=False):
     """Independent checks of a found path: shapely on dense samples (with the chord's
     sagitta as tolerance), curvature and direction from consecutive poses, the ends, and
     the lower bound."""
@@ -49,6 +49,7 @@ def check_path(world: World, res, start, goal, radius, *, ds=0.05):
     assert math.dist(end[:2], goal[:2]) < 1e-6
     if len(goal) == 3:
         assert abs(wrap(end[2] - goal[2])) < 1e-6
+    assert reverse or not any(p.reverse for p in res.segments)
     for a, b in zip(res.segments[:-1], res.segments[1:], strict=True):
         assert math.dist(a.end[:2], b.start[:2]) < 1e-6 and abs(wrap(a.end[2] - b.start[2])) \
             < 1e-6
@@ -66,13 +67,24 @@ def check_path(world: World, res, start, goal, radius, *, ds=0.05):
     d = np.diff(poses[:, :2], axis=0)
     chord = np.hypot(*d.T)
     turn = np.abs(wrap(np.diff(poses[:, 2])))
-    assert np.all(2 * radius * np.sin(turn / 2) <= chord * (1 + 1e-9) + 1e-9)
-    moving = chord > 1e-9
+    assert np.all(2 * radius * np.sin(turn / 2) <= chord * (1 + 1e-6) + 1e-6)
+    moving = chord > 1e-6  # shorter chords: their direction is rounding noise
     mid = poses[:-1, 2] + wrap(np.diff(poses[:, 2])) / 2
-    assert np.all(np.abs(wrap(np.arctan2(d[:, 1], d[:, 0]) - mid))[moving] < 1e-6)
+    off = np.abs(wrap(np.arctan2(d[:, 1], d[:, 0]) - mid))[moving]
+    backwards = any(p.reverse for p in res.segments)
+    if backwards:  # each chord along the nose or straight behind it
+        assert np.all((off < 1e-6) | (off > math.pi - 1e-6))
+        if any(p.reverse and p.length > 2 * ds for p in res.segments):
+            assert np.any(off > 3)
+    else:
+        assert np.all(off < 1e-6)
     # at least the lower bound
-    lb_dubins = dubins.shortest_path(start, goal, radius).length if len(start) == 3 and \
-        len(goal) == 3 else math.dist(start[:2], goal[:2])
+    if len(start) == 3 and len(goal) == 3:
+        lb_dubins = max(math.dist(start[:2], goal[:2]),
+                        radius * abs(wrap(goal[2] - start[2]))) if reverse else \
+            dubins.shortest_path(start, goal, radius).length
+    else:
+        lb_dubins = math.dist(start[:2], goal[:2])
     lb_2d = skyroute.plan(world, start[:2], goal[:2]).cost
     assert res.length >= max(lb_dubins, lb_2d) - 1e-9
     assert res.length == pytest.approx(sum(p.length for p in res.segments), abs=1e-9)
@@ -186,17 +198,18 @@ rects = st.lists(st.tuples(st.floats(0, 90), st.floats(0, 90), st.floats(3, 25),
 pose = st.tuples(st.floats(2, 98), st.floats(2, 98), st.floats(-math.pi, math.pi))
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
-@given(rects, pose, pose, st.sampled_from([3.0, 5.0, 8.0]), st.booleans(), st.booleans())
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@given(rects, pose, pose, st.sampled_from([3.0, 5.0, 8.0]), st.booleans(), st.booleans(),
+       st.booleans())
 def test_property_paths_are_free_curvature_bounded_and_not_too_short(
-        boxes, start, goal, radius, start_heading, goal_heading):
+        boxes, start, goal, radius, start_heading, goal_heading, reverse):
     world = make_world([(x, y, x + w, y + h) for x, y, w, h in boxes])
     assume(world.is_free([start[:2], goal[:2]]).all())
     s = start if start_heading else start[:2]
     g = goal if goal_heading else goal[:2]
-    res = plan(world, s, g, radius, max_expansions=20_000)
+    res = plan(world, s, g, radius, max_expansions=20_000, reverse=reverse)
     if res.found:
-        check_path(world, res, s, g, radius)
+        check_path(world, res, s, g, radius, reverse=reverse)
         assert res.extra["raw_length"] >= res.length - 1e-9  # shortcuts never lengthen
     else:
         assert res.status in (Status.NO_PATH, Status.BUDGET_EXHAUSTED)
@@ -245,7 +258,7 @@ def test_bad_inputs_raise_named_errors():
     with pytest.raises(OptionError, match="max_expansions"):
         plan(world, ok_s, ok_g, R, max_expansions=-1)
     with pytest.raises(OptionError, match="reverse"):
-        plan(world, ok_s, ok_g, R, reverse=True)
+        plan(world, ok_s, ok_g, R, reverse="yes")
     with pytest.raises(OptionError, match="approach"):
         plan(world, ok_s, ok_g, R, approach=-3)
     with pytest.raises(QueryError, match="goal"):
@@ -368,3 +381,35 @@ def test_result_pieces_describe_arcs():
             assert p.turn == pytest.approx((1 if p.kind == "L" else -1) * p.length / R)
             a = p.start_angle
             assert (cx + R * math.cos(a), cy + R * math.sin(a)) == pytest.approx(p.start[:2])
+
+
+# -- reverse gears ------------------------------------------------------------------------
+
+def test_reverse_never_longer_than_dubins_in_an_empty_world():
+    world = make_world([], (-200, -200, 200, 200))
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        start = (*rng.uniform(-30, 30, 2), rng.uniform(-math.pi, math.pi))
+        goal = (*rng.uniform(-30, 30, 2), rng.uniform(-math.pi, math.pi))
+        res = plan(world, start, goal, R, reverse=True)
+        assert res.length <= dubins.shortest_path(start, goal, R).length + 1e-9
+        check_path(world, res, start, goal, R, reverse=True)
+
+
+def test_reverse_backs_out_of_a_dead_end():
+    world = make_world([(20, 44, 60, 47), (20, 53, 60, 56), (17, 44, 20, 56)])
+    start, goal = (40, 50, math.pi), (80, 80, 0.0)
+    assert plan(world, start, goal, R).status is Status.NO_PATH
+    res = plan(world, start, goal, R, reverse=True)
+    check_path(world, res, start, goal, R, reverse=True)
+    assert res.segments[0].reverse  # it backs out first
+
+
+def test_reverse_parks_beside_where_it_started():
+    world = make_world([(0, 0, 100, 40)])  # a kerb below
+    start, goal = (30, 45, 0.0), (40, 45, math.pi)  # turn round in a 55 m wide street
+    forward = plan(world, start, goal, R)
+    res = plan(world, start, goal, R, reverse=True)
+    check_path(world, forward, start, goal, R)
+    check_path(world, res, start, goal, R, reverse=True)
+    assert res.length < forward.length

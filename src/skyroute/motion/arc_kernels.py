@@ -265,3 +265,15 @@ def chain_free(x, y, th, turns, lengths, r, edges, start, items, x0, y0, cell, n
             return False
         x, y, th = advance(x, y, th, turns[p], lengths[p], r)
     return True
+
+
+@njit(cache=True)
+def chain_reaches(x, y, th, turns, lengths, r, gx, gy, gth, tol):
+    """True when the pieces from pose (x, y, th) end within ``tol`` of (gx, gy) and
+    within 1e-9 rad of heading gth: closed forms lose digits on tiny or degenerate
+    queries, and a path must not jump (callers pass 1e-12 of the world's extent; a
+    well-posed Dubins path ends within about 1e-14 of it)."""
+    for p in range(turns.shape[0]):
+        x, y, th = advance(x, y, th, turns[p], lengths[p], r)
+    dh = (th - gth + math.pi) % TWO_PI - math.pi
+    return math.hypot(x - gx, y - gy) <= tol and abs(dh) <= 1e-9

@@ -48,12 +48,17 @@ curvature`; numbers in docs/architecture.md):
   Dubins paths (every heading bin when it lies inside a turning circle).
 - Without a boundary, states are kept within the bounding box of the obstacles, start
   and goal grown by 4 r + 2 step, so an enclosed goal ends in ``no_path``.
+- ``reverse=True`` keeps all of the above with six primitives and the cusp-free
+  Reeds-Shepp words (forward or backward Dubins paths); the full 48-word Reeds-Shepp
+  family (paths with cusps inside the analytic expansion) is not implemented, so
+  manoeuvres with cusps come from the lattice and its shortcutting.
 - ``no_path`` means no path on this lattice (Hybrid A* is resolution-complete only in
   the limit): every state reachable by the primitives was expanded.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import numbers
 import time
@@ -66,7 +71,7 @@ from skyroute.motion import hybrid_search
 from skyroute.motion.arc_kernels import chain_free, edge_index
 from skyroute.motion.corner_distance import corner_graph
 from skyroute.motion.dubins_kernel import TURNS, tangent_heading, words
-from skyroute.motion.pieces import Piece, chain, merge, sample
+from skyroute.motion.pieces import Piece, chain, merge, sample, time_reversed, turned_round
 from skyroute.motion.smooth import length, shortcut
 from skyroute.search.result import FOUND, NO_PATH, STATUS_OF_CODE, Status
 from skyroute.world.world import World
@@ -76,8 +81,8 @@ _EVERY, _WORDS = 10, 3  # analytic expansion: every 10th node; 3 words
 _SIGHT_TESTS = 3  # corners tried per node by the 2D bound
 _WEIGHT = 1.0  # f = g + weight h; 1 keeps the search best-first on the true bound
 _REVERSE_BUDGET = 500  # expansions of the reversed search that comes first
-_PRIM_K = np.array([1, 0, -1], np.int64)  # left, straight, right
-_PRIM_U = np.ones(3)
+_BACK_COST = 1.0  # reverse=True: a metre driven backwards costs as much as one forwards
+_SWITCH = 1.0  # reverse=True: each change of direction costs this many turning radii
 
 
 @dataclass(frozen=True)
@@ -154,7 +159,13 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         Arc length of one primitive, in (0, pi r]; default r pi / 9 rounded to whole
         heading bins.
     reverse : bool
-        Backward driving; not supported yet (raises OptionError).
+        Allow driving backwards (a car, not a plane): the lattice gains three reverse
+        primitives, a metre backwards costs as much as one forwards and each change of
+        direction costs one turning radius (``extra["cusps"]`` counts them; ``length``
+        stays the geometric length). The analytic expansion tries Dubins paths driven
+        wholly forwards or wholly backwards, the Reeds-Shepp words without a cusp; cusps
+        come from the lattice. The Dubins heuristic gives way to max(straight distance,
+        r times the heading change), which stays a bound with reversing.
     max_expansions : int, optional
         Stop with ``budget_exhausted`` (or with the best path found so far) after this
         many expansions.
@@ -202,16 +213,21 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         if not ok:
             raise QueryError(f"goal: the final approach of {approach:g} m to "
                              f"({threshold[0]:.2f}, {threshold[1]:.2f}) is not free")
-    lattice = _Lattice(world, index, r, H, step, _region(world, sxy, gxy, 4 * r + 2 * step))
+    lattice = _Lattice(world, index, r, H, step, _region(world, sxy, gxy, 4 * r + 2 * step),
+                       reverse)
     # Time reversal: a path from start to goal driven backwards is a forward path from
-    # the goal turned round to the start turned round. A short search that way first
-    # ends at once when the goal is boxed in (facing a wall, or only reachable from
+    # the goal turned round to the start turned round (with reverse gears: a path from
+    # the goal to the start, every piece's direction swapped). A short search that way
+    # first ends at once when the goal is boxed in (facing a wall, or only reachable from
     # outside the boundary), which the forward search would learn only after exhausting
     # the whole world; when it finishes it is the answer.
     first = min(budget, _REVERSE_BUDGET)
-    back = lattice.search(gxy, _turned(gth), sxy, _turned(sth), first)
+    if reverse:
+        back = lattice.search(gxy, gth, sxy, sth, first)
+    else:
+        back = lattice.search(gxy, _turned(gth), sxy, _turned(sth), first)
     if back.code == NO_PATH or (back.code == FOUND and back.expanded < first):
-        res, expanded = back.reversed(), back.expanded
+        res, expanded = back.reversed(reverse), back.expanded
     else:
         res = lattice.search(sxy, sth, gxy, gth, budget - back.expanded)
         expanded = back.expanded + res.expanded
@@ -225,15 +241,17 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     if pieces:  # exactly the given start (a reversed search ends there within rounding)
         head = pieces[0].start[2] if sth is None else sth
         start_pose = (float(sxy[0]), float(sxy[1]), float(head))
-        pieces[0] = Piece(pieces[0].kind, start_pose, pieces[0].length, r)
+        pieces[0] = Piece(pieces[0].kind, start_pose, pieces[0].length, r, pieces[0].reverse)
         goal_pose = (float(gxy[0]), float(gxy[1]), float(res.goal[2] if gth is None else gth))
     else:
         head = sth if sth is not None else (gth if gth is not None else 0.0)
-        start_pose = goal_pose = (float(sxy[0]), float(sxy[1]), float(head))
+        start_pose = (float(sxy[0]), float(sxy[1]), float(head))
+        goal_pose = (float(gxy[0]), float(gxy[1]), float(head))
     raw = length(pieces)
     shortcut_tries = 0
     if smooth:
-        pieces, shortcut_tries = shortcut(pieces, r, index, seed=seed)
+        pieces, shortcut_tries = shortcut(pieces, r, index, seed=seed, reverse=reverse,
+                                          back_cost=_BACK_COST, switch_cost=_SWITCH * r)
         pieces = merge(pieces)
     if final is not None:
         pieces.append(Piece("S", goal_pose, final.length, r))
@@ -242,7 +260,9 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
                         r, int(expanded), time.perf_counter() - t0,
                         {"raw_length": raw + (final.length if final else 0.0),
                          "tries": back.tries + res.tries, "shortcut_tries": shortcut_tries,
-                         "reversed": res.flipped})
+                         "reversed": res.flipped,
+                         "cusps": sum(a.reverse != b.reverse
+                                      for a, b in itertools.pairwise(pieces))})
 
 
 @dataclass
@@ -257,27 +277,31 @@ class _Found:
     goal: Pose | None = None
     flipped: bool = False
 
-    def reversed(self) -> _Found:
-        """The same path driven the other way (each piece turned round, L and R swapped)."""
+    def reversed(self, gears: bool) -> _Found:
+        """The path run backwards in time: with reverse ``gears``, each piece driven the
+        other way; without, also turned round (forward again, L and R swapped)."""
         if self.code != FOUND:
             return _Found(self.code, self.expanded, self.tries)
-        out = []
-        for p in reversed(self.pieces):
-            x, y, th = p.end
-            out.append(Piece({"L": "R", "R": "L", "S": "S"}[p.kind], (x, y, th + math.pi),
-                             p.length, p.radius, p.reverse))
+        out = time_reversed(self.pieces)
         start = self.pieces[0].start if self.pieces else self.goal
-        return _Found(self.code, self.expanded, self.tries, out,
-                      (start[0], start[1], start[2] + math.pi), True)
+        if not gears:
+            out = turned_round(out)
+            start = (start[0], start[1], start[2] + math.pi)
+        return _Found(self.code, self.expanded, self.tries, out, start, True)
 
 
 class _Lattice:
     """The search's fixed inputs for one query: edges, lattice sizes, region."""
 
-    def __init__(self, world, index, r, H, step, region):
+    def __init__(self, world, index, r, H, step, region, reverse):
         self.world, self.index, self.r, self.H, self.step = world, index, r, H, step
         self.region = np.array(region, dtype=float)
         self.graph = corner_graph(world)
+        self.reverse = reverse
+        n = 6 if reverse else 3
+        self.k = np.array([1, 0, -1, 1, 0, -1][:n], np.int64)  # left, straight, right
+        self.u = np.array([1.0, 1.0, 1.0, -1.0, -1.0, -1.0][:n]) * step  # > 0 forward
+        self.c = np.abs(self.u) * np.where(self.u < 0, _BACK_COST, 1.0)
 
     def search(self, sxy, sth, gxy, gth, budget) -> _Found:
         r, H, step = self.r, self.H, self.step
@@ -296,13 +320,13 @@ class _Lattice:
                 heads = np.r_[[h for h in tang if math.isfinite(h)], heads]
             seeds = np.c_[np.tile(sxy, (len(heads), 1)), heads]
         g = self.graph
-        code, end, end_head, end_word, _, expanded, tries, x, y, th, parent, prim = \
+        code, end, end_head, end_word, end_back, _, expanded, tries, x, y, th, parent, prim = \
             hybrid_search.search(
                 seeds, float(gxy[0]), float(gxy[1]), 0.0 if gth is None else float(gth),
-                gth is not None, r, _PRIM_K, _PRIM_U * step, _PRIM_U * step, float(ref),
-                dth, H, step / math.sqrt(2), self.region, *self.index.args(), g.corners,
-                g.to(gxy), g.edges, _SIGHT_TESTS, _WEIGHT, budget, _EVERY,
-                _WORDS)
+                gth is not None, r, self.k, self.u, self.c, float(ref), dth, H,
+                step / math.sqrt(2), self.region, *self.index.args(), g.corners,
+                g.to(gxy), g.edges, _SIGHT_TESTS, _WEIGHT, budget, _EVERY, _WORDS,
+                self.reverse, _BACK_COST, _SWITCH * r)
         if code != FOUND:
             return _Found(int(code), int(expanded), int(tries))
         nodes = [end]
@@ -310,12 +334,20 @@ class _Lattice:
             nodes.append(parent[nodes[-1]])
         nodes.reverse()
         start_pose = (float(sxy[0]), float(sxy[1]), float(th[nodes[0]]))
-        goal_pose = (float(gxy[0]), float(gxy[1]), float(end_head if gth is None else gth))
-        turns = [int(_PRIM_K[prim[n]]) for n in nodes[1:]]
+        head = end_head - (math.pi if end_back else 0.0)
+        goal_pose = (float(gxy[0]), float(gxy[1]), float(head if gth is None else gth))
+        turns = [int(self.k[prim[n]]) for n in nodes[1:]]
+        back = [bool(self.u[prim[n]] < 0) for n in nodes[1:]]
         node_end = (float(x[end]), float(y[end]), float(th[end]))
-        segs, _ = words(*node_end, *goal_pose, r)
-        pieces = merge(chain(start_pose, turns, [step] * len(turns), r) +
-                       chain(node_end, TURNS[end_word], segs[end_word], r))
+        if end_back:  # the forward Dubins path of the vehicle turned round, in reverse
+            a = (node_end[0], node_end[1], node_end[2] + math.pi)
+            b = (goal_pose[0], goal_pose[1], goal_pose[2] + math.pi)
+            segs, _ = words(*a, *b, r)
+            last = turned_round(chain(a, TURNS[end_word], segs[end_word], r))
+        else:
+            segs, _ = words(*node_end, *goal_pose, r)
+            last = chain(node_end, TURNS[end_word], segs[end_word], r)
+        pieces = merge(chain(start_pose, turns, [step] * len(turns), r, back) + last)
         return _Found(int(code), int(expanded), int(tries), pieces, goal_pose)
 
 
@@ -373,8 +405,8 @@ def _options(radius, heading_bins, step, reverse, max_expansions, seed):
     elif isinstance(step, bool) or not isinstance(step, numbers.Real) or \
             not (math.isfinite(step) and 0 < step <= math.pi * r):
         raise OptionError(f"step={step!r} must be in (0, pi * radius] = (0, {math.pi * r:g}]")
-    if reverse:
-        raise OptionError("reverse=True is not supported yet")
+    if not isinstance(reverse, bool):
+        raise OptionError(f"reverse={reverse!r} must be True or False")
     if max_expansions is None:
         budget = np.iinfo(np.int64).max
     elif isinstance(max_expansions, bool) or not isinstance(max_expansions,

@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit, types
 from numba.typed import Dict
 
-from skyroute.motion.arc_kernels import advance, chain_free, piece_free
+from skyroute.motion.arc_kernels import advance, chain_free, chain_reaches, piece_free
 from skyroute.motion.corner_distance import lower_bound
 from skyroute.motion.dubins_kernel import (
     TURNS,
@@ -95,19 +95,27 @@ def _pop(hf, hn, size):
 
 
 @njit(cache=True)
-def dubins_bound(x, y, th, gx, gy, gth, has_heading, r):
+def dubins_bound(x, y, th, gx, gy, gth, has_heading, r, reverse):
     """The obstacle-free Dubins length to the goal pose, or a lower bound on it to the
-    goal point with any heading."""
+    goal point with any heading. With ``reverse`` (Reeds-Shepp motion) a weaker bound:
+    the path covers the straight distance and turns at least the heading change, at a
+    radius of at least r."""
+    if reverse:
+        d = math.hypot(gx - x, gy - y)
+        if has_heading:
+            turn = abs((gth - th + math.pi) % TWO_PI - math.pi)
+            return max(d, r * turn)
+        return d
     if has_heading:
         return shortest_length(x, y, th, gx, gy, gth, r)
     return free_heading_bound(x, y, th, gx, gy, r)
 
 
 @njit(cache=True)
-def _analytic(x, y, th, g, best, gx, gy, gth, has_heading, r, ref, dth, H, max_words,
-              ed, st, it, x0, y0, cell, nx, ny, eps, clear, stamp, tick):
-    """The shortest free Dubins connection from pose (x, y, th) at cost g that beats
-    ``best``: (total cost or inf, goal heading, word index)."""
+def _analytic(x, y, th, g, scale, best, gx, gy, gth, has_heading, r, ref, dth, H,
+              max_words, ed, st, it, x0, y0, cell, nx, ny, eps, clear, stamp, tick):
+    """The shortest free Dubins connection from pose (x, y, th) whose cost, g + ``scale``
+    times its length, beats ``best``: (that cost or inf, goal heading, word index)."""
     n = 1 if has_heading else 2 + H
     heads = np.empty(n)
     if has_heading:
@@ -132,7 +140,7 @@ def _analytic(x, y, th, g, best, gx, gy, gth, has_heading, r, ref, dth, H, max_w
         order = np.argsort(total)
         for q in range(max_words if has_heading else 1):
             w = order[q]
-            if g + total[w] < best and not math.isinf(total[w]):
+            if g + scale * total[w] < best and not math.isinf(total[w]):
                 cand_len[m] = total[w]
                 cand_head[m] = h
                 cand_word[m] = w
@@ -149,21 +157,27 @@ def _analytic(x, y, th, g, best, gx, gy, gth, has_heading, r, ref, dth, H, max_w
         for p in range(3):
             turns[p] = TURNS[w, p]
             lens[p] = segs[w, p]
-        if chain_free(x, y, th, turns, lens, r, ed, st, it, x0, y0, cell, nx, ny, eps,
-                      clear, stamp, tick):
-            return g + cand_len[c], cand_head[c], w
+        if chain_reaches(x, y, th, turns, lens, r, gx, gy, cand_head[c], 1e-3 * eps) and \
+                chain_free(x, y, th, turns, lens, r, ed, st, it, x0, y0, cell, nx, ny, eps,
+                           clear, stamp, tick):
+            return g + scale * cand_len[c], cand_head[c], w
     return math.inf, 0.0, -1
 
 
 @njit(cache=True)
 def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth, H, cell,
            region, ed, st, it, x0, y0, bcell, nx, ny, eps, clear, corners, cdist,
-           sight_edges, sight_tests, weight, max_expansions, every, max_words):
+           sight_edges, sight_tests, weight, max_expansions, every, max_words, reverse,
+           back_cost, switch_cost):
     """Hybrid A* from the poses ``seeds`` (S, 3) to the goal.
 
     ``region`` (xmin, ymin, xmax, ymax): nodes outside it are dropped (states are keyed
-    relative to its corner). Returns (status, end node, goal heading, word, best cost,
-    expanded, analytic tries, x, y, th, parent, primitive).
+    relative to its corner). With ``reverse``, primitives with u < 0 drive backwards
+    (their costs in ``prim_c``), each change of direction costs ``switch_cost``, and the
+    analytic expansion also tries Dubins paths driven wholly in reverse (length times
+    ``back_cost``): the forward Dubins path of the vehicle turned round. Returns (status,
+    end node, goal heading, word, analytic path driven backwards, best cost, expanded,
+    analytic tries, x, y, th, parent, primitive).
     """
     cap = 4096
     x = np.empty(cap)
@@ -196,16 +210,17 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
         seen[key] = n
         x[n], y[n], th[n], g[n] = sx, sy, sth, 0.0
         parent[n], prim[n] = -1, -1
-        hd[n] = dubins_bound(sx, sy, sth, gx, gy, gth, has_heading, r)
+        hd[n] = dubins_bound(sx, sy, sth, gx, gy, gth, has_heading, r, reverse)
         d2[n] = math.hypot(gx - sx, gy - sy)
         fq[n] = weight * max(hd[n], d2[n])
         _push(hf, hn, size, fq[n], n)
         size += 1
         n += 1
     best = math.inf
-    end, end_head, end_word = -1, 0.0, -1
+    end, end_head, end_word, end_back = -1, 0.0, -1, False
     expanded = 0
     tries = 0
+    stopped = False
     while size > 0:
         f, i = _pop(hf, hn, size)
         size -= 1
@@ -230,16 +245,27 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
         else:
             sees = _sight(x[i], y[i], gx, gy, sight_edges)
         if expanded >= max_expansions:
+            stopped = True
             break
         closed[i] = True
         expanded += 1
+        came = 0.0 if prim[i] < 0 else prim_u[prim[i]]  # > 0 forward, < 0 backward
         if (sees or expanded % every == 1 or every == 1) and g[i] + hd[i] < best:
             tries += 1
-            c, h, w = _analytic(x[i], y[i], th[i], g[i], best, gx, gy, gth, has_heading,
-                                r, ref, dth, H, max_words, ed, st, it, x0, y0, bcell, nx,
-                                ny, eps, clear, stamp, tick)
+            extra = switch_cost if came < 0 else 0.0
+            c, h, w = _analytic(x[i], y[i], th[i], g[i] + extra, 1.0, best, gx, gy, gth,
+                                has_heading, r, ref, dth, H, max_words, ed, st, it, x0, y0,
+                                bcell, nx, ny, eps, clear, stamp, tick)
             if c < best:
-                best, end, end_head, end_word = c, i, h, w
+                best, end, end_head, end_word, end_back = c, i, h, w, False
+            if reverse:
+                extra = switch_cost if came > 0 else 0.0
+                c, h, w = _analytic(x[i], y[i], th[i] + math.pi, g[i] + extra, back_cost,
+                                    best, gx, gy, gth + math.pi, has_heading, r,
+                                    ref + math.pi, dth, H, max_words, ed, st, it, x0, y0,
+                                    bcell, nx, ny, eps, clear, stamp, tick)
+                if c < best:
+                    best, end, end_head, end_word, end_back = c, i, h, w, True
         for p in range(prim_k.shape[0]):
             k, u = prim_k[p], prim_u[p]
             if not piece_free(x[i], y[i], th[i], k, u, r, ed, st, it, x0, y0, bcell, nx,
@@ -250,6 +276,8 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
                 continue
             qth = qth % TWO_PI
             gq = g[i] + prim_c[p]
+            if came * u < 0:
+                gq += switch_cost
             b = np.int64(round((qth - ref) / dth)) % H
             key = ((np.int64(math.floor((qx - region[0]) / cell)) * ny_cells +
                     np.int64(math.floor((qy - region[1]) / cell))) * H + b)
@@ -274,7 +302,7 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
                 seen[key] = j
             x[j], y[j], th[j], g[j] = qx, qy, qth, gq
             parent[j], prim[j] = i, p
-            hd[j] = dubins_bound(qx, qy, qth, gx, gy, gth, has_heading, r)
+            hd[j] = dubins_bound(qx, qy, qth, gx, gy, gth, has_heading, r, reverse)
             d2[j] = max(math.hypot(gx - qx, gy - qy), d2[i] - abs(u))
             exact[j] = False
             fq[j] = gq + weight * max(hd[j], d2[j])
@@ -286,9 +314,9 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
             size += 1
     if end >= 0:
         status = FOUND
-    elif expanded >= max_expansions:
+    elif stopped:
         status = BUDGET_EXHAUSTED
     else:
         status = NO_PATH
-    return (status, end, end_head, end_word, best, expanded, tries, x[:n], y[:n], th[:n],
-            parent[:n], prim[:n])
+    return (status, end, end_head, end_word, end_back, best, expanded, tries, x[:n], y[:n],
+            th[:n], parent[:n], prim[:n])

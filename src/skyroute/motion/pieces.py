@@ -97,6 +97,23 @@ def chain(start, turns, lengths, radius: float, reverse=None) -> list[Piece]:
     return out
 
 
+_SWAP = {"L": "R", "R": "L", "S": "S"}
+
+
+def turned_round(pieces: list[Piece]) -> list[Piece]:
+    """The same curves driven the other way round: a vehicle whose nose points the other
+    way (heading + pi) covers each piece in the same direction of travel with the
+    reverse flag toggled, and a left turn of one is a right turn of the other."""
+    return [Piece(_SWAP[p.kind], (p.start[0], p.start[1], p.start[2] + math.pi), p.length,
+                  p.radius, not p.reverse) for p in pieces]
+
+
+def time_reversed(pieces: list[Piece]) -> list[Piece]:
+    """The chain run backwards in time: last piece first, each from its end to its start
+    with the nose kept (so forward pieces become reverse ones, and the other way)."""
+    return [Piece(p.kind, p.end, p.length, p.radius, not p.reverse) for p in reversed(pieces)]
+
+
 def merge(pieces: list[Piece]) -> list[Piece]:
     """Consecutive pieces of one kind and direction fused into one (the pose at the join
     is recomputed from the first piece's start, so the chain stays continuous)."""
@@ -118,6 +135,8 @@ def sample(pieces: list[Piece], step: float, start, goal=None) -> np.ndarray:
     for p in pieces:
         n = max(1, math.ceil(p.length / step - 1e-12))
         rows.append(p.poses(np.linspace(0.0, p.length, n + 1)[1:]))
+    if goal is not None and not pieces and tuple(goal) != tuple(start):
+        rows.append(np.array([goal], dtype=float))  # start and goal within rounding
     out = np.vstack(rows)
     out[0] = start
     if goal is not None:
