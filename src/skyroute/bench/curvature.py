@@ -1,0 +1,208 @@
+"""Turning-radius planning against OMPL: skyroute's Hybrid A* vs RRT* and BIT* in OMPL's
+DubinsStateSpace, on seeded random worlds.
+
+Each world is 100 m x 100 m inside a boundary, with 20 axis-aligned and 5 rotated
+rectangles (sides 5-20 m); each query joins two free poses at least 60 m apart with a
+free 2D path between them (random headings). Every path of every planner is re-checked
+with the exact arc test (:func:`skyroute.motion.hybrid.path_free`): OMPL checks states
+along its Dubins curves at a resolution, with a Python callback on the prepared union
+of the obstacles, so its paths may clip corners; between two of its states the motion
+is the shortest Dubins path, which is what is checked. Lengths are also given as ratios
+to a lower bound: max(free-space Dubins length, exact 2D shortest path).
+
+OMPL is PyPI ``ompl`` (a bench extra); without it only skyroute's rows are made.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+import shapely
+from shapely import affinity
+
+from skyroute.world.world import World
+
+
+def curvature_world(seed: int, *, size: float = 100.0, axis_aligned: int = 20,
+                    rotated: int = 5) -> World:
+    """Seeded world: ``axis_aligned`` + ``rotated`` rectangles, sides 5-20 % of ``size``,
+    in a square boundary."""
+    rng = np.random.default_rng(seed)
+    lo = rng.uniform(0, size * 0.9, size=(axis_aligned, 2))
+    wh = rng.uniform(size * 0.05, size * 0.2, size=(axis_aligned, 2))
+    hi = np.minimum(lo + wh, size)
+    boxes = list(shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1]))
+    for _ in range(rotated):
+        c = rng.uniform(0, size, 2)
+        w, h = rng.uniform(size * 0.05, size * 0.2, 2)
+        box = shapely.box(c[0] - w / 2, c[1] - h / 2, c[0] + w / 2, c[1] + h / 2)
+        boxes.append(affinity.rotate(box, rng.uniform(0, 180), origin="centroid"))
+    n = len(boxes)
+    return World(np.array(boxes, dtype=object), np.full(n, -np.inf), np.full(n, np.inf), (),
+                 shapely.box(0, 0, size, size), "metres", name=f"curvature-{seed}")
+
+
+def query_poses(world: World, rng: np.random.Generator, min_dist: float = 60.0) -> tuple:
+    """Start and goal poses: free points ``min_dist`` apart, joined by a free 2D path."""
+    from skyroute.bench.world import free_pair
+
+    a, b = free_pair(world, rng, min_dist)
+    h = rng.uniform(-math.pi, math.pi, 2)
+    return (float(a[0]), float(a[1]), float(h[0])), (float(b[0]), float(b[1]), float(h[1]))
+
+
+def lower_bound(world: World, start, goal, radius: float) -> float:
+    """max(free-space Dubins length, exact 2D shortest path)."""
+    from skyroute.motion.dubins import shortest_path
+    from skyroute.planner import plan
+
+    d2 = plan(world, start[:2], goal[:2])
+    return max(shortest_path(start, goal, radius).length, d2.cost if d2.found else math.inf)
+
+
+def dubins_chain_free(world: World, states: np.ndarray, radius: float) -> bool:
+    """The shortest Dubins paths between consecutive poses, exactly free."""
+    from skyroute.motion.hybrid import path_free
+    from skyroute.motion.smooth import dubins_pieces
+
+    pieces = []
+    for a, b in itertools.pairwise(states):
+        pieces += dubins_pieces(tuple(a), tuple(b), radius)
+    return path_free(world, pieces)
+
+
+def run_skyroute(world: World, start, goal, radius: float) -> dict:
+    """Hybrid A* on a fresh copy of ``world`` (edge buckets and corner table built and
+    timed), then again on the same world (those reused)."""
+    from skyroute.motion.hybrid import path_free, plan
+
+    fresh = World(world.obstacles, world.floors, world.ceilings, world.names,
+                  world.boundary, world.frame, world.home, world.name)
+    t0 = time.perf_counter()
+    r = plan(fresh, start, goal, radius)
+    cold = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    r = plan(fresh, start, goal, radius)
+    warm = time.perf_counter() - t0
+    return {"runner": "skyroute hybrid", "budget": None, "seconds": warm,
+            "cold_seconds": cold, "found": r.found, "length": r.length if r.found else None,
+            "raw_length": r.extra.get("raw_length"), "expanded": r.expanded,
+            "valid": path_free(world, r.segments) if r.found else None,
+            "status": r.status.value}
+
+
+def run_ompl(world: World, start, goal, radius: float, planner: str,
+             budget: float) -> dict:
+    """One OMPL solve in a DubinsStateSpace: time, exact solution or not, raw and
+    simplified lengths, and exact validity of both paths."""
+    from ompl import base as ob
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    ou.setLogLevel(ou.LOG_NONE)
+    union = shapely.unary_union(world.obstacles)
+    shapely.prepare(union)
+    inside = shapely.Polygon(world.boundary)
+    shapely.prepare(inside)
+    xmin, ymin, xmax, ymax = world.bounds
+    space = ob.DubinsStateSpace(radius)
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0, xmin)
+    bounds.setLow(1, ymin)
+    bounds.setHigh(0, xmax)
+    bounds.setHigh(1, ymax)
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+
+    def valid(state) -> bool:
+        x, y = state.getX(), state.getY()
+        return bool(shapely.contains_xy(inside, x, y)) and not shapely.contains_xy(union, x, y)
+
+    ss.setStateValidityChecker(valid)
+    s, g = space.allocState(), space.allocState()
+    s.setX(start[0]), s.setY(start[1]), s.setYaw(start[2])
+    g.setX(goal[0]), g.setY(goal[1]), g.setYaw(goal[2])
+    ss.setStartAndGoalStates(s, g)
+    ss.setPlanner(getattr(og, planner)(ss.getSpaceInformation()))
+    t0 = time.perf_counter()
+    status = ss.solve(budget)
+    seconds = time.perf_counter() - t0
+    row = {"runner": f"ompl {planner}", "budget": budget, "seconds": seconds,
+           "found": str(status) == "Exact solution" and ss.haveExactSolutionPath()}
+    if not row["found"]:
+        return {**row, "length": None, "valid": None, "simplified": None,
+                "simplified_valid": None}
+
+    def states():
+        p = ss.getSolutionPath()
+        return p.length(), np.array([(p.getState(i).getX(), p.getState(i).getY(),
+                                      p.getState(i).getYaw())
+                                     for i in range(p.getStateCount())])
+
+    length, pts = states()
+    row.update(length=length, valid=dubins_chain_free(world, pts, radius))
+    ss.simplifySolution()
+    slength, spts = states()
+    row.update(simplified=slength, simplified_valid=dubins_chain_free(world, spts, radius))
+    return row
+
+
+def curvature_benchmark(worlds: int = 10, seed: int = 0, budgets: tuple = (1.0, 5.0), *,
+                        planners: tuple = ("RRTstar", "BITstar"), radius: float = 5.0,
+                        on_step: Callable[[dict], None] | None = None) -> list[dict]:
+    """One query per seeded world; one row per planner run (``world``, ``runner``,
+    ``budget``, ``seconds``, ``found``, ``length``, ``valid``, ``ratio`` to the lower
+    bound, ...). ``on_step`` is called with each row as it is made."""
+    from skyroute.bench.world import ompl_available
+
+    rows = []
+    for w in range(worlds):
+        world = curvature_world(seed + w)
+        rng = np.random.default_rng([seed, w])
+        start, goal = query_poses(world, rng)
+        bound = lower_bound(world, start, goal, radius)
+        runs = [(run_skyroute, ())]
+        if ompl_available():
+            runs += [(run_ompl, (p, b)) for b in budgets for p in planners]
+        for run, extra in runs:
+            row = {"world": world.name, "start": start, "goal": goal, "bound": bound,
+                   **run(world, start, goal, radius, *extra)}
+            row["ratio"] = row["length"] / bound if row["length"] is not None else None
+            rows.append(row)
+            if on_step:
+                on_step(row)
+    return rows
+
+
+def summary(rows: list[dict]) -> dict:
+    """Per runner and budget: solved, exactly valid, median length ratio; skyroute's
+    median and p95 times; how often skyroute is no longer than RRT* at the largest
+    budget, and its worst length ratio to it."""
+    out: dict = {}
+    for key in sorted({(r["runner"], r["budget"] or 0) for r in rows}):
+        sel = [r for r in rows if (r["runner"], r["budget"] or 0) == key]
+        found = [r for r in sel if r["found"]]
+        out[f"{key[0]} @ {key[1]:g}s" if key[1] else key[0]] = {
+            "queries": len(sel), "found": len(found),
+            "valid": sum(bool(r["valid"]) for r in found),
+            "median_ratio": float(np.median([r["ratio"] for r in found])) if found else None,
+            "median_ms": float(np.median([r["seconds"] for r in sel]) * 1e3),
+            "p95_ms": float(np.percentile([r["seconds"] for r in sel], 95) * 1e3),
+        }
+    ours = {r["world"]: r for r in rows if r["runner"] == "skyroute hybrid"}
+    top = max((r["budget"] for r in rows if r["budget"]), default=None)
+    if top is not None:
+        for name in sorted({r["runner"] for r in rows if r["budget"]}):
+            peer = {r["world"]: r for r in rows if r["runner"] == name and r["budget"] == top}
+            both = [w for w in ours if ours[w]["found"] and w in peer and peer[w]["found"]]
+            ratios = [ours[w]["length"] / peer[w]["length"] for w in both]
+            out[f"skyroute vs {name} @ {top:g}s"] = {
+                "peer_solved_we_missed": sum(1 for w in peer if peer[w]["found"] and
+                                             not ours[w]["found"]),
+                "no_longer": sum(x <= 1.0 + 1e-9 for x in ratios), "compared": len(both),
+                "worst_ratio": max(ratios) if ratios else None}
+    return out

@@ -1,0 +1,167 @@
+"""Dubins words for one query, compiled: what a search calls per node.
+
+:mod:`skyroute.motion.dubins` evaluates the six words in numpy for many queries and
+:func:`~skyroute.motion.dubins.lengths` compiles only the shortest length. A search that
+tries analytic expansions needs the words themselves (which word, its three piece
+lengths) for one query at a time without leaving compiled code: :func:`words` gives all
+six, the same closed forms and the same angle snapping as :func:`dubins._words` (tested
+equal), and :func:`free_heading_bound` a lower bound on the shortest path to a point
+when the arrival heading is free.
+
+Word k's letters are ``WORDS[k]``; as numbers, ``TURNS[k]`` holds +1 (left), 0
+(straight), -1 (right) per piece.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from skyroute.motion.dubins import WORDS, _m2p
+
+TWO_PI = 2 * math.pi
+TURNS = np.array([[1 if c == "L" else -1 if c == "R" else 0 for c in w] for w in WORDS],
+                 dtype=np.int64)
+
+
+@njit(cache=True)
+def words(sx, sy, sth, gx, gy, gth, r):
+    """(6, 3) piece lengths in metres of the six words from (sx, sy, sth) to
+    (gx, gy, gth), NaN rows where a word does not exist, and (6,) their totals (inf)."""
+    out = np.full((6, 3), np.nan)
+    total = np.full(6, np.inf)
+    dx, dy = gx - sx, gy - sy
+    d = math.sqrt(dx * dx + dy * dy) / r
+    phi = math.atan2(dy, dx)
+    a = _m2p(sth - phi)
+    b = _m2p(gth - phi)
+    sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
+    cab = math.cos(a - b)
+    dd = d * d
+    p2 = 2 + dd - 2 * cab + 2 * d * (sa - sb)  # LSL
+    if p2 >= 0:
+        tmp = math.atan2(cb - ca, d + sa - sb)
+        out[0, 0], out[0, 1], out[0, 2] = _m2p(-a + tmp), math.sqrt(p2), _m2p(b - tmp)
+    p2 = 2 + dd - 2 * cab + 2 * d * (sb - sa)  # RSR
+    if p2 >= 0:
+        tmp = math.atan2(ca - cb, d - sa + sb)
+        out[1, 0], out[1, 1], out[1, 2] = _m2p(a - tmp), math.sqrt(p2), _m2p(-b + tmp)
+    p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
+    if p2 >= 0:
+        p = math.sqrt(p2)
+        tmp = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
+        out[2, 0], out[2, 1], out[2, 2] = _m2p(-a + tmp), p, _m2p(-_m2p(b) + tmp)
+    p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
+    if p2 >= 0:
+        p = math.sqrt(p2)
+        tmp = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
+        out[3, 0], out[3, 1], out[3, 2] = _m2p(a - tmp), p, _m2p(b - tmp)
+    c = (6.0 - dd + 2 * cab + 2 * d * (sa - sb)) / 8.0  # RLR
+    if abs(c) <= 1:
+        p = _m2p(TWO_PI - math.acos(c))
+        t = _m2p(a - math.atan2(ca - cb, d - sa + sb) + p / 2)
+        out[4, 0], out[4, 1], out[4, 2] = t, p, _m2p(a - b - t + p)
+    c = (6.0 - dd + 2 * cab + 2 * d * (sb - sa)) / 8.0  # LRL
+    if abs(c) <= 1:
+        p = _m2p(TWO_PI - math.acos(c))
+        t = _m2p(-a - math.atan2(ca - cb, d + sa - sb) + p / 2)
+        out[5, 0], out[5, 1], out[5, 2] = t, p, _m2p(_m2p(b) - a - t + p)
+    for k in range(6):
+        if not math.isnan(out[k, 0]):
+            for j in range(3):
+                out[k, j] *= r
+            total[k] = out[k, 0] + out[k, 1] + out[k, 2]
+    return out, total
+
+
+@njit(cache=True)
+def shortest_length(sx, sy, sth, gx, gy, gth, r):
+    """Length of the shortest Dubins path (metres): :func:`words` without its arrays
+    (the search calls this for every node it generates)."""
+    dx, dy = gx - sx, gy - sy
+    d = math.sqrt(dx * dx + dy * dy) / r
+    phi = math.atan2(dy, dx)
+    a = _m2p(sth - phi)
+    b = _m2p(gth - phi)
+    sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
+    cab = math.cos(a - b)
+    dd = d * d
+    t_lsl = math.atan2(cb - ca, d + sa - sb)
+    t_rsr = math.atan2(ca - cb, d - sa + sb)
+    best = math.inf
+    p2 = 2 + dd - 2 * cab + 2 * d * (sa - sb)  # LSL
+    if p2 >= 0:
+        best = min(best, _m2p(t_lsl - a) + math.sqrt(p2) + _m2p(b - t_lsl))
+    p2 = 2 + dd - 2 * cab + 2 * d * (sb - sa)  # RSR
+    if p2 >= 0:
+        best = min(best, _m2p(a - t_rsr) + math.sqrt(p2) + _m2p(t_rsr - b))
+    p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
+    if p2 >= 0:
+        p = math.sqrt(p2)
+        tmp = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
+        best = min(best, _m2p(tmp - a) + p + _m2p(tmp - _m2p(b)))
+    p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
+    if p2 >= 0:
+        p = math.sqrt(p2)
+        tmp = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
+        best = min(best, _m2p(a - tmp) + p + _m2p(b - tmp))
+    c = (6.0 - dd + 2 * cab + 2 * d * (sa - sb)) / 8.0  # RLR
+    if abs(c) <= 1:
+        p = _m2p(TWO_PI - math.acos(c))
+        t = _m2p(a - t_rsr + p / 2)
+        best = min(best, t + p + _m2p(a - b - t + p))
+    c = (6.0 - dd + 2 * cab + 2 * d * (sb - sa)) / 8.0  # LRL
+    if abs(c) <= 1:
+        p = _m2p(TWO_PI - math.acos(c))
+        t = _m2p(-a + t_lsl + p / 2)
+        best = min(best, t + p + _m2p(_m2p(b) - a - t + p))
+    return best * r
+
+
+@njit(cache=True)
+def tangent_heading(sx, sy, sth, gx, gy, r, side):
+    """Arrival heading at point g of the path that turns ``side`` (+1 left, -1 right) on
+    its start circle, then leaves it on the tangent through g; NaN when g lies strictly
+    inside that circle."""
+    cx = sx - side * r * math.sin(sth)
+    cy = sy + side * r * math.cos(sth)
+    dx, dy = gx - cx, gy - cy
+    d = math.hypot(dx, dy)
+    if d < r:
+        return math.nan
+    phi = math.atan2(dy, dx)
+    alpha = math.acos(min(1.0, r / d))
+    return phi - side * alpha + side * math.pi / 2
+
+
+@njit(cache=True)
+def tangent_length(sx, sy, sth, gx, gy, r, side):
+    """Length of the turn-then-straight path of :func:`tangent_heading` (inf when g lies
+    strictly inside the circle)."""
+    cx = sx - side * r * math.sin(sth)
+    cy = sy + side * r * math.cos(sth)
+    dx, dy = gx - cx, gy - cy
+    d = math.hypot(dx, dy)
+    if d < r:
+        return math.inf
+    h = tangent_heading(sx, sy, sth, gx, gy, r, side)
+    turn = _m2p(side * (h - sth))  # anticlockwise for a left turn
+    return turn * r + math.sqrt(max(0.0, d * d - r * r))
+
+
+@njit(cache=True)
+def free_heading_bound(sx, sy, sth, gx, gy, r):
+    """A lower bound on the shortest path from pose s to point g, any arrival heading.
+
+    When g lies outside both turning circles the shortest such path turns on one of them
+    and leaves on the tangent through g (Bui, Soueres, Boissonnat & Laumond 1994): the
+    smaller of the two tangent paths, exactly. Inside a circle: the straight distance.
+    """
+    e = math.hypot(gx - sx, gy - sy)
+    left = tangent_length(sx, sy, sth, gx, gy, r, 1)
+    right = tangent_length(sx, sy, sth, gx, gy, r, -1)
+    if math.isinf(left) or math.isinf(right):
+        return e
+    return max(e, min(left, right))

@@ -1,0 +1,442 @@
+"""Hybrid A* (Dolgov, Thrun, Montemerlo & Diebel 2010) for vehicles that drive forward
+and turn no tighter than a radius, among polygon obstacles.
+
+>>> import numpy as np, shapely
+>>> from skyroute.world.world import World
+>>> wall = np.array([shapely.box(45, 0, 55, 60)], dtype=object)
+>>> world = World(wall, [-np.inf], [np.inf], ("wall",), boundary=shapely.box(0, 0, 100, 100))
+>>> r = plan(world, (20, 20, 0.0), (80, 20, 0.0), radius=5)
+>>> r.status.value, r.length > 60, bool(np.allclose(r.sample(1.0)[-1], (80, 20, 0)))
+('found', True, True)
+
+The search runs on a continuous lattice: nodes keep their exact pose, states are
+(cell, heading bin); each expansion drives a left arc, a straight and a right arc of
+``step`` metres (:mod:`skyroute.motion.hybrid_search`, compiled). Every arc and straight
+is tested exactly against the obstacles' and the boundary's edges
+(:mod:`skyroute.motion.arc_kernels`); the path ends with an analytic Dubins expansion
+and is then shortcut (:mod:`skyroute.motion.smooth`).
+
+Choices, and why (measured on the curvature benchmark's worlds, :mod:`skyroute.bench.
+curvature`; numbers in docs/architecture.md):
+
+- ``step``: by default the arc that turns 20 degrees (r pi / 9, 1.75 m for r = 5),
+  rounded to whole heading bins so lattice headings stay exact multiples of the bin
+  width from the start heading. Turns of 15 degrees gave the same smoothed lengths (mean
+  within 0.1 %) at up to twice the time on hard queries; 30 degrees was faster still
+  but 1.5 % longer on average, with some detours.
+- Cell size ``step / sqrt(2)``: a straight primitive always leaves its cell (an arc's
+  chord nearly always), so an expansion does not land back in its own state.
+- Heuristic max(Dubins length ignoring obstacles, 2D distance around the obstacles),
+  both lower bounds. The 2D term comes from a per-goal table of every convex corner's
+  exact shortest distance to the goal (:mod:`skyroute.motion.corner_distance`: the
+  corners' bitangent visibility graph once per world, a compiled Dijkstra per goal in
+  well under a millisecond) and, per node, the cheapest corners it sees; after 3 blocked
+  candidates the next candidate's value is taken, still a bound. Evaluated lazily: a new
+  node gets max(|q - goal|, parent's bound - step) and the exact value only when popped.
+  No raster: a grid distance field stays a lower bound only after losing a cell
+  diagonal and the 8-neighbour metric's 8 %, and needs a raster per goal.
+- Analytic expansion (the shortest of up to 3 Dubins words that fits) from every node
+  that sees the goal and every 10th node, when it can still beat the best path found;
+  the search runs on until no open node can (f >= best), then the path is shortcut.
+- Time reversal first: a path driven backwards is a forward path from the goal turned
+  round to the start turned round, so a short (500-expansion) search that way ends at
+  once when the goal cannot be reached (say, facing the boundary), and when it finishes
+  its path is the answer; otherwise the forward search runs.
+- A start without heading seeds every heading bin, measured from the direction towards
+  the goal (so driving straight at it is one), and first the two headings that reach a
+  goal circle on a tangent; a goal without heading is reached by the turn-then-tangent
+  Dubins paths (every heading bin when it lies inside a turning circle).
+- Without a boundary, states are kept within the bounding box of the obstacles, start
+  and goal grown by 4 r + 2 step, so an enclosed goal ends in ``no_path``.
+- ``reverse=True`` keeps all of the above with six primitives and the cusp-free
+  Reeds-Shepp words (forward or backward Dubins paths); the full 48-word Reeds-Shepp
+  family (paths with cusps inside the analytic expansion) is not implemented, so
+  manoeuvres with cusps come from the lattice and its shortcutting.
+- ``no_path`` means no path on this lattice (Hybrid A* is resolution-complete only in
+  the limit): every state reachable by the primitives was expanded.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import numbers
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from skyroute.errors import OptionError, QueryError
+from skyroute.motion import hybrid_search
+from skyroute.motion.arc_kernels import chain_free, edge_index
+from skyroute.motion.corner_distance import corner_graph
+from skyroute.motion.dubins_kernel import TURNS, tangent_heading, words
+from skyroute.motion.pieces import Piece, chain, merge, sample, time_reversed, turned_round
+from skyroute.motion.smooth import length, shortcut
+from skyroute.search.result import FOUND, NO_PATH, STATUS_OF_CODE, Status
+from skyroute.world.world import World
+
+Pose = tuple[float, float, float]
+_EVERY, _WORDS = 10, 3  # analytic expansion: every 10th node; 3 words
+_SIGHT_TESTS = 3  # corners tried per node by the 2D bound
+_WEIGHT = 1.0  # f = g + weight h; 1 keeps the search best-first on the true bound
+_REVERSE_BUDGET = 500  # expansions of the reversed search that comes first
+_BACK_COST = 1.0  # reverse=True: a metre driven backwards costs as much as one forwards
+_SWITCH = 1.0  # reverse=True: each change of direction costs this many turning radii
+
+
+@dataclass(frozen=True)
+class HybridResult:
+    """A planned path of arcs and straights, its status and statistics.
+
+    ``segments`` are :class:`~skyroute.motion.pieces.Piece` objects laid end to end
+    (empty unless found); ``length`` their total (inf unless found); ``start`` and
+    ``goal`` the poses the path joins (the goal heading is the arrival heading when none
+    was asked for); ``expanded`` nodes expanded; ``seconds`` wall time of the planning.
+    ``extra``: ``raw_length`` before shortcutting, analytic ``tries``, ``shortcut_tries``.
+    """
+
+    status: Status
+    length: float
+    segments: tuple[Piece, ...]
+    start: Pose
+    goal: Pose
+    radius: float
+    expanded: int = 0
+    seconds: float = 0.0
+    extra: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def found(self) -> bool:
+        """True when a path was found."""
+        return self.status is Status.FOUND
+
+    def sample(self, step: float) -> np.ndarray:
+        """(K, 3) poses (x, y, heading in [0, 2 pi)) every ``step`` metres along each
+        piece and at every joint; the first row is exactly ``start`` and the last exactly
+        ``goal``. Empty unless found."""
+        if not (isinstance(step, numbers.Real) and math.isfinite(step) and step > 0):
+            raise OptionError(f"step={step!r} must be a positive number")
+        if not self.found:
+            return np.empty((0, 3))
+        return sample(list(self.segments), float(step), self.start, self.goal)
+
+
+def runway_goal(threshold, runway_heading: float, approach_length: float) -> tuple[Pose,
+                                                                                  Piece]:
+    """The pose where a straight final approach of ``approach_length`` metres begins, and
+    that final piece, which ends on the runway ``threshold`` (x, y) flying
+    ``runway_heading`` (the gate of :func:`skyroute.motion.dubins.runway_approach`)."""
+    tx, ty = _xy(threshold, "threshold")
+    h = float(runway_heading)
+    a = float(approach_length)
+    if not (math.isfinite(h) and math.isfinite(a) and a >= 0):
+        raise OptionError(f"runway_heading={runway_heading!r} and approach_length="
+                          f"{approach_length!r} must be finite, approach_length >= 0")
+    gate = (tx - a * math.cos(h), ty - a * math.sin(h), h)
+    return gate, Piece("S", gate, a, math.inf)
+
+
+def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
+         step: float | None = None, reverse: bool = False,
+         max_expansions: int | None = None, approach: float | None = None,
+         smooth: bool = True, seed: int = 0) -> HybridResult:
+    """A short path of arcs (radius ``radius``) and straights from ``start`` to ``goal``
+    that meets no obstacle interior and stays strictly inside the boundary.
+
+    Parameters
+    ----------
+    world : World
+        Obstacles and boundary in its plane (x, y).
+    start, goal : (x, y) or (x, y, heading)
+        Heading in radians anticlockwise from +x. Without one the planner picks the
+        start heading, or accepts any arrival heading.
+    radius : float
+        Smallest turning radius, > 0.
+    heading_bins : int
+        Heading resolution of the closed set, >= 4.
+    step : float, optional
+        Arc length of one primitive, in (0, pi r]; default r pi / 9 rounded to whole
+        heading bins.
+    reverse : bool
+        Allow driving backwards (a car, not a plane): the lattice gains three reverse
+        primitives, a metre backwards costs as much as one forwards and each change of
+        direction costs one turning radius (``extra["cusps"]`` counts them; ``length``
+        stays the geometric length). The analytic expansion tries Dubins paths driven
+        wholly forwards or wholly backwards, the Reeds-Shepp words without a cusp; cusps
+        come from the lattice. The Dubins heuristic gives way to max(straight distance,
+        r times the heading change), which stays a bound with reversing.
+    max_expansions : int, optional
+        Stop with ``budget_exhausted`` (or with the best path found so far) after this
+        many expansions.
+    approach : float, optional
+        ``goal`` is a runway threshold (x, y, runway heading) and the path ends with a
+        straight final approach this long along the runway (:func:`runway_goal`).
+    smooth : bool
+        Shortcut the path with free Dubins connections.
+    seed : int
+        Seed of the shortcutting's random pairs.
+
+    Returns
+    -------
+    HybridResult
+
+    Raises
+    ------
+    QueryError
+        a malformed pose, or a start or goal inside an obstacle or outside the boundary.
+    OptionError
+        an out-of-range option.
+    """
+    r, H, step, budget = _options(radius, heading_bins, step, reverse, max_expansions, seed)
+    sxy, sth = _pose(start, "start")
+    gxy, gth = _pose(goal, "goal")
+    world.check_point(sxy, "start")
+    final = None
+    if approach is not None:
+        if gth is None:
+            raise QueryError("goal needs a runway heading (x, y, heading) with approach=")
+        if not (isinstance(approach, numbers.Real) and math.isfinite(approach) and
+                approach >= 0):
+            raise OptionError(f"approach={approach!r} must be a number >= 0")
+        threshold = gxy
+        world.check_point(threshold, "goal")
+        gate, final = runway_goal(threshold, gth, approach)
+        gxy = np.array(gate[:2])
+        if approach == 0:
+            final = None
+    world.check_point(gxy, "goal")
+    t0 = time.perf_counter()
+    index = edge_index(world, _bucket(world))
+    if final is not None:
+        ok = _free(index, [Piece("S", final.start, final.length, r)])
+        if not ok:
+            raise QueryError(f"goal: the final approach of {approach:g} m to "
+                             f"({threshold[0]:.2f}, {threshold[1]:.2f}) is not free")
+    lattice = _Lattice(world, index, r, H, step, _region(world, sxy, gxy, 4 * r + 2 * step),
+                       reverse)
+    # Time reversal: a path from start to goal driven backwards is a forward path from
+    # the goal turned round to the start turned round (with reverse gears: a path from
+    # the goal to the start, every piece's direction swapped). A short search that way
+    # first ends at once when the goal is boxed in (facing a wall, or only reachable from
+    # outside the boundary), which the forward search would learn only after exhausting
+    # the whole world; when it finishes it is the answer.
+    first = min(budget, _REVERSE_BUDGET)
+    if reverse:
+        back = lattice.search(gxy, gth, sxy, sth, first)
+    else:
+        back = lattice.search(gxy, _turned(gth), sxy, _turned(sth), first)
+    if back.code == NO_PATH or (back.code == FOUND and back.expanded < first):
+        res, expanded = back.reversed(reverse), back.expanded
+    else:
+        res = lattice.search(sxy, sth, gxy, gth, budget - back.expanded)
+        expanded = back.expanded + res.expanded
+    status = STATUS_OF_CODE[res.code]
+    start_pose = (float(sxy[0]), float(sxy[1]), math.nan if sth is None else float(sth))
+    goal_pose = (float(gxy[0]), float(gxy[1]), math.nan if gth is None else float(gth))
+    if status is not Status.FOUND:
+        return HybridResult(status, math.inf, (), start_pose, goal_pose, r, int(expanded),
+                            time.perf_counter() - t0, {"tries": back.tries + res.tries})
+    pieces = res.pieces
+    if pieces:  # exactly the given start (a reversed search ends there within rounding)
+        head = pieces[0].start[2] if sth is None else sth
+        start_pose = (float(sxy[0]), float(sxy[1]), float(head))
+        pieces[0] = Piece(pieces[0].kind, start_pose, pieces[0].length, r, pieces[0].reverse)
+        goal_pose = (float(gxy[0]), float(gxy[1]), float(res.goal[2] if gth is None else gth))
+    else:
+        head = sth if sth is not None else (gth if gth is not None else 0.0)
+        start_pose = (float(sxy[0]), float(sxy[1]), float(head))
+        goal_pose = (float(gxy[0]), float(gxy[1]), float(head))
+    raw = length(pieces)
+    shortcut_tries = 0
+    if smooth:
+        pieces, shortcut_tries = shortcut(pieces, r, index, seed=seed, reverse=reverse,
+                                          back_cost=_BACK_COST, switch_cost=_SWITCH * r)
+        pieces = merge(pieces)
+    if final is not None:
+        pieces.append(Piece("S", goal_pose, final.length, r))
+        goal_pose = (float(threshold[0]), float(threshold[1]), goal_pose[2])
+    return HybridResult(Status.FOUND, length(pieces), tuple(pieces), start_pose, goal_pose,
+                        r, int(expanded), time.perf_counter() - t0,
+                        {"raw_length": raw + (final.length if final else 0.0),
+                         "tries": back.tries + res.tries, "shortcut_tries": shortcut_tries,
+                         "reversed": res.flipped,
+                         "cusps": sum(a.reverse != b.reverse
+                                      for a, b in itertools.pairwise(pieces))})
+
+
+@dataclass
+class _Found:
+    """One direction's outcome: kernel code, expansions, analytic tries, and the pieces
+    and goal pose when found."""
+
+    code: int
+    expanded: int
+    tries: int
+    pieces: list = field(default_factory=list)
+    goal: Pose | None = None
+    flipped: bool = False
+
+    def reversed(self, gears: bool) -> _Found:
+        """The path run backwards in time: with reverse ``gears``, each piece driven the
+        other way; without, also turned round (forward again, L and R swapped)."""
+        if self.code != FOUND:
+            return _Found(self.code, self.expanded, self.tries)
+        out = time_reversed(self.pieces)
+        start = self.pieces[0].start if self.pieces else self.goal
+        if not gears:
+            out = turned_round(out)
+            start = (start[0], start[1], start[2] + math.pi)
+        return _Found(self.code, self.expanded, self.tries, out, start, True)
+
+
+class _Lattice:
+    """The search's fixed inputs for one query: edges, lattice sizes, region."""
+
+    def __init__(self, world, index, r, H, step, region, reverse):
+        self.world, self.index, self.r, self.H, self.step = world, index, r, H, step
+        self.region = np.array(region, dtype=float)
+        self.graph = corner_graph(world)
+        self.reverse = reverse
+        n = 6 if reverse else 3
+        self.k = np.array([1, 0, -1, 1, 0, -1][:n], np.int64)  # left, straight, right
+        self.u = np.array([1.0, 1.0, 1.0, -1.0, -1.0, -1.0][:n]) * step  # > 0 forward
+        self.c = np.abs(self.u) * np.where(self.u < 0, _BACK_COST, 1.0)
+
+    def search(self, sxy, sth, gxy, gth, budget) -> _Found:
+        r, H, step = self.r, self.H, self.step
+        dth = 2 * math.pi / H
+        ref = sth if sth is not None else (
+            math.atan2(gxy[1] - sxy[1], gxy[0] - sxy[0]) if np.any(gxy != sxy) else 0.0)
+        if sth is not None:
+            seeds = np.array([[sxy[0], sxy[1], sth]])
+        else:
+            heads = ref + np.arange(H) * dth
+            if gth is not None:  # first the headings that leave straight on a tangent
+                # of a goal circle: the best ones without obstacles (time-reversed
+                # turn-then-tangent paths from the goal turned round)
+                tang = [tangent_heading(gxy[0], gxy[1], gth + math.pi, sxy[0], sxy[1], r,
+                                        side) + math.pi for side in (1, -1)]
+                heads = np.r_[[h for h in tang if math.isfinite(h)], heads]
+            seeds = np.c_[np.tile(sxy, (len(heads), 1)), heads]
+        g = self.graph
+        code, end, end_head, end_word, end_back, _, expanded, tries, x, y, th, parent, prim = \
+            hybrid_search.search(
+                seeds, float(gxy[0]), float(gxy[1]), 0.0 if gth is None else float(gth),
+                gth is not None, r, self.k, self.u, self.c, float(ref), dth, H,
+                step / math.sqrt(2), self.region, *self.index.args(), g.corners,
+                g.to(gxy), g.edges, _SIGHT_TESTS, _WEIGHT, budget, _EVERY, _WORDS,
+                self.reverse, _BACK_COST, _SWITCH * r)
+        if code != FOUND:
+            return _Found(int(code), int(expanded), int(tries))
+        nodes = [end]
+        while parent[nodes[-1]] >= 0:
+            nodes.append(parent[nodes[-1]])
+        nodes.reverse()
+        start_pose = (float(sxy[0]), float(sxy[1]), float(th[nodes[0]]))
+        head = end_head - (math.pi if end_back else 0.0)
+        goal_pose = (float(gxy[0]), float(gxy[1]), float(head if gth is None else gth))
+        turns = [int(self.k[prim[n]]) for n in nodes[1:]]
+        back = [bool(self.u[prim[n]] < 0) for n in nodes[1:]]
+        node_end = (float(x[end]), float(y[end]), float(th[end]))
+        if end_back:  # the forward Dubins path of the vehicle turned round, in reverse
+            a = (node_end[0], node_end[1], node_end[2] + math.pi)
+            b = (goal_pose[0], goal_pose[1], goal_pose[2] + math.pi)
+            segs, _ = words(*a, *b, r)
+            last = turned_round(chain(a, TURNS[end_word], segs[end_word], r))
+        else:
+            segs, _ = words(*node_end, *goal_pose, r)
+            last = chain(node_end, TURNS[end_word], segs[end_word], r)
+        pieces = merge(chain(start_pose, turns, [step] * len(turns), r, back) + last)
+        return _Found(int(code), int(expanded), int(tries), pieces, goal_pose)
+
+
+def path_free(world: World, pieces) -> bool:
+    """True when the chain of pieces passes the exact test on ``world`` (the test the
+    planner uses: more than 1e-9 of the extent from every obstacle and boundary edge)."""
+    return _free(edge_index(world, _bucket(world)), list(pieces))
+
+
+def _free(index, pieces: list[Piece]) -> bool:
+    if not pieces:
+        return True
+    stamp = np.zeros(len(index.edges), np.int64)
+    tick = np.zeros(1, np.int64)
+    for p in pieces:
+        turns = np.array([p.k], np.int64)
+        lens = np.array([p.signed_length])
+        r = p.radius if p.k != 0 else 1.0
+        if not chain_free(*p.start, turns, lens, r, *index.args(), stamp, tick):
+            return False
+    return True
+
+
+def _bucket(world: World) -> float:
+    """Edge buckets: about 64 across the world."""
+    xmin, ymin, xmax, ymax = world.bounds if (world.boundary is not None or
+                                              len(world.obstacles)) else (0, 0, 1, 1)
+    return max(xmax - xmin, ymax - ymin) / 64.0
+
+
+def _turned(h: float | None) -> float | None:
+    return None if h is None else h + math.pi
+
+
+def _region(world: World, s, g, margin: float) -> tuple[float, float, float, float]:
+    if world.boundary is not None:
+        return world.bounds
+    return world.extent_with([s, g], margin=margin) if len(world.obstacles) else (
+        min(s[0], g[0]) - margin, min(s[1], g[1]) - margin,
+        max(s[0], g[0]) + margin, max(s[1], g[1]) + margin)
+
+
+def _options(radius, heading_bins, step, reverse, max_expansions, seed):
+    if isinstance(radius, bool) or not isinstance(radius, numbers.Real) or \
+            not (math.isfinite(radius) and radius > 0):
+        raise OptionError(f"radius={radius!r} must be > 0 and finite")
+    r = float(radius)
+    if isinstance(heading_bins, bool) or not isinstance(heading_bins, numbers.Integral) or \
+            heading_bins < 4:
+        raise OptionError(f"heading_bins={heading_bins!r} must be an integer >= 4")
+    H = int(heading_bins)
+    if step is None:
+        arc = r * 2 * math.pi / H
+        step = arc * max(1, round(H / 18))
+    elif isinstance(step, bool) or not isinstance(step, numbers.Real) or \
+            not (math.isfinite(step) and 0 < step <= math.pi * r):
+        raise OptionError(f"step={step!r} must be in (0, pi * radius] = (0, {math.pi * r:g}]")
+    if not isinstance(reverse, bool):
+        raise OptionError(f"reverse={reverse!r} must be True or False")
+    if max_expansions is None:
+        budget = np.iinfo(np.int64).max
+    elif isinstance(max_expansions, bool) or not isinstance(max_expansions,
+                                                             numbers.Integral) \
+            or max_expansions < 0:
+        raise OptionError(f"max_expansions={max_expansions!r} must be an integer >= 0")
+    else:
+        budget = int(max_expansions)
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
+        raise OptionError(f"seed={seed!r} must be an integer")
+    return r, H, float(step), budget
+
+
+def _pose(p, what: str) -> tuple[np.ndarray, float | None]:
+    """(x, y) array and heading (None when absent) of a start or goal."""
+    try:
+        vals = list(p)
+    except TypeError:
+        raise QueryError(f"{what}={p!r} must be (x, y) or (x, y, heading)") from None
+    if len(vals) not in (2, 3) or not all(
+            isinstance(v, numbers.Real) and not isinstance(v, bool) for v in vals):
+        raise QueryError(f"{what}={p!r} must be (x, y) or (x, y, heading) numbers")
+    if not all(math.isfinite(float(v)) for v in vals):
+        raise QueryError(f"{what}={p!r} must be finite numbers")
+    xy = np.array([float(vals[0]), float(vals[1])])
+    return xy, (float(vals[2]) if len(vals) == 3 else None)
+
+
+def _xy(p, what: str) -> tuple[float, float]:
+    xy, h = _pose(p, what)
+    if h is not None:
+        raise QueryError(f"{what}={p!r} must be (x, y)")
+    return float(xy[0]), float(xy[1])

@@ -1,0 +1,415 @@
+"""Hybrid A* for turning-radius vehicles: exact freedom, curvature, lengths, statuses."""
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+import skyroute
+from skyroute.errors import OptionError, QueryError
+from skyroute.motion import dubins
+from skyroute.motion.arc_kernels import arc_segment_distance, segment_distance
+from skyroute.motion.dubins_kernel import free_heading_bound, words
+from skyroute.motion.hybrid import path_free, plan, runway_goal
+from skyroute.search.result import Status
+from skyroute.world.world import World
+
+R = 5.0
+
+
+def make_world(boxes, boundary=(0, 0, 100, 100)) -> World:
+    obs = np.array([shapely.box(*b) if not isinstance(b, shapely.Geometry) else b
+                    for b in boxes], dtype=object)
+    n = len(obs)
+    return World(obs, np.full(n, -np.inf), np.full(n, np.inf), (),
+                 boundary=shapely.box(*boundary) if boundary else None)
+
+
+def wrap(a):
+    return (np.asarray(a) + math.pi) % (2 * math.pi) - math.pi
+
+
+def check_path(world: World, res, start, goal, radius, *, ds=0.05, reverse=False):
+    """Independent checks of a found path: shapely on dense samples (with the chord's
+    sagitta as tolerance), curvature and direction from consecutive poses, the ends, and
+    the lower bound."""
+    assert res.found
+    poses = res.sample(ds)
+    assert np.allclose(poses[0, :2], start[:2], atol=0, rtol=0)
+    assert np.allclose(poses[-1, :2], goal[:2], atol=0, rtol=0)
+    if len(start) == 3:
+        assert abs(wrap(poses[0, 2] - start[2])) < 1e-12
+    if len(goal) == 3:
+        assert abs(wrap(poses[-1, 2] - goal[2])) < 1e-12
+    # the pieces themselves end at the goal (sample() only pins the last row)
+    end = res.segments[-1].end if res.segments else res.start
+    assert math.dist(end[:2], goal[:2]) < 1e-6
+    if len(goal) == 3:
+        assert abs(wrap(end[2] - goal[2])) < 1e-6
+    assert reverse or not any(p.reverse for p in res.segments)
+    for a, b in zip(res.segments[:-1], res.segments[1:], strict=True):
+        assert math.dist(a.end[:2], b.start[:2]) < 1e-6 and abs(wrap(a.end[2] - b.start[2])) \
+            < 1e-6
+    # free: every sample strictly free, and the polyline (within the sagitta of the arcs)
+    # meets no obstacle shrunk by that sagitta, and stays inside the boundary
+    assert world.is_free(poses[:, :2]).all()
+    sag = radius * (1 - math.cos(ds / (2 * radius))) + 1e-9
+    line = shapely.LineString(poses[:, :2]) if len(poses) > 1 else shapely.Point(poses[0, :2])
+    for ob in world.obstacles:
+        core = ob.buffer(-sag)
+        assert core.is_empty or not line.intersects(core)
+    if world.boundary is not None:
+        assert shapely.Polygon(world.boundary).buffer(sag).contains(line)
+    # curvature <= 1/r and motion along the heading
+    d = np.diff(poses[:, :2], axis=0)
+    chord = np.hypot(*d.T)
+    turn = np.abs(wrap(np.diff(poses[:, 2])))
+    assert np.all(2 * radius * np.sin(turn / 2) <= chord * (1 + 1e-6) + 1e-6)
+    moving = chord > 1e-6  # shorter chords: their direction is rounding noise
+    mid = poses[:-1, 2] + wrap(np.diff(poses[:, 2])) / 2
+    off = np.abs(wrap(np.arctan2(d[:, 1], d[:, 0]) - mid))[moving]
+    backwards = any(p.reverse for p in res.segments)
+    if backwards:  # each chord along the nose or straight behind it
+        assert np.all((off < 1e-6) | (off > math.pi - 1e-6))
+        if any(p.reverse and p.length > 2 * ds for p in res.segments):
+            assert np.any(off > 3)
+    else:
+        assert np.all(off < 1e-6)
+    # at least the lower bound
+    if len(start) == 3 and len(goal) == 3:
+        lb_dubins = max(math.dist(start[:2], goal[:2]),
+                        radius * abs(wrap(goal[2] - start[2]))) if reverse else \
+            dubins.shortest_path(start, goal, radius).length
+    else:
+        lb_dubins = math.dist(start[:2], goal[:2])
+    lb_2d = skyroute.plan(world, start[:2], goal[:2]).cost
+    assert res.length >= max(lb_dubins, lb_2d) - 1e-9
+    assert res.length == pytest.approx(sum(p.length for p in res.segments), abs=1e-9)
+    assert abs(res.length - chord.sum()) < 1e-3 * max(1.0, res.length)
+    assert path_free(world, res.segments)
+
+
+# -- the obstacle-free case is Dubins -----------------------------------------------------
+
+@pytest.mark.parametrize("boundary", [(-500, -500, 500, 500), None])
+@pytest.mark.parametrize("start,goal", [
+    ((0, 0, 0), (40, 0, 0)),
+    ((0, 0, 0), (0, 0, math.pi)),
+    ((3, -7, 1.2), (-20, 31, -2.5)),
+    ((0, 0, math.pi / 2), (5, 0, -math.pi / 2)),
+    ((10, 10, 0.3), (12, 9, 2.9)),
+])
+def test_empty_world_gives_the_dubins_length(boundary, start, goal):
+    world = make_world([], boundary)
+    res = plan(world, start, goal, R)
+    assert res.found
+    assert res.length == pytest.approx(dubins.shortest_path(start, goal, R).length, abs=1e-9)
+    check_path(world, res, start, goal, R)
+
+
+def test_empty_world_free_headings():
+    world = make_world([])
+    res = plan(world, (10, 10), (70, 50), R)  # no headings: the straight line
+    assert res.length == pytest.approx(math.dist((10, 10), (70, 50)), abs=1e-9)
+    res = plan(world, (10, 10, math.pi), (70, 50), R)  # turn, then the tangent
+    assert res.found and res.length == pytest.approx(
+        free_heading_bound(10, 10, math.pi, 70, 50, R), abs=1e-9)
+    check_path(world, res, (10, 10, math.pi), (70, 50), R)
+    res = plan(world, (10, 10), (70, 50, 0.5), R)
+    assert res.found and res.length < dubins.shortest_path((10, 10, 0), (70, 50, 0.5),
+                                                           R).length
+    check_path(world, res, (10, 10), (70, 50, 0.5), R)
+
+
+# -- walls, gaps, dead ends, budgets ------------------------------------------------------
+
+def test_wall_with_a_gap_wider_than_2r_is_passed():
+    world = make_world([(48, 0, 52, 45), (48, 57, 52, 100)])  # gap 12 m > 2 r
+    start, goal = (20, 80, -math.pi / 2), (80, 20, 0.0)
+    res = plan(world, start, goal, R)
+    check_path(world, res, start, goal, R)
+    assert res.length < 1.15 * skyroute.plan(world, start[:2], goal[:2]).cost + 2 * R
+
+
+def test_closed_wall_gives_no_path():
+    world = make_world([(48, 0, 52, 100)])
+    res = plan(world, (20, 50, 0.0), (80, 50, 0.0), R)
+    assert res.status is Status.NO_PATH and not res.found and res.length == math.inf
+    assert res.sample(1.0).shape == (0, 3) and res.segments == ()
+
+
+def test_dead_end_narrower_than_a_turn_gives_no_path():
+    # a corridor 6 m wide (< 2 r) closed at its end; the vehicle faces the closed end
+    world = make_world([(20, 44, 60, 47), (20, 53, 60, 56), (17, 44, 20, 56)])
+    res = plan(world, (40, 50, math.pi), (80, 80, 0.0), R)
+    assert res.status is Status.NO_PATH
+    res = plan(world, (40, 50, 0.0), (80, 80, 0.0), R)  # facing out it leaves
+    check_path(world, res, (40, 50, 0.0), (80, 80, 0.0), R)
+
+
+def test_budget_exhausted_is_its_own_status():
+    world = make_world([(48, 0, 52, 100)])
+    res = plan(world, (20, 50, 0.0), (80, 50, 0.0), R, max_expansions=50)
+    assert res.status is Status.BUDGET_EXHAUSTED and res.expanded == 50 and not res.found
+    free = make_world([(48, 0, 52, 80), (48, 92, 52, 100)])  # the way is round the top
+    start, goal = (20, 20, 0.0), (80, 20, math.pi)
+    res = plan(free, start, goal, R, max_expansions=5)
+    assert res.status is Status.BUDGET_EXHAUSTED and res.expanded == 5
+    res = plan(free, start, goal, R, max_expansions=0)
+    assert res.status is Status.BUDGET_EXHAUSTED and res.expanded == 0
+    check_path(free, plan(free, start, goal, R), start, goal, R)
+
+
+def test_no_boundary_enclosed_goal_is_no_path():
+    ring = shapely.box(30, 30, 70, 70).difference(shapely.box(35, 35, 65, 65))
+    world = make_world([ring], None)
+    res = plan(world, (0, 0, 0.0), (50, 50, 0.0), R)
+    assert res.status is Status.NO_PATH
+
+
+# -- the runway approach ------------------------------------------------------------------
+
+def test_runway_goal_and_final_approach():
+    gate, final = runway_goal((60, 40), math.pi / 2, 20)
+    assert gate == pytest.approx((60, 20, math.pi / 2)) and final.kind == "S"
+    assert final.end == pytest.approx((60, 40, math.pi / 2))
+    world = make_world([])
+    start = (10, 10, 0.0)
+    res = plan(world, start, (60, 40, math.pi / 2), R, approach=20)
+    legs = dubins.runway_approach(start, (60, 40), math.pi / 2, R, final=20)
+    assert legs[-1].start == pytest.approx(gate)
+    assert res.length == pytest.approx(sum(leg.length for leg in legs), abs=1e-9)
+    last = res.segments[-1]
+    assert last.kind == "S" and last.length >= 20 - 1e-9
+    assert res.sample(1.0)[-1] == pytest.approx((60, 40, math.pi / 2))
+    check_path(world, res, start, (60, 40, math.pi / 2), R)
+    blocked = make_world([(55, 25, 65, 30)])
+    with pytest.raises(QueryError, match=r"goal.*final approach"):
+        plan(blocked, start, (60, 40, math.pi / 2), R, approach=20)
+
+
+# -- property: random rectangle worlds ----------------------------------------------------
+
+rects = st.lists(st.tuples(st.floats(0, 90), st.floats(0, 90), st.floats(3, 25),
+                           st.floats(3, 25)), min_size=0, max_size=8)
+pose = st.tuples(st.floats(2, 98), st.floats(2, 98), st.floats(-math.pi, math.pi))
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@given(rects, pose, pose, st.sampled_from([3.0, 5.0, 8.0]), st.booleans(), st.booleans(),
+       st.booleans())
+def test_property_paths_are_free_curvature_bounded_and_not_too_short(
+        boxes, start, goal, radius, start_heading, goal_heading, reverse):
+    world = make_world([(x, y, x + w, y + h) for x, y, w, h in boxes])
+    assume(world.is_free([start[:2], goal[:2]]).all())
+    s = start if start_heading else start[:2]
+    g = goal if goal_heading else goal[:2]
+    res = plan(world, s, g, radius, max_expansions=20_000, reverse=reverse)
+    if res.found:
+        check_path(world, res, s, g, radius, reverse=reverse)
+        assert res.extra["raw_length"] >= res.length - 1e-9  # shortcuts never lengthen
+    else:
+        assert res.status in (Status.NO_PATH, Status.BUDGET_EXHAUSTED)
+
+
+def test_rotated_obstacles_and_a_slalom():
+    from shapely import affinity
+
+    slab = affinity.rotate(shapely.box(30, 20, 36, 80), 25, origin="centroid")
+    world = make_world([slab, (60, 0, 64, 60), (60, 70, 64, 100)])
+    start, goal = (10, 90, 0.0), (90, 90, math.pi / 2)
+    res = plan(world, start, goal, R)
+    check_path(world, res, start, goal, R)
+
+
+# -- bad inputs ---------------------------------------------------------------------------
+
+def test_bad_inputs_raise_named_errors():
+    world = make_world([(40, 40, 60, 60)])
+    ok_s, ok_g = (10, 10, 0.0), (90, 90, 0.0)
+    with pytest.raises(QueryError, match="start"):
+        plan(world, (50, 50, 0.0), ok_g, R)
+    with pytest.raises(QueryError, match="goal"):
+        plan(world, ok_s, (50, 50), R)
+    with pytest.raises(QueryError, match="start"):
+        plan(world, (-5, 10, 0.0), ok_g, R)
+    with pytest.raises(QueryError, match="goal"):
+        plan(world, ok_s, (150, 10), R)
+    for bad in [(1,), (1, 2, 3, 4), (1, float("nan")), ("a", 2), (1, 2, None), 5, None,
+                (1, 2, float("inf")), (True, 2)]:
+        with pytest.raises(QueryError, match="start"):
+            plan(world, bad, ok_g, R)
+        with pytest.raises(QueryError, match="goal"):
+            plan(world, ok_s, bad, R)
+    for radius in (-1, 0, float("nan"), float("inf"), "5"):
+        with pytest.raises(OptionError, match="radius"):
+            plan(world, ok_s, ok_g, radius)
+    with pytest.raises(OptionError, match="radius=-1 must be > 0"):
+        plan(world, ok_s, ok_g, -1)
+    for bins in (3, 0, 4.5, "72"):
+        with pytest.raises(OptionError, match="heading_bins"):
+            plan(world, ok_s, ok_g, R, heading_bins=bins)
+    for step in (0, -1, float("nan"), 100.0):
+        with pytest.raises(OptionError, match="step"):
+            plan(world, ok_s, ok_g, R, step=step)
+    with pytest.raises(OptionError, match="max_expansions"):
+        plan(world, ok_s, ok_g, R, max_expansions=-1)
+    with pytest.raises(OptionError, match="reverse"):
+        plan(world, ok_s, ok_g, R, reverse="yes")
+    with pytest.raises(OptionError, match="approach"):
+        plan(world, ok_s, ok_g, R, approach=-3)
+    with pytest.raises(QueryError, match="goal"):
+        plan(world, ok_s, (90, 90), R, approach=10)
+    with pytest.raises(OptionError, match="step"):
+        plan(world, ok_s, ok_g, R).sample(0)
+
+
+def test_options_change_the_lattice_not_the_contract():
+    world = make_world([(48, 0, 52, 45), (48, 57, 52, 100)])
+    start, goal = (20, 80, -math.pi / 2), (80, 20, 0.0)
+    for kw in ({"heading_bins": 36}, {"heading_bins": 8}, {"step": 1.0},
+               {"smooth": False}, {"seed": 3}):
+        res = plan(world, start, goal, R, **kw)
+        check_path(world, res, start, goal, R)
+
+
+# -- the kernels against references -------------------------------------------------------
+
+def test_compiled_words_match_the_numpy_words():
+    rng = np.random.default_rng(7)
+    s = np.c_[rng.uniform(-10, 10, (500, 2)), rng.uniform(-4, 4, 500)]
+    g = np.c_[rng.uniform(-10, 10, (500, 2)), rng.uniform(-4, 4, 500)]
+    ref = dubins._words(s, g, 1.7) * 1.7
+    for i in range(len(s)):
+        segs, total = words(*s[i], *g[i], 1.7)
+        np.testing.assert_allclose(segs, ref[i], atol=1e-12, equal_nan=True)
+        assert total.min() == pytest.approx(dubins.shortest_path(s[i], g[i], 1.7).length,
+                                            abs=1e-9)
+
+
+def test_free_heading_bound_is_the_best_heading():
+    rng = np.random.default_rng(8)
+    heads = np.linspace(0, 2 * math.pi, 4000, endpoint=False)
+    for _ in range(100):
+        s = np.r_[rng.uniform(-3, 3, 2), rng.uniform(-4, 4)]
+        g = rng.uniform(-4, 4, 2)
+        brute = dubins.lengths(np.tile(s, (len(heads), 1)),
+                               np.c_[np.tile(g, (len(heads), 1)), heads], 1.0).min()
+        b = free_heading_bound(*s, *g, 1.0)
+        assert b <= brute + 1e-9
+        assert b >= math.dist(s[:2], g) - 1e-12
+
+
+def test_arc_and_segment_distances_match_shapely():
+    rng = np.random.default_rng(9)
+    for _ in range(500):
+        c, r = rng.uniform(-3, 3, 2), rng.uniform(0.5, 3)
+        a0, sweep = rng.uniform(-4, 4), rng.uniform(-math.pi, math.pi)
+        a, b = rng.uniform(-5, 5, (2, 2))
+        n = 20001
+        ang = a0 + sweep * np.linspace(0, 1, n)
+        ref = shapely.distance(shapely.LineString(c + r * np.c_[np.cos(ang), np.sin(ang)]),
+                               shapely.LineString([a, b]))
+        sag = r * (1 - math.cos(abs(sweep) / (n - 1) / 2))
+        assert abs(arc_segment_distance(*c, r, a0, sweep, *a, *b) - ref) <= sag + 1e-12
+        p, q = rng.uniform(-3, 3, (2, 2))
+        assert segment_distance(*p, *q, *a, *b) == pytest.approx(
+            shapely.distance(shapely.LineString([p, q]), shapely.LineString([a, b])),
+            abs=1e-12)
+
+
+def test_path_free_is_exact_at_a_corner():
+    world = make_world([(40, 40, 60, 60)])
+    from skyroute.motion.pieces import Piece
+
+    # a straight that passes 1 mm above the box, and one that clips its corner by 1 mm
+    assert path_free(world, [Piece("S", (10, 60.001, 0.0), 80, R)])
+    assert not path_free(world, [Piece("S", (10, 59.999, 0.0), 80, R)])
+    # a half turn whose lowest point is 1 mm above / below the box's top edge
+    for dr, ok in ((-1e-3, True), (1e-3, False)):
+        rad = 10 + dr
+        p = Piece("L", (50 - rad, 70, -math.pi / 2), rad * math.pi, rad)
+        assert path_free(world, [p]) is ok
+
+
+# -- smaller contracts --------------------------------------------------------------------
+
+def test_docstring_examples():
+    import doctest
+
+    from skyroute.motion import hybrid, pieces
+
+    for module in (hybrid, pieces):
+        result = doctest.testmod(module)
+        assert result.attempted > 0 and result.failed == 0
+
+
+def test_same_start_and_goal():
+    world = make_world([(40, 40, 60, 60)])
+    res = plan(world, (10, 10, 1.0), (10, 10, 1.0), R)
+    assert res.found and res.length == 0 and res.segments == ()
+    assert res.sample(1.0).tolist() == [[10, 10, 1.0]]
+    res = plan(world, (10, 10, 0.0), (10, 10, math.pi), R)  # turn round: a loop
+    check_path(world, res, (10, 10, 0.0), (10, 10, math.pi), R)
+
+
+def test_a_boxed_in_goal_ends_at_once():
+    # the goal faces the boundary 1 m ahead: no forward path can arrive there
+    world = make_world([(40, 40, 60, 60)])
+    res = plan(world, (10, 10, 0.0), (99, 50, math.pi), R)
+    assert res.status is Status.NO_PATH and res.expanded < 20
+    # the start faces the boundary: the forward search ends at once too
+    res = plan(world, (1, 50, math.pi), (90, 90, 0.0), R)
+    assert res.status is Status.NO_PATH and res.expanded < 600
+
+
+def test_result_pieces_describe_arcs():
+    world = make_world([(48, 0, 52, 45), (48, 57, 52, 100)])
+    res = plan(world, (20, 80, -math.pi / 2), (80, 20, 0.0), R)
+    assert {p.kind for p in res.segments} <= {"L", "S", "R"}
+    for p in res.segments:
+        assert p.length > 0 and not p.reverse
+        if p.kind == "S":
+            assert p.centre is None and p.turn == 0
+        else:
+            cx, cy = p.centre
+            assert math.dist((cx, cy), p.start[:2]) == pytest.approx(R)
+            assert math.dist((cx, cy), p.end[:2]) == pytest.approx(R)
+            assert p.turn == pytest.approx((1 if p.kind == "L" else -1) * p.length / R)
+            a = p.start_angle
+            assert (cx + R * math.cos(a), cy + R * math.sin(a)) == pytest.approx(p.start[:2])
+
+
+# -- reverse gears ------------------------------------------------------------------------
+
+def test_reverse_never_longer_than_dubins_in_an_empty_world():
+    world = make_world([], (-200, -200, 200, 200))
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        start = (*rng.uniform(-30, 30, 2), rng.uniform(-math.pi, math.pi))
+        goal = (*rng.uniform(-30, 30, 2), rng.uniform(-math.pi, math.pi))
+        res = plan(world, start, goal, R, reverse=True)
+        assert res.length <= dubins.shortest_path(start, goal, R).length + 1e-9
+        check_path(world, res, start, goal, R, reverse=True)
+
+
+def test_reverse_backs_out_of_a_dead_end():
+    world = make_world([(20, 44, 60, 47), (20, 53, 60, 56), (17, 44, 20, 56)])
+    start, goal = (40, 50, math.pi), (80, 80, 0.0)
+    assert plan(world, start, goal, R).status is Status.NO_PATH
+    res = plan(world, start, goal, R, reverse=True)
+    check_path(world, res, start, goal, R, reverse=True)
+    assert res.segments[0].reverse  # it backs out first
+
+
+def test_reverse_parks_beside_where_it_started():
+    world = make_world([(0, 0, 100, 40)])  # a kerb below
+    start, goal = (30, 45, 0.0), (40, 45, math.pi)  # turn round in a 55 m wide street
+    forward = plan(world, start, goal, R)
+    res = plan(world, start, goal, R, reverse=True)
+    check_path(world, forward, start, goal, R)
+    check_path(world, res, start, goal, R, reverse=True)
+    assert res.length < forward.length
