@@ -14,7 +14,7 @@ from skyroute.motion import dubins
 from skyroute.motion.arc_kernels import arc_segment_distance, segment_distance
 from skyroute.motion.dubins_kernel import free_heading_bound, words
 from skyroute.motion.hybrid import path_free, plan, runway_goal
-from skyroute.search.result import Status
+from skyroute.result import Status
 from skyroute.world.world import World
 
 R = 5.0

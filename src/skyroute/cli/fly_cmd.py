@@ -24,6 +24,7 @@ from skyroute.world.load import load_world
 from skyroute.world.world import AXES
 
 VEHICLES = ("step", "dubins", "lattice", "field")
+PLANNERS = {"step": ("moves", "follow"), "dubins": ("hybrid", "waypoints")}  # default first
 EXIT_NOT_REACHED = 1
 
 
@@ -36,16 +37,30 @@ def fly_command(
     altitude: wa.Altitude = None,
     safety: wa.Safety = 0.0,
     boundary: wa.Boundary = None,
-    planner: Annotated[str, typer.Option(
-        help="step drone: moves (fewest moves, A*) or follow (round a Theta* path).")] =
-        "moves",
+    planner: Annotated[str | None, typer.Option(
+        help="step: moves (fewest moves, A*; default) or follow (round a Theta* path); "
+             "dubins: hybrid (Hybrid A* among the obstacles; default) or waypoints (Dubins "
+             "curves through the exact route's corners, which may cut them: reports "
+             "free).")] = None,
     radius: Annotated[float, typer.Option(help="dubins: turning radius.")] = 10.0,
-    start_heading: Annotated[float, typer.Option(
+    start_heading: Annotated[float | None, typer.Option(
         help="dubins / lattice: start heading, degrees in the frame's convention "
              "(clockwise from north in lonlat and ned; anticlockwise from east in enu and "
-             "degrees).")] = 0.0,
+             "degrees); or give it as --start A,B,HEADING. dubins: free when left out; "
+             "lattice: 0.")] = None,
     goal_heading: Annotated[float | None, typer.Option(
-        help="dubins: heading at the goal (degrees); free when left out.")] = None,
+        help="dubins: heading at the goal (degrees), or --goal A,B,HEADING; free when left "
+             "out.")] = None,
+    approach: Annotated[float | None, typer.Option(
+        help="dubins: the goal is a runway threshold with its heading; end with a straight "
+             "final approach this long along it.")] = None,
+    reverse: Annotated[bool, typer.Option(
+        "--reverse", help="dubins: the vehicle may also drive backwards (a car).")] = False,
+    max_expansions: Annotated[int | None, typer.Option(
+        help="dubins: Hybrid A*'s expansion budget (status budget_exhausted).")] = None,
+    targets: Annotated[Path | None, typer.Option(
+        help="dubins: visit these targets (a .csv or .json of A,B points in --frame) in the "
+             "shortest order from START; GOAL is not used.")] = None,
     headings: Annotated[int, typer.Option(help="lattice: 8 or 16 headings.")] = 8,
     speed: Annotated[float, typer.Option(help="lattice: metres (plane units) per second.")] =
         1.0,
@@ -74,26 +89,39 @@ def fly_command(
     its moves as ILP rows (from_lon, from_lat, angle, to_lon, to_lat).
     """
     check_choice("vehicle", vehicle, VEHICLES)
-    check_choice("planner", planner, ("moves", "follow"))
+    planner = planner or PLANNERS.get(vehicle, ("",))[0]
+    if vehicle in PLANNERS:
+        check_choice("planner", planner, PLANNERS[vehicle])
     if out is not None and out.suffix.lower() not in (".json", ".csv", ".geojson"):
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
+    if not (math.isfinite(radius) and radius > 0):
+        raise OptionError(f"--radius {radius!r} must be a number > 0")
+    if targets is not None and vehicle != "dubins":
+        raise OptionError("--targets: tours are flown by --vehicle dubins")
     frame = wa.frame_of(frame)
-    a = wa.parse_pair(start, "--start", wa.point_names(frame))
-    b = wa.parse_pair(goal, "--goal", wa.point_names(frame))
+    *a, h0 = wa.parse_pose(start, "--start", wa.point_names(frame))
+    *b, h1 = wa.parse_pose(goal, "--goal", wa.point_names(frame))
+    h0 = _one_heading(h0, start_heading, "start")
+    h1 = _one_heading(h1, goal_heading, "goal")
     world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
                        frame=frame)
     world.check_point(a, "start")  # one error, in the user's frame, for every vehicle
-    world.check_point(b, "goal")
-    h0 = math.radians(start_heading)
-    h1 = None if goal_heading is None else math.radians(goal_heading)
+    if targets is None:
+        world.check_point(b, "goal")
     if vehicle == "step":
         world, a, b = world.in_frame("degrees"), world.to_lonlat(a)[0], world.to_lonlat(b)[0]
         doc, rows, xy = _fly_step(world, a, b, planner)
+    elif vehicle == "dubins" and targets is not None:
+        doc, rows, xy = _fly_tour(world, a, h0, _read_targets(targets, world), radius, step,
+                                  max_expansions)
+    elif vehicle == "dubins" and planner == "hybrid":
+        doc, rows, xy = _fly_hybrid(world, a, b, h0, h1, radius, step, reverse,
+                                    max_expansions, approach)
     elif vehicle == "dubins":
-        doc, rows, xy = _fly_dubins(world, a, b, radius, h0, h1, step)
+        doc, rows, xy = _fly_dubins(world, a, b, radius, h0 or 0.0, h1, step)
     elif vehicle == "lattice":
         doc, rows, xy = _fly_lattice(world, a, b, headings, speed, math.radians(turn_rate),
-                                     h0, resolution)
+                                     h0 or 0.0, resolution)
     else:
         doc, rows, xy = _fly_field(world, a, b, step, escape, sensor_range, sensor_rays,
                                    field_mode, math.radians(max_turn))
@@ -105,7 +133,7 @@ def fly_command(
         plane = world.to_plane(xy)
         length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
         shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)
-        plot_world_path(world, shown, a, b, plot)
+        plot_world_path(world, shown, a, xy[-1], plot)
     if as_json:
         typer.echo(json.dumps({k: v for k, v in doc.items() if k != "columns"}))
     else:
@@ -117,6 +145,93 @@ def fly_command(
         Console().print(table)
     if not doc["reached"]:
         raise typer.Exit(EXIT_NOT_REACHED)
+
+
+def _one_heading(typed: float | None, option: float | None, what: str) -> float | None:
+    """A heading (radians) from ``--start A,B,HEADING`` or ``--start-heading`` (degrees)."""
+    if typed is not None and option is not None:
+        raise OptionError(f"give the {what} heading once: in --{what} A,B,HEADING or "
+                          f"--{what}-heading")
+    deg = typed if typed is not None else option
+    return None if deg is None else math.radians(deg)
+
+
+def _read_targets(path: Path, world) -> np.ndarray:
+    """(N, 2) target points from a .csv (A,B per line, an optional header) or a .json
+    list of [A, B]; errors name the file and line."""
+    from skyroute.errors import InputFormatError
+
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputFormatError(path, f"cannot read: {exc}") from None
+    if path.suffix.lower() == ".json":
+        try:
+            pts = np.asarray(json.loads(text), dtype=float)
+        except (json.JSONDecodeError, TypeError, ValueError):
+            raise InputFormatError(path, "expected a JSON list of [a, b] points") from None
+        if pts.ndim != 2 or pts.shape[1] != 2 or not np.isfinite(pts).all():
+            raise InputFormatError(path, "expected a JSON list of [a, b] points")
+    else:
+        rows = []
+        for n, line in enumerate(text.splitlines(), start=1):
+            parts = line.replace(" ", "").split(",")
+            if not line.strip() or (n == 1 and not _numbers(parts)):
+                continue
+            if len(parts) != 2 or not _numbers(parts):
+                raise InputFormatError(path, f"expected two numbers A,B, got {line[:60]!r}",
+                                       line=n)
+            rows.append([float(p) for p in parts])
+        pts = np.array(rows).reshape(-1, 2)
+    if len(pts) == 0:
+        raise InputFormatError(path, "no targets")
+    for i, p in enumerate(pts):
+        world.check_point(p, f"{path.name}: target {i + 1}")
+    return pts
+
+
+def _numbers(parts: list[str]) -> bool:
+    try:
+        return all(math.isfinite(float(p)) for p in parts)
+    except ValueError:
+        return False
+
+
+def _fly_hybrid(world, s, t, h0, h1, radius, step, reverse, max_expansions, approach):
+    from skyroute.motion.hybrid import plan as hybrid_plan
+
+    if approach is not None and h1 is None:
+        raise OptionError("--approach: give the runway heading as --goal A,B,HEADING")
+    start = (*s, h0) if h0 is not None else tuple(s)
+    goal = (*t, h1) if h1 is not None else tuple(t)
+    res = hybrid_plan(world, start, goal, radius, reverse=reverse,
+                      max_expansions=max_expansions, approach=approach)
+    metrics = {"status": res.status.value, "length": res.length, "expanded": res.expanded,
+               "seconds": res.seconds}
+    if not res.found:
+        return ({"reached": False, "metrics": metrics, "columns": []}, [], np.array([s]))
+    poses = res.sample(step)
+    metrics.update(pieces=len(res.segments), moves=len(poses) - 1,
+                   smoothness=_smoothness(world.heading_to_plane(poses[:, 2])))
+    rows = np.c_[poses[:, :2], np.degrees(poses[:, 2])].tolist()
+    return ({"reached": True, "trajectory": rows, "metrics": metrics,
+             "columns": _pose_columns(world)}, rows, poses[:, :2])
+
+
+def _fly_tour(world, s, h0, pts, radius, step, max_expansions):
+    from skyroute.motion.tour import tour
+
+    res = tour((*s, h0 or 0.0), pts, radius, world=world, max_expansions=max_expansions)
+    metrics = {"status": res.status.value, "length": res.length, "method": res.method,
+               "order": " ".join(str(k + 1) for k in res.order),
+               "greedy_bound": res.greedy_bound, "bound": res.bound,
+               "seconds": res.seconds}
+    if not res.found:
+        return ({"reached": False, "metrics": metrics, "columns": []}, [], np.array([s]))
+    poses = res.sample(step)
+    rows = np.c_[poses[:, :2], np.degrees(poses[:, 2])].tolist()
+    return ({"reached": True, "trajectory": rows, "metrics": metrics,
+             "columns": _pose_columns(world)}, rows, poses[:, :2])
 
 
 def _pose_rows(world, xy: np.ndarray, plane_headings: np.ndarray) -> list[list[float]]:

@@ -28,6 +28,22 @@ def parse_pair(text: str, option: str, names: str) -> tuple[float, float]:
     return a, b
 
 
+def parse_pose(text: str, option: str, names: str) -> tuple[float, float, float | None]:
+    """``"A,B"`` or ``"A,B,HEADING"`` -> two finite floats and a heading in degrees (or
+    None)."""
+    parts = text.replace(" ", "").split(",")
+    try:
+        if len(parts) not in (2, 3):
+            raise ValueError
+        vals = [float(p) for p in parts]
+        if not all(np.isfinite(vals)):
+            raise ValueError
+    except ValueError:
+        raise OptionError(f"{option} {text!r} must be two numbers {names}, optionally "
+                          "followed by a heading in degrees") from None
+    return vals[0], vals[1], (vals[2] if len(vals) == 3 else None)
+
+
 def frame_of(frame: str | None) -> str:
     """The frame a command reads points in: ``--frame``, or a world's own (lonlat)."""
     frame = DEFAULT_FRAME if frame is None else frame

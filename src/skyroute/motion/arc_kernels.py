@@ -30,7 +30,7 @@ import shapely
 from numba import njit
 
 from skyroute.motion.zone_kernels import crosses, zone_arrays
-from skyroute.world.segments import point_segment_dist2
+from skyroute.world.geometry import point_segment_dist2
 from skyroute.world.world import World
 
 TWO_PI = 2 * math.pi

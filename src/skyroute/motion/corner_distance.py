@@ -53,7 +53,7 @@ def corner_graph(world: World) -> CornerGraph:
 
 
 def _build(world: World) -> CornerGraph:
-    from skyroute.roadmap.visibility import convex_corners
+    from skyroute.world.geometry import convex_corners
 
     merged = world.merged()
     edges = np.ascontiguousarray(zone_arrays(merged)[0], dtype=float)

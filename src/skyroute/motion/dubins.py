@@ -24,9 +24,10 @@ import numpy as np
 from numba import njit, prange
 
 from skyroute.errors import OptionError
+from skyroute.motion.dubins_kernel import WORDS, _m2p
+from skyroute.motion.tour import TourResult, tour  # noqa: F401  (skyroute.motion.dubins.tour)
 from skyroute.result import Status
 
-WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
 TWO_PI = 2 * math.pi
 
 
@@ -102,15 +103,6 @@ def lengths(starts, goals, radius: float) -> np.ndarray:
     if s.shape != g.shape:
         raise OptionError(f"starts {s.shape} and goals {g.shape} must have the same shape")
     return _lengths_kernel(s, g, float(radius))
-
-
-@njit(cache=True)
-def _m2p(a):
-    """:func:`_mod2pi` for one angle."""
-    if a < 0 and a > -1e-12:
-        return 0.0
-    m = a - TWO_PI * math.floor(a / TWO_PI)
-    return 0.0 if TWO_PI - m < 1e-12 else m
 
 
 @njit(cache=True, parallel=True)
@@ -297,3 +289,5 @@ def loiter(center, radius: float, *, start_angle: float = 0.0, turns: float = 1.
     ang = start_angle + (-1 if clockwise else 1) * s / radius
     heading = ang + (-math.pi / 2 if clockwise else math.pi / 2)
     return np.c_[cx + radius * np.cos(ang), cy + radius * np.sin(ang), _mod2pi(heading)]
+
+

@@ -19,9 +19,18 @@ import math
 import numpy as np
 from numba import njit
 
-from skyroute.motion.dubins import WORDS, _m2p
-
 TWO_PI = 2 * math.pi
+WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
+@njit(cache=True)
+def _m2p(a):
+    """:func:`_mod2pi` for one angle."""
+    if a < 0 and a > -1e-12:
+        return 0.0
+    m = a - TWO_PI * math.floor(a / TWO_PI)
+    return 0.0 if TWO_PI - m < 1e-12 else m
+
+
+
 TURNS = np.array([[1 if c == "L" else -1 if c == "R" else 0 for c in w] for w in WORDS],
                  dtype=np.int64)
 

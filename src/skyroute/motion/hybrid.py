@@ -73,7 +73,7 @@ from skyroute.motion.corner_distance import corner_graph
 from skyroute.motion.dubins_kernel import TURNS, tangent_heading, words
 from skyroute.motion.pieces import Piece, chain, merge, sample, time_reversed, turned_round
 from skyroute.motion.smooth import length, shortcut
-from skyroute.search.result import FOUND, NO_PATH, STATUS_OF_CODE, Status
+from skyroute.result import FOUND, NO_PATH, STATUS_OF_CODE, Status
 from skyroute.world.world import World
 
 Pose = tuple[float, float, float]
@@ -89,11 +89,12 @@ _SWITCH = 1.0  # reverse=True: each change of direction costs this many turning 
 class HybridResult:
     """A planned path of arcs and straights, its status and statistics.
 
-    ``segments`` are :class:`~skyroute.motion.pieces.Piece` objects laid end to end
-    (empty unless found); ``length`` their total (inf unless found); ``start`` and
-    ``goal`` the poses the path joins (the goal heading is the arrival heading when none
-    was asked for); ``expanded`` nodes expanded; ``seconds`` wall time of the planning.
-    ``extra``: ``raw_length`` before shortcutting, analytic ``tries``, ``shortcut_tries``.
+    ``segments`` are :class:`~skyroute.motion.pieces.Piece` objects laid end to end in
+    the world's plane (empty unless found); ``length`` their total (inf unless found);
+    ``start`` and ``goal`` the plane poses the path joins (the goal heading is the arrival
+    heading when none was asked for); ``expanded`` nodes expanded; ``seconds`` wall time
+    of the planning. :meth:`sample` gives poses in the world's frame. ``extra``:
+    ``raw_length`` before shortcutting, analytic ``tries``, ``shortcut_tries``.
     """
 
     status: Status
@@ -105,6 +106,8 @@ class HybridResult:
     expanded: int = 0
     seconds: float = 0.0
     extra: dict = field(default_factory=dict, compare=False)
+    world: World | None = field(default=None, compare=False, repr=False)
+    given: tuple = field(default=(None, None), compare=False, repr=False)
 
     @property
     def found(self) -> bool:
@@ -112,14 +115,24 @@ class HybridResult:
         return self.status is Status.FOUND
 
     def sample(self, step: float) -> np.ndarray:
-        """(K, 3) poses (x, y, heading in [0, 2 pi)) every ``step`` metres along each
-        piece and at every joint; the first row is exactly ``start`` and the last exactly
-        ``goal``. Empty unless found."""
+        """(K, 3) poses every ``step`` plane units along each piece and at every joint,
+        in the world's frame (points as the world reads them, headings in [0, 2 pi) in
+        its convention); the first row is exactly the start as given and the last
+        exactly the goal (its heading too, when one was given). Empty unless found."""
         if not (isinstance(step, numbers.Real) and math.isfinite(step) and step > 0):
             raise OptionError(f"step={step!r} must be a positive number")
         if not self.found:
             return np.empty((0, 3))
-        return sample(list(self.segments), float(step), self.start, self.goal)
+        poses = sample(list(self.segments), float(step), self.start, self.goal)
+        if self.world is None:
+            return poses
+        out = np.c_[self.world.from_plane(poses[:, :2]),
+                    self.world.heading_from_plane(poses[:, 2])]
+        for row, pose in ((0, self.given[0]), (-1, self.given[1])):
+            if pose is not None:
+                out[row, :len(pose)] = pose
+                out[row, 2] %= 2 * math.pi
+        return out
 
 
 def runway_goal(threshold, runway_heading: float, approach_length: float) -> tuple[Pose,
@@ -147,12 +160,14 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     Parameters
     ----------
     world : World
-        Obstacles and boundary in its plane (x, y).
-    start, goal : (x, y) or (x, y, heading)
-        Heading in radians anticlockwise from +x. Without one the planner picks the
-        start heading, or accepts any arrival heading.
+        Obstacles and boundary; points are read in the world's frame.
+    start, goal : (a, b) or (a, b, heading)
+        A point in the world's frame and a heading in radians in its convention
+        (anticlockwise from +x in "enu" and "degrees", clockwise from north in "ned" and
+        "lonlat"). Without one the planner picks the start heading, or accepts any
+        arrival heading.
     radius : float
-        Smallest turning radius, > 0.
+        Smallest turning radius, > 0, in plane units (metres; degrees in "degrees").
     heading_bins : int
         Heading resolution of the closed set, >= 4.
     step : float, optional
@@ -189,9 +204,10 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         an out-of-range option.
     """
     r, H, step, budget = _options(radius, heading_bins, step, reverse, max_expansions, seed)
-    sxy, sth = _pose(start, "start")
-    gxy, gth = _pose(goal, "goal")
-    world.check_point(sxy, "start")
+    sxy, sth = _in_plane(world, *_pose(start, "start"))
+    gxy, gth = _in_plane(world, *_pose(goal, "goal"))
+    given = tuple(tuple(float(v) for v in p) for p in (start, goal))
+    world.check_plane_point(sxy, "start")
     final = None
     if approach is not None:
         if gth is None:
@@ -200,12 +216,12 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
                 approach >= 0):
             raise OptionError(f"approach={approach!r} must be a number >= 0")
         threshold = gxy
-        world.check_point(threshold, "goal")
+        world.check_plane_point(threshold, "goal")
         gate, final = runway_goal(threshold, gth, approach)
         gxy = np.array(gate[:2])
         if approach == 0:
             final = None
-    world.check_point(gxy, "goal")
+    world.check_plane_point(gxy, "goal")
     t0 = time.perf_counter()
     index = edge_index(world, _bucket(world))
     if final is not None:
@@ -236,7 +252,8 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     goal_pose = (float(gxy[0]), float(gxy[1]), math.nan if gth is None else float(gth))
     if status is not Status.FOUND:
         return HybridResult(status, math.inf, (), start_pose, goal_pose, r, int(expanded),
-                            time.perf_counter() - t0, {"tries": back.tries + res.tries})
+                            time.perf_counter() - t0, {"tries": back.tries + res.tries},
+                            world, given)
     pieces = res.pieces
     if pieces:  # exactly the given start (a reversed search ends there within rounding)
         head = pieces[0].start[2] if sth is None else sth
@@ -262,7 +279,8 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
                          "tries": back.tries + res.tries, "shortcut_tries": shortcut_tries,
                          "reversed": res.flipped,
                          "cusps": sum(a.reverse != b.reverse
-                                      for a, b in itertools.pairwise(pieces))})
+                                      for a, b in itertools.pairwise(pieces))},
+                        world, given)
 
 
 @dataclass
@@ -433,6 +451,12 @@ def _pose(p, what: str) -> tuple[np.ndarray, float | None]:
         raise QueryError(f"{what}={p!r} must be finite numbers")
     xy = np.array([float(vals[0]), float(vals[1])])
     return xy, (float(vals[2]) if len(vals) == 3 else None)
+
+
+def _in_plane(world: World, xy: np.ndarray, heading: float | None):
+    """A pose read in the world's frame, in its plane."""
+    p = world.to_plane(xy, "pose")[0]
+    return p, (None if heading is None else float(world.heading_to_plane(heading)))
 
 
 def _xy(p, what: str) -> tuple[float, float]:

@@ -40,7 +40,7 @@ from skyroute.motion.dubins_kernel import (
     words,
 )
 from skyroute.motion.move_search import _sight
-from skyroute.search.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 
 TWO_PI = 2 * math.pi
 

@@ -1,0 +1,193 @@
+"""Tours: visit several targets with a vehicle that turns no tighter than a radius, in
+the order and with the arrival headings that make the flown length shortest.
+
+A target may be reached on any heading; the search picks one of ``headings`` evenly
+spaced arrival headings per target. Leg costs are Dubins lengths (free space) or, among
+obstacles, max(Dubins length, shortest 2D distance round the obstacles), a lower bound
+on the leg Hybrid A* then flies. With those costs:
+
+- up to ``exact_limit`` (12) targets, Held-Karp dynamic programming over subsets gives
+  the exact optimum over the heading set (:func:`skyroute.motion.tour_dp.held_karp`;
+  0.14 s for 12 targets and 16 headings);
+- beyond, nearest-first order improved by 2-opt and or-opt moves, each candidate order
+  scored with its best headings by a chain DP (:func:`~skyroute.motion.tour_dp.improve`).
+
+The seed's drone visited targets greedily, nearest first (straight-line distance), each
+leg the shortest Dubins path from where it was; ``greedy_length`` is that baseline over
+the same heading set, for comparison (docs/benchmarks.md).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+
+from skyroute.errors import OptionError, QueryError
+from skyroute.motion import hybrid
+from skyroute.motion.dubins_kernel import TURNS, shortest_length, words
+from skyroute.motion.pieces import chain, sample
+from skyroute.motion.tour_dp import held_karp, improve, nearest_first
+from skyroute.result import Status
+from skyroute.world.points import as_points
+from skyroute.world.world import World
+
+TWO_PI = 2 * math.pi
+
+
+@dataclass(frozen=True)
+class TourResult:
+    """A tour: ``order`` (target indices as given, in visiting order), ``headings``
+    (arrival heading at each visited target, radians; the world's convention, or from +x
+    without a world), ``legs`` (free space: lists of :class:`Piece`; among obstacles:
+    :class:`~skyroute.motion.hybrid.HybridResult`), flown ``length``, ``method``
+    ("exact" or "local search"), ``bound`` (the tour's cost in the leg table: its length
+    in free space, a lower bound among obstacles) and ``greedy_bound`` (nearest-first's
+    cost in the same table)."""
+
+    status: Status
+    order: tuple[int, ...]
+    headings: np.ndarray
+    legs: tuple
+    length: float
+    method: str
+    bound: float
+    greedy_bound: float
+    seconds: float
+    extra: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def found(self) -> bool:
+        """True when every leg was flown."""
+        return self.status is Status.FOUND
+
+    def sample(self, step: float) -> np.ndarray:
+        """(K, 3) poses along the whole tour (the world's frame among obstacles)."""
+        if not self.found:
+            return np.empty((0, 3))
+        parts = []
+        for leg in self.legs:
+            poses = leg.sample(step) if isinstance(leg, hybrid.HybridResult) else \
+                sample(leg, step, leg[0].start) if leg else np.empty((0, 3))
+            parts.append(poses if not parts else poses[1:])
+        return np.vstack(parts) if parts else np.empty((0, 3))
+
+
+@njit(cache=True)
+def _dubins_table(starts, pts, cand, r):
+    """c0 from the start pose to every (target, heading), C between them (inf on the
+    same target)."""
+    n, H = len(pts), len(cand)
+    P = n * H
+    c0 = np.empty(P)
+    C = np.full((P, P), np.inf)
+    for p in range(P):
+        k, h = p // H, p % H
+        c0[p] = shortest_length(starts[0], starts[1], starts[2], pts[k, 0], pts[k, 1],
+                                cand[h], r)
+        for q in range(P):
+            j, g = q // H, q % H
+            if j != k:
+                C[p, q] = shortest_length(pts[k, 0], pts[k, 1], cand[h], pts[j, 0],
+                                          pts[j, 1], cand[g], r)
+    return c0, C
+
+
+def tour(start_pose, targets, radius: float, *, world: World | None = None,
+         headings: int = 16, exact_limit: int = 12, max_expansions: int | None = None,
+         seed: int = 0) -> TourResult:
+    """The shortest tour from ``start_pose`` (x, y, heading) through every target (x, y).
+
+    Without ``world``: plane coordinates, heading in radians anticlockwise from +x, legs
+    are Dubins paths. With ``world``: points and headings in the world's frame, and each
+    leg is flown by :func:`skyroute.motion.hybrid.plan` (``max_expansions``, ``seed``)
+    to the chosen arrival heading; a leg it cannot fly makes the tour's status.
+    """
+    t0 = time.perf_counter()
+    if not (isinstance(radius, (int, float)) and math.isfinite(radius) and radius > 0):
+        raise OptionError(f"radius={radius!r} must be > 0", param="radius")
+    if not (isinstance(headings, int) and 1 <= headings <= 72):
+        raise OptionError(f"headings={headings!r} must be an integer in 1..72",
+                          param="headings")
+    start = as_points(start_pose, "start_pose", dims=3)[0]
+    pts = as_points(targets, "targets")
+    if len(pts) == 0:
+        raise QueryError("targets must hold at least one (x, y) point")
+    s = start.copy()
+    if world is not None:
+        s[:2] = world.check_point(start[:2], "start_pose")
+        s[2] = float(world.heading_to_plane(start[2]))
+        plane = np.array([world.check_point(p, f"targets[{i}]") for i, p in enumerate(pts)])
+    else:
+        plane = pts
+    n, H = len(plane), headings
+    cand = np.arange(H) * TWO_PI / H
+    c0, C = _dubins_table(s, plane, cand, float(radius))
+    if world is not None:
+        c0, C = _with_obstacles(world, s, plane, H, c0, C)
+    if n <= exact_limit:
+        bound, places = held_karp(c0, C, n, H)
+        method = "exact"
+    else:
+        dist0 = np.hypot(*(plane - s[:2]).T)
+        D = np.hypot(*(plane[:, None] - plane[None]).transpose(2, 0, 1))
+        _, greedy = nearest_first(c0, C, dist0, D, n, H)
+        bound, places = improve(greedy // H, c0, C, H, 50)
+        method = "local search"
+    dist0 = np.hypot(*(plane - s[:2]).T)
+    D = np.hypot(*(plane[:, None] - plane[None]).transpose(2, 0, 1))
+    greedy_bound, _ = nearest_first(c0, C, dist0, D, n, H)
+    order = tuple(int(p // H) for p in places)
+    heads = cand[places % H]
+    legs, status, length = _fly(world, s, plane, order, heads, float(radius),
+                                max_expansions, seed)
+    out_heads = heads if world is None else world.heading_from_plane(heads)
+    return TourResult(status, order, np.asarray(out_heads, dtype=float), tuple(legs), length,
+                      method, float(bound), float(greedy_bound), time.perf_counter() - t0,
+                      {"headings": H, "targets": n})
+
+
+def _with_obstacles(world, s, plane, H, c0, C):
+    """Leg costs among obstacles: max(Dubins, shortest 2D distance round them)."""
+    from skyroute.roadmap.world_plan import visibility_graph
+
+    graph = visibility_graph(world)
+    pts = np.vstack([s[:2], plane])
+    m = len(pts)
+    d2 = np.zeros((m, m))
+    for a in range(m):
+        for b in range(a + 1, m):
+            r = graph.plan(pts[a], pts[b])
+            d2[a, b] = d2[b, a] = r.cost if r.found else math.inf
+    c0 = np.maximum(c0, np.repeat(d2[0, 1:], H))
+    C = np.maximum(C, np.repeat(np.repeat(d2[1:, 1:], H, axis=0), H, axis=1))
+    return c0, C
+
+
+def _fly(world, s, plane, order, heads, r, max_expansions, seed):
+    """The legs in visiting order: Dubins pieces, or Hybrid A* among obstacles."""
+    legs, length, pose = [], 0.0, tuple(float(v) for v in s)
+    for k, h in zip(order, heads, strict=True):
+        goal = (float(plane[k, 0]), float(plane[k, 1]), float(h))
+        if world is None:
+            lens, total = words(*pose, *goal, r)
+            w = int(np.argmin(total))
+            leg = chain(pose, TURNS[w], lens[w], r)
+            legs.append(leg)
+            length += float(total[w])
+        else:
+            a = (*world.from_plane([pose[:2]])[0], float(world.heading_from_plane(pose[2])))
+            b = (*world.from_plane([goal[:2]])[0], float(world.heading_from_plane(goal[2])))
+            leg = hybrid.plan(world, a, b, r, max_expansions=max_expansions, seed=seed)
+            legs.append(leg)
+            if not leg.found:
+                return legs, leg.status, math.inf
+            length += leg.length
+        pose = goal
+    return legs, Status.FOUND, length
+
+
+

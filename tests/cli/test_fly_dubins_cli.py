@@ -1,0 +1,123 @@
+"""``skyroute fly --vehicle dubins``: Hybrid A* by default, only free paths, tours.
+
+Every written trajectory is re-checked here without skyroute's collision code: shapely
+distances from its densely sampled poses, with the sagitta of the sampling as slack.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+import shapely
+
+import skyroute
+from tests.cli.test_cli import run
+from tests.conftest import ROOT
+
+CITY = str(ROOT / "examples" / "city.csv")
+BASE = ["fly", CITY, "--frame", "ned", "--vehicle", "dubins", "--altitude", "10",
+        "--safety", "2", "--radius", "8"]
+
+
+def assert_free(rows, radius: float, step: float) -> None:
+    """No sampled point inside a (grown) building, and none nearer to one than the
+    sagitta of an arc of ``step`` (so the arcs between samples stay out too)."""
+    world = skyroute.load_world(CITY, altitude=10, safety=2, frame="ned")
+    plane = world.to_plane(np.asarray(rows)[:, :2])
+    sagitta = radius * (1 - math.cos(step / (2 * radius)))
+    union = shapely.unary_union(world.obstacles)
+    d = shapely.distance(union, shapely.points(plane))
+    assert (d > sagitta - 1e-9).all(), d.min()
+
+
+def test_default_is_hybrid_and_every_written_pose_is_free(monkeypatch, capsys, tmp_path):
+    out, png = tmp_path / "t.csv", tmp_path / "t.png"
+    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,90",
+                          "--goal", "120,-180", "--step", "0.5", "--json", "--out", str(out),
+                          "--plot", str(png))
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["reached"] and doc["metrics"]["status"] == "found"
+    rows = [[float(v) for v in r] for r in list(csv.reader(out.open()))[1:]]
+    assert list(csv.reader(out.open()))[0] == ["north", "east", "heading_deg"]
+    assert rows[0] == [0.0, 0.0, 90.0]  # exactly the start pose typed (compass heading)
+    assert rows[-1][:2] == pytest.approx([120.0, -180.0], abs=1e-9)
+    assert_free(rows, 8.0, 0.5)
+    # it is at least as long as the exact 2D route, and not much longer
+    exact = skyroute.plan(skyroute.load_world(CITY, altitude=10, safety=2, frame="ned"),
+                          (0, 0), (120, -180)).cost
+    assert exact <= doc["metrics"]["length"] <= 1.2 * exact
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_goal_heading_and_runway_approach(monkeypatch, capsys):
+    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,0",
+                          "--goal", "-30,120,180", "--approach", "25", "--json")
+    assert code == 0, err
+    traj = np.array(json.loads(text)["trajectory"])
+    assert traj[-1].tolist() == [-30.0, 120.0, 180.0]
+    # the last 25 m are straight along the runway heading (south): east constant
+    tail = traj[traj[:, 0] >= -30.0 + 1e-9][-10:]
+    assert np.allclose(tail[:, 1], 120.0, atol=1e-6) and np.allclose(tail[:, 2], 180.0)
+
+
+def test_no_path_within_the_budget_exits_1_and_writes_nothing(monkeypatch, capsys,
+                                                              tmp_path):
+    out = tmp_path / "t.json"
+    code, text, _ = run(monkeypatch, capsys, *BASE, "--start", "0,0,90", "--goal",
+                        "120,-180", "--max-expansions", "5", "--json", "--out", str(out))
+    assert code == 1 and not out.exists()
+    assert json.loads(text)["metrics"]["status"] == "budget_exhausted"
+
+
+def test_waypoints_mode_is_explicit_and_reports_free(monkeypatch, capsys):
+    code, text, err = run(monkeypatch, capsys, *BASE, "--planner", "waypoints",
+                          "--start", "0,0", "--goal", "120,-180", "--json")
+    assert code == 0, err
+    assert json.loads(text)["metrics"]["free"] in (True, False)
+    assert "free" in json.loads(text)["metrics"] and "words" in json.loads(text)["metrics"]
+
+
+def test_tour_visits_every_target(monkeypatch, capsys, tmp_path):
+    targets = tmp_path / "targets.csv"
+    points = [(60.0, 30.0), (-60.0, 60.0), (0.0, -120.0), (-120.0, -60.0)]  # on streets
+    targets.write_text("north,east\n" + "".join(f"{n},{e}\n" for n, e in points))
+    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,0", "--goal", "0,0",
+                          "--targets", str(targets), "--step", "0.5", "--json")
+    assert code == 0, err
+    doc = json.loads(text)
+    m = doc["metrics"]
+    assert m["method"] == "exact" and sorted(m["order"].split()) == ["1", "2", "3", "4"]
+    traj = np.array(doc["trajectory"])
+    for p in points:
+        assert np.hypot(*(traj[:, :2] - p).T).min() < 1e-6
+    assert_free(doc["trajectory"], 8.0, 0.5)
+    assert m["bound"] <= m["length"] + 1e-9
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--start", "15,-30", "--goal", "120,-180"], "lies inside obstacle"),
+    (["--start", "0,0,north", "--goal", "120,-180"], "--start '0,0,north' must be"),
+    (["--start", "0,0", "--goal", "120,-180", "--radius", "-1"], "--radius -1.0 must be"),
+    (["--start", "0,0,10", "--start-heading", "10", "--goal", "120,-180"],
+     "give the start heading once"),
+    (["--start", "0,0", "--goal", "120,-180", "--approach", "20"], "--approach: give the"),
+    (["--start", "0,0", "--goal", "120,-180", "--planner", "moves"], "--planner 'moves'"),
+])
+def test_bad_poses_are_one_line_exit_2(monkeypatch, capsys, tmp_path, args, words):
+    out = tmp_path / "t.json"
+    code, text, err = run(monkeypatch, capsys, *BASE[:-2], *args, "--out", str(out))
+    assert code == 2 and err.count("\n") == 1 and words in err, err
+    assert not out.exists() and text == ""
+
+
+def test_bad_targets_file_names_the_line(monkeypatch, capsys, tmp_path):
+    targets = tmp_path / "t.csv"
+    targets.write_text("30,30\n30;x\n")
+    code, _, err = run(monkeypatch, capsys, *BASE, "--start", "0,0", "--goal", "0,0",
+                       "--targets", str(targets))
+    assert code == 2 and f"{targets}:2: expected two numbers" in err
