@@ -42,8 +42,9 @@ def test_default_is_hybrid_and_every_written_pose_is_free(monkeypatch, capsys, t
     assert code == 0, err
     doc = json.loads(text)
     assert doc["reached"] and doc["metrics"]["status"] == "found"
-    rows = [[float(v) for v in r] for r in list(csv.reader(out.open()))[1:]]
-    assert list(csv.reader(out.open()))[0] == ["north", "east", "heading_deg"]
+    header, *body = list(csv.reader(out.open()))
+    rows = [[float(v) for v in r] for r in body]
+    assert header == ["north", "east", "heading_deg"]
     assert rows[0] == [0.0, 0.0, 90.0]  # exactly the start pose typed (compass heading)
     assert rows[-1][:2] == pytest.approx([120.0, -180.0], abs=1e-9)
     assert_free(rows, 8.0, 0.5)
