@@ -43,7 +43,7 @@ def curvature_world(seed: int, *, size: float = 100.0, axis_aligned: int = 20,
         boxes.append(affinity.rotate(box, rng.uniform(0, 180), origin="centroid"))
     n = len(boxes)
     return World(np.array(boxes, dtype=object), np.full(n, -np.inf), np.full(n, np.inf), (),
-                 shapely.box(0, 0, size, size), "metres", name=f"curvature-{seed}")
+                 shapely.box(0, 0, size, size), "enu", name=f"curvature-{seed}")
 
 
 def query_poses(world: World, rng: np.random.Generator, min_dist: float = 60.0) -> tuple:
@@ -96,7 +96,7 @@ def run_skyroute(world: World, start, goal, radius: float) -> dict:
 
 
 def run_ompl(world: World, start, goal, radius: float, planner: str,
-             budget: float) -> dict:
+             seconds: float) -> dict:
     """One OMPL solve in a DubinsStateSpace: time, exact solution or not, raw and
     simplified lengths, and exact validity of both paths."""
     from ompl import base as ob
@@ -129,9 +129,9 @@ def run_ompl(world: World, start, goal, radius: float, planner: str,
     ss.setStartAndGoalStates(s, g)
     ss.setPlanner(getattr(og, planner)(ss.getSpaceInformation()))
     t0 = time.perf_counter()
-    status = ss.solve(budget)
-    seconds = time.perf_counter() - t0
-    row = {"runner": f"ompl {planner}", "budget": budget, "seconds": seconds,
+    status = ss.solve(seconds)
+    took = time.perf_counter() - t0
+    row = {"runner": f"ompl {planner}", "budget": seconds, "seconds": took,
            "found": str(status) == "Exact solution" and ss.haveExactSolutionPath()}
     if not row["found"]:
         return {**row, "length": None, "valid": None, "simplified": None,
@@ -151,25 +151,44 @@ def run_ompl(world: World, start, goal, radius: float, planner: str,
     return row
 
 
+def city_world(path, *, altitude: float = 10.0, safety: float = 2.0) -> World:
+    """A colliders city (e.g. ``examples/city.csv``) as a plane world inside a boundary
+    around its buildings, for OMPL's bounded state space."""
+    from skyroute.world.load import load_world
+
+    city = load_world(path, altitude=altitude, safety=safety, frame="enu")
+    x0, y0, x1, y1 = city.bounds
+    box = shapely.box(x0 - 20, y0 - 20, x1 + 20, y1 + 20)
+    return World(city.obstacles, city.floors, city.ceilings, city.names, box, "enu",
+                 city.home, f"{city.name} (boundary 20 m out)")
+
+
 def curvature_benchmark(worlds: int = 10, seed: int = 0, budgets: tuple = (1.0, 5.0), *,
                         planners: tuple = ("RRTstar", "BITstar"), radius: float = 5.0,
+                        city=None, city_queries: int = 5,
                         on_step: Callable[[dict], None] | None = None) -> list[dict]:
-    """One query per seeded world; one row per planner run (``world``, ``runner``,
-    ``budget``, ``seconds``, ``found``, ``length``, ``valid``, ``ratio`` to the lower
-    bound, ...). ``on_step`` is called with each row as it is made."""
+    """One query per seeded world (and ``city_queries`` on the ``city`` colliders file
+    when given); one row per planner run (``world``, ``runner``, ``budget``, ``seconds``,
+    ``found``, ``length``, ``valid``, ``ratio`` to the lower bound, ...). ``on_step`` is
+    called with each row as it is made."""
     from skyroute.bench.world import ompl_available
 
     rows = []
-    for w in range(worlds):
-        world = curvature_world(seed + w)
-        rng = np.random.default_rng([seed, w])
+    cases = [(curvature_world(seed + w), np.random.default_rng([seed, w]), w)
+             for w in range(worlds)]
+    if city is not None:
+        cw = city_world(city)
+        cases += [(cw, np.random.default_rng([seed, 1000 + q]), q)
+                  for q in range(city_queries)]
+    for world, rng, w in cases:
         start, goal = query_poses(world, rng)
         bound = lower_bound(world, start, goal, radius)
         runs = [(run_skyroute, ())]
         if ompl_available():
             runs += [(run_ompl, (p, b)) for b in budgets for p in planners]
         for run, extra in runs:
-            row = {"world": world.name, "start": start, "goal": goal, "bound": bound,
+            row = {"world": f"{world.name} #{w}", "start": start, "goal": goal,
+                   "bound": bound,
                    **run(world, start, goal, radius, *extra)}
             row["ratio"] = row["length"] / bound if row["length"] is not None else None
             rows.append(row)
@@ -206,3 +225,32 @@ def summary(rows: list[dict]) -> dict:
                 "no_longer": sum(x <= 1.0 + 1e-9 for x in ratios), "compared": len(both),
                 "worst_ratio": max(ratios) if ratios else None}
     return out
+
+
+def tour_benchmark(instances: int = 20, seed: int = 0, *, targets: int = 10,
+                   radius: float = 10.0, headings: int = 16, size: float = 200.0) -> dict:
+    """Seeded random tours in free space (start pose and ``targets`` points in a square
+    of ``size`` metres): the exact tour (Held-Karp), the local search alone (its gap to
+    the exact one) and the greedy nearest-first baseline (how much longer it is)."""
+    from skyroute.motion.tour import tour
+
+    gaps, saving, exact_s, local_s = [], [], [], []
+    for i in range(instances):
+        rng = np.random.default_rng([seed, i])
+        start = (*rng.uniform(0, size, 2), rng.uniform(0, 2 * math.pi))
+        pts = rng.uniform(0, size, (targets, 2))
+        exact = tour(start, pts, radius, headings=headings)
+        local = tour(start, pts, radius, headings=headings, exact_limit=0)
+        gaps.append(local.length / exact.length - 1)
+        saving.append(1 - exact.length / exact.greedy_bound)
+        exact_s.append(exact.seconds)
+        local_s.append(local.seconds)
+    return {"instances": instances, "targets": targets, "radius": radius,
+            "headings": headings,
+            "greedy_longer_mean": float(np.mean(saving)),
+            "greedy_longer_min": float(np.min(saving)),
+            "greedy_longer_max": float(np.max(saving)),
+            "local_gap_mean": float(np.mean(gaps)), "local_gap_max": float(np.max(gaps)),
+            "local_exact": int(sum(g < 1e-9 for g in gaps)),
+            "exact_ms_median": float(np.median(exact_s) * 1e3),
+            "local_ms_median": float(np.median(local_s) * 1e3)}

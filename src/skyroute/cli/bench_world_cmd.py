@@ -24,7 +24,7 @@ from skyroute.bench.world import (
 )
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_list
-from skyroute.errors import check_choice
+from skyroute.errors import OptionError, check_choice
 from skyroute.files import write_atomic
 from skyroute.motion.step_drone import MERGE
 from skyroute.world.load import load_world
@@ -107,7 +107,21 @@ def bench_world(
 
 @bench_app.command("motion")
 def bench_motion(
-    data: Annotated[Path, typer.Option(help="The ILP data folder (website/, testing/).")],
+    data: Annotated[Path | None, typer.Option(
+        help="The ILP data folder (website/, testing/): Dubins batch and step drone.")] =
+        None,
+    curvature: Annotated[bool, typer.Option(
+        "--curvature", help="Hybrid A* vs OMPL RRT*/BIT* on seeded worlds (and --city), "
+                            "then Dubins tours vs nearest-first.")] = False,
+    worlds: Annotated[int, typer.Option(help="--curvature: seeded random worlds.")] = 10,
+    seed: Annotated[int, typer.Option(help="--curvature: seed of worlds and queries.")] = 0,
+    budgets: Annotated[str, typer.Option(
+        help="--curvature: OMPL seconds per solve, comma-separated.")] = "1,5",
+    city: Annotated[Path | None, typer.Option(
+        help="--curvature: also plan on this colliders city (10 m altitude, 2 m safety).")]
+        = None,
+    tours: Annotated[int, typer.Option(
+        help="--curvature: seeded 10-target tour instances (0: none).")] = 20,
     max_expansions: Annotated[int, typer.Option(
         "--max-expansions", "--budget",
         help="plan_moves expansions per leg (--budget: old name).")] = 200_000,
@@ -116,7 +130,13 @@ def bench_motion(
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] =
         None,
 ) -> None:
-    """Dubins batch speed vs OMPL; step-drone fewest moves vs following a Theta* path."""
+    """Dubins batch speed vs OMPL and step-drone fewest moves vs following a Theta* path
+    (--data); Hybrid A* vs OMPL and Dubins tours (--curvature)."""
+    if curvature:
+        _bench_curvature(worlds, seed, budgets, city, tours, json_out)
+        return
+    if data is None:
+        raise OptionError("bench motion needs --data DIR (the ILP data) or --curvature")
     from skyroute.bench.motion import dubins_speed, step_drone_pairs
 
     out = Console()
@@ -141,3 +161,47 @@ def bench_motion(
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(0)
+
+
+def _bench_curvature(worlds, seed, budgets, city, tours, json_out) -> None:
+    from skyroute.bench.curvature import curvature_benchmark, summary, tour_benchmark
+
+    try:
+        secs = tuple(float(b) for b in budgets.split(",") if b.strip())
+    except ValueError:
+        raise OptionError(f"--budgets {budgets!r}: expected seconds like 1,5") from None
+    if worlds < 0 or tours < 0 or any(b <= 0 for b in secs):
+        raise OptionError("--worlds and --tours must be >= 0 and --budgets > 0")
+    out = Console()
+    with Progress(console=Console(stderr=True), transient=True) as progress:
+        task = progress.add_task("planner runs", total=None)
+        rows = curvature_benchmark(worlds, seed, secs, city=city,
+                                   on_step=lambda r: progress.advance(task))
+    summ = summary(rows)
+    table = Table(title="turning radius 5 m: one query per world")
+    for col in ("runner", "solved", "exactly free", "median ratio", "median ms", "p95 ms"):
+        table.add_column(col)
+    for name, s in summ.items():
+        if "found" in s:
+            ratio = f"{s['median_ratio']:.3f}" if s["median_ratio"] is not None else "-"
+            table.add_row(name, f"{s['found']}/{s['queries']}", f"{s['valid']}/{s['found']}",
+                          ratio, f"{s['median_ms']:.1f}", f"{s['p95_ms']:.1f}")
+    out.print(table)
+    for name, s in summ.items():
+        if "compared" in s:
+            worst = f"{s['worst_ratio']:.4f}" if s["worst_ratio"] is not None else "-"
+            out.print(f"{name}: no longer on {s['no_longer']}/{s['compared']}, worst ratio "
+                      f"{worst}; solved by the peer but not by skyroute: "
+                      f"{s['peer_solved_we_missed']}")
+    t = tour_benchmark(tours, seed) if tours else None
+    if t:
+        out.print(f"tours ({t['instances']} x {t['targets']} targets, r {t['radius']:g} m, "
+                  f"{t['headings']} headings): nearest-first is {t['greedy_longer_mean']:.1%} "
+                  f"longer on average (min {t['greedy_longer_min']:.1%}, max "
+                  f"{t['greedy_longer_max']:.1%}); local search alone {t['local_gap_mean']:.2%} "
+                  f"above the exact tour on average (max {t['local_gap_max']:.2%}, exact on "
+                  f"{t['local_exact']}); exact {t['exact_ms_median']:.0f} ms, local "
+                  f"{t['local_ms_median']:.0f} ms median")
+    if json_out:
+        write_atomic(json_out, json.dumps({"rows": rows, "summary": summ, "tours": t},
+                                          indent=1, default=str))
