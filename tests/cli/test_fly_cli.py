@@ -37,7 +37,8 @@ def test_step_drone_moves_and_follow(monkeypatch, capsys, tmp_path):
 
 def test_dubins_and_lattice(monkeypatch, capsys, tmp_path, city):
     code, text, err = run(monkeypatch, capsys, "fly", city, "--frame", "local", "--vehicle",
-                          "dubins", "--radius", "8", "--start", "0,0", "--goal", "120,-180",
+                          "dubins", "--planner", "waypoints", "--radius", "8", "--start", "0,0",
+                          "--goal", "120,-180",
                           "--altitude", "10", "--safety", "2", "--json")
     assert code == 0, err
     m = json.loads(text)["metrics"]
