@@ -1,0 +1,234 @@
+"""A fleet scenario: airports with their runways and gates, the drone type, the package
+stream and the airspace rules. Every parameter has the seed's default; files are YAML or
+TOML, validated with pydantic, and an error names the file and the field.
+
+Positions are metres north and east of the scenario's ``home`` (lat, lon), the ``ned``
+frame of docs/architecture.md; runway headings are compass degrees (clockwise from
+north). An airport's two runways cross at its position; each has its threshold at the
+end a drone meets first (landing) or starts from (take-off). Its two gates stand beside
+it, ``gate_width`` apart.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from skyroute.errors import InputFormatError, OptionError
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Runway(_Strict):
+    """A straight runway through its airport's position."""
+
+    heading_deg: float = Field(ge=0, lt=360, description="compass heading of travel")
+    length: float = Field(default=600.0, gt=0, description="metres")
+
+
+class Airport(_Strict):
+    """An airport: position, a landing and a take-off runway, two gates."""
+
+    id: str = Field(min_length=1)
+    north: float
+    east: float
+    landing: Runway
+    takeoff: Runway
+    gate_width: float = Field(default=30.0, gt=0, description="metres between gate centres")
+
+
+class Drone(_Strict):
+    """The fixed-wing type every drone of the fleet is."""
+
+    cruise_speed: float = Field(default=50.0, gt=0, description="m/s")
+    turn_radius: float = Field(default=250.0, gt=0, description="m")
+    climb_angle_deg: float = Field(default=20.0, gt=0, lt=90)
+    landing_speed: float = Field(default=40.0, gt=0, description="m/s at touchdown")
+    rollout: float = Field(default=192.0, gt=0, description="m from touchdown to a stop")
+    glide_angle_deg: float = Field(default=6.0, gt=0, lt=45)
+    taxi_speed: float = Field(default=10.0, gt=0)
+    taxi_near_speed: float = Field(default=3.0, gt=0, description="within one gate width")
+    taxi_gate_speed: float = Field(default=1.0, gt=0, description="within half a gate width")
+
+    @model_validator(mode="after")
+    def _speeds(self) -> Drone:
+        if self.landing_speed > self.cruise_speed:
+            raise ValueError("landing_speed must not exceed cruise_speed")
+        return self
+
+
+class Packages(_Strict):
+    """Where packages come from: a seeded Poisson stream or an explicit CSV."""
+
+    rate_per_hour: float = Field(default=60.0, ge=0)
+    csv: str | None = Field(default=None, description="t,from_airport,from_gate,"
+                                                      "to_airport,to_gate")
+
+
+class Airspace(_Strict):
+    """Cruise levels and separation minima."""
+
+    mode: Literal["layers", "shared"] = "layers"
+    sep_horizontal: float = Field(default=50.0, gt=0)
+    sep_vertical: float = Field(default=10.0, gt=0)
+    base_altitude: float = Field(default=50.0, ge=50.0, description="lowest cruise level")
+    layer_step: float = Field(default=10.0, gt=0)
+    shared_levels: int = Field(default=4, ge=1, description="levels by direction")
+
+
+class Scenario(_Strict):
+    """Everything a fleet simulation needs besides the hours, seed and dispatcher."""
+
+    name: str = "scenario"
+    home_lat: float = Field(default=50.8798, ge=-90, le=90)  # Leuven
+    home_lon: float = Field(default=4.7005, ge=-180, le=180)
+    airports: list[Airport] = Field(min_length=2)
+    drones: int = Field(default=3, ge=1)
+    drone: Drone = Drone()
+    packages: Packages = Packages()
+    airspace: Airspace = Airspace()
+
+    @model_validator(mode="after")
+    def _layout(self) -> Scenario:
+        ids = [a.id for a in self.airports]
+        if len(set(ids)) != len(ids):
+            raise ValueError(f"airport ids must be unique, got {ids}")
+        pos = np.array([[a.north, a.east] for a in self.airports])
+        d = np.hypot(*(pos[:, None] - pos[None]).transpose(2, 0, 1))
+        np.fill_diagonal(d, np.inf)
+        i, j = np.unravel_index(np.argmin(d), d.shape)
+        need = max(max(a.landing.length, a.takeoff.length) for a in self.airports)
+        if d[i, j] < need:
+            raise ValueError(f"airports {ids[i]} and {ids[j]} are {d[i, j]:.0f} m apart, "
+                             f"closer than a runway ({need:g} m)")
+        return self
+
+    def airport(self, airport_id: str) -> Airport:
+        """The airport of that id."""
+        for a in self.airports:
+            if a.id == airport_id:
+                return a
+        raise OptionError(f"no airport {airport_id!r}; airports: "
+                          + ", ".join(a.id for a in self.airports))
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read a YAML (.yaml, .yml) or TOML (.toml) scenario; errors name file and field."""
+    p = Path(path)
+    try:
+        text = p.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputFormatError(p, f"cannot read: {exc}") from None
+    if p.suffix.lower() == ".toml":
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise InputFormatError(p, f"not TOML: {exc}") from None
+    elif p.suffix.lower() in (".yaml", ".yml"):
+        import yaml
+
+        try:
+            data = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            raise InputFormatError(p, f"not YAML: {getattr(exc, 'problem', exc)}",
+                                   line=mark.line + 1 if mark else None) from None
+    else:
+        raise InputFormatError(p, f"unknown scenario type {p.suffix!r}; valid: .yaml, .yml, "
+                               ".toml")
+    return parse_scenario(data, p)
+
+
+def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
+    """A Scenario from plain data; the first error as one line naming the field."""
+    if not isinstance(data, dict):
+        raise InputFormatError(where, "expected a mapping of scenario fields")
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err["loc"])
+        msg = err["msg"].removeprefix("Value error, ")
+        raise InputFormatError(where, f"{field.lstrip('.') or 'scenario'}: {msg}") from None
+
+
+def generate(airports: int, drones: int, *, area_km: float = 8.0, seed: int = 0,
+             rate_per_hour: float | None = None) -> Scenario:
+    """A valid scenario: ``airports`` spread over an ``area_km`` square (at least 1.5
+    runways apart), runway headings seeded, ``drones`` drones."""
+    if airports < 2 or drones < 1 or not area_km > 0:
+        raise OptionError(f"airports={airports} must be >= 2, drones={drones} >= 1 and "
+                          f"area_km={area_km} > 0", param="airports")
+    rng = np.random.default_rng(seed)
+    size = area_km * 1000.0
+    spacing = 900.0
+    pts: list[np.ndarray] = []
+    for _ in range(10000):
+        if len(pts) == airports:
+            break
+        p = rng.uniform(0, size, 2)
+        if all(np.hypot(*(p - q)) >= spacing for q in pts):
+            pts.append(p)
+    else:
+        raise OptionError(f"airports={airports}: cannot place them {spacing:g} m apart in "
+                          f"{area_km:g} km", param="airports")
+    centre = size / 2
+    ports = []
+    for k, p in enumerate(pts):
+        land = float(rng.integers(0, 36) * 10)
+        ports.append(Airport(id=_name(k), north=round(float(p[0] - centre), 1),
+                             east=round(float(p[1] - centre), 1),
+                             landing=Runway(heading_deg=land),
+                             takeoff=Runway(heading_deg=(land + 90) % 360)))
+    rate = 20.0 * airports if rate_per_hour is None else rate_per_hour
+    return Scenario(name=f"{airports}x{drones}", airports=ports, drones=drones,
+                    packages=Packages(rate_per_hour=rate))
+
+
+PRESETS = {  # (airports, drones, area km, rate per hour): the seed's set-ups
+    "seed-3x3": (3, 3, 4.0, 60.0),
+    "seed-9x9": (9, 9, 8.0, 120.0),
+    "seed-18x9": (9, 18, 8.0, 180.0),
+}
+
+
+def preset(name: str) -> Scenario:
+    """One of the seed's set-ups (:data:`PRESETS`: drones, airports, area, offered rate)."""
+    if name not in PRESETS:
+        raise OptionError(f"preset={name!r} is not valid; choose one of "
+                          + ", ".join(repr(k) for k in PRESETS), param="preset")
+    airports, drones, area, rate = PRESETS[name]
+    s = generate(airports, drones, area_km=area, seed=0, rate_per_hour=rate)
+    return s.model_copy(update={"name": name})
+
+
+def to_yaml(s: Scenario) -> str:
+    """The scenario as YAML text (every field, defaults included, ready to edit)."""
+    import yaml
+
+    return yaml.safe_dump(s.model_dump(), sort_keys=False)
+
+
+def _name(k: int) -> str:
+    """A, B, ..., Z, AA, AB, ..."""
+    out = ""
+    k += 1
+    while k:
+        k, r = divmod(k - 1, 26)
+        out = chr(65 + r) + out
+    return out
+
+
+def runway_ends(a: Airport, runway: Runway) -> tuple[np.ndarray, np.ndarray]:
+    """(threshold, far end) of a runway through the airport, (north, east) metres."""
+    h = math.radians(runway.heading_deg)
+    d = np.array([math.cos(h), math.sin(h)]) * runway.length / 2
+    c = np.array([a.north, a.east])
+    return c - d, c + d
