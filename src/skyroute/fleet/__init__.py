@@ -1,0 +1,1 @@
+"""The fleet: drones flying between airports, their trajectories and their separation."""
