@@ -352,8 +352,7 @@ class Trajectory:
 
     def _add(self, piece: Piece) -> Trajectory:
         self._rows.append(piece)
-        one = Pieces.from_rows([piece])
-        self._pos = one.end()[0]
+        self._pos = _end(piece)
         self._t = piece.t1
         return self
 
@@ -403,6 +402,16 @@ class Trajectory:
     def pieces(self) -> Pieces:
         """The pieces built so far."""
         return Pieces.from_rows(self._rows)
+
+
+def _end(p: Piece) -> np.ndarray:
+    """Where piece ``p`` ends (the same formulas as :meth:`Pieces.at`)."""
+    d = p.t1 - p.t0
+    if p.kind == ARC:
+        th = p.angle + p.rate * d
+        return np.array([p.north + p.radius * np.cos(th), p.east + p.radius * np.sin(th),
+                         p.alt + p.v_alt * d])
+    return np.array([p.north + p.v_north * d, p.east + p.v_east * d, p.alt + p.v_alt * d])
 
 
 def _finite(name: str, value) -> float:
