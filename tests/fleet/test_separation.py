@@ -316,6 +316,15 @@ def test_small_fleet_agrees_with_brute_force_sampling():
         assert c.min_horizontal_m < 50 and c.vertical_m_at_min <= 10
 
 
+def test_across_cores_the_report_is_the_same(monkeypatch):
+    from skyroute.fleet import separation
+
+    f = synthetic_fleet(30, 0.5, seed=5, size=8000.0, airports=5)
+    serial = check(f)
+    monkeypatch.setattr(separation, "_SERIAL_BELOW", 0)  # the prange kernels
+    assert check(f) == serial
+
+
 def test_row_order_does_not_change_the_report():
     f = synthetic_fleet(30, 0.5, seed=5, size=8000.0, airports=5)
     perm = np.random.default_rng(0).permutation(len(f))
