@@ -111,10 +111,13 @@ class SeparationReport:
     (piece-pair stretches of the same two drones that overlap or touch are merged),
     ordered by drones then time. ``min_horizontal_m``: the smallest horizontal distance
     between two drones at a time they were closer than ``sep_vertical`` vertically (the
-    closest approach that matters; ``inf`` if never). ``min_vertical_m``: the smallest
-    vertical distance at a time they were closer than ``sep_horizontal`` horizontally
-    (``inf`` if never). ``pairs_checked``: piece pairs that passed the broad phase and were
-    examined exactly.
+    closest approach that matters; ``inf`` if never), a lower bound within ``tolerance``.
+    ``min_vertical_m``: the smallest vertical distance at a time they were closer than
+    ``sep_horizontal`` horizontally (``inf`` if never), taken over the same conservative
+    stretches as the conflicts (which may include times up to ``sep_horizontal +
+    tolerance`` apart), so never above the truth. ``pairs_checked``: piece pairs that
+    passed the broad phase and were examined exactly. The minima and the tolerance used
+    are kept as ``sep_horizontal``, ``sep_vertical``, ``tolerance``.
     """
 
     conflicts: tuple[Conflict, ...]
