@@ -5,7 +5,8 @@ import importlib
 
 import pytest
 
-MODULES = ["skyroute.world.grid", "skyroute.world.load", "skyroute.planner"]
+MODULES = ["skyroute.world.grid", "skyroute.world.load", "skyroute.planner",
+           "skyroute.fleet.trajectory", "skyroute.fleet.separation"]
 
 
 @pytest.mark.parametrize("name", MODULES)
