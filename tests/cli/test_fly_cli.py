@@ -21,6 +21,7 @@ def city(tmp_path, monkeypatch, capsys):
     return str(p)
 
 
+@pytest.mark.shared_data
 def test_step_drone_moves_and_follow(monkeypatch, capsys, tmp_path):
     out = tmp_path / "moves.csv"
     code, text, err = run(monkeypatch, capsys, "fly", ZONES, "--boundary", BOX, AT, SODERBERG,
@@ -65,6 +66,7 @@ def test_field_arc_mode(monkeypatch, capsys, tmp_path, city):
     assert code == 2 and "mode='glide' is not valid" in text + _
 
 
+@pytest.mark.shared_data
 @pytest.mark.parametrize("args, words", [
     (["--vehicle", "boat"], "vehicle='boat' is not valid"),
     (["--planner", "greedy"], "planner='greedy' is not valid"),

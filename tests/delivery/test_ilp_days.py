@@ -14,7 +14,7 @@ from tests.conftest import SHARED
 from tests.delivery.flight_check import check_day, money_pct, order_book, website
 
 ILP = SHARED / "ilp2021"
-pytestmark = pytest.mark.skipif(not ILP.exists(), reason="ILP data not beside the repo")
+pytestmark = pytest.mark.shared_data
 MARKER_DATES = ["2022-01-01", "2022-06-06", "2022-12-12", "2023-06-06", "2023-12-12"]
 PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1:5432/test")
 

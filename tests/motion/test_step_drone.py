@@ -15,7 +15,7 @@ from skyroute.motion.step_drone import HOVER, STEP, Flight, follow, plan_moves
 from tests.conftest import SHARED
 
 ILP = SHARED / "ilp2021"
-pytestmark = pytest.mark.skipif(not ILP.exists(), reason="ILP data not beside the repo")
+pytestmark = pytest.mark.shared_data
 AT = (-3.186874, 55.944494)
 AREA = (-3.192473, 55.942617, -3.184319, 55.946233)
 
