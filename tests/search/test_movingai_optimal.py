@@ -35,9 +35,9 @@ def test_optimal_costs_match_scenarios(map_path, scen_path):
             assert walked == pytest.approx(r.cost, rel=1e-9)
 
 
-@pytest.mark.shared_data
 def test_scenario_costs_fail_with_corner_cutting():
-    # The control of SOURCES.md: allowing corner cutting gives shorter, wrong costs.
+    # The control of SOURCES.md: allowing corner cutting gives shorter, wrong costs. It
+    # needs only the den312d map and scenarios bundled with skyroute, so it always runs.
     grid = skyroute.load_map("den312d")
     scen = read_scen(skyroute.bundled_maps()["den312d"].with_suffix(".map.scen"))
     shorter = 0
