@@ -2,8 +2,11 @@
 
 import csv
 import json
+import math
 
+import numpy as np
 import pytest
+import shapely
 
 import skyroute
 from tests.cli.test_cli import run
@@ -41,15 +44,21 @@ def test_dubins_and_lattice(monkeypatch, capsys, tmp_path, city):
                           "dubins", "--radius", "8", "--start", "0,0", "--goal", "120,-180",
                           "--altitude", "10", "--safety", "2", "--json")
     assert code == 0, err
-    m = json.loads(text)["metrics"]
-    assert m["length"] > 0 and isinstance(m["free"], bool) and len(m["words"].split()) >= 1
+    doc = json.loads(text)
+    m, track = doc["metrics"], shapely.LineString(np.array(doc["trajectory"])[:, :2])
+    assert m["length"] >= math.dist((0, 0), (-180, 120)) and track.length <= m["length"] + 1e-9
+    world = skyroute.load_world(city, frame="local", altitude=10, safety=2)
+    enters = shapely.unary_union(world.obstacles).relate_pattern(track, "T********")
+    assert m["free"] is (not enters)  # the samples checked again with shapely alone
+    assert set(m["words"].split()) <= {"LSL", "RSR", "LSR", "RSL", "RLR", "LRL"}
     gj = tmp_path / "lattice.geojson"
     code, text, err = run(monkeypatch, capsys, "fly", city, "--frame", "local", "--vehicle",
                           "lattice", "--start", "0,0", "--goal", "120,-180", "--altitude",
                           "10", "--safety", "2", "--resolution", "2", "--json", "--out",
                           str(gj))
     assert code == 0, err
-    assert json.loads(text)["metrics"]["time"] > 0
+    m = json.loads(text)["metrics"]
+    assert m["time"] >= m["length"] / 2  # 1 cell (2 m) a second, plus time to turn
     assert json.loads(gj.read_text())["features"][0]["geometry"]["type"] == "LineString"
 
 
