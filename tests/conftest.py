@@ -38,6 +38,31 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(skip, append=False)  # before parametrize's 'empty parameter set'
 
 
+@pytest.fixture(scope="session")
+def _flown_days() -> dict:
+    return {}
+
+
+@pytest.fixture
+def fly_once(monkeypatch, _flown_days):
+    """``plan_day`` flying each delivery day once per session, and put in place of the one
+    ``skyroute deliver`` calls in-process (``--jobs 1``): a day of the same data source,
+    date, orders, method and battery is the first flight of it. For tests of what is done
+    with a day (tables, files, stores); the flights themselves are checked by the tests
+    that fly them."""
+    from skyroute.delivery import day, days
+
+    def plan_day(site, date, orders, *, method="milp", battery=day.BATTERY):
+        key = (site.source, date, tuple(orders), method, battery)
+        if key not in _flown_days:
+            _flown_days[key] = day.plan_day(site, date, orders, method=method,
+                                            battery=battery)
+        return _flown_days[key]
+
+    monkeypatch.setattr(days, "plan_day", plan_day)
+    return plan_day
+
+
 @pytest.fixture(scope="session", autouse=True)
 def leg_cache(tmp_path_factory):
     """Delivery leg tables go to one temporary cache for the whole run, not ~/.cache."""

@@ -59,7 +59,8 @@ def site():
 
 
 @pytest.mark.parametrize("date", MARKER_DATES)
-def test_marker_dates_are_legal_and_pay(monkeypatch, capsys, ilp_store, book, site, date):
+def test_marker_dates_are_legal_and_pay(monkeypatch, capsys, ilp_store, book, site, date,
+                                        fly_once):
     url, out = ilp_store
     code, text, err = run(monkeypatch, capsys, "deliver", date, "--data", str(ILP), "--db",
                           url, "--out", str(out), "--json", "--no-plot")
@@ -82,7 +83,7 @@ def test_marker_dates_are_legal_and_pay(monkeypatch, capsys, ilp_store, book, si
     assert line["type"] == "LineString" and len(line["coordinates"]) == len(flight) + 1
 
 
-def test_sqlite_and_postgresql_store_identical_rows(monkeypatch, capsys, tmp_path):
+def test_sqlite_and_postgresql_store_identical_rows(monkeypatch, capsys, tmp_path, fly_once):
     try:
         eng = sa.create_engine(PG)
         with eng.begin() as c:  # a clean schema for this test
@@ -95,7 +96,7 @@ def test_sqlite_and_postgresql_store_identical_rows(monkeypatch, capsys, tmp_pat
             raise
         pytest.skip("no PostgreSQL server")
     lite = f"sqlite:///{tmp_path / 'a.db'}"
-    date = "2023-06-06"
+    date = "2023-06-06"  # flown once (fly_once), stored in both: the stores are compared
     for url in (lite, PG):
         code, _, err = run(monkeypatch, capsys, "deliver", date, "--data", str(ILP), "--db",
                            url, "--out", str(tmp_path), "--no-plot")
