@@ -33,6 +33,7 @@ def readme_cli_examples() -> list[str]:
             if line.strip().startswith("skyroute ")]
 
 
+@pytest.mark.slow
 def test_readme_cli_examples_run_in_order(monkeypatch, capsys, tmp_path):
     import shlex
     import sys

@@ -58,6 +58,7 @@ def site():
     return website(ILP)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("date", MARKER_DATES)
 def test_marker_dates_are_legal_and_pay(monkeypatch, capsys, ilp_store, book, site, date,
                                         fly_once):

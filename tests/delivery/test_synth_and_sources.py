@@ -28,6 +28,7 @@ def same_tree(a, b) -> bool:
     return all(same_tree(a / d, b / d) for d in cmp.common_dirs)
 
 
+@pytest.mark.slow
 def test_shipped_example_is_what_synth_writes(monkeypatch, capsys, tmp_path):
     code, out, err = run(monkeypatch, capsys, "data", "synth", str(tmp_path / "lunch"),
                          "--days", "3", "--orders-per-day", "36")
@@ -36,6 +37,7 @@ def test_shipped_example_is_what_synth_writes(monkeypatch, capsys, tmp_path):
     assert same_tree(EXAMPLE, tmp_path / "lunch")
 
 
+@pytest.mark.slow
 def test_synthetic_days_fly_legal_flights(monkeypatch, capsys, tmp_path):
     url = f"sqlite:///{tmp_path / 's.db'}"
     code, out, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
