@@ -8,6 +8,7 @@ every marked test is skipped with one reason, and the rest of the suite still ru
 
 from __future__ import annotations
 
+import hashlib
 import os
 from pathlib import Path
 
@@ -43,17 +44,34 @@ def _flown_days() -> dict:
     return {}
 
 
+def _site_key(source) -> object:
+    """What a site is loaded from: the bytes of every file of a data folder's website/
+    (two folders with the same files are the same site), or the server's URL."""
+    root = getattr(source, "root", None)
+    if root is None:
+        return source
+    web = Path(root) / "website"
+    digest = hashlib.sha256()
+    for p in sorted(web.rglob("*")):
+        if p.is_file():
+            digest.update(str(p.relative_to(web)).encode() + b"\0" + p.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
 @pytest.fixture
 def fly_once(monkeypatch, _flown_days):
-    """``plan_day`` flying each delivery day once per session, and put in place of the one
-    ``skyroute deliver`` calls in-process (``--jobs 1``): a day of the same data source,
-    date, orders, method and battery is the first flight of it. For tests of what is done
-    with a day (tables, files, stores); the flights themselves are checked by the tests
-    that fly them."""
+    """``plan_day`` flying each delivery day once per session, put in place of the one
+    ``skyroute deliver`` calls: a day of the same site (see ``_site_key``), date, orders,
+    method and battery is the first flight of it. ``--jobs N`` workers are forked from the
+    test's process and so reuse the days flown before them too. For tests of what is done
+    with a day (tables, files, stores, worker processes); the flights themselves are
+    checked by the tests that fly them (and, run alone, any test here flies its days).
+    Not for tests that change the planner's inputs by other means (e.g. a patched leg
+    table): the key would not see it."""
     from skyroute.delivery import day, days
 
     def plan_day(site, date, orders, *, method="milp", battery=day.BATTERY):
-        key = (site.source, date, tuple(orders), method, battery)
+        key = (_site_key(site.source), date, tuple(orders), method, battery)
         if key not in _flown_days:
             _flown_days[key] = day.plan_day(site, date, orders, method=method,
                                             battery=battery)

@@ -34,7 +34,9 @@ def readme_cli_examples() -> list[str]:
 
 
 @pytest.mark.slow
-def test_readme_cli_examples_run_in_order(monkeypatch, capsys, tmp_path):
+def test_readme_cli_examples_run_in_order(monkeypatch, capsys, tmp_path, fly_once):
+    """Each command as written, in one folder, exit code 0. Delivery days the suite has
+    already flown from the same data are reused (fly_once); run alone, it flies them."""
     import shlex
     import sys
 

@@ -38,7 +38,7 @@ def test_shipped_example_is_what_synth_writes(monkeypatch, capsys, tmp_path):
 
 
 @pytest.mark.slow
-def test_synthetic_days_fly_legal_flights(monkeypatch, capsys, tmp_path):
+def test_synthetic_days_fly_legal_flights(monkeypatch, capsys, tmp_path, fly_once):
     url = f"sqlite:///{tmp_path / 's.db'}"
     code, out, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
                          "2024-01-03", "--data", str(EXAMPLE), "--db", url, "--out",
