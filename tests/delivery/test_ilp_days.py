@@ -84,7 +84,8 @@ def test_marker_dates_are_legal_and_pay(monkeypatch, capsys, ilp_store, book, si
     assert line["type"] == "LineString" and len(line["coordinates"]) == len(flight) + 1
 
 
-def test_sqlite_and_postgresql_store_identical_rows(monkeypatch, capsys, tmp_path, fly_once):
+def test_sqlite_and_postgresql_store_identical_rows(monkeypatch, capsys, tmp_path, ilp_store,
+                                                    fly_once):
     try:
         eng = sa.create_engine(PG)
         with eng.begin() as c:  # a clean schema for this test
@@ -96,7 +97,7 @@ def test_sqlite_and_postgresql_store_identical_rows(monkeypatch, capsys, tmp_pat
         if os.environ.get("CI"):
             raise
         pytest.skip("no PostgreSQL server")
-    lite = f"sqlite:///{tmp_path / 'a.db'}"
+    lite = ilp_store[0]  # the marker days' SQLite store: its orders are imported already
     date = "2023-06-06"  # flown once (fly_once), stored in both: the stores are compared
     for url in (lite, PG):
         code, _, err = run(monkeypatch, capsys, "deliver", date, "--data", str(ILP), "--db",
