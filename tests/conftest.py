@@ -64,8 +64,9 @@ def fly_once(monkeypatch, _flown_days):
     ``skyroute deliver`` calls: a day of the same site (see ``_site_key``), date, orders,
     method and battery is the first flight of it. ``--jobs N`` workers are forked from the
     test's process and so reuse the days flown before them too. For tests of what is done
-    with a day (tables, files, stores, worker processes); the flights themselves are
-    checked by the tests that fly them (and, run alone, any test here flies its days).
+    with a day (tables, files, stores, worker processes); every stored move of the
+    synthetic and ILP days is checked independently (tests/delivery/flight_check.py) by
+    the synthetic range and the ILP marker-day tests. Run alone, a test flies its days.
     Not for tests that change the planner's inputs by other means (e.g. a patched leg
     table): the key would not see it."""
     from skyroute.delivery import day, days
