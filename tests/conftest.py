@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import hashlib
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -37,6 +39,35 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.get_closest_marker("shared_data"):
             item.add_marker(skip, append=False)  # before parametrize's 'empty parameter set'
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _early_processes(request, tmp_path_factory, leg_cache):
+    """The separate processes that the selected tests marked ``early_process(*args)`` check,
+    all started (``python *args``, each in a folder of its own) when the run begins: they
+    then run on the second core beside the in-process tests, not after them. Each test
+    waits for its own through the ``early_process`` fixture."""
+    started = {}
+    for item in request.session.items:
+        mark = item.get_closest_marker("early_process")
+        if mark is not None and item.get_closest_marker("skip") is None:
+            cwd = tmp_path_factory.mktemp("process")
+            started[item.nodeid] = cwd, subprocess.Popen(
+                [sys.executable, *mark.args], cwd=cwd, stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE, text=True)
+    yield started
+    for _, proc in started.values():  # a test that never ran (-x, Ctrl-C): stop its process
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+@pytest.fixture
+def early_process(request, _early_processes):
+    """(exit code, stdout, stderr, folder) of this test's ``early_process``, once it ends."""
+    cwd, proc = _early_processes[request.node.nodeid]
+    out, err = proc.communicate(timeout=300)
+    return proc.returncode, out, err, cwd
 
 
 @pytest.fixture(scope="session")

@@ -1,7 +1,6 @@
 """The CLI through its real entry point: output, exit codes, one-line errors, no partial files."""
 
 import json
-import subprocess
 import sys
 
 import pytest
@@ -124,11 +123,14 @@ def test_bench_grid_runs_and_reports_missing_peers(monkeypatch, capsys, tmp_path
     assert "den312d" in out
 
 
-def test_module_entry_point_has_no_traceback():
-    p = subprocess.run([sys.executable, "-m", "skyroute", "plan", "den312d", "--start", "0,0",
-                        "--goal", "1,1"], capture_output=True, text=True, timeout=120)
-    assert p.returncode == 2
-    assert p.stderr == "skyroute: error: start (0, 0) is on a blocked cell\n"
+@pytest.mark.early_process("-m", "skyroute", "plan", "den312d", "--start", "0,0", "--goal",
+                           "1,1")
+def test_module_entry_point_has_no_traceback(early_process):
+    # The one test of the real 'python -m skyroute' process: exit code 2 and a single
+    # line on stderr, nothing else (no traceback, no warning at start or exit).
+    code, out, err, _ = early_process
+    assert code == 2 and out == ""
+    assert err == "skyroute: error: start (0, 0) is on a blocked cell\n"
 
 
 def test_bench_malformed_scen_names_file_and_line(monkeypatch, capsys, tmp_path):
