@@ -1,11 +1,14 @@
-"""The docstring examples run as written."""
+"""The docstring and README examples run as written."""
 
 import doctest
+import filecmp
 import importlib
+import json
 
 import pytest
 
 MODULES = ["skyroute.world.grid", "skyroute.world.load", "skyroute.planner",
+           "skyroute.fleet.vehicle",
            "skyroute.fleet.trajectory", "skyroute.fleet.separation"]
 
 
@@ -34,21 +37,40 @@ def readme_cli_examples() -> list[str]:
             if line.strip().startswith("skyroute ")]
 
 
-def test_readme_cli_examples_run_in_order(monkeypatch, capsys, tmp_path):
+def same_tree(a, b) -> bool:
+    cmp = filecmp.dircmp(a, b)
+    if cmp.left_only or cmp.right_only or cmp.diff_files or cmp.funny_files:
+        return False
+    return all(same_tree(a / d, b / d) for d in cmp.common_dirs)
+
+
+@pytest.mark.slow
+def test_readme_cli_examples_run_in_order(monkeypatch, capsys, tmp_path, fly_once):
+    """Each command as written, in one folder, exit code 0. Delivery days the suite has
+    already flown from the same data are reused (fly_once); run alone, it flies them."""
     import shlex
     import sys
 
     from skyroute.cli.app import main
+    from tests.conftest import ROOT
 
     commands = readme_cli_examples()
     assert len(commands) >= 8
     monkeypatch.chdir(tmp_path)  # one folder: later examples read earlier outputs
+    printed = {}
     for command in commands:
         monkeypatch.setattr(sys, "argv", shlex.split(command))
         with pytest.raises(SystemExit) as exit_info:
             main()
-        assert exit_info.value.code == 0, (command, capsys.readouterr().err)
+        out, err = capsys.readouterr()
+        assert exit_info.value.code == 0, (command, err)
+        printed[command] = out
     assert (tmp_path / "city.png").exists() and (tmp_path / "city-waypoints.json").exists()
+    # The README's 'data synth' command writes what the repository ships in examples/lunch
+    # (the set the README's set-up command flies), file for file.
+    synth = next(c for c in commands if c.startswith("skyroute data synth "))
+    assert json.loads(printed[synth].replace("\n", ""))["orders"] == 108
+    assert same_tree(ROOT / "examples" / "lunch", tmp_path / shlex.split(synth)[3])
 
 
 def test_readme_lonlat_city_matches_plan_world(monkeypatch, capsys):

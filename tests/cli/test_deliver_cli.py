@@ -12,7 +12,7 @@ from tests.conftest import ROOT
 EXAMPLE = str(ROOT / "examples" / "lunch")
 
 
-def test_one_day_writes_its_files_and_table(monkeypatch, capsys, tmp_path):
+def test_one_day_writes_its_files_and_table(monkeypatch, capsys, tmp_path, fly_once):
     db = f"sqlite:///{tmp_path / 'd.db'}"
     code, out, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data", EXAMPLE,
                          "--db", db, "--out", str(tmp_path / "out"))
@@ -32,7 +32,7 @@ def test_one_day_writes_its_files_and_table(monkeypatch, capsys, tmp_path):
     assert empty["orders_placed"] == 0 and empty["moves"] == 0 and empty["money_pct"] is None
 
 
-def test_range_prints_a_monthly_table(monkeypatch, capsys, tmp_path):
+def test_range_prints_a_monthly_table(monkeypatch, capsys, tmp_path, fly_once):
     code, out, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
                          "2024-01-02", "--data", EXAMPLE, "--db",
                          f"sqlite:///{tmp_path / 'r.db'}", "--out", str(tmp_path))

@@ -2,8 +2,11 @@
 
 import csv
 import json
+import math
 
+import numpy as np
 import pytest
+import shapely
 
 import skyroute
 from tests.cli.test_cli import run
@@ -21,6 +24,7 @@ def city(tmp_path, monkeypatch, capsys):
     return str(p)
 
 
+@pytest.mark.shared_data
 def test_step_drone_moves_and_follow(monkeypatch, capsys, tmp_path):
     out = tmp_path / "moves.csv"
     code, text, err = run(monkeypatch, capsys, "fly", ZONES, "--boundary", BOX, AT, SODERBERG,
@@ -41,15 +45,23 @@ def test_dubins_and_lattice(monkeypatch, capsys, tmp_path, city):
                           "--goal", "120,-180",
                           "--altitude", "10", "--safety", "2", "--json")
     assert code == 0, err
-    m = json.loads(text)["metrics"]
-    assert m["length"] > 0 and isinstance(m["free"], bool) and len(m["words"].split()) >= 1
+    doc = json.loads(text)
+    world = skyroute.load_world(city, frame="local", altitude=10, safety=2)
+    # the trajectory is (north, east) in the ned frame; shapely works in the plane
+    m = doc["metrics"]
+    track = shapely.LineString(world.to_plane(np.array(doc["trajectory"])[:, :2]))
+    assert m["length"] >= math.dist((0, 0), (-180, 120)) and track.length <= m["length"] + 1e-9
+    enters = shapely.unary_union(world.obstacles).relate_pattern(track, "T********")
+    assert m["free"] is (not enters)  # the samples checked again with shapely alone
+    assert set(m["words"].split()) <= {"LSL", "RSR", "LSR", "RSL", "RLR", "LRL"}
     gj = tmp_path / "lattice.geojson"
     code, text, err = run(monkeypatch, capsys, "fly", city, "--frame", "local", "--vehicle",
                           "lattice", "--start", "0,0", "--goal", "120,-180", "--altitude",
                           "10", "--safety", "2", "--resolution", "2", "--json", "--out",
                           str(gj))
     assert code == 0, err
-    assert json.loads(text)["metrics"]["time"] > 0
+    m = json.loads(text)["metrics"]
+    assert m["time"] >= m["length"] / 1.0  # the default 1 m/s, plus the time to turn
     assert json.loads(gj.read_text())["features"][0]["geometry"]["type"] == "LineString"
 
 
@@ -66,6 +78,7 @@ def test_field_arc_mode(monkeypatch, capsys, tmp_path, city):
     assert code == 2 and "--field-mode 'glide' is not valid" in text + _
 
 
+@pytest.mark.shared_data
 @pytest.mark.parametrize("args, words", [
     (["--vehicle", "boat"], "--vehicle 'boat' is not valid"),
     (["--planner", "greedy"], "--planner 'greedy' is not valid"),

@@ -12,6 +12,7 @@ ZONES = str(SHARED / "ilp2021" / "website" / "buildings" / "no-fly-zones.geojson
 BOX = str(SHARED / "ilp2021" / "testing" / "confinement-zone.geojson")
 
 
+@pytest.mark.shared_data
 def test_fcnd_json_waypoints_geojson_plot(monkeypatch, capsys, tmp_path):
     wp, gj, png = tmp_path / "wp.json", tmp_path / "p.geojson", tmp_path / "p.png"
     code, out, err = run(monkeypatch, capsys, "plan-world", FCND, "--start=-122.397450,37.792480",
@@ -32,6 +33,7 @@ def test_fcnd_json_waypoints_geojson_plot(monkeypatch, capsys, tmp_path):
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.shared_data
 def test_local_frame_and_degrees_frame(monkeypatch, capsys):
     code, out, _ = run(monkeypatch, capsys, "plan-world", FCND, "--frame", "local",
                        "--start", "0,0", "--goal", "305.45,90.01", "--altitude", "5",
@@ -44,6 +46,7 @@ def test_local_frame_and_degrees_frame(monkeypatch, capsys):
     assert code == 0 and doc["path_local"] == doc["path_lonlat"] and doc["cost"] < 0.01
 
 
+@pytest.mark.shared_data
 @pytest.mark.parametrize("args, words", [
     (["--start=-3.1950,55.944", "--goal=-3.1913,55.9455"], "start (-3.1950000, 55.9440000) lies "
      "outside the map"),

@@ -14,7 +14,7 @@ from tests.conftest import SHARED
 from tests.delivery.flight_check import check_day, money_pct, order_book, website
 
 ILP = SHARED / "ilp2021"
-pytestmark = pytest.mark.skipif(not ILP.exists(), reason="ILP data not beside the repo")
+pytestmark = pytest.mark.shared_data
 MARKER_DATES = ["2022-01-01", "2022-06-06", "2022-12-12", "2023-06-06", "2023-12-12"]
 PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1:5432/test")
 
@@ -58,8 +58,10 @@ def site():
     return website(ILP)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("date", MARKER_DATES)
-def test_marker_dates_are_legal_and_pay(monkeypatch, capsys, ilp_store, book, site, date):
+def test_marker_dates_are_legal_and_pay(monkeypatch, capsys, ilp_store, book, site, date,
+                                        fly_once):
     url, out = ilp_store
     code, text, err = run(monkeypatch, capsys, "deliver", date, "--data", str(ILP), "--db",
                           url, "--out", str(out), "--json", "--no-plot")
@@ -82,7 +84,8 @@ def test_marker_dates_are_legal_and_pay(monkeypatch, capsys, ilp_store, book, si
     assert line["type"] == "LineString" and len(line["coordinates"]) == len(flight) + 1
 
 
-def test_sqlite_and_postgresql_store_identical_rows(monkeypatch, capsys, tmp_path):
+def test_sqlite_and_postgresql_store_identical_rows(monkeypatch, capsys, tmp_path, ilp_store,
+                                                    fly_once):
     try:
         eng = sa.create_engine(PG)
         with eng.begin() as c:  # a clean schema for this test
@@ -94,8 +97,8 @@ def test_sqlite_and_postgresql_store_identical_rows(monkeypatch, capsys, tmp_pat
         if os.environ.get("CI"):
             raise
         pytest.skip("no PostgreSQL server")
-    lite = f"sqlite:///{tmp_path / 'a.db'}"
-    date = "2023-06-06"
+    lite = ilp_store[0]  # the marker days' SQLite store: its orders are imported already
+    date = "2023-06-06"  # flown once (fly_once), stored in both: the stores are compared
     for url in (lite, PG):
         code, _, err = run(monkeypatch, capsys, "deliver", date, "--data", str(ILP), "--db",
                            url, "--out", str(tmp_path), "--no-plot")

@@ -17,7 +17,7 @@ from skyroute.errors import InputFormatError
 from tests.conftest import SHARED
 
 ILP = SHARED / "ilp2021"
-pytestmark = pytest.mark.skipif(not ILP.exists(), reason="ILP data not beside the repo")
+pytestmark = pytest.mark.shared_data
 
 
 @pytest.fixture(scope="module")

@@ -1,9 +1,10 @@
-"""The shipped synthetic set is what ``data synth`` writes; a day read over HTTP is the
-day read from the folder; unreachable servers and missing files are clear errors."""
+"""Synthetic days fly legal flights; a day read over HTTP is the day read from the folder;
+unreachable servers and missing files are clear errors. (That the shipped synthetic set
+is what ``data synth`` writes is checked by the README replay in tests/test_docs.py,
+whose own ``data synth`` command writes it.)"""
 
 from __future__ import annotations
 
-import filecmp
 import json
 
 import pytest
@@ -21,22 +22,8 @@ from tests.delivery.flight_check import check_day, order_book, website
 EXAMPLE = ROOT / "examples" / "lunch"
 
 
-def same_tree(a, b) -> bool:
-    cmp = filecmp.dircmp(a, b)
-    if cmp.left_only or cmp.right_only or cmp.diff_files or cmp.funny_files:
-        return False
-    return all(same_tree(a / d, b / d) for d in cmp.common_dirs)
-
-
-def test_shipped_example_is_what_synth_writes(monkeypatch, capsys, tmp_path):
-    code, out, err = run(monkeypatch, capsys, "data", "synth", str(tmp_path / "lunch"),
-                         "--days", "3", "--orders-per-day", "36")
-    assert code == 0, err
-    assert json.loads(out.replace("\n", ""))["orders"] == 108
-    assert same_tree(EXAMPLE, tmp_path / "lunch")
-
-
-def test_synthetic_days_fly_legal_flights(monkeypatch, capsys, tmp_path):
+@pytest.mark.slow
+def test_synthetic_days_fly_legal_flights(monkeypatch, capsys, tmp_path, fly_once):
     url = f"sqlite:///{tmp_path / 's.db'}"
     code, out, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
                          "2024-01-03", "--data", str(EXAMPLE), "--db", url, "--out",
@@ -52,7 +39,7 @@ def test_synthetic_days_fly_legal_flights(monkeypatch, capsys, tmp_path):
         assert flight and check_day(site, book, d, deliveries, flight) == []
 
 
-def test_http_source_gives_the_same_day(tmp_path):
+def test_http_source_gives_the_same_day(tmp_path, fly_once):
     server, url = serve_in_thread(EXAMPLE)
     try:
         by_http = load_site(HttpSource(url))
@@ -60,7 +47,7 @@ def test_http_source_gives_the_same_day(tmp_path):
         assert by_http.menu == by_dir.menu and by_http.home == by_dir.home
         orders = [o for o in read_csv_orders(EXAMPLE) if o.date.day == 2]
         a = plan_day(by_http, orders[0].date, orders)
-        b = plan_day(by_dir, orders[0].date, orders)
+        b = fly_once(by_dir, orders[0].date, orders)  # the folder's day, flown once
         assert a.flight.flight.rows() == b.flight.flight.rows()
         with pytest.raises(InputFormatError, match=r"/words/no/such/place/details.json: no "
                                                    r"such file \(HTTP 404\)"):

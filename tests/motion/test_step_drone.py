@@ -1,5 +1,6 @@
 """The ILP step drone: every move legal under an independent re-check; fewest moves."""
 
+import functools
 import json
 import math
 from collections import deque
@@ -15,7 +16,7 @@ from skyroute.motion.step_drone import HOVER, STEP, Flight, follow, plan_moves
 from tests.conftest import SHARED
 
 ILP = SHARED / "ilp2021"
-pytestmark = pytest.mark.skipif(not ILP.exists(), reason="ILP data not beside the repo")
+pytestmark = pytest.mark.shared_data
 AT = (-3.186874, 55.944494)
 AREA = (-3.192473, 55.942617, -3.184319, 55.946233)
 
@@ -111,19 +112,43 @@ def test_default_merge_loses_no_move_against_exact_search(world, places, leg):
     assert plan_moves(world, places[leg[0]], places[leg[1]]).moves == exact.moves
 
 
-def shortest_distance(polys, a, b):
-    """Obstacle-avoiding distance by networkx over a shapely visibility graph of every
-    zone vertex (lines may touch zones, not enter them)."""
+def _sees(polys, p, q) -> bool:
+    line = shapely.LineString([p, q])
+    return not any(line.relate_pattern(z, "T********") for z in polys)
+
+
+@functools.cache
+def _corner_graph():
+    """The zone vertices and the networkx graph of those that see each other (built once:
+    the zones never change, only the two end points do)."""
     import networkx as nx
 
-    pts = [tuple(a), tuple(b)] + [c for p in polys for c in p.exterior.coords[:-1]]
+    polys = zones()
+    corners = [c for p in polys for c in p.exterior.coords[:-1]]
     g = nx.Graph()
-    for i, p in enumerate(pts):
-        for j in range(i + 1, len(pts)):
-            line = shapely.LineString([p, pts[j]])
-            if not any(line.relate_pattern(z, "T********") for z in polys):
-                g.add_edge(i, j, weight=math.dist(p, pts[j]))
-    return nx.dijkstra_path_length(g, 0, 1)
+    g.add_nodes_from(range(len(corners)))
+    for i, p in enumerate(corners):
+        for j in range(i + 1, len(corners)):
+            if _sees(polys, p, corners[j]):
+                g.add_edge(i, j, weight=math.dist(p, corners[j]))
+    return polys, corners, g
+
+
+def shortest_distance(a, b):
+    """Obstacle-avoiding distance by networkx over a shapely visibility graph of every
+    zone vertex and the two points (lines may touch zones, not enter them)."""
+    import networkx as nx
+
+    polys, corners, g = _corner_graph()
+    g = g.copy()
+    ends = {"a": tuple(a), "b": tuple(b)}
+    for name, p in ends.items():
+        for j, c in enumerate(corners):
+            if _sees(polys, p, c):
+                g.add_edge(name, j, weight=math.dist(p, c))
+    if _sees(polys, ends["a"], ends["b"]):
+        g.add_edge("a", "b", weight=math.dist(ends["a"], ends["b"]))
+    return nx.dijkstra_path_length(g, "a", "b")
 
 
 @settings(max_examples=25, deadline=None)
@@ -140,13 +165,13 @@ def test_heuristic_never_exceeds_the_moves_left(world, places, u, v, k):
     sees = bool(world.segments_free([q], [t])[0])
     h = move_search.bound(q[0], q[1], sees, t[0], t[1], table.corners, table.dist,
                           _zones(world)[0], STEP)
-    d = shortest_distance(zones(), q, t)
+    d = shortest_distance(q, t)
     assert h <= max(0, math.ceil(d / STEP - 1 + 1e-9))
 
 
 def test_statuses_and_bad_frame(world):
     inside_zone = (-3.188896, 55.944913)  # Teviot's centroid
-    assert world.blocking([inside_zone])[0] >= 0
+    assert world.names[world.blocking([inside_zone])[0]] == "Teviot"
     with pytest.raises(skyroute.QueryError):
         plan_moves(world, inside_zone, AT)
     budget = plan_moves(world, AT, (-3.1913, 55.9455), max_expansions=3)

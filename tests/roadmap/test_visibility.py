@@ -114,7 +114,17 @@ def test_start_inside_an_obstacle_names_it_and_a_free_point():
 
 
 def test_repeated_queries_reuse_the_graph():
-    world = rect_world([(1, 1, 3, 3), (5, 0, 6, 8)])
+    boxes = [(1, 1, 3, 3), (5, 0, 6, 8)]
+    world = rect_world(boxes)
     first = skyroute.plan(world, (0, 0), (8, 4))
     again = skyroute.plan(world, (0, 0), (8, 4))
-    assert first.cost == again.cost and again.los_checks <= first.los_checks
+    fresh = skyroute.plan(rect_world(boxes), (0, 0), (8, 4))  # the same world, new graph
+    assert first.cost == again.cost == fresh.cost
+    np.testing.assert_array_equal(first.path, again.path)
+    # The first query kept its corner-to-corner verdicts: asked again, the graph tests only
+    # the edges from the start and to the goal, and learns no new verdict. A new graph
+    # (no cache) repeats every test of the first query.
+    assert first.extra["known_edges"] > 0
+    assert again.extra["known_edges"] == first.extra["known_edges"]
+    assert fresh.los_checks == first.los_checks
+    assert again.los_checks == first.los_checks - first.extra["known_edges"]

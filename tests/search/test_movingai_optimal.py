@@ -9,14 +9,14 @@ import pytest
 
 import skyroute
 from skyroute.world.movingai import read_map, read_scen
-from tests.conftest import movingai_pairs, needs_shared
+from tests.conftest import movingai_pairs
 from tests.search.checks import assert_grid_path_legal
 
 PAIRS = movingai_pairs()
 PER_MAP = 12
 
 
-@needs_shared
+@pytest.mark.shared_data
 @pytest.mark.parametrize("map_path, scen_path", PAIRS, ids=[m.stem for m, _ in PAIRS])
 def test_optimal_costs_match_scenarios(map_path, scen_path):
     grid, scen = read_map(map_path), read_scen(scen_path)
@@ -35,9 +35,9 @@ def test_optimal_costs_match_scenarios(map_path, scen_path):
             assert walked == pytest.approx(r.cost, rel=1e-9)
 
 
-@needs_shared
 def test_scenario_costs_fail_with_corner_cutting():
-    # The control of SOURCES.md: allowing corner cutting gives shorter, wrong costs.
+    # The control of SOURCES.md: allowing corner cutting gives shorter, wrong costs. It
+    # needs only the den312d map and scenarios bundled with skyroute, so it always runs.
     grid = skyroute.load_map("den312d")
     scen = read_scen(skyroute.bundled_maps()["den312d"].with_suffix(".map.scen"))
     shorter = 0

@@ -96,6 +96,13 @@ def test_segment_file_and_errors(tmp_path):
     p.write_text("0,0,2\n")
     with pytest.raises(InputFormatError, match=r"walls\.csv:1: expected 4 columns"):
         load_map(p)
+    # The first file's grid: the walls' extent plus the clearance and one cell each side,
+    # so 7 x 7 cells of 0.5 m from (-0.75, -0.75); blocked are the cells the walls cross
+    # (y = 0 is row 1, x = 2 is column 5), no centre of another lying within 0.25 m.
+    expected = np.zeros((7, 7), bool)
+    expected[1, 1:6] = expected[1:6, 5] = True
+    np.testing.assert_array_equal(g.blocked, expected)
+    assert tuple(g.origin) == (-0.75, -0.75)
 
 
 def test_png_dark_pixels_are_blocked(tmp_path):

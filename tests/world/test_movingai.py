@@ -5,7 +5,7 @@ import pytest
 
 from skyroute import InputFormatError, load_map
 from skyroute.world.movingai import read_map, read_scen
-from tests.conftest import MOVINGAI, movingai_pairs, needs_shared
+from tests.conftest import MOVINGAI, movingai_pairs
 
 SMALL = "type octile\nheight 3\nwidth 4\nmap\n.@..\nGTS.\n..OW\n"
 
@@ -91,7 +91,7 @@ def test_malformed_scen_name_the_line(tmp_path, text, line, words):
     assert err.value.line == line and words in str(err.value)
 
 
-@needs_shared
+@pytest.mark.shared_data
 def test_every_shared_map_and_scen_parses():
     pairs = movingai_pairs()
     assert len(pairs) == 18
@@ -102,7 +102,7 @@ def test_every_shared_map_and_scen_parses():
         assert not g.blocked[sc.goals[:, 1], sc.goals[:, 0]].any()
 
 
-@needs_shared
+@pytest.mark.shared_data
 def test_bundled_maps_are_the_reference_bytes():
     from skyroute import bundled_maps
 

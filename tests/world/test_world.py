@@ -14,7 +14,6 @@ from tests.conftest import SHARED
 
 FCND = SHARED / "fcnd" / "colliders.csv"
 ILP = SHARED / "ilp2021"
-needs_fcnd = pytest.mark.skipif(not FCND.exists(), reason="FCND data not beside the repo")
 
 
 def write(path, text):
@@ -100,6 +99,7 @@ def test_exact_point_and_segment_queries():
     assert w.segment_free((-1, 0), (0, 1)) and w.clearance([[3, 0.5]])[0] == 2.0
 
 
+@pytest.mark.shared_data
 def test_ilp_zones_in_degrees_and_metres():
     w = skyroute.load_world(ILP / "website/buildings/no-fly-zones.geojson", frame="degrees",
                             boundary=ILP / "testing/confinement-zone.geojson")
@@ -114,7 +114,7 @@ def test_ilp_zones_in_degrees_and_metres():
     assert m.frame == "lonlat" and m.plane == "metres" and 200 < m.bounds[2] - m.bounds[0] < 206
 
 
-@needs_fcnd
+@pytest.mark.shared_data
 def test_fcnd_home_to_goal_is_free_and_theta_within_one_percent():
     w = skyroute.load_world(FCND, altitude=5, safety=5, frame="enu")
     goal = lonlat_to_enu(-122.396428, 37.795232, 0.0, w.home)[0, :2]
@@ -130,7 +130,7 @@ def test_fcnd_home_to_goal_is_free_and_theta_within_one_percent():
     assert math.dist((0, 0), goal) <= exact.cost
 
 
-@needs_fcnd
+@pytest.mark.shared_data
 def test_fcnd_prm_and_grid_paths_are_free():
     w = skyroute.load_world(FCND, altitude=5, safety=5, frame="enu")
     goal = lonlat_to_enu(-122.396428, 37.795232, 0.0, w.home)[0, :2]

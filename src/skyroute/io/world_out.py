@@ -82,16 +82,22 @@ def plot_world_path(world: World, result: PlanResult, start, goal, path: str | P
 
 
 def draw_world(ax, world: World) -> None:
-    """Obstacles filled grey (holes white) and the boundary dashed."""
-    import shapely
+    """Obstacles filled grey (holes white) and the boundary dashed.
 
+    The obstacles go in two collections, not one patch each: a city of thousands of
+    boxes then draws (and places the legend) in a fraction of a second."""
+    import shapely
+    from matplotlib.collections import PolyCollection
+
+    shells, holes = [], []
     for poly in world.obstacles:
         for part in getattr(poly, "geoms", [poly]):
-            x, y = part.exterior.xy
-            ax.fill(x, y, color="0.45", lw=0)
-            for hole in part.interiors:
-                hx, hy = hole.xy
-                ax.fill(hx, hy, color="white", lw=0)
+            shells.append(np.asarray(part.exterior.coords))
+            holes.extend(np.asarray(hole.coords) for hole in part.interiors)
+    for rings, colour in ((shells, "0.45"), (holes, "white")):
+        if rings:
+            ax.add_collection(PolyCollection(rings, facecolors=colour, linewidths=0))
+    ax.autoscale_view()
     if world.boundary is not None:
         x, y = shapely.Polygon(world.boundary).exterior.xy
         ax.plot(x, y, "--", color="tab:orange", lw=1.2, label="boundary")
