@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit, prange
 
 from skyroute.errors import OptionError
-from skyroute.motion.dubins_kernel import WORDS, _m2p
+from skyroute.motion.dubins_kernel import WORDS, shortest_length
 from skyroute.motion.tour import TourResult, tour  # noqa: F401  (skyroute.motion.dubins.tour)
 from skyroute.result import Status
 
@@ -107,50 +107,12 @@ def lengths(starts, goals, radius: float) -> np.ndarray:
 
 @njit(cache=True, parallel=True)
 def _lengths_kernel(s, g, r):
-    """The six closed forms of :func:`_words`, one query per iteration, across cores;
-    atan2 terms shared between words (LRL's is LSL's negated, RLR's is RSR's)."""
+    """The shortest of the six closed forms, one query per iteration, across cores
+    (:func:`skyroute.motion.dubins_kernel.shortest_length`, inlined)."""
     n = s.shape[0]
     out = np.empty(n)
     for i in prange(n):
-        dx = g[i, 0] - s[i, 0]
-        dy = g[i, 1] - s[i, 1]
-        d = math.sqrt(dx * dx + dy * dy) / r
-        phi = math.atan2(dy, dx)
-        a = _m2p(s[i, 2] - phi)
-        b = _m2p(g[i, 2] - phi)
-        sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
-        cab = math.cos(a - b)
-        dd = d * d
-        t_lsl = math.atan2(cb - ca, d + sa - sb)  # LRL uses -t_lsl
-        t_rsr = math.atan2(ca - cb, d - sa + sb)  # RLR uses it too
-        best = math.inf
-        p2 = 2 + dd - 2 * cab + 2 * d * (sa - sb)  # LSL
-        if p2 >= 0:
-            best = min(best, _m2p(t_lsl - a) + math.sqrt(p2) + _m2p(b - t_lsl))
-        p2 = 2 + dd - 2 * cab + 2 * d * (sb - sa)  # RSR
-        if p2 >= 0:
-            best = min(best, _m2p(a - t_rsr) + math.sqrt(p2) + _m2p(t_rsr - b))
-        p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
-        if p2 >= 0:
-            p = math.sqrt(p2)
-            tmp = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
-            best = min(best, _m2p(tmp - a) + p + _m2p(tmp - b))
-        p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
-        if p2 >= 0:
-            p = math.sqrt(p2)
-            tmp = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
-            best = min(best, _m2p(a - tmp) + p + _m2p(b - tmp))
-        c = (6.0 - dd + 2 * cab + 2 * d * (sa - sb)) / 8.0  # RLR
-        if abs(c) <= 1:
-            p = _m2p(TWO_PI - math.acos(c))
-            t = _m2p(a - t_rsr + p / 2)
-            best = min(best, t + p + _m2p(a - b - t + p))
-        c = (6.0 - dd + 2 * cab + 2 * d * (sb - sa)) / 8.0  # LRL
-        if abs(c) <= 1:
-            p = _m2p(TWO_PI - math.acos(c))
-            t = _m2p(-a + t_lsl + p / 2)
-            best = min(best, t + p + _m2p(b - a - t + p))
-        out[i] = best * r
+        out[i] = shortest_length(s[i, 0], s[i, 1], s[i, 2], g[i, 0], g[i, 1], g[i, 2], r)
     return out
 
 

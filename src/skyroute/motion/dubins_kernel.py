@@ -85,7 +85,7 @@ def words(sx, sy, sth, gx, gy, gth, r):
     return out, total
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def shortest_length(sx, sy, sth, gx, gy, gth, r):
     """Length of the shortest Dubins path (metres): :func:`words` without its arrays
     (the search calls this for every node it generates)."""

@@ -41,57 +41,9 @@ from skyroute.motion.dubins_kernel import (
 )
 from skyroute.motion.move_search import _sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
+from skyroute.search import heap
 
 TWO_PI = 2 * math.pi
-
-
-@njit(cache=True)
-def _grow(a, n):
-    if n <= a.shape[0]:
-        return a
-    b = np.empty(max(2 * a.shape[0], n), a.dtype)
-    b[:a.shape[0]] = a
-    return b
-
-
-@njit(cache=True)
-def _push(hf, hn, size, f, node):
-    i = size
-    while i > 0:
-        p = (i - 1) >> 1
-        if f < hf[p]:
-            hf[i] = hf[p]
-            hn[i] = hn[p]
-            i = p
-        else:
-            break
-    hf[i] = f
-    hn[i] = node
-
-
-@njit(cache=True)
-def _pop(hf, hn, size):
-    """Remove the minimum of a heap of ``size`` entries; return (f, node)."""
-    topf, top = hf[0], hn[0]
-    size -= 1
-    lf, ln = hf[size], hn[size]
-    i = 0
-    while True:
-        b = 2 * i + 1
-        if b >= size:
-            break
-        if b + 1 < size and hf[b + 1] < hf[b]:
-            b += 1
-        if hf[b] < lf:
-            hf[i] = hf[b]
-            hn[i] = hn[b]
-            i = b
-        else:
-            break
-    if size > 0:
-        hf[i] = lf
-        hn[i] = ln
-    return topf, top
 
 
 @njit(cache=True)
@@ -213,7 +165,7 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
         hd[n] = dubins_bound(sx, sy, sth, gx, gy, gth, has_heading, r, reverse)
         d2[n] = math.hypot(gx - sx, gy - sy)
         fq[n] = weight * max(hd[n], d2[n])
-        _push(hf, hn, size, fq[n], n)
+        heap.push_plain(hf, hn, size, fq[n], n)
         size += 1
         n += 1
     best = math.inf
@@ -222,7 +174,8 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
     tries = 0
     stopped = False
     while size > 0:
-        f, i = _pop(hf, hn, size)
+        f = hf[0]
+        i = heap.pop_plain(hf, hn, size)
         size -= 1
         if closed[i] or f != fq[i]:
             continue  # stale entry
@@ -237,9 +190,9 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
             f2 = g[i] + weight * max(hd[i], d2[i])
             if f2 > f:
                 if size + 1 > hf.shape[0]:
-                    hf, hn = _grow(hf, size + 1), _grow(hn, size + 1)
+                    hf, hn = heap.grow(hf, size + 1), heap.grow(hn, size + 1)
                 fq[i] = f2
-                _push(hf, hn, size, f2, i)
+                heap.push_plain(hf, hn, size, f2, i)
                 size += 1
                 continue
         else:
@@ -290,9 +243,10 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
                 j = n
                 n += 1
                 if n > x.shape[0]:
-                    x, y, th, g = _grow(x, n), _grow(y, n), _grow(th, n), _grow(g, n)
-                    hd, d2, fq = _grow(hd, n), _grow(d2, n), _grow(fq, n)
-                    parent, prim = _grow(parent, n), _grow(prim, n)
+                    x, y = heap.grow(x, n), heap.grow(y, n)
+                    th, g = heap.grow(th, n), heap.grow(g, n)
+                    hd, d2, fq = heap.grow(hd, n), heap.grow(d2, n), heap.grow(fq, n)
+                    parent, prim = heap.grow(parent, n), heap.grow(prim, n)
                     c2 = np.zeros(x.shape[0], np.bool_)
                     c2[:closed.shape[0]] = closed
                     closed = c2
@@ -309,8 +263,8 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
             if fq[j] >= best:
                 continue
             if size + 1 > hf.shape[0]:
-                hf, hn = _grow(hf, size + 1), _grow(hn, size + 1)
-            _push(hf, hn, size, fq[j], j)
+                hf, hn = heap.grow(hf, size + 1), heap.grow(hn, size + 1)
+            heap.push_plain(hf, hn, size, fq[j], j)
             size += 1
     if end >= 0:
         status = FOUND

@@ -73,15 +73,6 @@ def bound(qx, qy, sees, tx, ty, corners, cdist, edges, step):
 
 
 @njit(cache=True)
-def _grow(a, n):
-    if n < a.shape[0]:
-        return a
-    b = np.empty(max(2 * a.shape[0], n + 1), a.dtype)
-    b[:a.shape[0]] = a
-    return b
-
-
-@njit(cache=True)
 def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners, cdist,
            step, merge, max_expansions, eps):
     """A* from (sx, sy) to closer than ``step`` to (tx, ty).
@@ -130,7 +121,7 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
             f = g[i] + moves_left(dist[i], step)
             if f > (top >> 20):
                 if size + 1 > hk.shape[0]:
-                    hk, hn = _grow(hk, size + 1), _grow(hn, size + 1)
+                    hk, hn = heap.grow(hk, size + 2), heap.grow(hn, size + 2)
                 heap.push_plain(hk, hn, size, (np.int64(f) << 20) | (_TIE - min(g[i], _TIE)), i)
                 size += 1
                 continue
@@ -155,8 +146,9 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
                 j = n
                 n += 1
                 if n > x.shape[0]:
-                    x, y, parent = _grow(x, n), _grow(y, n), _grow(parent, n)
-                    move, g, dist = _grow(move, n), _grow(g, n), _grow(dist, n)
+                    x, y = heap.grow(x, n + 1), heap.grow(y, n + 1)
+                    parent, move = heap.grow(parent, n + 1), heap.grow(move, n + 1)
+                    g, dist = heap.grow(g, n + 1), heap.grow(dist, n + 1)
                     c2 = np.zeros(x.shape[0], np.bool_)
                     c2[:closed.shape[0]] = closed
                     closed = c2
@@ -169,7 +161,7 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
             exact[j] = False
             f = gi + moves_left(dist[j], step)
             if size + 1 > hk.shape[0]:
-                hk, hn = _grow(hk, size + 1), _grow(hn, size + 1)
+                hk, hn = heap.grow(hk, size + 2), heap.grow(hn, size + 2)
             heap.push_plain(hk, hn, size, (np.int64(f) << 20) | (_TIE - min(gi, _TIE)), j)
             size += 1
     return NO_PATH, -1, expanded, x[:n], y[:n], parent[:n], move[:n]

@@ -13,6 +13,7 @@ each level once.
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from skyroute.result import NO_PATH
@@ -139,3 +140,14 @@ def pop_plain(hk, hn, size):
         hk[i] = lk
         hn[i] = ln
     return top
+
+
+@njit(cache=True)
+def grow(a, n):
+    """``a`` itself when it holds at least ``n`` entries, else a copy twice as long (or
+    ``n`` long): growable arrays for searches that cannot size them in advance."""
+    if n <= a.shape[0]:
+        return a
+    b = np.empty(max(2 * a.shape[0], n), a.dtype)
+    b[:a.shape[0]] = a
+    return b
