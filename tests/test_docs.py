@@ -6,7 +6,8 @@ import importlib
 import pytest
 
 MODULES = ["skyroute.world.grid", "skyroute.world.load", "skyroute.planner",
-           "skyroute.fleet.trajectory", "skyroute.fleet.separation"]
+           "skyroute.fleet.trajectory", "skyroute.fleet.separation",
+           "skyroute.fleet.flightplan"]
 
 
 @pytest.mark.parametrize("name", MODULES)
