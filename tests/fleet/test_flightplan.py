@@ -9,7 +9,13 @@ import numpy as np
 import pytest
 
 from skyroute.errors import OptionError
-from skyroute.fleet.flightplan import PHASES, gate_position, horizontal_lengths, plan_flight
+from skyroute.fleet.flightplan import (
+    PHASES,
+    gate_position,
+    ground_position,
+    horizontal_lengths,
+    plan_flight,
+)
 from skyroute.fleet.scenario import Airport, Runway, Scenario, preset
 from skyroute.fleet.separation import check
 from skyroute.fleet.trajectory import ARC, Pieces, check_continuous, position
@@ -311,3 +317,30 @@ def test_bad_loiter_count_and_phase_name(straight):
     assert err.value.param == "n"
     with pytest.raises(OptionError, match="choose one of 'taxi_out'"):
         straight.phase("loiter")
+
+
+# ------------------------------------------------------------------ on the ground
+
+def test_ground_position_hand_worked(straight):
+    t_roll = straight.phase("takeoff")
+    t_out = straight.phase("rollout")
+    t_in = straight.phase("taxi_in")
+    roll = 609.2866 - 100 / TAN20
+    g = ground_position(straight, [
+        0.0,  # gate 0 of A
+        15.0,  # half a gate width at 1 m/s: A itself
+        20.0,  # then 15 m at 3 m/s: 15 m west of A
+        30.0,  # then 10 s at 10 m/s: 115 m west of A
+        t_roll.start + (t_roll.end - t_roll.start) / 2,  # a quarter of the roll
+        t_roll.end,  # lift-off
+        t_out.start,  # touchdown
+        t_out.start + 4.8,  # half the roll-out time: three quarters of 192 m
+        t_in.end - 15.0,  # half a gate width from the gate: B itself
+        t_in.end,  # gate 0 of B: B takes off northbound, so its left gate is 15 m west
+        straight.phase("cruise").start,  # airborne
+        -1.0,  # not yet
+    ])
+    expect = [[15, 0], [0, 0], [0, -15], [0, -115], [0, -300 + roll / 4],
+              [0, -300 + roll], [0, 4700], [0, 4700 + 144], [0, 5000], [0, 4985]]
+    assert np.allclose(g[:10], expect, atol=1e-9)
+    assert np.isnan(g[10:]).all()

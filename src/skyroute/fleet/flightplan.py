@@ -72,7 +72,7 @@ from typing import NamedTuple
 import numpy as np
 
 from skyroute.errors import OptionError, check_choice
-from skyroute.fleet.scenario import Airport, Scenario, runway_ends
+from skyroute.fleet.scenario import Airport, Drone, Scenario, runway_ends
 from skyroute.fleet.trajectory import ARC, LINE, Pieces, Trajectory, arc_piece
 from skyroute.fleet.vehicle import (
     MIN_CRUISE_ALTITUDE,
@@ -107,7 +107,9 @@ class FlightPlan:
     ``loiter_seconds`` long. Ground geometry, (north, east) metres: ``taxi_out_route``
     and ``taxi_in_route`` (gate first / gate last), ``takeoff_roll`` and ``rollout_roll``
     (start, end); ``approach_gate`` (north, east, altitude) with ``approach_heading``
-    (compass radians); ``loiter_centre`` and ``loiter_rate`` (rad/s, < 0 left-hand).
+    (compass radians); ``loiter_centre`` and ``loiter_rate`` (rad/s, < 0 left-hand);
+    ``aircraft`` the drone type and ``gate_widths`` the two airports' (for the taxi
+    profile of :func:`ground_position`).
     """
 
     drone: int
@@ -130,6 +132,8 @@ class FlightPlan:
     taxi_in_route: np.ndarray
     takeoff_roll: np.ndarray
     rollout_roll: np.ndarray
+    aircraft: Drone
+    gate_widths: tuple[float, float]
 
     def phase(self, name: str) -> Phase:
         """The phase called ``name``; an OptionError names the phases of this plan."""
@@ -324,7 +328,49 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
         approach_gate=(float(gate[0]), float(gate[1]), h), approach_heading=psi_down,
         loiter_centre=loiter_centre, loiter_rate=side * v / r,
         taxi_out_route=route_out, taxi_in_route=route_in,
-        takeoff_roll=rolls[0], rollout_roll=rolls[1])
+        takeoff_roll=rolls[0], rollout_roll=rolls[1], aircraft=d,
+        gate_widths=(a.gate_width, b.gate_width))
+
+
+def ground_position(plan: FlightPlan, t) -> np.ndarray:
+    """(north, east) of the drone at times ``t`` (vectorised: shape ``(*t.shape, 2)``) while it
+    is on the ground: taxiing (the taxi profile, speeds changing instantly), rolling for
+    take-off (even acceleration from rest) or rolling out (even braking to a stop); NaN
+    while airborne and outside the flight. At the instant a ground phase meets an
+    airborne one (lift-off, touchdown) the ground position is given."""
+    t = np.asarray(t, dtype=float)
+    out = np.full((*t.shape, 2), np.nan)
+    d = plan.aircraft
+    speeds = (d.taxi_gate_speed, d.taxi_near_speed, d.taxi_speed)
+    for name in ("taxi_out", "takeoff", "rollout", "taxi_in"):
+        ph = plan.phase(name)
+        at = (t >= ph.start) & (t <= ph.end)
+        if not at.any():
+            continue
+        tau = t[at] - ph.start
+        span = ph.end - ph.start
+        if name == "taxi_out":
+            out[at] = _taxi(plan.taxi_out_route, tau, plan.gate_widths[0], speeds)
+        elif name == "taxi_in":
+            out[at] = _taxi(plan.taxi_in_route[::-1], span - tau, plan.gate_widths[1],
+                            speeds)
+        else:
+            a, b = plan.takeoff_roll if name == "takeoff" else plan.rollout_roll
+            f = tau / span
+            f = f * f if name == "takeoff" else 1.0 - (1.0 - f) ** 2
+            out[at] = a + f[:, None] * (b - a)
+    return out
+
+
+def _taxi(route: np.ndarray, tau: np.ndarray, gate_width: float, speeds) -> np.ndarray:
+    """Points ``tau`` seconds out from the gate (``route[0]``) along ``route``."""
+    seg = np.hypot(*np.diff(route, axis=0).T)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    s = np.minimum([0.0, gate_width / 2, gate_width, np.inf], cum[-1])
+    times = np.concatenate([[0.0], np.cumsum(np.diff(s) / np.array(speeds))])
+    dist = np.interp(tau, times, s)
+    return np.stack([np.interp(dist, cum, route[:, 0]), np.interp(dist, cum, route[:, 1])],
+                    axis=-1)
 
 
 def _polyline_length(points: np.ndarray) -> float:
