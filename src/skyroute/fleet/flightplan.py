@@ -306,6 +306,8 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
     # approach: one straight glide from the approach gate to the threshold
     slope = math.hypot(final, h)
     t_down = add("approach", slope / d.landing_speed)
+    # restart the builder at the exact gate (the cruise ends within rounding of it) so
+    # the glide and every loiter circle start from one point; no time passes
     tr.ground(t_ask, (*gate, h)).line_to(t_down, (*land_thr, 0.0))
     add("landing", 0.0)
 
