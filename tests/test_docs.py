@@ -8,8 +8,8 @@ import json
 import pytest
 
 MODULES = ["skyroute.world.grid", "skyroute.world.load", "skyroute.planner",
-           "skyroute.fleet.vehicle",
-           "skyroute.fleet.trajectory", "skyroute.fleet.separation"]
+           "skyroute.fleet.vehicle", "skyroute.fleet.trajectory",
+           "skyroute.fleet.separation", "skyroute.fleet.flightplan"]
 
 
 @pytest.mark.parametrize("name", MODULES)
