@@ -103,19 +103,15 @@ def run_ompl(world: World, start, goal, radius: float, planner: str,
     from ompl import geometric as og
     from ompl import util as ou
 
+    from skyroute.bench.world import ompl_bounds
+
     ou.setLogLevel(ou.LOG_NONE)
     union = shapely.unary_union(world.obstacles)
     shapely.prepare(union)
     inside = shapely.Polygon(world.boundary)
     shapely.prepare(inside)
-    xmin, ymin, xmax, ymax = world.bounds
     space = ob.DubinsStateSpace(radius)
-    bounds = ob.RealVectorBounds(2)
-    bounds.setLow(0, xmin)
-    bounds.setLow(1, ymin)
-    bounds.setHigh(0, xmax)
-    bounds.setHigh(1, ymax)
-    space.setBounds(bounds)
+    space.setBounds(ompl_bounds(ob, world))
     ss = og.SimpleSetup(space)
 
     def valid(state) -> bool:

@@ -72,14 +72,8 @@ def run_ompl(world: World, start, goal, planner: str, seconds: float) -> dict:
     if inside is not None:
         inside = shapely.Polygon(inside)
         shapely.prepare(inside)
-    xmin, ymin, xmax, ymax = world.bounds
     space = ob.RealVectorStateSpace(2)
-    bounds = ob.RealVectorBounds(2)
-    bounds.setLow(0, xmin)
-    bounds.setLow(1, ymin)
-    bounds.setHigh(0, xmax)
-    bounds.setHigh(1, ymax)
-    space.setBounds(bounds)
+    space.setBounds(ompl_bounds(ob, world))
     ss = og.SimpleSetup(space)
 
     def valid(state) -> bool:
@@ -197,3 +191,14 @@ def repeated_queries(world: World, count: int, rng: np.random.Generator) -> dict
     return {"build_seconds": build, "first_seconds": float(t[0]), "queries": count,
             "found": found, "median_ms": float(np.median(t[1:]) * 1e3),
             "p90_ms": float(np.percentile(t[1:], 90) * 1e3), "max_ms": float(t[1:].max() * 1e3)}
+
+
+def ompl_bounds(ob, world: World):
+    """OMPL RealVectorBounds of the world's (x, y) extent (``ob`` is ``ompl.base``)."""
+    xmin, ymin, xmax, ymax = world.bounds
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0, xmin)
+    bounds.setLow(1, ymin)
+    bounds.setHigh(0, xmax)
+    bounds.setHigh(1, ymax)
+    return bounds

@@ -213,6 +213,27 @@ def _merge(drones: np.ndarray, ev: np.ndarray) -> tuple[Conflict, ...]:
 # ----------------------------------------------------------------- compiled kernels
 
 
+@njit(cache=True, inline="always")
+def _put(stk, k, s, u, gs, gps, gu, gpu, lo, depth, up):
+    """Stack row k: an interval [s, u], g and g' at both ends, its bounds, its depth."""
+    stk[k, 0] = s
+    stk[k, 1] = u
+    stk[k, 2] = gs
+    stk[k, 3] = gps
+    stk[k, 4] = gu
+    stk[k, 5] = gpu
+    stk[k, 6] = lo
+    stk[k, 7] = depth
+    stk[k, 8] = up
+
+
+@njit(cache=True, inline="always")
+def _get(stk, k):
+    """Stack row k as (s, u, gs, gps, gu, gpu, lo, depth, up)."""
+    return (stk[k, 0], stk[k, 1], stk[k, 2], stk[k, 3], stk[k, 4], stk[k, 5], stk[k, 6],
+            stk[k, 7], stk[k, 8])
+
+
 @njit(cache=True)
 def _horizontal(P, kind, i, t):
     """(north, east, v_north, v_east) of piece ``i`` at time ``t``."""
@@ -350,25 +371,11 @@ def _min_g(P, kind, i, j, a, b, tol, cap, stk):
         tbest = b
     lo, _ = _bounds(ga, gpa, gb, gpb, b - a, V, A, C)
     low = math.inf
-    stk[0, 0] = a
-    stk[0, 1] = b
-    stk[0, 2] = ga
-    stk[0, 3] = gpa
-    stk[0, 4] = gb
-    stk[0, 5] = gpb
-    stk[0, 6] = lo
-    stk[0, 7] = 0.0
+    _put(stk, 0, a, b, ga, gpa, gb, gpb, lo, 0.0, math.inf)
     top = 1
     while top > 0:
         top -= 1
-        s = stk[top, 0]
-        u = stk[top, 1]
-        gs = stk[top, 2]
-        gps = stk[top, 3]
-        gu = stk[top, 4]
-        gpu = stk[top, 5]
-        lo = stk[top, 6]
-        depth = stk[top, 7]
+        s, u, gs, gps, gu, gpu, lo, depth, _ = _get(stk, top)
         m = 0.5 * (s + u)
         if (lo >= cap or math.sqrt(lo) >= math.sqrt(best) - tol or depth >= _MAXDEPTH
                 or not (s < m < u)):
@@ -386,22 +393,9 @@ def _min_g(P, kind, i, j, a, b, tol, cap, stk):
         for k in range(2):
             left = (k == 0) == (l1 > l2)
             if left:
-                stk[top, 0] = s
-                stk[top, 1] = m
-                stk[top, 2] = gs
-                stk[top, 3] = gps
-                stk[top, 4] = gm
-                stk[top, 5] = gpm
-                stk[top, 6] = l1
+                _put(stk, top, s, m, gs, gps, gm, gpm, l1, depth + 1.0, math.inf)
             else:
-                stk[top, 0] = m
-                stk[top, 1] = u
-                stk[top, 2] = gm
-                stk[top, 3] = gpm
-                stk[top, 4] = gu
-                stk[top, 5] = gpu
-                stk[top, 6] = l2
-            stk[top, 7] = depth + 1.0
+                _put(stk, top, m, u, gm, gpm, gu, gpu, l2, depth + 1.0, math.inf)
             top += 1
     return min(best, low), tbest
 
@@ -441,27 +435,11 @@ def _below(P, kind, i, j, a, b, thr, slack, stk, comps):
     V, A, C = _curvature(P, kind, i, j, a, b)
     ga, gpa = _rel(P, kind, i, j, a)
     gb, gpb = _rel(P, kind, i, j, b)
-    stk[0, 0] = a
-    stk[0, 1] = b
-    stk[0, 2] = ga
-    stk[0, 3] = gpa
-    stk[0, 4] = gb
-    stk[0, 5] = gpb
-    stk[0, 6] = 0.0
-    stk[0, 7] = 0.0
-    stk[0, 8] = math.inf
+    _put(stk, 0, a, b, ga, gpa, gb, gpb, 0.0, 0.0, math.inf)
     top = 1
     while top > 0:
         top -= 1
-        s = stk[top, 0]
-        u = stk[top, 1]
-        gs = stk[top, 2]
-        gps = stk[top, 3]
-        gu = stk[top, 4]
-        gpu = stk[top, 5]
-        plo = stk[top, 6]
-        depth = stk[top, 7]
-        pup = stk[top, 8]
+        s, u, gs, gps, gu, gpu, plo, depth, pup = _get(stk, top)
         lo, up = _bounds(gs, gps, gu, gpu, u - s, V, A, C)
         lo = max(lo, plo)
         up = min(up, pup)
@@ -471,25 +449,9 @@ def _below(P, kind, i, j, a, b, thr, slack, stk, comps):
         if not (up < thr or up - lo <= slack or depth >= _MAXDEPTH or not (s < m < u)):
             gm, gpm = _rel(P, kind, i, j, m)
             # right half first, so the left one is popped first: stretches in time order
-            stk[top, 0] = m
-            stk[top, 1] = u
-            stk[top, 2] = gm
-            stk[top, 3] = gpm
-            stk[top, 4] = gu
-            stk[top, 5] = gpu
-            stk[top, 6] = lo
-            stk[top, 7] = depth + 1.0
-            stk[top, 8] = up
+            _put(stk, top, m, u, gm, gpm, gu, gpu, lo, depth + 1.0, up)
             top += 1
-            stk[top, 0] = s
-            stk[top, 1] = m
-            stk[top, 2] = gs
-            stk[top, 3] = gps
-            stk[top, 4] = gm
-            stk[top, 5] = gpm
-            stk[top, 6] = lo
-            stk[top, 7] = depth + 1.0
-            stk[top, 8] = up
+            _put(stk, top, s, m, gs, gps, gm, gpm, lo, depth + 1.0, up)
             top += 1
             continue
         if n > 0 and comps[n - 1, 1] == s:

@@ -247,12 +247,8 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
                     th, g = heap.grow(th, n), heap.grow(g, n)
                     hd, d2, fq = heap.grow(hd, n), heap.grow(d2, n), heap.grow(fq, n)
                     parent, prim = heap.grow(parent, n), heap.grow(prim, n)
-                    c2 = np.zeros(x.shape[0], np.bool_)
-                    c2[:closed.shape[0]] = closed
-                    closed = c2
-                    e2 = np.zeros(x.shape[0], np.bool_)
-                    e2[:exact.shape[0]] = exact
-                    exact = e2
+                    closed = heap.grow_zeroed(closed, x.shape[0])
+                    exact = heap.grow_zeroed(exact, x.shape[0])
                 seen[key] = j
             x[j], y[j], th[j], g[j] = qx, qy, qth, gq
             parent[j], prim[j] = i, p

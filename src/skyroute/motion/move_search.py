@@ -149,12 +149,8 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
                     x, y = heap.grow(x, n + 1), heap.grow(y, n + 1)
                     parent, move = heap.grow(parent, n + 1), heap.grow(move, n + 1)
                     g, dist = heap.grow(g, n + 1), heap.grow(dist, n + 1)
-                    c2 = np.zeros(x.shape[0], np.bool_)
-                    c2[:closed.shape[0]] = closed
-                    closed = c2
-                    e2 = np.zeros(x.shape[0], np.bool_)
-                    e2[:exact.shape[0]] = exact
-                    exact = e2
+                    closed = heap.grow_zeroed(closed, x.shape[0])
+                    exact = heap.grow_zeroed(exact, x.shape[0])
                 seen[key] = j
             x[j], y[j], parent[j], move[j], g[j] = qx, qy, i, k, gi
             dist[j] = max(math.hypot(qx - tx, qy - ty), dist[i] - step)

@@ -151,3 +151,13 @@ def grow(a, n):
     b = np.empty(max(2 * a.shape[0], n), a.dtype)
     b[:a.shape[0]] = a
     return b
+
+
+@njit(cache=True)
+def grow_zeroed(a, n):
+    """:func:`grow`, with the new entries zero (False): flags of nodes not seen yet."""
+    if n <= a.shape[0]:
+        return a
+    b = np.zeros(max(2 * a.shape[0], n), a.dtype)
+    b[:a.shape[0]] = a
+    return b
