@@ -75,12 +75,20 @@ def test_no_path_within_the_budget_exits_1_and_writes_nothing(monkeypatch, capsy
     assert json.loads(text)["metrics"]["status"] == "budget_exhausted"
 
 
-def test_waypoints_mode_is_explicit_and_reports_free(monkeypatch, capsys):
-    code, text, err = run(monkeypatch, capsys, *BASE, "--planner", "waypoints",
-                          "--start", "0,0", "--goal", "120,-180", "--json")
+def test_waypoints_cut_a_building_where_hybrid_finds_a_free_path(monkeypatch, capsys):
+    """The issue's case: curves through the route's corners clip a building (and say so);
+    Hybrid A* on the same query flies round it."""
+    query = ["--start", "0,0,90", "--goal", "120,-180", "--step", "0.5", "--json"]
+    code, text, err = run(monkeypatch, capsys, *BASE, "--planner", "waypoints", *query)
     assert code == 0, err
-    assert json.loads(text)["metrics"]["free"] in (True, False)
-    assert "free" in json.loads(text)["metrics"] and "words" in json.loads(text)["metrics"]
+    old = json.loads(text)
+    world = skyroute.load_world(CITY, altitude=10, safety=2, frame="ned")
+    track = shapely.LineString(world.to_plane(np.array(old["trajectory"])[:, :2]))
+    assert old["metrics"]["free"] is False
+    assert shapely.unary_union(world.obstacles).relate_pattern(track, "T********")
+    code, text, err = run(monkeypatch, capsys, *BASE, *query)
+    assert code == 0, err
+    assert_free(json.loads(text)["trajectory"], 8.0, 0.5)
 
 
 def test_tour_visits_every_target(monkeypatch, capsys, tmp_path):

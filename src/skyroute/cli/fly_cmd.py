@@ -89,9 +89,11 @@ def fly_command(
     its moves as ILP rows (from_lon, from_lat, angle, to_lon, to_lat).
     """
     check_choice("vehicle", vehicle, VEHICLES)
-    planner = planner or PLANNERS.get(vehicle, ("",))[0]
     if vehicle in PLANNERS:
+        planner = planner or PLANNERS[vehicle][0]
         check_choice("planner", planner, PLANNERS[vehicle])
+    elif planner is not None:
+        raise OptionError(f"--planner {planner!r}: --vehicle {vehicle} has no planner choice")
     if out is not None and out.suffix.lower() not in (".json", ".csv", ".geojson"):
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
     if not (math.isfinite(radius) and radius > 0):

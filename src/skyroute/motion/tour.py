@@ -128,18 +128,15 @@ def tour(start_pose, targets, radius: float, *, world: World | None = None,
     c0, C = _dubins_table(s, plane, cand, float(radius))
     if world is not None:
         c0, C = _with_obstacles(world, s, plane, H, c0, C)
+    dist0 = np.hypot(*(plane - s[:2]).T)
+    D = np.hypot(*(plane[:, None] - plane[None]).transpose(2, 0, 1))
+    greedy_bound, greedy = nearest_first(c0, C, dist0, D, n, H)
     if n <= exact_limit:
         bound, places = held_karp(c0, C, n, H)
         method = "exact"
     else:
-        dist0 = np.hypot(*(plane - s[:2]).T)
-        D = np.hypot(*(plane[:, None] - plane[None]).transpose(2, 0, 1))
-        _, greedy = nearest_first(c0, C, dist0, D, n, H)
         bound, places = improve(greedy // H, c0, C, H, 50)
         method = "local search"
-    dist0 = np.hypot(*(plane - s[:2]).T)
-    D = np.hypot(*(plane[:, None] - plane[None]).transpose(2, 0, 1))
-    greedy_bound, _ = nearest_first(c0, C, dist0, D, n, H)
     order = tuple(int(p // H) for p in places)
     heads = cand[places % H]
     legs, status, length = _fly(world, s, plane, order, heads, float(radius),
