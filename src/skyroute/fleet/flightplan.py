@@ -87,6 +87,8 @@ PHASES = ("taxi_out", "takeoff", "climb", "cruise", "loiter", "approach", "landi
           "rollout", "taxi_in")
 AIRBORNE = ("climb", "cruise", "loiter", "approach")
 LOITER_SIDES = ("left", "right")
+_PIECE_COLUMNS = ("drone", "kind", "t0", "t1", "north", "east", "alt", "v_north", "v_east",
+                  "v_alt", "radius", "angle", "rate")
 
 
 class Phase(NamedTuple):
@@ -174,6 +176,22 @@ class FlightPlan:
         return arc_piece(self.drone, t0, t1, (n, e), math.hypot(gn - n, ge - e),
                          math.atan2(ge - e, gn - n), self.loiter_rate, alt)
 
+    def shifted(self, dt: float, *, drone: int | None = None) -> FlightPlan:
+        """This plan ``dt`` seconds later (same geometry: every time moves by ``dt``),
+        flown by ``drone`` (default the same one)."""
+        dt = float(dt)
+        drone = self.drone if drone is None else int(drone)
+        if dt == 0.0 and drone == self.drone:
+            return self
+        cols = {k: getattr(self.pieces, k) for k in _PIECE_COLUMNS}
+        cols["t0"] = cols["t0"] + dt
+        cols["t1"] = cols["t1"] + dt
+        cols["drone"] = np.full(len(self.pieces), drone, dtype=np.int64)
+        return replace(self, drone=drone, pieces=Pieces(**cols),
+                       phases=tuple(Phase(p.name, p.start + dt, p.end + dt)
+                                    for p in self.phases),
+                       landing_request=self.landing_request + dt)
+
     def with_loiters(self, n: int) -> FlightPlan:
         """This plan with ``n`` more loiter circles before the approach: the approach
         and everything after it (pieces and phases) ``n * loiter_seconds`` later."""
@@ -185,9 +203,7 @@ class FlightPlan:
         shift = n * self.loiter_seconds
         p = self.pieces
         later = p.t0 >= t_ask
-        cols = {k: getattr(p, k) for k in ("drone", "kind", "t0", "t1", "north", "east",
-                                           "alt", "v_north", "v_east", "v_alt", "radius",
-                                           "angle", "rate")}
+        cols = {k: getattr(p, k) for k in _PIECE_COLUMNS}
         cols["t0"] = np.where(later, p.t0 + shift, p.t0)
         cols["t1"] = np.where(later, p.t1 + shift, p.t1)
         # circle k over [t_ask + k T, t_ask + (k + 1) T]; the last ends exactly where the

@@ -91,6 +91,8 @@ class Scenario(_Strict):
     home_lon: float = Field(default=4.7005, ge=-180, le=180)
     airports: list[Airport] = Field(min_length=2)
     drones: int = Field(default=3, ge=1)
+    handover_seconds: float = Field(default=30.0, ge=0, description="at a gate: unload, "
+                                    "load")
     drone: Drone = Drone()
     packages: Packages = Packages()
     airspace: Airspace = Airspace()

@@ -1,0 +1,154 @@
+"""The stream of packages a fleet carries: a seeded Poisson stream or an explicit CSV.
+
+A package has a spawn time (seconds), an origin airport and gate and a destination airport
+and gate; airports are indices into ``scenario.airports``, gates 0 or 1. A package never
+joins the two gates of one airport.
+
+The Poisson stream draws every arrival and every origin-destination pair from one
+generator seeded with ``seed``, so two runs that differ only in the dispatcher or the
+airspace see the very same packages (common random numbers for fair comparisons).
+
+>>> from skyroute.fleet.scenario import preset
+>>> s = preset("seed-3x3")
+>>> p = poisson(s, hours=1.0, seed=4)
+>>> len(p) == len(poisson(s, hours=1.0, seed=4)), bool((p.origin != p.destination).all())
+(True, True)
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from skyroute.errors import InputFormatError, OptionError
+from skyroute.fleet.scenario import Scenario
+
+CSV_HEADER = ("t", "from_airport", "from_gate", "to_airport", "to_gate")
+
+
+@dataclass(frozen=True, eq=False)
+class Stream:
+    """Packages in spawn order, as columns (one row per package, row = package id)."""
+
+    t: np.ndarray
+    origin: np.ndarray
+    origin_gate: np.ndarray
+    destination: np.ndarray
+    destination_gate: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+
+def _stream(t, origin, og, dest, dg) -> Stream:
+    order = np.argsort(np.asarray(t, dtype=float), kind="stable")
+    cols = [np.asarray(c)[order] for c in (t, origin, og, dest, dg)]
+    cols = [cols[0].astype(float)] + [c.astype(np.int64) for c in cols[1:]]
+    for c in cols:
+        c.setflags(write=False)
+    return Stream(*cols)
+
+
+def _hours(hours) -> float:
+    h = float(hours)
+    if not (math.isfinite(h) and h > 0):
+        raise OptionError(f"hours={hours!r} must be a number > 0", param="hours")
+    return h
+
+
+def poisson(scenario: Scenario, *, hours: float, seed: int = 0,
+            rate_per_hour: float | None = None) -> Stream:
+    """A Poisson stream over ``[0, hours * 3600)`` at ``rate_per_hour`` (default the
+    scenario's), origin and destination airports and gates uniform, airports distinct."""
+    h = _hours(hours)
+    rate = scenario.packages.rate_per_hour if rate_per_hour is None else float(rate_per_hour)
+    if not (math.isfinite(rate) and rate >= 0):
+        raise OptionError(f"rate_per_hour={rate_per_hour!r} must be a number >= 0",
+                          param="rate_per_hour")
+    rng = np.random.default_rng(seed)
+    horizon = h * 3600.0
+    if rate == 0:
+        n = 0
+        t = np.empty(0)
+    else:
+        n = int(rng.poisson(rate * h))
+        t = np.sort(rng.uniform(0.0, horizon, n))  # given the count, arrivals are uniform
+    a = len(scenario.airports)
+    origin = rng.integers(0, a, n)
+    dest = (origin + rng.integers(1, a, n)) % a  # any other airport, uniformly
+    og = rng.integers(0, 2, n)
+    dg = rng.integers(0, 2, n)
+    return _stream(t, origin, og, dest, dg)
+
+
+def read_csv(path: str | Path, scenario: Scenario) -> Stream:
+    """Packages from a CSV with header ``t,from_airport,from_gate,to_airport,to_gate``
+    (airport ids of the scenario, gates 0 or 1, ``t`` seconds >= 0); an error names the
+    file, the line and the field."""
+    p = Path(path)
+    ids = {a.id: k for k, a in enumerate(scenario.airports)}
+    rows = []
+    try:
+        with p.open(newline="") as fh:
+            reader = csv.reader(fh)
+            header = next(reader, None)
+            if header is None or tuple(h.strip() for h in header) != CSV_HEADER:
+                raise InputFormatError(p, "header must be " + ",".join(CSV_HEADER), line=1)
+            for line, rec in enumerate(reader, start=2):
+                if not rec or all(not x.strip() for x in rec):
+                    continue
+                rows.append(_row(p, line, rec, ids))
+    except OSError as exc:
+        raise InputFormatError(p, f"cannot read: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise InputFormatError(p, f"not text: {exc}") from None
+    if not rows:
+        return _stream(*(np.empty(0) for _ in range(5)))
+    return _stream(*zip(*rows, strict=True))
+
+
+def _row(p: Path, line: int, rec: list[str], ids: dict[str, int]) -> tuple:
+    if len(rec) != len(CSV_HEADER):
+        raise InputFormatError(p, f"expected {len(CSV_HEADER)} fields, got {len(rec)}",
+                               line=line)
+    t_s, fa, fg, ta, tg = (x.strip() for x in rec)
+    try:
+        t = float(t_s)
+    except ValueError:
+        t = math.nan
+    if not (math.isfinite(t) and t >= 0):
+        raise InputFormatError(p, f"t: {t_s!r} must be a number of seconds >= 0", line=line)
+    out = [t]
+    for name, airport, gate in (("from", fa, fg), ("to", ta, tg)):
+        if airport not in ids:
+            raise InputFormatError(p, f"{name}_airport: no airport {airport!r}; airports: "
+                                   + ", ".join(ids), line=line)
+        if gate not in ("0", "1"):
+            raise InputFormatError(p, f"{name}_gate: {gate!r} must be 0 or 1", line=line)
+        out += [ids[airport], int(gate)]
+    if out[1] == out[3]:
+        raise InputFormatError(p, f"to_airport: {ta!r} is the origin; a package joins two "
+                               "airports", line=line)
+    return tuple(out)
+
+
+def for_scenario(scenario: Scenario, *, hours: float, seed: int = 0,
+                 base: str | Path | None = None,
+                 rate_per_hour: float | None = None) -> Stream:
+    """The scenario's packages over ``hours``: its CSV (a relative path read from ``base``,
+    the scenario file's folder; rows at or after the horizon dropped) when it names one,
+    else the Poisson stream."""
+    h = _hours(hours)
+    if scenario.packages.csv is None or rate_per_hour is not None:
+        return poisson(scenario, hours=h, seed=seed, rate_per_hour=rate_per_hour)
+    path = Path(scenario.packages.csv)
+    if not path.is_absolute() and base is not None:
+        path = Path(base) / path
+    s = read_csv(path, scenario)
+    keep = s.t < h * 3600.0
+    return _stream(*(getattr(s, c)[keep] for c in ("t", "origin", "origin_gate",
+                                                     "destination", "destination_gate")))

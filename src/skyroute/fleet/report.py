@@ -1,0 +1,151 @@
+"""What a fleet run achieved, as the flat numbers of ``report.json``.
+
+Rates count only the measured window ``[warm-up, horizon]``: the first
+:data:`~skyroute.fleet.simulate.WARMUP_SHARE` of the horizon (drones spreading out from
+their start gates) is excluded. ``offered`` are the packages spawned in the window,
+``delivered`` the hand-overs completed in it (whenever the package spawned), so
+``served_share`` compares two rates over one window. Delivery times (spawn to hand-over)
+are those of the packages delivered in the window.
+
+``lost`` is counted from the event log alone, not from the simulation's own arrays: a
+package is lost unless its events read spawn, then at most one assign, pickup and
+delivery in that order, picked up at its origin gate and delivered at its destination
+gate, with nothing after the delivery. ``conflicts``, ``min_horizontal_m`` and
+``min_vertical_m`` come from the independent separation checker
+(:func:`skyroute.fleet.separation.check`) over every airborne piece of every flight;
+``min_vertical_m`` is the least vertical distance of pairs closer than
+``sep_horizontal`` horizontally (infinite when no pair came that close).
+
+``capacity_bound_per_hour`` is ``drones * 3600 / mean cycle``, the cycle being the time
+a drone spends on one delivered package: the reposition flight when there was one, the
+delivery flight, the hand-over windows (gate to gate, loiters and ground holds
+included). It is what the fleet could deliver with no drone ever idle.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from skyroute.fleet.separation import SeparationReport, check
+from skyroute.fleet.simulate import SAMPLE_DT, WARMUP_SHARE, Simulation
+
+FIELDS = ("offered", "delivered", "delivered_per_hour", "served_share", "p50_delivery_s",
+          "p95_delivery_s", "max_wait_s", "loiters", "loiter_s", "conflicts",
+          "min_horizontal_m", "min_vertical_m", "lost", "capacity_bound_per_hour",
+          "simulated_hours", "wall_seconds")
+
+
+def lost_packages(events: list[dict], run: Simulation) -> list[int]:
+    """Package ids whose event history is not a proper one (see the module docstring)."""
+    st = run.stream
+    ids = [a.id for a in run.scenario.airports]
+    seen: dict[int, list[dict]] = {}
+    for e in events:
+        if "package" in e and e["kind"] in ("spawn", "assign", "pickup", "delivered"):
+            seen.setdefault(e["package"], []).append(e)
+    bad = []
+    for p in range(len(st)):
+        if st.t[p] > run.horizon:
+            continue
+        hist = seen.get(p, [])
+        kinds = [e["kind"] for e in hist]
+        ok = (kinds in (["spawn"], ["spawn", "assign"], ["spawn", "assign", "pickup"],
+                        ["spawn", "assign", "pickup", "delivered"])
+              and all(a["t"] <= b["t"] for a, b in zip(hist, hist[1:], strict=False)))
+        if ok and "pickup" in kinds:
+            e = hist[2]
+            ok = e["airport"] == ids[st.origin[p]] and e["gate"] == st.origin_gate[p]
+        if ok and "delivered" in kinds:
+            e = hist[3]
+            ok = (e["airport"] == ids[st.destination[p]]
+                  and e["gate"] == st.destination_gate[p])
+        if not ok:
+            bad.append(p)
+    return bad
+
+
+def report(run: Simulation, separation: SeparationReport | None = None) -> dict:
+    """The ``report.json`` numbers of ``run`` (:data:`FIELDS` first, then
+    ``settings`` and a few more counts); runs the separation checker unless given its
+    report."""
+    s = run.scenario
+    sep = separation
+    if sep is None:
+        pieces = run.pieces()
+        sep = check(pieces, sep_horizontal=s.airspace.sep_horizontal,
+                    sep_vertical=s.airspace.sep_vertical)
+    H = run.horizon
+    w0 = WARMUP_SHARE * H
+    hours = (H - w0) / 3600.0
+    st = run.stream
+    spawned = (st.t >= w0) & (st.t <= H)
+    done = (run.delivered >= w0) & (run.delivered <= H)
+    offered = int(spawned.sum())
+    delivered = int(done.sum())
+    times = (run.delivered - st.t)[done]
+    waited = np.where(np.isnan(run.pickup) | (run.pickup > H), H, run.pickup) - st.t
+    waited = waited[st.t <= H]
+    flights = [f for f in run.flights if f.plan.depart <= H]
+    loiter_s = 2 * math.pi * s.drone.turn_radius / s.drone.cruise_speed
+    circles = sum(sum(1 for j in range(f.plan.loiters)
+                      if f.plan.landing_request + j * loiter_s <= H) for f in flights)
+    cycle = _mean_cycle(run, done)
+    out = {
+        "offered": offered,
+        "delivered": delivered,
+        "delivered_per_hour": delivered / hours,
+        "served_share": delivered / offered if offered else 1.0,
+        "p50_delivery_s": float(np.percentile(times, 50)) if len(times) else None,
+        "p95_delivery_s": float(np.percentile(times, 95)) if len(times) else None,
+        "max_wait_s": float(waited.max()) if len(waited) else 0.0,
+        "loiters": circles,
+        "loiter_s": circles * loiter_s,
+        "conflicts": len(sep.conflicts),
+        "min_horizontal_m": _finite(sep.min_horizontal_m),
+        "min_vertical_m": _finite(sep.min_vertical_m),
+        "lost": len(lost_packages(run.events, run)),
+        "capacity_bound_per_hour": s.drones * 3600.0 / cycle if cycle else None,
+        "simulated_hours": run.hours,
+        "wall_seconds": run.wall_seconds,
+        "offered_per_hour": offered / hours,
+        "mean_cycle_s": cycle,
+        "flights": len(flights),
+        "reposition_flights": sum(f.kind == "reposition" for f in flights),
+        "sim_seconds_per_wall_second": H / run.wall_seconds if run.wall_seconds else None,
+        "settings": {
+            "scenario": s.name, "airports": len(s.airports), "drones": s.drones,
+            "rate_per_hour": run.rate_per_hour, "hours": run.hours, "seed": run.seed,
+            "scheduler": run.scheduler, "airspace": run.airspace,
+            "sep_horizontal": s.airspace.sep_horizontal,
+            "sep_vertical": s.airspace.sep_vertical, "warmup_s": w0,
+            "handover_seconds": s.handover_seconds, "reservation_step_s": SAMPLE_DT,
+        },
+    }
+    return out
+
+
+def _finite(x: float) -> float | None:
+    """JSON has no infinity: None when no pair came near."""
+    return float(x) if math.isfinite(x) else None
+
+
+def _mean_cycle(run: Simulation, done: np.ndarray) -> float | None:
+    """Mean drone time per package delivered in the window (see the module docstring):
+    the union of its flights' ``[depart - handover, at gate + handover]``."""
+    H = run.scenario.handover_seconds
+    spans: dict[int, list[tuple[float, float]]] = {}
+    for f in run.flights:
+        spans.setdefault(f.package, []).append((f.plan.depart - H, f.plan.at_gate + H))
+    ids = np.flatnonzero(done)
+    if len(ids) == 0:
+        return None
+    total = []
+    for p in ids:
+        busy, end = 0.0, -math.inf
+        for a, b in sorted(spans[int(p)]):
+            busy += b - max(a, end) if b > end else 0.0
+            end = max(end, b)
+        total.append(busy)
+    return float(np.mean(total))

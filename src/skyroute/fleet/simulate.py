@@ -1,0 +1,403 @@
+"""The fleet simulation: a deterministic discrete-event run of drones carrying packages.
+
+An event heap (time, then insertion order) drives three kinds of events: a package
+spawns, a drone becomes ready at a gate, a drone arrives to fetch a package. At each the
+dispatcher (:mod:`skyroute.fleet.dispatch`) may pair ready drones with waiting packages;
+each pair becomes one or two flights (an empty **reposition** flight to the package's
+airport when the drone is elsewhere, then the **delivery** flight).
+
+A flight is released only once it is planned whole (strategic deconfliction): its
+departure gate, take-off runway, the airspace of its climb, cruise, loiters and approach
+(:class:`~skyroute.fleet.airspace.Reservations`), the landing runway and the arrival gate
+are booked before it leaves. The landing is the airport manager's (seed) rule: the drone
+asks at the approach gate; the runway is granted only when no other drone is landing
+there or still rolling on it and the gate is free for the hand-over; each refusal is one
+full loiter circle. Because every booking is known when the flight is released, the
+number of circles is decided then, and so is the whole trajectory; when no number of
+circles (up to :data:`MAX_LOITERS`), no level (``shared``) and no airspace slot fits,
+the departure is held on the ground a little longer and tried again.
+
+Gates hold a drone only for a hand-over window of ``handover_seconds`` (unloading on
+arrival, loading before departure; a drone that lands at the gate it departs from loads
+in the same window); between flights it waits on the apron beside them (not tracked).
+
+The run is deterministic: no clock, no unordered iteration, one seeded stream.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from skyroute.errors import OptionError, SkyrouteError, check_choice
+from skyroute.fleet import dispatch, packages
+from skyroute.fleet.airspace import (
+    MODES,
+    Reservations,
+    layer_altitude,
+    level_choices,
+    samples,
+)
+from skyroute.fleet.flightplan import FlightPlan, plan_flight
+from skyroute.fleet.packages import Stream
+from skyroute.fleet.scenario import Scenario, runway_ends
+from skyroute.fleet.timetable import Timetable
+from skyroute.fleet.trajectory import Pieces
+
+MAX_LOITERS = 12
+WARMUP_SHARE = 0.1
+SAMPLE_DT = 1.0
+# ground holds tried before a departure, seconds after the earliest one
+_HOLDS = (0, 2, 5, 10, 15, 20, 30, 45, 60, 75, 90, 120, 150, 180, 240, 300) + tuple(
+    range(360, 4 * 3600 + 1, 60))
+_SPAWN, _READY, _FETCH = 0, 1, 2
+KINDS = ("spawn", "assign", "pickup", "takeoff", "landing_request", "landing_denied",
+         "landing_granted", "touchdown", "delivered")
+
+
+class SimulationError(SkyrouteError, RuntimeError):
+    """The simulation could not go on (a flight found no slot within the hold limit)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Flight:
+    """A released flight: its plan, ``kind`` (``reposition`` or ``delivery``), the
+    package it carries or goes to fetch, and when it was released."""
+
+    plan: FlightPlan
+    kind: str
+    package: int
+    released: float
+
+
+@dataclass(eq=False)
+class Simulation:
+    """What a run produced (filled by :func:`simulate`)."""
+
+    scenario: Scenario
+    stream: Stream
+    hours: float
+    seed: int
+    scheduler: str
+    airspace: str
+    flights: list[Flight] = field(default_factory=list)
+    events: list[dict] = field(default_factory=list)
+    assigned: np.ndarray | None = None
+    pickup: np.ndarray | None = None
+    delivered: np.ndarray | None = None
+    carrier: np.ndarray | None = None
+    wall_seconds: float = 0.0
+    rate_per_hour: float | None = None
+
+    @property
+    def horizon(self) -> float:
+        """Simulated seconds."""
+        return self.hours * 3600.0
+
+    def pieces(self) -> Pieces:
+        """Every airborne piece of every flight (whole flights, also past the horizon)."""
+        return Pieces.concat([f.plan.pieces for f in self.flights])
+
+
+def run(scenario: Scenario, *, hours: float, seed: int = 0, scheduler: str = "seed",
+        airspace: str | None = None, rate_per_hour: float | None = None,
+        base=None, progress=None) -> Simulation:
+    """Simulate ``scenario`` for ``hours`` on its own packages
+    (:func:`skyroute.fleet.packages.for_scenario`: its CSV, read from ``base``, or the
+    Poisson stream of ``seed`` at ``rate_per_hour``, default the scenario's)."""
+    stream = packages.for_scenario(scenario, hours=hours, seed=seed, base=base,
+                                   rate_per_hour=rate_per_hour)
+    sim = simulate(scenario, stream, hours=hours, seed=seed, scheduler=scheduler,
+                   airspace=airspace, progress=progress)
+    if scenario.packages.csv is None or rate_per_hour is not None:
+        sim.rate_per_hour = (scenario.packages.rate_per_hour if rate_per_hour is None
+                             else float(rate_per_hour))
+    return sim
+
+
+def simulate(scenario: Scenario, stream: Stream, *, hours: float, seed: int = 0,
+             scheduler: str = "seed", airspace: str | None = None,
+             progress=None) -> Simulation:
+    """Run ``scenario`` for ``hours`` on the packages of ``stream`` (``seed`` is recorded;
+    the stream carries the randomness) with the ``scheduler`` (``seed`` or ``optimal``)
+    and ``airspace`` (``layers`` or ``shared``; default the scenario's).
+    ``progress(t)`` is called now and then with the simulated time reached."""
+    check_choice("scheduler", scheduler, dispatch.SCHEDULERS)
+    mode = scenario.airspace.mode if airspace is None else airspace
+    check_choice("airspace", mode, MODES)
+    h = float(hours)
+    if not (math.isfinite(h) and h > 0):
+        raise OptionError(f"hours={hours!r} must be a number > 0", param="hours")
+    run = Simulation(scenario, stream, h, int(seed), scheduler, mode)
+    wall = time.perf_counter()
+    _Engine(run, progress).go()
+    run.wall_seconds = time.perf_counter() - wall
+    return run
+
+
+class _Engine:
+    """The event loop and the state it mutates (one per run)."""
+
+    def __init__(self, run: Simulation, progress) -> None:
+        self.run = run
+        s = self.s = run.scenario
+        self.progress = progress
+        self.ids = [a.id for a in s.airports]
+        self.index = {a: k for k, a in enumerate(self.ids)}
+        self.horizon = run.horizon
+        n_pk = len(run.stream)
+        run.assigned = np.full(n_pk, np.nan)
+        run.pickup = np.full(n_pk, np.nan)
+        run.delivered = np.full(n_pk, np.nan)
+        run.carrier = np.full(n_pk, -1, dtype=np.int64)
+        self.heap: list = []
+        self.seq = 0
+        self.waiting: list[int] = []  # package ids in spawn order
+        n = s.drones
+        a = len(s.airports)
+        # drone d starts parked at airport d mod a, gate (d // a) mod 2, ready at 0
+        self.at = [(d % a, (d // a) % 2) for d in range(n)]
+        self.ready_at = [0.0] * n
+        self.idle = [True] * n
+        self.job = [-1] * n  # the package a busy drone is fetching or carrying
+        self.next_free: dict[int, float] = {}  # delivering drones: ready time (optimal)
+        self.heading: dict[tuple[int, int], int] = {}
+        self.gates = [[Timetable(f"gate {i} {g}") for g in (0, 1)] for i in self.ids]
+        self.landing = [Timetable(f"landing runway {i}") for i in self.ids]
+        self.takeoff = [Timetable(f"take-off runway {i}") for i in self.ids]
+        d = s.drone
+        self.res = Reservations(sep_horizontal=s.airspace.sep_horizontal,
+                                sep_vertical=s.airspace.sep_vertical, dt=SAMPLE_DT,
+                                speed_bound=d.cruise_speed,
+                                climb_bound=d.cruise_speed * math.sin(
+                                    math.radians(max(d.climb_angle_deg,
+                                                     d.glide_angle_deg))))
+        self.handover = s.handover_seconds
+        self.templates: dict[tuple, tuple] = {}
+        self.travel = self._travel_times()
+
+    # -- events -------------------------------------------------------------------
+    def push(self, t: float, kind: int, a: int) -> None:
+        heapq.heappush(self.heap, (t, self.seq, kind, a))
+        self.seq += 1
+
+    def log(self, t: float, kind: str, *, drone=None, package=None, airport=None,
+            gate=None) -> None:
+        if t > self.horizon:
+            return
+        e = {"t": round(float(t), 3), "kind": kind}
+        if drone is not None:
+            e["drone"] = int(drone)
+        if package is not None:
+            e["package"] = int(package)
+        if airport is not None:
+            e["airport"] = self.ids[airport]
+        if gate is not None:
+            e["gate"] = int(gate)
+        self.run.events.append((float(t), len(self.run.events), e))
+
+    def go(self) -> None:
+        st = self.run.stream
+        for p in range(len(st)):
+            if st.t[p] < self.horizon:
+                self.push(float(st.t[p]), _SPAWN, p)
+        for d in range(self.s.drones):
+            self.push(0.0, _READY, d)
+        count = 0
+        while self.heap:
+            t, _, kind, a = heapq.heappop(self.heap)
+            if t > self.horizon:
+                break
+            self.now = t
+            if kind == _SPAWN:
+                self.waiting.append(a)
+                p = a
+                self.log(t, "spawn", package=p, airport=int(st.origin[p]),
+                         gate=int(st.origin_gate[p]))
+            elif kind == _READY:
+                self.idle[a] = True
+                self.job[a] = -1
+                self.next_free.pop(a, None)
+                for key in [k for k, v in self.heading.items() if v == a]:
+                    del self.heading[key]
+            else:  # _FETCH: the drone is at the package's gate; fly it
+                self._deliver(a, self.job[a], t)
+            self._dispatch(t)
+            count += 1
+            if count % 256 == 0:
+                self._forget(t)
+                if self.progress is not None:
+                    self.progress(t)
+        if self.progress is not None:
+            self.progress(self.horizon)
+        self.run.events = [e for _, _, e in sorted(self.run.events, key=lambda x: x[:2])]
+
+    def _forget(self, t: float) -> None:
+        before = t - self.handover - 1.0
+        for tt in (*self.landing, *self.takeoff, *(g for pair in self.gates for g in pair)):
+            tt.forget(before)
+        self.res.forget(t - 10.0)
+
+    # -- dispatch -----------------------------------------------------------------
+    def _dispatch(self, now: float) -> None:
+        if not self.waiting or not any(self.idle):
+            return
+        st = self.run.stream
+        if self.run.scheduler == "seed":
+            pairs = dispatch.seed(
+                packages=[(p, int(st.origin[p]), int(st.origin_gate[p]),
+                           int(st.destination[p]), int(st.destination_gate[p]))
+                          for p in self.waiting],
+                drones=[(d, *self.at[d]) for d in range(self.s.drones) if self.idle[d]],
+                travel=self.travel, heading=self.heading)
+        else:
+            drones = [(d, self.at[d][0], now) for d in range(self.s.drones) if self.idle[d]]
+            drones += [(d, self.at[d][0], r) for d, r in sorted(self.next_free.items())]
+            pairs = dispatch.optimal(
+                now=now, packages=[(p, int(st.origin[p]), float(st.t[p]))
+                                   for p in self.waiting],
+                drones=drones, travel=self.travel)
+        for d, p in pairs:
+            self._assign(d, p, now)
+
+    def _assign(self, d: int, p: int, now: float) -> None:
+        st = self.run.stream
+        self.waiting.remove(p)
+        self.idle[d] = False
+        self.job[d] = p
+        self.run.assigned[p] = now
+        self.log(now, "assign", drone=d, package=p)
+        a, g = int(st.origin[p]), int(st.origin_gate[p])
+        if self.run.scheduler == "seed":
+            self.heading[(int(st.destination[p]), int(st.destination_gate[p]))] = d
+        start = max(now, self.ready_at[d])
+        if self.at[d][0] == a:
+            self._deliver(d, p, start)
+            return
+        if self.run.scheduler == "seed":
+            self.heading[(a, g)] = d
+        f = self._release(d, a, g, start, "reposition", p)
+        self.push(f.at_gate, _FETCH, d)
+
+    def _deliver(self, d: int, p: int, earliest: float) -> None:
+        st = self.run.stream
+        if self.run.scheduler == "seed":
+            self.heading.pop((int(st.origin[p]), int(st.origin_gate[p])), None)
+        f = self._release(d, int(st.destination[p]), int(st.destination_gate[p]),
+                          max(earliest, self.ready_at[d]), "delivery", p,
+                          gate=int(st.origin_gate[p]))
+        self.run.pickup[p] = f.depart
+        self.run.carrier[p] = d
+        self.log(f.depart, "pickup", drone=d, package=p, airport=int(st.origin[p]),
+                 gate=int(st.origin_gate[p]))
+        done = f.at_gate + self.handover
+        self.run.delivered[p] = done
+        self.log(done, "delivered", drone=d, package=p, airport=int(st.destination[p]),
+                 gate=int(st.destination_gate[p]))
+        if self.run.scheduler == "optimal":
+            self.next_free[d] = done
+        self.push(done, _READY, d)
+
+    # -- flights ------------------------------------------------------------------
+    def _template(self, o: int, og: int, b: int, bg: int, alt: float):
+        key = (o, og, b, bg, alt)
+        tpl = self.templates.get(key)
+        if tpl is None:
+            plan = plan_flight(self.s, 0, self.ids[o], self.ids[b], depart=0.0, altitude=alt,
+                               origin_gate=og, destination_gate=bg)
+            d = self.s.drone
+            a_o, a_b = self.s.airports[o], self.s.airports[b]
+            thr, _ = runway_ends(a_o, a_o.takeoff)
+            # on the take-off runway from the airport's position to lift-off
+            on_rwy = plan.phase("taxi_out").end - math.hypot(
+                thr[0] - a_o.north, thr[1] - a_o.east) / d.taxi_speed
+            stop = plan.rollout_roll[1]
+            # the landing runway: from the start of the approach until the drone has
+            # rolled out and taxied back to the airport's position
+            off_rwy = plan.phase("rollout").end + math.hypot(
+                stop[0] - a_b.north, stop[1] - a_b.east) / d.taxi_speed
+            tpl = (plan, on_rwy, plan.phase("takeoff").end, plan.landing_request, off_rwy,
+                   plan.at_gate)
+            self.templates[key] = tpl
+        return tpl
+
+    def _levels(self, d: int, o: int, b: int) -> list[float]:
+        if self.run.airspace == "layers":
+            return [layer_altitude(self.s.airspace, d)]
+        ao, ab = self.s.airports[o], self.s.airports[b]
+        bearing = math.degrees(math.atan2(ab.east - ao.east, ab.north - ao.north))
+        return level_choices(self.s.airspace, bearing)
+
+    def _release(self, d: int, b: int, bg: int, earliest: float, kind: str, p: int, *,
+                 gate: int | None = None) -> FlightPlan:
+        """Plan, book and log the flight of drone ``d`` from where it is (leaving by its
+        own gate, or ``gate`` of the same airport) to airport ``b`` gate ``bg``."""
+        o = self.at[d][0]
+        og = self.at[d][1] if gate is None else gate
+        H = self.handover
+        loiter_s = 2 * math.pi * self.s.drone.turn_radius / self.s.drone.cruise_speed
+        gate_out = self.gates[o][og]
+        for hold in _HOLDS:
+            dep = earliest + hold
+            if not gate_out.free(dep - H, dep, owner=d):
+                continue
+            for alt in self._levels(d, o, b):
+                plan, on_rwy, lift, ask, off_rwy, at_gate = self._template(o, og, b, bg, alt)
+                if not self.takeoff[o].free(dep + on_rwy, dep + lift):
+                    continue
+                for k in range(MAX_LOITERS + 1):
+                    shift = dep + k * loiter_s
+                    if (self.landing[b].free(ask + shift, off_rwy + shift)
+                            and self.gates[b][bg].free(at_gate + shift, at_gate + shift + H,
+                                                       owner=d)):
+                        break
+                else:
+                    continue
+                fp = plan.shifted(dep, drone=d).with_loiters(k)
+                k0, S = samples(fp.pieces, SAMPLE_DT)
+                if not self.res.clear(d, k0, S):
+                    continue
+                self.res.add(d, k0, S)
+                gate_out.book(dep - H, dep, owner=d)
+                self.takeoff[o].book(dep + on_rwy, dep + lift, owner=d)
+                shift = dep + k * loiter_s
+                self.landing[b].book(ask + shift, off_rwy + shift, owner=d)
+                self.gates[b][bg].book(at_gate + shift, at_gate + shift + H, owner=d)
+                self._record(d, fp, kind, p, o, b, bg, loiter_s)
+                self.at[d] = (b, bg)
+                self.ready_at[d] = fp.at_gate + H
+                return fp
+        raise SimulationError(f"drone {d}: no slot for a flight {self.ids[o]} -> "
+                              f"{self.ids[b]} within {_HOLDS[-1] / 3600:g} h of "
+                              f"t={earliest:.0f} s")
+
+    def _record(self, d, fp: FlightPlan, kind, p, o, b, bg, loiter_s) -> None:
+        self.run.flights.append(Flight(fp, kind, p, self.now))
+        carried = p if kind == "delivery" else None
+        self.log(fp.phase("takeoff").end, "takeoff", drone=d, package=carried, airport=o)
+        for j in range(fp.loiters + 1):  # asks at the approach gate, one per circle
+            ask = fp.landing_request + j * loiter_s
+            self.log(ask, "landing_request", drone=d, package=carried, airport=b, gate=bg)
+            if j < fp.loiters:
+                self.log(ask, "landing_denied", drone=d, package=carried, airport=b,
+                         gate=bg)
+        self.log(fp.cleared, "landing_granted", drone=d, package=carried, airport=b, gate=bg)
+        self.log(fp.touchdown, "touchdown", drone=d, package=carried, airport=b)
+
+    # -- travel times -------------------------------------------------------------
+    def _travel_times(self) -> np.ndarray:
+        """Gate-to-gate seconds between airports at the lowest level (plus a hand-over):
+        the dispatcher's estimate of a flight."""
+        a = len(self.ids)
+        out = np.zeros((a, a))
+        alt = self.s.airspace.base_altitude
+        for i in range(a):
+            for j in range(a):
+                if i != j:
+                    plan = self._template(i, 0, j, 0, alt)[0]
+                    out[i, j] = plan.at_gate - plan.depart + self.handover
+        return out
