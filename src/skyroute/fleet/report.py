@@ -24,6 +24,7 @@ included). It is what the fleet could deliver with no drone ever idle.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -53,7 +54,7 @@ def lost_packages(events: list[dict], run: Simulation) -> list[int]:
         kinds = [e["kind"] for e in hist]
         ok = (kinds in (["spawn"], ["spawn", "assign"], ["spawn", "assign", "pickup"],
                         ["spawn", "assign", "pickup", "delivered"])
-              and all(a["t"] <= b["t"] for a, b in zip(hist, hist[1:], strict=False)))
+              and all(a["t"] <= b["t"] for a, b in itertools.pairwise(hist)))
         if ok and "pickup" in kinds:
             e = hist[2]
             ok = e["airport"] == ids[st.origin[p]] and e["gate"] == st.origin_gate[p]

@@ -52,8 +52,8 @@ MAX_LOITERS = 12
 WARMUP_SHARE = 0.1
 SAMPLE_DT = 1.0
 # ground holds tried before a departure, seconds after the earliest one
-_HOLDS = (0, 2, 5, 10, 15, 20, 30, 45, 60, 75, 90, 120, 150, 180, 240, 300) + tuple(
-    range(360, 4 * 3600 + 1, 60))
+_HOLDS = (0, 2, 5, 10, 15, 20, 30, 45, 60, 75, 90, 120, 150, 180, 240, 300,
+          *range(360, 4 * 3600 + 1, 60))
 _SPAWN, _READY, _FETCH = 0, 1, 2
 KINDS = ("spawn", "assign", "pickup", "takeoff", "landing_request", "landing_denied",
          "landing_granted", "touchdown", "delivered")

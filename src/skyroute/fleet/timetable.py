@@ -3,8 +3,9 @@
 A :class:`Timetable` keeps the booked intervals of one resource, sorted and disjoint;
 :meth:`Timetable.free` says whether ``[start, end]`` overlaps none of them (intervals that
 only meet at an end point do not overlap; a drone's own bookings do not count against
-it), :meth:`Timetable.book` adds one and refuses an overlap with another's, :meth:`Timetable.forget` drops those that ended before a time (they can no
-longer matter to a simulation that has moved past them).
+it), :meth:`Timetable.book` adds one and refuses an overlap with another's,
+:meth:`Timetable.forget` drops those that ended before a time (they can no longer matter
+to a simulation that has moved past them).
 
 >>> tt = Timetable("runway A")
 >>> tt.book(10.0, 20.0, owner=3)
