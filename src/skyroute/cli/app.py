@@ -12,6 +12,7 @@ from skyroute.cli.data_cmd import data_app
 from skyroute.cli.db_cmd import db_app
 from skyroute.cli.deliver_cmd import deliver_command
 from skyroute.cli.errors import run_cli
+from skyroute.cli.fleet_cmd import fleet_app
 from skyroute.cli.fly_cmd import fly_command
 from skyroute.cli.plan_cmd import plan_command
 from skyroute.cli.world_cmd import plan_world_command, synth_city_command
@@ -29,6 +30,7 @@ app.add_typer(bench_app, name="bench")
 app.command("deliver")(deliver_command)
 app.add_typer(db_app, name="db")
 app.add_typer(data_app, name="data")
+app.add_typer(fleet_app, name="fleet")
 
 
 @app.command("maps")

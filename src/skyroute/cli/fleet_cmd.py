@@ -1,0 +1,363 @@
+"""``skyroute fleet``: simulate a fleet, write a scenario to edit, sweep settings."""
+
+from __future__ import annotations
+
+import json
+import math
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from skyroute.errors import OptionError, check_choice
+from skyroute.fleet.scenario import PRESETS, Scenario, generate, load_scenario, preset, to_yaml
+
+fleet_app = typer.Typer(help="Fixed-wing drones carry packages between airports: simulate, "
+                             "write scenarios, sweep settings.", no_args_is_help=True)
+
+SCHEDULERS = ("seed", "optimal")
+AIRSPACES = ("layers", "shared")
+_PRESET_HELP = "One of the seed's set-ups: " + ", ".join(PRESETS) + "."
+
+ScenarioFile = Annotated[Path | None, typer.Argument(
+    metavar="[SCENARIO]", help="Scenario file (.yaml, .yml or .toml); see 'fleet scenario'.")]
+Preset = Annotated[str | None, typer.Option(help=_PRESET_HELP)]
+Airports = Annotated[int | None, typer.Option(help="Generate a scenario with N airports.")]
+Drones = Annotated[int | None, typer.Option(help="Number of drones (overrides the scenario's).")]
+AreaKm = Annotated[float, typer.Option(help="Side of the square the airports are spread over "
+                                            "(generated scenarios).")]
+Hours = Annotated[float, typer.Option(help="Simulated hours.")]
+Seed = Annotated[int, typer.Option(help="Seed of the package stream (and of a generated "
+                                        "scenario's layout).")]
+
+
+def _number(name: str, value: float | None, *, low: float, strict: bool) -> None:
+    ok = value is not None and math.isfinite(value) and (value > low if strict else value >= low)
+    if value is not None and not ok:
+        raise OptionError(f"--{name} {value!r} must be a number {'>' if strict else '>='} "
+                          f"{low:g}")
+
+
+def resolve_scenario(path: Path | None, preset_name: str | None, airports: int | None,
+                     drones: int | None, area_km: float, seed: int) -> Scenario:
+    """The scenario from exactly one of a file, a preset or ``--airports``; ``--drones``
+    overrides the drone count of any."""
+    given = [x for x in (path, preset_name, airports) if x is not None]
+    if len(given) != 1:
+        raise OptionError("give exactly one of SCENARIO, --preset or --airports (with "
+                          "--drones)")
+    if drones is not None and drones < 1:
+        raise OptionError(f"--drones {drones} must be at least 1")
+    if path is not None:
+        s = load_scenario(path)
+    elif preset_name is not None:
+        s = preset(preset_name)
+    else:
+        if drones is None:
+            raise OptionError("--airports needs --drones")
+        s = generate(airports, drones, area_km=area_km, seed=seed)
+    if drones is not None and drones != s.drones:
+        s = s.model_copy(update={"drones": drones})
+    return s
+
+
+def _with_separation(s: Scenario, sep_h: float | None, sep_v: float | None) -> Scenario:
+    _number("sep-horizontal", sep_h, low=0, strict=True)
+    _number("sep-vertical", sep_v, low=0, strict=True)
+    change = {k: v for k, v in (("sep_horizontal", sep_h), ("sep_vertical", sep_v))
+              if v is not None}
+    if not change:
+        return s
+    return s.model_copy(update={"airspace": s.airspace.model_copy(update=change)})
+
+
+def _progress(console: Console) -> Progress:
+    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                    TimeRemainingColumn(), console=console, transient=True)
+
+
+@fleet_app.command("simulate")
+def simulate_command(
+    scenario: ScenarioFile = None,
+    preset_name: Annotated[str | None, typer.Option("--preset", help=_PRESET_HELP)] = None,
+    airports: Airports = None,
+    drones: Drones = None,
+    area_km: AreaKm = 8.0,
+    hours: Hours = 4.0,
+    rate: Annotated[float | None, typer.Option(
+        help="Packages offered per hour (default the scenario's).")] = None,
+    seed: Seed = 0,
+    scheduler: Annotated[str, typer.Option(help="seed (the KU Leuven rule) or optimal.")] =
+        "seed",
+    airspace: Annotated[str | None, typer.Option(
+        help="layers (each drone its own level) or shared (levels by direction, 4D "
+             "reservations); default the scenario's.")] = None,
+    sep_horizontal: Annotated[float | None, typer.Option(
+        help="Horizontal separation minimum, m (default the scenario's, 50).")] = None,
+    sep_vertical: Annotated[float | None, typer.Option(
+        help="Vertical separation minimum, m (default the scenario's, 10).")] = None,
+    track_step: Annotated[float, typer.Option(help="Seconds between rows of tracks.csv.")] =
+        1.0,
+    out: Annotated[Path | None, typer.Option(
+        help="Folder for report.json, events.jsonl, tracks.csv, packages.csv, "
+             "fleet.geojson (and the PNGs with --plot).")] = None,
+    plot: Annotated[bool, typer.Option(help="Draw map.png and timeline.png into --out.")] =
+        False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the report as JSON.")] = False,
+) -> None:
+    """Simulate a fleet for some hours; report throughput, delivery times and separation.
+
+    Exits 1 when the independent checker finds a loss of separation or a package is lost.
+    """
+    from skyroute.fleet.report import report
+    from skyroute.fleet.simulate import run
+
+    check_choice("scheduler", scheduler, SCHEDULERS)
+    if airspace is not None:
+        check_choice("airspace", airspace, AIRSPACES)
+    _number("hours", hours, low=0, strict=True)
+    _number("rate", rate, low=0, strict=False)
+    _number("track-step", track_step, low=0, strict=True)
+    if plot and out is None:
+        raise OptionError("--plot needs --out DIR (the folder for map.png and timeline.png)")
+    s = _with_separation(resolve_scenario(scenario, preset_name, airports, drones, area_km,
+                                          seed), sep_horizontal, sep_vertical)
+    err = Console(stderr=True)
+    with _progress(err) as progress:
+        task = progress.add_task("simulated seconds", total=round(hours * 3600))
+        sim = run(s, hours=hours, seed=seed, scheduler=scheduler, airspace=airspace,
+                  rate_per_hour=rate, base=scenario.parent if scenario else None,
+                  progress=lambda t: progress.update(task, completed=round(t)))
+        progress.update(task, description="separation check")
+        rep = report(sim)
+    files: list[Path] = []
+    if out is not None:
+        from skyroute.io.fleet_out import write_run
+
+        files = write_run(sim, rep, out, track_step=track_step, plot=plot)
+    if as_json:
+        typer.echo(json.dumps(rep))
+    else:
+        Console().print(_report_table(rep, files))
+    if rep["conflicts"] or rep["lost"]:
+        Console(stderr=True).print(f"skyroute: {rep['conflicts']} loss(es) of separation, "
+                                   f"{rep['lost']} lost package(s)", markup=False)
+        raise typer.Exit(1)
+
+
+def _fmt(x, spec: str = ".1f", unit: str = "") -> str:
+    return "-" if x is None else f"{x:{spec}}{unit}"
+
+
+def _report_table(rep: dict, files: list[Path]) -> Table:
+    st = rep["settings"]
+    t = Table(title=f"fleet {st['scenario']}: {st['drones']} drones, {st['airports']} "
+                    f"airports, {st['hours']:g} h, {st['scheduler']} + {st['airspace']}, "
+                    f"seed {st['seed']}", show_header=False)
+    t.add_column(style="bold")
+    t.add_column()
+    rows = [
+        ("offered", f"{rep['offered']} ({rep['offered_per_hour']:.1f}/h after the "
+                    f"{st['warmup_s'] / 60:g} min warm-up)"),
+        ("delivered", f"{rep['delivered']} ({rep['delivered_per_hour']:.1f}/h, served "
+                      f"{rep['served_share']:.1%})"),
+        ("capacity bound", _fmt(rep["capacity_bound_per_hour"], ".1f", "/h")
+         + f" (mean cycle {_fmt(rep['mean_cycle_s'], '.0f', ' s')})"),
+        ("delivery time p50 / p95", f"{_fmt(rep['p50_delivery_s'], '.0f', ' s')} / "
+                                    f"{_fmt(rep['p95_delivery_s'], '.0f', ' s')}"),
+        ("longest wait", _fmt(rep["max_wait_s"], ".0f", " s")),
+        ("loiter circles", f"{rep['loiters']} ({rep['loiter_s']:.0f} s)"),
+        ("flights", f"{rep['flights']} ({rep['reposition_flights']} empty repositioning)"),
+        ("conflicts", str(rep["conflicts"])),
+        ("closest pair", f"{_fmt(rep['min_horizontal_m'], '.1f', ' m')} horizontally; "
+                         f"{_fmt(rep['min_vertical_m'], '.1f', ' m')} vertically within "
+                         f"{st['sep_horizontal']:g} m"),
+        ("lost packages", str(rep["lost"])),
+        ("wall time", f"{rep['wall_seconds']:.2f} s "
+                      f"({_fmt(rep['sim_seconds_per_wall_second'], ',.0f')} simulated s/s)"),
+    ]
+    rows += [("file", str(p)) for p in files]
+    for k, v in rows:
+        t.add_row(k, v)
+    return t
+
+
+@fleet_app.command("scenario")
+def scenario_command(
+    airports: Annotated[int, typer.Option(help="Number of airports (>= 2).")],
+    drones: Annotated[int, typer.Option(help="Number of drones (>= 1).")],
+    area_km: AreaKm = 8.0,
+    seed: Seed = 0,
+    rate: Annotated[float | None, typer.Option(
+        help="Packages offered per hour (default 20 per airport).")] = None,
+) -> None:
+    """Print a valid scenario as YAML, every field with its default, ready to edit."""
+    _number("rate", rate, low=0, strict=False)
+    typer.echo(to_yaml(generate(airports, drones, area_km=area_km, seed=seed,
+                                rate_per_hour=rate)), nl=False)
+
+
+def parse_seeds(text: str) -> list[int]:
+    """``"0-29"``, ``"1,4,7"`` or a mix -> the seeds, in order, no repeats."""
+    out: list[int] = []
+    try:
+        for part in (p.strip() for p in text.split(",") if p.strip()):
+            if "-" in part[1:]:
+                a, b = part.split("-", 1) if not part.startswith("-") else (part, "")
+                lo, hi = int(a), int(b)
+                if hi < lo:
+                    raise ValueError
+                out += range(lo, hi + 1)
+            else:
+                out.append(int(part))
+    except ValueError:
+        raise OptionError(f"--seeds {text!r}: expected seeds like 0-29 or 1,4,7") from None
+    if not out:
+        raise OptionError(f"--seeds {text!r}: no seed given")
+    return list(dict.fromkeys(out))
+
+
+def _choices(text: str, option: str, valid: tuple[str, ...]) -> list[str]:
+    items = [p.strip() for p in text.split(",") if p.strip()]
+    for x in items:
+        if x not in valid:
+            raise OptionError(f"{option} {x!r} is not valid; choose from "
+                              + ", ".join(valid))
+    if not items:
+        raise OptionError(f"{option}: give at least one of " + ", ".join(valid))
+    return list(dict.fromkeys(items))
+
+
+def _rates(text: str | None) -> list[float | None]:
+    if text is None:
+        return [None]
+    try:
+        rates = [float(p) for p in text.split(",") if p.strip()]
+    except ValueError:
+        raise OptionError(f"--rates {text!r}: expected numbers like 30,60,90") from None
+    if not rates or not all(math.isfinite(r) and r >= 0 for r in rates):
+        raise OptionError(f"--rates {text!r}: expected numbers >= 0 like 30,60,90")
+    return rates
+
+
+def _one(args: tuple) -> dict:
+    """One run of a sweep (in a worker process): its report without the settings."""
+    from skyroute.fleet.report import report
+    from skyroute.fleet.simulate import run
+
+    data, hours, seed, scheduler, airspace, rate = args
+    sim = run(Scenario.model_validate(data), hours=hours, seed=seed, scheduler=scheduler,
+              airspace=airspace, rate_per_hour=rate)
+    return report(sim)
+
+
+def mean_ci(values: list[float]) -> tuple[float, float]:
+    """Mean and the half-width of its 95% confidence interval (Student's t)."""
+    from scipy.stats import t as student
+
+    x = [v for v in values if v is not None]
+    if not x:
+        return math.nan, math.nan
+    m = sum(x) / len(x)
+    if len(x) < 2:
+        return m, math.nan
+    sd = math.sqrt(sum((v - m) ** 2 for v in x) / (len(x) - 1))
+    return m, float(student.ppf(0.975, len(x) - 1)) * sd / math.sqrt(len(x))
+
+
+SWEEP_METRICS = ("delivered_per_hour", "served_share", "p95_delivery_s", "max_wait_s",
+                 "loiters", "capacity_bound_per_hour")
+
+
+@fleet_app.command("sweep")
+def sweep_command(
+    scenario: ScenarioFile = None,
+    preset_name: Annotated[str | None, typer.Option("--preset", help=_PRESET_HELP)] = None,
+    airports: Airports = None,
+    drones: Drones = None,
+    area_km: AreaKm = 8.0,
+    scheduler: Annotated[str, typer.Option(help="Comma-separated: seed,optimal.")] =
+        "seed,optimal",
+    airspace: Annotated[str, typer.Option(help="Comma-separated: layers,shared.")] =
+        "layers,shared",
+    rates: Annotated[str | None, typer.Option(
+        help="Comma-separated packages per hour (default the scenario's).")] = None,
+    seeds: Annotated[str, typer.Option(help="Seeds, like 0-29 or 1,4,7.")] = "0-9",
+    hours: Hours = 4.0,
+    jobs: Annotated[int, typer.Option(help="Worker processes.")] = 1,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the rows as JSON.")] = False,
+) -> None:
+    """Run every scheduler x airspace x rate on every seed (the same package streams for
+    each setting); one table of means with 95% confidence intervals."""
+    scheds = _choices(scheduler, "--scheduler", SCHEDULERS)
+    spaces = _choices(airspace, "--airspace", AIRSPACES)
+    rate_list = _rates(rates)
+    seed_list = parse_seeds(seeds)
+    _number("hours", hours, low=0, strict=True)
+    if jobs < 1:
+        raise OptionError(f"--jobs {jobs} must be at least 1")
+    s = resolve_scenario(scenario, preset_name, airports, drones, area_km, 0)
+    if scenario is not None and s.packages.csv is not None:
+        raise OptionError("sweep runs Poisson streams; this scenario names a package CSV")
+    data = s.model_dump()
+    configs = [(sc, sp, r) for r in rate_list for sc in scheds for sp in spaces]
+    work = [(data, hours, seed, sc, sp, r) for sc, sp, r in configs for seed in seed_list]
+    err = Console(stderr=True)
+    reports: list[dict] = []
+    with _progress(err) as progress:
+        task = progress.add_task("runs", total=len(work))
+        if jobs == 1:
+            for w in work:
+                reports.append(_one(w))
+                progress.advance(task)
+        else:
+            with ProcessPoolExecutor(max_workers=jobs) as pool:
+                for rep in pool.map(_one, work):
+                    reports.append(rep)
+                    progress.advance(task)
+    rows = []
+    n = len(seed_list)
+    for k, (sc, sp, _) in enumerate(configs):
+        reps = reports[k * n:(k + 1) * n]
+        row = {"scheduler": sc, "airspace": sp,
+               "rate_per_hour": reps[0]["settings"]["rate_per_hour"], "runs": n,
+               "conflicts": sum(x["conflicts"] for x in reps),
+               "lost": sum(x["lost"] for x in reps)}
+        for m in SWEEP_METRICS:
+            row[m], row[m + "_ci95"] = mean_ci([x[m] for x in reps])
+        rows.append(row)
+    if as_json:
+        clean = [{k: None if isinstance(v, float) and math.isnan(v) else v
+                  for k, v in r.items()} for r in rows]
+        typer.echo(json.dumps({"scenario": s.name, "hours": hours, "seeds": seed_list,
+                               "rows": clean}, allow_nan=False))
+    else:
+        Console().print(_sweep_table(s, hours, seed_list, rows))
+    if any(r["conflicts"] or r["lost"] for r in rows):
+        raise typer.Exit(1)
+
+
+def _sweep_table(s: Scenario, hours: float, seeds: list[int], rows: list[dict]) -> Table:
+    t = Table(title=f"fleet sweep {s.name}: {s.drones} drones, {len(s.airports)} airports, "
+                    f"{hours:g} h x {len(seeds)} seeds (mean ± 95% CI)")
+    for col in ("scheduler", "airspace", "offered/h", "delivered/h", "served", "p95 delivery s",
+                "longest wait s", "loiters", "capacity/h", "conflicts", "lost"):
+        t.add_column(col, justify="right")
+
+    def pm(r, m, spec):
+        v, ci = r[m], r[m + "_ci95"]
+        if v is None or (isinstance(v, float) and math.isnan(v)):
+            return "-"
+        return f"{v:{spec}}" + ("" if ci is None or math.isnan(ci) else f" ± {ci:{spec}}")
+
+    for r in rows:
+        t.add_row(r["scheduler"], r["airspace"], _fmt(r["rate_per_hour"], ".0f"),
+                  pm(r, "delivered_per_hour", ".1f"), pm(r, "served_share", ".3f"),
+                  pm(r, "p95_delivery_s", ".0f"), pm(r, "max_wait_s", ".0f"),
+                  pm(r, "loiters", ".1f"), pm(r, "capacity_bound_per_hour", ".1f"),
+                  str(r["conflicts"]), str(r["lost"]))
+    return t
