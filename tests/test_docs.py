@@ -9,7 +9,8 @@ import pytest
 
 MODULES = ["skyroute.world.grid", "skyroute.world.load", "skyroute.planner",
            "skyroute.fleet.vehicle", "skyroute.fleet.trajectory",
-           "skyroute.fleet.separation", "skyroute.fleet.flightplan"]
+           "skyroute.fleet.separation", "skyroute.fleet.flightplan",
+           "skyroute.io.fleet_out"]
 
 
 @pytest.mark.parametrize("name", MODULES)
