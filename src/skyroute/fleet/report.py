@@ -48,7 +48,7 @@ def lost_packages(events: list[dict], run: Simulation) -> list[int]:
             seen.setdefault(e["package"], []).append(e)
     bad = []
     for p in range(len(st)):
-        if st.t[p] > run.horizon:
+        if st.t[p] >= run.horizon:  # the run spawns packages before the horizon only
             continue
         hist = seen.get(p, [])
         kinds = [e["kind"] for e in hist]
@@ -81,13 +81,13 @@ def report(run: Simulation, separation: SeparationReport | None = None) -> dict:
     w0 = WARMUP_SHARE * H
     hours = (H - w0) / 3600.0
     st = run.stream
-    spawned = (st.t >= w0) & (st.t <= H)
+    spawned = (st.t >= w0) & (st.t < H)
     done = (run.delivered >= w0) & (run.delivered <= H)
     offered = int(spawned.sum())
     delivered = int(done.sum())
     times = (run.delivered - st.t)[done]
     waited = np.where(np.isnan(run.pickup) | (run.pickup > H), H, run.pickup) - st.t
-    waited = waited[st.t <= H]
+    waited = waited[st.t < H]
     flights = [f for f in run.flights if f.plan.depart <= H]
     loiter_s = 2 * math.pi * s.drone.turn_radius / s.drone.cruise_speed
     circles = sum(sum(1 for j in range(f.plan.loiters)

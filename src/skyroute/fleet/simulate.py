@@ -17,9 +17,11 @@ number of circles is decided then, and so is the whole trajectory; when no numbe
 circles (up to :data:`MAX_LOITERS`), no level (``shared``) and no airspace slot fits,
 the departure is held on the ground a little longer and tried again.
 
-Gates hold a drone only for a hand-over window of ``handover_seconds`` (unloading on
-arrival, loading before departure; a drone that lands at the gate it departs from loads
-in the same window); between flights it waits on the apron beside them (not tracked).
+Gates hold a drone only for hand-over windows of ``handover_seconds``: unloading after
+arrival, loading before departure (which starts once both the drone is free and the
+package is assigned; an empty drone that landed to fetch a package loads in the window
+it arrived in). Between flights a drone waits on the apron beside the gates (not
+tracked); a drone never holds a gate outside its windows.
 
 The run is deterministic: no clock, no unordered iteration, one seeded stream.
 """
@@ -47,6 +49,8 @@ from skyroute.fleet.packages import Stream
 from skyroute.fleet.scenario import Scenario, runway_ends
 from skyroute.fleet.timetable import Timetable
 from skyroute.fleet.trajectory import Pieces
+from skyroute.geo import heading_to_plane
+from skyroute.motion import dubins
 
 MAX_LOITERS = 12
 WARMUP_SHARE = 0.1
@@ -162,7 +166,7 @@ class _Engine:
         # drone d starts parked at airport d mod a, gate (d // a) mod 2, ready at 0
         self.at = [(d % a, (d // a) % 2) for d in range(n)]
         self.ready_at = [0.0] * n
-        self.idle = [True] * n
+        self.idle: set[int] = set()  # ready drones (each gets a _READY at 0)
         self.job = [-1] * n  # the package a busy drone is fetching or carrying
         self.next_free: dict[int, float] = {}  # delivering drones: ready time (optimal)
         self.heading: dict[tuple[int, int], int] = {}
@@ -219,7 +223,7 @@ class _Engine:
                 self.log(t, "spawn", package=p, airport=int(st.origin[p]),
                          gate=int(st.origin_gate[p]))
             elif kind == _READY:
-                self.idle[a] = True
+                self.idle.add(a)
                 self.job[a] = -1
                 self.next_free.pop(a, None)
                 for key in [k for k, v in self.heading.items() if v == a]:
@@ -244,7 +248,7 @@ class _Engine:
 
     # -- dispatch -----------------------------------------------------------------
     def _dispatch(self, now: float) -> None:
-        if not self.waiting or not any(self.idle):
+        if not self.waiting or not self.idle:
             return
         st = self.run.stream
         if self.run.scheduler == "seed":
@@ -252,14 +256,20 @@ class _Engine:
                 packages=[(p, int(st.origin[p]), int(st.origin_gate[p]),
                            int(st.destination[p]), int(st.destination_gate[p]))
                           for p in self.waiting],
-                drones=[(d, *self.at[d]) for d in range(self.s.drones) if self.idle[d]],
+                drones=[(d, *self.at[d]) for d in sorted(self.idle)],
                 travel=self.travel, heading=self.heading)
         else:
-            drones = [(d, self.at[d][0], now) for d in range(self.s.drones) if self.idle[d]]
-            drones += [(d, self.at[d][0], r) for d, r in sorted(self.next_free.items())]
+            # a bounded window, the oldest packages (age wins ties of distance) and the
+            # soonest-ready drones, keeps the assignment small: its cost grows with the
+            # cube of its size
+            idle = sorted(self.idle)
+            k = 8 * len(idle) + 16
+            soon = sorted(self.next_free.items(), key=lambda x: (x[1], x[0]))[:4 * k]
+            drones = [(d, self.at[d][0], now) for d in idle]
+            drones += [(d, self.at[d][0], r) for d, r in soon]
             pairs = dispatch.optimal(
                 now=now, packages=[(p, int(st.origin[p]), float(st.t[p]))
-                                   for p in self.waiting],
+                                   for p in self.waiting[:k]],
                 drones=drones, travel=self.travel)
         for d, p in pairs:
             self._assign(d, p, now)
@@ -267,7 +277,7 @@ class _Engine:
     def _assign(self, d: int, p: int, now: float) -> None:
         st = self.run.stream
         self.waiting.remove(p)
-        self.idle[d] = False
+        self.idle.discard(d)
         self.job[d] = p
         self.run.assigned[p] = now
         self.log(now, "assign", drone=d, package=p)
@@ -276,7 +286,7 @@ class _Engine:
             self.heading[(int(st.destination[p]), int(st.destination_gate[p]))] = d
         start = max(now, self.ready_at[d])
         if self.at[d][0] == a:
-            self._deliver(d, p, start)
+            self._deliver(d, p, now)
             return
         if self.run.scheduler == "seed":
             self.heading[(a, g)] = d
@@ -287,8 +297,10 @@ class _Engine:
         st = self.run.stream
         if self.run.scheduler == "seed":
             self.heading.pop((int(st.origin[p]), int(st.origin_gate[p])), None)
+        # loading takes the hand-over window before departure, once both the drone is
+        # free at the airport and the package is there to load
         f = self._release(d, int(st.destination[p]), int(st.destination_gate[p]),
-                          max(earliest, self.ready_at[d]), "delivery", p,
+                          max(earliest, self.ready_at[d]) + self.handover, "delivery", p,
                           gate=int(st.origin_gate[p]))
         self.run.pickup[p] = f.depart
         self.run.carrier[p] = d
@@ -369,7 +381,9 @@ class _Engine:
                 self.gates[b][bg].book(at_gate + shift, at_gate + shift + H, owner=d)
                 self._record(d, fp, kind, p, o, b, bg, loiter_s)
                 self.at[d] = (b, bg)
-                self.ready_at[d] = fp.at_gate + H
+                # free after unloading a delivery; an empty drone at once (it loads in
+                # the window it arrived in)
+                self.ready_at[d] = fp.at_gate + (H if kind == "delivery" else 0.0)
                 return fp
         raise SimulationError(f"drone {d}: no slot for a flight {self.ids[o]} -> "
                               f"{self.ids[b]} within {_HOLDS[-1] / 3600:g} h of "
@@ -390,14 +404,28 @@ class _Engine:
 
     # -- travel times -------------------------------------------------------------
     def _travel_times(self) -> np.ndarray:
-        """Gate-to-gate seconds between airports at the lowest level (plus a hand-over):
-        the dispatcher's estimate of a flight."""
+        """Gate-to-gate seconds between airports at the lowest level plus a hand-over:
+        the dispatcher's estimate of a flight. The time to the climb-out point depends
+        on the origin only and the time from the approach gate on the destination only;
+        the Dubins cruise between them is one vectorised call over all pairs."""
         a = len(self.ids)
-        out = np.zeros((a, a))
         alt = self.s.airspace.base_altitude
+        d = self.s.drone
+        out_s, in_s = np.zeros(a), np.zeros(a)
+        top, gate = np.zeros((a, 3)), np.zeros((a, 3))
         for i in range(a):
-            for j in range(a):
-                if i != j:
-                    plan = self._template(i, 0, j, 0, alt)[0]
-                    out[i, j] = plan.at_gate - plan.depart + self.handover
+            f = self._template(i, 0, (i + 1) % a, 0, alt)[0]
+            out_s[i] = f.phase("climb").end - f.depart
+            n, e, _ = f.pieces.end()[0]  # the climb's end
+            top[i] = e, n, heading_to_plane(math.radians(self.s.airports[i].takeoff
+                                                         .heading_deg), "ned")
+            g = self._template((i + 1) % a, 0, i, 0, alt)[0]
+            in_s[i] = g.at_gate - g.landing_request
+            gn, ge, _ = g.approach_gate
+            gate[i] = ge, gn, heading_to_plane(g.approach_heading, "ned")
+        starts = np.repeat(top, a, axis=0)
+        goals = np.tile(gate, (a, 1))
+        cruise = dubins.lengths(starts, goals, d.turn_radius).reshape(a, a) / d.cruise_speed
+        out = out_s[:, None] + cruise + in_s[None, :] + self.handover
+        np.fill_diagonal(out, 0.0)
         return out

@@ -24,6 +24,7 @@ import numpy as np
 from numba import njit, prange
 
 from skyroute.errors import OptionError
+from skyroute.motion import dubins_kernel
 from skyroute.motion.dubins_kernel import WORDS, shortest_length
 from skyroute.motion.tour import TourResult, tour  # noqa: F401  (skyroute.motion.dubins.tour)
 from skyroute.result import Status
@@ -189,9 +190,9 @@ def shortest_path(start, goal, radius: float) -> DubinsPath:
     g = tuple(float(v) for v in np.asarray(goal, dtype=float).reshape(3))
     if not all(map(math.isfinite, s + g)):
         raise OptionError(f"poses must be finite, got {start!r} and {goal!r}")
-    w = _words([s], [g], radius)[0]
-    k = int(np.nanargmin(w.sum(axis=1)))
-    return DubinsPath(s, g, float(radius), WORDS[k], tuple(float(v) * radius for v in w[k]))
+    seg, total = dubins_kernel.words(*s, *g, float(radius))  # compiled: one query
+    k = int(np.argmin(total))
+    return DubinsPath(s, g, float(radius), WORDS[k], tuple(float(v) for v in seg[k]))
 
 
 def through(points, radius: float, *, start_heading: float | None = None,
