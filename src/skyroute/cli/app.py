@@ -6,7 +6,10 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from skyroute.cli import bench_world_cmd  # noqa: F401  (registers 'bench world')
+from skyroute.cli import (
+    bench_fleet_cmd,  # noqa: F401  (registers 'bench fleet')
+    bench_world_cmd,  # noqa: F401  (registers 'bench world')
+)
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.data_cmd import data_app
 from skyroute.cli.db_cmd import db_app

@@ -13,6 +13,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
+from skyroute.cli.tables import wide_console
 from skyroute.errors import OptionError, check_choice
 from skyroute.fleet.scenario import PRESETS, Scenario, generate, load_scenario, preset, to_yaml
 
@@ -336,28 +337,29 @@ def sweep_command(
         typer.echo(json.dumps({"scenario": s.name, "hours": hours, "seeds": seed_list,
                                "rows": clean}, allow_nan=False))
     else:
-        Console().print(_sweep_table(s, hours, seed_list, rows))
+        wide_console().print(_sweep_table(s, hours, seed_list, rows))
     if any(r["conflicts"] or r["lost"] for r in rows):
         raise typer.Exit(1)
 
 
 def _sweep_table(s: Scenario, hours: float, seeds: list[int], rows: list[dict]) -> Table:
     t = Table(title=f"fleet sweep {s.name}: {s.drones} drones, {len(s.airports)} airports, "
-                    f"{hours:g} h x {len(seeds)} seeds (mean ± 95% CI)")
-    for col in ("scheduler", "airspace", "offered/h", "delivered/h", "served", "p95 delivery s",
-                "longest wait s", "loiters", "capacity/h", "conflicts", "lost"):
+                    f"{hours:g} h x {len(seeds)} seeds (mean ±95% CI)")
+    for col in ("scheduler", "airspace", "offered/h", "delivered/h", "served %", "p95 s",
+                "max wait s", "loiters", "capacity/h", "conflicts", "lost"):
         t.add_column(col, justify="right")
 
-    def pm(r, m, spec):
+    def pm(r, m, spec, scale=1.0):
         v, ci = r[m], r[m + "_ci95"]
         if v is None or (isinstance(v, float) and math.isnan(v)):
             return "-"
-        return f"{v:{spec}}" + ("" if ci is None or math.isnan(ci) else f" ± {ci:{spec}}")
+        text = f"{v * scale:{spec}}"
+        return text if ci is None or math.isnan(ci) else f"{text}±{ci * scale:{spec}}"
 
     for r in rows:
         t.add_row(r["scheduler"], r["airspace"], _fmt(r["rate_per_hour"], ".0f"),
-                  pm(r, "delivered_per_hour", ".1f"), pm(r, "served_share", ".3f"),
+                  pm(r, "delivered_per_hour", ".1f"), pm(r, "served_share", ".1f", 100.0),
                   pm(r, "p95_delivery_s", ".0f"), pm(r, "max_wait_s", ".0f"),
-                  pm(r, "loiters", ".1f"), pm(r, "capacity_bound_per_hour", ".1f"),
+                  pm(r, "loiters", ".0f"), pm(r, "capacity_bound_per_hour", ".1f"),
                   str(r["conflicts"]), str(r["lost"]))
     return t

@@ -1,7 +1,8 @@
-"""The Rich table that shows one PlanResult."""
+"""Rich tables: the one that shows a PlanResult, and a console wide enough for them."""
 
 from __future__ import annotations
 
+from rich.console import Console
 from rich.table import Table
 
 from skyroute.result import PlanResult
@@ -28,3 +29,10 @@ def result_table(title: str, result: PlanResult, *, unit: str = "",
         if path:
             table.add_row(label, str(path))
     return table
+
+
+def wide_console() -> Console:
+    """Stdout for wide tables: at least 160 columns when it is a file or a pipe (where
+    Rich would otherwise wrap every cell at 80)."""
+    out = Console()
+    return out if out.is_terminal else Console(width=160)

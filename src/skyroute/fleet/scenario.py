@@ -91,7 +91,7 @@ class Scenario(_Strict):
     home_lon: float = Field(default=4.7005, ge=-180, le=180)
     airports: list[Airport] = Field(min_length=2)
     drones: int = Field(default=3, ge=1)
-    handover_seconds: float = Field(default=30.0, ge=0, description="at a gate: unload, "
+    handover_seconds: float = Field(default=15.0, ge=0, description="at a gate: unload, "
                                     "load")
     drone: Drone = Drone()
     packages: Packages = Packages()
@@ -195,7 +195,7 @@ def generate(airports: int, drones: int, *, area_km: float = 8.0, seed: int = 0,
 
 
 PRESETS = {  # (airports, drones, area km, rate per hour): the seed's set-ups
-    "seed-3x3": (3, 3, 4.0, 60.0),
+    "seed-3x3": (3, 3, 2.0, 60.0),
     "seed-9x9": (9, 9, 8.0, 120.0),
     "seed-18x9": (9, 18, 8.0, 180.0),
 }

@@ -1,0 +1,67 @@
+"""``skyroute bench fleet``: the fleet simulation's speed on the issue's two large cases."""
+
+from __future__ import annotations
+
+import json
+import platform
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from skyroute.bench.fleet import CASES, bench_case
+from skyroute.cli.bench_cmd import bench_app
+from skyroute.cli.tables import wide_console
+from skyroute.errors import OptionError, check_choice
+from skyroute.files import write_atomic
+
+
+@bench_app.command("fleet")
+def bench_fleet(
+    case: Annotated[list[int] | None, typer.Option(
+        help="Only case K (repeatable; 1: 100 drones/30 airports/24 h, 2: 1000 drones/100 "
+             "airports/1 h).")] = None,
+    scheduler: Annotated[str, typer.Option(help="seed or optimal.")] = "optimal",
+    airspace: Annotated[str, typer.Option(help="layers or shared.")] = "shared",
+    seed: Annotated[int, typer.Option(help="Seed of the package stream.")] = 0,
+    json_out: Annotated[Path | None, typer.Option("--json", help="Write the rows here.")] =
+        None,
+) -> None:
+    """Time large fleet simulations (and the separation check of every piece)."""
+    check_choice("scheduler", scheduler, ("seed", "optimal"))
+    check_choice("airspace", airspace, ("layers", "shared"))
+    chosen = case or list(range(1, len(CASES) + 1))
+    for k in chosen:
+        if not 1 <= k <= len(CASES):
+            raise OptionError(f"--case {k} is not valid; choose 1 to {len(CASES)}")
+    err = Console(stderr=True)
+    rows = []
+    with Progress(TextColumn("{task.description}"), BarColumn(), TimeElapsedColumn(),
+                  console=err, transient=True) as progress:
+        for k in chosen:
+            name, airports, drones, area, hours, rate = CASES[k - 1]
+            task = progress.add_task(name, total=round(hours * 3600))
+            row = bench_case(airports, drones, area, hours, rate, scheduler=scheduler,
+                             airspace=airspace, seed=seed,
+                             progress=lambda t, task=task: progress.update(
+                                 task, completed=round(t)))
+            progress.remove_task(task)
+            rows.append({"case": name, **row})
+    t = Table(title=f"fleet simulation speed ({scheduler} + {airspace}, seed {seed})")
+    for col in ("case", "offered/h", "flights", "simulate s", "check s", "simulated s/s",
+                "delivered/h", "conflicts", "lost"):
+        t.add_column(col, justify="left" if col == "case" else "right")
+    for r in rows:
+        t.add_row(r["case"], f"{r['rate_per_hour']:.0f}", f"{r['flights']:,}",
+                  f"{r['sim_seconds']:.1f}", f"{r['check_seconds']:.2f}",
+                  f"{r['sim_seconds_per_wall_second']:,.0f}", f"{r['delivered_per_hour']:.0f}",
+                  str(r["conflicts"]), str(r["lost"]))
+    wide_console().print(t)
+    if json_out:
+        write_atomic(json_out, json.dumps({"machine": {"python": platform.python_version(),
+                                                       "processor": platform.processor()
+                                                       or platform.machine()},
+                                           "rows": rows}, indent=1))
