@@ -243,6 +243,7 @@ def test_geojson_is_near_home_and_round_trips_through_ned(sim):
 
 
 def test_write_run_writes_whole_files_and_no_pictures(sim, rep, tmp_path):
+    rep = {**rep, "min_vertical_m": None}  # no pair came within sep_horizontal: null
     out = tmp_path / "new" / "run"
     paths = write_run(sim, rep, out)
     assert paths == [out / name for name in FILES]

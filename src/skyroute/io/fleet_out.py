@@ -30,11 +30,11 @@ released before the end but still flying at it has rows up to the horizon only.
 >>> sim = run(preset("seed-3x3"), hours=0.25, seed=1)
 >>> tr = tracks(sim, step=1.0)
 >>> [str(p) for p in TRACK_PHASES if p in tr["phase"]]
-['taxi', 'takeoff', 'climb', 'cruise', 'approach', 'rollout']
+['taxi', 'takeoff', 'climb', 'cruise', 'loiter', 'approach', 'rollout']
 >>> bool((tr["alt"][tr["phase"] == "taxi"] == 0).all())
 True
 >>> tracks_csv(sim, step=1.0).splitlines()[:2]
-[b't,drone,north,east,alt,phase', b'25,1,-1848.920,-1941.302,0.000,taxi']
+[b't,drone,north,east,alt,phase', b'40,1,-930.920,-974.302,0.000,taxi']
 >>> events_jsonl(sim).splitlines()[0]
 '{"t":24.803,"kind":"spawn","package":0,"airport":"B","gate":0}'
 """
