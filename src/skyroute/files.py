@@ -9,6 +9,16 @@ from pathlib import Path
 from skyroute.errors import SkyrouteError
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+# mkstemp makes files only the owner can read; outputs get the usual mode instead
+_MODE = 0o666 & ~_umask()
+
+
 def write_atomic(path: str | Path, data: bytes | str) -> Path:
     """Write ``data`` to a temporary file beside ``path``, then rename it into place.
 
@@ -23,6 +33,7 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data.encode() if isinstance(data, str) else data)
+        os.chmod(tmp, _MODE)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
