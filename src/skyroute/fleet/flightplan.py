@@ -71,7 +71,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from skyroute.errors import OptionError, check_choice
+from skyroute.errors import OptionError, QueryError, check_choice
+from skyroute.fleet import nofly
 from skyroute.fleet.scenario import Airport, Drone, Scenario, runway_ends
 from skyroute.fleet.trajectory import ARC, LINE, Pieces, Trajectory, arc_piece
 from skyroute.fleet.vehicle import (
@@ -284,6 +285,7 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
 
     # climb: one straight piece from the lift-off point to the climb-out point
     top = lift_off + climb * u_up
+    nofly.check_line(scenario, lift_off, top, f"airport {origin}'s climb-out to {h:g} m")
     tr = Trajectory(drone, t_lift, (*lift_off, 0.0))
     tr.line_to(add("climb", climb_s), (*top, h))
 
@@ -294,11 +296,16 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
     final = h / math.tan(math.radians(d.glide_angle_deg))
     gate = land_thr - final * u_down
     r, v = d.turn_radius, d.cruise_speed
-    path = shortest_path((top[1], top[0], float(heading_to_plane(psi_up, "ned"))),
-                         (gate[1], gate[0], float(heading_to_plane(psi_down, "ned"))), r)
+    nofly.check_line(scenario, gate, land_thr, f"airport {destination}'s final approach "
+                     f"from {h:g} m")
+    plane_start = (top[1], top[0], float(heading_to_plane(psi_up, "ned")))
+    plane_goal = (gate[1], gate[0], float(heading_to_plane(psi_down, "ned")))
+    path = shortest_path(plane_start, plane_goal, r)
+    route = nofly.cruise(scenario, plane_start, plane_goal, r, path,  # around no-fly zones
+                         what=f"{origin} -> {destination} at {h:g} m")
     psi = psi_up  # compass heading (radians) along the way
     clock = tr.t
-    for letter, length in zip(path.word, path.segments, strict=True):
+    for letter, length in route:
         if not length > 1e-9:  # a turn of float noise (the word's unused letter)
             continue
         clock += length / v
@@ -314,10 +321,18 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
     phases.append(Phase("cruise", phases[-1].end, clock))
     t_ask = clock
 
-    # the loiter circle through the approach gate, tangent to the approach course
+    # the loiter circle through the approach gate, tangent to the approach course (on
+    # the other side when a no-fly zone is in the way)
     side = -1.0 if loiter_side == "left" else 1.0
-    loiter_centre = (float(gate[0] - side * r * math.sin(psi_down)),
-                     float(gate[1] + side * r * math.cos(psi_down)))
+    for s_try in (side, -side):
+        loiter_centre = (float(gate[0] - s_try * r * math.sin(psi_down)),
+                         float(gate[1] + s_try * r * math.cos(psi_down)))
+        if nofly.circle_clear(scenario, loiter_centre, r):
+            side = s_try
+            break
+    else:
+        raise QueryError(f"airport {destination}: both loiter circles at {h:g} m cross a "
+                         "no-fly zone", param="no_fly_zones")
 
     # approach: one straight glide from the approach gate to the threshold
     slope = math.hypot(final, h)

@@ -83,6 +83,22 @@ class Airspace(_Strict):
     shared_levels: int = Field(default=4, ge=1, description="levels by direction")
 
 
+class NoFlyZone(_Strict):
+    """A polygon no drone may fly into: (north, east) metres, at least three corners."""
+
+    name: str = Field(default="zone", min_length=1)
+    points: list[tuple[float, float]] = Field(min_length=3)
+
+    @model_validator(mode="after")
+    def _valid(self) -> NoFlyZone:
+        import shapely
+
+        poly = shapely.Polygon([(e, n) for n, e in self.points])
+        if not (poly.is_valid and poly.area > 0):
+            raise ValueError(f"zone {self.name!r} is not a simple polygon with an area")
+        return self
+
+
 class Scenario(_Strict):
     """Everything a fleet simulation needs besides the hours, seed and dispatcher."""
 
@@ -96,6 +112,7 @@ class Scenario(_Strict):
     drone: Drone = Drone()
     packages: Packages = Packages()
     airspace: Airspace = Airspace()
+    no_fly_zones: list[NoFlyZone] = Field(default_factory=list)
 
     @model_validator(mode="after")
     def _layout(self) -> Scenario:
@@ -110,6 +127,17 @@ class Scenario(_Strict):
         if d[i, j] < need:
             raise ValueError(f"airports {ids[i]} and {ids[j]} are {d[i, j]:.0f} m apart, "
                              f"closer than a runway ({need:g} m)")
+        if self.no_fly_zones:
+            import shapely
+
+            for k, z in enumerate(self.no_fly_zones):
+                poly = shapely.Polygon([(e, n) for n, e in z.points])
+                for a in self.airports:
+                    for rw in (a.landing, a.takeoff):
+                        ends = runway_ends(a, rw)
+                        if poly.intersects(shapely.LineString([(p[1], p[0]) for p in ends])):
+                            raise ValueError(f"no_fly_zones[{k}] ({z.name!r}) covers a "
+                                             f"runway of airport {a.id}")
         return self
 
     def airport(self, airport_id: str) -> Airport:

@@ -1,0 +1,78 @@
+"""No-fly zones: cruises go round them (checked with shapely, not our planner's own
+test), what cannot bend is refused with the zone's name, and a fleet run keeps out."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+
+from skyroute.errors import InputFormatError, QueryError
+from skyroute.fleet.flightplan import plan_flight
+from skyroute.fleet.report import report
+from skyroute.fleet.scenario import parse_scenario, preset
+from skyroute.fleet.simulate import run
+from skyroute.fleet.trajectory import ARC
+
+ZONE = [[-400, -700], [-400, 700], [300, 700], [300, -700]]  # (north, east) metres
+
+
+def _inside(pieces, poly) -> int:
+    """Pieces with a point strictly inside ``poly``: lines exactly, arcs densely."""
+    bad = 0
+    for i in range(len(pieces)):
+        if pieces.kind[i] == ARC:
+            ts = np.linspace(pieces.t0[i], pieces.t1[i], 400)
+            pts = pieces.at(np.full(len(ts), i), ts)
+            hit = shapely.contains_xy(poly, pts[:, 1], pts[:, 0]).any()
+        else:
+            a, b = pieces.at([i, i], [pieces.t0[i], pieces.t1[i]])
+            line = shapely.LineString([(a[1], a[0]), (b[1], b[0])])
+            hit = line.intersects(poly) and not line.touches(poly)
+        bad += bool(hit)
+    return bad
+
+
+def _two_airports(zone):
+    return parse_scenario({
+        "airports": [
+            {"id": "W", "north": 0, "east": -3000, "landing": {"heading_deg": 90},
+             "takeoff": {"heading_deg": 90}},
+            {"id": "E", "north": 0, "east": 3000, "landing": {"heading_deg": 90},
+             "takeoff": {"heading_deg": 90}}],
+        "no_fly_zones": [{"name": "wall", "points": zone}]})
+
+
+def test_a_cruise_goes_round_a_zone_on_its_straight_line():
+    s = _two_airports([[-300, -500], [-300, 500], [300, 500], [300, -500]])
+    f = plan_flight(s, 0, "W", "E", depart=0.0, altitude=100.0)
+    poly = shapely.Polygon([(e, n) for n, e in s.no_fly_zones[0].points])
+    assert _inside(f.pieces, poly) == 0
+    # the Dubins path without the zone crosses it; the detour is longer
+    free = plan_flight(s.model_copy(update={"no_fly_zones": []}), 0, "W", "E", depart=0.0,
+                       altitude=100.0)
+    assert _inside(free.pieces, poly) > 0
+    assert f.landing_request > free.landing_request
+
+
+def test_what_cannot_bend_is_refused_with_the_zones_name(tmp_path):
+    # the final approach to E from 100 m starts 951 m out: a zone there blocks it
+    s = _two_airports([[-100, 2200], [-100, 2500], [100, 2500], [100, 2200]])
+    with pytest.raises(QueryError, match=r"airport E's final approach .* 'wall'"):
+        plan_flight(s, 0, "W", "E", depart=0.0, altitude=100.0)
+    with pytest.raises(InputFormatError, match=r"no_fly_zones\[0\].*covers a runway of "
+                                               "airport W"):
+        _two_airports([[-50, -3100], [-50, -2900], [50, -2900], [50, -3100]])
+    with pytest.raises(InputFormatError, match=r"no_fly_zones\[0\]\.points: List should"):
+        _two_airports([[0, 0], [1, 1]])
+
+
+def test_a_fleet_run_keeps_out_of_a_zone_and_apart():
+    d = preset("seed-9x9").model_dump()
+    d["no_fly_zones"] = [{"name": "centre", "points": ZONE}]
+    s = parse_scenario(d)
+    sim = run(s, hours=1.0, seed=2, scheduler="optimal", airspace="shared")
+    rep = report(sim)
+    assert rep["conflicts"] == 0 and rep["lost"] == 0 and rep["delivered"] > 0
+    poly = shapely.Polygon([(e, n) for n, e in ZONE])
+    assert _inside(sim.pieces(), poly) == 0
