@@ -23,10 +23,11 @@ from hypothesis import given, settings, target
 from hypothesis import strategies as st
 
 from skyroute.fleet.airspace import Reservations, samples
+from skyroute.fleet.packages import Stream
 from skyroute.fleet.report import report
 from skyroute.fleet.scenario import generate, preset
 from skyroute.fleet.separation import check
-from skyroute.fleet.simulate import Simulation, run
+from skyroute.fleet.simulate import Simulation, run, simulate
 from skyroute.fleet.trajectory import Pieces, Trajectory, check_continuous
 
 PRESETS = ("seed-3x3", "seed-9x9", "seed-18x9")
@@ -77,7 +78,7 @@ def by_key(items, key) -> dict:
 # ------------------------------------------------------------------ the matrix
 
 def test_no_conflict_and_no_lost_package(config):
-    sim, rep = config
+    _, rep = config
     assert rep["conflicts"] == 0
     assert rep["lost"] == 0
     assert rep["offered"] > 0 and rep["delivered"] > 0  # the run did something
@@ -224,6 +225,17 @@ def test_a_drone_flies_one_flight_at_a_time_from_where_it_landed(config):
                 assert b.plan.depart >= a.plan.at_gate + H
 
 
+def test_a_drone_takes_one_package_at_a_time(config):
+    sim, _ = config
+    for drone, evs in by_key([e for e in sim.events if e["kind"] in ("assign", "delivered")],
+                             lambda e: e["drone"]).items():
+        kinds = [e["kind"] for e in evs]
+        assert kinds[::2] == ["assign"] * len(kinds[::2]), f"drone {drone}: {kinds}"
+        assert kinds[1::2] == ["delivered"] * len(kinds[1::2]), f"drone {drone}: {kinds}"
+        assert all(a["package"] == b["package"] for a, b in zip(evs[::2], evs[1::2],
+                                                                 strict=False))
+
+
 def test_a_gate_holds_one_drone_at_a_time(config):
     sim, _ = config
     H = sim.scenario.handover_seconds
@@ -238,6 +250,31 @@ def test_a_gate_holds_one_drone_at_a_time(config):
         assert not clash, f"two drones at gate {gate}: {clash[:3]}"
 
 
+@pytest.mark.parametrize("cfg", [c for c in CONFIGS if c[2] == "seed"], ids=config_id)
+def test_seed_rule_sends_one_drone_at_a_time_to_a_gate(cfg):
+    # the seed's rule: a drone flying to a gate (to fetch there, or to deliver there)
+    # holds it from its assignment until it has arrived (fetch) or handed over (delivery);
+    # times as the event log rounds them
+    sim, _ = simulated(*cfg)
+    ids = [a.id for a in sim.scenario.airports]
+    st_ = sim.stream
+    times = {(e["kind"], e["package"]): e["t"] for e in sim.events
+             if e["kind"] in ("assign", "delivered")}
+    heading = []
+    for f in sim.flights:
+        p, fp = f.package, f.plan
+        start = times[("assign", p)]
+        if f.kind == "reposition":
+            heading.append((start, round(fp.at_gate, 3), fp.drone, ids[st_.origin[p]],
+                            int(st_.origin_gate[p])))
+        else:
+            heading.append((start, times.get(("delivered", p), math.inf), fp.drone,
+                            fp.destination, fp.destination_gate))
+    for gate, group in by_key(heading, lambda w: w[3:]).items():
+        clash = overlapping(group)
+        assert not clash, f"two drones heading to gate {gate}: {clash[:3]}"
+
+
 @pytest.mark.parametrize("name, scheduler, airspace", [
     ("seed-3x3", "seed", "layers"), ("seed-9x9", "optimal", "shared"),
     ("seed-18x9", "optimal", "layers")])
@@ -245,6 +282,37 @@ def test_a_rerun_gives_identical_events(name, scheduler, airspace):
     first, _ = simulated(name, 1, scheduler, airspace)
     again = run(preset(name), hours=HOURS, seed=1, scheduler=scheduler, airspace=airspace)
     assert json.dumps(again.events) == json.dumps(first.events)
+
+
+# ------------------------------------------------------------------ regressions
+
+def three_packages(t0: float) -> Simulation:
+    """Drones 0, 1, 2 parked at A, B, C (gate 0). Drone 0 takes package 0 from A to B's
+    gate 1; package 1 leaves from B's gate 1 with drone 1 (parked at B); package 2 wants
+    to go from C to B's gate 1, where drone 0 is still heading."""
+    s = generate(3, 3, area_km=4.0, seed=0)
+    stream = Stream(t=np.array([t0, 10.0, 20.0]), origin=np.array([0, 1, 2]),
+                    origin_gate=np.array([0, 1, 1]), destination=np.array([1, 2, 1]),
+                    destination_gate=np.array([1, 0, 1]))
+    return simulate(s, stream, hours=1.0, scheduler="seed")
+
+
+@pytest.mark.parametrize("t0", [5.0, 0.0])
+def test_seed_rule_a_pickup_does_not_free_another_drones_gate(t0):
+    # was: the pickup of package 1 at B's gate 1 dropped drone 0's claim on that gate,
+    # and package 2 was sent to it at once
+    sim = three_packages(t0)
+    ev = {(e["kind"], e["package"]): e for e in sim.events}
+    assert [ev[("assign", p)]["drone"] for p in range(3)] == [0, 1, 2]
+    assert ev[("assign", 2)]["t"] == ev[("delivered", 0)]["t"]  # it waits for drone 0
+
+
+def test_a_package_at_time_zero_keeps_its_drone_busy():
+    # was: the drones' first READY came after a spawn at t = 0 and marked the drone that
+    # had just taken it idle, so it was given package 1 while still carrying package 0
+    sim = three_packages(0.0)
+    assigned = [(e["drone"], e["package"]) for e in sim.events if e["kind"] == "assign"]
+    assert assigned == [(0, 0), (1, 1), (2, 2)]
 
 
 # ------------------------------------------------------------------ small random fleets

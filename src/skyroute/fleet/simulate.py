@@ -206,11 +206,13 @@ class _Engine:
 
     def go(self) -> None:
         st = self.run.stream
+        # the drones' first READY before any spawn: at t = 0 a package must not be
+        # given to a drone that a later READY would then mark idle again
+        for d in range(self.s.drones):
+            self.push(0.0, _READY, d)
         for p in range(len(st)):
             if st.t[p] < self.horizon:
                 self.push(float(st.t[p]), _SPAWN, p)
-        for d in range(self.s.drones):
-            self.push(0.0, _READY, d)
         count = 0
         while self.heap:
             t, _, kind, a = heapq.heappop(self.heap)
@@ -295,8 +297,9 @@ class _Engine:
 
     def _deliver(self, d: int, p: int, earliest: float) -> None:
         st = self.run.stream
-        if self.run.scheduler == "seed":
-            self.heading.pop((int(st.origin[p]), int(st.origin_gate[p])), None)
+        key = (int(st.origin[p]), int(st.origin_gate[p]))
+        if self.heading.get(key) == d:  # it has arrived; another's claim on the gate stays
+            del self.heading[key]
         # loading takes the hand-over window before departure, once both the drone is
         # free at the airport and the package is there to load
         f = self._release(d, int(st.destination[p]), int(st.destination_gate[p]),
