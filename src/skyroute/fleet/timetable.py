@@ -1,6 +1,7 @@
 """A resource booked in time: a runway or a gate holds one drone at a time.
 
-A :class:`Timetable` keeps the booked intervals of one resource, sorted and disjoint;
+A :class:`Timetable` keeps the booked intervals of one resource, sorted (by start, then
+end, so the ends are sorted too: the searches bisect both) and disjoint;
 :meth:`Timetable.free` says whether ``[start, end]`` overlaps none of them (intervals that
 only meet at an end point do not overlap; a drone's own bookings do not count against
 it), :meth:`Timetable.book` adds one and refuses an overlap with another's,
@@ -61,6 +62,8 @@ class Timetable:
             del self._start[hit.start:hit.stop], self._end[hit.start:hit.stop]
             del self._owner[hit.start:hit.stop]
         k = bisect_right(self._start, start)
+        while k > 0 and self._start[k - 1] == start and self._end[k - 1] > end:
+            k -= 1  # equal starts: an instant [t, t] before [t, u], so the ends stay sorted
         self._start.insert(k, start)
         self._end.insert(k, end)
         self._owner.insert(k, owner)
