@@ -81,6 +81,91 @@ def test_airports_closer_than_a_runway_are_refused():
     s = sc.preset("seed-3x3").model_dump()
     s["airports"][1]["north"] = s["airports"][0]["north"] + 100
     s["airports"][1]["east"] = s["airports"][0]["east"]
-    with pytest.raises(InputFormatError, match="airports A and B are 100 m apart, closer "
-                                               "than a runway"):
+    with pytest.raises(InputFormatError, match="^s.yaml: airports: A and B are 100 m apart, "
+                                               r"closer than a runway \(600 m\)$"):
         sc.parse_scenario(s, "s.yaml")
+
+
+def _near(data: dict, k: int, north: float, east: float) -> list[float]:
+    """A point ``north``, ``east`` metres from airport ``k`` of a scenario's data."""
+    a = data["airports"][k]
+    return [a["north"] + north, a["east"] + east]
+
+
+def _other_beside_first(d: dict) -> None:
+    d["airports"][1]["north"], d["airports"][1]["east"] = _near(d, 0, 0, 100)
+
+
+@pytest.mark.parametrize("edit, words", [
+    # unknown fields, anywhere
+    (lambda d: d.update(drone_count=3), "drone_count: Extra inputs are not permitted"),
+    (lambda d: d["airports"][1].update(runway={"heading_deg": 0}),
+     "airports[1].runway: Extra inputs are not permitted"),
+    # gates: overlapping, too many, too far, not a point
+    (lambda d: d["airports"][0].update(gates=[_near(d, 0, 0, 5), _near(d, 0, 0, -5)]),
+     "airports[0].gates: gates overlapping: 10 m apart, closer than gate_width (30 m)"),
+    (lambda d: d["airports"][2].update(gate_width=50.0,
+                                       gates=[_near(d, 2, 40, 0), _near(d, 2, 0, 0)]),
+     "airports[2].gates: gates overlapping: 40 m apart, closer than gate_width (50 m)"),
+    (lambda d: d["airports"][0].update(gates=[_near(d, 0, 0, 20)] * 3),
+     "airports[0].gates: expected exactly two gates [[north, east], [north, east]], got 3"),
+    (lambda d: d["airports"][2].update(gates=[_near(d, 2, 0, 20), _near(d, 2, 400, 400)]),
+     "airports[2].gates: gate 1 is 566 m from the airport, farther than 500 m"),
+    (lambda d: d["airports"][1].update(gates=[[0.0, 0.0, 5.0], _near(d, 1, 0, 50)]),
+     "airports[1].gates[0]: Tuple should have at most 2 items"),
+    # negative speeds
+    (lambda d: d["drone"].update(cruise_speed=-50.0),
+     "drone.cruise_speed: Input should be greater than 0"),
+    (lambda d: d["drone"].update(taxi_speed=-10.0),
+     "drone.taxi_speed: Input should be greater than 0"),
+    # the layout
+    (_other_beside_first, "airports: A and B are 100 m apart, closer than a runway (600 m)"),
+    (lambda d: d["airports"][2].update(id="A"), "airports: ids must be unique"),
+])
+def test_bad_scenario_files_give_one_line_naming_the_field(tmp_path, edit, words):
+    import yaml
+
+    data = sc.preset("seed-3x3").model_dump()
+    edit(data)
+    p = tmp_path / "bad.yaml"
+    p.write_text(yaml.safe_dump(data, sort_keys=False))
+    with pytest.raises(InputFormatError) as info:
+        sc.load_scenario(p)
+    msg = str(info.value)
+    assert msg.startswith(f"{p}: ") and words in msg and "\n" not in msg
+
+
+def test_a_gate_just_within_500_m_is_allowed():
+    data = sc.preset("seed-3x3").model_dump()
+    data["airports"][2]["gates"] = [_near(data, 2, 0, 20), _near(data, 2, 300, -399.9)]
+    assert sc.parse_scenario(data).airports[2].gates[1] == tuple(_near(data, 2, 300, -399.9))
+
+
+def test_explicit_gates_place_the_taxi_routes_and_round_trip(tmp_path):
+    from skyroute.fleet.flightplan import gate_position, plan_flight
+    from skyroute.fleet.simulate import run
+    from skyroute.fleet.trajectory import check_continuous
+
+    base = sc.preset("seed-3x3")
+    data = base.model_dump()
+    a, b = _near(data, 0, 120, 0), _near(data, 0, 120, 60)
+    data["airports"][0]["gates"] = [a, b]
+    s = sc.parse_scenario(data)
+    A = s.airports[0]
+    assert gate_position(A, 0).tolist() == a and gate_position(A, 1).tolist() == b
+    # without gates, the derived ones: gate_width apart across the airport's position
+    d0, d1 = gate_position(base.airports[0], 0), gate_position(base.airports[0], 1)
+    assert math.dist(d0, d1) == pytest.approx(30.0)
+    assert (d0 + d1) / 2 == pytest.approx([base.airports[0].north, base.airports[0].east])
+    f = plan_flight(s, 0, "A", "B", depart=0.0, altitude=60.0, origin_gate=1)
+    back = plan_flight(s, 0, "B", "A", depart=0.0, altitude=60.0, destination_gate=0)
+    assert f.taxi_out_route[0].tolist() == b and back.taxi_in_route[-1].tolist() == a
+    # the gate 120 m out is a longer taxi than the derived one 15 m out
+    plain = plan_flight(base, 0, "A", "B", depart=0.0, altitude=60.0, origin_gate=1)
+    assert f.phase("taxi_out").end > plain.phase("taxi_out").end
+    p = tmp_path / "gates.yaml"
+    p.write_text(sc.to_yaml(s))
+    assert sc.load_scenario(p) == s
+    sim = run(s, hours=0.5, seed=2)
+    assert sim.flights and all(fl.plan.origin_gate in (0, 1) for fl in sim.flights)
+    check_continuous(sim.pieces())

@@ -45,7 +45,8 @@ Phases, in order (each ``[start, end]`` seconds; the next starts where one ends)
     roll-out end -> airport position -> gate, straight lines, the taxi profile.
 
 Gates: an airport's gate 0 stands ``gate_width / 2`` to the left of its position (seen
-along the take-off runway's heading), gate 1 as far to the right (:func:`gate_position`).
+along the take-off runway's heading), gate 1 as far to the right, unless the airport's
+``gates`` place them (:func:`gate_position`).
 
 >>> from skyroute.fleet.scenario import Airport, Runway, Scenario
 >>> s = Scenario(airports=[
@@ -228,10 +229,13 @@ class FlightPlan:
 
 
 def gate_position(airport: Airport, gate: int) -> np.ndarray:
-    """(north, east) of gate 0 (left of the take-off runway's heading) or 1 (right),
-    ``gate_width / 2`` from the airport's position."""
+    """(north, east) of gate 0 or 1: where the airport's ``gates`` put it, else gate 0
+    ``gate_width / 2`` left of the airport's position (seen along the take-off runway's
+    heading) and gate 1 as far right."""
     if gate not in (0, 1):
         raise OptionError(f"gate={gate!r} is not valid; choose 0 or 1", param="gate")
+    if airport.gates is not None:
+        return np.array(airport.gates[gate], dtype=float)
     h = math.radians(airport.takeoff.heading_deg)
     right = np.array([-math.sin(h), math.cos(h)])
     return np.array([airport.north, airport.east]) + (gate - 0.5) * airport.gate_width * right

@@ -6,7 +6,7 @@ Positions are metres north and east of the scenario's ``home`` (lat, lon), the `
 frame of docs/architecture.md; runway headings are compass degrees (clockwise from
 north). An airport's two runways cross at its position; each has its threshold at the
 end a drone meets first (landing) or starts from (take-off). Its two gates stand beside
-it, ``gate_width`` apart.
+it, ``gate_width`` apart, or where its ``gates`` field puts them.
 """
 
 from __future__ import annotations
@@ -17,9 +17,20 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    FiniteFloat,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from skyroute.errors import InputFormatError, OptionError
+
+MAX_GATE_DISTANCE = 500.0  # metres from an airport's position to a gate it places
 
 
 class _Strict(BaseModel):
@@ -34,7 +45,13 @@ class Runway(_Strict):
 
 
 class Airport(_Strict):
-    """An airport: position, a landing and a take-off runway, two gates."""
+    """An airport: position, a landing and a take-off runway, two gates.
+
+    The gates stand ``gate_width`` apart beside the airport's position (see
+    :func:`skyroute.fleet.flightplan.gate_position`) unless ``gates`` places them: two
+    ``[north, east]`` positions in metres, in the scenario's frame like the airport's
+    own, at least ``gate_width`` apart and within :data:`MAX_GATE_DISTANCE` of it.
+    """
 
     id: str = Field(min_length=1)
     north: float
@@ -42,6 +59,30 @@ class Airport(_Strict):
     landing: Runway
     takeoff: Runway
     gate_width: float = Field(default=30.0, gt=0, description="metres between gate centres")
+    gates: tuple[tuple[FiniteFloat, FiniteFloat], ...] | None = Field(
+        default=None, description="[[north, east], [north, east]] of gates 0 and 1, metres")
+
+    @field_validator("gates")
+    @classmethod
+    def _gates(cls, gates, info: ValidationInfo):
+        if gates is None:
+            return gates
+        if len(gates) != 2:
+            raise ValueError(f"expected exactly two gates [[north, east], [north, east]], "
+                             f"got {len(gates)}")
+        known = info.data  # the fields above that validated
+        if "north" in known and "east" in known:
+            for k, (n, e) in enumerate(gates):
+                d = math.hypot(n - known["north"], e - known["east"])
+                if d > MAX_GATE_DISTANCE:
+                    raise ValueError(f"gate {k} is {d:.0f} m from the airport, farther than "
+                                     f"{MAX_GATE_DISTANCE:g} m")
+        gap = math.hypot(gates[0][0] - gates[1][0], gates[0][1] - gates[1][1])
+        width = known.get("gate_width")
+        if width is not None and gap < width:
+            raise ValueError(f"gates overlapping: {gap:g} m apart, closer than gate_width "
+                             f"({width:g} m)")
+        return gates
 
 
 class Drone(_Strict):
@@ -114,19 +155,24 @@ class Scenario(_Strict):
     airspace: Airspace = Airspace()
     no_fly_zones: list[NoFlyZone] = Field(default_factory=list)
 
-    @model_validator(mode="after")
-    def _layout(self) -> Scenario:
-        ids = [a.id for a in self.airports]
+    @field_validator("airports")
+    @classmethod
+    def _layout(cls, airports: list[Airport]) -> list[Airport]:
+        ids = [a.id for a in airports]
         if len(set(ids)) != len(ids):
-            raise ValueError(f"airport ids must be unique, got {ids}")
-        pos = np.array([[a.north, a.east] for a in self.airports])
+            raise ValueError(f"ids must be unique, got {ids}")
+        pos = np.array([[a.north, a.east] for a in airports])
         d = np.hypot(*(pos[:, None] - pos[None]).transpose(2, 0, 1))
         np.fill_diagonal(d, np.inf)
         i, j = np.unravel_index(np.argmin(d), d.shape)
-        need = max(max(a.landing.length, a.takeoff.length) for a in self.airports)
+        need = max(max(a.landing.length, a.takeoff.length) for a in airports)
         if d[i, j] < need:
-            raise ValueError(f"airports {ids[i]} and {ids[j]} are {d[i, j]:.0f} m apart, "
-                             f"closer than a runway ({need:g} m)")
+            raise ValueError(f"{ids[i]} and {ids[j]} are {d[i, j]:.0f} m apart, closer than a "
+                             f"runway ({need:g} m)")
+        return airports
+
+    @model_validator(mode="after")
+    def _zones(self) -> Scenario:
         if self.no_fly_zones:
             import shapely
 
