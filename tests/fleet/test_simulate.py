@@ -284,6 +284,23 @@ def test_a_rerun_gives_identical_events(name, scheduler, airspace):
     assert json.dumps(again.events) == json.dumps(first.events)
 
 
+_OTHER_PROCESS = ("import json\n"
+                  "from skyroute.fleet.scenario import preset\n"
+                  "from skyroute.fleet.simulate import run\n"
+                  "sim = run(preset('seed-9x9'), hours=2.0, seed=1, scheduler='optimal', "
+                  "airspace='shared')\n"
+                  "print(json.dumps(sim.events))\n")
+
+
+@pytest.mark.early_process("-c", _OTHER_PROCESS)
+def test_another_process_gives_identical_events(early_process):
+    # another interpreter: another string hash seed, fresh caches
+    code, out, err, _ = early_process
+    assert code == 0, err
+    first, _ = simulated("seed-9x9", 1, "optimal", "shared")
+    assert out.strip() == json.dumps(first.events)
+
+
 # ------------------------------------------------------------------ regressions
 
 def three_packages(t0: float) -> Simulation:
