@@ -135,6 +135,35 @@ def test_bad_scenario_files_give_one_line_naming_the_field(tmp_path, edit, words
     assert msg.startswith(f"{p}: ") and words in msg and "\n" not in msg
 
 
+@pytest.mark.parametrize("edit, words", [
+    (lambda d: d["drone"].update(cruise_sped=50.0),
+     "drone.cruise_sped: Extra inputs are not permitted"),
+    (lambda d: d["airports"][0].update(gates=[_near(d, 0, 0, 5), _near(d, 0, 0, -5)]),
+     "airports[0].gates: gates overlapping"),
+    (lambda d: d["drone"].update(cruise_speed=-50.0), "drone.cruise_speed: Input should be"),
+    (_other_beside_first, "airports: A and B are 100 m apart, closer than a runway"),
+])
+def test_the_command_line_prints_one_line_and_exits_2(tmp_path, monkeypatch, capsys, edit,
+                                                      words):
+    import sys
+
+    import yaml
+
+    from skyroute.cli.app import main
+
+    data = sc.preset("seed-3x3").model_dump()
+    edit(data)
+    p = tmp_path / "bad.yaml"
+    p.write_text(yaml.safe_dump(data, sort_keys=False))
+    monkeypatch.setattr(sys, "argv", ["skyroute", "fleet", "simulate", str(p), "--hours",
+                                      "0.1"])
+    with pytest.raises(SystemExit) as info:
+        main()
+    out, err = capsys.readouterr()
+    assert info.value.code == 2 and out == ""
+    assert err.count("\n") == 1 and f"{p}: " in err and words in err
+
+
 def test_a_gate_just_within_500_m_is_allowed():
     data = sc.preset("seed-3x3").model_dump()
     data["airports"][2]["gates"] = [_near(data, 2, 0, 20), _near(data, 2, 300, -399.9)]
