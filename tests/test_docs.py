@@ -60,13 +60,20 @@ def test_readme_cli_examples_run_in_order(monkeypatch, capsys, tmp_path, fly_onc
     monkeypatch.chdir(tmp_path)  # one folder: later examples read earlier outputs
     printed = {}
     for command in commands:
-        monkeypatch.setattr(sys, "argv", shlex.split(command))
+        line, _, target = command.partition(" > ")  # 'cmd > file': stdout into the file
+        monkeypatch.setattr(sys, "argv", shlex.split(line))
         with pytest.raises(SystemExit) as exit_info:
             main()
         out, err = capsys.readouterr()
         assert exit_info.value.code == 0, (command, err)
         printed[command] = out
+        if target:
+            (tmp_path / target.strip()).write_text(out)
     assert (tmp_path / "city.png").exists() and (tmp_path / "city-waypoints.json").exists()
+    fleet_run = json.loads(printed[next(c for c in commands if " fleet.yaml " in c
+                                        and "--json" in c)])
+    assert fleet_run["conflicts"] == 0 and fleet_run["settings"]["drones"] == 8
+    assert (tmp_path / "fleet-out" / "map.png").exists()
     # The README's 'data synth' command writes what the repository ships in examples/lunch
     # (the set the README's set-up command flies), file for file.
     synth = next(c for c in commands if c.startswith("skyroute data synth "))

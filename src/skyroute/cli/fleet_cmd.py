@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Annotated
@@ -316,7 +317,10 @@ def sweep_command(
                 reports.append(_one(w))
                 progress.advance(task)
         else:
-            with ProcessPoolExecutor(max_workers=jobs) as pool:
+            # spawn, not fork: the checker's compiled kernels run OpenMP threads, and a
+            # forked child of a process that has started them dies
+            with ProcessPoolExecutor(max_workers=jobs,
+                                     mp_context=multiprocessing.get_context("spawn")) as pool:
                 for rep in pool.map(_one, work):
                     reports.append(rep)
                     progress.advance(task)

@@ -1,0 +1,95 @@
+"""skyroute fleet simulate | scenario | sweep and bench fleet, as a user runs them."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import yaml
+
+from skyroute.bench.fleet import bench_case
+from skyroute.cli.fleet_cmd import mean_ci, parse_seeds
+from skyroute.fleet.report import FIELDS
+from skyroute.fleet.scenario import load_scenario
+from tests.cli.test_cli import run
+
+
+def test_simulate_json_and_files(monkeypatch, capsys, tmp_path):
+    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", "--preset", "seed-3x3",
+                         "--hours", "1", "--seed", "3", "--scheduler", "optimal",
+                         "--airspace", "shared", "--out", str(tmp_path), "--json")
+    assert code == 0, err
+    rep = json.loads(out)
+    assert list(rep)[:len(FIELDS)] == list(FIELDS)
+    assert rep["conflicts"] == 0 and rep["lost"] == 0
+    assert rep["settings"]["scheduler"] == "optimal" and rep["settings"]["seed"] == 3
+    assert json.loads((tmp_path / "report.json").read_text())["offered"] == rep["offered"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "events.jsonl", "fleet.geojson", "packages.csv", "report.json", "tracks.csv"]
+
+
+def test_simulate_table_and_separation_override(monkeypatch, capsys):
+    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", "--airports", "3",
+                         "--drones", "2", "--area-km", "3", "--hours", "0.5",
+                         "--sep-horizontal", "80", "--rate", "30")
+    assert code == 0, err
+    assert "conflicts" in out and "within 80 m" in out and "2 drones, 3 airports" in out
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--preset", "seed-3x3", "--plot"], "--plot needs --out"),
+    (["--preset", "seed-3x3", "--airports", "3"], "exactly one of SCENARIO"),
+    (["--preset", "seed-3x3", "--hours", "0"], "--hours 0"),
+    (["--preset", "seed-3x3", "--scheduler", "fifo"], "--scheduler 'fifo'"),
+    (["--preset", "seed-3x3", "--sep-vertical", "-1"], "--sep-vertical -1"),
+    (["--airports", "3"], "--airports needs --drones"),
+])
+def test_bad_simulate_options_are_one_line_and_exit_2(monkeypatch, capsys, args, words):
+    code, _, err = run(monkeypatch, capsys, "fleet", "simulate", *args)
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_scenario_writes_a_loadable_file(monkeypatch, capsys, tmp_path):
+    code, out, err = run(monkeypatch, capsys, "fleet", "scenario", "--airports", "4",
+                         "--drones", "5", "--area-km", "5", "--seed", "2", "--rate", "33")
+    assert code == 0, err
+    p = tmp_path / "s.yaml"
+    p.write_text(out)
+    s = load_scenario(p)
+    assert len(s.airports) == 4 and s.drones == 5 and s.packages.rate_per_hour == 33
+    assert yaml.safe_load(out)["airspace"]["sep_horizontal"] == 50.0
+
+
+def test_sweep_rows_with_confidence_intervals(monkeypatch, capsys):
+    code, out, err = run(monkeypatch, capsys, "fleet", "sweep", "--preset", "seed-3x3",
+                         "--scheduler", "seed,optimal", "--airspace", "shared",
+                         "--rates", "20", "--seeds", "0-2", "--hours", "1", "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["seeds"] == [0, 1, 2] and len(doc["rows"]) == 2
+    for row in doc["rows"]:
+        assert row["runs"] == 3 and row["conflicts"] == 0 and row["lost"] == 0
+        assert row["rate_per_hour"] == 20 and row["delivered_per_hour_ci95"] >= 0
+
+
+def test_sweep_option_errors(monkeypatch, capsys):
+    code, _, err = run(monkeypatch, capsys, "fleet", "sweep", "--preset", "seed-3x3",
+                       "--seeds", "5-2")
+    assert code == 2 and "--seeds '5-2'" in err
+    code, _, err = run(monkeypatch, capsys, "fleet", "sweep", "--preset", "seed-3x3",
+                       "--airspace", "layers,open")
+    assert code == 2 and "--airspace 'open'" in err
+
+
+def test_seed_lists_and_confidence_intervals():
+    assert parse_seeds("0-3,7,2") == [0, 1, 2, 3, 7]
+    m, ci = mean_ci([1.0, 2.0, 3.0])
+    # mean 2, sd 1, t(0.975, 2) = 4.302652729911275 (tables): half-width 4.3027 / sqrt 3
+    assert m == 2.0 and ci == pytest.approx(4.302652729911275 / 3 ** 0.5)
+
+
+def test_bench_case_times_and_checks_a_small_fleet():
+    row = bench_case(4, 6, 4.0, 0.5, 40.0)
+    assert row["conflicts"] == 0 and row["lost"] == 0 and row["flights"] > 0
+    assert row["sim_seconds"] > 0 and row["check_seconds"] > 0
+    assert row["sim_seconds_per_wall_second"] == pytest.approx(1800 / row["wall_seconds"])
