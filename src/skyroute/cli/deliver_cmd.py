@@ -11,9 +11,9 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
+from skyroute.cli.tables import progress_bar
 from skyroute.delivery.day import METHODS, DayResult
 from skyroute.delivery.store import DEFAULT_DB
 from skyroute.errors import OptionError, SkyrouteError, check_choice
@@ -85,7 +85,7 @@ def deliver_command(
     for d in (d0 + dt.timedelta(k) for k in range((d1 - d0).days + 1)):
         by_date.setdefault(d, [])
     all_orders = [o for v in by_date.values() for o in v]
-    with _progress(err) as progress:
+    with progress_bar(err) as progress:
         task = progress.add_task("leg table", total=None)
         prepare_legs(site, all_orders, on_leg=lambda: progress.advance(task),
                      on_total=lambda n: progress.update(task, total=n))
@@ -106,10 +106,6 @@ def deliver_command(
     else:
         _summary(results, wall, jobs, as_json)
 
-
-def _progress(console: Console) -> Progress:
-    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                    TimeRemainingColumn(), console=console, transient=True)
 
 
 def _one_day(r: DayResult, out: Path, as_json: bool) -> None:

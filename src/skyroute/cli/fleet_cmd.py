@@ -11,10 +11,9 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
-from skyroute.cli.tables import wide_console
+from skyroute.cli.tables import progress_bar, wide_console
 from skyroute.errors import OptionError, check_choice
 from skyroute.fleet.scenario import PRESETS, Scenario, generate, load_scenario, preset, to_yaml
 
@@ -77,10 +76,6 @@ def _with_separation(s: Scenario, sep_h: float | None, sep_v: float | None) -> S
     return s.model_copy(update={"airspace": s.airspace.model_copy(update=change)})
 
 
-def _progress(console: Console) -> Progress:
-    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                    TimeRemainingColumn(), console=console, transient=True)
-
 
 @fleet_app.command("simulate")
 def simulate_command(
@@ -129,7 +124,7 @@ def simulate_command(
     s = _with_separation(resolve_scenario(scenario, preset_name, airports, drones, area_km,
                                           seed), sep_horizontal, sep_vertical)
     err = Console(stderr=True)
-    with _progress(err) as progress:
+    with progress_bar(err) as progress:
         task = progress.add_task("simulated seconds", total=round(hours * 3600))
         sim = run(s, hours=hours, seed=seed, scheduler=scheduler, airspace=airspace,
                   rate_per_hour=rate, base=scenario.parent if scenario else None,
@@ -310,7 +305,7 @@ def sweep_command(
     work = [(data, hours, seed, sc, sp, r) for sc, sp, r in configs for seed in seed_list]
     err = Console(stderr=True)
     reports: list[dict] = []
-    with _progress(err) as progress:
+    with progress_bar(err) as progress:
         task = progress.add_task("runs", total=len(work))
         if jobs == 1:
             for w in work:

@@ -1,8 +1,10 @@
-"""Rich tables: the one that shows a PlanResult, and a console wide enough for them."""
+"""Rich output shared by commands: the PlanResult table, a console wide enough for tables,
+the progress bar of long runs."""
 
 from __future__ import annotations
 
 from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from skyroute.result import PlanResult
@@ -36,3 +38,10 @@ def wide_console() -> Console:
     Rich would otherwise wrap every cell at 80)."""
     out = Console()
     return out if out.is_terminal else Console(width=160)
+
+
+def progress_bar(console: Console) -> Progress:
+    """The progress bar of a long run (description, bar, done/total, time left), on
+    ``console`` (stderr), gone when finished."""
+    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                    TimeRemainingColumn(), console=console, transient=True)
