@@ -14,8 +14,11 @@ answer (a package spawns, a drone becomes ready) and releases the pairs it retur
     ready and soon-ready drones (in flight to a delivery, with nothing after it) to the
     waiting packages. A pair costs the expected pickup time (until the drone is ready,
     plus the flight to the package's airport) minus the package's age times
-    ``age_weight``: among more packages than drones the oldest win, and as a waiting
-    package's age grows without bound while pickup times stay bounded, none is stranded.
+    ``age_weight`` (0.1: ten seconds of waiting weigh as one second of pickup, so while
+    the queue is long a drone still takes a package where it stands rather than fly
+    empty to an older one; measured on 18x9 at saturation, 1.0 delivered 205/h, 0.1
+    228/h, 0.02 231/h). A waiting package's age grows without bound while pickup times
+    stay bounded, so none is stranded.
     Only pairs whose drone is ready now are released; the rest are re-solved at the
     next event (a drone that lands may find a better package, or a package a closer
     drone).
@@ -33,7 +36,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 SCHEDULERS = ("seed", "optimal")
-AGE_WEIGHT = 1.0
+AGE_WEIGHT = 0.1
 
 
 def seed(*, packages, drones, travel, heading) -> list[tuple[int, int]]:

@@ -55,6 +55,7 @@ from skyroute.motion import dubins
 MAX_LOITERS = 12
 WARMUP_SHARE = 0.1
 SAMPLE_DT = 1.0
+_LOCAL = 4  # optimal dispatch: packages considered per airport beyond the oldest
 # ground holds tried before a departure, seconds after the earliest one
 _HOLDS = (0, 2, 5, 10, 15, 20, 30, 45, 60, 75, 90, 120, 150, 180, 240, 300,
           *range(360, 4 * 3600 + 1, 60))
@@ -269,9 +270,19 @@ class _Engine:
             soon = sorted(self.next_free.items(), key=lambda x: (x[1], x[0]))[:4 * k]
             drones = [(d, self.at[d][0], now) for d in idle]
             drones += [(d, self.at[d][0], r) for d, r in soon]
+            # the oldest packages, and the oldest few at every airport a drone is (or
+            # lands) at: a long queue must not hide the packages a drone need not fly
+            # empty to fetch
+            here = {a for _, a, _ in drones}
+            per: dict[int, int] = {}
+            chosen = []
+            for j, p in enumerate(self.waiting):
+                a = int(st.origin[p])
+                if j < k or (a in here and per.get(a, 0) < _LOCAL):
+                    chosen.append(p)
+                    per[a] = per.get(a, 0) + 1
             pairs = dispatch.optimal(
-                now=now, packages=[(p, int(st.origin[p]), float(st.t[p]))
-                                   for p in self.waiting[:k]],
+                now=now, packages=[(p, int(st.origin[p]), float(st.t[p])) for p in chosen],
                 drones=drones, travel=self.travel)
         for d, p in pairs:
             self._assign(d, p, now)
