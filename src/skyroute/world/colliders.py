@@ -23,12 +23,14 @@ HEADER = "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ"
 _HOME = re.compile(r"^\s*lat0\s+(-?[\d.]+)\s*,\s*lon0\s+(-?[\d.]+)\s*$")
 
 
-def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonlat") -> World:
+def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonlat",
+                   text: str | None = None) -> World:
     """Read a colliders file into a World in ``frame`` ("lonlat", "ned" or "enu"; the
-    plane is east/north metres around home at (lon0, lat0))."""
+    plane is east/north metres around home at (lon0, lat0)). ``text``: the file's content,
+    already in hand (an upload); ``path`` then only names it in errors."""
     path = Path(path)
     try:
-        lines = path.read_text().splitlines()
+        lines = (path.read_text() if text is None else text).splitlines()
     except (OSError, UnicodeDecodeError) as exc:
         raise InputFormatError(path, f"cannot read: {exc}") from None
     m = _HOME.match(lines[0]) if lines else None

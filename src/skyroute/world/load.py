@@ -79,7 +79,8 @@ def load_map(path: str | Path, *, resolution: float | None = None, safety: float
 
 
 def load_world(path: str | Path, *, altitude: float | None = None, safety: float = 0.0,
-               boundary: str | Path | None = None, frame: str = "lonlat") -> World:
+               boundary: str | Path | None = None, frame: str = "lonlat",
+               text: str | None = None) -> World:
     """Read a continuous world: a ``colliders.csv`` city or a GeoJSON file of zones.
 
     ``frame`` is how points are given to and returned by everything that takes this
@@ -89,7 +90,9 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
     metres) or "degrees" ((lon, lat) on a flat plane, the ILP rules; GeoJSON only). A
     colliders file's home is its ``lat0, lon0``; a GeoJSON file's the centre of its
     zones and boundary. ``altitude`` keeps the obstacles that count there; ``safety``
-    grows every obstacle (metres, or degrees in the degrees frame).
+    grows every obstacle (metres, or degrees in the degrees frame). ``text``: the file's
+    content, already in hand (an upload); ``path`` then only names it and its suffix
+    tells the format.
     """
     from skyroute.world.colliders import read_colliders
     from skyroute.world.geojson_world import parse_boundary, read_geojson_world
@@ -99,17 +102,18 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
     if not (np.isfinite(safety) and safety >= 0):
         raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
     p = Path(path)
-    if not p.exists():
+    if text is None and not p.exists():
         raise InputFormatError(p, "no such file")
     if p.suffix.lower() == ".csv":
         if frame == "degrees":
             raise OptionError("frame='degrees': a colliders.csv city is in metres; use "
                               "'lonlat', 'ned' or 'enu'", param="frame")
-        world = read_colliders(p, safety=safety, frame=frame)
+        world = read_colliders(p, safety=safety, frame=frame, text=text)
         if boundary is not None:
             world = _with_boundary(world, parse_boundary(boundary))
     elif p.suffix.lower() in (".geojson", ".json"):
-        world = read_geojson_world(p, boundary=boundary, safety=safety, frame=frame)
+        world = read_geojson_world(p, boundary=boundary, safety=safety, frame=frame,
+                                   text=text)
     else:
         raise InputFormatError(p, f"unknown world type {p.suffix!r}; valid: .csv (colliders), "
                                ".geojson")

@@ -21,11 +21,12 @@ PASSABLE = ".GS"
 BLOCKED = "@OTW"
 
 
-def _lines(path: Path) -> list[str]:
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
+def _lines(path: Path, raw: bytes | None = None) -> list[str]:
+    if raw is None:
+        try:
+            raw = path.read_bytes()
+        except OSError as exc:
+            raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
     if not raw.strip():
         raise InputFormatError(path, "the file is empty", line=1)
     try:
@@ -51,14 +52,15 @@ def _header_int(path: Path, lines: list[str], index: int, key: str) -> int:
     return value
 
 
-def read_map(path: str | Path) -> Grid:
+def read_map(path: str | Path, *, text: str | bytes | None = None) -> Grid:
     """Read a MovingAI ``.map`` file into a :class:`Grid` with 1 m cells.
 
-    Raises :class:`~skyroute.errors.InputFormatError` naming the line of a bad header,
-    a row of the wrong width, an unknown character or a wrong number of rows.
+    ``text``: the file's content, already in hand (an upload); ``path`` then only names
+    it in errors. Raises :class:`~skyroute.errors.InputFormatError` naming the line of a
+    bad header, a row of the wrong width, an unknown character or a wrong number of rows.
     """
     path = Path(path)
-    lines = _lines(path)
+    lines = _lines(path, text.encode("utf-8") if isinstance(text, str) else text)
     if not lines or lines[0].strip() != "type octile":
         got = lines[0].strip() if lines else "an empty file"
         raise InputFormatError(path, f"expected 'type octile', got {got!r}", line=1)

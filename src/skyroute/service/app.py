@@ -1,0 +1,49 @@
+"""The app factory: ``create_app(settings)`` -> a FastAPI app with every router, the
+error handlers, the body limit, the timing header and the static viewer at ``/``.
+
+Making the app opens nothing; the store, the site and the job executor open on first use
+(:mod:`skyroute.service.resources`) and close when the app shuts down.
+"""
+
+from __future__ import annotations
+
+from contextlib import asynccontextmanager
+from pathlib import Path
+
+from fastapi import FastAPI
+from fastapi.staticfiles import StaticFiles
+
+import skyroute
+from skyroute.service import problems
+from skyroute.service.middleware import BodyLimit, ServerTiming
+from skyroute.service.resources import Resources
+from skyroute.service.routers import days, fleet, health, jobs, maps, orders, plan, site
+from skyroute.service.settings import Settings
+
+STATIC = Path(__file__).parent / "static"
+
+DESCRIPTION = """Plan paths on grids and worlds, read stored delivery days, run delivery
+and fleet jobs. Reads are open; writes (`POST`) need `Authorization: Bearer TOKEN`.
+Every error is `application/problem+json` naming the field at fault."""
+
+
+def create_app(settings: Settings | None = None) -> FastAPI:
+    """A new app for ``settings`` (default: ``Settings()``, a random token)."""
+    settings = settings or Settings()
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI):
+        yield
+        app.state.resources.close()
+
+    app = FastAPI(title="skyroute", version=skyroute.__version__, description=DESCRIPTION,
+                  lifespan=lifespan)
+    app.state.settings = settings
+    app.state.resources = Resources(settings)
+    problems.install(app)
+    for module in (health, maps, days, orders, site, plan, jobs, fleet):
+        app.include_router(module.router)
+    app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
+    app.add_middleware(ServerTiming)
+    app.mount("/", StaticFiles(directory=STATIC, html=True), name="static")
+    return app

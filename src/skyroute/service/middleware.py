@@ -1,0 +1,102 @@
+"""Two plain ASGI middlewares: the request body limit (413 past it, before any handler
+reads a byte too many) and the server-side timing header every response carries
+(``Server-Timing: app;dur=MS``, which the load benchmark reads)."""
+
+from __future__ import annotations
+
+import time
+
+from skyroute.service.problems import problem_response
+
+BODY_METHODS = (b"POST", b"PUT", b"PATCH")
+
+
+class BodyLimit:
+    """Refuse a body over ``limit`` bytes with a 413 problem. A declared Content-Length
+    is checked first; a chunked body is read up to the limit and handed on whole."""
+
+    def __init__(self, app, limit: int) -> None:
+        self.app, self.limit = app, limit
+
+    async def __call__(self, scope, receive, send) -> None:
+        if scope["type"] != "http" or scope["method"] not in ("POST", "PUT", "PATCH"):
+            await self.app(scope, receive, send)
+            return
+        declared = dict(scope["headers"]).get(b"content-length")
+        if declared is not None:
+            try:
+                size = int(declared)
+            except ValueError:
+                size = -1
+            if size < 0:
+                await self._refuse(scope, receive, send, 400, "Content-Length is not a number")
+                return
+            if size > self.limit:
+                await self._refuse(scope, receive, send, 413, self._too_large(size))
+                return
+            await self.app(scope, receive, send)
+            return
+        chunks, size = [], 0
+        while True:
+            message = await receive()
+            if message["type"] != "http.request":
+                await self.app(scope, _replay([message]), send)
+                return
+            chunks.append(message.get("body", b""))
+            size += len(chunks[-1])
+            if size > self.limit:
+                await self._refuse(scope, receive, send, 413, self._too_large(size, at_least=True))
+                return
+            if not message.get("more_body", False):
+                break
+        await self.app(scope, _replay([{"type": "http.request", "body": b"".join(chunks),
+                                         "more_body": False}]), send)
+
+    def _too_large(self, size: int, *, at_least: bool = False) -> str:
+        return (f"the request body is {'over ' if at_least else ''}{size:,} bytes; the "
+                f"limit is {self.limit:,}")
+
+    async def _refuse(self, scope, receive, send, status: int, detail: str) -> None:
+        response = problem_response(status, detail, headers={"Connection": "close"})
+        await response(scope, receive, send)
+
+
+def _replay(messages: list[dict]):
+    queue = list(messages)
+
+    async def receive() -> dict:
+        if queue:
+            return queue.pop(0)
+        return {"type": "http.disconnect"}
+
+    return receive
+
+
+class ServerTiming:
+    """Adds ``Server-Timing: app;dur=<milliseconds>`` (from the request reaching the app
+    to its response headers), after any metric a handler set itself."""
+
+    def __init__(self, app) -> None:
+        self.app = app
+
+    async def __call__(self, scope, receive, send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        t0 = time.perf_counter()
+
+        async def timed_send(message) -> None:
+            if message["type"] == "http.response.start":
+                ms = (time.perf_counter() - t0) * 1e3
+                headers = list(message.get("headers", []))
+                mine = f"app;dur={ms:.3f}".encode()
+                for i, (k, v) in enumerate(headers):
+                    if k.lower() == b"server-timing":
+                        headers[i] = (k, v + b", " + mine)
+                        break
+                else:
+                    headers.append((b"server-timing", mine))
+                message = {**message, "headers": headers}
+            await send(message)
+
+        await self.app(scope, receive, timed_send)

@@ -1,0 +1,150 @@
+"""Every error as ``application/problem+json`` (RFC 9457): ``type``, ``title``,
+``status``, ``detail``, and for a bad input the ``field`` at fault (``errors`` lists them
+all). Nothing from inside the server leaks: an unexpected exception is logged and
+answered by a generic 500.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+from pydantic import BaseModel, Field
+from starlette.exceptions import HTTPException as StarletteHTTPException
+
+from skyroute.errors import InputFormatError, SkyrouteError
+
+MEDIA_TYPE = "application/problem+json"
+TYPE_BASE = "urn:skyroute:problem:"
+log = logging.getLogger("skyroute.service")
+
+TITLES = {400: "bad request", 401: "not authenticated", 403: "forbidden",
+          404: "not found", 405: "method not allowed", 409: "conflict",
+          413: "request body too large", 415: "unsupported media type",
+          422: "invalid input", 429: "too many jobs", 500: "internal error",
+          503: "service unavailable"}
+
+
+class FieldError(BaseModel):
+    field: str = Field(description="The input at fault, e.g. `start[0]`, `date`.")
+    message: str
+
+
+class ProblemDoc(BaseModel):
+    """The body of every error response (media type application/problem+json)."""
+
+    type: str = Field(description="A URI naming the kind of problem.")
+    title: str
+    status: int
+    detail: str
+    field: str | None = Field(None, description="The input at fault (422).")
+    errors: list[FieldError] | None = Field(None, description="Every input at fault (422).")
+
+
+class Problem(Exception):  # noqa: N818  (an answer, not a failure of the server)
+    """Raised by a router to answer with a problem document."""
+
+    def __init__(self, status: int, detail: str, *, field: str | None = None,
+                 kind: str | None = None, headers: dict[str, str] | None = None) -> None:
+        super().__init__(detail)
+        self.status, self.detail, self.field = status, detail, field
+        self.kind = kind or TITLES.get(status, "error").replace(" ", "-")
+        self.headers = headers
+
+
+def problem_response(status: int, detail: str, *, field: str | None = None,
+                     kind: str | None = None, errors: list[dict] | None = None,
+                     headers: dict[str, str] | None = None) -> JSONResponse:
+    title = TITLES.get(status, "error")
+    doc = {"type": TYPE_BASE + (kind or title.replace(" ", "-")), "title": title,
+           "status": status, "detail": detail}
+    if field is not None:
+        doc["field"] = field
+        doc["errors"] = errors or [{"field": field, "message": detail}]
+    return JSONResponse(doc, status_code=status, media_type=MEDIA_TYPE, headers=headers)
+
+
+def from_skyrouteerror(exc: SkyrouteError, *, field: str | None = None) -> Problem:
+    """A library error on a caller's input as a 422 naming the field (``param`` when the
+    library names one; a file error is reported against ``field``, with its line)."""
+    if isinstance(exc, InputFormatError):
+        where = f"line {exc.line}: " if exc.line is not None else ""
+        return Problem(422, f"{field or 'input'}: {where}{exc.reason}", field=field,
+                       kind="bad-file")
+    param = exc.param if isinstance(exc.param, str) else \
+        (exc.param[0] if exc.param else None)
+    return Problem(422, str(exc), field=param or field)
+
+
+def field_name(loc: tuple) -> str:
+    """``("body", "start", 0)`` -> ``start[0]``; the request part is left out."""
+    parts = list(loc)
+    if len(parts) > 1 and parts[0] in ("body", "query", "path", "header"):
+        parts = parts[1:]
+    out = ""
+    for p in parts:
+        if isinstance(p, int):
+            out += f"[{p}]"
+        elif str(p).startswith(("function-", "tagged-union[")):
+            continue  # pydantic's label of a validator, not a field
+        else:
+            out += ("." if out else "") + str(p)
+    return out or "body"
+
+
+def _message(err: dict) -> str:
+    msg = err.get("msg", "invalid")
+    return msg.removeprefix("Value error, ")
+
+
+async def _validation(request: Request, exc: RequestValidationError) -> JSONResponse:
+    errors = [{"field": field_name(tuple(e.get("loc", ()))), "message": _message(e)}
+              for e in exc.errors()]
+    first = errors[0] if errors else {"field": "body", "message": "invalid input"}
+    detail = f"{first['field']}: {first['message']}"
+    if len(errors) > 1:
+        detail += f" (and {len(errors) - 1} more)"
+    return problem_response(422, detail, field=first["field"], errors=errors)
+
+
+async def _problem(request: Request, exc: Problem) -> JSONResponse:
+    return problem_response(exc.status, exc.detail, field=exc.field, kind=exc.kind,
+                            headers=exc.headers)
+
+
+async def _http(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+    detail = exc.detail if isinstance(exc.detail, str) else TITLES.get(exc.status_code,
+                                                                        "error")
+    if exc.status_code == 404 and detail == "Not Found":
+        detail = f"no such resource: {request.url.path}"
+    elif exc.status_code == 405:
+        detail = f"{request.method} is not allowed on {request.url.path}"
+    return problem_response(exc.status_code, detail, headers=getattr(exc, "headers", None))
+
+
+async def _library(request: Request, exc: SkyrouteError) -> JSONResponse:
+    return await _problem(request, from_skyrouteerror(exc))
+
+
+async def _internal(request: Request, exc: Exception) -> JSONResponse:
+    log.exception("unhandled error on %s %s", request.method, request.url.path)
+    return problem_response(500, "the server could not answer this request; the error "
+                            "is in its log")
+
+
+def install(app: FastAPI) -> None:
+    """Register the handlers on ``app``."""
+    app.add_exception_handler(RequestValidationError, _validation)
+    app.add_exception_handler(Problem, _problem)
+    app.add_exception_handler(StarletteHTTPException, _http)
+    app.add_exception_handler(SkyrouteError, _library)
+    app.add_exception_handler(Exception, _internal)
+
+
+def responses(*codes: int) -> dict:
+    """OpenAPI ``responses=`` entries for these error codes."""
+    return {c: {"model": ProblemDoc, "description": TITLES.get(c, "error"),
+                "content": {MEDIA_TYPE: {"schema": {"$ref": "#/components/schemas/ProblemDoc"}}}}
+            for c in codes}

@@ -1,0 +1,1 @@
+"""One router per resource: health, maps, days, orders, site, plan, jobs, fleet."""

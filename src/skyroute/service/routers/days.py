@@ -1,0 +1,180 @@
+"""Stored delivery days: ``GET /days``, ``GET /days/{date}`` (report, deliveries and
+every order's fate) and ``GET /days/{date}/flightpath.geojson`` (the flight, as the
+``deliver`` command writes it)."""
+
+from __future__ import annotations
+
+import datetime as dt
+import hashlib
+import json
+from typing import Annotated
+
+from fastapi import APIRouter, Depends, Path, Request, Response
+from pydantic import BaseModel, Field
+
+from skyroute.service.problems import Problem, responses
+from skyroute.service.resources import Resources, engine, resources
+
+router = APIRouter(tags=["days"])
+GEOJSON = "application/geo+json"
+
+DayDate = Annotated[dt.date, Path(description="The day, YYYY-MM-DD.")]
+
+
+class DaySummary(BaseModel):
+    date: dt.date
+    moves: int
+    orders_placed: int
+    orders_delivered: int
+    money_pct: float | None = Field(description="Money delivered as % of money placed; "
+                                    "null on a day without orders.")
+
+
+class InvalidOrder(BaseModel):
+    order_no: str
+    reason: str
+
+
+class DayReport(BaseModel):
+    """The CLI's report fields (``deliver --json``) as the store keeps them."""
+
+    date: dt.date
+    orders_placed: int
+    orders_delivered: int
+    orders_invalid: int
+    invalid: list[InvalidOrder] | None = Field(
+        description="Each invalid order's reason, where the server has the site to price "
+                    "them (null without one).")
+    money_placed: int
+    money_delivered: int
+    money_pct: float | None
+    moves: int
+    moves_left: int
+    seconds: float
+    started: str
+    finished: str
+    settings: dict
+
+
+class Delivery(BaseModel):
+    order_no: str
+    delivered_to: str
+    cost_in_pence: int
+
+
+class DayOrder(BaseModel):
+    order_no: str
+    customer: str
+    deliver_to: str
+    items: list[str]
+    status: str = Field(description="delivered, invalid, or not_delivered (valid, but "
+                        "not flown within the battery); invalid is known only with the site.")
+    value: int | None = Field(description="Pence: the delivery's cost, or the priced order "
+                              "where the site is known.")
+    reason: str | None = None
+    lonlat: tuple[float, float] | None = Field(None, description="The customer's place "
+                                               "where the site is known.")
+
+
+class Day(BaseModel):
+    date: dt.date
+    report: DayReport
+    deliveries: list[Delivery] = Field(description="Delivered orders in flying order.")
+    orders: list[DayOrder] = Field(description="Every order of the day.")
+
+
+@router.get("/days", response_model=list[DaySummary], summary="Stored delivery days")
+def list_days(eng=Depends(engine)) -> list[dict]:
+    from skyroute.delivery.reads import stored_days
+
+    return stored_days(eng)
+
+
+def _report(eng, date: dt.date) -> dict:
+    from skyroute.delivery.reads import day_report
+
+    rep = day_report(eng, date)
+    if rep is None:
+        raise Problem(404, f"day {date} is not stored; GET /days lists the stored days",
+                      kind="unknown-date")
+    return rep
+
+
+@router.get("/days/{date}", response_model=Day, responses=responses(404, 422),
+            summary="A stored day: report, deliveries, orders")
+def get_day(date: DayDate, eng=Depends(engine),
+            res: Resources = Depends(resources)) -> dict:
+    from skyroute.delivery.orders import Priced, price
+    from skyroute.delivery.reads import day_deliveries
+    from skyroute.delivery.store import orders_between
+
+    rep = _report(eng, date)
+    delivered = day_deliveries(eng, date)
+    cost = {d["order_no"]: d["cost_in_pence"] for d in delivered}
+    orders = orders_between(eng, date, date).get(date, [])
+    site = res.site() if res.settings.has_site else None
+    rows, invalid = [], []
+    for o in orders:
+        row = {"order_no": o.order_no, "customer": o.customer, "deliver_to": o.deliver_to,
+               "items": list(o.items), "value": cost.get(o.order_no), "reason": None,
+               "lonlat": None,
+               "status": "delivered" if o.order_no in cost else "not_delivered"}
+        if site is not None:
+            p = price(site, o)
+            if isinstance(p, Priced):
+                row["value"], row["lonlat"] = p.cost, p.lonlat
+            else:
+                row["status"], row["reason"] = "invalid", p
+                invalid.append({"order_no": o.order_no, "reason": p})
+        rows.append(row)
+    rep["invalid"] = invalid if site is not None else None
+    return {"date": date, "report": rep, "deliveries": delivered, "orders": rows}
+
+
+@router.get("/days/{date}/flightpath.geojson", response_class=Response,
+            responses={200: {"content": {GEOJSON: {"schema": {"type": "object"}}},
+                             "description": "The flight as one LineString in lon/lat "
+                             "(the file `deliver` writes), with each move's ILP angle and "
+                             "order number in its properties."},
+                       **responses(404, 422)},
+            summary="A stored day's flight as GeoJSON")
+def get_flightpath(date: DayDate, request: Request, eng=Depends(engine),
+                   res: Resources = Depends(resources)) -> Response:
+    from skyroute.delivery.reads import day_version
+
+    version = day_version(eng, date)
+    if version is None:
+        _report(eng, date)  # the 404
+    key = f"flightpath:{version}"
+    body = res.cache.get(key)
+    if body is None:
+        body = _flightpath(eng, date, res)
+        for k in [k for k in res.cache if k.startswith(f"flightpath:{date}:")]:
+            res.cache.pop(k, None)  # an older flight of the same day
+        res.cache[key] = body
+    etag = '"' + hashlib.sha1(version.encode()).hexdigest()[:20] + '"'
+    if request.headers.get("if-none-match") == etag:
+        return Response(status_code=304, headers={"ETag": etag})
+    return Response(body, media_type=GEOJSON, headers={"ETag": etag})
+
+
+def _flightpath(eng, date: dt.date, res: Resources) -> bytes:
+    import numpy as np
+
+    from skyroute.delivery.reads import day_moves
+
+    m = day_moves(eng, date)
+    n = len(m["angle"])
+    if n:
+        geometry = {"type": "LineString",
+                    "coordinates": np.vstack([m["frm"][:1], m["to"]]).tolist()}
+    elif res.settings.has_site:  # as the CLI writes a day without moves: home to home
+        home = list(res.site().home)
+        geometry = {"type": "LineString", "coordinates": [home, home]}
+    else:
+        geometry = None
+    doc = {"type": "FeatureCollection", "features": [{
+        "type": "Feature", "geometry": geometry,
+        "properties": {"date": date.isoformat(), "moves": n, "angles": m["angle"].tolist(),
+                       "orders": m["order_no"]}}]}
+    return json.dumps(doc, separators=(",", ":")).encode()

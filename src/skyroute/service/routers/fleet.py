@@ -1,0 +1,140 @@
+"""Stored fleet runs: ``GET /fleet/runs``, ``GET /fleet/runs/{id}`` (report, scenario
+and a page of events: ``?offset&limit``) and the run's files ``events.jsonl``,
+``tracks.csv`` and ``fleet.geojson``.
+
+Runs are written by fleet jobs (:mod:`skyroute.jobs.store`, imported on first use;
+without it these endpoints answer 503).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Annotated, Any
+
+from fastapi import APIRouter, Depends, Path, Query, Response
+from pydantic import BaseModel, Field
+
+from skyroute.service.problems import Problem, responses
+from skyroute.service.resources import Resources, resources
+
+router = APIRouter(tags=["fleet"])
+RunId = Annotated[str, Path(max_length=100)]
+
+
+class RunSummary(BaseModel):
+    id: str
+    scenario: str | None = Field(None, description="The scenario's name.")
+    params: dict[str, Any] | None = None
+    report: dict[str, Any] | None = None
+
+
+class Run(BaseModel):
+    id: str
+    report: dict[str, Any]
+    scenario: dict[str, Any]
+    params: dict[str, Any] | None = None
+    events: list[dict[str, Any]] = Field(description="Events offset .. offset + limit.")
+    offset: int
+    limit: int
+    events_total: int
+    files: dict[str, str]
+
+
+def _store():
+    try:
+        from skyroute.jobs import store
+    except ImportError:
+        raise Problem(503, "fleet runs are not available in this installation "
+                      "(skyroute.jobs is missing)", kind="jobs-unavailable") from None
+    return store
+
+
+def _run(res: Resources, run_id: str) -> dict:
+    run = _store().get_fleet_run(res.engine(), run_id)
+    if run is None:
+        raise Problem(404, f"no fleet run {run_id!r}; GET /fleet/runs lists them",
+                      kind="unknown-run")
+    return run
+
+
+def _as_dict(value) -> dict:
+    if isinstance(value, str):
+        return json.loads(value)
+    return dict(value or {})
+
+
+@router.get("/fleet/runs", response_model=list[RunSummary], responses=responses(503),
+            summary="Stored fleet runs")
+def list_runs(res: Annotated[Resources, Depends(resources)]) -> list[dict]:
+    out = []
+    for r in _store().list_fleet_runs(res.engine()):
+        sc = r.get("scenario")
+        name = sc.get("name") if isinstance(sc, dict) else sc
+        out.append({"id": str(r["id"]), "scenario": name, "params": r.get("params"),
+                    "report": r.get("report")})
+    return out
+
+
+@router.get("/fleet/runs/{run_id}", response_model=Run, responses=responses(404, 422, 503),
+            summary="A fleet run: report, scenario, a page of events")
+def get_run(run_id: RunId, res: Annotated[Resources, Depends(resources)],
+            offset: Annotated[int, Query(ge=0)] = 0,
+            limit: Annotated[int, Query(ge=1, le=10_000)] = 1000) -> dict:
+    run = _run(res, run_id)
+    lines = (run.get("events") or "").splitlines()
+    page = [json.loads(x) for x in lines[offset:offset + limit]]
+    base = f"/fleet/runs/{run_id}"
+    return {"id": str(run["id"]), "report": _as_dict(run.get("report")),
+            "scenario": _as_dict(run.get("scenario")), "params": run.get("params"),
+            "events": page, "offset": offset, "limit": limit, "events_total": len(lines),
+            "files": {k: f"{base}/{k}" for k in ("events.jsonl", "tracks.csv",
+                                                 "fleet.geojson")}}
+
+
+def _file(content: str, media_type: str, name: str) -> Response:
+    return Response(content, media_type=media_type,
+                    headers={"Content-Disposition": f'attachment; filename="{name}"'})
+
+
+@router.get("/fleet/runs/{run_id}/events.jsonl", response_class=Response,
+            responses={200: {"content": {"application/x-ndjson": {}}}, **responses(404, 503)},
+            summary="A fleet run's events, one JSON object a line")
+def get_events(run_id: RunId, res: Annotated[Resources, Depends(resources)]) -> Response:
+    return _file(_run(res, run_id).get("events") or "", "application/x-ndjson",
+                 "events.jsonl")
+
+
+@router.get("/fleet/runs/{run_id}/tracks.csv", response_class=Response,
+            responses={200: {"content": {"text/csv": {}}}, **responses(404, 503)},
+            summary="A fleet run's tracks (one row per drone and time step)")
+def get_tracks(run_id: RunId, res: Annotated[Resources, Depends(resources)]) -> Response:
+    return _file(_run(res, run_id).get("tracks") or "", "text/csv", "tracks.csv")
+
+
+@router.get("/fleet/runs/{run_id}/fleet.geojson", response_class=Response,
+            responses={200: {"content": {"application/geo+json": {}}},
+                       **responses(404, 503)},
+            summary="A fleet run's airports, runways and tracks in lon/lat")
+def get_geojson(run_id: RunId, res: Annotated[Resources, Depends(resources)]) -> Response:
+    run = _run(res, run_id)
+    text = run.get("geojson")
+    if text is None:
+        text = _fleet_geojson(run)
+    return _file(text if isinstance(text, str) else json.dumps(text),
+                 "application/geo+json", "fleet.geojson")
+
+
+def _fleet_geojson(run: dict) -> str:
+    """The run's fleet.geojson rebuilt from what the store keeps (scenario and tracks),
+    when the store does not keep the file itself."""
+    import io
+
+    import numpy as np
+
+    from skyroute.fleet.scenario import parse_scenario
+    from skyroute.io.fleet_out import fleet_geojson_from_tracks
+
+    scenario = parse_scenario(_as_dict(run.get("scenario")), "scenario")
+    table = np.genfromtxt(io.StringIO(run.get("tracks") or ""), delimiter=",", names=True,
+                          dtype=None, encoding="utf-8")
+    return json.dumps(fleet_geojson_from_tracks(scenario, table))

@@ -1,0 +1,172 @@
+"""Long work as jobs: ``POST /jobs/deliver`` (a day or a range of stored orders),
+``POST /jobs/fleet`` (a fleet run) -> 202 ``{"id"}``; ``GET /jobs/{id}`` -> its state,
+progress, result or error.
+
+The jobs themselves (tables, Dask or local processes) live in :mod:`skyroute.jobs`,
+imported on first use; without it these endpoints answer 503. A server holds at most
+``job_queue`` jobs queued or running; one more is a 429 with ``Retry-After``.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import threading
+from typing import Annotated, Any, Literal
+
+from fastapi import APIRouter, Depends, Path
+from fastapi.responses import JSONResponse
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from skyroute.errors import SkyrouteError
+from skyroute.service.auth import require_token
+from skyroute.service.problems import Problem, responses
+from skyroute.service.resources import Resources, resources
+
+router = APIRouter(tags=["jobs"])
+MAX_DAYS = 3660
+MAX_HOURS = 24.0
+_SUBMIT = threading.Lock()
+
+
+class DeliverJob(BaseModel):
+    """``{"date": D}`` for one day or ``{"from": D, "to": D}`` for a range, over the
+    orders already in the store (the site is the server's --data or --source)."""
+
+    model_config = ConfigDict(extra="forbid", populate_by_name=True)
+
+    date: dt.date | None = None
+    from_: dt.date | None = Field(None, alias="from")
+    to: dt.date | None = None
+    method: Literal["milp", "greedy"] = "milp"
+
+    @model_validator(mode="after")
+    def _days(self) -> DeliverJob:
+        ranged = self.from_ is not None or self.to is not None
+        if (self.date is None) == ranged or (ranged and (self.from_ is None or self.to is None)):
+            raise ValueError("give date, or both from and to")
+        if ranged and self.to < self.from_:
+            raise ValueError(f"to {self.to} is before from {self.from_}")
+        if ranged and (self.to - self.from_).days >= MAX_DAYS:
+            raise ValueError(f"at most {MAX_DAYS} days in one job")
+        return self
+
+
+class FleetJob(BaseModel):
+    """A fleet run: a preset's or a posted scenario's drones for ``hours``."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+    preset: Literal["seed-3x3", "seed-9x9", "seed-18x9"] | None = None
+    scenario: dict[str, Any] | None = Field(None, description="A scenario (the fields of "
+                                            "`skyroute fleet scenario`'s YAML).")
+    hours: float = Field(1.0, gt=0, le=MAX_HOURS)
+    seed: int = Field(0, ge=0, le=2**32 - 1)
+    scheduler: Literal["seed", "optimal"] = "seed"
+    airspace: Literal["layers", "shared"] | None = None
+    rate: float | None = Field(None, gt=0, le=1e5, description="Packages per hour "
+                               "(default: the scenario's).")
+
+    @model_validator(mode="after")
+    def _one(self) -> FleetJob:
+        if (self.preset is None) == (self.scenario is None):
+            raise ValueError("give exactly one of preset and scenario")
+        return self
+
+
+class JobId(BaseModel):
+    id: str
+
+
+class JobState(BaseModel):
+    id: str
+    kind: str | None = None
+    state: Literal["queued", "running", "done", "failed"]
+    progress: float = Field(ge=0, le=1)
+    result: Any = None
+    error: str | None = None
+
+
+def _jobs():
+    try:
+        from skyroute.jobs import runner
+    except ImportError:
+        raise Problem(503, "jobs are not available in this installation (skyroute.jobs is "
+                      "missing)", kind="jobs-unavailable") from None
+    return runner
+
+
+def _submit(res: Resources, kind: str, params: dict) -> JSONResponse:
+    runner = _jobs()
+    eng = res.engine()
+    with _SUBMIT:
+        active = 0
+        for i in list(res.job_ids):
+            job = runner.get(eng, i)
+            if job is None or job["state"] in ("done", "failed"):
+                res.job_ids.remove(i)
+            else:
+                active += 1
+        if active >= res.settings.job_queue:
+            raise Problem(429, f"{active} jobs are queued or running, this server's limit; "
+                          "try again later", headers={"Retry-After": "10"})
+        try:
+            job_id = runner.submit(eng, kind, params, executor=res.executor())
+        except SkyrouteError as exc:
+            raise Problem(422, str(exc), field=exc.param if isinstance(exc.param, str)
+                          else None) from None
+        res.job_ids.append(job_id)
+    return JSONResponse({"id": job_id}, status_code=202,
+                        headers={"Location": f"/jobs/{job_id}"})
+
+
+@router.post("/jobs/deliver", status_code=202, response_model=JobId,
+             dependencies=[Depends(require_token)],
+             responses=responses(401, 403, 404, 413, 422, 429, 503),
+             summary="Fly a day or a range of days as a job")
+def post_deliver(body: DeliverJob, res: Annotated[Resources, Depends(resources)]):
+    res.site()  # 404 without a site: the job would fail on every day
+    s = res.settings
+    first, last = (body.date, body.date) if body.date else (body.from_, body.to)
+    params = {"from": first.isoformat(), "to": last.isoformat(), "method": body.method,
+              "db": s.db_url, "data": None if s.data_dir is None else str(s.data_dir),
+              "source": s.source_url}
+    return _submit(res, "deliver", params)
+
+
+@router.post("/jobs/fleet", status_code=202, response_model=JobId,
+             dependencies=[Depends(require_token)],
+             responses=responses(401, 403, 413, 422, 429, 503),
+             summary="Run a fleet simulation as a job")
+def post_fleet(body: FleetJob, res: Annotated[Resources, Depends(resources)]):
+    from skyroute.fleet.scenario import Scenario, parse_scenario, preset
+
+    if body.scenario is not None:
+        if (body.scenario.get("packages") or {}).get("csv") is not None:
+            raise Problem(422, "scenario.packages.csv: a posted scenario cannot name a "
+                          "file on the server; give packages.rate_per_hour",
+                          field="scenario.packages.csv")
+        try:
+            scenario: Scenario = parse_scenario(body.scenario, "scenario")
+        except SkyrouteError as exc:
+            text = str(exc).removeprefix("scenario: ")
+            raise Problem(422, f"scenario.{text}", field="scenario." + text.split(":")[0]
+                          ) from None
+    else:
+        scenario = preset(body.preset)
+    params = {"scenario": scenario.model_dump(mode="json"), "preset": body.preset,
+              "hours": body.hours, "seed": body.seed, "scheduler": body.scheduler,
+              "airspace": body.airspace, "rate": body.rate}
+    return _submit(res, "fleet", params)
+
+
+@router.get("/jobs/{job_id}", response_model=JobState, responses=responses(404, 503),
+            summary="A job's state, progress and result")
+def get_job(job_id: Annotated[str, Path(max_length=100)],
+            res: Annotated[Resources, Depends(resources)]) -> dict:
+    runner = _jobs()
+    job = runner.get(res.engine(), job_id)
+    if job is None:
+        raise Problem(404, f"no job {job_id!r}", kind="unknown-job")
+    return {"id": job_id, "kind": job.get("kind"), "state": job["state"],
+            "progress": float(job.get("progress") or 0.0), "result": job.get("result"),
+            "error": job.get("error")}

@@ -1,0 +1,227 @@
+"""``POST /plan``: one query of :func:`skyroute.plan` over HTTP, on a bundled map (by
+name), an uploaded map text, or an uploaded world (colliders CSV or GeoJSON zones).
+
+The answer is the planner's own result (``PlanResult.to_dict``: the same status, cost,
+path and expansions as the same call in Python) plus the path as GeoJSON. A request may
+lower, never raise, the server's search budget (``max_expansions``); PRM samples and
+raster sizes are capped too. Bad input is a 422 naming the field.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Annotated, Literal
+
+from fastapi import APIRouter, Depends, Response
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from skyroute.errors import InputFormatError, QueryError, SkyrouteError
+from skyroute.service.auth import require_token
+from skyroute.service.problems import Problem, from_skyrouteerror, responses
+from skyroute.service.resources import Resources, resources
+
+router = APIRouter(tags=["plan"])
+
+Algorithm = Literal["astar", "dijkstra", "bfs", "jps", "theta", "lazy_theta", "visibility",
+                    "prm"]
+Number = Annotated[float, Field(allow_inf_nan=False)]
+Point = tuple[Number, Number]
+
+
+class PlanRequest(BaseModel):
+    """One planning query. Give exactly one of ``map``, ``map_text`` and ``world_text``.
+
+    On a map, ``start`` and ``goal`` are (x, y) cells (column, row) and the options are
+    those of :func:`skyroute.plan` on a Grid. On a world they are points in ``frame``
+    and ``algorithm`` defaults to ``visibility``."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, json_schema_extra={
+        "examples": [{"map": "den312d", "start": [50, 76], "goal": [60, 13],
+                      "algorithm": "astar"}]})
+
+    map: str | None = Field(None, max_length=200, description="A bundled map's name "
+                            "(GET /maps).")
+    map_text: str | None = Field(None, description="A MovingAI .map file's text.")
+    world_text: str | None = Field(None, description="A world file's text.")
+    world_format: Literal["colliders", "geojson"] | None = Field(
+        None, description="How to read world_text: colliders (FCND colliders.csv) or "
+        "geojson (zones). Required with world_text.")
+    frame: Literal["lonlat", "ned", "local", "enu", "degrees"] = Field(
+        "lonlat", description="Worlds: the frame of start, goal and the path.")
+    altitude: Number | None = Field(None, description="Worlds: keep obstacles that count "
+                                    "at this altitude.")
+    safety: Number = Field(0.0, ge=0, description="Grow obstacles by this margin.")
+    boundary: str | None = Field(None, max_length=200, description="Worlds: "
+                                 "MINLON,MINLAT,MAXLON,MAXLAT.")
+    start: Point
+    goal: Point
+    algorithm: Algorithm | None = Field(None, description="Default astar on maps, "
+                                        "visibility on worlds.")
+    connectivity: Literal[4, 8] | None = None
+    corner_cutting: bool = False
+    heuristic: Literal["octile", "euclidean", "manhattan", "zero"] | None = None
+    weight: Number = Field(1.0, ge=1.0, le=1e6)
+    prune: Literal["none", "collinear", "los"] | None = None
+    max_expansions: int | None = Field(None, ge=1, le=2**62, description="Stop after this "
+                                       "many expansions; capped by the server's budget.")
+    resolution: Number | None = Field(None, gt=0, description="Worlds, grid algorithms: "
+                                      "cell size in world units.")
+    samples: int = Field(1000, ge=1, le=10**9, description="PRM samples.")
+    neighbours: int = Field(10, ge=1, le=1000, description="PRM neighbours.")
+    prm_star: bool = False
+    seed: int = Field(0, ge=0, le=2**32 - 1, description="PRM seed.")
+    geojson: bool = Field(True, description="Add the path as GeoJSON.")
+
+    @model_validator(mode="after")
+    def _one_source(self) -> PlanRequest:
+        given = [k for k in ("map", "map_text", "world_text") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError("give exactly one of map, map_text and world_text"
+                             + (f" (got {', '.join(given)})" if given else ""))
+        if self.world_text is not None and self.world_format is None:
+            raise ValueError("world_format (colliders or geojson) is required with "
+                             "world_text")
+        return self
+
+
+class PlanAnswer(BaseModel):
+    status: Literal["found", "no_path", "budget_exhausted"]
+    cost: float | None = Field(description="Path length (cells on a map, world units on a "
+                               "world); null unless found.")
+    path: list[tuple[float, float]] = Field(description="Cells (x, y) on a map; points in "
+                                            "the frame on a world.")
+    expanded: int
+    max_frontier: int
+    los_checks: int
+    seconds: float = Field(description="The search's own wall time.")
+    algorithm: str
+    max_expansions: int = Field(description="The budget the search ran with.")
+    path_lonlat: list[tuple[float, float]] | None = None
+    frame: str | None = None
+    waypoints: list[list[float]] | None = Field(
+        None, description="Worlds: [north, east, altitude, heading] per point (FCND).")
+    geojson: dict | None = None
+
+
+# Planning is CPU work that holds the GIL: more than one search at a time per process
+# only adds switching, so searches take turns (the wait shows in Server-Timing).
+_SEARCH = threading.Lock()
+
+
+@router.post("/plan", response_model=PlanAnswer, response_model_exclude_none=True,
+             dependencies=[Depends(require_token)],
+             responses=responses(401, 403, 413, 422), summary="Plan one path")
+def post_plan(body: PlanRequest, response: Response,
+              res: Annotated[Resources, Depends(resources)]) -> dict:
+    t0 = time.perf_counter()
+    with _SEARCH:
+        t1 = time.perf_counter()
+        try:
+            out = _plan(body, res)
+        finally:
+            t2 = time.perf_counter()
+    response.headers["Server-Timing"] = (f"wait;dur={(t1 - t0) * 1e3:.3f}, "
+                                         f"plan;dur={(t2 - t1) * 1e3:.3f}")
+    return out
+
+
+def _plan(body: PlanRequest, res: Resources) -> dict:
+    try:
+        return _plan_checked(body, res)
+    except QueryError as exc:
+        field = exc.param or next((w for w in ("start", "goal") if str(exc).startswith(w)),
+                                  None)
+        raise Problem(422, str(exc), field=field) from None
+    except InputFormatError as exc:
+        field = "map_text" if body.map_text is not None else "world_text"
+        raise from_skyrouteerror(exc, field=field) from None
+    except SkyrouteError as exc:
+        raise from_skyrouteerror(exc) from None
+
+
+def _plan_checked(body: PlanRequest, res: Resources) -> dict:
+    from skyroute.planner import plan
+
+    cap = res.settings.max_expansions
+    budget = cap if body.max_expansions is None else min(body.max_expansions, cap)
+    if body.world_text is None:
+        grid = _grid(body, res)
+        start, goal = _cell(body.start, "start"), _cell(body.goal, "goal")
+        r = plan(grid, start, goal, algorithm=body.algorithm or "astar",
+                 connectivity=body.connectivity, corner_cutting=body.corner_cutting,
+                 heuristic=body.heuristic, weight=body.weight, prune=body.prune,
+                 max_expansions=budget)
+        out = r.to_dict()
+        if body.geojson:
+            from skyroute.io.geojson import grid_path_geojson
+
+            out["geojson"] = grid_path_geojson(grid, r)
+    else:
+        world = _world(body)
+        _check_world_limits(body, world, res)
+        r = plan(world, tuple(body.start), tuple(body.goal),
+                 algorithm=body.algorithm or "visibility", connectivity=body.connectivity,
+                 corner_cutting=body.corner_cutting, heuristic=body.heuristic,
+                 weight=body.weight, prune=body.prune, max_expansions=budget,
+                 resolution=body.resolution, samples=body.samples,
+                 neighbours=body.neighbours, prm_star=body.prm_star, seed=body.seed)
+        out = r.to_dict()
+        out["frame"] = world.frame
+        if r.found:
+            from skyroute.io.world_out import waypoints
+
+            out["waypoints"] = waypoints(world, r.path, body.altitude or 0.0)
+        if body.geojson:
+            from skyroute.io.world_out import world_path_geojson
+
+            out["geojson"] = world_path_geojson(world, r)
+    out["max_expansions"] = budget
+    return out
+
+
+def _grid(body: PlanRequest, res: Resources):
+    if body.map is not None:
+        grid = res.grid(body.map)
+        if grid is None:
+            from skyroute.world.load import bundled_maps
+
+            raise Problem(422, f"map {body.map!r} is not a bundled map; choose one of "
+                          + ", ".join(repr(m) for m in bundled_maps()), field="map")
+    else:
+        from skyroute.world.movingai import read_map
+
+        grid = read_map("map_text", text=body.map_text)
+    if body.safety:
+        grid = grid.inflate(body.safety)
+    return grid
+
+
+def _cell(p, name: str) -> tuple[int, int]:
+    if not all(float(v).is_integer() for v in p):
+        raise Problem(422, f"{name} {list(p)}: a cell on a map is two integers (x, y)",
+                      field=name)
+    return int(p[0]), int(p[1])
+
+
+def _world(body: PlanRequest):
+    from skyroute.world.load import load_world
+
+    name = "world_text.csv" if body.world_format == "colliders" else "world_text.geojson"
+    return load_world(name, text=body.world_text, altitude=body.altitude,
+                      safety=body.safety, boundary=body.boundary, frame=body.frame)
+
+
+def _check_world_limits(body: PlanRequest, world, res: Resources) -> None:
+    s = res.settings
+    algorithm = body.algorithm or "visibility"
+    if algorithm == "prm" and body.samples > s.max_samples:
+        raise Problem(422, f"samples={body.samples} is over this server's limit of "
+                      f"{s.max_samples:,}", field="samples")
+    if algorithm not in ("prm", "visibility") and body.resolution is not None:
+        x0, y0, x1, y1 = world.bounds
+        cells = ((x1 - x0) / body.resolution + 1) * ((y1 - y0) / body.resolution + 1)
+        if cells > s.max_raster_cells:
+            raise Problem(422, f"resolution={body.resolution:g} makes a raster of about "
+                          f"{cells:,.0f} cells; this server's limit is "
+                          f"{s.max_raster_cells:,}", field="resolution")

@@ -1,0 +1,51 @@
+"""What a service instance is configured with (``skyroute serve`` fills it from flags).
+
+Every limit that protects the server lives here, with its default: the request body
+size, the search budget per ``POST /plan``, the raster and roadmap sizes a caller may
+ask for, and the job queue length.
+"""
+
+from __future__ import annotations
+
+import secrets
+from pathlib import Path
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from skyroute.delivery.store import DEFAULT_DB
+
+MB = 1024 * 1024
+
+
+class Settings(BaseModel):
+    """A service's configuration; immutable once the app is made."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    db_url: str = Field(DEFAULT_DB, description="SQLAlchemy URL of the delivery store.")
+    data_dir: Path | None = Field(None, description="The delivery site: a data folder in the "
+                                  "ILP layout (as `deliver --data`).")
+    source_url: str | None = Field(None, description="The delivery site over HTTP "
+                                   "(as `deliver --source`).")
+    token: str = Field(default_factory=lambda: secrets.token_urlsafe(32), min_length=1,
+                       description="Bearer token the write endpoints require.")
+    max_body_bytes: int = Field(10 * MB, gt=0, description="Largest request body (413 past it).")
+    max_expansions: int = Field(2_000_000, gt=0, description="Search budget per POST /plan: "
+                                "a larger or missing max_expansions is capped to it.")
+    max_raster_cells: int = Field(4_000_000, gt=0, description="Largest raster a grid "
+                                  "algorithm on a world may ask for (resolution).")
+    max_samples: int = Field(20_000, gt=0, description="Largest PRM roadmap per request.")
+    job_queue: int = Field(8, ge=1, description="Jobs queued or running at once (429 past it).")
+    dask_address: str | None = Field(None, description="Run jobs on this Dask scheduler "
+                                     "(tcp://HOST:8786) instead of local processes.")
+    job_workers: int | None = Field(None, ge=1, description="Local worker processes for jobs.")
+
+    @model_validator(mode="after")
+    def _one_site(self) -> Settings:
+        if self.data_dir is not None and self.source_url is not None:
+            raise ValueError("give at most one of data_dir and source_url")
+        return self
+
+    @property
+    def has_site(self) -> bool:
+        return self.data_dir is not None or self.source_url is not None
