@@ -7,10 +7,11 @@ Routers reach these through the dependencies at the bottom (``Depends(engine)``,
 
 from __future__ import annotations
 
+import contextlib
 import threading
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Annotated, Any
 
-from fastapi import Request
+from fastapi import Depends, Request
 
 from skyroute.errors import SkyrouteError
 from skyroute.service.problems import Problem
@@ -108,10 +109,8 @@ class Resources:
         for closer in (getattr(self._executor, "close", None),
                        getattr(self._engine, "dispose", None)):
             if closer is not None:
-                try:
+                with contextlib.suppress(Exception):  # shutting down: nothing to tell
                     closer()
-                except Exception:
-                    pass
         self._executor = self._engine = None
 
 
@@ -125,3 +124,7 @@ def engine(request: Request) -> sa.Engine:
 
 def site(request: Request) -> Site:
     return resources(request).site()
+
+
+ResourcesDep = Annotated[Resources, Depends(resources)]
+EngineDep = Annotated[Any, Depends(engine)]  # a sqlalchemy Engine, opened on first use

@@ -9,11 +9,11 @@ import hashlib
 import json
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, Path, Request, Response
+from fastapi import APIRouter, Path, Request, Response
 from pydantic import BaseModel, Field
 
 from skyroute.service.problems import Problem, responses
-from skyroute.service.resources import Resources, engine, resources
+from skyroute.service.resources import EngineDep, Resources, ResourcesDep
 
 router = APIRouter(tags=["days"])
 GEOJSON = "application/geo+json"
@@ -84,7 +84,7 @@ class Day(BaseModel):
 
 
 @router.get("/days", response_model=list[DaySummary], summary="Stored delivery days")
-def list_days(eng=Depends(engine)) -> list[dict]:
+def list_days(eng: EngineDep) -> list[dict]:
     from skyroute.delivery.reads import stored_days
 
     return stored_days(eng)
@@ -102,8 +102,8 @@ def _report(eng, date: dt.date) -> dict:
 
 @router.get("/days/{date}", response_model=Day, responses=responses(404, 422),
             summary="A stored day: report, deliveries, orders")
-def get_day(date: DayDate, eng=Depends(engine),
-            res: Resources = Depends(resources)) -> dict:
+def get_day(date: DayDate, eng: EngineDep,
+            res: ResourcesDep) -> dict:
     from skyroute.delivery.orders import Priced, price
     from skyroute.delivery.reads import day_deliveries
     from skyroute.delivery.store import orders_between
@@ -138,8 +138,8 @@ def get_day(date: DayDate, eng=Depends(engine),
                              "order number in its properties."},
                        **responses(404, 422)},
             summary="A stored day's flight as GeoJSON")
-def get_flightpath(date: DayDate, request: Request, eng=Depends(engine),
-                   res: Resources = Depends(resources)) -> Response:
+def get_flightpath(date: DayDate, request: Request, eng: EngineDep,
+                   res: ResourcesDep) -> Response:
     from skyroute.delivery.reads import day_version
 
     version = day_version(eng, date)

@@ -11,11 +11,11 @@ from __future__ import annotations
 import json
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Depends, Path, Query, Response
+from fastapi import APIRouter, Path, Query, Response
 from pydantic import BaseModel, Field
 
 from skyroute.service.problems import Problem, responses
-from skyroute.service.resources import Resources, resources
+from skyroute.service.resources import Resources, ResourcesDep
 
 router = APIRouter(tags=["fleet"])
 RunId = Annotated[str, Path(max_length=100)]
@@ -65,7 +65,7 @@ def _as_dict(value) -> dict:
 
 @router.get("/fleet/runs", response_model=list[RunSummary], responses=responses(503),
             summary="Stored fleet runs")
-def list_runs(res: Annotated[Resources, Depends(resources)]) -> list[dict]:
+def list_runs(res: ResourcesDep) -> list[dict]:
     out = []
     for r in _store().list_fleet_runs(res.engine()):
         sc = r.get("scenario")
@@ -77,7 +77,7 @@ def list_runs(res: Annotated[Resources, Depends(resources)]) -> list[dict]:
 
 @router.get("/fleet/runs/{run_id}", response_model=Run, responses=responses(404, 422, 503),
             summary="A fleet run: report, scenario, a page of events")
-def get_run(run_id: RunId, res: Annotated[Resources, Depends(resources)],
+def get_run(run_id: RunId, res: ResourcesDep,
             offset: Annotated[int, Query(ge=0)] = 0,
             limit: Annotated[int, Query(ge=1, le=10_000)] = 1000) -> dict:
     run = _run(res, run_id)
@@ -99,7 +99,7 @@ def _file(content: str, media_type: str, name: str) -> Response:
 @router.get("/fleet/runs/{run_id}/events.jsonl", response_class=Response,
             responses={200: {"content": {"application/x-ndjson": {}}}, **responses(404, 503)},
             summary="A fleet run's events, one JSON object a line")
-def get_events(run_id: RunId, res: Annotated[Resources, Depends(resources)]) -> Response:
+def get_events(run_id: RunId, res: ResourcesDep) -> Response:
     return _file(_run(res, run_id).get("events") or "", "application/x-ndjson",
                  "events.jsonl")
 
@@ -107,7 +107,7 @@ def get_events(run_id: RunId, res: Annotated[Resources, Depends(resources)]) -> 
 @router.get("/fleet/runs/{run_id}/tracks.csv", response_class=Response,
             responses={200: {"content": {"text/csv": {}}}, **responses(404, 503)},
             summary="A fleet run's tracks (one row per drone and time step)")
-def get_tracks(run_id: RunId, res: Annotated[Resources, Depends(resources)]) -> Response:
+def get_tracks(run_id: RunId, res: ResourcesDep) -> Response:
     return _file(_run(res, run_id).get("tracks") or "", "text/csv", "tracks.csv")
 
 
@@ -115,7 +115,7 @@ def get_tracks(run_id: RunId, res: Annotated[Resources, Depends(resources)]) -> 
             responses={200: {"content": {"application/geo+json": {}}},
                        **responses(404, 503)},
             summary="A fleet run's airports, runways and tracks in lon/lat")
-def get_geojson(run_id: RunId, res: Annotated[Resources, Depends(resources)]) -> Response:
+def get_geojson(run_id: RunId, res: ResourcesDep) -> Response:
     run = _run(res, run_id)
     text = run.get("geojson")
     if text is None:

@@ -20,7 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from skyroute.errors import SkyrouteError
 from skyroute.service.auth import require_token
 from skyroute.service.problems import Problem, responses
-from skyroute.service.resources import Resources, resources
+from skyroute.service.resources import Resources, ResourcesDep
 
 router = APIRouter(tags=["jobs"])
 MAX_DAYS = 3660
@@ -123,7 +123,7 @@ def _submit(res: Resources, kind: str, params: dict) -> JSONResponse:
              dependencies=[Depends(require_token)],
              responses=responses(401, 403, 404, 413, 422, 429, 503),
              summary="Fly a day or a range of days as a job")
-def post_deliver(body: DeliverJob, res: Annotated[Resources, Depends(resources)]):
+def post_deliver(body: DeliverJob, res: ResourcesDep):
     res.site()  # 404 without a site: the job would fail on every day
     s = res.settings
     first, last = (body.date, body.date) if body.date else (body.from_, body.to)
@@ -137,7 +137,7 @@ def post_deliver(body: DeliverJob, res: Annotated[Resources, Depends(resources)]
              dependencies=[Depends(require_token)],
              responses=responses(401, 403, 413, 422, 429, 503),
              summary="Run a fleet simulation as a job")
-def post_fleet(body: FleetJob, res: Annotated[Resources, Depends(resources)]):
+def post_fleet(body: FleetJob, res: ResourcesDep):
     from skyroute.fleet.scenario import Scenario, parse_scenario, preset
 
     if body.scenario is not None:
@@ -162,7 +162,7 @@ def post_fleet(body: FleetJob, res: Annotated[Resources, Depends(resources)]):
 @router.get("/jobs/{job_id}", response_model=JobState, responses=responses(404, 503),
             summary="A job's state, progress and result")
 def get_job(job_id: Annotated[str, Path(max_length=100)],
-            res: Annotated[Resources, Depends(resources)]) -> dict:
+            res: ResourcesDep) -> dict:
     runner = _jobs()
     job = runner.get(res.engine(), job_id)
     if job is None:

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, Path
+from fastapi import APIRouter, Path
 from pydantic import BaseModel, Field
 
 from skyroute.service.problems import Problem, responses
-from skyroute.service.resources import Resources, resources
+from skyroute.service.resources import ResourcesDep
 from skyroute.world.movingai import BLOCKED, PASSABLE
 
 router = APIRouter(tags=["maps"])
@@ -29,7 +29,7 @@ class MapRows(MapInfo):
 
 
 @router.get("/maps", response_model=list[MapInfo], summary="The bundled maps")
-def list_maps(res: Annotated[Resources, Depends(resources)]) -> list[MapInfo]:
+def list_maps(res: ResourcesDep) -> list[MapInfo]:
     from skyroute.world.load import bundled_maps
 
     out = []
@@ -42,7 +42,7 @@ def list_maps(res: Annotated[Resources, Depends(resources)]) -> list[MapInfo]:
 @router.get("/maps/{name}", response_model=MapRows, responses=responses(404),
             summary="One bundled map's rows")
 def get_map(name: Annotated[str, Path(max_length=200)],
-            res: Annotated[Resources, Depends(resources)]) -> MapRows:
+            res: ResourcesDep) -> MapRows:
     from skyroute.world.load import bundled_maps
 
     key = f"map-rows:{name}"

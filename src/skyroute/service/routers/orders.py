@@ -5,11 +5,11 @@ from __future__ import annotations
 import datetime as dt
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, Query
+from fastapi import APIRouter, Query
 from pydantic import BaseModel
 
 from skyroute.service.problems import responses
-from skyroute.service.resources import engine
+from skyroute.service.resources import EngineDep
 
 router = APIRouter(tags=["days"])
 
@@ -25,7 +25,7 @@ class OrderOut(BaseModel):
 @router.get("/orders", response_model=list[OrderOut], responses=responses(422),
             summary="The stored orders of a day")
 def list_orders(date: Annotated[dt.date, Query(description="The day, YYYY-MM-DD.")],
-                eng=Depends(engine)) -> list[dict]:
+                eng: EngineDep) -> list[dict]:
     from skyroute.delivery.store import orders_between
 
     return [{"order_no": o.order_no, "date": o.date, "customer": o.customer,

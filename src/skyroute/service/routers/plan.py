@@ -19,7 +19,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from skyroute.errors import InputFormatError, QueryError, SkyrouteError
 from skyroute.service.auth import require_token
 from skyroute.service.problems import Problem, from_skyrouteerror, responses
-from skyroute.service.resources import Resources, resources
+from skyroute.service.resources import Resources, ResourcesDep
 
 router = APIRouter(tags=["plan"])
 
@@ -113,7 +113,7 @@ _SEARCH = threading.Lock()
              dependencies=[Depends(require_token)],
              responses=responses(401, 403, 413, 422), summary="Plan one path")
 def post_plan(body: PlanRequest, response: Response,
-              res: Annotated[Resources, Depends(resources)]) -> dict:
+              res: ResourcesDep) -> dict:
     t0 = time.perf_counter()
     with _SEARCH:
         t1 = time.perf_counter()

@@ -5,10 +5,10 @@ stored order."""
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Depends, Response
+from fastapi import APIRouter, Response
 
 from skyroute.service.problems import responses
-from skyroute.service.resources import Resources, resources
+from skyroute.service.resources import Resources, ResourcesDep
 
 router = APIRouter(tags=["days"])
 GEOJSON = "application/geo+json"
@@ -21,7 +21,7 @@ GEOJSON = "application/geo+json"
                              "customer."},
                        **responses(404, 503)},
             summary="The delivery site in lon/lat")
-def get_site(res: Resources = Depends(resources)) -> Response:
+def get_site(res: ResourcesDep) -> Response:
     site = res.site()
     body = res.cache.get("site")
     if body is None:
