@@ -100,16 +100,24 @@ def fly_once(monkeypatch, _flown_days):
     the synthetic range and the ILP marker-day tests. Run alone, a test flies its days.
     Not for tests that change the planner's inputs by other means (e.g. a patched leg
     table): the key would not see it."""
-    from skyroute.delivery import day, days
+    from skyroute.delivery import days
+
+    plan_day = caching_plan_day(_flown_days)
+    monkeypatch.setattr(days, "plan_day", plan_day)
+    return plan_day
+
+
+def caching_plan_day(flown: dict):
+    """``plan_day`` that flies each day once into ``flown`` (see ``fly_once``); for
+    fixtures wider than a test, which patch it in with ``pytest.MonkeyPatch.context()``."""
+    from skyroute.delivery import day
 
     def plan_day(site, date, orders, *, method="milp", battery=day.BATTERY):
         key = (_site_key(site.source), date, tuple(orders), method, battery)
-        if key not in _flown_days:
-            _flown_days[key] = day.plan_day(site, date, orders, method=method,
-                                            battery=battery)
-        return _flown_days[key]
+        if key not in flown:
+            flown[key] = day.plan_day(site, date, orders, method=method, battery=battery)
+        return flown[key]
 
-    monkeypatch.setattr(days, "plan_day", plan_day)
     return plan_day
 
 

@@ -4,8 +4,9 @@ is 403; compared in constant time (:func:`secrets.compare_digest`)."""
 from __future__ import annotations
 
 import secrets
+from typing import Annotated
 
-from fastapi import Request
+from fastapi import Depends, Request
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
 from skyroute.service.problems import Problem
@@ -14,9 +15,10 @@ _bearer = HTTPBearer(auto_error=False, description="The server's token: SKYROUTE
                      "--token-file, or the one `skyroute serve` printed at start.")
 
 
-async def require_token(request: Request) -> None:
+async def require_token(
+        request: Request,
+        cred: Annotated[HTTPAuthorizationCredentials | None, Depends(_bearer)]) -> None:
     """A FastAPI dependency: passes with ``Authorization: Bearer <the token>``."""
-    cred: HTTPAuthorizationCredentials | None = await _bearer(request)
     if cred is None:
         raise Problem(401, "this endpoint needs 'Authorization: Bearer TOKEN'",
                       headers={"WWW-Authenticate": "Bearer"})

@@ -1,0 +1,141 @@
+"""The app as a whole: health, OpenAPI, the static page, errors as problem+json, limits,
+the timing header, and that making an app connects to nothing."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.service.conftest import AUTH, TOKEN, make_client
+
+PROBLEM = "application/problem+json"
+
+
+def assert_problem(r, status: int, field: str | None = None, words: str = "") -> dict:
+    assert r.status_code == status, r.text
+    assert r.headers["content-type"] == PROBLEM
+    doc = r.json()
+    assert doc["status"] == status and doc["type"].startswith("urn:skyroute:problem:")
+    assert doc["title"] and doc["detail"]
+    assert "Traceback" not in r.text and 'File "' not in r.text
+    if field is not None:
+        assert doc["field"] == field, doc
+        assert doc["errors"][0]["field"] == field
+    assert words in doc["detail"], doc
+    return doc
+
+
+def test_health_docs_and_static_page(client):
+    r = client.get("/health")
+    assert r.status_code == 200 and r.json() == {"status": "ok", "version": "0.1.0"}
+    assert r.headers["server-timing"].startswith("app;dur=")
+    spec = client.get("/openapi.json").json()
+    for path in ("/health", "/maps", "/maps/{name}", "/days", "/days/{date}",
+                 "/days/{date}/flightpath.geojson", "/orders", "/site.geojson", "/plan",
+                 "/jobs/deliver", "/jobs/fleet", "/jobs/{job_id}", "/fleet/runs",
+                 "/fleet/runs/{run_id}", "/fleet/runs/{run_id}/events.jsonl",
+                 "/fleet/runs/{run_id}/tracks.csv", "/fleet/runs/{run_id}/fleet.geojson"):
+        assert path in spec["paths"], path
+    assert spec["components"]["securitySchemes"]["HTTPBearer"]["scheme"] == "bearer"
+    assert "swagger" in client.get("/docs").text.lower()
+    page = client.get("/")
+    assert page.status_code == 200 and page.headers["content-type"].startswith("text/html")
+    assert 'href="/docs"' in page.text and "POST /plan" in page.text
+
+
+def test_unknown_path_and_method_are_problems(client):
+    assert_problem(client.get("/no/such/thing"), 404, words="/no/such/thing")
+    assert_problem(client.delete("/health"), 405, words="DELETE")
+
+
+def test_making_an_app_connects_to_nothing(tmp_path):
+    """A store that cannot be opened fails the requests that need it (503), not the
+    app: create_app and /health never touch it."""
+    with make_client(db_url="postgresql+psycopg://nobody@127.0.0.1:1/none") as c:
+        assert c.get("/health").status_code == 200
+        assert c.get("/maps").status_code == 200
+        doc = assert_problem(c.get("/days"), 503, words="cannot connect")
+        assert "password" not in doc["detail"]
+
+
+def test_settings_refuse_two_sites_and_bad_limits(tmp_path):
+    from pydantic import ValidationError
+
+    from skyroute.service.settings import Settings
+
+    with pytest.raises(ValidationError, match="at most one of data_dir and source_url"):
+        Settings(data_dir=tmp_path, source_url="http://x")
+    with pytest.raises(ValidationError):
+        Settings(max_body_bytes=0)
+    a, b = Settings(), Settings()
+    assert a.token != b.token and len(a.token) >= 32  # a fresh random token each time
+
+
+def test_body_over_the_limit_is_413(tmp_path):
+    with make_client(db_url=f"sqlite:///{tmp_path / 'x.db'}", max_body_bytes=1000) as c:
+        big = {"map_text": "x" * 2000, "start": [0, 0], "goal": [1, 1]}
+        assert_problem(c.post("/plan", json=big, headers=AUTH), 413, words="limit is 1,000")
+
+        def chunks():  # no Content-Length: counted as it streams in
+            for _ in range(5):
+                yield b"x" * 300
+
+        assert_problem(c.post("/plan", content=chunks(), headers=AUTH), 413,
+                       words="limit is 1,000")
+        small = {"map": "den312d", "start": [50, 76], "goal": [60, 13], "geojson": False}
+        assert c.post("/plan", json=small, headers=AUTH).status_code == 200
+
+
+def test_a_chunked_body_under_the_limit_arrives_whole(client):
+    body = b'{"map": "den312d", "start": [50, 76], "goal": [60, 13], "geojson": false}'
+
+    def chunks():
+        for k in range(0, len(body), 7):
+            yield body[k:k + 7]
+
+    r = client.post("/plan", content=chunks(), headers={**AUTH,
+                                                         "Content-Type": "application/json"})
+    assert r.status_code == 200 and r.json()["status"] == "found"
+
+
+def test_an_unexpected_error_is_a_500_that_hides_its_cause(tmp_path):
+    from fastapi.testclient import TestClient
+
+    from skyroute.service.app import create_app
+    from skyroute.service.settings import Settings
+
+    app = create_app(Settings(token=TOKEN))
+
+    @app.get("/boom")
+    def boom():
+        raise RuntimeError("secret internals at /etc/shadow")
+
+    app.router.routes.insert(0, app.router.routes.pop())  # before the static mount
+    with TestClient(app, raise_server_exceptions=False) as c:
+        doc = assert_problem(c.get("/boom"), 500)
+        assert "secret" not in c.get("/boom").text and "RuntimeError" not in doc["detail"]
+
+
+@pytest.mark.parametrize("headers, status", [
+    ({}, 401),
+    ({"Authorization": "Basic dXNlcjpwYXNz"}, 401),
+    ({"Authorization": "Bearer"}, 401),
+    ({"Authorization": "Bearer wrong-token"}, 403),
+    ({"Authorization": f"Bearer {TOKEN}x"}, 403),
+    ({"Authorization": f"Bearer {TOKEN[:-1]}"}, 403),
+])
+@pytest.mark.parametrize("path, body", [
+    ("/plan", {"map": "den312d", "start": [50, 76], "goal": [60, 13]}),
+    ("/plan", {"bad": "body"}),  # the token is checked before the body
+    ("/jobs/deliver", {"date": "2024-01-03"}),
+    ("/jobs/fleet", {"preset": "seed-3x3"}),
+])
+def test_writes_need_the_token(client, headers, status, path, body):
+    r = client.post(path, json=body, headers=headers)
+    assert_problem(r, status)
+    if status == 401:
+        assert r.headers["www-authenticate"] == "Bearer"
+
+
+def test_reads_need_no_token(client):
+    for path in ("/health", "/maps", "/maps/den312d", "/days", "/orders?date=2024-01-01"):
+        assert client.get(path).status_code == 200, path
