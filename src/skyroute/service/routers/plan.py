@@ -96,7 +96,8 @@ class PlanAnswer(BaseModel):
     los_checks: int
     seconds: float = Field(description="The search's own wall time.")
     algorithm: str
-    max_expansions: int = Field(description="The budget the search ran with.")
+    max_expansions: int | None = Field(description="The budget the search ran with (null "
+                                       "for PRM, bounded by its samples instead).")
     path_lonlat: list[tuple[float, float]] | None = None
     frame: str | None = None
     waypoints: list[list[float]] | None = Field(
@@ -109,7 +110,7 @@ class PlanAnswer(BaseModel):
 _SEARCH = threading.Lock()
 
 
-@router.post("/plan", response_model=PlanAnswer, response_model_exclude_none=True,
+@router.post("/plan", response_model=PlanAnswer,
              dependencies=[Depends(require_token)],
              responses=responses(401, 403, 413, 422), summary="Plan one path")
 def post_plan(body: PlanRequest, response: Response,
@@ -160,10 +161,14 @@ def _plan_checked(body: PlanRequest, res: Resources) -> dict:
     else:
         world = _world(body)
         _check_world_limits(body, world, res)
+        algorithm = body.algorithm or "visibility"
+        if algorithm == "prm":
+            budget = None  # scipy's Dijkstra has no budget; samples bound the work
         r = plan(world, tuple(body.start), tuple(body.goal),
-                 algorithm=body.algorithm or "visibility", connectivity=body.connectivity,
+                 algorithm=algorithm, connectivity=body.connectivity,
                  corner_cutting=body.corner_cutting, heuristic=body.heuristic,
-                 weight=body.weight, prune=body.prune, max_expansions=budget,
+                 weight=body.weight, prune=body.prune,
+                 max_expansions=None if algorithm == "prm" else budget,
                  resolution=body.resolution, samples=body.samples,
                  neighbours=body.neighbours, prm_star=body.prm_star, seed=body.seed)
         out = r.to_dict()

@@ -1,0 +1,181 @@
+"""``POST /plan``: the same answer as :func:`skyroute.plan` on the same query (bundled
+maps, uploaded map text, the shipped city world, GeoJSON zones), the server's budget,
+and every bad input as a 422 naming its field."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import skyroute
+from skyroute.world.load import bundled_maps
+from skyroute.world.movingai import read_scen
+from tests.conftest import ROOT
+from tests.service.conftest import AUTH, make_client
+from tests.service.test_app import assert_problem
+
+CITY = ROOT / "examples" / "city.csv"
+CITY_LONLAT = ((-3.1890, 55.9456), (-3.1850, 55.9432))
+DEN = {"map": "den312d", "start": [50, 76], "goal": [60, 13]}
+
+
+def same(answer: dict, r: skyroute.PlanResult) -> None:
+    """The service's answer is the planner's result (all but the timing)."""
+    want = r.to_dict()
+    for key in ("status", "cost", "path", "expanded", "max_frontier", "los_checks",
+                "algorithm"):
+        assert answer[key] == want[key], key
+    if "path_lonlat" in want:
+        assert answer["path_lonlat"] == want["path_lonlat"]
+
+
+@pytest.mark.parametrize("options", [
+    {}, {"algorithm": "dijkstra"}, {"algorithm": "bfs"}, {"algorithm": "jps"},
+    {"algorithm": "theta"}, {"algorithm": "lazy_theta", "prune": "los"},
+    {"algorithm": "astar", "weight": 1.5, "corner_cutting": True},
+    {"algorithm": "astar", "connectivity": 4, "heuristic": "manhattan"},
+])
+def test_bundled_map_equals_plan(client, options):
+    r = client.post("/plan", json={**DEN, **options}, headers=AUTH)
+    assert r.status_code == 200, r.text
+    a = r.json()
+    same(a, skyroute.plan(skyroute.load_map("den312d"), (50, 76), (60, 13), **options))
+    assert a["max_expansions"] == 2_000_000 and a["seconds"] > 0
+    feature = a["geojson"]["features"][0]
+    assert feature["geometry"]["coordinates"][0] == [50.5, 76.5]  # cell centre, metres
+    assert "wait;dur=" in r.headers["server-timing"] and "plan;dur=" in r.headers[
+        "server-timing"]
+
+
+def test_512_map_scenario_lines_equal_plan_and_the_optimum(client):
+    grid = skyroute.load_map("Paris_1_512")
+    scen = read_scen(str(bundled_maps()["Paris_1_512"]) + ".scen")
+    for i in (0, 950, len(scen) - 1):
+        s, g = scen.starts[i].tolist(), scen.goals[i].tolist()
+        r = client.post("/plan", json={"map": "Paris_1_512", "start": s, "goal": g,
+                                       "geojson": False}, headers=AUTH)
+        a = r.json()
+        same(a, skyroute.plan(grid, tuple(s), tuple(g)))
+        assert scen.matches(i, a["cost"]) and a["geojson"] is None
+
+
+def test_map_text_equals_the_file(client):
+    text = bundled_maps()["den312d"].read_text()
+    r = client.post("/plan", json={"map_text": text, "start": [50, 76], "goal": [60, 13]},
+                    headers=AUTH)
+    same(r.json(), skyroute.plan(skyroute.load_map("den312d"), (50, 76), (60, 13)))
+
+
+@pytest.mark.parametrize("frame, options", [
+    ("lonlat", {}),
+    ("ned", {}),
+    ("lonlat", {"algorithm": "astar", "resolution": 2.0}),
+    ("enu", {"algorithm": "prm", "samples": 300, "seed": 3}),
+])
+def test_city_world_equals_plan(client, frame, options):
+    world = skyroute.load_world(CITY, altitude=10, safety=2, frame="lonlat")
+    a, b = CITY_LONLAT
+    if frame != "lonlat":  # the same two places, given in the frame
+        w = world.in_frame(frame)
+        a, b = (w.from_plane(world.to_plane([p], "p"))[0].tolist() for p in (a, b))
+    body = {"world_text": CITY.read_text(), "world_format": "colliders", "frame": frame,
+            "altitude": 10, "safety": 2, "start": list(a), "goal": list(b), **options}
+    r = client.post("/plan", json=body, headers=AUTH)
+    assert r.status_code == 200, r.text
+    ans = r.json()
+    w = skyroute.load_world(CITY, altitude=10, safety=2, frame=frame)
+    want = skyroute.plan(w, tuple(a), tuple(b), **options)
+    same(ans, want)
+    assert ans["frame"] == frame and want.found
+    assert len(ans["waypoints"]) == len(ans["path"]) and ans["waypoints"][0][2] == 10.0
+    coords = ans["geojson"]["features"][0]["geometry"]["coordinates"]
+    assert np.allclose(coords, ans["path_lonlat"])
+
+
+def test_geojson_zones_world(client):
+    zones = {"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {"name": "block"},
+         "geometry": {"type": "Polygon", "coordinates": [[[0.001, -0.001], [0.002, -0.001],
+                                                          [0.002, 0.001], [0.001, 0.001],
+                                                          [0.001, -0.001]]]}}]}
+    body = {"world_text": json.dumps(zones), "world_format": "geojson",
+            "boundary": "-0.01,-0.01,0.01,0.01", "start": [0.0, 0.0], "goal": [0.003, 0.0]}
+    ans = client.post("/plan", json=body, headers=AUTH).json()
+    path = ROOT / "zones.geojson"
+    try:
+        path.write_text(json.dumps(zones))
+        w = skyroute.load_world(path, boundary="-0.01,-0.01,0.01,0.01")
+    finally:
+        path.unlink()
+    same(ans, skyroute.plan(w, (0.0, 0.0), (0.003, 0.0)))
+    assert ans["status"] == "found" and ans["cost"] > 300  # metres round the block
+
+
+def test_the_servers_budget_caps_each_request(tmp_path):
+    with make_client(max_expansions=50) as c:
+        a = c.post("/plan", json=DEN, headers=AUTH).json()
+        assert a["status"] == "budget_exhausted" and a["max_expansions"] == 50
+        assert a["cost"] is None and a["path"] == [] and a["expanded"] == 50
+        a = c.post("/plan", json={**DEN, "max_expansions": 10**9}, headers=AUTH).json()
+        assert a["max_expansions"] == 50  # asked for more: still the cap
+        a = c.post("/plan", json={**DEN, "max_expansions": 7}, headers=AUTH).json()
+        assert a["max_expansions"] == 7 and a["expanded"] == 7  # a lower one is kept
+
+
+def test_no_path_is_a_status(client):
+    text = "type octile\nheight 3\nwidth 5\nmap\n..@..\n..@..\n..@..\n"
+    a = client.post("/plan", json={"map_text": text, "start": [0, 0], "goal": [4, 2]},
+                    headers=AUTH).json()
+    assert a["status"] == "no_path" and a["cost"] is None and a["path"] == []
+
+
+CITY_BODY = {"world_format": "colliders", "altitude": 10, "safety": 2,
+             "start": list(CITY_LONLAT[0]), "goal": list(CITY_LONLAT[1])}
+
+
+@pytest.mark.parametrize("body, field, words", [
+    ({"start": [50, 76], "goal": [60, 13]}, "body", "exactly one of map, map_text and "
+                                                    "world_text"),
+    ({**DEN, "map_text": "x"}, "body", "got map, map_text"),
+    ({**DEN, "map": "atlantis"}, "map", "choose one of 'Berlin_1_256'"),
+    ({**DEN, "start": [0, 0]}, "start", "on a blocked cell"),
+    ({**DEN, "goal": [600, 13]}, "goal", "outside the 65x81 grid"),
+    ({**DEN, "start": [50.5, 76]}, "start", "two integers"),
+    ({**DEN, "start": [50]}, "start[1]", "Field required"),
+    ({**DEN, "start": [50, "north"]}, "start[1]", "valid number"),
+    ({**DEN, "algorithm": "magic"}, "algorithm", "'astar'"),
+    ({**DEN, "algorithm": "visibility"}, "algorithm", "choose one of"),
+    ({**DEN, "weight": 0.5}, "weight", "greater than or equal to 1"),
+    ({**DEN, "connectivity": 6}, "connectivity", "4 or 8"),
+    ({**DEN, "max_expansions": 0}, "max_expansions", "greater than or equal to 1"),
+    ({**DEN, "corner_cuting": True}, "corner_cuting", "Extra inputs are not permitted"),
+    ({"map_text": "type octile\nheight 1\nwidth 2\nmap\n.Q\n", "start": [0, 0],
+      "goal": [1, 0]}, "map_text", "line 5: unknown terrain 'Q'"),
+    ({"map_text": "", "start": [0, 0], "goal": [1, 0]}, "map_text", "empty"),
+    ({**CITY_BODY, "world_format": None, "world_text": "x"}, "body", "world_format"),
+    ({**CITY_BODY, "world_text": "lat0 x\n"}, "world_text", "line 1: expected 'lat0"),
+    ({**CITY_BODY, "world_text": "{}", "world_format": "geojson"}, "world_text", ""),
+    ({**CITY_BODY, "frame": "polar"}, "frame", "'lonlat'"),
+    ({**CITY_BODY, "frame": "degrees"}, "frame", "in metres"),
+    ({**CITY_BODY, "safety": -1}, "safety", "greater than or equal to 0"),
+    ({**CITY_BODY, "start": [-3.1890, 95.0]}, "start", ""),
+    ({**CITY_BODY, "algorithm": "astar", "resolution": 0.001}, "resolution",
+     "this server's limit"),
+    ({**CITY_BODY, "algorithm": "prm", "samples": 10**6}, "samples", "limit of 20,000"),
+])
+def test_bad_input_is_422_naming_the_field(client, body, field, words):
+    if "world_format" in body and "world_text" not in body:
+        body = {**body, "world_text": CITY.read_text()}
+    body = {k: v for k, v in body.items() if v is not None}
+    assert_problem(client.post("/plan", json=body, headers=AUTH), 422, field, words)
+
+
+def test_not_json_and_not_finite_are_422(client):
+    r = client.post("/plan", content=b"{not json", headers={**AUTH, "Content-Type":
+                                                           "application/json"})
+    assert_problem(r, 422)
+    r = client.post("/plan", content=b'{"map": "den312d", "start": [NaN, 1], "goal": [1, 1]}',
+                    headers={**AUTH, "Content-Type": "application/json"})
+    assert_problem(r, 422, "start[0]")
