@@ -1,0 +1,164 @@
+"""Stored delivery days through the service: the CLI's report and files, read back from
+the store the CLI filled (examples/lunch, 2024-01-03), and the site in lon/lat."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from tests.service.conftest import DAY, EXAMPLE, make_client
+from tests.service.test_app import assert_problem
+
+
+def test_days_lists_the_stored_days(day_client, lunch):
+    _, report, _, _ = lunch
+    days = day_client.get("/days").json()
+    assert [d["date"] for d in days] == [DAY, "2024-02-01"]
+    assert days[0]["money_pct"] == report["money_pct"] and days[0]["moves"] == report["moves"]
+    assert days[1]["money_pct"] is None and days[1]["moves"] == 0
+
+
+def test_a_day_has_the_clis_report(day_client, lunch):
+    _, report, _, _ = lunch
+    doc = day_client.get(f"/days/{DAY}").json()
+    assert doc["date"] == DAY
+    rep = doc["report"]
+    for key in ("date", "orders_placed", "orders_delivered", "orders_invalid", "invalid",
+                "money_placed", "money_delivered", "money_pct", "moves", "moves_left",
+                "settings"):
+        assert rep[key] == report[key], key
+    assert rep["seconds"] == pytest.approx(report["seconds"], abs=1e-5)
+    delivered = doc["deliveries"]
+    assert len(delivered) == report["orders_delivered"]
+    assert sum(d["cost_in_pence"] for d in delivered) == report["money_delivered"]
+    orders = doc["orders"]
+    assert len(orders) == report["orders_placed"] == 36
+    status = {o["order_no"]: o["status"] for o in orders}
+    assert {d["order_no"] for d in delivered} == {k for k, v in status.items()
+                                                  if v == "delivered"}
+    assert sum(v == "invalid" for v in status.values()) == report["orders_invalid"]
+    assert sum(o["value"] for o in orders if o["status"] != "invalid") == \
+        report["money_placed"] - sum(50 for o in orders if o["status"] == "invalid") \
+        - _invalid_items(orders)
+    assert all(o["lonlat"] is not None for o in orders if o["status"] != "invalid")
+
+
+def _invalid_items(orders) -> int:
+    """Money placed counts the known items of invalid orders too (DayResult.money_placed)."""
+    from skyroute.delivery.day import _placed_value
+    from skyroute.delivery.orders import Order
+    from skyroute.delivery.site import load_site
+    from skyroute.delivery.source import DirSource
+
+    site = load_site(DirSource(EXAMPLE))
+    return sum(_placed_value(site, Order(o["order_no"], None, o["customer"], o["deliver_to"],
+                                         tuple(o["items"]))) - 50
+               for o in orders if o["status"] == "invalid")
+
+
+def test_deliveries_come_in_flying_order(day_client):
+    doc = day_client.get(f"/days/{DAY}").json()
+    angles_orders = day_client.get(f"/days/{DAY}/flightpath.geojson").json()[
+        "features"][0]["properties"]["orders"]
+    flown = list(dict.fromkeys(o for o in angles_orders if o))
+    assert [d["order_no"] for d in doc["deliveries"]] == \
+        [o for o in flown if o in {d["order_no"] for d in doc["deliveries"]}]
+
+
+def test_flightpath_is_the_clis_file(day_client, lunch):
+    _, report, geojson, _ = lunch
+    r = day_client.get(f"/days/{DAY}/flightpath.geojson")
+    assert r.status_code == 200 and r.headers["content-type"] == "application/geo+json"
+    mine, cli = r.json()["features"][0], json.loads(geojson)["features"][0]
+    assert mine["geometry"] == cli["geometry"]  # the same floats, to the last bit
+    assert mine["properties"]["moves"] == report["moves"]
+    assert len(mine["properties"]["angles"]) == report["moves"]
+    again = day_client.get(f"/days/{DAY}/flightpath.geojson",
+                           headers={"If-None-Match": r.headers["etag"]})
+    assert again.status_code == 304 and not again.content
+    empty = day_client.get("/days/2024-02-01/flightpath.geojson").json()["features"][0]
+    assert empty["geometry"] == json.loads((lunch[3] / "drone-01-02-2024.geojson")
+                                           .read_text())["features"][0]["geometry"]
+
+
+def test_a_day_stored_again_is_served_fresh(tmp_path, lunch):
+    """The flight path is cached by the day's run: storing the day again changes it."""
+    import shutil
+
+    import sqlalchemy as sa
+
+    from skyroute.delivery.store import connect
+
+    db = tmp_path / "copy.db"
+    shutil.copy(lunch[0].removeprefix("sqlite:///"), db)
+    with make_client(db_url=f"sqlite:///{db}") as c:
+        first = c.get(f"/days/{DAY}/flightpath.geojson")
+        eng = connect(f"sqlite:///{db}")
+        with eng.begin() as conn:
+            conn.execute(sa.text("update flightpath set to_lon = to_lon + 1 where seq = 0 "
+                                 "and delivery_date = :d"), {"d": DAY})
+            conn.execute(sa.text("update runs set finished = '2030-01-01 00:00:00.000000' "
+                                 "where delivery_date = :d"), {"d": DAY})
+        second = c.get(f"/days/{DAY}/flightpath.geojson")
+        assert second.headers["etag"] != first.headers["etag"]
+        a = first.json()["features"][0]["geometry"]["coordinates"][1]
+        b = second.json()["features"][0]["geometry"]["coordinates"][1]
+        assert b[0] == pytest.approx(a[0] + 1)
+
+
+@pytest.mark.parametrize("path", ["/days/2023-06-01", "/days/2023-06-01/flightpath.geojson"])
+def test_unknown_date_is_404(day_client, path):
+    assert_problem(day_client.get(path), 404, words="2023-06-01 is not stored")
+
+
+@pytest.mark.parametrize("path, field", [
+    ("/days/2024-13-01", "date"), ("/days/yesterday/flightpath.geojson", "date"),
+    ("/orders?date=2024-02-30", "date"), ("/orders", "date"),
+])
+def test_bad_date_is_422(day_client, path, field):
+    assert_problem(day_client.get(path), 422, field)
+
+
+def test_orders_of_a_day(day_client):
+    orders = day_client.get(f"/orders?date={DAY}").json()
+    assert len(orders) == 36 and all(o["date"] == DAY for o in orders)
+    assert all(1 <= len(o["items"]) for o in orders if o["order_no"])
+    assert day_client.get("/orders?date=1999-01-01").json() == []
+
+
+def test_site_in_lonlat(day_client):
+    r = day_client.get("/site.geojson")
+    assert r.status_code == 200 and r.headers["content-type"] == "application/geo+json"
+    kinds: dict[str, list] = {}
+    for f in r.json()["features"]:
+        kinds.setdefault(f["properties"]["kind"], []).append(f)
+    menus = json.loads((EXAMPLE / "website" / "menus" / "menus.json").read_text())
+    zones = json.loads((EXAMPLE / "website" / "buildings" / "no-fly-zones.geojson")
+                       .read_text())
+    assert len(kinds["shop"]) == len(menus) and len(kinds["home"]) == 1
+    assert len(kinds["no_fly_zone"]) == len(zones["features"])
+    assert len(kinds["confinement"]) == 1
+    assert kinds["confinement"][0]["geometry"]["type"] == "Polygon"
+    customers = {f["properties"]["words"] for f in kinds["customer"]}
+    day = day_client.get(f"/days/{DAY}").json()
+    assert {o["deliver_to"] for o in day["orders"] if o["lonlat"]} <= customers
+    for f in kinds["shop"] + kinds["customer"]:
+        lon, lat = f["geometry"]["coordinates"]
+        assert -3.3 < lon < -3.1 and 55.9 < lat < 56.0  # Edinburgh, not (lat, lon)
+
+
+def test_without_a_site(lunch):
+    with make_client(db_url=lunch[0]) as c:
+        assert_problem(c.get("/site.geojson"), 404, words="--data DIR or --source URL")
+        doc = c.get(f"/days/{DAY}").json()
+        assert doc["report"]["invalid"] is None
+        assert all(o["status"] in ("delivered", "not_delivered") for o in doc["orders"])
+        empty = c.get("/days/2024-02-01/flightpath.geojson").json()["features"][0]
+        assert empty["geometry"] is None and empty["properties"]["moves"] == 0
+
+
+def test_a_broken_site_is_503(tmp_path, lunch):
+    (tmp_path / "website").mkdir()
+    with make_client(db_url=lunch[0], data_dir=tmp_path) as c:
+        assert_problem(c.get("/site.geojson"), 503, words="menus.json")
