@@ -18,6 +18,7 @@ from skyroute.cli.errors import run_cli
 from skyroute.cli.fleet_cmd import fleet_app
 from skyroute.cli.fly_cmd import fly_command
 from skyroute.cli.plan_cmd import plan_command
+from skyroute.cli.serve_cmd import serve_command
 from skyroute.cli.world_cmd import plan_world_command, synth_city_command
 from skyroute.world.load import bundled_maps
 from skyroute.world.movingai import read_map
@@ -34,6 +35,7 @@ app.command("deliver")(deliver_command)
 app.add_typer(db_app, name="db")
 app.add_typer(data_app, name="data")
 app.add_typer(fleet_app, name="fleet")
+app.command("serve")(serve_command)
 
 
 @app.command("maps")

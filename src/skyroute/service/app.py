@@ -47,3 +47,14 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(ServerTiming)
     app.mount("/", StaticFiles(directory=STATIC, html=True), name="static")
     return app
+
+
+SETTINGS_ENV = "SKYROUTE_SERVICE_SETTINGS"
+
+
+def app_from_env() -> FastAPI:
+    """The app for the settings in ``$SKYROUTE_SERVICE_SETTINGS`` (JSON): how each of
+    ``skyroute serve --workers N``'s processes makes its own app."""
+    import os
+
+    return create_app(Settings.model_validate_json(os.environ[SETTINGS_ENV]))

@@ -22,20 +22,24 @@ GEOJSON = "application/geo+json"
                        **responses(404, 503)},
             summary="The delivery site in lon/lat")
 def get_site(res: ResourcesDep) -> Response:
+    from skyroute.delivery.store import order_dates
+
     site = res.site()
-    body = res.cache.get("site")
+    dates = order_dates(res.engine())
+    key = f"site:{len(dates)}:{dates[0] if dates else ''}:{dates[-1] if dates else ''}"
+    body = res.cache.get(key)  # customers come from the stored orders: keyed by their days
     if body is None:
-        body = _site_doc(site, res)
-        res.cache["site"] = body
+        body = _site_doc(site, res, dates)
+        res.cache[key] = body
     return Response(body, media_type=GEOJSON)
 
 
-def _site_doc(site, res: Resources) -> bytes:
+def _site_doc(site, res: Resources, dates: list) -> bytes:
     import json
 
     import shapely
 
-    from skyroute.delivery.store import order_dates, orders_between
+    from skyroute.delivery.store import orders_between
     from skyroute.errors import InputFormatError
 
     features = []
@@ -49,7 +53,6 @@ def _site_doc(site, res: Resources) -> bytes:
     for s in site.shops:
         features.append(_point(s.lonlat, kind="shop", name=s.name, words=s.words))
     eng = res.engine()
-    dates = order_dates(eng)
     words = sorted({o.deliver_to for v in (orders_between(eng, dates[0], dates[-1]).values()
                                            if dates else ()) for o in v})
     for w in words:

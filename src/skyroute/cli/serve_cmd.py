@@ -1,0 +1,102 @@
+"""``skyroute serve``: the REST service and viewer on uvicorn."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from skyroute.delivery.store import DEFAULT_DB
+from skyroute.errors import OptionError
+
+TOKEN_ENV = "SKYROUTE_TOKEN"
+
+
+def read_token(token_file: Path | None) -> tuple[str | None, str]:
+    """(token, where it came from): ``$SKYROUTE_TOKEN``, else ``--token-file``, else
+    (None, "generated")."""
+    if os.environ.get(TOKEN_ENV):
+        return os.environ[TOKEN_ENV].strip(), TOKEN_ENV
+    if token_file is not None:
+        try:
+            token = token_file.read_text().strip()
+        except OSError as exc:
+            raise OptionError(f"--token-file {token_file}: cannot read: {exc.strerror}"
+                              ) from None
+        if not token:
+            raise OptionError(f"--token-file {token_file}: the file is empty")
+        return token, str(token_file)
+    return None, "generated"
+
+
+def serve_command(
+    db: Annotated[str, typer.Option(help="SQLAlchemy URL of the store.")] = DEFAULT_DB,
+    data: Annotated[Path | None, typer.Option(
+        help="The delivery site: a data folder in the ILP layout (as 'deliver').")] = None,
+    source: Annotated[str | None, typer.Option(
+        help="The delivery site over HTTP (as 'deliver').")] = None,
+    host: Annotated[str, typer.Option(help="Address to listen on.")] = "127.0.0.1",
+    port: Annotated[int, typer.Option(help="Port to listen on.")] = 8000,
+    dask: Annotated[str | None, typer.Option(
+        help="Run jobs on this Dask scheduler (tcp://HOST:8786); default: local "
+             "processes.")] = None,
+    token_file: Annotated[Path | None, typer.Option(
+        help="Read the write token from this file (else $SKYROUTE_TOKEN, else one is made "
+             "and printed).")] = None,
+    workers: Annotated[int, typer.Option(help="Server processes.")] = 1,
+    max_body_mb: Annotated[float, typer.Option(help="Largest request body, MB.")] = 10.0,
+    max_expansions: Annotated[int, typer.Option(
+        help="Search budget of one POST /plan.")] = 2_000_000,
+    job_queue: Annotated[int, typer.Option(help="Jobs queued or running at once.")] = 8,
+    log_level: Annotated[str, typer.Option(help="uvicorn's log level.")] = "info",
+) -> None:
+    """Serve the REST API (/docs) and the web viewer (/) with uvicorn.
+
+    Reads are open; writes need 'Authorization: Bearer TOKEN'. The token comes from
+    $SKYROUTE_TOKEN or --token-file; without either, one is made and printed once.
+    """
+    import uvicorn
+    from pydantic import ValidationError
+
+    from skyroute.service.app import SETTINGS_ENV, create_app
+    from skyroute.service.resources import make_engine
+    from skyroute.service.settings import MB, Settings
+
+    if data is not None and source is not None:
+        raise OptionError("give at most one of --data DIR and --source URL")
+    if data is not None or source is not None:
+        from skyroute.delivery.source import open_source
+
+        open_source(data, source)  # a bad folder or URL: one line now, not a 503 later
+    if not 0 < port < 65536:
+        raise OptionError(f"--port {port} must be 1..65535")
+    if workers < 1:
+        raise OptionError(f"--workers {workers} must be at least 1")
+    make_engine(db).dispose()  # the store opens and is migrated before anyone asks
+    token, where = read_token(token_file)
+    try:
+        settings = Settings(db_url=db, data_dir=data, source_url=source, dask_address=dask,
+                            max_body_bytes=int(max_body_mb * MB),
+                            max_expansions=max_expansions, job_queue=job_queue,
+                            **({"token": token} if token else {}))
+    except ValidationError as exc:  # a limit out of range
+        err = exc.errors()[0]
+        flag = {"max_body_bytes": "--max-body-mb", "job_queue": "--job-queue",
+                "max_expansions": "--max-expansions"}.get(str(err["loc"][0]) if err["loc"]
+                                                         else "", "--token-file")
+        raise OptionError(f"{flag}: {err['msg']}") from None
+    url = f"http://{host}:{port}/"
+    typer.echo(f"skyroute service on {url} (API docs {url}docs)", err=True)
+    if where == "generated":
+        typer.echo(f"write token (give it as 'Authorization: Bearer TOKEN'; set "
+                   f"{TOKEN_ENV} or --token-file to choose one):\n    {settings.token}")
+    else:
+        typer.echo(f"write token from {where}", err=True)
+    if workers == 1:
+        uvicorn.run(create_app(settings), host=host, port=port, log_level=log_level)
+    else:
+        os.environ[SETTINGS_ENV] = settings.model_dump_json()
+        uvicorn.run("skyroute.service.app:app_from_env", factory=True, workers=workers,
+                    host=host, port=port, log_level=log_level)

@@ -1,0 +1,105 @@
+"""``skyroute serve``: uvicorn in a process of its own on a free port answers /health and
+the token works; bad flags are one line and exit 2."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import time
+
+import httpx
+import pytest
+
+from tests.cli.test_cli import run
+from tests.conftest import ROOT
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def start(tmp_path, *args: str, env: dict | None = None) -> tuple[subprocess.Popen, str]:
+    port = free_port()
+    cmd = [sys.executable, "-m", "skyroute", "serve", "--port", str(port), "--db",
+           f"sqlite:///{tmp_path / 's.db'}", "--log-level", "warning", *args]
+    environ = {**os.environ, "PYTHONPATH": str(ROOT / "src"), **(env or {})}
+    if env is None:
+        environ.pop("SKYROUTE_TOKEN", None)
+    proc = subprocess.Popen(cmd, cwd=tmp_path, env=environ, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    url = f"http://127.0.0.1:{port}"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            raise AssertionError(f"serve exited {proc.returncode}: {proc.stderr.read()}")
+        try:
+            if httpx.get(url + "/health", timeout=1).status_code == 200:
+                return proc, url
+        except httpx.HTTPError:
+            time.sleep(0.2)
+    proc.kill()
+    raise AssertionError("serve did not answer /health within 60 s")
+
+
+def stop(proc: subprocess.Popen) -> tuple[str, str]:
+    proc.terminate()
+    try:
+        return proc.communicate(timeout=20)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        return proc.communicate()
+
+
+@pytest.mark.slow
+def test_serve_prints_a_generated_token_once(tmp_path):
+    proc, url = start(tmp_path)
+    try:
+        body = {"map": "den312d", "start": [50, 76], "goal": [60, 13], "geojson": False}
+        assert httpx.post(url + "/plan", json=body).status_code == 401
+        time.sleep(0.2)
+    finally:
+        out, err = stop(proc)
+    assert proc.returncode in (0, -15), err  # uvicorn re-raises SIGTERM once shut down
+    lines = out.splitlines()
+    assert "write token" in lines[0] and len(lines) == 2, out
+    token = lines[1].strip()
+    assert len(token) >= 32 and out.count(token) == 1 and token not in err
+    assert "skyroute service on http://127.0.0.1:" in err
+
+
+@pytest.mark.slow
+def test_serve_with_a_token_file_and_two_workers(tmp_path):
+    (tmp_path / "token").write_text("s3cret-token\n")
+    proc, url = start(tmp_path, "--token-file", str(tmp_path / "token"), "--workers", "2",
+                      "--data", str(ROOT / "examples" / "lunch"))
+    try:
+        body = {"map": "den312d", "start": [50, 76], "goal": [60, 13], "geojson": False}
+        ok = httpx.post(url + "/plan", json=body,
+                        headers={"Authorization": "Bearer s3cret-token"})
+        assert ok.status_code == 200 and ok.json()["status"] == "found"
+        bad = httpx.post(url + "/plan", json=body, headers={"Authorization": "Bearer x"})
+        assert bad.status_code == 403
+        assert httpx.get(url + "/site.geojson").status_code == 200
+    finally:
+        out, err = stop(proc)
+    assert "s3cret" not in out + err and "write token from" in err
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--data", "/nonexistent", "--source", "http://x"], "at most one of --data"),
+    (["--data", "/nonexistent"], "not a data folder"),
+    (["--source", "ftp://x"], "expected an http:// or https:// URL"),
+    (["--port", "0"], "--port 0 must be"),
+    (["--db", "nonsense"], "not a database URL"),
+    (["--token-file", "/nonexistent/token"], "--token-file /nonexistent/token: cannot read"),
+    (["--job-queue", "0"], "--job-queue: Input should be greater than or equal to 1"),
+])
+def test_bad_flags_are_one_line(monkeypatch, capsys, tmp_path, args, words):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("SKYROUTE_TOKEN", raising=False)
+    code, _, err = run(monkeypatch, capsys, "serve", *args)
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
