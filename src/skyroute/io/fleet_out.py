@@ -325,17 +325,7 @@ def fleet_geojson(sim: Simulation, step: float = 2.0) -> dict:
     step = _check_step("step", step)
     s = sim.scenario
     home = Home(lon=s.home_lon, lat=s.home_lat)
-    ground: list[tuple[dict, np.ndarray]] = []  # (properties, (north, east) points)
-    for a in s.airports:
-        ground.append(({"kind": "airport", "id": a.id}, np.array([[a.north, a.east]])))
-    for a in s.airports:
-        for g in (0, 1):
-            ground.append(({"kind": "gate", "airport": a.id, "gate": g},
-                           gate_position(a, g)[None]))
-    for a in s.airports:
-        for kind, rwy in (("landing", a.landing), ("takeoff", a.takeoff)):
-            ground.append(({"kind": kind, "airport": a.id, "heading_deg": rwy.heading_deg,
-                            "length_m": rwy.length}, np.array(runway_ends(a, rwy))))
+    ground = _ground(s)
     flights = []
     for f in sim.flights:
         t, pos = airborne_samples(f.plan, step, sim.horizon)
@@ -344,14 +334,8 @@ def fleet_geojson(sim: Simulation, step: float = 2.0) -> dict:
     ne = np.concatenate([g[1] for g in ground] + [pos[:, :2] for _, pos in flights])
     lonlat = np.round(ned_to_lonlat(ne[:, 0], ne[:, 1], -_alts(ground, flights), home)
                       [:, :2], 7)
-    features = []
-    i = 0
-    for props, pts in ground:
-        ll = lonlat[i:i + len(pts)].tolist()
-        i += len(pts)
-        geom = ({"type": "Point", "coordinates": ll[0]} if len(pts) == 1
-                else {"type": "LineString", "coordinates": ll})
-        features.append({"type": "Feature", "geometry": geom, "properties": props})
+    features = _ground_features(ground, lonlat)
+    i = sum(len(pts) for _, pts in ground)
     for f, pos in flights:
         ll = np.column_stack([lonlat[i:i + len(pos)], np.round(pos[:, 2], 2)]).tolist()
         i += len(pos)
@@ -367,6 +351,83 @@ def fleet_geojson(sim: Simulation, step: float = 2.0) -> dict:
                                         "depart_s": round(plan.depart, 3),
                                         "at_gate_s": round(plan.at_gate, 3)}})
     return {"type": "FeatureCollection", "features": features}
+
+
+def fleet_geojson_from_tracks(scenario, tracks_csv_text: str | bytes) -> dict:
+    """What a store keeps of a run (its scenario and ``tracks.csv``) as a FeatureCollection
+    in lon/lat: the airports, gates and runways of :func:`fleet_geojson`, and one
+    LineString (``kind`` ``track``; lon, lat, altitude) per stretch a drone is airborne in
+    the tracks, with its ``drone``, ``t0_s`` and ``t1_s``. Coarser than the run's own
+    file: the tracks' step, without package or flight plan."""
+    s = scenario
+    home = Home(lon=s.home_lon, lat=s.home_lat)
+    ground = _ground(s)
+    text = tracks_csv_text.decode() if isinstance(tracks_csv_text, bytes) else tracks_csv_text
+    rows = list(csv.reader(io.StringIO(text)))
+    if rows and tuple(rows[0]) != TRACK_HEADER:
+        raise SkyrouteError(f"tracks.csv: header {rows[0]!r}; expected {TRACK_HEADER!r}")
+    body = rows[1:]
+    t = np.array([float(r[0]) for r in body])
+    drone = np.array([int(r[1]) for r in body], dtype=np.int64)
+    pos = np.array([[float(v) for v in r[2:5]] for r in body]).reshape(-1, 3)
+    up = np.array([r[5] in ("climb", "cruise", "loiter", "approach") for r in body],
+                  dtype=bool)
+    order = np.lexsort((t, drone))
+    t, drone, pos, up = t[order], drone[order], pos[order], up[order]
+    # a stretch: consecutive airborne rows of one drone, none left out between them
+    new = np.ones(len(t), dtype=bool)
+    new[1:] = (drone[1:] != drone[:-1]) | ~up[:-1]
+    starts = np.flatnonzero(up & new)
+    stretches = []
+    for a in starts:
+        b = a
+        while b + 1 < len(t) and up[b + 1] and drone[b + 1] == drone[a]:
+            b += 1
+        if b > a:
+            stretches.append((a, b + 1))
+    ne = np.concatenate([g[1] for g in ground] + [pos[a:b, :2] for a, b in stretches])
+    alts = np.concatenate([np.zeros(len(g[1])) for g in ground]
+                          + [pos[a:b, 2] for a, b in stretches])
+    lonlat = np.round(ned_to_lonlat(ne[:, 0], ne[:, 1], -alts, home)[:, :2], 7)
+    features = _ground_features(ground, lonlat)
+    i = sum(len(pts) for _, pts in ground)
+    for a, b in stretches:
+        ll = np.column_stack([lonlat[i:i + b - a], np.round(pos[a:b, 2], 2)]).tolist()
+        i += b - a
+        features.append({"type": "Feature",
+                         "geometry": {"type": "LineString", "coordinates": ll},
+                         "properties": {"kind": "track", "drone": int(drone[a]),
+                                        "t0_s": float(t[a]), "t1_s": float(t[b - 1])}})
+    return {"type": "FeatureCollection", "features": features}
+
+
+def _ground(s) -> list[tuple[dict, np.ndarray]]:
+    """(properties, (north, east) points) of the airports, gates and runways."""
+    ground: list[tuple[dict, np.ndarray]] = []
+    for a in s.airports:
+        ground.append(({"kind": "airport", "id": a.id}, np.array([[a.north, a.east]])))
+    for a in s.airports:
+        for g in (0, 1):
+            ground.append(({"kind": "gate", "airport": a.id, "gate": g},
+                           gate_position(a, g)[None]))
+    for a in s.airports:
+        for kind, rwy in (("landing", a.landing), ("takeoff", a.takeoff)):
+            ground.append(({"kind": kind, "airport": a.id, "heading_deg": rwy.heading_deg,
+                            "length_m": rwy.length}, np.array(runway_ends(a, rwy))))
+    return ground
+
+
+def _ground_features(ground, lonlat: np.ndarray) -> list[dict]:
+    """The ground features, their points taken in order from the start of ``lonlat``."""
+    features = []
+    i = 0
+    for props, pts in ground:
+        ll = lonlat[i:i + len(pts)].tolist()
+        i += len(pts)
+        geom = ({"type": "Point", "coordinates": ll[0]} if len(pts) == 1
+                else {"type": "LineString", "coordinates": ll})
+        features.append({"type": "Feature", "geometry": geom, "properties": props})
+    return features
 
 
 def _alts(ground, flights) -> np.ndarray:

@@ -63,6 +63,38 @@ def _as_dict(value) -> dict:
     return dict(value or {})
 
 
+def _text(run: dict, *keys: str) -> str:
+    """A stored file's text under the first of ``keys`` the store uses."""
+    for k in keys:
+        v = run.get(k)
+        if v is not None:
+            return v.decode() if isinstance(v, bytes | bytearray | memoryview) \
+                else str(v)
+    return ""
+
+
+def _scenario(run: dict) -> dict:
+    """The run's scenario as an object: stored whole, in its parameters, or a preset's
+    name."""
+    sc = run.get("scenario")
+    if isinstance(sc, dict):
+        return sc
+    params = _as_dict(run.get("params"))
+    if isinstance(params.get("scenario"), dict):
+        return params["scenario"]
+    name = params.get("preset") or sc
+    if isinstance(name, str):
+        from skyroute.fleet.scenario import PRESETS, preset
+
+        if name in PRESETS:
+            return preset(name).model_dump(mode="json")
+        try:
+            return json.loads(name)
+        except ValueError:
+            pass
+    return {}
+
+
 @router.get("/fleet/runs", response_model=list[RunSummary], responses=responses(503),
             summary="Stored fleet runs")
 def list_runs(res: ResourcesDep) -> list[dict]:
@@ -70,8 +102,9 @@ def list_runs(res: ResourcesDep) -> list[dict]:
     for r in _store().list_fleet_runs(res.engine()):
         sc = r.get("scenario")
         name = sc.get("name") if isinstance(sc, dict) else sc
-        out.append({"id": str(r["id"]), "scenario": name, "params": r.get("params"),
-                    "report": r.get("report")})
+        out.append({"id": str(r["id"]), "scenario": name,
+                    "params": _as_dict(r.get("params")),
+                    "report": _as_dict(r.get("report"))})
     return out
 
 
@@ -81,11 +114,11 @@ def get_run(run_id: RunId, res: ResourcesDep,
             offset: Annotated[int, Query(ge=0)] = 0,
             limit: Annotated[int, Query(ge=1, le=10_000)] = 1000) -> dict:
     run = _run(res, run_id)
-    lines = (run.get("events") or "").splitlines()
+    lines = _text(run, "events", "events_jsonl").splitlines()
     page = [json.loads(x) for x in lines[offset:offset + limit]]
     base = f"/fleet/runs/{run_id}"
     return {"id": str(run["id"]), "report": _as_dict(run.get("report")),
-            "scenario": _as_dict(run.get("scenario")), "params": run.get("params"),
+            "scenario": _scenario(run), "params": _as_dict(run.get("params")),
             "events": page, "offset": offset, "limit": limit, "events_total": len(lines),
             "files": {k: f"{base}/{k}" for k in ("events.jsonl", "tracks.csv",
                                                  "fleet.geojson")}}
@@ -100,7 +133,7 @@ def _file(content: str, media_type: str, name: str) -> Response:
             responses={200: {"content": {"application/x-ndjson": {}}}, **responses(404, 503)},
             summary="A fleet run's events, one JSON object a line")
 def get_events(run_id: RunId, res: ResourcesDep) -> Response:
-    return _file(_run(res, run_id).get("events") or "", "application/x-ndjson",
+    return _file(_text(_run(res, run_id), "events", "events_jsonl"), "application/x-ndjson",
                  "events.jsonl")
 
 
@@ -108,7 +141,7 @@ def get_events(run_id: RunId, res: ResourcesDep) -> Response:
             responses={200: {"content": {"text/csv": {}}}, **responses(404, 503)},
             summary="A fleet run's tracks (one row per drone and time step)")
 def get_tracks(run_id: RunId, res: ResourcesDep) -> Response:
-    return _file(_run(res, run_id).get("tracks") or "", "text/csv", "tracks.csv")
+    return _file(_text(_run(res, run_id), "tracks", "tracks_csv"), "text/csv", "tracks.csv")
 
 
 @router.get("/fleet/runs/{run_id}/fleet.geojson", response_class=Response,
@@ -117,24 +150,12 @@ def get_tracks(run_id: RunId, res: ResourcesDep) -> Response:
             summary="A fleet run's airports, runways and tracks in lon/lat")
 def get_geojson(run_id: RunId, res: ResourcesDep) -> Response:
     run = _run(res, run_id)
-    text = run.get("geojson")
-    if text is None:
-        text = _fleet_geojson(run)
-    return _file(text if isinstance(text, str) else json.dumps(text),
-                 "application/geo+json", "fleet.geojson")
+    text = _text(run, "fleet_geojson", "geojson")
+    if not text:
+        from skyroute.fleet.scenario import parse_scenario
+        from skyroute.io.fleet_out import fleet_geojson_from_tracks
 
-
-def _fleet_geojson(run: dict) -> str:
-    """The run's fleet.geojson rebuilt from what the store keeps (scenario and tracks),
-    when the store does not keep the file itself."""
-    import io
-
-    import numpy as np
-
-    from skyroute.fleet.scenario import parse_scenario
-    from skyroute.io.fleet_out import fleet_geojson_from_tracks
-
-    scenario = parse_scenario(_as_dict(run.get("scenario")), "scenario")
-    table = np.genfromtxt(io.StringIO(run.get("tracks") or ""), delimiter=",", names=True,
-                          dtype=None, encoding="utf-8")
-    return json.dumps(fleet_geojson_from_tracks(scenario, table))
+        scenario = parse_scenario(_scenario(run), "scenario")
+        text = json.dumps(fleet_geojson_from_tracks(scenario, _text(run, "tracks",
+                                                                    "tracks_csv")))
+    return _file(text, "application/geo+json", "fleet.geojson")

@@ -42,7 +42,7 @@ class DeliverJob(BaseModel):
     @model_validator(mode="after")
     def _days(self) -> DeliverJob:
         ranged = self.from_ is not None or self.to is not None
-        if (self.date is None) == ranged or (ranged and (self.from_ is None or self.to is None)):
+        if (self.date is not None) == ranged or (ranged and None in (self.from_, self.to)):
             raise ValueError("give date, or both from and to")
         if ranged and self.to < self.from_:
             raise ValueError(f"to {self.to} is before from {self.from_}")
@@ -128,8 +128,8 @@ def post_deliver(body: DeliverJob, res: ResourcesDep):
     s = res.settings
     first, last = (body.date, body.date) if body.date else (body.from_, body.to)
     params = {"from": first.isoformat(), "to": last.isoformat(), "method": body.method,
-              "db": s.db_url, "data": None if s.data_dir is None else str(s.data_dir),
-              "source": s.source_url}
+              **({"data": str(s.data_dir)} if s.data_dir is not None else
+                 {"source": s.source_url})}
     return _submit(res, "deliver", params)
 
 
@@ -153,9 +153,11 @@ def post_fleet(body: FleetJob, res: ResourcesDep):
                           ) from None
     else:
         scenario = preset(body.preset)
-    params = {"scenario": scenario.model_dump(mode="json"), "preset": body.preset,
+    params = {**({"preset": body.preset} if body.preset else
+                 {"scenario": scenario.model_dump(mode="json")}),
               "hours": body.hours, "seed": body.seed, "scheduler": body.scheduler,
-              "airspace": body.airspace, "rate": body.rate}
+              **({"airspace": body.airspace} if body.airspace else {}),
+              **({"rate_per_hour": body.rate} if body.rate is not None else {})}
     return _submit(res, "fleet", params)
 
 

@@ -1,0 +1,281 @@
+"""Jobs and fleet runs through the service. The routers are checked here against a
+stand-in for ``skyroute.jobs`` (its interface: ``runner.submit/get``,
+``executor.open_executor``, ``store.get_fleet_run/list_fleet_runs``) so they are tested
+whether or not that package is installed; the tests marked ``needs_jobs`` run the real
+jobs and skip while it is missing."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+import time
+import types
+import uuid
+
+import pytest
+
+from tests.service.conftest import AUTH, DAY, EXAMPLE, make_client
+from tests.service.test_app import assert_problem
+
+HAVE_JOBS = importlib.util.find_spec("skyroute.jobs") is not None
+needs_jobs = pytest.mark.skipif(not HAVE_JOBS, reason="skyroute.jobs is not installed "
+                                "(branch jobs not merged yet)")
+
+
+# -- a stand-in for skyroute.jobs -------------------------------------------------------
+class FakeJobs:
+    def __init__(self):
+        self.jobs: dict[str, dict] = {}
+        self.runs: dict[str, dict] = {}
+        self.submitted: list[tuple[str, dict]] = []
+
+    def install(self, monkeypatch):
+        pkg = types.ModuleType("skyroute.jobs")
+        runner = types.ModuleType("skyroute.jobs.runner")
+        store = types.ModuleType("skyroute.jobs.store")
+        executor = types.ModuleType("skyroute.jobs.executor")
+        runner.submit = self.submit
+        runner.get = lambda engine, i: self.jobs.get(i)
+        store.get_fleet_run = lambda engine, i: self.runs.get(i)
+        store.list_fleet_runs = lambda engine: list(self.runs.values())
+        executor.open_executor = lambda kind="local", address=None, workers=None: \
+            types.SimpleNamespace(kind=kind, close=lambda: None)
+        for name, mod in (("skyroute.jobs", pkg), ("skyroute.jobs.runner", runner),
+                          ("skyroute.jobs.store", store), ("skyroute.jobs.executor", executor)):
+            monkeypatch.setitem(sys.modules, name, mod)
+        pkg.runner, pkg.store, pkg.executor = runner, store, executor
+        return self
+
+    def submit(self, engine, kind, params, *, executor):
+        from skyroute.errors import OptionError
+
+        if params.get("hours") == 23.5:
+            raise OptionError("hours=23.5 is refused by the runner", param="hours")
+        i = str(uuid.uuid4())
+        self.submitted.append((kind, params))
+        self.jobs[i] = {"id": i, "kind": kind, "state": "queued", "progress": 0.0,
+                        "result": None, "error": None}
+        return i
+
+
+@pytest.fixture
+def fake(monkeypatch):
+    return FakeJobs().install(monkeypatch)
+
+
+@pytest.fixture
+def site_client(tmp_path):
+    with make_client(db_url=f"sqlite:///{tmp_path / 'j.db'}", data_dir=EXAMPLE,
+                     job_queue=2) as c:
+        yield c
+
+
+def test_deliver_job_is_202_with_an_id(site_client, fake):
+    r = site_client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH)
+    assert r.status_code == 202 and r.headers["location"] == f"/jobs/{r.json()['id']}"
+    assert fake.submitted[-1] == ("deliver", {"from": DAY, "to": DAY, "method": "milp",
+                                              "data": str(EXAMPLE)})
+    r = site_client.post("/jobs/deliver", json={"from": "2024-01-01", "to": "2024-01-02",
+                                                "method": "greedy"}, headers=AUTH)
+    assert r.status_code == 202
+    assert fake.submitted[-1][1]["from"] == "2024-01-01"
+    job = site_client.get(f"/jobs/{r.json()['id']}").json()
+    assert job == {"id": r.json()["id"], "kind": "deliver", "state": "queued",
+                   "progress": 0.0, "result": None, "error": None}
+
+
+def test_the_queue_limit_is_429_until_a_job_ends(site_client, fake):
+    ids = [site_client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH).json()["id"]
+           for _ in range(2)]
+    r = site_client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH)
+    assert_problem(r, 429, words="2 jobs are queued or running")
+    assert r.headers["retry-after"] == "10"
+    fake.jobs[ids[0]].update(state="done", progress=1.0, result={"days": 1})
+    assert site_client.post("/jobs/deliver", json={"date": DAY},
+                            headers=AUTH).status_code == 202
+    done = site_client.get(f"/jobs/{ids[0]}").json()
+    assert done["state"] == "done" and done["result"] == {"days": 1}
+
+
+def test_fleet_job_params(site_client, fake):
+    r = site_client.post("/jobs/fleet", json={"preset": "seed-3x3", "hours": 0.5, "seed": 4,
+                                              "scheduler": "optimal", "rate": 30},
+                         headers=AUTH)
+    assert r.status_code == 202
+    assert fake.submitted[-1] == ("fleet", {"preset": "seed-3x3", "hours": 0.5, "seed": 4,
+                                            "scheduler": "optimal", "rate_per_hour": 30.0})
+    from skyroute.fleet.scenario import preset
+
+    scenario = preset("seed-3x3").model_dump(mode="json")
+    r = site_client.post("/jobs/fleet", json={"scenario": scenario, "airspace": "shared"},
+                         headers=AUTH)
+    assert r.status_code == 202
+    kind, params = fake.submitted[-1]
+    assert params["scenario"] == scenario and params["airspace"] == "shared"
+
+
+@pytest.mark.parametrize("path, body, field, words", [
+    ("/jobs/deliver", {}, "body", "give date, or both from and to"),
+    ("/jobs/deliver", {"date": DAY, "from": DAY}, "body", "give date, or both"),
+    ("/jobs/deliver", {"from": "2024-01-02", "to": "2024-01-01"}, "body", "is before from"),
+    ("/jobs/deliver", {"date": "2024-02-30"}, "date", "date"),
+    ("/jobs/deliver", {"date": DAY, "method": "magic"}, "method", "'milp'"),
+    ("/jobs/deliver", {"date": DAY, "jobs": 4}, "jobs", "Extra inputs"),
+    ("/jobs/fleet", {}, "body", "exactly one of preset and scenario"),
+    ("/jobs/fleet", {"preset": "seed-2x2"}, "preset", "'seed-3x3'"),
+    ("/jobs/fleet", {"preset": "seed-3x3", "hours": 0}, "hours", "greater than 0"),
+    ("/jobs/fleet", {"preset": "seed-3x3", "hours": 100}, "hours", "less than or equal"),
+    ("/jobs/fleet", {"preset": "seed-3x3", "seed": -1}, "seed", "greater than or equal"),
+    ("/jobs/fleet", {"preset": "seed-3x3", "scheduler": "fifo"}, "scheduler", "'seed'"),
+    ("/jobs/fleet", {"scenario": {"drones": 2}}, "scenario.airports", "Field required"),
+    ("/jobs/fleet", {"scenario": {"airports": [], "drones": 2, "packages": {
+        "csv": "/etc/passwd"}}}, "scenario.packages.csv", "cannot name a file"),
+    ("/jobs/fleet", {"preset": "seed-3x3", "hours": 23.5}, "hours", "refused by the runner"),
+])
+def test_bad_job_input_is_422(site_client, fake, path, body, field, words):
+    assert_problem(site_client.post(path, json=body, headers=AUTH), 422, field, words)
+
+
+def test_unknown_job_is_404(site_client, fake):
+    assert_problem(site_client.get("/jobs/nope"), 404, words="no job 'nope'")
+
+
+def test_a_deliver_job_needs_a_site(client, fake):
+    assert_problem(client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH), 404,
+                   words="no delivery site")
+
+
+@pytest.mark.skipif(HAVE_JOBS, reason="skyroute.jobs is installed")
+def test_without_the_jobs_package_jobs_are_503(site_client):
+    assert_problem(site_client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH), 503,
+                   words="skyroute.jobs is missing")
+    assert_problem(site_client.get("/jobs/x"), 503)
+    assert_problem(site_client.get("/fleet/runs"), 503)
+
+
+# -- fleet runs against the stand-in store, filled by a real run ------------------------
+@pytest.fixture(scope="module")
+def small_run():
+    from skyroute.fleet.report import report
+    from skyroute.fleet.scenario import preset
+    from skyroute.fleet.simulate import run
+    from skyroute.io.fleet_out import events_jsonl, fleet_geojson, tracks_csv
+
+    sim = run(preset("seed-3x3"), hours=0.25, seed=1)
+    return {"sim": sim, "report": report(sim), "events": events_jsonl(sim),
+            "tracks": tracks_csv(sim).decode(), "geojson": fleet_geojson(sim)}
+
+
+@pytest.mark.parametrize("layout", ["brief", "store"])
+def test_fleet_run_pages_and_files(client, fake, small_run, layout):
+    rid = "run-1"
+    if layout == "brief":  # the keys of the interface the service was built against
+        from skyroute.fleet.scenario import preset
+
+        fake.runs[rid] = {"id": rid, "scenario": preset("seed-3x3").model_dump(mode="json"),
+                          "params": {"preset": "seed-3x3", "hours": 0.25, "seed": 1},
+                          "report": small_run["report"], "events": small_run["events"],
+                          "tracks": small_run["tracks"]}
+    else:  # the jobs branch's store: files under their names, the scenario by name
+        fake.runs[rid] = {"id": rid, "scenario": "seed-3x3",
+                          "params": {"preset": "seed-3x3", "hours": 0.25, "seed": 1},
+                          "report": small_run["report"],
+                          "events_jsonl": small_run["events"],
+                          "tracks_csv": small_run["tracks"].encode(),
+                          "fleet_geojson": json.dumps(small_run["geojson"])}
+    runs = client.get("/fleet/runs").json()
+    assert runs[0]["id"] == rid and runs[0]["scenario"] == "seed-3x3"
+    lines = small_run["events"].splitlines()
+    doc = client.get(f"/fleet/runs/{rid}?offset=3&limit=5").json()
+    assert doc["events"] == [json.loads(x) for x in lines[3:8]]
+    assert doc["events_total"] == len(lines) and doc["report"] == json.loads(
+        json.dumps(small_run["report"]))
+    assert doc["scenario"]["name"] == "seed-3x3" and len(doc["scenario"]["airports"]) == 3
+    assert client.get(f"/fleet/runs/{rid}").json()["events"] == \
+        [json.loads(x) for x in lines[:1000]]
+    ev = client.get(doc["files"]["events.jsonl"])
+    assert ev.text == small_run["events"] and ev.headers["content-type"].startswith(
+        "application/x-ndjson")
+    tr = client.get(doc["files"]["tracks.csv"])
+    assert tr.text == small_run["tracks"] and tr.headers["content-type"].startswith(
+        "text/csv")
+    gj = client.get(doc["files"]["fleet.geojson"]).json()
+    kinds = [f["properties"]["kind"] for f in gj["features"]]
+    assert kinds.count("airport") == 3 and kinds.count("gate") == 6
+    flights = [f for f in small_run["geojson"]["features"]
+               if f["properties"]["kind"] in ("delivery", "reposition")]
+    assert len(gj["features"]) == len(small_run["geojson"]["features"])
+    if layout == "store":
+        assert gj == small_run["geojson"]
+    else:  # rebuilt from the tracks: one airborne stretch per flight
+        assert sum(k == "track" for k in kinds) == len(flights)
+
+
+@pytest.mark.parametrize("query, field", [("offset=-1", "offset"), ("limit=0", "limit"),
+                                          ("limit=100000", "limit")])
+def test_fleet_run_paging_is_checked(client, fake, query, field):
+    fake.runs["r"] = {"id": "r", "scenario": "seed-3x3", "params": {}, "report": {},
+                      "events_jsonl": ""}
+    assert_problem(client.get(f"/fleet/runs/r?{query}"), 422, field)
+
+
+@pytest.mark.parametrize("suffix", ["", "/events.jsonl", "/tracks.csv", "/fleet.geojson"])
+def test_unknown_fleet_run_is_404(client, fake, suffix):
+    assert_problem(client.get(f"/fleet/runs/nope{suffix}"), 404, words="no fleet run")
+
+
+# -- the real jobs -------------------------------------------------------------------
+def wait(c, job_id: str, timeout: float = 600) -> dict:
+    end = time.monotonic() + timeout
+    seen = set()
+    while time.monotonic() < end:
+        job = c.get(f"/jobs/{job_id}").json()
+        seen.add(job["state"])
+        assert 0 <= job["progress"] <= 1
+        if job["state"] in ("done", "failed"):
+            job["seen"] = seen
+            return job
+        time.sleep(0.1)
+    raise AssertionError(f"job {job_id} did not end in {timeout} s")
+
+
+@needs_jobs
+@pytest.mark.slow
+def test_a_delivery_job_stores_the_clis_rows(tmp_path, lunch):
+    import datetime as dt
+
+    from skyroute.delivery.days import open_store
+    from skyroute.delivery.orders import read_csv_orders
+    from skyroute.delivery.store import day_rows, import_orders, init
+
+    db = f"sqlite:///{tmp_path / 'job.db'}"
+    eng = open_store(db)
+    init(eng)
+    import_orders(eng, read_csv_orders(EXAMPLE))
+    with make_client(db_url=db, data_dir=EXAMPLE, job_workers=1) as c:
+        r = c.post("/jobs/deliver", json={"date": DAY}, headers=AUTH)
+        assert r.status_code == 202, r.text
+        job = wait(c, r.json()["id"])
+        assert job["state"] == "done", job
+        assert c.get("/days").json()[0]["date"] == DAY
+    cli = open_store(lunch[0])
+    d = dt.date.fromisoformat(DAY)
+    assert day_rows(eng, d) == day_rows(cli, d)
+
+
+@needs_jobs
+@pytest.mark.slow
+def test_a_fleet_job_stores_a_run(tmp_path, small_run):
+    with make_client(db_url=f"sqlite:///{tmp_path / 'f.db'}", job_workers=1) as c:
+        r = c.post("/jobs/fleet", json={"preset": "seed-3x3", "hours": 0.25, "seed": 1},
+                   headers=AUTH)
+        assert r.status_code == 202, r.text
+        job = wait(c, r.json()["id"])
+        assert job["state"] == "done", job
+        runs = c.get("/fleet/runs").json()
+        assert len(runs) == 1
+        doc = c.get(f"/fleet/runs/{runs[0]['id']}").json()
+        assert c.get(doc["files"]["events.jsonl"]).text == small_run["events"]
+        assert c.get(doc["files"]["tracks.csv"]).text == small_run["tracks"]
+        assert c.get(doc["files"]["fleet.geojson"]).status_code == 200
