@@ -111,7 +111,7 @@ def test_fleet_job_params(site_client, fake):
     r = site_client.post("/jobs/fleet", json={"scenario": scenario, "airspace": "shared"},
                          headers=AUTH)
     assert r.status_code == 202
-    kind, params = fake.submitted[-1]
+    _, params = fake.submitted[-1]
     assert params["scenario"] == scenario and params["airspace"] == "shared"
 
 
