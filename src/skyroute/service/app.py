@@ -41,6 +41,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.settings = settings
     app.state.resources = Resources(settings)
     problems.install(app)
+    problems.document(app)
     for module in (health, maps, days, orders, site, plan, jobs, fleet):
         app.include_router(module.router)
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)

@@ -144,7 +144,42 @@ def install(app: FastAPI) -> None:
 
 
 def responses(*codes: int) -> dict:
-    """OpenAPI ``responses=`` entries for these error codes."""
-    return {c: {"model": ProblemDoc, "description": TITLES.get(c, "error"),
-                "content": {MEDIA_TYPE: {"schema": {"$ref": "#/components/schemas/ProblemDoc"}}}}
-            for c in codes}
+    """OpenAPI ``responses=`` entries for these error codes (their media type is set to
+    problem+json by :func:`document`)."""
+    return {c: {"model": ProblemDoc, "description": TITLES.get(c, "error")} for c in codes}
+
+
+def document(app: FastAPI) -> None:
+    """Make ``app``'s OpenAPI say what the handlers do: every error response is
+    ``application/problem+json`` with :class:`ProblemDoc` (FastAPI documents its 422 as
+    JSON of its own shape), an operation with inputs documents 422, and a write 413."""
+    from fastapi.openapi.utils import get_openapi
+
+    def openapi() -> dict:
+        if app.openapi_schema:
+            return app.openapi_schema
+        spec = get_openapi(title=app.title, version=app.version,
+                           description=app.description, routes=app.routes)
+        schemas = spec.setdefault("components", {}).setdefault("schemas", {})
+        schemas["ProblemDoc"] = ProblemDoc.model_json_schema(
+            ref_template="#/components/schemas/{model}")
+        for name, sub in schemas["ProblemDoc"].pop("$defs", {}).items():
+            schemas[name] = sub
+        for name in ("HTTPValidationError", "ValidationError"):
+            schemas.pop(name, None)
+        problem = {MEDIA_TYPE: {"schema": {"$ref": "#/components/schemas/ProblemDoc"}}}
+        for ops in spec.get("paths", {}).values():
+            for method, op in ops.items():
+                codes = op.setdefault("responses", {})
+                if op.get("parameters") or op.get("requestBody"):
+                    codes.setdefault("422", {})
+                if method in ("post", "put", "patch"):
+                    codes.setdefault("413", {})
+                for code, resp in codes.items():
+                    if code[0] in "45":
+                        resp["description"] = TITLES.get(int(code), "error")
+                        resp["content"] = problem
+        app.openapi_schema = spec
+        return spec
+
+    app.openapi = openapi

@@ -18,6 +18,7 @@ from skyroute.service.resources import EngineDep, Resources, ResourcesDep
 router = APIRouter(tags=["days"])
 GEOJSON = "application/geo+json"
 
+LonLat = Annotated[list[float], Field(min_length=2, max_length=2)]
 DayDate = Annotated[dt.date, Path(description="The day, YYYY-MM-DD.")]
 
 
@@ -72,8 +73,8 @@ class DayOrder(BaseModel):
     value: int | None = Field(description="Pence: the delivery's cost, or the priced order "
                               "where the site is known.")
     reason: str | None = None
-    lonlat: tuple[float, float] | None = Field(None, description="The customer's place "
-                                               "where the site is known.")
+    lonlat: LonLat | None = Field(None, description="The customer's place where the site "
+                                  "is known.")
 
 
 class Day(BaseModel):

@@ -27,6 +27,7 @@ Algorithm = Literal["astar", "dijkstra", "bfs", "jps", "theta", "lazy_theta", "v
                     "prm"]
 Number = Annotated[float, Field(allow_inf_nan=False)]
 Point = tuple[Number, Number]
+Pair = Annotated[list[float], Field(min_length=2, max_length=2)]
 
 
 class PlanRequest(BaseModel):
@@ -89,7 +90,7 @@ class PlanAnswer(BaseModel):
     status: Literal["found", "no_path", "budget_exhausted"]
     cost: float | None = Field(description="Path length (cells on a map, world units on a "
                                "world); null unless found.")
-    path: list[tuple[float, float]] = Field(description="Cells (x, y) on a map; points in "
+    path: list[Pair] = Field(description="Cells (x, y) on a map; points in "
                                             "the frame on a world.")
     expanded: int
     max_frontier: int
@@ -98,7 +99,7 @@ class PlanAnswer(BaseModel):
     algorithm: str
     max_expansions: int | None = Field(description="The budget the search ran with (null "
                                        "for PRM, bounded by its samples instead).")
-    path_lonlat: list[tuple[float, float]] | None = None
+    path_lonlat: list[Pair] | None = None
     frame: str | None = None
     waypoints: list[list[float]] | None = Field(
         None, description="Worlds: [north, east, altitude, heading] per point (FCND).")
