@@ -8,6 +8,7 @@ from rich.table import Table
 
 from skyroute.cli import (
     bench_fleet_cmd,  # noqa: F401  (registers 'bench fleet')
+    bench_service_cmd,  # noqa: F401  (registers 'bench service')
     bench_world_cmd,  # noqa: F401  (registers 'bench world')
 )
 from skyroute.cli.bench_cmd import bench_app

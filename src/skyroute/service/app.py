@@ -44,8 +44,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     problems.document(app)
     for module in (health, maps, days, orders, site, plan, jobs, fleet):
         app.include_router(module.router)
+    app.add_middleware(ServerTiming)  # inside the body limit: the body is in hand
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
-    app.add_middleware(ServerTiming)
     app.mount("/", StaticFiles(directory=STATIC, html=True), name="static")
     return app
 

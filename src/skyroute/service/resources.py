@@ -114,16 +114,13 @@ class Resources:
         self._executor = self._engine = None
 
 
-def resources(request: Request) -> Resources:
+async def resources(request: Request) -> Resources:
+    """(async: a sync dependency would cost a trip through the thread pool)"""
     return request.app.state.resources
 
 
 def engine(request: Request) -> sa.Engine:
-    return resources(request).engine()
-
-
-def site(request: Request) -> Site:
-    return resources(request).site()
+    return request.app.state.resources.engine()
 
 
 ResourcesDep = Annotated[Resources, Depends(resources)]

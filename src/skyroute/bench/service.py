@@ -1,0 +1,207 @@
+"""``skyroute bench service``: the REST service under load on 127.0.0.1.
+
+The server is ``skyroute serve`` in a process of its own (uvicorn, ``workers``
+processes); the load comes from one asyncio process of ``clients`` concurrent httpx
+clients, each sending its next request as soon as the last one is answered (a closed
+loop). Two loads:
+
+- ``plan``: ``POST /plan`` on a bundled map with queries drawn (seeded) from the map's
+  MovingAI scenario file, A* by default;
+- ``flightpath``: ``GET /days/{date}/flightpath.geojson`` of a stored day.
+
+Server-side time is the app's own ``Server-Timing: app;dur=`` (from the request reaching
+the app to its response headers; for ``/plan`` also ``wait`` for the search slot and
+``plan``, the search and its JSON). Client latency adds the network stack, uvicorn's
+parsing and the client's own queueing on a shared machine.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import re
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from skyroute.errors import SkyrouteError
+
+TOKEN = "bench-service-token"
+_TIMING = re.compile(r"(\w+);dur=([0-9.]+)")
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Server:
+    """``skyroute serve`` on a free port of 127.0.0.1, until ``stop()``."""
+
+    def __init__(self, *, db: str, workers: int = 1, data: Path | None = None,
+                 max_expansions: int | None = None) -> None:
+        self.port = free_port()
+        self.url = f"http://127.0.0.1:{self.port}"
+        cmd = [sys.executable, "-m", "skyroute", "serve", "--port", str(self.port), "--db",
+               db, "--workers", str(workers), "--log-level", "warning"]
+        if data is not None:
+            cmd += ["--data", str(data)]
+        if max_expansions is not None:
+            cmd += ["--max-expansions", str(max_expansions)]
+        env = {**os.environ, "SKYROUTE_TOKEN": TOKEN}
+        self.proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
+                                     stderr=subprocess.PIPE, text=True)
+        self._wait()
+
+    def _wait(self, timeout: float = 120.0) -> None:
+        import httpx
+
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if self.proc.poll() is not None:
+                raise SkyrouteError("the server did not start: "
+                                    + (self.proc.stderr.read().strip().splitlines() or
+                                       ["(no message)"])[-1])
+            try:
+                if httpx.get(self.url + "/health", timeout=1).status_code == 200:
+                    return
+            except httpx.HTTPError:
+                time.sleep(0.2)
+        self.stop()
+        raise SkyrouteError(f"the server did not answer /health within {timeout:g} s")
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(20)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+    def __enter__(self) -> Server:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+
+def _timings(header: str | None) -> dict[str, float]:
+    return {k: float(v) for k, v in _TIMING.findall(header or "")}
+
+
+async def _load(url: str, requests: list[tuple[str, str, dict | None]], clients: int,
+                headers: dict) -> tuple[list[dict], float]:
+    """Send every request, ``clients`` at a time (closed loop); (one record per request,
+    wall seconds)."""
+    import httpx
+
+    records: list[dict] = []
+    queue = iter(requests)
+    limits = httpx.Limits(max_connections=clients, max_keepalive_connections=clients)
+
+    async def client(http: httpx.AsyncClient) -> None:
+        for method, path, body in queue:
+            t0 = time.perf_counter()
+            try:
+                r = await http.request(method, path, json=body)
+                await r.aread()
+                rec = {"status": r.status_code, "client_ms": (time.perf_counter() - t0) * 1e3,
+                       **_timings(r.headers.get("server-timing")), "bytes": len(r.content)}
+            except httpx.HTTPError as exc:
+                rec = {"status": 0, "error": type(exc).__name__,
+                       "client_ms": (time.perf_counter() - t0) * 1e3}
+            records.append(rec)
+
+    async with httpx.AsyncClient(base_url=url, headers=headers, limits=limits,
+                                 timeout=60.0) as http:
+        t0 = time.perf_counter()
+        await asyncio.gather(*(client(http) for _ in range(clients)))
+        wall = time.perf_counter() - t0
+    return records, wall
+
+
+def _summary(records: list[dict], wall: float) -> dict:
+    ok = [r for r in records if r["status"] == 200]
+
+    def pct(key: str) -> dict:
+        v = np.array([r[key] for r in ok if key in r])
+        if not len(v):
+            return {}
+        return {f"{key}_p50": float(np.percentile(v, 50)),
+                f"{key}_p99": float(np.percentile(v, 99)),
+                f"{key}_max": float(v.max())}
+
+    out = {"requests": len(records), "errors": len(records) - len(ok), "wall_seconds": wall,
+           "requests_per_second": len(records) / wall if wall else 0.0}
+    for key in ("app", "wait", "plan", "client_ms"):
+        out.update(pct(key))
+    statuses: dict[int, int] = {}
+    for r in records:
+        statuses[r["status"]] = statuses.get(r["status"], 0) + 1
+    out["statuses"] = statuses
+    return out
+
+
+def plan_queries(map_name: str, n: int, *, seed: int = 0,
+                 algorithm: str = "astar") -> list[dict]:
+    """``n`` POST /plan bodies: scenario lines of ``map_name`` drawn uniformly (seeded)."""
+    from skyroute.world.load import bundled_maps
+    from skyroute.world.movingai import read_scen
+
+    maps = bundled_maps()
+    if map_name not in maps:
+        raise SkyrouteError(f"map={map_name!r} is not a bundled map; choose one of "
+                            + ", ".join(repr(m) for m in maps), param="map")
+    scen = read_scen(str(maps[map_name]) + ".scen")
+    rows = np.random.default_rng(seed).integers(0, len(scen), n)
+    return [{"map": map_name, "start": scen.starts[i].tolist(),
+             "goal": scen.goals[i].tolist(), "algorithm": algorithm, "geojson": False}
+            for i in rows]
+
+
+def bench_plan(*, map_name: str = "Paris_1_512", clients: int = 50, requests: int = 2000,
+               warmup: int = 100, workers: int = 1, seed: int = 0, algorithm: str = "astar",
+               db: str | None = None) -> dict:
+    """POST /plan under load: the summary (server-side ``app``, ``wait``, ``plan`` and
+    client latency percentiles in ms, requests/s, errors)."""
+    import tempfile
+
+    queries = plan_queries(map_name, warmup + requests, seed=seed, algorithm=algorithm)
+    auth = {"Authorization": f"Bearer {TOKEN}"}
+    with tempfile.TemporaryDirectory() as tmp, \
+            Server(db=db or f"sqlite:///{Path(tmp) / 'bench.db'}", workers=workers) as srv:
+        asyncio.run(_load(srv.url, [("POST", "/plan", q) for q in queries[:warmup]],
+                          min(clients, 8), auth))
+        records, wall = asyncio.run(_load(
+            srv.url, [("POST", "/plan", q) for q in queries[warmup:]], clients, auth))
+    return {"load": "POST /plan", "map": map_name, "algorithm": algorithm,
+            "clients": clients, "workers": workers, **_summary(records, wall)}
+
+
+def bench_flightpath(*, db: str, date: str | None = None, clients: int = 50,
+                     requests: int = 5000, warmup: int = 200, workers: int = 1) -> dict:
+    """GET /days/{date}/flightpath.geojson under load (the first stored day unless
+    ``date``): the summary, as :func:`bench_plan`'s."""
+    import httpx
+
+    with Server(db=db, workers=workers) as srv:
+        days = httpx.get(srv.url + "/days", timeout=30).json()
+        if date is None:
+            flown = [d["date"] for d in days if d["moves"]]
+            if not flown:
+                raise SkyrouteError(f"db={db}: no day with moves stored; fly one first, "
+                                    "e.g. 'skyroute deliver 2024-01-03 --data "
+                                    "examples/lunch --db URL'", param="db")
+            date = flown[0]
+        path = f"/days/{date}/flightpath.geojson"
+        asyncio.run(_load(srv.url, [("GET", path, None)] * warmup, min(clients, 8), {}))
+        records, wall = asyncio.run(_load(srv.url, [("GET", path, None)] * requests,
+                                          clients, {}))
+    return {"load": f"GET {path}", "clients": clients, "workers": workers,
+            **_summary(records, wall)}

@@ -1,0 +1,80 @@
+"""``skyroute bench service``: the REST service under concurrent load on 127.0.0.1."""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from skyroute.cli.bench_cmd import bench_app
+from skyroute.errors import OptionError, check_choice
+from skyroute.files import write_atomic
+
+LOADS = ("plan", "flightpath")
+
+
+@bench_app.command("service")
+def bench_service(
+    load: Annotated[list[str] | None, typer.Option(
+        help="plan (POST /plan) or flightpath (GET /days/{date}/flightpath.geojson); "
+             "repeatable; default both (flightpath needs --db).")] = None,
+    clients: Annotated[int, typer.Option(help="Concurrent clients.")] = 50,
+    requests: Annotated[int, typer.Option(help="Measured requests per load.")] = 2000,
+    workers: Annotated[int, typer.Option(help="Server processes.")] = 1,
+    map_name: Annotated[str, typer.Option("--map", help="Bundled map for POST /plan.")] =
+        "Paris_1_512",
+    algorithm: Annotated[str, typer.Option(help="Planner for POST /plan.")] = "astar",
+    db: Annotated[str | None, typer.Option(
+        help="Store with a flown day, for flightpath (e.g. "
+             "postgresql+psycopg://postgres@127.0.0.1:5432/test).")] = None,
+    date: Annotated[str | None, typer.Option(help="Day for flightpath (default: the "
+                                                  "first stored day with moves).")] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the drawn scenario lines.")] = 0,
+    json_out: Annotated[Path | None, typer.Option("--json", help="Write the rows here.")] =
+        None,
+) -> None:
+    """Load the service on 127.0.0.1 (uvicorn in a process of its own) and report
+    server-side (Server-Timing) and client latency percentiles, requests/s and errors."""
+    from skyroute.bench.service import bench_flightpath, bench_plan
+
+    loads = load or (["plan", "flightpath"] if db else ["plan"])
+    for x in loads:
+        check_choice("load", x, LOADS)
+    if "flightpath" in loads and db is None:
+        raise OptionError("--load flightpath needs --db URL (a store with a flown day)")
+    if clients < 1 or requests < 1 or workers < 1:
+        raise OptionError("--clients, --requests and --workers must be at least 1")
+    rows = []
+    err = Console(stderr=True)
+    for x in loads:
+        err.print(f"{x}: {requests:,} requests, {clients} clients, {workers} server "
+                  "process(es) ...")
+        if x == "plan":
+            rows.append(bench_plan(map_name=map_name, clients=clients, requests=requests,
+                                   workers=workers, seed=seed, algorithm=algorithm))
+        else:
+            rows.append(bench_flightpath(db=db, date=date, clients=clients,
+                                         requests=requests, workers=workers))
+    t = Table(title=f"service under load on 127.0.0.1 ({os.cpu_count()} cores, "
+                    f"{platform.python_implementation()} {platform.python_version()})")
+    for col in ("load", "req/s", "errors", "server p50 ms", "server p99 ms",
+                "search p50 ms", "search p99 ms", "client p50 ms", "client p99 ms"):
+        t.add_column(col, justify="left" if col == "load" else "right")
+
+    def ms(r: dict, key: str) -> str:
+        return f"{r[key]:.2f}" if key in r else "-"
+
+    for r in rows:
+        t.add_row(r["load"] if r["load"] != "POST /plan" else f"POST /plan {r['map']}",
+                  f"{r['requests_per_second']:,.0f}", str(r["errors"]), ms(r, "app_p50"),
+                  ms(r, "app_p99"), ms(r, "plan_p50"), ms(r, "plan_p99"),
+                  ms(r, "client_ms_p50"), ms(r, "client_ms_p99"))
+    Console().print(t)
+    if json_out:
+        write_atomic(json_out, json.dumps(rows, indent=1))
