@@ -4,6 +4,7 @@ the store the CLI filled (examples/lunch, 2024-01-03), and the site in lon/lat."
 from __future__ import annotations
 
 import json
+import time
 
 import pytest
 
@@ -92,7 +93,7 @@ def test_a_day_stored_again_is_served_fresh(tmp_path, lunch):
 
     db = tmp_path / "copy.db"
     shutil.copy(lunch[0].removeprefix("sqlite:///"), db)
-    with make_client(db_url=f"sqlite:///{db}") as c:
+    with make_client(db_url=f"sqlite:///{db}", fresh_seconds=0.2) as c:
         first = c.get(f"/days/{DAY}/flightpath.geojson")
         eng = connect(f"sqlite:///{db}")
         with eng.begin() as conn:
@@ -100,6 +101,8 @@ def test_a_day_stored_again_is_served_fresh(tmp_path, lunch):
                                  "and delivery_date = :d"), {"d": DAY})
             conn.execute(sa.text("update runs set finished = '2030-01-01 00:00:00.000000' "
                                  "where delivery_date = :d"), {"d": DAY})
+        assert c.get(f"/days/{DAY}/flightpath.geojson").content == first.content
+        time.sleep(0.25)  # fresh_seconds later the store is asked again
         second = c.get(f"/days/{DAY}/flightpath.geojson")
         assert second.headers["etag"] != first.headers["etag"]
         a = first.json()["features"][0]["geometry"]["coordinates"][1]

@@ -35,6 +35,9 @@ class Settings(BaseModel):
     max_raster_cells: int = Field(4_000_000, gt=0, description="Largest raster a grid "
                                   "algorithm on a world may ask for (resolution).")
     max_samples: int = Field(20_000, gt=0, description="Largest PRM roadmap per request.")
+    fresh_seconds: float = Field(1.0, ge=0, description="How long a file made from a "
+                                 "stored day is served before the store is asked again "
+                                 "whether the day changed.")
     job_queue: int = Field(8, ge=1, description="Jobs queued or running at once (429 past it).")
     dask_address: str | None = Field(None, description="Run jobs on this Dask scheduler "
                                      "(tcp://HOST:8786) instead of local processes.")

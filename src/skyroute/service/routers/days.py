@@ -7,9 +7,11 @@ from __future__ import annotations
 import datetime as dt
 import hashlib
 import json
+import time
 from typing import Annotated
 
 from fastapi import APIRouter, Path, Request, Response
+from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, Field
 
 from skyroute.service.problems import Problem, responses
@@ -139,24 +141,36 @@ def get_day(date: DayDate, eng: EngineDep,
                              "order number in its properties."},
                        **responses(404, 422)},
             summary="A stored day's flight as GeoJSON")
-def get_flightpath(date: DayDate, request: Request, eng: EngineDep,
-                   res: ResourcesDep) -> Response:
-    from skyroute.delivery.reads import day_version
-
-    version = day_version(eng, date)
-    if version is None:
-        _report(eng, date)  # the 404
-    key = f"flightpath:{version}"
-    body = res.cache.get(key)
-    if body is None:
-        body = _flightpath(eng, date, res)
-        for k in [k for k in res.cache if k.startswith(f"flightpath:{date}:")]:
-            res.cache.pop(k, None)  # an older flight of the same day
-        res.cache[key] = body
-    etag = '"' + hashlib.sha1(version.encode()).hexdigest()[:20] + '"'
+async def get_flightpath(date: DayDate, request: Request, res: ResourcesDep) -> Response:
+    # The file is made once per stored version of the day and served from memory; the
+    # store is asked again whether the day changed once fresh_seconds have passed (on
+    # the thread pool, so the event loop never waits for the database).
+    key = f"flightpath:{date}"
+    entry = res.cache.get(key)
+    if entry is None or time.monotonic() - entry[0] > res.settings.fresh_seconds:
+        if entry is not None:  # one request asks; the others meanwhile serve what is held
+            res.cache[key] = (time.monotonic(), *entry[1:])
+        entry = await run_in_threadpool(_flightpath_entry, date, res, entry)
+        res.cache[key] = entry
+    _, _, etag, body = entry
     if request.headers.get("if-none-match") == etag:
         return Response(status_code=304, headers={"ETag": etag})
     return Response(body, media_type=GEOJSON, headers={"ETag": etag})
+
+
+def _flightpath_entry(date: dt.date, res: Resources, old: tuple | None) -> tuple:
+    """(checked at, version, ETag, body) of the day's file, made again only when the
+    day's version in the store changed."""
+    from skyroute.delivery.reads import day_version
+
+    eng = res.engine()
+    version = day_version(eng, date)
+    if version is None:
+        _report(eng, date)  # the 404
+    if old is not None and old[1] == version:
+        return (time.monotonic(), *old[1:])
+    etag = '"' + hashlib.sha1(version.encode()).hexdigest()[:20] + '"'
+    return time.monotonic(), version, etag, _flightpath(eng, date, res)
 
 
 def _flightpath(eng, date: dt.date, res: Resources) -> bytes:
