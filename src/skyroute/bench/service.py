@@ -3,7 +3,8 @@
 The server is ``skyroute serve`` in a process of its own (uvicorn, ``workers``
 processes); the load comes from one asyncio process of ``clients`` concurrent httpx
 clients, each sending its next request as soon as the last one is answered (a closed
-loop). Two loads:
+loop; ``client_processes`` splits them over that many processes when one process of
+httpx cannot keep the server busy). Two loads:
 
 - ``plan``: ``POST /plan`` on a bundled map with queries drawn (seeded) from the map's
   MovingAI scenario file, A* by default;
@@ -91,6 +92,32 @@ class Server:
         self.stop()
 
 
+def cpu_seconds(pid: int) -> float | None:
+    """CPU seconds (user + system) used so far by process ``pid`` and its descendants,
+    from /proc (None where there is no /proc): what the server spent, whatever else
+    the machine was doing meanwhile."""
+    proc = Path("/proc")
+    if not (proc / str(pid) / "stat").exists():
+        return None
+    tick = os.sysconf("SC_CLK_TCK")
+    parent, used = {}, {}
+    for d in proc.iterdir():
+        if d.name.isdigit():
+            try:
+                fields = (d / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            parent[int(d.name)] = int(fields[1])
+            used[int(d.name)] = (int(fields[11]) + int(fields[12])) / tick
+    tree, todo = {pid}, [pid]
+    while todo:
+        p = todo.pop()
+        kids = [c for c, pp in parent.items() if pp == p and c not in tree]
+        tree.update(kids)
+        todo.extend(kids)
+    return sum(used.get(p, 0.0) for p in tree)
+
+
 def _timings(header: str | None) -> dict[str, float]:
     return {k: float(v) for k, v in _TIMING.findall(header or "")}
 
@@ -124,6 +151,34 @@ async def _load(url: str, requests: list[tuple[str, str, dict | None]], clients:
         await asyncio.gather(*(client(http) for _ in range(clients)))
         wall = time.perf_counter() - t0
     return records, wall
+
+
+def _load_share(args) -> tuple[list[dict], float, float]:
+    """One client process's share: (records, start, end) in wall-clock seconds."""
+    url, requests, clients, headers, barrier = args
+    barrier.wait()
+    t0 = time.time()
+    records, _ = asyncio.run(_load(url, requests, clients, headers))
+    return records, t0, time.time()
+
+
+def _run_load(url: str, requests: list, clients: int, headers: dict,
+              processes: int = 1) -> tuple[list[dict], float]:
+    """:func:`_load` in ``processes`` client processes (each ``clients / processes``
+    clients and every ``processes``-th request), started together; (records, wall)."""
+    if processes == 1:
+        return asyncio.run(_load(url, requests, clients, headers))
+    import multiprocessing as mp
+
+    ctx = mp.get_context("spawn")
+    with ctx.Manager() as manager:
+        barrier = manager.Barrier(processes)
+        shares = [(url, requests[k::processes], max(1, clients // processes), headers,
+                   barrier) for k in range(processes)]
+        with ctx.Pool(processes) as pool:
+            out = pool.map(_load_share, shares)
+    records = [r for rec, _, _ in out for r in rec]
+    return records, max(e for _, _, e in out) - min(b for _, b, _ in out)
 
 
 def _summary(records: list[dict], wall: float) -> dict:
@@ -167,7 +222,7 @@ def plan_queries(map_name: str, n: int, *, seed: int = 0,
 
 def bench_plan(*, map_name: str = "Paris_1_512", clients: int = 50, requests: int = 2000,
                warmup: int = 100, workers: int = 1, seed: int = 0, algorithm: str = "astar",
-               db: str | None = None) -> dict:
+               db: str | None = None, client_processes: int = 1) -> dict:
     """POST /plan under load: the summary (server-side ``app``, ``wait``, ``plan`` and
     client latency percentiles in ms, requests/s, errors)."""
     import tempfile
@@ -178,14 +233,18 @@ def bench_plan(*, map_name: str = "Paris_1_512", clients: int = 50, requests: in
             Server(db=db or f"sqlite:///{Path(tmp) / 'bench.db'}", workers=workers) as srv:
         asyncio.run(_load(srv.url, [("POST", "/plan", q) for q in queries[:warmup]],
                           min(clients, 8), auth))
-        records, wall = asyncio.run(_load(
-            srv.url, [("POST", "/plan", q) for q in queries[warmup:]], clients, auth))
+        cpu0 = cpu_seconds(srv.proc.pid)
+        records, wall = _run_load(srv.url, [("POST", "/plan", q) for q in queries[warmup:]],
+                                  clients, auth, client_processes)
+        cpu1 = cpu_seconds(srv.proc.pid)
     return {"load": "POST /plan", "map": map_name, "algorithm": algorithm,
-            "clients": clients, "workers": workers, **_summary(records, wall)}
+            "clients": clients, "workers": workers, "client_processes": client_processes,
+            **_summary(records, wall), **_cpu(cpu0, cpu1, len(records))}
 
 
 def bench_flightpath(*, db: str, date: str | None = None, clients: int = 50,
-                     requests: int = 5000, warmup: int = 200, workers: int = 1) -> dict:
+                     requests: int = 5000, warmup: int = 200, workers: int = 1,
+                     client_processes: int = 1) -> dict:
     """GET /days/{date}/flightpath.geojson under load (the first stored day unless
     ``date``): the summary, as :func:`bench_plan`'s."""
     import httpx
@@ -201,7 +260,19 @@ def bench_flightpath(*, db: str, date: str | None = None, clients: int = 50,
             date = flown[0]
         path = f"/days/{date}/flightpath.geojson"
         asyncio.run(_load(srv.url, [("GET", path, None)] * warmup, min(clients, 8), {}))
-        records, wall = asyncio.run(_load(srv.url, [("GET", path, None)] * requests,
-                                          clients, {}))
+        cpu0 = cpu_seconds(srv.proc.pid)
+        records, wall = _run_load(srv.url, [("GET", path, None)] * requests, clients, {},
+                                  client_processes)
+        cpu1 = cpu_seconds(srv.proc.pid)
     return {"load": f"GET {path}", "clients": clients, "workers": workers,
-            **_summary(records, wall)}
+            "client_processes": client_processes, **_summary(records, wall),
+            **_cpu(cpu0, cpu1, len(records))}
+
+
+def _cpu(before: float | None, after: float | None, n: int) -> dict:
+    """The server's CPU per request, and the requests per second one core of it could
+    answer at that cost (the load generator and other work left out)."""
+    if before is None or after is None or not n or after <= before:
+        return {}
+    ms = (after - before) * 1e3 / n
+    return {"server_cpu_ms_per_request": ms, "per_core_requests_per_second": 1e3 / ms}

@@ -13,6 +13,7 @@ from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli.bench_cmd import bench_app
+from skyroute.cli.tables import wide_console
 from skyroute.errors import OptionError, check_choice
 from skyroute.files import write_atomic
 
@@ -27,6 +28,8 @@ def bench_service(
     clients: Annotated[int, typer.Option(help="Concurrent clients.")] = 50,
     requests: Annotated[int, typer.Option(help="Measured requests per load.")] = 2000,
     workers: Annotated[int, typer.Option(help="Server processes.")] = 1,
+    client_processes: Annotated[int, typer.Option(
+        help="Processes the clients are spread over.")] = 1,
     map_name: Annotated[str, typer.Option("--map", help="Bundled map for POST /plan.")] =
         "Paris_1_512",
     algorithm: Annotated[str, typer.Option(help="Planner for POST /plan.")] = "astar",
@@ -48,23 +51,27 @@ def bench_service(
         check_choice("load", x, LOADS)
     if "flightpath" in loads and db is None:
         raise OptionError("--load flightpath needs --db URL (a store with a flown day)")
-    if clients < 1 or requests < 1 or workers < 1:
-        raise OptionError("--clients, --requests and --workers must be at least 1")
+    if min(clients, requests, workers, client_processes) < 1:
+        raise OptionError("--clients, --requests, --workers and --client-processes must be "
+                          "at least 1")
     rows = []
     err = Console(stderr=True)
     for x in loads:
-        err.print(f"{x}: {requests:,} requests, {clients} clients, {workers} server "
-                  "process(es) ...")
+        err.print(f"{x}: {requests:,} requests, {clients} clients in {client_processes} "
+                  f"process(es), {workers} server process(es) ...")
         if x == "plan":
             rows.append(bench_plan(map_name=map_name, clients=clients, requests=requests,
-                                   workers=workers, seed=seed, algorithm=algorithm))
+                                   workers=workers, seed=seed, algorithm=algorithm,
+                                   client_processes=client_processes))
         else:
             rows.append(bench_flightpath(db=db, date=date, clients=clients,
-                                         requests=requests, workers=workers))
+                                         requests=requests, workers=workers,
+                                         client_processes=client_processes))
     t = Table(title=f"service under load on 127.0.0.1 ({os.cpu_count()} cores, "
                     f"{platform.python_implementation()} {platform.python_version()})")
     for col in ("load", "req/s", "errors", "server p50 ms", "server p99 ms",
-                "search p50 ms", "search p99 ms", "client p50 ms", "client p99 ms"):
+                "search p50 ms", "search p99 ms", "client p50 ms", "client p99 ms",
+                "server CPU ms/req", "req/s per server core"):
         t.add_column(col, justify="left" if col == "load" else "right")
 
     def ms(r: dict, key: str) -> str:
@@ -74,7 +81,10 @@ def bench_service(
         t.add_row(r["load"] if r["load"] != "POST /plan" else f"POST /plan {r['map']}",
                   f"{r['requests_per_second']:,.0f}", str(r["errors"]), ms(r, "app_p50"),
                   ms(r, "app_p99"), ms(r, "plan_p50"), ms(r, "plan_p99"),
-                  ms(r, "client_ms_p50"), ms(r, "client_ms_p99"))
-    Console().print(t)
+                  ms(r, "client_ms_p50"), ms(r, "client_ms_p99"),
+                  ms(r, "server_cpu_ms_per_request"),
+                  f"{r['per_core_requests_per_second']:,.0f}"
+                  if "per_core_requests_per_second" in r else "-")
+    wide_console().print(t)
     if json_out:
         write_atomic(json_out, json.dumps(rows, indent=1))
