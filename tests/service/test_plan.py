@@ -101,7 +101,7 @@ def test_geojson_zones_world(client):
                                                           [0.002, 0.001], [0.001, 0.001],
                                                           [0.001, -0.001]]]}}]}
     body = {"world_text": json.dumps(zones), "world_format": "geojson",
-            "boundary": "-0.01,-0.01,0.01,0.01", "start": [0.0, 0.0], "goal": [0.003, 0.0]}
+            "boundary": [-0.01, -0.01, 0.01, 0.01], "start": [0.0, 0.0], "goal": [0.003, 0.0]}
     ans = client.post("/plan", json=body, headers=AUTH).json()
     path = ROOT / "zones.geojson"
     try:
@@ -160,6 +160,8 @@ CITY_BODY = {"world_format": "colliders", "altitude": 10, "safety": 2,
     ({**CITY_BODY, "frame": "polar"}, "frame", "'lonlat'"),
     ({**CITY_BODY, "frame": "degrees"}, "frame", "in metres"),
     ({**CITY_BODY, "safety": -1}, "safety", "greater than or equal to 0"),
+    ({**CITY_BODY, "boundary": "/etc/passwd"}, "boundary", "valid"),
+    ({**CITY_BODY, "boundary": [0, 0, -1, -1]}, "boundary", "min must be below max"),
     ({**CITY_BODY, "start": [-3.1890, 95.0]}, "start", ""),
     ({**CITY_BODY, "algorithm": "astar", "resolution": 0.001}, "resolution",
      "this server's limit"),

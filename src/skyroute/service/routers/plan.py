@@ -55,8 +55,8 @@ class PlanRequest(BaseModel):
     altitude: Number | None = Field(None, description="Worlds: keep obstacles that count "
                                     "at this altitude.")
     safety: Number = Field(0.0, ge=0, description="Grow obstacles by this margin.")
-    boundary: str | None = Field(None, max_length=200, description="Worlds: "
-                                 "MINLON,MINLAT,MAXLON,MAXLAT.")
+    boundary: tuple[Number, Number, Number, Number] | None = Field(
+        None, description="Worlds: [min_lon, min_lat, max_lon, max_lat].")
     start: Point
     goal: Point
     algorithm: Algorithm | None = Field(None, description="Default astar on maps, "
@@ -226,8 +226,11 @@ def _world(body: PlanRequest):
     from skyroute.world.load import load_world
 
     name = "world_text.csv" if body.world_format == "colliders" else "world_text.geojson"
+    # the boundary goes in as numbers only: load_world would read any other string as a
+    # file name, and a request names no file on the server
+    box = None if body.boundary is None else ",".join(repr(float(v)) for v in body.boundary)
     return load_world(name, text=body.world_text, altitude=body.altitude,
-                      safety=body.safety, boundary=body.boundary, frame=body.frame)
+                      safety=body.safety, boundary=box, frame=body.frame)
 
 
 def _check_world_limits(body: PlanRequest, world, res: Resources) -> None:
