@@ -4,7 +4,8 @@ The server is ``skyroute serve`` in a process of its own (uvicorn, ``workers``
 processes); the load comes from one asyncio process of ``clients`` concurrent httpx
 clients, each sending its next request as soon as the last one is answered (a closed
 loop; ``client_processes`` splits them over that many processes when one process of
-httpx cannot keep the server busy). Two loads:
+httpx cannot keep the server busy; ``client="raw"`` uses a minimal HTTP/1.1 client on
+asyncio streams instead, which costs far less CPU per request). Two loads:
 
 - ``plan``: ``POST /plan`` on a bundled map with queries drawn (seeded) from the map's
   MovingAI scenario file, A* by default;
@@ -32,6 +33,7 @@ import numpy as np
 from skyroute.errors import SkyrouteError
 
 TOKEN = "bench-service-token"
+CLIENTS = ("httpx", "raw")
 _TIMING = re.compile(r"(\w+);dur=([0-9.]+)")
 
 
@@ -147,34 +149,80 @@ async def _load(url: str, requests: list[tuple[str, str, dict | None]], clients:
 
     async with httpx.AsyncClient(base_url=url, headers=headers, limits=limits,
                                  timeout=60.0) as http:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         await asyncio.gather(*(client(http) for _ in range(clients)))
-        wall = time.perf_counter() - t0
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    for r in records:  # the load generator's own CPU, shared out (it competes for cores)
+        r["client_cpu_ms"] = cpu * 1e3 / len(records)
+    return records, wall
+
+
+async def _load_raw(url: str, requests: list[tuple[str, str, dict | None]], clients: int,
+                    headers: dict) -> tuple[list[dict], float]:
+    """:func:`_load` with a minimal HTTP/1.1 keep-alive client on asyncio streams instead
+    of httpx: what the server answers when the load generator costs little CPU."""
+    import json
+
+    host, port = url.removeprefix("http://").split(":")
+    extra = "".join(f"{k}: {v}\r\n" for k, v in headers.items())
+    records: list[dict] = []
+    queue = iter(requests)
+
+    async def client() -> None:
+        reader, writer = await asyncio.open_connection(host, int(port))
+        try:
+            for method, path, body in queue:
+                data = b"" if body is None else json.dumps(body).encode()
+                head = (f"{method} {path} HTTP/1.1\r\nHost: {host}\r\n{extra}"
+                        + (f"Content-Type: application/json\r\nContent-Length: {len(data)}"
+                           "\r\n" if body is not None else "") + "\r\n")
+                t0 = time.perf_counter()
+                writer.write(head.encode() + data)
+                lines = (await reader.readuntil(b"\r\n\r\n")).decode("latin-1").split("\r\n")
+                fields = {k.lower(): v.strip() for k, _, v in
+                          (x.partition(":") for x in lines[1:] if x)}
+                content = await reader.readexactly(int(fields.get("content-length", 0)))
+                records.append({"status": int(lines[0].split()[1]),
+                                "client_ms": (time.perf_counter() - t0) * 1e3,
+                                **_timings(fields.get("server-timing")),
+                                "bytes": len(content)})
+        finally:
+            writer.close()
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    await asyncio.gather(*(client() for _ in range(clients)))
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    for r in records:
+        r["client_cpu_ms"] = cpu * 1e3 / len(records)
     return records, wall
 
 
 def _load_share(args) -> tuple[list[dict], float, float]:
     """One client process's share: (records, start, end) in wall-clock seconds."""
-    url, requests, clients, headers, barrier = args
+    url, requests, clients, headers, barrier, raw = args
     barrier.wait()
     t0 = time.time()
-    records, _ = asyncio.run(_load(url, requests, clients, headers))
+    records, _ = asyncio.run((_load_raw if raw else _load)(url, requests, clients, headers))
     return records, t0, time.time()
 
 
 def _run_load(url: str, requests: list, clients: int, headers: dict,
-              processes: int = 1) -> tuple[list[dict], float]:
+              processes: int = 1, client: str = "httpx") -> tuple[list[dict], float]:
     """:func:`_load` in ``processes`` client processes (each ``clients / processes``
     clients and every ``processes``-th request), started together; (records, wall)."""
+    if client not in CLIENTS:
+        raise SkyrouteError(f"client={client!r} is not valid; choose one of "
+                            + ", ".join(repr(c) for c in CLIENTS), param="client")
+    raw = client == "raw"
     if processes == 1:
-        return asyncio.run(_load(url, requests, clients, headers))
+        return asyncio.run((_load_raw if raw else _load)(url, requests, clients, headers))
     import multiprocessing as mp
 
     ctx = mp.get_context("spawn")
     with ctx.Manager() as manager:
         barrier = manager.Barrier(processes)
         shares = [(url, requests[k::processes], max(1, clients // processes), headers,
-                   barrier) for k in range(processes)]
+                   barrier, raw) for k in range(processes)]
         with ctx.Pool(processes) as pool:
             out = pool.map(_load_share, shares)
     records = [r for rec, _, _ in out for r in rec]
@@ -193,7 +241,9 @@ def _summary(records: list[dict], wall: float) -> dict:
                 f"{key}_max": float(v.max())}
 
     out = {"requests": len(records), "errors": len(records) - len(ok), "wall_seconds": wall,
-           "requests_per_second": len(records) / wall if wall else 0.0}
+           "requests_per_second": len(records) / wall if wall else 0.0,
+           "client_cpu_ms_per_request": float(np.mean([r.get("client_cpu_ms", 0.0)
+                                                       for r in records]))}
     for key in ("app", "wait", "plan", "client_ms"):
         out.update(pct(key))
     statuses: dict[int, int] = {}
@@ -222,7 +272,8 @@ def plan_queries(map_name: str, n: int, *, seed: int = 0,
 
 def bench_plan(*, map_name: str = "Paris_1_512", clients: int = 50, requests: int = 2000,
                warmup: int = 100, workers: int = 1, seed: int = 0, algorithm: str = "astar",
-               db: str | None = None, client_processes: int = 1) -> dict:
+               db: str | None = None, client_processes: int = 1,
+               client: str = "httpx") -> dict:
     """POST /plan under load: the summary (server-side ``app``, ``wait``, ``plan`` and
     client latency percentiles in ms, requests/s, errors)."""
     import tempfile
@@ -235,16 +286,17 @@ def bench_plan(*, map_name: str = "Paris_1_512", clients: int = 50, requests: in
                           min(clients, 8), auth))
         cpu0 = cpu_seconds(srv.proc.pid)
         records, wall = _run_load(srv.url, [("POST", "/plan", q) for q in queries[warmup:]],
-                                  clients, auth, client_processes)
+                                  clients, auth, client_processes, client)
         cpu1 = cpu_seconds(srv.proc.pid)
     return {"load": "POST /plan", "map": map_name, "algorithm": algorithm,
-            "clients": clients, "workers": workers, "client_processes": client_processes,
-            **_summary(records, wall), **_cpu(cpu0, cpu1, len(records))}
+            "clients": clients, "client": client, "workers": workers,
+            "client_processes": client_processes, **_summary(records, wall),
+            **_cpu(cpu0, cpu1, len(records))}
 
 
 def bench_flightpath(*, db: str, date: str | None = None, clients: int = 50,
                      requests: int = 5000, warmup: int = 200, workers: int = 1,
-                     client_processes: int = 1) -> dict:
+                     client_processes: int = 1, client: str = "httpx") -> dict:
     """GET /days/{date}/flightpath.geojson under load (the first stored day unless
     ``date``): the summary, as :func:`bench_plan`'s."""
     import httpx
@@ -262,9 +314,9 @@ def bench_flightpath(*, db: str, date: str | None = None, clients: int = 50,
         asyncio.run(_load(srv.url, [("GET", path, None)] * warmup, min(clients, 8), {}))
         cpu0 = cpu_seconds(srv.proc.pid)
         records, wall = _run_load(srv.url, [("GET", path, None)] * requests, clients, {},
-                                  client_processes)
+                                  client_processes, client)
         cpu1 = cpu_seconds(srv.proc.pid)
-    return {"load": f"GET {path}", "clients": clients, "workers": workers,
+    return {"load": f"GET {path}", "clients": clients, "client": client, "workers": workers,
             "client_processes": client_processes, **_summary(records, wall),
             **_cpu(cpu0, cpu1, len(records))}
 

@@ -30,6 +30,9 @@ def bench_service(
     workers: Annotated[int, typer.Option(help="Server processes.")] = 1,
     client_processes: Annotated[int, typer.Option(
         help="Processes the clients are spread over.")] = 1,
+    client: Annotated[str, typer.Option(
+        help="httpx (AsyncClient) or raw (a minimal HTTP/1.1 client on asyncio streams: "
+             "little CPU per request).")] = "httpx",
     map_name: Annotated[str, typer.Option("--map", help="Bundled map for POST /plan.")] =
         "Paris_1_512",
     algorithm: Annotated[str, typer.Option(help="Planner for POST /plan.")] = "astar",
@@ -44,11 +47,12 @@ def bench_service(
 ) -> None:
     """Load the service on 127.0.0.1 (uvicorn in a process of its own) and report
     server-side (Server-Timing) and client latency percentiles, requests/s and errors."""
-    from skyroute.bench.service import bench_flightpath, bench_plan
+    from skyroute.bench.service import CLIENTS, bench_flightpath, bench_plan
 
     loads = load or (["plan", "flightpath"] if db else ["plan"])
     for x in loads:
         check_choice("load", x, LOADS)
+    check_choice("client", client, CLIENTS)
     if "flightpath" in loads and db is None:
         raise OptionError("--load flightpath needs --db URL (a store with a flown day)")
     if min(clients, requests, workers, client_processes) < 1:
@@ -57,21 +61,21 @@ def bench_service(
     rows = []
     err = Console(stderr=True)
     for x in loads:
-        err.print(f"{x}: {requests:,} requests, {clients} clients in {client_processes} "
+        err.print(f"{x}: {requests:,} requests, {clients} {client} clients in {client_processes} "
                   f"process(es), {workers} server process(es) ...")
         if x == "plan":
             rows.append(bench_plan(map_name=map_name, clients=clients, requests=requests,
                                    workers=workers, seed=seed, algorithm=algorithm,
-                                   client_processes=client_processes))
+                                   client_processes=client_processes, client=client))
         else:
             rows.append(bench_flightpath(db=db, date=date, clients=clients,
                                          requests=requests, workers=workers,
-                                         client_processes=client_processes))
+                                         client_processes=client_processes, client=client))
     t = Table(title=f"service under load on 127.0.0.1 ({os.cpu_count()} cores, "
                     f"{platform.python_implementation()} {platform.python_version()})")
     for col in ("load", "req/s", "errors", "server p50 ms", "server p99 ms",
                 "search p50 ms", "search p99 ms", "client p50 ms", "client p99 ms",
-                "server CPU ms/req", "req/s per server core"):
+                "server CPU ms/req", "req/s per server core", "client CPU ms/req"):
         t.add_column(col, justify="left" if col == "load" else "right")
 
     def ms(r: dict, key: str) -> str:
@@ -84,7 +88,8 @@ def bench_service(
                   ms(r, "client_ms_p50"), ms(r, "client_ms_p99"),
                   ms(r, "server_cpu_ms_per_request"),
                   f"{r['per_core_requests_per_second']:,.0f}"
-                  if "per_core_requests_per_second" in r else "-")
+                  if "per_core_requests_per_second" in r else "-",
+                  ms(r, "client_cpu_ms_per_request"))
     wide_console().print(t)
     if json_out:
         write_atomic(json_out, json.dumps(rows, indent=1))
