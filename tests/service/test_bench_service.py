@@ -1,0 +1,43 @@
+"""``skyroute bench service``: a small load of each kind against a real server process,
+and its flags."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from tests.cli.test_cli import run
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("client", ["httpx", "raw"])
+def test_plan_load(client):
+    from skyroute.bench.service import bench_plan
+
+    r = bench_plan(map_name="den312d", clients=4, requests=40, warmup=4, client=client)
+    assert r["requests"] == 40 and r["errors"] == 0 and r["statuses"] == {200: 40}
+    assert 0 < r["plan_p50"] <= r["app_p50"] and r["requests_per_second"] > 0
+
+
+@pytest.mark.slow
+def test_flightpath_load_from_the_cli(monkeypatch, capsys, tmp_path, lunch):
+    out = tmp_path / "rows.json"
+    code, text, err = run(monkeypatch, capsys, "bench", "service", "--load", "flightpath",
+                          "--db", lunch[0], "--requests", "30", "--clients", "3",
+                          "--client", "raw", "--json", str(out))
+    assert code == 0, err
+    (row,) = json.loads(out.read_text())
+    assert row["load"] == "GET /days/2024-01-03/flightpath.geojson"
+    assert row["errors"] == 0 and row["requests"] == 30 and "req/s" in text
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--load", "flightpath"], "--load flightpath needs --db URL"),
+    (["--load", "upload"], "--load 'upload' is not valid"),
+    (["--client", "curl"], "--client 'curl' is not valid"),
+    (["--clients", "0"], "must be at least 1"),
+])
+def test_bad_flags(monkeypatch, capsys, args, words):
+    code, _, err = run(monkeypatch, capsys, "bench", "service", *args)
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
