@@ -174,6 +174,12 @@ def test_bad_input_is_422_naming_the_field(client, body, field, words):
     assert_problem(client.post("/plan", json=body, headers=AUTH), 422, field, words)
 
 
+def test_a_body_that_is_not_text_is_400(client):
+    r = client.post("/plan", content=b'{"map": "\xff\xfe"}', headers={
+        **AUTH, "Content-Type": "application/json"})
+    assert_problem(r, 400, words="cannot be read as JSON text")
+
+
 def test_not_json_and_not_finite_are_422(client):
     r = client.post("/plan", content=b"{not json", headers={**AUTH, "Content-Type":
                                                            "application/json"})

@@ -119,6 +119,8 @@ async def _http(request: Request, exc: StarletteHTTPException) -> JSONResponse:
                                                                         "error")
     if exc.status_code == 404 and detail == "Not Found":
         detail = f"no such resource: {request.url.path}"
+    elif exc.status_code == 400 and detail == "There was an error parsing the body":
+        detail = "the request body cannot be read as JSON text (UTF-8)"
     elif exc.status_code == 405:
         detail = f"{request.method} is not allowed on {request.url.path}"
     return problem_response(exc.status_code, detail, headers=getattr(exc, "headers", None))
@@ -173,6 +175,8 @@ def document(app: FastAPI) -> None:
                 codes = op.setdefault("responses", {})
                 if op.get("parameters") or op.get("requestBody"):
                     codes.setdefault("422", {})
+                if op.get("requestBody"):
+                    codes.setdefault("400", {})  # a body that is not UTF-8 text
                 if method in ("post", "put", "patch"):
                     codes.setdefault("413", {})
                 for code, resp in codes.items():
