@@ -234,7 +234,7 @@ async function plan() {
     say(status, errors.map((r) => explain(r.error, r.algorithm)).join(" "), "error");
   } else {
     const found = results.filter((r) => r.answer.status === "found");
-    say(status, `Planned (${start}) → (${goal}) with ${results.length} algorithm${results.length > 1 ? "s" : ""}: ` +
+    say(status, `Planned (${start.join(", ")}) → (${goal.join(", ")}) with ${results.length} algorithm${results.length > 1 ? "s" : ""}: ` +
       `${found.length} found a path.`, "ok");
   }
   showResults();

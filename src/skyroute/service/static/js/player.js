@@ -59,9 +59,11 @@ export class Player {
   }
 
   pause() {
+    const was = this.playing;
     this.playing = false;
     this.play.textContent = "Play";
     this.play.setAttribute("aria-pressed", "false");
+    if (was) this.show(); // whatever is refreshed less often while playing catches up
   }
 
   frame(now) {
