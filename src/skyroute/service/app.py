@@ -17,7 +17,17 @@ import skyroute
 from skyroute.service import problems
 from skyroute.service.middleware import BodyLimit, ServerTiming
 from skyroute.service.resources import Resources
-from skyroute.service.routers import days, fleet, health, jobs, maps, orders, plan, site
+from skyroute.service.routers import (
+    days,
+    fleet,
+    fleet_packages,
+    health,
+    jobs,
+    maps,
+    orders,
+    plan,
+    site,
+)
 from skyroute.service.settings import Settings
 
 STATIC = Path(__file__).parent / "static"
@@ -42,7 +52,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.resources = Resources(settings)
     problems.install(app)
     problems.document(app)
-    for module in (health, maps, days, orders, site, plan, jobs, fleet):
+    for module in (health, maps, days, orders, site, plan, jobs, fleet, fleet_packages):
         app.include_router(module.router)
     app.add_middleware(ServerTiming)  # inside the body limit: the body is in hand
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)

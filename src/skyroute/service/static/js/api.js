@@ -1,0 +1,102 @@
+// Talking to the skyroute service: JSON and text reads, authorised writes, the bearer
+// token (kept in this tab's sessionStorage, never in a cookie or the URL), and errors
+// (application/problem+json) turned into one sentence for the status line.
+
+const TOKEN_KEY = "skyroute.token";
+
+/** An answer other than 2xx: its status, the problem's detail and field. */
+export class ApiError extends Error {
+  constructor(status, detail, field = null) {
+    super(detail);
+    this.status = status;
+    this.detail = detail;
+    this.field = field;
+  }
+}
+
+async function failure(response) {
+  let detail = `${response.status} ${response.statusText}`.trim();
+  let field = null;
+  try {
+    const doc = await response.json();
+    if (doc && typeof doc.detail === "string") detail = doc.detail;
+    if (doc && typeof doc.field === "string") field = doc.field;
+  } catch {
+    // not JSON: keep the status line
+  }
+  return new ApiError(response.status, detail, field);
+}
+
+async function send(path, init) {
+  let response;
+  try {
+    response = await fetch(path, init);
+  } catch {
+    throw new ApiError(0, "the server did not answer (is skyroute serve still running?)");
+  }
+  if (!response.ok) throw await failure(response);
+  return response;
+}
+
+export async function getJSON(path) {
+  return (await send(path, { headers: { Accept: "application/json" } })).json();
+}
+
+export async function getText(path) {
+  return (await send(path, {})).text();
+}
+
+/** POST a JSON body with the bearer token; the answer's JSON. */
+export async function postJSON(path, body) {
+  const headers = { "Content-Type": "application/json", Accept: "application/json" };
+  const token = getToken();
+  if (token) headers.Authorization = `Bearer ${token}`;
+  return (await send(path, { method: "POST", headers, body: JSON.stringify(body) })).json();
+}
+
+export function getToken() {
+  try {
+    return (sessionStorage.getItem(TOKEN_KEY) || "").trim();
+  } catch {
+    return "";
+  }
+}
+
+/** Keep ``input`` and the stored token in step. */
+export function bindToken(input) {
+  input.value = getToken();
+  input.addEventListener("input", () => {
+    try {
+      sessionStorage.setItem(TOKEN_KEY, input.value.trim());
+    } catch {
+      // storage refused (private mode): the field still works for this page
+    }
+  });
+}
+
+/** One sentence for the user about ``err`` (an ApiError or anything thrown). */
+export function explain(err, what = "the request") {
+  if (!(err instanceof ApiError)) return `${what} failed: ${err && err.message ? err.message : err}`;
+  if (err.status === 401) {
+    return `${what} needs the server's token: paste it into the Token field ` +
+      "(skyroute serve prints it when it starts, or reads SKYROUTE_TOKEN).";
+  }
+  if (err.status === 403) return `the server refused the token (403): check the Token field.`;
+  if (err.status === 0) return `${what} failed: ${err.detail}.`;
+  return `${what} failed (${err.status}): ${err.detail}`;
+}
+
+let spec = null;
+
+/** The choices the server's OpenAPI schema lists for ``schema.property`` (so the pages
+ * offer what this server accepts); ``fallback`` when the schema cannot be read. */
+export async function choices(schema, property, fallback) {
+  try {
+    spec = spec || (await getJSON("/openapi.json"));
+    const prop = spec.components.schemas[schema].properties[property];
+    for (const s of [prop, ...(prop.anyOf || [])]) if (Array.isArray(s.enum)) return s.enum;
+  } catch {
+    // an older server or no schema: the pages' own list
+  }
+  return fallback;
+}

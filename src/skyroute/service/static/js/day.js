@@ -1,0 +1,281 @@
+// The delivery day page: a stored day's flight over the site (no-fly zones, confinement
+// area, shops, customers), animated move by move, with the orders and the money so far.
+//
+// Reads GET /days, /site.geojson, /days/{date} and /days/{date}/flightpath.geojson.
+
+import { ApiError, explain, getJSON } from "./api.js";
+import { Player } from "./player.js";
+import { fmt, h, pounds, say } from "./ui.js";
+import { MapView, bbox, dot, grow, label, localProjection } from "./view.js";
+
+const $ = (id) => document.getElementById(id);
+const status = $("status");
+const select = $("date");
+const tbody = document.querySelector("#orders tbody");
+
+let site = null; // {zones: [[ring, ...]], confinement: ring|null, home, shops, customers} in lon/lat
+let day = null; // the loaded day, see load()
+let proj = null;
+let t = 0;
+
+const view = new MapView($("map"), { draw: drawMap });
+const player = new Player({
+  play: $("play"), speed: $("speed"), slider: $("time"), output: $("time-text"),
+  describe: (x) => (day ? `move ${Math.floor(x)} of ${day.moves}` : "move 0 of 0"),
+  onTime: (x) => {
+    t = x;
+    update();
+  },
+  onEnd: () => {
+    if (day) {
+      say(status, `The flight of ${day.date} is over: ${day.report.orders_delivered} of ` +
+        `${day.report.orders_placed} orders delivered, ${fmt(day.report.money_pct, 1)} % of the money ` +
+        `in ${day.moves} moves.`, "ok");
+    }
+  },
+});
+
+function siteFrom(doc) {
+  const s = { zones: [], confinement: null, home: null, shops: [], customers: [] };
+  for (const f of doc.features || []) {
+    const p = f.properties || {};
+    const g = f.geometry;
+    if (!g) continue;
+    if (p.kind === "no_fly_zone") {
+      const polys = g.type === "Polygon" ? [g.coordinates] : g.type === "MultiPolygon" ? g.coordinates : [];
+      for (const poly of polys) s.zones.push({ rings: poly, name: p.name || "" });
+    } else if (p.kind === "confinement" && g.type === "Polygon") {
+      s.confinement = g.coordinates[0];
+    } else if (p.kind === "home") {
+      s.home = g.coordinates;
+    } else if (p.kind === "shop") {
+      s.shops.push({ at: g.coordinates, name: p.name || "shop" });
+    } else if (p.kind === "customer") {
+      s.customers.push({ at: g.coordinates, words: p.words || "" });
+    }
+  }
+  return s;
+}
+
+async function start() {
+  let days;
+  try {
+    days = await getJSON("/days");
+  } catch (err) {
+    say(status, explain(err, "Reading the stored days"), "error");
+    return;
+  }
+  try {
+    site = siteFrom(await getJSON("/site.geojson"));
+  } catch (err) {
+    site = null;
+    const why = err instanceof ApiError && err.status === 404 ? "the server was started without --data or --source"
+      : explain(err, "reading the site");
+    say(status, `No site to draw (${why}): the flight is shown alone.`, "info");
+  }
+  if (!days.length) {
+    select.replaceChildren(h("option", {}, "no stored days"));
+    say(status, "The store holds no delivery day yet: fly one with `skyroute deliver DATE --data DIR --db URL` " +
+      "or POST /jobs/deliver.", "info");
+    return;
+  }
+  select.replaceChildren(...days.map((d) => h("option", { value: d.date },
+    `${d.date} · ${d.money_pct === null ? "no orders" : `${fmt(d.money_pct, 1)} %`}`)));
+  select.disabled = false;
+  const wanted = new URLSearchParams(location.hash.slice(1)).get("date");
+  if (wanted && days.some((d) => d.date === wanted)) select.value = wanted;
+  select.addEventListener("change", () => load(select.value));
+  await load(select.value);
+}
+
+async function load(date) {
+  player.pause();
+  say(status, `Loading ${date}…`, "busy");
+  let detail, flight;
+  try {
+    [detail, flight] = await Promise.all([
+      getJSON(`/days/${encodeURIComponent(date)}`),
+      getJSON(`/days/${encodeURIComponent(date)}/flightpath.geojson`),
+    ]);
+  } catch (err) {
+    say(status, explain(err, `Reading ${date}`), "error");
+    return;
+  }
+  history.replaceState(null, "", `#date=${date}`);
+  const feature = flight.features[0];
+  const coords = feature.geometry ? feature.geometry.coordinates : [];
+  const props = feature.properties || {};
+  const moveOrders = props.orders || [];
+  const moves = props.moves ?? Math.max(coords.length - 1, 0);
+  // an order is delivered by its last move (the hover at the customer)
+  const doneAt = new Map();
+  moveOrders.forEach((no, k) => no && doneAt.set(no, k + 1));
+  const cost = new Map(detail.deliveries.map((d) => [d.order_no, d.cost_in_pence]));
+  const deliveries = detail.deliveries.map((d) => ({ ...d, at: doneAt.get(d.order_no) ?? moves }));
+  const battery = detail.report.settings && detail.report.settings.battery
+    ? detail.report.settings.battery : detail.report.moves + detail.report.moves_left;
+  day = { date, report: detail.report, orders: detail.orders || [], deliveries, coords, moves, battery, cost, doneAt };
+
+  // the plane: metres around the middle of everything drawn
+  const ll = [...coords];
+  if (site) {
+    if (site.confinement) ll.push(...site.confinement);
+    for (const z of site.zones) ll.push(...z.rings[0]);
+    for (const s of site.shops) ll.push(s.at);
+  }
+  for (const o of day.orders) if (o.lonlat) ll.push(o.lonlat);
+  if (!ll.length) ll.push([0, 0]);
+  const b = bbox(ll);
+  proj = localProjection((b[0] + b[2]) / 2, (b[1] + b[3]) / 2);
+  day.xy = coords.map(proj.fwd);
+  view.setBounds(grow(bbox(ll.map(proj.fwd)), 0.03, 5));
+
+  fillOrders();
+  player.load(moves, 1);
+  say(status, `${date}: ${moves} moves, ${detail.report.orders_delivered} of ${detail.report.orders_placed} ` +
+    `orders delivered, ${fmt(detail.report.money_pct, 1)} % of the money. Press Play to fly it.`, "ok");
+  $("s-final").textContent = `Report: ${detail.report.orders_invalid} invalid orders, ` +
+    `${detail.report.moves_left} moves of battery left at the end.`;
+}
+
+function fillOrders() {
+  const rank = { delivered: 0, not_delivered: 1, invalid: 2 };
+  const rows = [...day.orders].sort((a, b) =>
+    (rank[a.status] ?? 3) - (rank[b.status] ?? 3) ||
+    (day.doneAt.get(a.order_no) ?? 0) - (day.doneAt.get(b.order_no) ?? 0) ||
+    a.order_no.localeCompare(b.order_no));
+  day.rows = [];
+  tbody.replaceChildren(...rows.map((o) => {
+    const result = o.status === "delivered" ? h("span", { class: "tag ok" }, "delivered")
+      : o.status === "invalid" ? h("span", { class: "tag bad", title: o.reason || "" }, `invalid: ${o.reason || "?"}`)
+        : h("span", { class: "tag busy" }, "not delivered");
+    const flown = h("td", {});
+    const tr = h("tr", { dataset: { order: o.order_no, status: o.status } },
+      h("td", {}, h("code", {}, o.order_no)), h("td", {}, o.deliver_to),
+      h("td", { class: "num" }, o.items.length), h("td", { class: "num" }, pounds(o.value)),
+      h("td", {}, result), flown);
+    const at = o.status === "delivered" ? day.doneAt.get(o.order_no) : undefined;
+    day.rows.push({ tr, flown, at, done: null });
+    return tr;
+  }));
+}
+
+function update() {
+  if (!day) return;
+  const k = Math.floor(t);
+  let n = 0;
+  let money = 0;
+  for (const d of day.deliveries) {
+    if (d.at <= k) {
+      n += 1;
+      money += d.cost_in_pence;
+    }
+  }
+  $("s-moves").textContent = `${k} of ${day.moves}`;
+  $("s-orders").textContent = `${n} of ${day.report.orders_placed}`;
+  $("s-money").textContent = `${pounds(money)} of ${pounds(day.report.money_placed)}`;
+  $("s-pct").textContent = day.report.money_placed ? `${fmt((100 * money) / day.report.money_placed, 1)} %` : "–";
+  $("s-battery").textContent = `${day.battery - k} moves`;
+  for (const r of day.rows) {
+    const done = r.at !== undefined && r.at <= k;
+    if (done === r.done) continue;
+    r.done = done;
+    r.tr.classList.toggle("done", done);
+    r.flown.replaceChildren(r.at === undefined ? "–"
+      : done ? `✓ move ${r.at}` : h("span", { class: "pending" }, `at move ${r.at}`));
+  }
+  view.render();
+}
+
+function drawMap(ctx, v) {
+  if (!day) return;
+  const P = (ll) => v.px(proj.fwd(ll));
+  if (site) {
+    if (site.confinement) {
+      v.path(site.confinement.map(proj.fwd), true);
+      ctx.fillStyle = "#ffffff";
+      ctx.fill();
+      ctx.setLineDash([6, 4]);
+      ctx.strokeStyle = "#5b6475";
+      ctx.lineWidth = 1.5;
+      ctx.stroke();
+      ctx.setLineDash([]);
+    }
+    for (const z of site.zones) {
+      ctx.beginPath();
+      for (const ring of z.rings) {
+        ring.forEach((p, i) => {
+          const [x, y] = P(p);
+          if (i) ctx.lineTo(x, y);
+          else ctx.moveTo(x, y);
+        });
+        ctx.closePath();
+      }
+      ctx.fillStyle = "rgba(214, 69, 65, .22)";
+      ctx.fill("evenodd");
+      ctx.strokeStyle = "#b3261e";
+      ctx.lineWidth = 1;
+      ctx.stroke();
+    }
+  }
+  // customers of the day: blue, green once their order is delivered
+  const k = Math.floor(t);
+  for (const o of day.orders) {
+    if (!o.lonlat) continue;
+    const at = o.status === "delivered" ? day.doneAt.get(o.order_no) : undefined;
+    dot(ctx, P(o.lonlat), 4.5, at !== undefined && at <= k ? "#1b7a3d" : o.status === "delivered" ? "#0072b2" : "#8a8f99");
+  }
+  if (site) {
+    for (const s of site.shops) {
+      const [x, y] = P(s.at);
+      ctx.fillStyle = "#e69f00";
+      ctx.strokeStyle = "#fff";
+      ctx.lineWidth = 1.5;
+      ctx.fillRect(x - 5, y - 5, 10, 10);
+      ctx.strokeRect(x - 5, y - 5, 10, 10);
+      if (v.width > 500) label(ctx, s.name, [x + 8, y + 4], { font: "11px system-ui, sans-serif" });
+    }
+    if (site.home) {
+      const [x, y] = P(site.home);
+      ctx.fillStyle = "#1d2433";
+      ctx.beginPath();
+      ctx.moveTo(x, y - 8);
+      ctx.lineTo(x + 7, y);
+      ctx.lineTo(x + 5, y);
+      ctx.lineTo(x + 5, y + 6);
+      ctx.lineTo(x - 5, y + 6);
+      ctx.lineTo(x - 5, y);
+      ctx.lineTo(x - 7, y);
+      ctx.closePath();
+      ctx.fill();
+      label(ctx, "home", [x + 9, y + 4], { font: "bold 11px system-ui, sans-serif" });
+    }
+  }
+  // the flight so far, and the drone between two moves
+  const xy = day.xy;
+  if (xy.length) {
+    const i = Math.min(k, xy.length - 1);
+    const f = t - k;
+    const here = i + 1 < xy.length
+      ? [xy[i][0] + (xy[i + 1][0] - xy[i][0]) * f, xy[i][1] + (xy[i + 1][1] - xy[i][1]) * f] : xy[i];
+    v.path([...xy.slice(0, i + 1), here]);
+    ctx.strokeStyle = "#d55e00";
+    ctx.lineWidth = 1.6;
+    ctx.lineJoin = "round";
+    ctx.stroke();
+    const [x, y] = v.px(here);
+    ctx.beginPath();
+    ctx.arc(x, y, 7, 0, 2 * Math.PI);
+    ctx.fillStyle = "#d55e00";
+    ctx.fill();
+    ctx.strokeStyle = "#fff";
+    ctx.lineWidth = 2;
+    ctx.stroke();
+    ctx.beginPath();
+    ctx.arc(x, y, 2.5, 0, 2 * Math.PI);
+    ctx.fillStyle = "#fff";
+    ctx.fill();
+  }
+}
+
+start();

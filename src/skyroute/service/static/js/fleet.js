@@ -1,0 +1,299 @@
+// Fleet replay: a stored fleet run (or a new one, started as a job) replayed on a
+// minimap of airports, runways and gates, with a drone table and a package table that
+// follow the time slider, as the seed's testbed GUI and minimap did.
+//
+// Reads GET /fleet/runs, /fleet/runs/{id}, its tracks.csv, events.jsonl, fleet.geojson
+// and packages.csv; starts runs with POST /jobs/fleet and follows GET /jobs/{id}.
+
+import { ApiError, bindToken, choices, explain, getJSON, getText, postJSON } from "./api.js";
+import { EventFold, dronesAt, parseEvents, parseRoutes, parseTracks, trail } from "./fleetstate.js";
+import { Player } from "./player.js";
+import { PALETTE, clock, fmt, h, say } from "./ui.js";
+import { MapView, bbox, dot, grow, label, localProjection } from "./view.js";
+
+const $ = (id) => document.getElementById(id);
+const status = $("status");
+const jobStatus = $("job-status");
+const runSelect = $("run");
+const TRAIL_S = 90; // seconds of track drawn behind a flying drone
+const TABLE_EVERY_MS = 150; // table refreshes while playing
+const MAX_PACKAGE_ROWS = 60;
+
+let runs = [];
+let run = null; // {id, tracks, fold, ground, drones, horizon}
+let t = 0;
+let lastTables = 0;
+
+const view = new MapView($("map"), { draw: drawMap });
+const player = new Player({
+  play: $("play"), speed: $("speed"), slider: $("time"), output: $("time-text"),
+  describe: (x) => (run ? `${clock(x)} of ${clock(run.horizon)}` : "0:00"),
+  onTime: (x) => {
+    t = x;
+    view.render();
+    const now = performance.now();
+    if (!player.playing || now - lastTables > TABLE_EVERY_MS) {
+      lastTables = now;
+      tables();
+    }
+  },
+  onEnd: () => {
+    tables();
+    if (run) say(status, `Replay of ${run.name} finished at ${clock(run.horizon)}.`, "ok");
+  },
+});
+bindToken($("token"));
+
+function colour(d, count) {
+  if (count <= PALETTE.length) return PALETTE[d % PALETTE.length];
+  return `hsl(${(d * 137.508) % 360}, 65%, 42%)`;
+}
+
+function runLabel(r) {
+  const p = r.params || {};
+  const rep = r.report || {};
+  const hours = p.hours ?? rep.simulated_hours;
+  const seed = p.seed ?? (rep.settings || {}).seed;
+  const parts = [r.scenario || "scenario"];
+  if (hours !== undefined) parts.push(`${fmt(hours, 2)} h`);
+  if (seed !== undefined) parts.push(`seed ${seed}`);
+  if (rep.delivered !== undefined) parts.push(`${rep.delivered}/${rep.offered} delivered`);
+  return parts.join(" · ");
+}
+
+async function listRuns(select = null) {
+  try {
+    runs = await getJSON("/fleet/runs");
+  } catch (err) {
+    runSelect.replaceChildren(h("option", {}, "no runs"));
+    const why = err instanceof ApiError && err.status === 503 ? "fleet runs are not available on this server"
+      : explain(err, "Reading the fleet runs");
+    say(status, why.charAt(0).toUpperCase() + why.slice(1), "error");
+    return false;
+  }
+  if (!runs.length) {
+    runSelect.replaceChildren(h("option", {}, "no stored runs"));
+    runSelect.disabled = true;
+    say(status, "No fleet run is stored yet: start one below.", "info");
+    return false;
+  }
+  runSelect.replaceChildren(...runs.map((r) => h("option", { value: r.id }, runLabel(r))));
+  runSelect.disabled = false;
+  const wanted = select || new URLSearchParams(location.hash.slice(1)).get("run");
+  if (wanted && runs.some((r) => String(r.id) === wanted)) runSelect.value = wanted;
+  return true;
+}
+
+async function load(id) {
+  player.pause();
+  const entry = runs.find((r) => String(r.id) === String(id)) || { id };
+  const base = `/fleet/runs/${encodeURIComponent(id)}`;
+  say(status, `Loading run ${runLabel(entry)}…`, "busy");
+  let detail, tracksText, eventsText, geo, routesText;
+  try {
+    [detail, tracksText, eventsText, geo, routesText] = await Promise.all([
+      getJSON(`${base}?limit=1`), getText(`${base}/tracks.csv`), getText(`${base}/events.jsonl`),
+      getJSON(`${base}/fleet.geojson`),
+      getText(`${base}/packages.csv`).catch(() => null), // routes known from the start (else from events)
+    ]);
+  } catch (err) {
+    say(status, explain(err, "Reading the run"), "error");
+    return;
+  }
+  const scenario = [detail.scenario, (detail.params || {}).scenario, (entry.params || {}).scenario]
+    .find((s) => s && typeof s === "object" && s.home_lon !== undefined);
+  if (!scenario) {
+    say(status, "This run does not give its scenario's home (home_lon, home_lat): its tracks cannot be placed.", "error");
+    return;
+  }
+  let tracks;
+  try {
+    tracks = parseTracks(tracksText);
+  } catch (err) {
+    say(status, `tracks.csv: ${err.message}`, "error");
+    return;
+  }
+  const events = parseEvents(eventsText);
+  const proj = localProjection(scenario.home_lon, scenario.home_lat);
+  const ground = { airports: [], gates: [], runways: [] };
+  for (const f of geo.features || []) {
+    const p = f.properties || {};
+    const g = f.geometry;
+    if (!g) continue;
+    if (p.kind === "airport") ground.airports.push({ id: p.id, at: proj.fwd(g.coordinates) });
+    else if (p.kind === "gate") ground.gates.push({ airport: p.airport, gate: p.gate, at: proj.fwd(g.coordinates) });
+    else if (p.kind === "landing" || p.kind === "takeoff") {
+      ground.runways.push({ kind: p.kind, airport: p.airport, line: g.coordinates.map((c) => proj.fwd(c)) });
+    }
+  }
+  const rep = detail.report || entry.report || {};
+  const params = detail.params || entry.params || {};
+  let maxDrone = -1;
+  for (const d of tracks.byDrone.keys()) maxDrone = Math.max(maxDrone, d);
+  const drones = Math.max(maxDrone + 1, Number((rep.settings || {}).drones) || 0);
+  const lastEvent = events.length ? events[events.length - 1].t : 0;
+  const horizon = (params.hours ?? rep.simulated_hours) * 3600 ||
+    Math.max(tracks.n ? tracks.t[tracks.n - 1] : 0, lastEvent);
+  const pts = [...ground.airports.map((a) => a.at), ...ground.gates.map((g) => g.at), ...ground.runways.flatMap((r) => r.line)];
+  let b = bbox(pts);
+  for (let i = 0; i < tracks.n; i++) b = bbox([[tracks.east[i], tracks.north[i]]], b);
+  run = {
+    id, name: runLabel(entry), tracks, drones, horizon, ground,
+    fold: new EventFold(events, routesText ? parseRoutes(routesText) : null),
+  };
+  history.replaceState(null, "", `#run=${encodeURIComponent(id)}`);
+  $("s-scenario").textContent = `${scenario.name || entry.scenario || "–"}, ${params.scheduler || (rep.settings || {}).scheduler || "seed"} dispatch`;
+  $("s-size").textContent = `${ground.airports.length} airports, ${drones} drones`;
+  $("s-delivered").textContent = rep.delivered === undefined ? "–" : `${rep.delivered} of ${rep.offered} packages`;
+  $("s-rate").textContent = rep.delivered_per_hour === undefined ? "–" : `${fmt(rep.delivered_per_hour, 1)} delivered`;
+  $("s-safety").textContent = rep.loiters === undefined ? "–" : `${rep.loiters}, ${rep.conflicts}`;
+  view.setBounds(grow(b, 0.04, 50));
+  player.load(horizon, tracks.step);
+  say(status, `${run.name}: ${clock(horizon)} of flying, ${events.length} events. Press Play or move the time slider.`, "ok");
+}
+
+function tables() {
+  if (!run) return;
+  const fold = run.fold.at(t);
+  const drones = dronesAt(run.tracks, t, run.drones);
+  $("drones").querySelector("tbody").replaceChildren(...drones.map((d) => {
+    const p = fold.job.get(d.id);
+    const pk = p === undefined ? null : fold.packages.get(p);
+    const what = pk ? `#${p} ${pk.state === "carried" ? "carried" : "to fetch"}` : "–";
+    return h("tr", { dataset: { drone: d.id, phase: d.phase } },
+      h("td", { class: "num" }, h("span", { class: "swatch", style: `background:${colour(d.id, run.drones)}`, "aria-hidden": "true" }), d.id),
+      h("td", {}, d.phase), h("td", { class: "num" }, fmt(d.alt, 1)), h("td", {}, what),
+      h("td", { class: "num" }, d.north === null ? "–" : `${fmt(d.north, 0)}, ${fmt(d.east, 0)}`));
+  }));
+  const all = [...fold.packages.values()];
+  const count = { waiting: 0, assigned: 0, carried: 0, delivered: 0 };
+  for (const p of all) count[p.state] += 1;
+  const open = all.filter((p) => p.state !== "delivered").sort((a, b) => a.id - b.id);
+  const done = all.filter((p) => p.state === "delivered").sort((a, b) => b.since - a.since);
+  const shown = [...open, ...done].slice(0, MAX_PACKAGE_ROWS);
+  $("packages-caption").textContent = `Packages at ${clock(t)}: ${count.waiting} waiting, ${count.assigned} assigned, ` +
+    `${count.carried} carried, ${count.delivered} delivered` + (all.length > shown.length ? ` (first ${shown.length} shown)` : "");
+  const tag = { waiting: "tag busy", assigned: "tag", carried: "tag", delivered: "tag ok" };
+  $("packages").querySelector("tbody").replaceChildren(...shown.map((p) => h("tr", { dataset: { package: p.id, state: p.state } },
+    h("td", { class: "num" }, p.id), h("td", {}, p.from ?? "?"), h("td", {}, p.to ?? "?"),
+    h("td", {}, h("span", { class: tag[p.state] }, p.state)), h("td", { class: "num" }, p.drone ?? "–"))));
+}
+
+function drawMap(ctx, v) {
+  if (!run) return;
+  const g = run.ground;
+  ctx.lineCap = "butt";
+  for (const kind of ["takeoff", "landing"]) {
+    for (const r of g.runways.filter((x) => x.kind === kind)) {
+      v.path(r.line);
+      ctx.strokeStyle = kind === "landing" ? "#3b4252" : "#aab2c0";
+      ctx.lineWidth = 5;
+      ctx.stroke();
+    }
+  }
+  for (const gate of g.gates) {
+    const [x, y] = v.px(gate.at);
+    ctx.fillStyle = "#b3261e";
+    ctx.fillRect(x - 3, y - 3, 6, 6);
+  }
+  for (const a of g.airports) {
+    const [x, y] = v.px(a.at);
+    label(ctx, a.id, [x + 9, y - 9], { font: "bold 13px system-ui, sans-serif" });
+  }
+  const drones = dronesAt(run.tracks, t, run.drones);
+  ctx.lineCap = "round";
+  ctx.lineJoin = "round";
+  for (const d of drones) {
+    if (!d.flying) continue;
+    const pts = trail(run.tracks, d.id, t - TRAIL_S, t);
+    if (pts.length < 2) continue;
+    v.path(pts);
+    ctx.strokeStyle = colour(d.id, run.drones);
+    ctx.globalAlpha = 0.55;
+    ctx.lineWidth = 2;
+    ctx.stroke();
+    ctx.globalAlpha = 1;
+  }
+  const small = v.width < 500;
+  for (const d of drones) {
+    if (d.north === null) continue;
+    const at = v.px([d.east, d.north]);
+    const c = colour(d.id, run.drones);
+    if (d.flying) {
+      dot(ctx, at, small ? 5 : 6.5, c);
+      if (run.drones <= 30) label(ctx, String(d.id), [at[0] + 8, at[1] + 4], { font: "11px system-ui, sans-serif" });
+    } else {
+      ctx.beginPath();
+      ctx.arc(at[0], at[1], 4, 0, 2 * Math.PI);
+      ctx.strokeStyle = c;
+      ctx.lineWidth = 2;
+      ctx.stroke();
+    }
+  }
+}
+
+// -- new runs as jobs --------------------------------------------------------------
+$("job").addEventListener("submit", async (ev) => {
+  ev.preventDefault();
+  const body = {
+    preset: $("preset").value, scheduler: $("scheduler").value,
+    hours: Number($("hours").value), seed: Number($("seed").value),
+  };
+  $("start").disabled = true;
+  $("progress").value = 0;
+  say(jobStatus, "Submitting the run…", "busy");
+  let id;
+  try {
+    ({ id } = await postJSON("/jobs/fleet", body));
+  } catch (err) {
+    say(jobStatus, explain(err, "Starting the run"), "error");
+    if (err.status === 401 || err.status === 403) $("token").focus();
+    $("start").disabled = false;
+    return;
+  }
+  try {
+    await follow(id);
+  } finally {
+    $("start").disabled = false;
+  }
+});
+
+async function follow(id) {
+  for (;;) {
+    let job;
+    try {
+      job = await getJSON(`/jobs/${encodeURIComponent(id)}`);
+    } catch (err) {
+      say(jobStatus, explain(err, "Following the job"), "error");
+      return;
+    }
+    $("progress").value = job.progress || 0;
+    if (job.state === "failed") {
+      say(jobStatus, `The run failed: ${job.error || "no reason given"}`, "error");
+      return;
+    }
+    if (job.state === "done") {
+      const r = job.result || {};
+      const runId = r.fleet_run ?? r.run_id ?? r.id;
+      say(jobStatus, "The run is done and stored.", "ok");
+      if (runId !== undefined && (await listRuns(String(runId)))) await load(runSelect.value);
+      return;
+    }
+    say(jobStatus, `Job ${job.state}: ${fmt(100 * (job.progress || 0), 0)} %`, "busy");
+    await new Promise((resolve) => setTimeout(resolve, 500));
+  }
+}
+
+async function start() {
+  const [presets, schedulers] = await Promise.all([
+    choices("FleetJob", "preset", ["seed-3x3", "seed-9x9", "seed-18x9"]),
+    choices("FleetJob", "scheduler", ["seed", "optimal"]),
+  ]);
+  $("preset").replaceChildren(...presets.map((p) => h("option", { value: p }, p)));
+  $("scheduler").replaceChildren(...schedulers.map((s) => h("option", { value: s }, s)));
+  runSelect.addEventListener("change", () => load(runSelect.value));
+  view.setBounds([0, 0, 1000, 600]);
+  if (await listRuns()) await load(runSelect.value);
+}
+
+start();

@@ -1,0 +1,63 @@
+// Small DOM helpers shared by the pages: building elements (text only, never HTML from
+// data), the aria-live status line, number formats and file downloads.
+
+/** ``h("td", {class: "num"}, "12")``: an element with properties and children. */
+export function h(tag, props = {}, ...children) {
+  const el = document.createElement(tag);
+  for (const [k, v] of Object.entries(props || {})) {
+    if (v === null || v === undefined || v === false) continue;
+    if (k === "class") el.className = v;
+    else if (k === "dataset") Object.assign(el.dataset, v);
+    else if (k.startsWith("on")) el.addEventListener(k.slice(2), v);
+    else if (k in el && typeof v !== "string") el[k] = v;
+    else el.setAttribute(k, v === true ? "" : String(v));
+  }
+  for (const c of children.flat()) {
+    if (c === null || c === undefined || c === false) continue;
+    el.append(c instanceof Node ? c : document.createTextNode(String(c)));
+  }
+  return el;
+}
+
+/** Set the status line ``el`` (an aria-live region): kind info, ok, busy or error. */
+export function say(el, text, kind = "info") {
+  el.dataset.kind = kind;
+  el.textContent = text;
+}
+
+export function fmt(x, digits = 0) {
+  if (x === null || x === undefined || Number.isNaN(x)) return "–";
+  return Number(x).toLocaleString("en-GB", { minimumFractionDigits: digits, maximumFractionDigits: digits });
+}
+
+export function pounds(pence) {
+  return pence === null || pence === undefined ? "–" : `£${(pence / 100).toFixed(2)}`;
+}
+
+/** ``seconds`` as m:ss or h:mm:ss. */
+export function clock(seconds) {
+  const s = Math.max(0, Math.floor(seconds));
+  const hh = Math.floor(s / 3600);
+  const mm = Math.floor((s % 3600) / 60);
+  const ss = String(s % 60).padStart(2, "0");
+  return hh ? `${hh}:${String(mm).padStart(2, "0")}:${ss}` : `${mm}:${ss}`;
+}
+
+/** Offer ``text`` as a file download called ``name``. */
+export function download(name, text, type = "application/json") {
+  const url = URL.createObjectURL(new Blob([text], { type }));
+  const a = h("a", { href: url, download: name });
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 1000);
+}
+
+/** Replace a table body's rows. */
+export function fillRows(tbody, rows) {
+  tbody.replaceChildren(...rows);
+}
+
+/** Distinct colours for paths and drones (colour-blind friendly first eight: Okabe-Ito). */
+export const PALETTE = ["#0072b2", "#d55e00", "#009e73", "#cc79a7", "#e69f00", "#56b4e9",
+  "#7a5195", "#000000", "#8c564b", "#bcbd22"];

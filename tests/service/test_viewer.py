@@ -1,0 +1,296 @@
+"""The web viewer in a browser: Playwright driving Debian's Chromium (headless, no
+browser download) against the app served by uvicorn on 127.0.0.1, over the store of
+``skyroute deliver`` flying examples/lunch (plus a fleet run when ``skyroute.jobs`` is
+there). Each page loads without a console error, its main action works, and it is
+photographed at 1280x800 and 360x740 into artefacts/screenshots/ (look at them)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import socket
+import threading
+import time
+from pathlib import Path
+
+import httpx
+import pytest
+
+from tests.conftest import ROOT
+from tests.service.conftest import AUTH, DAY, EXAMPLE, TOKEN
+
+CHROMIUM = Path("/usr/bin/chromium")
+if not CHROMIUM.exists():
+    pytest.skip(f"browser tests: no Chromium at {CHROMIUM} (apt-get install chromium)",
+                allow_module_level=True)
+sync_api = pytest.importorskip("playwright.sync_api",
+                               reason="browser tests: playwright is not installed (dev extra)")
+
+SHOTS = ROOT / "artefacts" / "screenshots"
+VIEWPORTS = {"desktop": {"width": 1280, "height": 800}, "phone": {"width": 360, "height": 740}}
+FLEET_SEED = 1
+
+
+def _fleet_run(db: str) -> str | None:
+    """Store one short seed-3x3 run the way a fleet job does; its id (None without
+    skyroute.jobs)."""
+    try:
+        from skyroute.jobs.fleet import FleetTask, RunSpec, fly_fleet
+    except ImportError:
+        return None
+    from skyroute.fleet.scenario import preset
+    from skyroute.service.resources import make_engine
+
+    make_engine(db).dispose()  # the store at the newest migration (fleet_runs)
+    spec = RunSpec(preset("seed-3x3").model_dump(), 0.25, FLEET_SEED)
+    return fly_fleet(FleetTask(db, "viewer-test-run", None, spec))["id"]
+
+
+@pytest.fixture(scope="module")
+def server(lunch, tmp_path_factory):
+    """(base URL, fleet run id or None): the app on a free port of 127.0.0.1, in a
+    thread, over a copy of the lunch store with the examples/lunch site."""
+    import uvicorn
+
+    from skyroute.service.app import create_app
+    from skyroute.service.settings import Settings
+
+    folder = tmp_path_factory.mktemp("viewer")
+    source = Path(lunch[0].removeprefix("sqlite:///"))
+    db = f"sqlite:///{shutil.copy(source, folder / 'viewer.db')}"
+    run_id = _fleet_run(db)
+    app = create_app(Settings(db_url=db, data_dir=EXAMPLE, token=TOKEN))
+    sock = socket.socket()
+    sock.bind(("127.0.0.1", 0))
+    port = sock.getsockname()[1]
+    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    end = time.monotonic() + 20
+    while not server.started:
+        assert thread.is_alive() and time.monotonic() < end, "uvicorn did not start"
+        time.sleep(0.02)
+    yield f"http://127.0.0.1:{port}", run_id
+    server.should_exit = True
+    thread.join(10)
+    sock.close()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=str(CHROMIUM), headless=True)
+        yield b
+        b.close()
+
+
+@pytest.fixture(scope="module")
+def api(server):
+    with httpx.Client(base_url=server[0], headers=AUTH, timeout=60) as c:
+        yield c
+
+
+class Page:
+    """A page in a fresh context at one viewport, with every console error and uncaught
+    exception collected."""
+
+    def __init__(self, browser, url: str, size: str):
+        self.size = size
+        self.context = browser.new_context(viewport=VIEWPORTS[size], accept_downloads=True)
+        self.page = self.context.new_page()
+        self.errors: list[str] = []
+        self.closed = False
+        self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
+        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
+        self.page.goto(url)
+
+    def done(self, name: str) -> None:
+        """Check the page: no console error, nothing wider than the viewport; photograph it."""
+        p = self.page
+        assert not self.errors, self.errors
+        wide = p.evaluate("document.documentElement.scrollWidth - window.innerWidth")
+        assert wide <= 0, f"{name} at {self.size} is {wide}px wider than the viewport"
+        SHOTS.mkdir(parents=True, exist_ok=True)
+        p.screenshot(path=str(SHOTS / f"{name}-{self.size}.png"), full_page=True)
+        self.close()
+
+    def close(self) -> None:
+        if not self.closed:
+            self.closed = True
+            self.context.close()
+
+
+@pytest.fixture
+def open_page(browser, server):
+    pages = []
+
+    def make(path: str, size: str) -> Page:
+        pages.append(Page(browser, server[0] + path, size))
+        return pages[-1]
+
+    yield make
+    for pg in pages:
+        pg.close()
+
+
+def set_slider(page, selector: str, value: float) -> None:
+    page.eval_on_selector(
+        selector, "(e, v) => { e.value = v; e.dispatchEvent(new Event('input')); }", value)
+
+
+def click_canvas(page, fx: float, fy: float) -> None:
+    """A click at a share (fx, fy) of the map canvas, on whole pixels."""
+    canvas = page.locator("#map")
+    canvas.scroll_into_view_if_needed()
+    box = canvas.bounding_box()
+    page.mouse.click(round(box["x"] + fx * box["width"]), round(box["y"] + fy * box["height"]))
+
+
+@pytest.mark.parametrize("size", VIEWPORTS)
+def test_home_page_links_every_page(open_page, size):
+    pg = open_page("/", size)
+    links = pg.page.locator("nav a").evaluate_all("a => a.map(x => x.getAttribute('href'))")
+    assert links == ["/day.html", "/planner.html", "/world.html", "/fleet.html", "/docs"]
+    pg.done("home")
+
+
+@pytest.mark.parametrize("size", VIEWPORTS)
+def test_day_animates_to_its_end(open_page, api, size):
+    report = api.get(f"/days/{DAY}").json()["report"]
+    pg = open_page(f"/day.html#date={DAY}", size)
+    p = pg.page
+    p.wait_for_function("document.querySelector('#time').max > 0")
+    assert p.input_value("#date") == DAY
+    assert p.locator("#orders tbody tr").count() == report["orders_placed"]
+    p.select_option("#speed", "1000")
+    p.click("#play")
+    p.wait_for_function("(t => t.value === t.max)(document.querySelector('#time'))"
+                        " && document.querySelector('#play').textContent === 'Play'",
+                        timeout=15_000)
+    moves = report["moves"]
+    assert p.inner_text("#time-text") == f"move {moves} of {moves}"
+    assert p.inner_text("#s-pct") == f"{report['money_pct']:.1f} %"
+    assert p.inner_text("#s-orders") == f"{report['orders_delivered']} of {report['orders_placed']}"
+    assert p.locator("#orders tbody tr.done").count() == report["orders_delivered"]
+    assert "is over" in p.inner_text("#status")
+    if size == "phone":  # the picture halfway through
+        set_slider(p, "#time", moves // 2)
+        assert p.inner_text("#time-text") == f"move {moves // 2} of {moves}"
+    pg.done("day")
+
+
+def _free_cells(rows: list[str], passable: str) -> list[tuple[int, int]]:
+    """Cells whose 5x5 neighbourhood is passable (a click a pixel off still lands on one)."""
+    h, w = len(rows), len(rows[0])
+    ok = [[c in passable for c in row] for row in rows]
+    return [(x, y) for y in range(2, h - 2) for x in range(2, w - 2)
+            if all(ok[y + j][x + i] for i in range(-2, 3) for j in range(-2, 3))]
+
+
+@pytest.mark.parametrize("size", VIEWPORTS)
+def test_planner_click_pair_matches_post_plan(open_page, api, size):
+    doc = api.get("/maps/den312d").json()
+    free = _free_cells(doc["rows"], doc["passable"])
+    start, goal = min(free, key=lambda c: c[0] + c[1]), max(free, key=lambda c: c[0] + c[1])
+    api.post("/plan", json={"map": "den312d", "start": start, "goal": goal})  # compiled, warm
+    pg = open_page("/planner.html", size)
+    p = pg.page
+    p.wait_for_function("document.querySelector('#map-name').options.length > 1")
+    p.fill("#token", TOKEN)
+    p.select_option("#map-name", "den312d")
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('den312d')")
+    blank = p.evaluate("document.querySelector('#map').toDataURL()")
+    for x, y in (start, goal):
+        click_canvas(p, (x + 0.5) / doc["width"], (y + 0.5) / doc["height"])
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'"
+                        " && document.querySelector('#status').textContent.startsWith('Planned')",
+                        timeout=30_000)
+    cells = [int(p.input_value(f"#{k}")) for k in ("sx", "sy", "gx", "gy")]
+    assert max(abs(a - b) for a, b in zip(cells, [*start, *goal], strict=True)) <= 1, cells
+    rows = p.locator("#results tbody tr")
+    algorithms = rows.evaluate_all("r => r.map(x => x.dataset.algorithm)")
+    assert algorithms == ["astar", "jps", "theta"]
+    for k, name in enumerate(algorithms):
+        want = api.post("/plan", json={"map": "den312d", "start": cells[:2], "goal": cells[2:],
+                                       "algorithm": name, "corner_cutting": False}).json()
+        row = rows.nth(k)
+        assert want["status"] == "found"
+        assert float(row.get_attribute("data-cost")) == want["cost"], name
+        assert int(row.get_attribute("data-expanded")) == want["expanded"], name
+    assert p.evaluate("document.querySelector('#map').toDataURL()") != blank  # paths drawn
+    pg.done("planner")
+
+
+def test_planner_without_a_token_says_so(open_page):
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'")
+    p.fill("#token", "")
+    p.fill("#sx", "1")
+    p.fill("#sy", "1")
+    p.fill("#gx", "2")
+    p.fill("#gy", "2")
+    p.click("#run")
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'error'")
+    assert "needs the server's token" in p.inner_text("#status")
+    assert p.evaluate("document.activeElement.id") == "token"
+    p.fill("#token", "wrong")
+    p.click("#run")
+    p.wait_for_function("document.querySelector('#status').textContent.includes('403')")
+    assert all("401" in e or "403" in e for e in pg.errors), pg.errors  # the refused requests
+
+
+@pytest.mark.parametrize("size", VIEWPORTS)
+def test_world_draws_a_path_and_offers_waypoints(open_page, api, size):
+    pg = open_page("/world.html", size)
+    p = pg.page
+    p.wait_for_function("document.querySelector('#algorithm').options.length > 0")
+    p.fill("#token", TOKEN)
+    p.set_input_files("#file", str(ROOT / "examples" / "city.csv"))
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('city.csv')")
+    blank = p.evaluate("document.querySelector('#map').toDataURL()")
+    click_canvas(p, 0.05, 0.05)
+    click_canvas(p, 0.95, 0.95)
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('Found')",
+                        timeout=30_000)
+    start = [float(p.input_value("#s0")), float(p.input_value("#s1"))]
+    goal = [float(p.input_value("#g0")), float(p.input_value("#g1"))]
+    want = api.post("/plan", json={"world_text": (ROOT / "examples" / "city.csv").read_text(),
+                                   "world_format": "colliders", "frame": "ned", "start": start,
+                                   "goal": goal, "algorithm": "visibility", "altitude": 5,
+                                   "safety": 5}).json()
+    assert p.inner_text("#r-cost") == f"{want['cost']:,.2f} m"
+    assert p.locator("#waypoints tbody tr").count() == len(want["waypoints"])
+    assert p.evaluate("document.querySelector('#map').toDataURL()") != blank
+    with p.expect_download() as download:
+        p.click("#dl-waypoints")
+    got = json.loads(Path(download.value.path()).read_text())
+    assert got == want["waypoints"]
+    pg.done("world")
+
+
+@pytest.mark.parametrize("size", VIEWPORTS)
+def test_fleet_replay_moves_drones_with_the_slider(open_page, server, size):
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree (jobs branch not merged): no fleet run")
+    pg = open_page(f"/fleet.html#run={server[1]}", size)
+    p = pg.page
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    assert p.input_value("#run") == server[1]
+    assert p.locator("#drones tbody tr").count() == 3
+
+    def drones() -> list[str]:
+        return p.locator("#drones tbody tr").evaluate_all("r => r.map(x => x.innerText)")
+
+    set_slider(p, "#time", 100)
+    before, picture = drones(), p.evaluate("document.querySelector('#map').toDataURL()")
+    set_slider(p, "#time", 400)
+    after = drones()
+    assert after != before and any("cruise" in d or "climb" in d for d in after), after
+    assert p.evaluate("document.querySelector('#map').toDataURL()") != picture
+    assert p.locator("#packages tbody tr").count() > 0
+    assert "delivered" in p.inner_text("#packages-caption")
+    p.click("#play")
+    p.wait_for_function("Number(document.querySelector('#time').value) > 400")
+    p.click("#play")  # pause for the picture
+    pg.done("fleet")
