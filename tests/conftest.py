@@ -93,14 +93,16 @@ def _site_key(source) -> object:
 def fly_once(monkeypatch, _flown_days):
     """``plan_day`` flying each delivery day once per session, put in place of the one
     ``skyroute deliver`` calls: a day of the same site (see ``_site_key``), date, orders,
-    method and battery is the first flight of it. ``--jobs N`` workers are forked from the
-    test's process and so reuse the days flown before them too. For tests of what is done
+    method and battery is the first flight of it. It reaches the days run in the test's
+    own process (``--jobs 1``); spawned ``--jobs N`` workers and Dask workers fly theirs
+    (skyroute.jobs.deliver calls ``plan_day`` there). For tests of what is done
     with a day (tables, files, stores, worker processes); every stored move of the
     synthetic and ILP days is checked independently (tests/delivery/flight_check.py) by
     the synthetic range and the ILP marker-day tests. Run alone, a test flies its days.
     Not for tests that change the planner's inputs by other means (e.g. a patched leg
     table): the key would not see it."""
-    from skyroute.delivery import day, days
+    from skyroute.delivery import day
+    from skyroute.jobs import deliver
 
     def plan_day(site, date, orders, *, method="milp", battery=day.BATTERY):
         key = (_site_key(site.source), date, tuple(orders), method, battery)
@@ -109,7 +111,7 @@ def fly_once(monkeypatch, _flown_days):
                                             battery=battery)
         return _flown_days[key]
 
-    monkeypatch.setattr(days, "plan_day", plan_day)
+    monkeypatch.setattr(deliver, "plan_day", plan_day)
     return plan_day
 
 
