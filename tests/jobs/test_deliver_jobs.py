@@ -45,7 +45,7 @@ def stored(engine, dates) -> dict:
 
 def test_local_and_dask_store_the_same_rows(tmp_path, dask_executor):
     with open_executor("local", workers=1) as local:
-        a, ra, seen_a = fly(tmp_path, "local", local)
+        a, ra, _ = fly(tmp_path, "local", local)
     b, rb, seen_b = fly(tmp_path, "dask", dask_executor)
     dates = [dt.date(2024, 1, 1), dt.date(2024, 1, 2)]
     assert [r.date for r in ra] == [r.date for r in rb] == dates  # in date order
@@ -100,3 +100,14 @@ def test_deliver_params_are_completed():
     assert check_params({"date": "2024-01-03", "source": "http://h:9898"}) == {
         "from": "2024-01-03", "to": "2024-01-03", "method": "milp",
         "source": "http://h:9898"}
+
+
+def test_dask_workers_write_to_postgresql_what_sqlite_holds(tmp_path, pg_url, dask_executor):
+    with open_executor("local", workers=1) as local:
+        lite, _, _ = fly(tmp_path, "lite", local)
+    engine = lunch_store(pg_url, DATES)
+    by_date = days_between(engine, dt.date(2024, 1, 1), dt.date(2024, 1, 2))
+    run_days(engine, DirSource(EXAMPLE), by_date, executor=dask_executor)
+    dates = list(by_date)
+    assert stored(engine, dates) == stored(lite, dates)
+    engine.dispose()

@@ -82,7 +82,7 @@ def test_a_jobs_life(engine):
     job = store.get_job(engine, other)
     assert job["state"] == "failed" and job["error"] == "scenario.airports: too few (see the docs)"
     assert store.get_job(engine, "no-such-id") is None
-    with pytest.raises(OptionError, match="progress=1.5 must be within 0..1"):
+    with pytest.raises(OptionError, match=r"progress=1.5 must be within 0\.\.1"):
         store.set_progress(engine, job_id, 1.5)
 
 

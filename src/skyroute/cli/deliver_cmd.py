@@ -75,35 +75,36 @@ def deliver_command(
     src = open_source(data, source)
     site = load_site(src)
     engine = open_store(db)
-    err = Console(stderr=True)
-    if data is not None:
-        added, _ = import_orders(engine, read_csv_orders(data))
-        if added:
-            err.print(f"imported {added:,} orders from {data / 'database'}")
-    elif not order_dates(engine):
-        raise SkyrouteError(f"{db}: no orders stored; load them with 'skyroute db import DIR' "
-                            "or give --data DIR")
-    by_date = days_between(engine, d0, d1)
-    all_orders = [o for v in by_date.values() for o in v]
-    with progress_bar(err) as progress:
-        task = progress.add_task("leg table", total=None)
-        prepare_legs(site, all_orders, on_leg=lambda: progress.advance(task),
-                     on_total=lambda n: progress.update(task, total=n))
-        progress.remove_task(task)
-        days = progress.add_task("days", total=len(by_date))
-        t0 = time.perf_counter()
-        draw = (day is not None) if plot is None else plot
+    # the executor before any work: a wrong --dask address fails at once
+    with open_from_flags(executor, dask, jobs, (d1 - d0).days + 1) as ex:
+        err = Console(stderr=True)
+        if data is not None:
+            added, _ = import_orders(engine, read_csv_orders(data))
+            if added:
+                err.print(f"imported {added:,} orders from {data / 'database'}")
+        elif not order_dates(engine):
+            raise SkyrouteError(f"{db}: no orders stored; load them with 'skyroute db "
+                                "import DIR' or give --data DIR")
+        by_date = days_between(engine, d0, d1)
+        all_orders = [o for v in by_date.values() for o in v]
+        with progress_bar(err) as progress:
+            task = progress.add_task("leg table", total=None)
+            prepare_legs(site, all_orders, on_leg=lambda: progress.advance(task),
+                         on_total=lambda n: progress.update(task, total=n))
+            progress.remove_task(task)
+            days = progress.add_task("days", total=len(by_date))
+            t0 = time.perf_counter()
+            draw = (day is not None) if plot is None else plot
 
-        def finished(r: DayResult) -> None:
-            if out is not None:
-                write_outputs(site, r, out, plot=draw)
-            progress.advance(days)
+            def finished(r: DayResult) -> None:
+                if out is not None:
+                    write_outputs(site, r, out, plot=draw)
+                progress.advance(days)
 
-        with open_from_flags(executor, dask, jobs, len(by_date)) as ex:
             results = run_days(engine, src, by_date, executor=ex, method=method,
                                on_day=finished)
-            workers = ex.workers
-        wall = time.perf_counter() - t0
+            wall = time.perf_counter() - t0
+        workers = ex.workers
     if day is not None:
         _one_day(results[0], out, as_json)
     else:
