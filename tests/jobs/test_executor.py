@@ -65,3 +65,23 @@ def test_a_scheduler_that_does_not_answer_is_an_error_within_the_timeout(monkeyp
         open_executor("dask", address="tcp://127.0.0.1:9")
     assert err.value.param == "address" and time.perf_counter() - t0 < 10
     assert not isinstance(err.value, OptionError)
+
+
+def test_an_existing_scheduler_runs_the_tasks(dask_executor):
+    address = dask_executor.client.scheduler.address
+    with open_executor("dask", address=address, workers=5) as ex:  # workers: unused
+        assert ex.workers == 2 and ex.map(math.sqrt, [16.0, 9.0]) == [4.0, 3.0]
+
+
+def test_another_skyroute_on_the_cluster_is_refused(dask_executor, monkeypatch):
+    import importlib.metadata
+
+    real = importlib.metadata.version
+    monkeypatch.setattr(importlib.metadata, "version",
+                        lambda name: "9.9" if name == "skyroute" else real(name))
+    address = dask_executor.client.scheduler.address
+    with pytest.raises(SkyrouteError) as err:
+        open_executor("dask", address=address)
+    assert str(err.value) == (f"address={address!r}: the scheduler has skyroute "
+                              f"{real('skyroute')}, this machine 9.9; install the same "
+                              "skyroute on the scheduler and every worker")

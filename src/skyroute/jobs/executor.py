@@ -160,6 +160,31 @@ class DaskExecutor(_Executor):
                 raise SkyrouteError(f"address={address!r}: no Dask scheduler there "
                                     f"({reason}); expected tcp://HOST:8786",
                                     param="address") from None
+            try:
+                self._check_versions()
+            except BaseException:
+                self.client.close()
+                raise
+
+    def _check_versions(self) -> None:
+        """The scheduler and every worker must have this skyroute: the tasks name its
+        functions, and a worker that cannot import them dies reading the task."""
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            mine = version("skyroute")
+        except PackageNotFoundError:  # running from a source tree: nothing to compare
+            return
+        v = self.client.get_versions(packages=["skyroute"])
+        where = [("the scheduler", v["scheduler"]["packages"].get("skyroute"))]
+        where += [(f"worker {w}", info["packages"].get("skyroute"))
+                  for w, info in sorted(v["workers"].items())]
+        for name, theirs in where:
+            if theirs != mine:
+                raise SkyrouteError(
+                    f"address={self.address!r}: {name} has skyroute "
+                    f"{theirs or '(not installed)'}, this machine {mine}; install the same "
+                    "skyroute on the scheduler and every worker", param="address")
 
     def __repr__(self) -> str:
         where = self.address or "LocalCluster"
@@ -187,6 +212,13 @@ class DaskExecutor(_Executor):
                 out[i] = f.result()
                 if on_result:
                     on_result(i, out[i])
+        except RuntimeError as exc:
+            self.client.cancel(futures)
+            if "deserializ" not in str(exc):
+                raise
+            raise SkyrouteError(f"the Dask scheduler at {self.client.scheduler.address} "
+                                "cannot read skyroute's tasks; install the same skyroute on "
+                                "the scheduler and every worker") from None
         except BaseException:
             self.client.cancel(futures)
             raise
