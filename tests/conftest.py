@@ -93,23 +93,25 @@ def _site_key(source) -> object:
 def fly_once(monkeypatch, _flown_days):
     """``plan_day`` flying each delivery day once per session, put in place of the one
     ``skyroute deliver`` calls: a day of the same site (see ``_site_key``), date, orders,
-    method and battery is the first flight of it. ``--jobs N`` workers are forked from the
-    test's process and so reuse the days flown before them too. For tests of what is done
+    method and battery is the first flight of it. It reaches the days run in the test's
+    own process (``--jobs 1``); spawned ``--jobs N`` workers and Dask workers fly theirs
+    (skyroute.jobs.deliver calls ``plan_day`` there). For tests of what is done
     with a day (tables, files, stores, worker processes); every stored move of the
     synthetic and ILP days is checked independently (tests/delivery/flight_check.py) by
     the synthetic range and the ILP marker-day tests. Run alone, a test flies its days.
     Not for tests that change the planner's inputs by other means (e.g. a patched leg
     table): the key would not see it."""
-    from skyroute.delivery import days
+    from skyroute.jobs import deliver
 
     plan_day = caching_plan_day(_flown_days)
-    monkeypatch.setattr(days, "plan_day", plan_day)
+    monkeypatch.setattr(deliver, "plan_day", plan_day)
     return plan_day
 
 
 def caching_plan_day(flown: dict):
     """``plan_day`` that flies each day once into ``flown`` (see ``fly_once``); for
-    fixtures wider than a test, which patch it in with ``pytest.MonkeyPatch.context()``."""
+    fixtures wider than a test, which patch it in (at ``skyroute.jobs.deliver``) with
+    ``pytest.MonkeyPatch.context()``."""
     from skyroute.delivery import day
 
     def plan_day(site, date, orders, *, method="milp", battery=day.BATTERY):

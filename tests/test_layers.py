@@ -22,7 +22,7 @@ LAYERS = [
     {"motion"},
     {"delivery", "fleet"},
     {"io"},
-    {"bench"},
+    {"bench", "jobs"},
     {"cli", "service", "__main__", "__init__"},
 ]
 RANK = {name: i for i, names in enumerate(LAYERS) for name in names}

@@ -8,9 +8,10 @@ import pytest
 import yaml
 
 from skyroute.bench.fleet import bench_case
-from skyroute.cli.fleet_cmd import mean_ci, parse_seeds
+from skyroute.cli.fleet_cmd import parse_seeds
 from skyroute.fleet.report import FIELDS
 from skyroute.fleet.scenario import load_scenario
+from skyroute.jobs.fleet import mean_ci
 from tests.cli.test_cli import run
 
 

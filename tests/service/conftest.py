@@ -55,12 +55,12 @@ def lunch(tmp_path_factory, _flown_days):
     """(db URL, the CLI's report of DAY, its GeoJSON file's text, the out folder): the
     day flown by ``skyroute deliver DAY --data examples/lunch``, plus 2024-02-01 (a day
     without orders)."""
-    from skyroute.delivery import days
+    from skyroute.jobs import deliver
 
     folder = tmp_path_factory.mktemp("lunch")
     db = f"sqlite:///{folder / 'lunch.db'}"
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(days, "plan_day", caching_plan_day(_flown_days))
+        mp.setattr(deliver, "plan_day", caching_plan_day(_flown_days))
         code, out = cli("deliver", DAY, "--data", str(EXAMPLE), "--db", db, "--out",
                         str(folder), "--no-plot", "--json")
         assert code == 0, out

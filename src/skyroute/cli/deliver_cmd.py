@@ -5,7 +5,6 @@ from __future__ import annotations
 import datetime as dt
 import json
 import time
-from collections import defaultdict
 from pathlib import Path
 from typing import Annotated
 
@@ -13,6 +12,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
 from skyroute.cli.tables import progress_bar
 from skyroute.delivery.day import METHODS, DayResult
 from skyroute.delivery.store import DEFAULT_DB
@@ -42,6 +42,8 @@ def deliver_command(
     out: Annotated[Path, typer.Option(help="Folder for the GeoJSON, PNG and report files.")] =
         Path("."),
     jobs: Annotated[int, typer.Option(help="Worker processes for a range of days.")] = 1,
+    executor: Executor = None,
+    dask: DaskAddress = None,
     method: Annotated[str, typer.Option(help="milp (exact over the leg table) or greedy.")] =
         "milp",
     plot: Annotated[bool | None, typer.Option(
@@ -52,12 +54,13 @@ def deliver_command(
 
     Stores deliveries and flightpath; writes drone-DD-MM-YYYY.geojson, a report, a map.
     """
-    from skyroute.delivery.days import open_store, prepare_legs, run_days
+    from skyroute.delivery.days import open_store, prepare_legs
     from skyroute.delivery.orders import read_csv_orders
     from skyroute.delivery.site import load_site
     from skyroute.delivery.source import open_source
-    from skyroute.delivery.store import import_orders, order_dates, orders_between
+    from skyroute.delivery.store import import_orders, order_dates
     from skyroute.io.day_out import write_outputs
+    from skyroute.jobs.deliver import days_between, run_days
 
     check_choice("method", method, METHODS)
     day, d0, d1 = _date(date, "DATE"), _date(first, "--from"), _date(last, "--to")
@@ -68,44 +71,44 @@ def deliver_command(
         d0 = d1 = day
     if d1 < d0:
         raise OptionError(f"--to {d1} is before --from {d0}")
-    if jobs < 1:
-        raise OptionError(f"--jobs {jobs} must be at least 1")
+    executor_kind(executor, dask, jobs)
     src = open_source(data, source)
     site = load_site(src)
     engine = open_store(db)
-    err = Console(stderr=True)
-    if data is not None:
-        added, _ = import_orders(engine, read_csv_orders(data))
-        if added:
-            err.print(f"imported {added:,} orders from {data / 'database'}")
-    elif not order_dates(engine):
-        raise SkyrouteError(f"{db}: no orders stored; load them with 'skyroute db import DIR' "
-                            "or give --data DIR")
-    by_date = orders_between(engine, d0, d1)
-    for d in (d0 + dt.timedelta(k) for k in range((d1 - d0).days + 1)):
-        by_date.setdefault(d, [])
-    all_orders = [o for v in by_date.values() for o in v]
-    with progress_bar(err) as progress:
-        task = progress.add_task("leg table", total=None)
-        prepare_legs(site, all_orders, on_leg=lambda: progress.advance(task),
-                     on_total=lambda n: progress.update(task, total=n))
-        progress.remove_task(task)
-        days = progress.add_task("days", total=len(by_date))
-        t0 = time.perf_counter()
-        draw = (day is not None) if plot is None else plot
+    # the executor before any work: a wrong --dask address fails at once
+    with open_from_flags(executor, dask, jobs, (d1 - d0).days + 1) as ex:
+        err = Console(stderr=True)
+        if data is not None:
+            added, _ = import_orders(engine, read_csv_orders(data))
+            if added:
+                err.print(f"imported {added:,} orders from {data / 'database'}")
+        elif not order_dates(engine):
+            raise SkyrouteError(f"{db}: no orders stored; load them with 'skyroute db "
+                                "import DIR' or give --data DIR")
+        by_date = days_between(engine, d0, d1)
+        all_orders = [o for v in by_date.values() for o in v]
+        with progress_bar(err) as progress:
+            task = progress.add_task("leg table", total=None)
+            prepare_legs(site, all_orders, on_leg=lambda: progress.advance(task),
+                         on_total=lambda n: progress.update(task, total=n))
+            progress.remove_task(task)
+            days = progress.add_task("days", total=len(by_date))
+            t0 = time.perf_counter()
+            draw = (day is not None) if plot is None else plot
 
-        def finished(r: DayResult) -> None:
-            if out is not None:
-                write_outputs(site, r, out, plot=draw)
-            progress.advance(days)
+            def finished(r: DayResult) -> None:
+                if out is not None:
+                    write_outputs(site, r, out, plot=draw)
+                progress.advance(days)
 
-        results = run_days(site, engine, by_date, jobs=jobs, method=method, on_day=finished)
-        wall = time.perf_counter() - t0
+            results = run_days(engine, src, by_date, executor=ex, method=method,
+                               on_day=finished)
+            wall = time.perf_counter() - t0
+        workers = ex.workers
     if day is not None:
         _one_day(results[0], out, as_json)
     else:
-        _summary(results, wall, jobs, as_json)
-
+        _summary(results, wall, jobs, workers, ex.kind, as_json)
 
 
 def _one_day(r: DayResult, out: Path, as_json: bool) -> None:
@@ -129,34 +132,19 @@ def _one_day(r: DayResult, out: Path, as_json: bool) -> None:
         Console(stderr=True).print(f"invalid order {o.order_no}: {reason}", markup=False)
 
 
-def summarise(results: list[DayResult]) -> dict:
-    """Mean and minimum money % over the days with orders, and per month."""
-    pcts = [(r.date, r.money_pct) for r in results if r.money_pct is not None]
-    if not pcts:
-        return {"days": len(results), "days_with_orders": 0}
-    months = defaultdict(list)
-    for d, p in pcts:
-        months[f"{d:%Y-%m}"].append(p)
-    worst = min(pcts, key=lambda x: x[1])
-    return {"days": len(results), "days_with_orders": len(pcts),
-            "mean_pct": sum(p for _, p in pcts) / len(pcts), "min_pct": worst[1],
-            "min_date": worst[0].isoformat(),
-            "months": {m: {"mean_pct": sum(v) / len(v), "min_pct": min(v), "days": len(v)}
-                       for m, v in sorted(months.items())},
-            "moves_max": max(r.flight.moves for r in results),
-            "seconds_per_day_mean": sum(r.seconds for r in results) / len(results),
-            "seconds_per_day_max": max(r.seconds for r in results)}
+def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kind: str,
+             as_json: bool) -> None:
+    from skyroute.jobs.deliver import summarise
 
-
-def _summary(results: list[DayResult], wall: float, jobs: int, as_json: bool) -> None:
     s = summarise(results)
-    s["wall_seconds"], s["jobs"] = wall, jobs
+    s.update(wall_seconds=wall, jobs=jobs, executor=kind, workers=workers)
     if as_json:
         typer.echo(json.dumps(s))
         return
     if not s["days_with_orders"]:
         raise SkyrouteError("no orders on any of these days")
-    t = Table(title=f"{s['days']} days, {wall:.1f} s with {jobs} job(s): money delivered "
+    who = f"{workers} job(s)" if kind == "local" else f"{workers} Dask worker(s)"
+    t = Table(title=f"{s['days']} days, {wall:.1f} s with {who}: money delivered "
                     f"mean {s['mean_pct']:.2f}%, worst {s['min_pct']:.2f}% on {s['min_date']}")
     for col in ("month", "days", "mean %", "min %"):
         t.add_column(col, justify="right")

@@ -14,7 +14,7 @@ EXIT_BAD_INPUT = 2
 
 # Library parameters whose CLI flag is not simply --name-with-dashes.
 FLAG_OF = {"url": "--db", "names": "--map", "waypoints_out": "--waypoints",
-           "mode": "--field-mode"}
+           "mode": "--field-mode", "address": "--dask", "workers": "--jobs"}
 
 
 def in_flags(exc: SkyrouteError) -> str:

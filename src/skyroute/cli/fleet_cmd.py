@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-import multiprocessing
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Annotated
 
@@ -13,6 +11,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
 from skyroute.cli.tables import progress_bar, wide_console
 from skyroute.errors import OptionError, check_choice
 from skyroute.fleet.scenario import PRESETS, Scenario, generate, load_scenario, preset, to_yaml
@@ -241,35 +240,6 @@ def _rates(text: str | None) -> list[float | None]:
     return rates
 
 
-def _one(args: tuple) -> dict:
-    """One run of a sweep (in a worker process): its report without the settings."""
-    from skyroute.fleet.report import report
-    from skyroute.fleet.simulate import run
-
-    data, hours, seed, scheduler, airspace, rate = args
-    sim = run(Scenario.model_validate(data), hours=hours, seed=seed, scheduler=scheduler,
-              airspace=airspace, rate_per_hour=rate)
-    return report(sim)
-
-
-def mean_ci(values: list[float]) -> tuple[float, float]:
-    """Mean and the half-width of its 95% confidence interval (Student's t)."""
-    from scipy.stats import t as student
-
-    x = [v for v in values if v is not None]
-    if not x:
-        return math.nan, math.nan
-    m = sum(x) / len(x)
-    if len(x) < 2:
-        return m, math.nan
-    sd = math.sqrt(sum((v - m) ** 2 for v in x) / (len(x) - 1))
-    return m, float(student.ppf(0.975, len(x) - 1)) * sd / math.sqrt(len(x))
-
-
-SWEEP_METRICS = ("delivered_per_hour", "served_share", "p95_delivery_s", "max_wait_s",
-                 "loiters", "capacity_bound_per_hour")
-
-
 @fleet_app.command("sweep")
 def sweep_command(
     scenario: ScenarioFile = None,
@@ -286,50 +256,31 @@ def sweep_command(
     seeds: Annotated[str, typer.Option(help="Seeds, like 0-29 or 1,4,7.")] = "0-9",
     hours: Hours = 4.0,
     jobs: Annotated[int, typer.Option(help="Worker processes.")] = 1,
+    executor: Executor = None,
+    dask: DaskAddress = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the rows as JSON.")] = False,
 ) -> None:
     """Run every scheduler x airspace x rate on every seed (the same package streams for
     each setting); one table of means with 95% confidence intervals."""
+    from skyroute.jobs.fleet import sweep
+
     scheds = _choices(scheduler, "--scheduler", SCHEDULERS)
     spaces = _choices(airspace, "--airspace", AIRSPACES)
     rate_list = _rates(rates)
     seed_list = parse_seeds(seeds)
     _number("hours", hours, low=0, strict=True)
-    if jobs < 1:
-        raise OptionError(f"--jobs {jobs} must be at least 1")
+    executor_kind(executor, dask, jobs)
     s = resolve_scenario(scenario, preset_name, airports, drones, area_km, 0)
     if scenario is not None and s.packages.csv is not None:
         raise OptionError("sweep runs Poisson streams; this scenario names a package CSV")
-    data = s.model_dump()
-    configs = [(sc, sp, r) for r in rate_list for sc in scheds for sp in spaces]
-    work = [(data, hours, seed, sc, sp, r) for sc, sp, r in configs for seed in seed_list]
+    runs = len(scheds) * len(spaces) * len(rate_list) * len(seed_list)
     err = Console(stderr=True)
-    reports: list[dict] = []
     with progress_bar(err) as progress:
-        task = progress.add_task("runs", total=len(work))
-        if jobs == 1:
-            for w in work:
-                reports.append(_one(w))
-                progress.advance(task)
-        else:
-            # spawn, not fork: the checker's compiled kernels run OpenMP threads, and a
-            # forked child of a process that has started them dies
-            with ProcessPoolExecutor(max_workers=jobs,
-                                     mp_context=multiprocessing.get_context("spawn")) as pool:
-                for rep in pool.map(_one, work):
-                    reports.append(rep)
-                    progress.advance(task)
-    rows = []
-    n = len(seed_list)
-    for k, (sc, sp, _) in enumerate(configs):
-        reps = reports[k * n:(k + 1) * n]
-        row = {"scheduler": sc, "airspace": sp,
-               "rate_per_hour": reps[0]["settings"]["rate_per_hour"], "runs": n,
-               "conflicts": sum(x["conflicts"] for x in reps),
-               "lost": sum(x["lost"] for x in reps)}
-        for m in SWEEP_METRICS:
-            row[m], row[m + "_ci95"] = mean_ci([x[m] for x in reps])
-        rows.append(row)
+        task = progress.add_task("runs", total=runs)
+        with open_from_flags(executor, dask, jobs, runs) as ex:
+            rows = sweep(s, schedulers=scheds, airspaces=spaces, rates=rate_list,
+                         seeds=seed_list, hours=hours, executor=ex,
+                         on_result=lambda _i, _rep: progress.advance(task))
     if as_json:
         clean = [{k: None if isinstance(v, float) and math.isnan(v) else v
                   for k, v in r.items()} for r in rows]

@@ -8,6 +8,8 @@ Tables (the course's schemas plus the day and order of moves):
 - ``flightpath(delivery_date, seq, order_no, from_lon, from_lat, angle, to_lon, to_lat)``
 - ``runs(delivery_date, started, finished, moves, money_delivered, money_placed, ...)``
 
+and, from revision 0002, ``jobs`` and ``fleet_runs`` (:mod:`skyroute.jobs.store`).
+
 A SQLite file by default, PostgreSQL (or any SQLAlchemy URL) by ``--db``. The schema is
 made and upgraded by Alembic migrations shipped in the package (``db init`` runs them).
 A day's results go in one transaction: its old rows are deleted and the new ones
@@ -28,20 +30,26 @@ from skyroute.errors import SkyrouteError
 
 DEFAULT_DB = "sqlite:///skyroute.db"
 TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
-_REFLECTED: dict[str, dict[str, sa.Table]] = {}
+_REFLECTED: dict[tuple[str, tuple[str, ...]], dict[str, sa.Table]] = {}
 register(_REFLECTED.clear)
 
 
-def tables(engine: sa.Engine) -> dict[str, sa.Table]:
-    """The tables as the migrations made them (reflected once per database): the
-    migrations are the one definition of the schema."""
-    key = str(engine.url)
+def tables(engine: sa.Engine, names: tuple[str, ...] = TABLES) -> dict[str, sa.Table]:
+    """The tables ``names`` (default the delivery tables) as the migrations made them,
+    reflected once per database: the migrations are the one definition of the schema.
+    Other packages' tables (``jobs``, ``fleet_runs``) live in the same store."""
+    key = (str(engine.url), names)
     if key not in _REFLECTED:
-        if not sa.inspect(engine).has_table("runs"):
-            raise SkyrouteError(f"{_safe(key)}: no skyroute tables; run 'skyroute db init' "
-                                "first")
+        have = set(sa.inspect(engine).get_table_names())
+        if "runs" not in have:
+            raise SkyrouteError(f"{_safe(key[0])}: no skyroute tables; run 'skyroute db "
+                                "init' first")
+        missing = [n for n in names if n not in have]
+        if missing:
+            raise SkyrouteError(f"{_safe(key[0])}: no table {', '.join(missing)} (an older "
+                                "schema); run 'skyroute db init' to upgrade it")
         md = sa.MetaData()
-        md.reflect(engine, only=TABLES)
+        md.reflect(engine, only=names)
         _REFLECTED[key] = dict(md.tables)
     return _REFLECTED[key]
 
@@ -83,7 +91,8 @@ def init(engine: sa.Engine) -> str:
     with engine.begin() as conn:
         cfg.attributes["connection"] = conn
         command.upgrade(cfg, "head")
-    _REFLECTED.pop(str(engine.url), None)
+    for key in [k for k in _REFLECTED if k[0] == str(engine.url)]:
+        del _REFLECTED[key]
     with engine.connect() as conn:
         return MigrationContext.configure(conn).get_current_revision()
 

@@ -1,0 +1,42 @@
+"""How long commands (``deliver`` ranges, ``fleet sweep``) choose where their tasks run:
+``--executor local|dask``, ``--dask ADDRESS`` and ``--jobs N`` (the workers)."""
+
+from __future__ import annotations
+
+import os
+from typing import Annotated
+
+import typer
+
+from skyroute.errors import OptionError, check_choice
+from skyroute.jobs.executor import KINDS, open_executor
+
+Executor = Annotated[str | None, typer.Option(
+    "--executor", metavar="local|dask",
+    help="local: --jobs processes on this machine; dask: a Dask cluster (in-process with "
+         "--jobs worker processes, or the scheduler at --dask). Default: dask with --dask, "
+         "else local.")]
+DaskAddress = Annotated[str | None, typer.Option(
+    "--dask", metavar="ADDRESS",
+    help="An existing Dask scheduler, e.g. tcp://10.0.0.5:8786 (its workers run the "
+         "tasks; --jobs is then unused).")]
+
+
+def executor_kind(executor: str | None, dask: str | None, jobs: int) -> str:
+    """The executor's kind the flags ask for (checked before any work starts)."""
+    kind = executor or ("dask" if dask else "local")
+    check_choice("executor", kind, KINDS)
+    if kind == "local" and dask is not None:
+        raise OptionError("--dask ADDRESS runs on a Dask cluster; drop --executor local")
+    if jobs < 1:
+        raise OptionError(f"--jobs {jobs} must be at least 1")
+    return kind
+
+
+def open_from_flags(executor: str | None, dask: str | None, jobs: int, tasks: int):
+    """The executor the flags ask for, for ``tasks`` tasks: local processes are capped
+    at the CPU count and the task count, an in-process Dask cluster at the task count."""
+    kind = executor_kind(executor, dask, jobs)
+    cap = max(1, tasks)
+    workers = min(jobs, os.cpu_count() or 1, cap) if kind == "local" else min(jobs, cap)
+    return open_executor(kind, address=dask, workers=None if dask else workers)

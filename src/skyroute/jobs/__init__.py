@@ -1,0 +1,14 @@
+"""Long work as independent tasks on a local process pool or a Dask cluster.
+
+- :mod:`~skyroute.jobs.executor`: ``open_executor("local" | "dask", address=, workers=)``,
+  one ``map`` for both.
+- :mod:`~skyroute.jobs.store`: the ``jobs`` and ``fleet_runs`` tables (in the delivery
+  store, migration 0002).
+- :mod:`~skyroute.jobs.deliver`: a range of delivery days, one task per day, each stored
+  by its worker in one transaction.
+- :mod:`~skyroute.jobs.fleet`: fleet runs (stored in ``fleet_runs``) and sweeps.
+- :mod:`~skyroute.jobs.runner`: ``submit`` / ``get``: jobs in a background thread with
+  their state and progress in the store (what the service calls).
+
+See docs/scaling.md for running on a cluster.
+"""

@@ -1,0 +1,189 @@
+"""A range of delivery days as tasks, one per day, on any executor with the same rows.
+
+What a worker gets (:class:`DayTask`): the store's URL, where the site is read from (a
+folder or an HTTP URL; the worker loads the site once and keeps it), the date, that day's
+orders and the method. The worker flies the day, writes it to the store itself in one
+transaction that first deletes whatever an earlier run stored for that date
+(:func:`skyroute.delivery.store.store_day`), and sends the :class:`DayResult` back. So a
+day run twice, or re-run on another worker after its worker died, is stored once, and a
+worker killed halfway leaves the previous state of that day.
+
+The caller fills the leg table first (:func:`skyroute.delivery.days.prepare_legs`);
+workers sharing its cache folder only read it, and a worker on another machine fills its
+own on first use (the legs are the same, so are the days).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import sqlalchemy as sa
+
+from skyroute.caches import register
+from skyroute.delivery import store
+from skyroute.delivery.day import METHODS, DayResult, plan_day
+from skyroute.delivery.days import prepare_legs
+from skyroute.delivery.orders import Order
+from skyroute.delivery.site import load_site
+from skyroute.delivery.source import DirSource, HttpSource, open_source
+from skyroute.errors import OptionError, SkyrouteError, check_choice
+from skyroute.jobs.store import engine_for, worker_url
+
+
+@dataclass(frozen=True)
+class DayTask:
+    """One day for a worker: store URL, site source, date, its orders, method."""
+
+    url: str
+    source: DirSource | HttpSource
+    date: dt.date
+    orders: tuple[Order, ...]
+    method: str = "milp"
+
+
+_SITES: dict = {}
+register(_SITES.clear)
+
+
+def _site(source):
+    if source not in _SITES:
+        _SITES[source] = load_site(source)
+    return _SITES[source]
+
+
+def fly_day(task: DayTask) -> DayResult:
+    """The worker's task: fly the day, store it (one transaction, replacing any earlier
+    run of it), return it."""
+    result = plan_day(_site(task.source), task.date, list(task.orders), method=task.method)
+    engine = engine_for(task.url)
+    try:
+        store.store_day(engine, result)
+    except sa.exc.IntegrityError:
+        # a second run of this task wrote the same day at the same moment (a worker the
+        # scheduler thought dead): write again after it, replacing its rows
+        store.store_day(engine, result)
+    return result
+
+
+def days_between(engine: sa.Engine, first: dt.date, last: dt.date) -> dict[dt.date, list]:
+    """Every date from ``first`` to ``last`` with its stored orders (a date without any
+    is an empty day, still flown and stored)."""
+    by_date = store.orders_between(engine, first, last)
+    for k in range((last - first).days + 1):
+        by_date.setdefault(first + dt.timedelta(k), [])
+    return dict(sorted(by_date.items()))
+
+
+def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executor,
+             method: str = "milp",
+             on_day: Callable[[DayResult], None] | None = None) -> list[DayResult]:
+    """Fly and store every day of ``by_date`` as one task each on ``executor``; results
+    in date order, ``on_day`` called with each as it arrives. Ends by checking that the
+    store holds every day (workers that wrote to another database are an error)."""
+    check_choice("method", method, METHODS)
+    url = worker_url(engine)
+    tasks = [DayTask(url, source, d, tuple(orders), method)
+             for d, orders in sorted(by_date.items())]
+    results = executor.map(fly_day, tasks,
+                           on_result=(lambda _i, r: on_day(r)) if on_day else None)
+    _check_stored(engine, [t.date for t in tasks])
+    return results
+
+
+def _check_stored(engine: sa.Engine, dates: list[dt.date]) -> None:
+    if not dates:
+        return
+    runs = store.tables(engine)["runs"]
+    with engine.connect() as c:
+        have = set(c.scalars(sa.select(runs.c.delivery_date)
+                             .where(runs.c.delivery_date.between(min(dates), max(dates)))))
+    missing = sorted(set(dates) - have)
+    if missing:
+        raise SkyrouteError(f"{store._safe(str(engine.url))}: {len(missing)} day(s) flown "
+                            f"but not stored here (first {missing[0]}); workers on other "
+                            "machines must reach the same database (use PostgreSQL)")
+
+
+def summarise(results: list[DayResult]) -> dict:
+    """Mean and minimum money % over the days with orders, and per month."""
+    pcts = [(r.date, r.money_pct) for r in results if r.money_pct is not None]
+    if not pcts:
+        return {"days": len(results), "days_with_orders": 0}
+    months: dict[str, list[float]] = {}
+    for d, p in pcts:
+        months.setdefault(f"{d:%Y-%m}", []).append(p)
+    worst = min(pcts, key=lambda x: x[1])
+    return {"days": len(results), "days_with_orders": len(pcts),
+            "mean_pct": sum(p for _, p in pcts) / len(pcts), "min_pct": worst[1],
+            "min_date": worst[0].isoformat(),
+            "months": {m: {"mean_pct": sum(v) / len(v), "min_pct": min(v), "days": len(v)}
+                       for m, v in sorted(months.items())},
+            "moves_max": max(r.flight.moves for r in results),
+            "seconds_per_day_mean": sum(r.seconds for r in results) / len(results),
+            "seconds_per_day_max": max(r.seconds for r in results)}
+
+
+# -- the runner's "deliver" job ------------------------------------------------------------
+
+def _date(params: dict, key: str) -> dt.date:
+    text = params.get(key)
+    try:
+        return dt.date.fromisoformat(text)
+    except (TypeError, ValueError):
+        raise OptionError(f"{key}={text!r}: expected a date YYYY-MM-DD", param=key) from None
+
+
+def check_params(params: dict) -> dict:
+    """The ``deliver`` job's parameters checked and completed: ``{"date": D}`` or
+    ``{"from": D, "to": D}`` (ISO dates), exactly one of ``data`` (a folder in the ILP
+    layout) or ``source`` (an HTTP URL) naming the site, and ``method`` (``milp``
+    default, or ``greedy``). The orders must be in the store already (``skyroute db
+    import``). Errors name the field."""
+    if not isinstance(params, dict):
+        raise OptionError("params must be a mapping", param="params")
+    known = {"date", "from", "to", "data", "source", "method"}
+    unknown = sorted(set(params) - known)
+    if unknown:
+        raise OptionError(f"{unknown[0]}: unknown parameter of a deliver job; valid: "
+                          + ", ".join(sorted(known)), param=unknown[0])
+    if "date" in params:
+        if "from" in params or "to" in params:
+            raise OptionError("give date, or from and to, not both", param="date")
+        first = last = _date(params, "date")
+    else:
+        first, last = _date(params, "from"), _date(params, "to")
+        if last < first:
+            raise OptionError(f"to={last} is before from={first}", param="to")
+    method = params.get("method", "milp")
+    check_choice("method", method, METHODS)
+    data, source = params.get("data"), params.get("source")
+    open_source(None if data is None else Path(data), source)  # validates the one given
+    out = {"from": first.isoformat(), "to": last.isoformat(), "method": method}
+    out.update({"data": str(data)} if data is not None else {"source": source})
+    return out
+
+
+def deliver_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
+                progress: Callable[[float], None]) -> dict:
+    """Fly ``params``' days (see :func:`check_params`) on ``executor``; the summary of
+    :func:`summarise` with ``from`` and ``to``. ``progress`` gets the share of days
+    done."""
+    p = check_params(params)
+    data = p.get("data")
+    src = open_source(None if data is None else Path(data), p.get("source"))
+    first, last = dt.date.fromisoformat(p["from"]), dt.date.fromisoformat(p["to"])
+    by_date = days_between(engine, first, last)
+    prepare_legs(load_site(src), [o for v in by_date.values() for o in v])
+    done = 0
+
+    def on_day(_r: DayResult) -> None:
+        nonlocal done
+        done += 1
+        progress(done / len(by_date))
+
+    results = run_days(engine, src, by_date, executor=executor, method=p["method"],
+                       on_day=on_day)
+    return {"from": p["from"], "to": p["to"], **summarise(results)}

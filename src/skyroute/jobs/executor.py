@@ -1,0 +1,232 @@
+"""Where a list of independent tasks runs: a local process pool or a Dask cluster, behind
+one small interface.
+
+>>> with open_executor("local", workers=1) as ex:
+...     ex.map(abs, [-2, 3, -5])
+[2, 3, 5]
+
+``map(fn, items, on_result=None)`` runs ``fn(item)`` for every item and returns the
+results in item order; ``on_result(index, result)`` is called in the calling thread as
+each one finishes (in finishing order), for progress bars and job progress. An exception
+in a task is raised by ``map`` (the tasks not yet started are cancelled). ``fn`` and the
+items must pickle: ``fn`` a module-level function, the items plain data.
+
+- ``local``: ``workers`` processes started with the ``spawn`` method (a forked child of
+  a process whose compiled kernels have started OpenMP threads dies), created on the
+  first ``map`` and reused until ``close``; one worker runs the tasks in the calling
+  process, as a plain loop.
+- ``dask``: a ``distributed.Client`` on an existing scheduler (``address`` such as
+  ``tcp://10.0.0.5:8786``) or on an in-process ``LocalCluster`` of ``workers`` worker
+  processes, one thread each. Dask re-runs the tasks of a worker that dies on another
+  one, so every task must be safe to run twice (each of skyroute's tasks writes its
+  result in one transaction that replaces an earlier run of the same task).
+"""
+
+from __future__ import annotations
+
+import logging
+import multiprocessing
+import os
+from collections.abc import Callable, Iterable
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from typing import Any
+
+from skyroute.errors import OptionError, SkyrouteError, check_choice
+
+KINDS = ("local", "dask")
+CONNECT_TIMEOUT = "10s"  # an existing scheduler that does not answer within this is an error
+
+
+def open_executor(kind: str = "local", *, address: str | None = None,
+                  workers: int | None = None) -> LocalExecutor | DaskExecutor:
+    """An executor of ``kind`` (``local`` or ``dask``); close it (or use ``with``).
+
+    ``workers``: processes (default: the CPU count); for ``dask`` the workers of the
+    in-process cluster, ignored with ``address`` (the scheduler has its own workers).
+    ``address``: an existing Dask scheduler; only for ``dask``. A malformed address or a
+    scheduler that does not answer is a :class:`SkyrouteError` naming ``address``.
+    """
+    check_choice("kind", kind, KINDS)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise OptionError(f"workers={workers!r} must be an integer >= 1", param="workers")
+    if kind == "local":
+        if address is not None:
+            raise OptionError(f"address={address!r} needs kind='dask'", param="address")
+        return LocalExecutor(workers or os.cpu_count() or 1)
+    return DaskExecutor(address=address, workers=workers)
+
+
+class _Executor:
+    workers: int
+
+    def map(self, fn: Callable, items: Iterable, *,
+            on_result: Callable[[int, Any], None] | None = None) -> list:
+        raise NotImplementedError
+
+    def close(self) -> None:
+        raise NotImplementedError
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class LocalExecutor(_Executor):
+    """Tasks in ``workers`` spawned processes (or in this process when ``workers`` is 1)."""
+
+    kind = "local"
+
+    def __init__(self, workers: int) -> None:
+        self.workers = workers
+        self._pool: ProcessPoolExecutor | None = None
+
+    def __repr__(self) -> str:
+        return f"LocalExecutor(workers={self.workers})"
+
+    def map(self, fn, items, *, on_result=None) -> list:
+        items = list(items)
+        if self.workers == 1 or len(items) <= 1:
+            out = []
+            for i, item in enumerate(items):
+                out.append(fn(item))
+                if on_result:
+                    on_result(i, out[-1])
+            return out
+        if self._pool is None:
+            self._pool = ProcessPoolExecutor(
+                self.workers, mp_context=multiprocessing.get_context("spawn"))
+        futures = {self._pool.submit(fn, item): i for i, item in enumerate(items)}
+        return _gather(futures, on_result)
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = None
+
+
+def _gather(futures: dict, on_result) -> list:
+    """Results of ``futures`` (future -> index) in index order; ``on_result`` as each
+    finishes. On an error or Ctrl-C the futures not yet started are cancelled."""
+    out: list = [None] * len(futures)
+    pending = set(futures)
+    try:
+        while pending:
+            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for f in sorted(done, key=futures.get):
+                i = futures[f]
+                out[i] = f.result()
+                if on_result:
+                    on_result(i, out[i])
+    except BaseException:
+        for f in pending:
+            f.cancel()
+        raise
+    return out
+
+
+class DaskExecutor(_Executor):
+    """Tasks on a Dask cluster: an existing scheduler, or an in-process ``LocalCluster``.
+
+    ``client`` is the ``distributed.Client`` (tests use it to reach the workers).
+    """
+
+    kind = "dask"
+
+    def __init__(self, *, address: str | None, workers: int | None) -> None:
+        try:
+            from distributed import Client, LocalCluster
+        except ModuleNotFoundError:  # pragma: no cover - a dependency of skyroute
+            raise SkyrouteError("the dask executor needs 'distributed' "
+                                "(pip install 'dask[distributed]')") from None
+        self.address = address
+        self._cluster = None
+        if address is None:
+            self._cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
+                                         threads_per_worker=1, processes=True,
+                                         dashboard_address=None,
+                                         silence_logs=logging.ERROR)
+            self.client = Client(self._cluster)
+        else:
+            if not isinstance(address, str):
+                raise OptionError(f"address={address!r} must be a scheduler address like "
+                                  "tcp://HOST:8786", param="address")
+            try:
+                self.client = Client(address, timeout=CONNECT_TIMEOUT)
+            except (OSError, ValueError, TypeError) as exc:
+                reason = " ".join(str(exc).split()) or type(exc).__name__
+                raise SkyrouteError(f"address={address!r}: no Dask scheduler there "
+                                    f"({reason}); expected tcp://HOST:8786",
+                                    param="address") from None
+            try:
+                self._check_versions()
+            except BaseException:
+                self.client.close()
+                raise
+
+    def _check_versions(self) -> None:
+        """The scheduler and every worker must have this skyroute: the tasks name its
+        functions, and a worker that cannot import them dies reading the task."""
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            mine = version("skyroute")
+        except PackageNotFoundError:  # running from a source tree: nothing to compare
+            return
+        v = self.client.get_versions(packages=["skyroute"])
+        where = [("the scheduler", v["scheduler"]["packages"].get("skyroute"))]
+        where += [(f"worker {w}", info["packages"].get("skyroute"))
+                  for w, info in sorted(v["workers"].items())]
+        for name, theirs in where:
+            if theirs != mine:
+                raise SkyrouteError(
+                    f"address={self.address!r}: {name} has skyroute "
+                    f"{theirs or '(not installed)'}, this machine {mine}; install the same "
+                    "skyroute on the scheduler and every worker", param="address")
+
+    def __repr__(self) -> str:
+        where = self.address or "LocalCluster"
+        return f"DaskExecutor({where}, workers={self.workers})"
+
+    @property
+    def workers(self) -> int:
+        """Workers the scheduler knows now."""
+        return len(self.client.scheduler_info(n_workers=-1)["workers"])
+
+    def map(self, fn, items, *, on_result=None) -> list:
+        from distributed import as_completed
+
+        items = list(items)
+        if not items:
+            return []
+        # pure=False: a task is run each time it is asked for, never served from an
+        # earlier identical call (the tasks write to the store)
+        futures = self.client.map(fn, items, pure=False)
+        index = {f.key: i for i, f in enumerate(futures)}
+        out: list = [None] * len(items)
+        try:
+            for f in as_completed(futures):
+                i = index[f.key]
+                out[i] = f.result()
+                if on_result:
+                    on_result(i, out[i])
+        except RuntimeError as exc:
+            self.client.cancel(futures)
+            if "deserializ" not in str(exc):
+                raise
+            raise SkyrouteError(f"the Dask scheduler at {self.client.scheduler.address} "
+                                "cannot read skyroute's tasks; install the same skyroute on "
+                                "the scheduler and every worker") from None
+        except BaseException:
+            self.client.cancel(futures)
+            raise
+        finally:
+            del futures
+        return out
+
+    def close(self) -> None:
+        self.client.close()
+        if self._cluster is not None:
+            self._cluster.close()

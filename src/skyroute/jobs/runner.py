@@ -1,0 +1,147 @@
+"""Long jobs in the background, their state in the store: what the service calls.
+
+``submit(engine, kind, params, executor=ex)`` checks ``params`` (an
+:class:`~skyroute.errors.OptionError` naming the field when one is wrong), records the job
+as ``queued`` and returns its id at once; ``get(engine, job_id)`` reads it back as
+``{"id", "kind", "params", "state", "progress", "result", "error", "created",
+"updated"}`` (None for an unknown id).
+
+Kinds (:data:`KINDS`) and their parameters:
+
+- ``deliver``: ``{"date": D}`` or ``{"from": D, "to": D}``, ``data`` (folder) or
+  ``source`` (URL) naming the site, ``method``; orders already in the store
+  (:func:`skyroute.jobs.deliver.check_params`). Result: the range's summary.
+- ``fleet``: ``preset`` or ``scenario``, ``hours``, ``seed``, ``scheduler``,
+  ``airspace``, ``rate_per_hour``, ``track_step``
+  (:func:`skyroute.jobs.fleet.check_fleet_params`). Result: ``{"fleet_run": id,
+  "report"}``; the run's files are in ``fleet_runs`` (:func:`skyroute.jobs.store.get_fleet_run`).
+- ``sweep``: ``preset`` or ``scenario``, ``schedulers``, ``airspaces``, ``rates``,
+  ``seeds``, ``hours`` (:func:`skyroute.jobs.fleet.check_sweep_params`). Result:
+  ``{"rows": [...]}``.
+
+Jobs run one at a time in the order submitted, in one background thread per process
+(each job already spreads its tasks over every worker of the executor); a job waiting
+for the one before it stays ``queued``. While a job runs it is ``running`` with its
+progress, the share of its tasks done (a fleet run is one task: 0, then 1). It ends
+``done`` with its result, or ``failed`` with a one-line error: a SkyrouteError's message,
+else the exception's type and message; the traceback goes to the ``skyroute.jobs``
+logger, never into the store. The thread is a daemon: a job still running when the
+process ends stays ``running`` in the store.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+import time
+from collections.abc import Callable
+from typing import NamedTuple
+
+import sqlalchemy as sa
+
+from skyroute.errors import SkyrouteError, check_choice
+from skyroute.jobs import deliver, fleet, store
+
+log = logging.getLogger("skyroute.jobs")
+PROGRESS_EVERY = 0.2  # seconds between progress writes (the last one always goes)
+
+
+class Kind(NamedTuple):
+    check: Callable[[dict], dict]
+    run: Callable[..., dict]
+
+
+KINDS = {
+    "deliver": Kind(deliver.check_params, deliver.deliver_job),
+    "fleet": Kind(fleet.check_fleet_params, fleet.fleet_job),
+    "sweep": Kind(fleet.check_sweep_params, fleet.sweep_job),
+}
+
+_queue: queue.Queue = queue.Queue()
+_lock = threading.Lock()
+_thread: threading.Thread | None = None
+_pending = 0
+
+
+def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
+    """Check ``params``, record the job (``queued``) and queue it to run on
+    ``executor`` (an open :func:`~skyroute.jobs.executor.open_executor`, which the
+    caller keeps open and closes); the job's id."""
+    global _thread, _pending
+    check_choice("kind", kind, tuple(KINDS))
+    params = KINDS[kind].check(params)
+    job_id = store.create_job(engine, kind, params)
+    with _lock:
+        _pending += 1
+        _queue.put((engine, job_id, kind, params, executor))
+        if _thread is None or not _thread.is_alive():
+            _thread = threading.Thread(target=_work, name="skyroute-jobs", daemon=True)
+            _thread.start()
+    return job_id
+
+
+def get(engine: sa.Engine, job_id: str) -> dict | None:
+    """The job as :func:`skyroute.jobs.store.get_job` gives it; None for an unknown id."""
+    return store.get_job(engine, job_id)
+
+
+def pending() -> int:
+    """Jobs submitted in this process and not finished yet (queued or running)."""
+    return _pending
+
+
+def wait(engine: sa.Engine, job_id: str, *, timeout: float | None = None,
+         every: float = 0.05) -> dict:
+    """Poll until the job is ``done`` or ``failed`` (or ``timeout`` seconds pass); the
+    job as :func:`get` gives it."""
+    end = None if timeout is None else time.monotonic() + timeout
+    while True:
+        job = get(engine, job_id)
+        if job is None:
+            raise SkyrouteError(f"job_id={job_id!r}: no such job", param="job_id")
+        if job["state"] in ("done", "failed") or (end is not None and time.monotonic() > end):
+            return job
+        time.sleep(every)
+
+
+def error_line(exc: BaseException) -> str:
+    """One line for the store: a SkyrouteError's message, else type and message."""
+    text = str(exc) if isinstance(exc, SkyrouteError) else f"{type(exc).__name__}: {exc}"
+    return " ".join(text.split()) or type(exc).__name__
+
+
+def _work() -> None:
+    global _pending
+    while True:
+        engine, job_id, kind, params, executor = _queue.get()
+        try:
+            _run(engine, job_id, kind, params, executor)
+        except Exception:  # the store itself failed: keep serving the queue
+            log.exception("job %s: could not record its state", job_id)
+        finally:
+            with _lock:
+                _pending -= 1
+
+
+def _run(engine, job_id: str, kind: str, params: dict, executor) -> None:
+    store.set_progress(engine, job_id, 0.0)
+    last = time.monotonic()
+
+    def progress(share: float) -> None:
+        nonlocal last
+        now = time.monotonic()
+        if share >= 1.0 or now - last >= PROGRESS_EVERY:
+            store.set_progress(engine, job_id, min(1.0, max(0.0, share)))
+            last = now
+
+    try:
+        result = KINDS[kind].run(engine, job_id, params, executor=executor,
+                                 progress=progress)
+    except Exception as exc:
+        expected = isinstance(exc, SkyrouteError)
+        log.log(logging.INFO if expected else logging.ERROR, "job %s (%s) failed", job_id,
+                kind, exc_info=True)
+        store.fail_job(engine, job_id, error_line(exc))
+        return
+    store.finish_job(engine, job_id, result)

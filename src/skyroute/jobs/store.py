@@ -1,0 +1,191 @@
+"""Jobs and fleet runs in the SQL store of the delivery days (same database, same
+migrations: revision 0002 adds the two tables; ``skyroute db init`` upgrades to it).
+
+- ``jobs(id, kind, params, state, progress, result, error, created, updated)``: ``state``
+  is ``queued``, ``running``, ``done`` or ``failed``; ``progress`` 0..1; ``params`` and
+  ``result`` JSON; ``error`` one line. Times are UTC.
+- ``fleet_runs(id, job_id, scenario, params, report, events_jsonl, tracks_csv,
+  packages_csv, fleet_geojson, created)``: a fleet run's ``report.json``,
+  ``events.jsonl``, ``tracks.csv`` (bytes), ``packages.csv`` and ``fleet.geojson`` as
+  :mod:`skyroute.io.fleet_out` writes them (a big run's tracks are big: 1 s rows of 1000
+  drones for an hour are about 150 MB; use a coarser ``track_step``).
+
+Every function takes the engine first and runs one short transaction. Lookups of an
+unknown id return None.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+import uuid
+from pathlib import Path
+
+import sqlalchemy as sa
+
+from skyroute.caches import register
+from skyroute.delivery.store import connect, tables
+from skyroute.errors import OptionError
+
+STATES = ("queued", "running", "done", "failed")
+TABLES = ("jobs", "fleet_runs")
+
+
+_ENGINES: dict[str, sa.Engine] = {}
+register(_ENGINES.clear)
+
+
+def worker_url(engine: sa.Engine) -> str:
+    """The URL a worker connects with: the engine's, password included (it goes to the
+    workers, never into a job's params), a relative SQLite path made absolute."""
+    url = engine.url
+    if url.drivername.startswith("sqlite") and url.database not in (None, "", ":memory:"):
+        url = url.set(database=str(Path(url.database).resolve()))
+    return url.render_as_string(hide_password=False)
+
+
+def engine_for(url: str) -> sa.Engine:
+    """One engine per URL in this process (a worker keeps its own across tasks)."""
+    if url not in _ENGINES:
+        _ENGINES[url] = connect(url)
+    return _ENGINES[url]
+
+
+def _t(engine: sa.Engine) -> dict[str, sa.Table]:
+    return tables(engine, TABLES)
+
+
+def _now() -> dt.datetime:
+    return dt.datetime.now(dt.UTC).replace(tzinfo=None)
+
+
+def _iso(t: dt.datetime | None) -> str | None:
+    return None if t is None else t.replace(tzinfo=dt.UTC).isoformat()
+
+
+def json_safe(value):
+    """``value`` with NaN and infinities as None (JSON has neither; PostgreSQL refuses
+    them), tuples as lists; raises OptionError on what JSON cannot hold."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {str(k): json_safe(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_safe(v) for v in value]
+    if value is None or isinstance(value, str | int | bool):
+        return value
+    if hasattr(value, "item"):  # numpy scalars
+        return json_safe(value.item())
+    raise OptionError(f"{type(value).__name__} {value!r} cannot be stored as JSON")
+
+
+def create_job(engine: sa.Engine, kind: str, params: dict) -> str:
+    """Record a new job (``queued``, progress 0); its id (a UUID string)."""
+    job_id = str(uuid.uuid4())
+    now = _now()
+    with engine.begin() as c:
+        c.execute(_t(engine)["jobs"].insert().values(
+            id=job_id, kind=kind, params=json_safe(params), state="queued", progress=0.0,
+            created=now, updated=now))
+    return job_id
+
+
+def set_progress(engine: sa.Engine, job_id: str, progress: float) -> None:
+    """Mark the job ``running`` at ``progress`` (0..1). A job already done or failed is
+    left as it is."""
+    p = float(progress)
+    if not 0.0 <= p <= 1.0:
+        raise OptionError(f"progress={progress!r} must be within 0..1", param="progress")
+    jobs = _t(engine)["jobs"]
+    with engine.begin() as c:
+        c.execute(jobs.update().where(jobs.c.id == job_id,
+                                      jobs.c.state.in_(("queued", "running")))
+                  .values(state="running", progress=p, updated=_now()))
+
+
+def finish_job(engine: sa.Engine, job_id: str, result: dict | None) -> None:
+    """Mark the job ``done`` (progress 1) with its JSON ``result``."""
+    jobs = _t(engine)["jobs"]
+    with engine.begin() as c:
+        c.execute(jobs.update().where(jobs.c.id == job_id)
+                  .values(state="done", progress=1.0, result=json_safe(result),
+                          error=None, updated=_now()))
+
+
+def fail_job(engine: sa.Engine, job_id: str, error: str) -> None:
+    """Mark the job ``failed`` with ``error`` (made one line; no traceback belongs here)."""
+    jobs = _t(engine)["jobs"]
+    line = " ".join(str(error).split()) or "failed"
+    with engine.begin() as c:
+        c.execute(jobs.update().where(jobs.c.id == job_id)
+                  .values(state="failed", error=line, updated=_now()))
+
+
+def get_job(engine: sa.Engine, job_id: str) -> dict | None:
+    """``{"id", "kind", "params", "state", "progress", "result", "error", "created",
+    "updated"}`` (times ISO 8601 UTC), or None for an unknown id."""
+    jobs = _t(engine)["jobs"]
+    with engine.connect() as c:
+        r = c.execute(sa.select(jobs).where(jobs.c.id == str(job_id))).mappings().first()
+    if r is None:
+        return None
+    return {"id": r["id"], "kind": r["kind"], "params": r["params"], "state": r["state"],
+            "progress": r["progress"], "result": r["result"], "error": r["error"],
+            "created": _iso(r["created"]), "updated": _iso(r["updated"])}
+
+
+def save_fleet_run(engine: sa.Engine, *, scenario: str, params: dict, report: dict,
+                   events_jsonl: str, tracks_csv: bytes, packages_csv: str,
+                   fleet_geojson: str, job_id: str | None = None,
+                   run_id: str | None = None) -> str:
+    """Store a fleet run in one transaction; its id. Saving again under the same
+    ``run_id`` replaces the run (a task re-run after its worker died stores it once)."""
+    run_id = run_id or str(uuid.uuid4())
+    runs = _t(engine)["fleet_runs"]
+    with engine.begin() as c:
+        c.execute(runs.delete().where(runs.c.id == run_id))
+        c.execute(runs.insert().values(
+            id=run_id, job_id=job_id, scenario=scenario, params=json_safe(params),
+            report=json_safe(report), events_jsonl=events_jsonl,
+            tracks_csv=bytes(tracks_csv), packages_csv=packages_csv,
+            fleet_geojson=fleet_geojson, created=_now()))
+    return run_id
+
+
+_HEAD = ("id", "job_id", "scenario", "params", "report", "created")
+FILES = ("events_jsonl", "tracks_csv", "packages_csv", "fleet_geojson")
+
+
+def _run_dict(r) -> dict:
+    out = {k: r[k] for k in _HEAD}
+    out["created"] = _iso(out["created"])
+    for k in FILES:
+        if k in r:
+            out[k] = bytes(r[k]) if k == "tracks_csv" else r[k]
+    return out
+
+
+def get_fleet_run(engine: sa.Engine, run_id: str, *, files: bool = True) -> dict | None:
+    """``{"id", "job_id", "scenario", "params", "report", "created"}`` and, with
+    ``files``, ``events_jsonl`` (text), ``tracks_csv`` (bytes) and ``packages_csv``
+    (text); None for an unknown id."""
+    runs = _t(engine)["fleet_runs"]
+    cols = [runs.c[k] for k in (*_HEAD, *(FILES if files else ()))]
+    with engine.connect() as c:
+        r = c.execute(sa.select(*cols).where(runs.c.id == str(run_id))).mappings().first()
+    return None if r is None else _run_dict(r)
+
+
+def list_fleet_runs(engine: sa.Engine, *, job_id: str | None = None,
+                    limit: int = 100) -> list[dict]:
+    """The newest fleet runs first (of one job when ``job_id`` is given), without their
+    files: ``{"id", "job_id", "scenario", "params", "report", "created"}``."""
+    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
+        raise OptionError(f"limit={limit!r} must be an integer >= 1", param="limit")
+    runs = _t(engine)["fleet_runs"]
+    q = sa.select(*[runs.c[k] for k in _HEAD]).order_by(runs.c.created.desc(),
+                                                        runs.c.id).limit(limit)
+    if job_id is not None:
+        q = q.where(runs.c.job_id == job_id)
+    with engine.connect() as c:
+        return [_run_dict(r) for r in c.execute(q).mappings()]

@@ -1,0 +1,68 @@
+"""Fixtures of the jobs tests: a store of the synthetic lunch orders, a Dask cluster per
+module (a LocalCluster of two worker processes starts in about a second; its workers
+then import skyroute on their first task), PostgreSQL when a server answers."""
+
+from __future__ import annotations
+
+import datetime as dt
+import os
+
+import pytest
+import sqlalchemy as sa
+
+from tests.conftest import ROOT
+
+EXAMPLE = ROOT / "examples" / "lunch"
+PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1:5432/test")
+PG_DB = "skyroute_jobs_test"  # a database of its own: the delivery tests reset "test"
+
+
+def lunch_store(url: str, dates: tuple[str, ...] | None = None):
+    """A store at ``url`` (schema at the newest revision) holding the lunch orders of
+    ``dates`` (default all three days)."""
+    from skyroute.delivery.days import open_store
+    from skyroute.delivery.orders import read_csv_orders
+    from skyroute.delivery.store import import_orders
+
+    engine = open_store(url)
+    keep = None if dates is None else {dt.date.fromisoformat(d) for d in dates}
+    import_orders(engine, [o for o in read_csv_orders(EXAMPLE)
+                           if keep is None or o.date in keep])
+    return engine
+
+
+@pytest.fixture(scope="module")
+def dask_executor(leg_cache):
+    """One in-process Dask cluster (2 worker processes) for the module; started after the
+    session's leg cache is set, so the workers read the same cache."""
+    from skyroute.jobs.executor import open_executor
+
+    ex = open_executor("dask", workers=2)
+    yield ex
+    ex.close()
+
+
+@pytest.fixture(scope="session")
+def pg_url() -> str:
+    """A URL of a clean database of its own on the local PostgreSQL server (skipped when
+    none answers, unless $CI is set)."""
+    base = sa.engine.make_url(PG)
+    try:
+        admin = sa.create_engine(base, isolation_level="AUTOCOMMIT")
+        with admin.connect() as c:
+            if not c.scalar(sa.text("select 1 from pg_database where datname = :d"),
+                            {"d": PG_DB}):
+                c.execute(sa.text(f"create database {PG_DB}"))
+        admin.dispose()
+    except sa.exc.OperationalError:
+        if os.environ.get("CI"):
+            raise
+        pytest.skip("no PostgreSQL server")
+    url = base.set(database=PG_DB).render_as_string(hide_password=False)
+    eng = sa.create_engine(url)
+    with eng.begin() as c:
+        for t in ("fleet_runs", "jobs", "runs", "flightpath", "deliveries", "order_details",
+                  "orders", "alembic_version"):
+            c.execute(sa.text(f"drop table if exists {t} cascade"))
+    eng.dispose()
+    return url

@@ -1,0 +1,64 @@
+"""deliver and fleet sweep with --executor dask: the same output as local processes;
+bad executor flags are one line and exit 2 before any work."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+
+import pytest
+
+from skyroute.delivery import store
+from tests.cli.test_cli import run
+from tests.jobs.conftest import EXAMPLE
+
+RANGE = ["--from", "2024-01-01", "--to", "2024-01-02"]  # (2024-01-03: see test_deliver_jobs)
+TIMING = ("wall_seconds", "seconds_per_day_mean", "seconds_per_day_max", "jobs",
+          "executor", "workers")
+
+
+def test_deliver_range_on_dask_is_the_local_range(monkeypatch, capsys, tmp_path):
+    out = {}
+    for name, flags in (("local", ["--jobs", "1"]), ("dask", ["--executor", "dask",
+                                                               "--jobs", "2"])):
+        db = f"sqlite:///{tmp_path / name}.db"
+        code, text, err = run(monkeypatch, capsys, "deliver", *RANGE, "--data", str(EXAMPLE),
+                              "--db", db, "--out", str(tmp_path / name), "--json", *flags)
+        assert code == 0, err
+        out[name] = json.loads(text), store.connect(db)
+    (a, ea), (b, eb) = out["local"], out["dask"]
+    assert (b["executor"], b["workers"], a["executor"]) == ("dask", 2, "local")
+    assert {k: v for k, v in a.items() if k not in TIMING} == \
+        {k: v for k, v in b.items() if k not in TIMING}
+    for d in (dt.date(2024, 1, 1), dt.date(2024, 1, 2)):
+        assert store.day_rows(ea, d) == store.day_rows(eb, d)
+    geo = "drone-02-01-2024.geojson"
+    assert (tmp_path / "local" / geo).read_text() == (tmp_path / "dask" / geo).read_text()
+
+
+def test_sweep_on_dask_prints_the_local_rows(monkeypatch, capsys):
+    args = ["fleet", "sweep", "--preset", "seed-3x3", "--scheduler", "seed", "--airspace",
+            "shared", "--seeds", "0-1", "--hours", "0.25", "--json"]
+    code, local, err = run(monkeypatch, capsys, *args)
+    assert code == 0, err
+    code, dask, err = run(monkeypatch, capsys, *args, "--executor", "dask", "--jobs", "2")
+    assert code == 0, err
+    assert json.loads(local) == json.loads(dask)
+
+
+@pytest.mark.parametrize("flags, words", [
+    (["--executor", "spark"], "--executor 'spark' is not valid; choose one of 'local', 'dask'"),
+    (["--executor", "local", "--dask", "tcp://127.0.0.1:8786"],
+     "--dask ADDRESS runs on a Dask cluster; drop --executor local"),
+    (["--dask", "nonsense"], "--dask 'nonsense': no Dask scheduler there"),
+    (["--executor", "dask", "--jobs", "0"], "--jobs 0 must be at least 1"),
+])
+@pytest.mark.parametrize("command", [
+    ["deliver", *RANGE, "--data", str(EXAMPLE)],
+    ["fleet", "sweep", "--preset", "seed-3x3", "--seeds", "0", "--hours", "0.1"],
+])
+def test_bad_executor_flags_are_one_line(monkeypatch, capsys, tmp_path, command, flags,
+                                         words):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run(monkeypatch, capsys, *command, *flags)
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err

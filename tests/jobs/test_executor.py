@@ -1,0 +1,87 @@
+"""open_executor: the same results in item order on every kind, progress as tasks end,
+errors raised as themselves, bad addresses one clear line."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import pytest
+
+from skyroute.errors import OptionError, SkyrouteError
+from skyroute.jobs import executor as executor_mod
+from skyroute.jobs.executor import open_executor
+
+ITEMS = [4.0, 1.0, 9.0, 16.0, 25.0]
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_local_results_in_item_order_and_each_reported_once(workers):
+    seen = []
+    with open_executor("local", workers=workers) as ex:
+        out = ex.map(math.sqrt, ITEMS, on_result=lambda i, r: seen.append((i, r)))
+    assert out == [2.0, 1.0, 3.0, 4.0, 5.0]
+    assert sorted(seen) == list(enumerate(out))
+
+
+def test_dask_gives_what_local_gives(dask_executor):
+    seen = []
+    out = dask_executor.map(math.sqrt, ITEMS, on_result=lambda i, r: seen.append((i, r)))
+    assert out == [2.0, 1.0, 3.0, 4.0, 5.0] and sorted(seen) == list(enumerate(out))
+    assert dask_executor.map(math.sqrt, []) == []
+    assert dask_executor.workers == 2 and dask_executor.kind == "dask"
+
+
+@pytest.mark.parametrize("kind", ["local", "dask"])
+def test_a_failing_task_raises_its_own_error(kind, dask_executor):
+    ex = dask_executor if kind == "dask" else open_executor("local", workers=2)
+    try:
+        with pytest.raises(ValueError, match="math domain error"):
+            ex.map(math.sqrt, [1.0, -1.0, 4.0])
+        assert ex.map(math.sqrt, [9.0]) == [3.0]  # still usable afterwards
+    finally:
+        if kind == "local":
+            ex.close()
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"kind": "spark"}, "kind='spark' is not valid; choose one of 'local', 'dask'"),
+    ({"kind": "local", "workers": 0}, "workers=0 must be an integer >= 1"),
+    ({"kind": "local", "address": "tcp://h:8786"}, "address='tcp://h:8786' needs kind='dask'"),
+    ({"kind": "dask", "address": "nonsense"}, "address='nonsense': no Dask scheduler there"),
+    ({"kind": "dask", "address": "http://127.0.0.1:8786"}, "unknown address scheme 'http'"),
+])
+def test_bad_options_are_one_line_errors(kwargs, words):
+    with pytest.raises(SkyrouteError) as err:
+        open_executor(**kwargs)
+    assert words in str(err.value) and "\n" not in str(err.value)
+
+
+def test_a_scheduler_that_does_not_answer_is_an_error_within_the_timeout(monkeypatch):
+    monkeypatch.setattr(executor_mod, "CONNECT_TIMEOUT", "1s")
+    t0 = time.perf_counter()
+    with pytest.raises(SkyrouteError, match=r"address='tcp://127.0.0.1:9': no Dask "
+                                            r"scheduler there \(Timed out") as err:
+        open_executor("dask", address="tcp://127.0.0.1:9")
+    assert err.value.param == "address" and time.perf_counter() - t0 < 10
+    assert not isinstance(err.value, OptionError)
+
+
+def test_an_existing_scheduler_runs_the_tasks(dask_executor):
+    address = dask_executor.client.scheduler.address
+    with open_executor("dask", address=address, workers=5) as ex:  # workers: unused
+        assert ex.workers == 2 and ex.map(math.sqrt, [16.0, 9.0]) == [4.0, 3.0]
+
+
+def test_another_skyroute_on_the_cluster_is_refused(dask_executor, monkeypatch):
+    import importlib.metadata
+
+    real = importlib.metadata.version
+    monkeypatch.setattr(importlib.metadata, "version",
+                        lambda name: "9.9" if name == "skyroute" else real(name))
+    address = dask_executor.client.scheduler.address
+    with pytest.raises(SkyrouteError) as err:
+        open_executor("dask", address=address)
+    assert str(err.value) == (f"address={address!r}: the scheduler has skyroute "
+                              f"{real('skyroute')}, this machine 9.9; install the same "
+                              "skyroute on the scheduler and every worker")

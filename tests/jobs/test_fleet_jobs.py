@@ -1,0 +1,96 @@
+"""Fleet sweeps and runs as tasks: local and Dask give the same rows; a fleet run job's
+stored files are the files of the same run made in this process."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from skyroute.fleet.report import report
+from skyroute.fleet.scenario import preset
+from skyroute.fleet.simulate import run
+from skyroute.io.fleet_out import events_jsonl, fleet_geojson, packages_csv, tracks_csv
+from skyroute.io.geojson import dumps
+from skyroute.jobs import runner, store
+from skyroute.jobs.executor import open_executor
+from skyroute.jobs.fleet import check_fleet_params, check_sweep_params, sweep
+from tests.jobs.conftest import lunch_store
+
+SWEEP = {"schedulers": ["seed", "optimal"], "airspaces": ["shared"], "seeds": [0, 1],
+         "hours": 0.5}
+TIMING = ("wall_seconds", "sim_seconds_per_wall_second")
+
+
+def same(a, b) -> bool:
+    """Equal, NaN equal to NaN."""
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    return a == b
+
+
+def test_a_sweep_gives_the_same_rows_locally_and_on_dask(dask_executor):
+    s = preset("seed-3x3")
+    with open_executor("local", workers=1) as local:
+        a = sweep(s, **SWEEP, executor=local)
+    done = []
+    b = sweep(s, **SWEEP, executor=dask_executor, on_result=lambda i, _r: done.append(i))
+    assert sorted(done) == [0, 1, 2, 3]
+    assert len(a) == 2 and [r["scheduler"] for r in a] == ["seed", "optimal"]
+    assert all(same(x, y) for x, y in zip(a, b, strict=True))
+    assert all(r["runs"] == 2 and r["conflicts"] == 0 and r["lost"] == 0 for r in b)
+
+
+def test_a_fleet_job_stores_the_runs_files(tmp_path, dask_executor):
+    engine = lunch_store(f"sqlite:///{tmp_path / 'f.db'}", ())
+    params = {"preset": "seed-3x3", "hours": 0.25, "seed": 2, "scheduler": "optimal",
+              "track_step": 2.0}
+    job = runner.wait(engine, runner.submit(engine, "fleet", params,
+                                            executor=dask_executor), timeout=300)
+    assert job["state"] == "done", job["error"]
+    saved = store.get_fleet_run(engine, job["result"]["fleet_run"])
+    assert saved["job_id"] == job["id"] and saved["scenario"] == "seed-3x3"
+    assert store.list_fleet_runs(engine, job_id=job["id"])[0]["id"] == saved["id"]
+
+    sim = run(preset("seed-3x3"), hours=0.25, seed=2, scheduler="optimal")
+    here = report(sim)
+    for rep in (saved["report"], job["result"]["report"]):
+        assert {k: v for k, v in rep.items() if k not in TIMING} == \
+            {k: v for k, v in here.items() if k not in TIMING}
+    assert saved["events_jsonl"] == events_jsonl(sim)
+    assert saved["tracks_csv"] == tracks_csv(sim, 2.0)
+    assert saved["packages_csv"] == packages_csv(sim)
+    assert saved["fleet_geojson"] == dumps(fleet_geojson(sim))
+    assert saved["params"]["scenario"]["name"] == "seed-3x3"
+    assert saved["params"]["track_step"] == 2.0 and saved["params"]["airspace"] == "layers"
+
+
+def test_fleet_and_sweep_params_are_completed():
+    assert check_fleet_params({"preset": "seed-3x3"}) == {
+        "preset": "seed-3x3", "hours": 1.0, "seed": 0, "scheduler": "seed",
+        "airspace": "layers", "rate_per_hour": None, "track_step": 1.0}
+    p = check_sweep_params({"scenario": preset("seed-3x3").model_dump(), "rates": [30],
+                            "seeds": [3, 1, 3]})
+    assert p["seeds"] == [3, 1] and p["rates"] == [30.0] and p["hours"] == 1.0
+    assert p["schedulers"] == ["seed", "optimal"] and p["airspaces"] == ["layers", "shared"]
+    assert p["scenario"]["name"] == "seed-3x3"
+
+
+@pytest.mark.parametrize("params, words", [
+    ({}, "give exactly one of preset (a name) or scenario (its fields)"),
+    ({"preset": "seed-3x3", "scenario": {}}, "give exactly one of preset"),
+    ({"preset": "seed-3x3", "seed": -1}, "seed=-1 must be an integer >= 0"),
+    ({"preset": "seed-3x3", "seed": True}, "seed=True must be an integer"),
+    ({"preset": "seed-3x3", "rate_per_hour": "many"}, "rate_per_hour='many' must be a number"),
+    ({"preset": "seed-3x3", "track_step": 0}, "track_step=0 must be a number > 0"),
+    ({"preset": "seed-3x3", "scheduler": "fifo"}, "scheduler='fifo' is not valid"),
+    ({"preset": "seed-3x3", "drones": 4}, "drones: unknown parameter of a fleet job"),
+])
+def test_bad_fleet_params_name_the_field(params, words):
+    from skyroute.errors import OptionError
+
+    with pytest.raises(OptionError) as err:
+        check_fleet_params(params)
+    assert words in str(err.value)

@@ -1,0 +1,99 @@
+"""The runner as the service sees it: submit returns at once, the job's state moves
+queued -> running (with progress) -> done in the store, a failure is one line, bad
+parameters are refused before anything is queued."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from skyroute.errors import OptionError
+from skyroute.jobs import runner
+from skyroute.jobs.executor import open_executor
+from tests.jobs.conftest import EXAMPLE, lunch_store
+
+
+def watch(engine, ids: list[str], timeout: float = 300) -> dict[str, list[tuple]]:
+    """Every distinct (state, progress) of each job, polled until all have ended."""
+    seen: dict[str, list[tuple]] = {i: [] for i in ids}
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        for i in ids:
+            j = runner.get(engine, i)
+            if not seen[i] or seen[i][-1] != (j["state"], j["progress"]):
+                seen[i].append((j["state"], j["progress"]))
+        if all(s[-1][0] in ("done", "failed") for s in seen.values()):
+            return seen
+        time.sleep(0.01)
+    raise AssertionError(f"jobs still running after {timeout} s: {seen}")
+
+
+def test_states_move_from_queued_through_running_to_done(tmp_path):
+    engine = lunch_store(f"sqlite:///{tmp_path / 'r.db'}")
+    days = {"from": "2024-01-01", "to": "2024-01-04", "data": str(EXAMPLE)}
+    with open_executor("local", workers=1) as ex:
+        first = runner.submit(engine, "deliver", days, executor=ex)
+        second = runner.submit(engine, "deliver", {**days, "to": "2024-01-02"}, executor=ex)
+        assert runner.get(engine, second)["state"] == "queued"  # behind the first
+        assert runner.pending() == 2
+        seen = watch(engine, [first, second])
+    for job_id in (first, second):
+        states = [s for s, _ in seen[job_id]]
+        assert states[-1] == "done" and "queued" not in states[states.index("running"):]
+        progress = [p for s, p in seen[job_id] if s == "running"]
+        assert progress == sorted(progress)
+    assert seen[second][0] == ("queued", 0.0)
+    # the first job's 4 days: some share of them done while it was still running
+    assert any(0 < p < 1 for s, p in seen[first] if s == "running"), seen[first]
+    job = runner.get(engine, first)
+    assert job["progress"] == 1.0 and job["error"] is None
+    assert job["result"]["days"] == 4 and job["result"]["days_with_orders"] == 3
+    assert job["params"] == {**days, "method": "milp"}
+    assert runner.pending() == 0
+
+
+def test_a_failing_job_ends_failed_with_one_line(tmp_path):
+    engine = lunch_store(f"sqlite:///{tmp_path / 'f.db'}")
+    (tmp_path / "empty" / "website").mkdir(parents=True)  # a site without its files
+    with open_executor("local", workers=1) as ex:
+        job_id = runner.submit(engine, "deliver", {"date": "2024-01-01",
+                                                   "data": str(tmp_path / "empty")},
+                               executor=ex)
+        job = runner.wait(engine, job_id, timeout=60)
+    assert job["state"] == "failed" and job["result"] is None
+    assert job["error"].endswith("website/menus/menus.json: no such file"), job["error"]
+    assert "\n" not in job["error"] and "Traceback" not in job["error"]
+
+
+def test_an_unexpected_error_is_its_type_and_message(tmp_path, monkeypatch):
+    from skyroute.jobs import fleet
+
+    def boom(*_args, **_kwargs):
+        raise ZeroDivisionError("division by zero\nsecond line")
+
+    monkeypatch.setattr(fleet, "_simulate", boom)
+    engine = lunch_store(f"sqlite:///{tmp_path / 'u.db'}", ())
+    with open_executor("local", workers=1) as ex:
+        job = runner.wait(engine, runner.submit(engine, "fleet", {"preset": "seed-3x3"},
+                                                executor=ex), timeout=60)
+    assert job["state"] == "failed"
+    assert job["error"] == "ZeroDivisionError: division by zero second line"
+
+
+@pytest.mark.parametrize("kind, params, words", [
+    ("plan", {}, "kind='plan' is not valid; choose one of 'deliver', 'fleet', 'sweep'"),
+    ("deliver", {"date": "tomorrow", "data": str(EXAMPLE)}, "date='tomorrow'"),
+    ("fleet", {"preset": "seed-1x1"}, "preset='seed-1x1' is not valid"),
+    ("fleet", {"preset": "seed-3x3", "hours": 0}, "hours=0 must be a number > 0"),
+    ("fleet", {"scenario": {"airports": []}}, "scenario: airports"),
+    ("sweep", {"preset": "seed-3x3", "seeds": [1.5]}, "seeds=1.5 must be an integer"),
+    ("sweep", {"preset": "seed-3x3", "airspaces": ["open"]}, "airspaces='open'"),
+])
+def test_bad_params_are_refused_before_queueing(tmp_path, kind, params, words):
+    engine = lunch_store(f"sqlite:///{tmp_path / 'b.db'}", ())
+    with pytest.raises(OptionError) as err:
+        runner.submit(engine, kind, params, executor=None)
+    assert words in str(err.value) and "\n" not in str(err.value)
+    with engine.connect() as c:
+        assert c.exec_driver_sql("select count(*) from jobs").scalar_one() == 0
