@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.bench.peers import PEERS, available, octile_cost
+from skyroute.bench.random_maps import far_queries, parse_random, random_grid
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.planner import plan
 from skyroute.search.grid_plan import GRID_ALGORITHMS
@@ -107,6 +108,26 @@ def bench_map(map_path: Path, scen_path: Path, *, per_map: int, algorithms: Sequ
     if (scen.width, scen.height) != (grid.width, grid.height):
         raise InputFormatError(scen_path, f"scenario is for a {scen.width}x{scen.height} map, "
                                f"{map_path.name} is {grid.width}x{grid.height}")
+    return bench_queries(grid, scen, map_path.name, per_map=per_map, algorithms=algorithms,
+                         peers=peers, seed=seed, on_query=on_query)
+
+
+def bench_random(spec: str, *, per_map: int, algorithms: Sequence[str],
+                 peers: Sequence[str], seed: int,
+                 on_query: Callable[[], None] | None = None) -> dict:
+    """A synthetic ``SIDE:SHARE`` map (numpy seed ``seed``) with ``per_map`` far queries
+    whose optima come from scipy; its report as :func:`bench_map`'s."""
+    side, share = parse_random(spec)
+    grid = random_grid(side, share, seed)
+    scen = far_queries(grid, max(per_map, 1), seed)
+    return bench_queries(grid, scen, grid.name, per_map=0, algorithms=algorithms,
+                         peers=peers, seed=seed, on_query=on_query)
+
+
+def bench_queries(grid: Grid, scen: Scenario, label: str, *, per_map: int,
+                  algorithms: Sequence[str], peers: Sequence[str], seed: int,
+                  on_query: Callable[[], None] | None = None) -> dict:
+    """Run ``per_map`` sampled lines of ``scen`` (0: all) through every runner."""
     rng = np.random.default_rng(seed)
     n = len(scen) if per_map <= 0 else min(per_map, len(scen))
     idx = np.sort(rng.choice(len(scen), size=n, replace=False))
@@ -138,7 +159,7 @@ def bench_map(map_path: Path, scen_path: Path, *, per_map: int, algorithms: Sequ
             p["runner"]: p["median_ms"] / row["median_ms"]
             for p in rows if p["peer"] and p["median_ms"] and row["median_ms"]
             and not row["peer"]}
-    return {"map": map_path.name, "scen": scen_path.name, "size": [grid.width, grid.height],
+    return {"map": label, "scen": scen.path.name, "size": [grid.width, grid.height],
             "queries": int(n), "scen_lines": len(scen), "rows": rows}
 
 

@@ -8,6 +8,7 @@ from rich.table import Table
 
 from skyroute.cli import (
     bench_fleet_cmd,  # noqa: F401  (registers 'bench fleet')
+    bench_jobs_cmd,  # noqa: F401  (registers 'bench jobs')
     bench_service_cmd,  # noqa: F401  (registers 'bench service')
     bench_world_cmd,  # noqa: F401  (registers 'bench world')
 )

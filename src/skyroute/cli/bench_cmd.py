@@ -12,7 +12,8 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
-from skyroute.bench.grid import bench_map, check_runners, count_queries, find_pairs
+from skyroute.bench.grid import bench_map, bench_random, check_runners, count_queries, find_pairs
+from skyroute.bench.random_maps import parse_random
 from skyroute.cli.parse import parse_list
 from skyroute.files import write_atomic
 from skyroute.world.load import bundled_maps
@@ -34,14 +35,22 @@ def bench_grid(
                                        "networkx ('' for none).")] =
         "pyastar2d,pathfinding,networkx",
     seed: Annotated[int, typer.Option(help="Seed for sampling scenario lines.")] = 0,
+    random: Annotated[list[str] | None, typer.Option(
+        help="Also a synthetic SIDE:SHARE map (repeatable), e.g. 512:0.2: SHARE of the cells "
+             "blocked at random (numpy --seed), --per-map far queries with optima from "
+             "scipy. Alone, only these maps run.")] = None,
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] =
         None,
 ) -> None:
     """Run MovingAI scenarios through skyroute's planners and the installed peers."""
     folder = maps or next(iter(bundled_maps().values())).parent
     algs, have, missing = check_runners(parse_list(algorithms), parse_list(peers))
-    pairs = find_pairs(folder, map_names or ())
-    total = count_queries(pairs, per_map)
+    randoms = list(random or ())
+    for spec in randoms:
+        parse_random(spec)
+    only_random = randoms and maps is None and not map_names
+    pairs = [] if only_random else find_pairs(folder, map_names or ())
+    total = count_queries(pairs, per_map) + len(randoms) * max(per_map, 1)
     console = Console(stderr=True)
     for p in missing:
         console.print(f"[yellow]peer {p} is not installed; skipped "
@@ -56,12 +65,17 @@ def bench_grid(
             reports.append(bench_map(map_path, scen_path, per_map=per_map, algorithms=algs,
                                      peers=have, seed=seed,
                                      on_query=lambda: progress.advance(task)))
+        for spec in randoms:
+            progress.update(task, description=f"random {spec}")
+            reports.append(bench_random(spec, per_map=per_map, algorithms=algs, peers=have,
+                                        seed=seed, on_query=lambda: progress.advance(task)))
     out = Console()
     for rep in reports:
         out.print(_table(rep, have))
     if json_out:
-        doc = {"settings": {"maps": str(folder), "per_map": per_map, "algorithms": algs,
-                            "peers": have, "missing_peers": missing, "seed": seed},
+        doc = {"settings": {"maps": str(folder), "per_map": per_map, "random": randoms,
+                            "algorithms": algs, "peers": have, "missing_peers": missing,
+                            "seed": seed},
                "machine": {"python": platform.python_version(),
                            "processor": platform.processor() or platform.machine()},
                "maps": reports}

@@ -1,0 +1,96 @@
+"""``skyroute bench jobs``: a range of delivery days on local processes and on Dask."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import platform
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from skyroute.cli.bench_cmd import bench_app
+from skyroute.cli.parse import parse_list
+from skyroute.cli.tables import progress_bar, wide_console
+from skyroute.errors import OptionError
+from skyroute.files import write_atomic
+
+
+def _day(text: str, option: str) -> dt.date:
+    try:
+        return dt.date.fromisoformat(text)
+    except ValueError:
+        raise OptionError(f"{option} {text!r}: expected a date YYYY-MM-DD") from None
+
+
+@bench_app.command("jobs")
+def bench_jobs_command(
+    data: Annotated[Path, typer.Option(
+        help="Data folder in the ILP layout (website/, database/).")],
+    first: Annotated[str, typer.Option("--from", help="First day.")] = "2022-01-01",
+    last: Annotated[str, typer.Option("--to", help="Last day.")] = "2023-12-31",
+    runs: Annotated[str, typer.Option(
+        help="Executors to time, KIND:WORKERS comma-separated (KIND local or dask).")] =
+        "local:1,local:2,dask:1,dask:2",
+    simulate: Annotated[str, typer.Option(
+        help="Worker counts to simulate from the local:1 task times ('' for none).")] =
+        "1,2,4,8,16",
+    method: Annotated[str, typer.Option(help="milp or greedy.")] = "milp",
+    json_out: Annotated[Path | None, typer.Option("--json", help="Write the rows here.")] =
+        None,
+) -> None:
+    """Time a range of delivery days on each executor; simulate more workers."""
+    from skyroute.bench.jobs import bench_jobs, parse_runs
+    from skyroute.bench.jobs import simulate as simulated
+
+    d0, d1 = _day(first, "--from"), _day(last, "--to")
+    if d1 < d0:
+        raise OptionError(f"--to {d1} is before --from {d0}")
+    plan = parse_runs(runs)
+    counts = [int(n) for n in parse_list(simulate)] if simulate.strip() else []
+    n_days = (d1 - d0).days + 1
+    with progress_bar(Console(stderr=True)) as progress:
+        task = progress.add_task("days", total=n_days * len(plan))
+        got = bench_jobs(data, d0, d1, plan, method=method,
+                         on_day=lambda: progress.advance(task))
+    rows, durations = got["rows"], got["durations"]
+    base = next((r["start_seconds"] + r["wall_seconds"] for r in rows
+                 if (r["executor"], r["workers"]) == ("local", 1)), None)
+    t = Table(title=f"{n_days} delivery days ({d0} to {d1}, {method}), measured")
+    for col in ("executor", "workers", "start s", "range s", "total s", "speed-up",
+                "mean %", "min %"):
+        t.add_column(col, justify="right")
+    for r in rows:
+        total = r["start_seconds"] + r["wall_seconds"]
+        t.add_row(r["executor"], str(r["workers"]), f"{r['start_seconds']:.1f}",
+                  f"{r['wall_seconds']:.1f}", f"{total:.1f}",
+                  "-" if base is None else f"{base / total:.2f}x",
+                  f"{r['mean_pct']:.2f}" if r["mean_pct"] is not None else "-",
+                  f"{r['min_pct']:.2f}" if r["min_pct"] is not None else "-")
+    out = wide_console()
+    out.print(t)
+    sims = simulated(rows, durations, counts) if durations and counts else []
+    if sims:
+        s = Table(title=f"simulated from the local:1 task times (sum {sum(durations):.1f} s, "
+                        f"longest day {max(durations):.2f} s)")
+        for col in ("workers", "local s", "speed-up", "dask s", "dask speed-up"):
+            s.add_column(col, justify="right")
+        for r in sims:
+            dask = r["dask_seconds"] is not None
+            s.add_row(str(r["workers"]), f"{r['local_seconds']:.1f}", f"{r['speedup']:.2f}x",
+                      f"{r['dask_seconds']:.1f}" if dask else "-",
+                      f"{r['dask_speedup']:.2f}x" if dask else "-")
+        out.print(s)
+    if json_out:
+        write_atomic(json_out, json.dumps(
+            {"machine": {"python": platform.python_version(), "cpus": _cpus()},
+             "rows": rows, "simulated": sims, "durations": durations}, indent=1))
+
+
+def _cpus() -> int:
+    import os
+
+    return os.cpu_count() or 1
