@@ -228,15 +228,15 @@ def test_unknown_fleet_run_is_404(client, fake, suffix):
 # -- the real jobs -------------------------------------------------------------------
 def wait(c, job_id: str, timeout: float = 600) -> dict:
     end = time.monotonic() + timeout
-    seen = set()
+    seen = []
     while time.monotonic() < end:
         job = c.get(f"/jobs/{job_id}").json()
-        seen.add(job["state"])
+        seen.append((job["state"], job["progress"]))
         assert 0 <= job["progress"] <= 1
         if job["state"] in ("done", "failed"):
             job["seen"] = seen
             return job
-        time.sleep(0.1)
+        time.sleep(0.05)
     raise AssertionError(f"job {job_id} did not end in {timeout} s")
 
 
@@ -262,6 +262,30 @@ def test_a_delivery_job_stores_the_clis_rows(tmp_path, lunch):
     cli = open_store(lunch[0])
     d = dt.date.fromisoformat(DAY)
     assert day_rows(eng, d) == day_rows(cli, d)
+
+
+@needs_jobs
+@pytest.mark.slow
+def test_a_range_job_shows_its_progress_while_running(tmp_path):
+    from skyroute.delivery.days import open_store
+    from skyroute.delivery.orders import read_csv_orders
+    from skyroute.delivery.store import import_orders, order_dates
+
+    db = f"sqlite:///{tmp_path / 'range.db'}"
+    eng = open_store(db)
+    import_orders(eng, read_csv_orders(EXAMPLE))
+    dates = order_dates(eng)
+    first, last = min(dates).isoformat(), max(dates).isoformat()
+    with make_client(db_url=db, data_dir=EXAMPLE, job_workers=1) as c:
+        r = c.post("/jobs/deliver", json={"from": first, "to": last}, headers=AUTH)
+        assert r.status_code == 202, r.text
+        job = wait(c, r.json()["id"])
+        assert job["state"] == "done" and job["progress"] == 1, job
+        states = [s for s, _ in job["seen"]]
+        assert "running" in states and "queued" not in states[states.index("running"):]
+        # some days stored while the job still ran, seen through GET /jobs/{id}
+        assert any(s == "running" and 0 < p < 1 for s, p in job["seen"]), job["seen"]
+        assert {d["date"] for d in c.get("/days").json()} >= {d.isoformat() for d in dates}
 
 
 @needs_jobs
