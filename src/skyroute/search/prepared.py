@@ -174,8 +174,9 @@ def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
             data = {k: z[k] for k in z.files}
     except FileNotFoundError:
         raise InputFormatError(path, "no such index file") from None
-    except (OSError, ValueError, zipfile.BadZipFile) as e:
-        raise InputFormatError(path, f"not a skyroute index (.npz): {e}") from None
+    except (OSError, ValueError, zipfile.BadZipFile):
+        raise InputFormatError(path, "not a skyroute index (an .npz file written by "
+                               "'skyroute prepare')") from None
     missing = [k for k in ("version", "method", "shape", "digest", *INDEX_ARRAYS)
                if k not in data]
     if missing:

@@ -127,10 +127,10 @@ def _to_xy(flat, Wp):
 def subgoal_query(blk, sg, cells, clr, offs, nbr, label, ws, gs, Wp, s, t):
     """One exact query from flat cell s to flat cell t.
 
-    ``Wp`` is the padded row length; ``ws`` (8, m + 2) int64 and ``gs`` (m + 2) float64 are the workspace:
-    rows parent, state, heap cells, heap keys, start list, goal list, goal flags, seen; the
-    state and flag rows are zero between queries. Returns (code, path (K, 2), cost,
-    expanded, max_frontier).
+    ``Wp`` is the padded row length; ``ws`` (8, m + 2) int64 and ``gs`` (m + 2) float64
+    are the workspace: rows parent, state, heap cells, heap keys, start list, goal list,
+    goal flags, seen; the state and flag rows are zero between queries. Returns (code,
+    path (K, 2), cost, expanded, max_frontier).
     """
     if label[s] != label[t] or label[s] < 0:
         return NO_PATH, np.empty((0, 2)), math.inf, 0, 0
