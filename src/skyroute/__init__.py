@@ -8,6 +8,7 @@ from skyroute.caches import clear_caches
 from skyroute.errors import InputFormatError, OptionError, QueryError, SkyrouteError
 from skyroute.planner import plan
 from skyroute.result import PlanResult, Status
+from skyroute.search.prepared import PreparedGrid, load_index, prepare
 from skyroute.world.grid import Grid
 from skyroute.world.load import bundled_maps, load_map, load_world
 from skyroute.world.world import World
@@ -19,13 +20,16 @@ __all__ = [
            "InputFormatError",
            "OptionError",
            "PlanResult",
+           "PreparedGrid",
            "QueryError",
            "SkyrouteError",
            "Status",
            "World",
            "bundled_maps",
            "clear_caches",
+           "load_index",
            "load_map",
            "load_world",
            "plan",
+           "prepare",
 ]

@@ -3,7 +3,9 @@
 All runners answer the same queries in one process, interleaved (the order rotates each
 query, so drift in machine speed spreads evenly), after one untimed warm-up query each.
 Times are wall clock around one call: ``skyroute.plan`` for ours (validation included),
-the peer's query function for a peer (its one-off set-up is not timed).
+``PreparedGrid.plan`` for the ``prepared`` runner (its index is built once per map, timed
+apart as ``build_seconds``, its size the arrays' ``nbytes``), the peer's query function
+for a peer (its one-off set-up is not timed).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from skyroute.bench.random_maps import far_queries, parse_random, random_grid
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.planner import plan
 from skyroute.search.grid_plan import GRID_ALGORITHMS
+from skyroute.search.prepared import prepare
 from skyroute.world.grid import Grid
 from skyroute.world.movingai import Scenario, read_map, read_scen
 
@@ -89,6 +92,19 @@ def _ours(grid: Grid, algorithm: str) -> Callable:
     return run
 
 
+def _prepared(grid: Grid, info: dict) -> Callable:
+    index = prepare(grid)  # first build: loads the compiled kernels from numba's cache
+    index = prepare(grid)
+    info.update(build_seconds=index.build_seconds, index_bytes=index.nbytes,
+                subgoals=index.subgoals, edges=index.edges)
+
+    def run(s, t):
+        r = index.plan(s, t)
+        return r.cost if r.found else None, r.expanded, r.seconds
+
+    return run
+
+
 def _peer(grid: Grid, name: str) -> Callable:
     query = PEERS[name].prepare(grid)
 
@@ -100,20 +116,21 @@ def _peer(grid: Grid, name: str) -> Callable:
 
 
 def bench_map(map_path: Path, scen_path: Path, *, per_map: int, algorithms: Sequence[str],
-              peers: Sequence[str], seed: int,
+              peers: Sequence[str], seed: int, prepared: bool = False,
               on_query: Callable[[], None] | None = None) -> dict:
-    """Run one map's sampled queries through every runner; return its report."""
+    """Run one map's sampled queries through every runner (with ``prepared``, also
+    through a prepared index); return its report."""
     grid = read_map(map_path)
     scen: Scenario = read_scen(scen_path)
     if (scen.width, scen.height) != (grid.width, grid.height):
         raise InputFormatError(scen_path, f"scenario is for a {scen.width}x{scen.height} map, "
                                f"{map_path.name} is {grid.width}x{grid.height}")
     return bench_queries(grid, scen, map_path.name, per_map=per_map, algorithms=algorithms,
-                         peers=peers, seed=seed, on_query=on_query)
+                         peers=peers, seed=seed, prepared=prepared, on_query=on_query)
 
 
 def bench_random(spec: str, *, per_map: int, algorithms: Sequence[str],
-                 peers: Sequence[str], seed: int,
+                 peers: Sequence[str], seed: int, prepared: bool = False,
                  on_query: Callable[[], None] | None = None) -> dict:
     """A synthetic ``SIDE:SHARE`` map (numpy seed ``seed``) with ``per_map`` far queries
     whose optima come from scipy; its report as :func:`bench_map`'s."""
@@ -121,17 +138,21 @@ def bench_random(spec: str, *, per_map: int, algorithms: Sequence[str],
     grid = random_grid(side, share, seed)
     scen = far_queries(grid, max(per_map, 1), seed)
     return bench_queries(grid, scen, grid.name, per_map=0, algorithms=algorithms,
-                         peers=peers, seed=seed, on_query=on_query)
+                         peers=peers, seed=seed, prepared=prepared, on_query=on_query)
 
 
 def bench_queries(grid: Grid, scen: Scenario, label: str, *, per_map: int,
                   algorithms: Sequence[str], peers: Sequence[str], seed: int,
+                  prepared: bool = False,
                   on_query: Callable[[], None] | None = None) -> dict:
     """Run ``per_map`` sampled lines of ``scen`` (0: all) through every runner."""
     rng = np.random.default_rng(seed)
     n = len(scen) if per_map <= 0 else min(per_map, len(scen))
     idx = np.sort(rng.choice(len(scen), size=n, replace=False))
     runners = [(RunnerStats(a, False), _ours(grid, a)) for a in algorithms]
+    info: dict = {}
+    if prepared:
+        runners.append((RunnerStats("prepared", False), _prepared(grid, info)))
     runners += [(RunnerStats(p, True), _peer(grid, p)) for p in peers]
     first = idx[0]
     for _, run in runners:  # warm-up: compile, caches
@@ -159,8 +180,11 @@ def bench_queries(grid: Grid, scen: Scenario, label: str, *, per_map: int,
             p["runner"]: p["median_ms"] / row["median_ms"]
             for p in rows if p["peer"] and p["median_ms"] and row["median_ms"]
             and not row["peer"]}
-    return {"map": label, "scen": scen.path.name, "size": [grid.width, grid.height],
-            "queries": int(n), "scen_lines": len(scen), "rows": rows}
+    report = {"map": label, "scen": scen.path.name, "size": [grid.width, grid.height],
+              "queries": int(n), "scen_lines": len(scen), "rows": rows}
+    if prepared:
+        report["prepared"] = info
+    return report
 
 
 def check_runners(algorithms: Sequence[str], peers: Sequence[str]) -> tuple[list, list, list]:

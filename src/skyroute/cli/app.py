@@ -19,7 +19,7 @@ from skyroute.cli.deliver_cmd import deliver_command
 from skyroute.cli.errors import run_cli
 from skyroute.cli.fleet_cmd import fleet_app
 from skyroute.cli.fly_cmd import fly_command
-from skyroute.cli.plan_cmd import plan_command
+from skyroute.cli.plan_cmd import plan_command, prepare_command
 from skyroute.cli.serve_cmd import serve_command
 from skyroute.cli.world_cmd import plan_world_command, synth_city_command
 from skyroute.world.load import bundled_maps
@@ -29,6 +29,7 @@ app = typer.Typer(help="skyroute: plan where drones and small robots fly or driv
                        "they deliver.",
                   no_args_is_help=True, add_completion=False, pretty_exceptions_enable=False)
 app.command("plan")(plan_command)
+app.command("prepare")(prepare_command)
 app.command("plan-world")(plan_world_command)
 app.command("synth-city")(synth_city_command)
 app.command("fly")(fly_command)

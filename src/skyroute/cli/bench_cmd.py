@@ -39,6 +39,9 @@ def bench_grid(
         help="Also a synthetic SIDE:SHARE map (repeatable), e.g. 512:0.2: SHARE of the cells "
              "blocked at random (numpy --seed), --per-map far queries with optima from "
              "scipy. Alone, only these maps run.")] = None,
+    prepared: Annotated[bool, typer.Option(
+        "--prepared", help="Also a prepared index per map (skyroute.prepare): its build "
+                           "seconds and bytes, and its queries as one more runner.")] = False,
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] =
         None,
 ) -> None:
@@ -63,17 +66,19 @@ def bench_grid(
         for map_path, scen_path in pairs:
             progress.update(task, description=map_path.stem)
             reports.append(bench_map(map_path, scen_path, per_map=per_map, algorithms=algs,
-                                     peers=have, seed=seed,
+                                     peers=have, seed=seed, prepared=prepared,
                                      on_query=lambda: progress.advance(task)))
         for spec in randoms:
             progress.update(task, description=f"random {spec}")
             reports.append(bench_random(spec, per_map=per_map, algorithms=algs, peers=have,
-                                        seed=seed, on_query=lambda: progress.advance(task)))
+                                        seed=seed, prepared=prepared,
+                                        on_query=lambda: progress.advance(task)))
     out = Console()
     for rep in reports:
         out.print(_table(rep, have))
     if json_out:
         doc = {"settings": {"maps": str(folder), "per_map": per_map, "random": randoms,
+                            "prepared": prepared,
                             "algorithms": algs, "peers": have, "missing_peers": missing,
                             "seed": seed},
                "machine": {"python": platform.python_version(),
@@ -87,8 +92,12 @@ def _fmt(v, spec):
 
 
 def _table(rep: dict, peers: list[str]) -> Table:
+    prep = rep.get("prepared")
+    caption = (f"prepared: built in {prep['build_seconds']:.3f} s, "
+               f"{prep['index_bytes'] / 1e6:.1f} MB (arrays' nbytes), {prep['subgoals']} "
+               f"subgoals, {prep['edges']} edges" if prep else None)
     t = Table(title=f"{rep['map']} ({rep['size'][0]}x{rep['size'][1]}): "
-                    f"{rep['queries']} of {rep['scen_lines']} scenario lines")
+                    f"{rep['queries']} of {rep['scen_lines']} scenario lines", caption=caption)
     for col in ("runner", "median ms", "M exp/s", "matched", "cost/opt mean", "cost/opt max"):
         t.add_column(col, justify="left" if col == "runner" else "right")
     for p in peers:

@@ -11,10 +11,12 @@ from rich.console import Console
 
 from skyroute.cli.parse import parse_cell
 from skyroute.cli.tables import result_table
+from skyroute.errors import OptionError
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps, grid_path_geojson
 from skyroute.planner import plan
 from skyroute.search.grid_plan import GRID_ALGORITHMS, grid_options
+from skyroute.search.prepared import load_index, prepare
 from skyroute.world.load import load_map
 
 EXIT_NOT_FOUND = 1
@@ -46,6 +48,9 @@ def plan_command(
              "name).")] = 1.0,
     max_expansions: Annotated[int | None, typer.Option(
         help="Give up after this many expansions (status budget_exhausted).")] = None,
+    index: Annotated[Path | None, typer.Option(
+        help="Answer from this prepared index ('skyroute prepare MAP -o MAP.idx'): the exact "
+             "octile path; only with the default search options.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG picture here.")] = None,
     geojson: Annotated[Path | None, typer.Option(help="Write the path as GeoJSON here.")] = None,
@@ -59,10 +64,17 @@ def plan_command(
     opts = grid_options(algorithm, connectivity=connectivity, corner_cutting=corner_cutting,
                         heuristic=heuristic, weight=weight, prune=prune,
                         max_expansions=max_expansions)
+    if index is not None and opts != grid_options("astar"):
+        raise OptionError("--index answers exact octile queries: leave --algorithm, "
+                          "--connectivity, --corner-cutting, --heuristic, --weight, --prune "
+                          "and --max-expansions at their defaults", param="index")
     grid = load_map(map_file, resolution=resolution, safety=safety)
-    result = plan(grid, s, t, algorithm=opts.algorithm, connectivity=opts.connectivity,
-                  corner_cutting=opts.corner_cutting, heuristic=opts.heuristic,
-                  weight=opts.weight, prune=opts.prune, max_expansions=max_expansions)
+    if index is not None:
+        result = load_index(index, grid).plan(s, t)
+    else:
+        result = plan(grid, s, t, algorithm=opts.algorithm, connectivity=opts.connectivity,
+                      corner_cutting=opts.corner_cutting, heuristic=opts.heuristic,
+                      weight=opts.weight, prune=opts.prune, max_expansions=max_expansions)
     if result.found:
         if geojson:
             write_atomic(geojson, dumps(grid_path_geojson(grid, result)))
@@ -77,3 +89,23 @@ def plan_command(
         Console().print(result_table(f"{grid.name}: {result.algorithm}", result, files=files))
     if not result.found:
         raise typer.Exit(EXIT_NOT_FOUND)
+
+
+def prepare_command(
+    map_file: Annotated[str, typer.Argument(metavar="MAP", help=(
+        "A grid map file (as for 'skyroute plan') or the name of a bundled map."))],
+    out: Annotated[Path, typer.Option("-o", "--out", help="Write the index here (.npz "
+                                      "format), e.g. MAP.idx.")],
+    method: Annotated[str, typer.Option(help="Index kind: subgoal.")] = "subgoal",
+    safety: Annotated[float, typer.Option(
+        help="Block cells within this many metres of an obstacle (as for plan).")] = 0.0,
+    resolution: Annotated[float, typer.Option(
+        help="Metres per cell for .csv walls (as for plan).")] = 1.0,
+) -> None:
+    """Build a map's index once for fast exact queries ('skyroute plan MAP --index ...')."""
+    grid = load_map(map_file, resolution=resolution, safety=safety)
+    index = prepare(grid, method=method)
+    written = index.save(out)
+    Console().print(f"{grid.name}: {index.method} index, {index.subgoals} subgoals, "
+                    f"{index.edges} edges, built in {index.build_seconds:.3f} s, "
+                    f"{written.stat().st_size / 1e6:.2f} MB -> {written}")

@@ -1,0 +1,184 @@
+"""Prepared grids (skyroute.prepare): exact optima through the subgoal index, against the
+MovingAI scenarios, Dijkstra on random grids, and the corner cases; the .npz round trip
+and its refusals; the CLI's prepare and plan --index."""
+
+import json
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import skyroute
+from skyroute.cli.app import main
+from skyroute.search.prepared import FORMAT_VERSION
+from skyroute.world.movingai import read_map, read_scen
+from tests.conftest import movingai_pairs
+from tests.search.checks import assert_grid_path_legal
+
+PAIRS = movingai_pairs()
+PER_MAP = 40
+
+
+def _check_scenario(grid, scen, lines):
+    index = skyroute.prepare(grid)
+    for i in lines:
+        s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
+        r = index.plan(s, t)
+        assert r.found, (grid.name, i)
+        assert scen.matches(int(i), r.cost), (grid.name, i, r.cost, scen.optimal[i])
+        assert tuple(r.path[0]) == s and tuple(r.path[-1]) == t
+        assert assert_grid_path_legal(grid.blocked, r.path) == pytest.approx(r.cost, abs=1e-9)
+
+
+@pytest.mark.parametrize("name", sorted(skyroute.bundled_maps()))
+def test_every_line_of_the_bundled_scenarios(name):
+    path = skyroute.bundled_maps()[name]
+    grid, scen = read_map(path), read_scen(path.with_name(path.name + ".scen"))
+    _check_scenario(grid, scen, range(len(scen)))
+
+
+@pytest.mark.shared_data
+@pytest.mark.parametrize("map_path, scen_path", PAIRS, ids=[m.stem for m, _ in PAIRS])
+def test_sampled_lines_of_the_shared_scenarios(map_path, scen_path):
+    grid, scen = read_map(map_path), read_scen(scen_path)
+    rng = np.random.default_rng(20261123)
+    lines = rng.choice(len(scen), size=min(PER_MAP, len(scen)), replace=False)
+    _check_scenario(grid, scen, [*lines, len(scen) - 1])  # the longest bucket too
+
+
+@st.composite
+def random_query(draw):
+    h, w = draw(st.integers(2, 24)), draw(st.integers(2, 24))
+    share = draw(st.sampled_from([0.1, 0.2, 0.3, 0.4]))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    blocked = rng.random((h, w)) < share
+    if draw(st.booleans()):  # one-cell corridors: walls every other row with gaps
+        blocked[1::2, :] = True
+        blocked[1::2, rng.integers(0, w, size=blocked[1::2].shape[0])] = False
+    free = np.argwhere(~blocked)
+    if len(free) == 0:
+        blocked[0, 0] = False
+        free = np.argwhere(~blocked)
+    s = free[draw(st.integers(0, len(free) - 1))]
+    t = free[draw(st.integers(0, len(free) - 1))]
+    return blocked, (int(s[1]), int(s[0])), (int(t[1]), int(t[0]))
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_query())
+def test_prepared_costs_equal_dijkstra(q):
+    blocked, s, t = q
+    grid = skyroute.Grid(blocked)
+    want = skyroute.plan(grid, s, t, algorithm="dijkstra")
+    got = skyroute.prepare(grid).plan(s, t)
+    assert got.status == want.status
+    if want.found:
+        assert got.cost == pytest.approx(want.cost, abs=1e-9)
+        assert assert_grid_path_legal(blocked, got.path) == pytest.approx(got.cost, abs=1e-9)
+        assert tuple(got.path[0]) == s and tuple(got.path[-1]) == t
+    else:
+        assert got.path.shape == (0, 2) and got.cost == np.inf
+
+
+def test_every_pair_of_a_corridor_maze_matches_dijkstra():
+    # one-cell corridors, dead ends and starts right beside walls: all pairs
+    rows = ["....#.....",
+            "###.#.###.",
+            "..#...#...",
+            ".####.#.##",
+            "......#..."]
+    blocked = np.array([[c == "#" for c in r] for r in rows])
+    grid = skyroute.Grid(blocked)
+    index = skyroute.prepare(grid)
+    free = [(int(x), int(y)) for y, x in np.argwhere(~blocked)]
+    for s in free:
+        for t in free:
+            want = skyroute.plan(grid, s, t, algorithm="dijkstra")
+            got = index.plan(s, t)
+            assert got.status == want.status and got.cost == pytest.approx(want.cost)
+
+
+def test_no_path_across_components_is_answered_from_the_labels():
+    blocked = np.zeros((20, 30), bool)
+    blocked[:, 15] = True  # a wall splits the map
+    index = skyroute.prepare(skyroute.Grid(blocked))
+    r = index.plan((0, 0), (29, 19))
+    assert r.status is skyroute.Status.NO_PATH and r.expanded == 0 and r.cost == np.inf
+    # a diagonal gap is no way through without corner cutting
+    index = skyroute.prepare(skyroute.Grid(np.array([[False, True], [True, False]])))
+    assert index.plan((0, 0), (1, 1)).status is skyroute.Status.NO_PATH
+
+
+def test_start_equals_goal_and_bad_queries():
+    grid = skyroute.load_map("den312d")
+    index = skyroute.prepare(grid)
+    r = index.plan((50, 76), (50, 76))
+    assert r.found and r.cost == 0.0 and r.path.tolist() == [[50.0, 76.0]]
+    assert index.plan(np.array([50, 76]), (60, 13)).cost == pytest.approx(112.55634918)
+    with pytest.raises(skyroute.QueryError, match=r"start .* outside"):
+        index.plan((500, 1), (60, 13))
+    with pytest.raises(skyroute.QueryError, match=r"goal .* blocked"):
+        index.plan((50, 76), (0, 0))
+    with pytest.raises(skyroute.OptionError, match="method"):
+        skyroute.prepare(grid, method="cpd")
+
+
+def test_save_load_round_trip_and_refusals(tmp_path):
+    grid = skyroute.load_map("den312d")
+    index = skyroute.prepare(grid)
+    path = index.save(tmp_path / "den312d.idx")
+    loaded = skyroute.load_index(path, grid)
+    assert (loaded.subgoals, loaded.edges) == (index.subgoals, index.edges)
+    a, b = index.plan((50, 76), (60, 13)), loaded.plan((50, 76), (60, 13))
+    assert a.cost == b.cost and np.array_equal(a.path, b.path)
+    # the same shape, one cell changed: stale
+    changed = grid.blocked.copy()
+    changed[76, 50] = True
+    with pytest.raises(skyroute.InputFormatError, match=r"den312d.idx: index is stale"):
+        skyroute.load_index(path, skyroute.Grid(changed))
+    with pytest.raises(skyroute.InputFormatError, match="index is for a 65x81 map"):
+        skyroute.load_index(path, skyroute.load_map("Berlin_1_256"))
+    junk = tmp_path / "junk.idx"
+    junk.write_text("not an index")
+    with pytest.raises(skyroute.InputFormatError, match=r"junk.idx: not a skyroute index"):
+        skyroute.load_index(junk, grid)
+    with np.load(path) as z:
+        data = dict(z)
+    data["version"] = np.int64(FORMAT_VERSION + 1)
+    old = tmp_path / "future.idx"
+    with open(old, "wb") as f:
+        np.savez(f, **data)
+    with pytest.raises(skyroute.InputFormatError, match=r"future.idx: index format"):
+        skyroute.load_index(old, grid)
+
+
+def _run(monkeypatch, capsys, *args):
+    monkeypatch.setattr(sys, "argv", ["skyroute", *args])
+    with pytest.raises(SystemExit) as exit_info:
+        main()
+    out, err = capsys.readouterr()
+    return exit_info.value.code, out, err
+
+
+def test_cli_prepare_then_plan_with_index(monkeypatch, capsys, tmp_path):
+    idx = tmp_path / "den312d.idx"
+    monkeypatch.setattr(sys, "argv", ["skyroute", "prepare", "den312d", "-o", str(idx)])
+    with pytest.raises(SystemExit) as e:
+        main()
+    assert e.value.code in (0, None) and idx.exists()
+    capsys.readouterr()
+    query = ["den312d", "--start", "50,76", "--goal", "60,13"]
+    code, out, err = _run(monkeypatch, capsys, "plan", *query, "--index", str(idx), "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["algorithm"] == "subgoal"
+    assert doc["cost"] == pytest.approx(112.55634918, abs=1e-8)
+    code, _, err = _run(monkeypatch, capsys, "plan", *query, "--index", str(idx),
+                        "--algorithm", "jps")
+    assert code == 2 and "--index" in err and "Traceback" not in err
+    code, _, err = _run(monkeypatch, capsys, "plan", "Berlin_1_256", "--start", "1,1",
+                        "--goal", "2,2", "--index", str(idx))
+    assert code == 2 and err.strip().endswith("Berlin_1_256.map is 256x256")
+    assert len(err.strip().splitlines()) == 1
