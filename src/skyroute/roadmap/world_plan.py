@@ -83,11 +83,11 @@ def roadmap_edges(world: World, algorithm: str, *, samples: int = 1000,
                   neighbours: int = 10, prm_star: bool = False,
                   seed: int = 0) -> np.ndarray | None:
     """(E, 2, 2) plane segments of the roadmap a planner has built on ``world`` (for
-    plots): the edges a visibility graph has checked and found free, or a PRM's edges;
+    plots): the free edges of a visibility graph, or a PRM's edges;
     None when that planner has built nothing on this world."""
     per_world = _ROADMAPS.get(world, {})
     if algorithm == "visibility" and ("visibility",) in per_world:
-        return per_world[("visibility",)].checked_edges()
+        return per_world[("visibility",)].edge_segments()
     key = ("prm", samples, neighbours, prm_star, seed)
     if algorithm == "prm" and key in per_world:
         return per_world[key].edge_segments()
