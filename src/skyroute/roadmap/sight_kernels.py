@@ -5,11 +5,11 @@ The obstacles are the merged world's polygons, as edges (rings and holes, groupe
 polygon) bucketed on a uniform grid (:func:`edge_index`). A segment walks the grid cells
 it passes (column by column, grown by ``eps``) and meets each edge there once:
 
-- both segments' orientation tests have certain signs (a floating-point error bound,
-  as in Shewchuk's fast orient2d) and say they cross properly: BLOCKED at once;
+- both segments' orientation tests have certain signs (beyond a floating-point error
+  bound, as in Shewchuk's fast orient2d) and say they cross properly: BLOCKED at once;
 - a certain sign says they are apart: nothing;
-- otherwise they touch, which the kernel accepts only where the zero is exact (a shared
-  vertex, or points on one axis-parallel line); it notes where along the segment the
+- otherwise they touch where an orientation is exactly zero (a shared vertex, or exact
+  arithmetic on an expansion says so); the kernel notes where along the segment the
   contact lies (and the stretches it runs along an edge). The pieces between contacts
   lie wholly inside or wholly outside each touched polygon, so the midpoint of each
   piece not along an edge is tested (even-odd rule).
@@ -205,9 +205,8 @@ def _inside(mx, my, edges, lo, hi, eps):
         ax, ay, bx, by = edges[e, 0], edges[e, 1], edges[e, 2], edges[e, 3]
         if point_segment_dist2(mx, my, ax, ay, bx, by) <= e2:
             return 2
-        if (ay > my) != (by > my):
-            if mx < ax + (my - ay) * (bx - ax) / (by - ay):
-                inside = not inside
+        if (ay > my) != (by > my) and mx < ax + (my - ay) * (bx - ax) / (by - ay):
+            inside = not inside
     return 1 if inside else 0
 
 
