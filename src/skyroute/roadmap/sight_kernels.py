@@ -213,7 +213,8 @@ def _inside(mx, my, edges, lo, hi, eps):
 @njit(cache=True)
 def segment_code(px, py, qx, qy, edges, owner, first, start, items, x0, y0, cell, nx, ny,
                  eps, stamp, ts, spans, touched):
-    """FREE, BLOCKED or UNSURE for segment pq. ``stamp``: (E + 1,) int64 scratch whose
+    """FREE, BLOCKED or UNSURE for segment pq, whose ends lie in no obstacle's interior
+    (corners, checked points: a segment wholly inside one would pass). ``stamp``: (E + 1,) int64 scratch whose
     last entry counts calls; ``ts`` (MAX_CONTACTS,), ``spans`` (MAX_CONTACTS, 2) float
     and ``touched`` (MAX_CONTACTS,) int64 scratch."""
     if px == qx and py == qy:
