@@ -214,9 +214,10 @@ def _inside(mx, my, edges, lo, hi, eps):
 def segment_code(px, py, qx, qy, edges, owner, first, start, items, x0, y0, cell, nx, ny,
                  eps, stamp, ts, spans, touched):
     """FREE, BLOCKED or UNSURE for segment pq, whose ends lie in no obstacle's interior
-    (corners, checked points: a segment wholly inside one would pass). ``stamp``: (E + 1,) int64 scratch whose
-    last entry counts calls; ``ts`` (MAX_CONTACTS,), ``spans`` (MAX_CONTACTS, 2) float
-    and ``touched`` (MAX_CONTACTS,) int64 scratch."""
+    (corners, checked points: a segment wholly inside one would pass). Scratch (see
+    :func:`scratch`): ``stamp`` (E + 1,) int64, its last entry counting calls; ``ts``
+    (MAX_CONTACTS,) and ``spans`` (MAX_CONTACTS, 2) float; ``touched`` (MAX_CONTACTS,)
+    int64."""
     if px == qx and py == qy:
         return UNSURE
     tick = stamp[-1] + 1
