@@ -2,11 +2,12 @@
 
 Worlds: seeded random rectangle worlds and, when given, a colliders.csv city at an
 altitude. Each query runs skyroute's visibility graph (first query on a fresh graph,
-build included, then the same query again), PRM and Theta* on a raster, and OMPL's
-PRM, PRM*, RRT*, RRTConnect and InformedRRT* (PyPI ``ompl``, a bench extra) with a time
-budget, each in a fresh SimpleSetup. OMPL checks states with a Python callback on the
-prepared union of the obstacles and checks motions at its default resolution; every
-returned path, ours and OMPL's, is re-checked with the exact segment test.
+build included and not read from the disk cache, then the same query again), PRM and
+Theta* on a raster, and OMPL's PRM, PRM*, RRT*, RRTConnect and InformedRRT* (PyPI
+``ompl``, a bench extra) with a time budget, each in a fresh SimpleSetup. OMPL checks
+states with a Python callback on the prepared union of the obstacles and checks motions
+at its default resolution; every returned path, ours and OMPL's, is re-checked with the
+exact segment test.
 """
 
 from __future__ import annotations
@@ -113,11 +114,13 @@ def run_ours(world: World, start, goal, other: tuple | None = None) -> list[dict
     """skyroute's planners on one query (fresh caches: the build is timed); ``other``, a
     second query timed on the graph the first one built."""
     from skyroute.planner import plan
+    from skyroute.roadmap.world_plan import visibility_graph
 
     fresh = World(world.obstacles, world.floors, world.ceilings, world.names,
                   world.boundary, world.frame, world.home, world.name)
     rows = []
     t0 = time.perf_counter()
+    visibility_graph(fresh, cache=False)  # built here, not read from the disk cache
     r = plan(fresh, start, goal)
     rows.append({"runner": "visibility (1st, with build)",
                  "seconds": time.perf_counter() - t0, "length": r.cost,

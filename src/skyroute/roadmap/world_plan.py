@@ -31,9 +31,10 @@ def _roadmap(world: World, key: tuple, build):
     return per_world[key]
 
 
-def visibility_graph(world: World) -> VisibilityGraph:
-    """The world's visibility graph (built on first use, kept with the world)."""
-    return _roadmap(world, ("visibility",), lambda: VisibilityGraph(world))
+def visibility_graph(world: World, *, cache: bool | None = None) -> VisibilityGraph:
+    """The world's visibility graph (built on first use, kept with the world; ``cache``:
+    the disk cache's use on that first build, see :class:`VisibilityGraph`)."""
+    return _roadmap(world, ("visibility",), lambda: VisibilityGraph(world, cache=cache))
 
 
 def prm_roadmap(world: World, *, samples: int = 1000, neighbours: int = 10,
