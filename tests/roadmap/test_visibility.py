@@ -13,6 +13,7 @@ from scipy.sparse.csgraph import dijkstra
 
 import skyroute
 from skyroute import QueryError, Status, World
+from skyroute.roadmap.world_plan import visibility_graph
 
 
 def rect_world(boxes, boundary=None, frame="enu"):
@@ -117,14 +118,14 @@ def test_repeated_queries_reuse_the_graph():
     boxes = [(1, 1, 3, 3), (5, 0, 6, 8)]
     world = rect_world(boxes)
     first = skyroute.plan(world, (0, 0), (8, 4))
+    graph = visibility_graph(world)
     again = skyroute.plan(world, (0, 0), (8, 4))
     fresh = skyroute.plan(rect_world(boxes), (0, 0), (8, 4))  # the same world, new graph
     assert first.cost == again.cost == fresh.cost
     np.testing.assert_array_equal(first.path, again.path)
-    # The first query kept its corner-to-corner verdicts: asked again, the graph tests only
-    # the edges from the start and to the goal, and learns no new verdict. A new graph
-    # (no cache) repeats every test of the first query.
-    assert first.extra["known_edges"] > 0
-    assert again.extra["known_edges"] == first.extra["known_edges"]
-    assert fresh.los_checks == first.los_checks
-    assert again.los_checks == first.los_checks - first.extra["known_edges"]
+    # the graph is kept with the world; a query tests only its own segments (the direct
+    # one, and those from the start and to the goal), never corner-to-corner edges
+    assert visibility_graph(world) is graph
+    assert again.los_checks == first.los_checks == fresh.los_checks
+    assert first.los_checks <= 1 + 2 * len(graph.corners)
+    assert first.extra["edges"] == graph.edge_count > 0

@@ -2,11 +2,12 @@
 
 Worlds: seeded random rectangle worlds and, when given, a colliders.csv city at an
 altitude. Each query runs skyroute's visibility graph (first query on a fresh graph,
-build included, then the same query again), PRM and Theta* on a raster, and OMPL's
-PRM, PRM*, RRT*, RRTConnect and InformedRRT* (PyPI ``ompl``, a bench extra) with a time
-budget, each in a fresh SimpleSetup. OMPL checks states with a Python callback on the
-prepared union of the obstacles and checks motions at its default resolution; every
-returned path, ours and OMPL's, is re-checked with the exact segment test.
+build included and not read from the disk cache, then the same query again), PRM and
+Theta* on a raster, and OMPL's PRM, PRM*, RRT*, RRTConnect and InformedRRT* (PyPI
+``ompl``, a bench extra) with a time budget, each in a fresh SimpleSetup. OMPL checks
+states with a Python callback on the prepared union of the obstacles and checks motions
+at its default resolution; every returned path, ours and OMPL's, is re-checked with the
+exact segment test.
 """
 
 from __future__ import annotations
@@ -113,11 +114,13 @@ def run_ours(world: World, start, goal, other: tuple | None = None) -> list[dict
     """skyroute's planners on one query (fresh caches: the build is timed); ``other``, a
     second query timed on the graph the first one built."""
     from skyroute.planner import plan
+    from skyroute.roadmap.world_plan import visibility_graph
 
     fresh = World(world.obstacles, world.floors, world.ceilings, world.names,
                   world.boundary, world.frame, world.home, world.name)
     rows = []
     t0 = time.perf_counter()
+    visibility_graph(fresh, cache=False)  # built here, not read from the disk cache
     r = plan(fresh, start, goal)
     rows.append({"runner": "visibility (1st, with build)",
                  "seconds": time.perf_counter() - t0, "length": r.cost,
@@ -169,28 +172,64 @@ def bench_query(world: World, start, goal, *, seconds: float, planners: tuple,
             "rrtstar_budget_within_1pct": reached if ompl_available() else None}
 
 
-def repeated_queries(world: World, count: int, rng: np.random.Generator) -> dict:
-    """Build the visibility graph, then time ``count`` queries between random free
-    points (any distance): the plan-once, query-many case."""
+def random_free_pair(world: World, rng: np.random.Generator, min_dist: float) -> tuple:
+    """Two free points drawn uniformly over the world's extent, at least ``min_dist``
+    apart (whether a path joins them is not checked)."""
+    xmin, ymin, xmax, ymax = world.bounds
+    for _ in range(100_000):
+        p = rng.uniform([xmin, ymin], [xmax, ymax], size=(2, 2))
+        if math.dist(*p) >= min_dist and world.is_free(p).all():
+            return p[0], p[1]
+    raise RuntimeError(f"no free pair {min_dist:g} apart found in {world.name}")
+
+
+def city_queries(world: World, count: int, rng: np.random.Generator, *,
+                 no_path: int = 5, far: float = 0.6) -> dict:
+    """Plan once, query many on ``world`` (a city): the visibility graph built without
+    the disk cache (``build_seconds``), built again from the disk cache
+    (``cached_build_seconds``), the first query on the fresh graph (``first_seconds``),
+    then ``count`` random far pairs (free points at least ``far`` x the longer side of
+    the extent apart; median, 95th percentile, worst), and ``no_path`` pairs that lie
+    in different free regions (drawn at any distance until that many answer no path)."""
     from skyroute.roadmap.visibility import VisibilityGraph
 
     t0 = time.perf_counter()
-    graph = VisibilityGraph(world)
+    graph = VisibilityGraph(world, cache=False)
     build = time.perf_counter() - t0
     xmin, ymin, xmax, ymax = world.bounds
+    min_dist = far * max(xmax - xmin, ymax - ymin)
+    pairs = [random_free_pair(world, rng, min_dist) for _ in range(count + 1)]
+    t0 = time.perf_counter()
+    graph.plan(*pairs[0])
+    first = time.perf_counter() - t0
     times, found = [], 0
-    while len(times) < count:
-        p = rng.uniform([xmin, ymin], [xmax, ymax], size=(2, 2))
-        if not graph.world.is_free(p).all():
-            continue
+    for s, g in pairs[1:]:
         t0 = time.perf_counter()
-        r = graph.plan(p[0], p[1])
+        r = graph.plan(s, g)
         times.append(time.perf_counter() - t0)
         found += r.found
-    t = np.array(times)
-    return {"build_seconds": build, "first_seconds": float(t[0]), "queries": count,
-            "found": found, "median_ms": float(np.median(t[1:]) * 1e3),
-            "p90_ms": float(np.percentile(t[1:], 90) * 1e3), "max_ms": float(t[1:].max() * 1e3)}
+    VisibilityGraph(world, cache=True)  # writes the cache file (when not there yet)
+    t0 = time.perf_counter()
+    VisibilityGraph(world, cache=True)
+    cached = time.perf_counter() - t0
+    none, tries = [], 0
+    while len(none) < no_path and tries < 200 * max(no_path, 1):
+        tries += 1
+        s, g = random_free_pair(world, rng, 0.0)
+        t0 = time.perf_counter()
+        r = graph.plan(s, g)
+        dt = time.perf_counter() - t0
+        if r.status.value == "no_path":
+            none.append(dt)
+    t = np.array(times) * 1e3
+    n = np.array(none) * 1e3
+    return {"build_seconds": build, "cached_build_seconds": cached, "first_seconds": first,
+            "first_with_build_seconds": build + first, "queries": count, "found": found,
+            "min_dist": min_dist, "median_ms": float(np.median(t)),
+            "p95_ms": float(np.percentile(t, 95)), "max_ms": float(t.max()),
+            "no_path_pairs": len(n), "no_path_median_ms": float(np.median(n)) if len(n)
+            else None, "no_path_max_ms": float(n.max()) if len(n) else None,
+            "corners": len(graph.corners)}
 
 
 def ompl_bounds(ob, world: World):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import sys
+import tempfile
 from pathlib import Path
 from typing import Annotated
 
@@ -17,10 +18,10 @@ from rich.table import Table
 from skyroute.bench.world import (
     OMPL_PLANNERS,
     bench_query,
+    city_queries,
     free_pair,
     ompl_available,
     random_rect_world,
-    repeated_queries,
 )
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_list
@@ -38,8 +39,11 @@ def bench_world(
         help="Also a colliders.csv city (at --altitude, with --safety).")] = None,
     altitude: Annotated[float, typer.Option(help="City altitude (m).")] = 5.0,
     safety: Annotated[float, typer.Option(help="City safety margin (m).")] = 5.0,
-    city_queries: Annotated[int, typer.Option(
-        help="Random queries timed on the city's graph once built.")] = 30,
+    city_queries_n: Annotated[int, typer.Option(
+        "--city-queries", help="Random far pairs timed on the city's graph once built.")]
+        = 30,
+    no_path: Annotated[int, typer.Option(
+        help="City pairs in different free regions to time (no path).")] = 5,
     seconds: Annotated[float, typer.Option(
         "--seconds", "--budget", help="Seconds per OMPL solve (--budget: old name).")] = 1.0,
     planners: Annotated[str, typer.Option(help="OMPL planners, comma-separated.")] =
@@ -48,6 +52,26 @@ def bench_world(
         None,
 ) -> None:
     """Path length relative to the visibility-graph optimum, and time, against OMPL."""
+    with tempfile.TemporaryDirectory() as cache:  # builds are timed cold, not from disk
+        os.environ["SKYROUTE_CACHE"], old = cache, os.environ.get("SKYROUTE_CACHE")
+        try:
+            _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path,
+                         seconds, planners, json_out)
+        finally:
+            if old is None:
+                os.environ.pop("SKYROUTE_CACHE", None)
+            else:
+                os.environ["SKYROUTE_CACHE"] = old
+    if "ompl" in sys.modules:
+        # OMPL's nanobind bindings print a reference-leak report at interpreter exit;
+        # everything is written and flushed, so leave without running finalisers.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(0)
+
+
+def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, seconds,
+                 planners, json_out) -> None:
     chosen = tuple(parse_list(planners))
     for p in chosen:
         check_choice("planner", p, OMPL_PLANNERS)
@@ -85,24 +109,23 @@ def bench_world(
                       {True: "yes", False: "no", None: "-"}[row.get("valid")])
         out.print(t)
     city_timing = None
-    if city is not None and city_queries > 1:
-        city_timing = repeated_queries(cases[-1], city_queries, np.random.default_rng(seed))
-        out.print(f"{cases[-1].name}: visibility graph built in "
-                  f"{city_timing['build_seconds']:.3f} s; first query "
-                  f"{city_timing['first_seconds'] * 1e3:.1f} ms; {city_queries - 1} more: "
-                  f"median {city_timing['median_ms']:.1f} ms, 90th percentile "
-                  f"{city_timing['p90_ms']:.1f} ms, max {city_timing['max_ms']:.1f} ms "
-                  f"({city_timing['found']} of {city_queries} found a path)")
+    if city is not None and city_queries_n > 1:
+        c = city_timing = city_queries(cases[-1], city_queries_n, np.random.default_rng(seed),
+                                       no_path=no_path)
+        out.print(f"{cases[-1].name}: visibility graph of {c['corners']} corners built in "
+                  f"{c['build_seconds']:.3f} s ({c['cached_build_seconds']:.3f} s from the "
+                  f"disk cache); first query {c['first_seconds'] * 1e3:.1f} ms (with the "
+                  f"build {c['first_with_build_seconds']:.3f} s); {city_queries_n} far pairs "
+                  f"(>= {c['min_dist']:.0f} m apart, {c['found']} with a path): median "
+                  f"{c['median_ms']:.2f} ms, 95th percentile {c['p95_ms']:.2f} ms, max "
+                  f"{c['max_ms']:.2f} ms; {c['no_path_pairs']} pairs in different free "
+                  "regions: no path in median "
+                  + ("-" if c["no_path_median_ms"] is None else
+                     f"{c['no_path_median_ms']:.2f} ms, max {c['no_path_max_ms']:.2f} ms"))
     if json_out:
         write_atomic(json_out, json.dumps({"seconds": seconds, "seed": seed, "worlds": reports,
                                            "city_queries": city_timing},
                                           indent=1, default=float))
-    if "ompl" in sys.modules:
-        # OMPL's nanobind bindings print a reference-leak report at interpreter exit;
-        # everything is written and flushed, so leave without running finalisers.
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(0)
 
 
 @bench_app.command("motion")

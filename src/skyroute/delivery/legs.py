@@ -11,23 +11,18 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from pathlib import Path
 
 import numpy as np
 import shapely
 
-from skyroute.caches import register
+from skyroute.caches import cache_dir, register
 from skyroute.errors import SkyrouteError
 from skyroute.files import write_atomic
 from skyroute.motion.step_drone import MERGE, STEP, plan_moves
 from skyroute.world.world import World
 
 VERSION = 1  # bump when plan_moves' results may change
-
-
-def cache_dir() -> Path:
-    return Path(os.environ.get("SKYROUTE_CACHE", Path.home() / ".cache" / "skyroute"))
 
 
 def _world_key(world: World) -> str:

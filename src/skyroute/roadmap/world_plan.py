@@ -31,9 +31,10 @@ def _roadmap(world: World, key: tuple, build):
     return per_world[key]
 
 
-def visibility_graph(world: World) -> VisibilityGraph:
-    """The world's visibility graph (built on first use, kept with the world)."""
-    return _roadmap(world, ("visibility",), lambda: VisibilityGraph(world))
+def visibility_graph(world: World, *, cache: bool | None = None) -> VisibilityGraph:
+    """The world's visibility graph (built on first use, kept with the world; ``cache``:
+    the disk cache's use on that first build, see :class:`VisibilityGraph`)."""
+    return _roadmap(world, ("visibility",), lambda: VisibilityGraph(world, cache=cache))
 
 
 def prm_roadmap(world: World, *, samples: int = 1000, neighbours: int = 10,
@@ -83,11 +84,11 @@ def roadmap_edges(world: World, algorithm: str, *, samples: int = 1000,
                   neighbours: int = 10, prm_star: bool = False,
                   seed: int = 0) -> np.ndarray | None:
     """(E, 2, 2) plane segments of the roadmap a planner has built on ``world`` (for
-    plots): the edges a visibility graph has checked and found free, or a PRM's edges;
+    plots): the free edges of a visibility graph, or a PRM's edges;
     None when that planner has built nothing on this world."""
     per_world = _ROADMAPS.get(world, {})
     if algorithm == "visibility" and ("visibility",) in per_world:
-        return per_world[("visibility",)].checked_edges()
+        return per_world[("visibility",)].edge_segments()
     key = ("prm", samples, neighbours, prm_star, seed)
     if algorithm == "prm" and key in per_world:
         return per_world[key].edge_segments()
