@@ -91,9 +91,9 @@ def _maps():
 
 
 # In the order of 'skyroute --help': commands, then groups (as Typer lists them).
-COMMANDS = {"plan": _plan, "prepare": _prepare, "plan-world": _plan_world, "synth-city": _synth_city,
-            "fly": _fly, "deliver": _deliver, "serve": _serve, "maps": _maps,
-            "bench": _bench, "db": _db, "data": _data, "fleet": _fleet}
+COMMANDS = {"plan": _plan, "prepare": _prepare, "plan-world": _plan_world,
+            "synth-city": _synth_city, "fly": _fly, "deliver": _deliver, "serve": _serve,
+            "maps": _maps, "bench": _bench, "db": _db, "data": _data, "fleet": _fleet}
 
 app = typer.Typer(help="skyroute: plan where drones and small robots fly or drive, and what "
                        "they deliver.",
