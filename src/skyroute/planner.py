@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from skyroute.errors import OptionError
 from skyroute.result import PlanResult
-from skyroute.roadmap.world_plan import plan_world
 from skyroute.search.grid_plan import grid_options, plan_grid
 from skyroute.world.grid import Grid
-from skyroute.world.world import World
+
+if TYPE_CHECKING:
+    from skyroute.world.world import World
 
 
 def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
@@ -69,7 +72,14 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
     >>> skyroute.plan(grid, (50, 76), (60, 13), algorithm="theta").cost < r.cost
     True
     """
-    if isinstance(grid, World):
+    if not isinstance(grid, Grid):
+        # shapely and the roadmaps are imported only here: a grid plan never loads them
+        from skyroute.roadmap.world_plan import plan_world
+        from skyroute.world.world import World
+
+        if not isinstance(grid, World):
+            raise OptionError(f"grid must be a skyroute Grid or World, got "
+                              f"{type(grid).__name__}")
         extra = {k: v for k, v in (("connectivity", connectivity), ("heuristic", heuristic),
                                    ("prune", prune)) if v is not None}
         if corner_cutting:
@@ -80,8 +90,6 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
                           resolution=resolution, samples=samples, neighbours=neighbours,
                           prm_star=prm_star, seed=seed, max_expansions=max_expansions,
                           **extra)
-    if not isinstance(grid, Grid):
-        raise OptionError(f"grid must be a skyroute Grid or World, got {type(grid).__name__}")
     algorithm = algorithm or "astar"
     opts = grid_options(algorithm, connectivity=connectivity, corner_cutting=corner_cutting,
                         heuristic=heuristic, weight=weight, prune=prune,

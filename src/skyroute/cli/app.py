@@ -1,49 +1,121 @@
-"""The ``skyroute`` Typer application and its entry point."""
+"""The ``skyroute`` Typer application and its entry point.
+
+Every command is registered by a loader that imports its module when the command runs
+(:mod:`skyroute.cli.lazy_group`), so each command pays only for its own imports:
+``skyroute plan`` on a grid loads numpy, numba, Typer and Rich, not SQLAlchemy, pydantic,
+scipy or shapely (tests/cli/test_startup.py).
+"""
 
 from __future__ import annotations
 
 import typer
-from rich.console import Console
-from rich.table import Table
 
-from skyroute.cli import (
-    bench_fleet_cmd,  # noqa: F401  (registers 'bench fleet')
-    bench_jobs_cmd,  # noqa: F401  (registers 'bench jobs')
-    bench_service_cmd,  # noqa: F401  (registers 'bench service')
-    bench_world_cmd,  # noqa: F401  (registers 'bench world')
-)
-from skyroute.cli.bench_cmd import bench_app
-from skyroute.cli.data_cmd import data_app
-from skyroute.cli.db_cmd import db_app
-from skyroute.cli.deliver_cmd import deliver_command
 from skyroute.cli.errors import run_cli
-from skyroute.cli.fleet_cmd import fleet_app
-from skyroute.cli.fly_cmd import fly_command
-from skyroute.cli.plan_cmd import plan_command, prepare_command
-from skyroute.cli.serve_cmd import serve_command
-from skyroute.cli.world_cmd import plan_world_command, synth_city_command
-from skyroute.world.load import bundled_maps
-from skyroute.world.movingai import read_map
+from skyroute.cli.lazy_group import lazy_group
+
+
+def _plan():
+    from skyroute.cli.plan_cmd import plan_command
+
+    return plan_command
+
+
+def _prepare():
+    from skyroute.cli.plan_cmd import prepare_command
+
+    return prepare_command
+
+
+def _plan_world():
+    from skyroute.cli.world_cmd import plan_world_command
+
+    return plan_world_command
+
+
+def _synth_city():
+    from skyroute.cli.world_cmd import synth_city_command
+
+    return synth_city_command
+
+
+def _fly():
+    from skyroute.cli.fly_cmd import fly_command
+
+    return fly_command
+
+
+def _bench():
+    from skyroute.cli import (
+        bench_fleet_cmd,  # noqa: F401  (registers 'bench fleet')
+        bench_jobs_cmd,  # noqa: F401  (registers 'bench jobs')
+        bench_service_cmd,  # noqa: F401  (registers 'bench service')
+        bench_world_cmd,  # noqa: F401  (registers 'bench world' and 'bench motion')
+    )
+    from skyroute.cli.bench_cmd import bench_app
+
+    return bench_app
+
+
+def _deliver():
+    from skyroute.cli.deliver_cmd import deliver_command
+
+    return deliver_command
+
+
+def _db():
+    from skyroute.cli.db_cmd import db_app
+
+    return db_app
+
+
+def _data():
+    from skyroute.cli.data_cmd import data_app
+
+    return data_app
+
+
+def _fleet():
+    from skyroute.cli.fleet_cmd import fleet_app
+
+    return fleet_app
+
+
+def _serve():
+    from skyroute.cli.serve_cmd import serve_command
+
+    return serve_command
+
+
+def _maps():
+    return maps_command
+
+
+# In the order of 'skyroute --help': commands, then groups (as Typer lists them).
+COMMANDS = {"plan": _plan, "prepare": _prepare, "plan-world": _plan_world,
+            "synth-city": _synth_city, "fly": _fly, "deliver": _deliver, "serve": _serve,
+            "maps": _maps, "bench": _bench, "db": _db, "data": _data, "fleet": _fleet}
 
 app = typer.Typer(help="skyroute: plan where drones and small robots fly or drive, and what "
                        "they deliver.",
-                  no_args_is_help=True, add_completion=False, pretty_exceptions_enable=False)
-app.command("plan")(plan_command)
-app.command("prepare")(prepare_command)
-app.command("plan-world")(plan_world_command)
-app.command("synth-city")(synth_city_command)
-app.command("fly")(fly_command)
-app.add_typer(bench_app, name="bench")
-app.command("deliver")(deliver_command)
-app.add_typer(db_app, name="db")
-app.add_typer(data_app, name="data")
-app.add_typer(fleet_app, name="fleet")
-app.command("serve")(serve_command)
+                  cls=lazy_group(COMMANDS), no_args_is_help=True, add_completion=False,
+                  pretty_exceptions_enable=False)
 
 
-@app.command("maps")
+@app.callback()
+def _group() -> None:
+    # With no command registered Typer would not build a group; a callback makes it one
+    # (the loaders' commands are added by the group class).
+    pass
+
+
 def maps_command() -> None:
     """List the MovingAI maps bundled with skyroute (usable by name as MAP)."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from skyroute.world.load import bundled_maps
+    from skyroute.world.movingai import read_map
+
     table = Table(title="bundled maps (Sturtevant 2012, MovingAI; see CITATION.md)")
     for col in ("name", "size", "free", "scenario lines", "file"):
         table.add_column(col)

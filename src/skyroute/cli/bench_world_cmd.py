@@ -62,12 +62,7 @@ def bench_world(
                 os.environ.pop("SKYROUTE_CACHE", None)
             else:
                 os.environ["SKYROUTE_CACHE"] = old
-    if "ompl" in sys.modules:
-        # OMPL's nanobind bindings print a reference-leak report at interpreter exit;
-        # everything is written and flushed, so leave without running finalisers.
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(0)
+    _exit_past_ompl()
 
 
 def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, seconds,
@@ -145,6 +140,9 @@ def bench_motion(
         = None,
     tours: Annotated[int, typer.Option(
         help="--curvature: seeded 10-target tour instances (0: none).")] = 20,
+    dubins: Annotated[bool, typer.Option(
+        "--dubins", help="Only the Dubins batch against OMPL (100k and 1M queries, 1 and 2 "
+                         "threads); needs no --data.")] = False,
     max_expansions: Annotated[int, typer.Option(
         "--max-expansions", "--budget",
         help="plan_moves expansions per leg (--budget: old name).")] = 200_000,
@@ -158,15 +156,19 @@ def bench_motion(
     if curvature:
         _bench_curvature(worlds, seed, budgets, city, tours, json_out)
         return
-    if data is None:
-        raise OptionError("bench motion needs --data DIR (the ILP data) or --curvature")
+    if data is None and not dubins:
+        raise OptionError("bench motion needs --data DIR (the ILP data), --dubins or "
+                          "--curvature")
     from skyroute.bench.motion import dubins_speed, step_drone_pairs
 
     out = Console()
     d = dubins_speed()
-    out.print(f"Dubins: {d['skyroute_us']:.3f} us per query for {d['queries']:,} queries "
-              "(compiled batch)" + (f"; OMPL distance() from Python {d['ompl_us']:.3f} us "
-                                    "per call" if "ompl_us" in d else ""))
+    out.print(_dubins_table(d))
+    if dubins:
+        if json_out:
+            write_atomic(json_out, json.dumps({"dubins": d}, indent=1))
+        _exit_past_ompl()
+        return
     with Progress(console=Console(stderr=True), transient=True) as progress:
         task = progress.add_task("pairs", total=14 * 13)
         r = step_drone_pairs(data, max_expansions=max_expansions, merge=merge,
@@ -180,7 +182,28 @@ def bench_motion(
               f"p90 {r['p90_ms']:.1f} ms, max {r['max_ms']:.1f} ms")
     if json_out:
         write_atomic(json_out, json.dumps({"dubins": d, "step_drone": r}, indent=1))
+    _exit_past_ompl()
+
+
+def _dubins_table(d: dict) -> Table:
+    """The Dubins batch rows: us per query (median, best), OMPL's, the ratio."""
+    table = Table(title=f"Dubins lengths, r = {d['radius']} (numba threading layer "
+                        f"{d['threading_layer']}; max |skyroute - OMPL| "
+                        f"{d.get('max_abs_diff_ompl', float('nan')):.1e})")
+    for col in ("queries", "threads", "skyroute us/query", "best", "OMPL us/call", "ratio"):
+        table.add_column(col, justify="right")
+    for row in d["rows"]:
+        ompl = row.get("ompl_us")
+        table.add_row(f"{row['queries']:,}", str(row["threads"]), f"{row['skyroute_us']:.4f}",
+                      f"{row['skyroute_min_us']:.4f}", "-" if ompl is None else f"{ompl:.3f}",
+                      "-" if ompl is None else f"{ompl / row['skyroute_us']:.1f}x")
+    return table
+
+
+def _exit_past_ompl() -> None:
     if "ompl" in sys.modules:
+        # OMPL's nanobind bindings print a reference-leak report at interpreter exit;
+        # everything is written and flushed, so leave without running finalisers.
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(0)

@@ -16,7 +16,6 @@ from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps, grid_path_geojson
 from skyroute.planner import plan
 from skyroute.search.grid_plan import GRID_ALGORITHMS, grid_options
-from skyroute.search.prepared import load_index, prepare
 from skyroute.world.load import load_map
 
 EXIT_NOT_FOUND = 1
@@ -70,6 +69,8 @@ def plan_command(
                           "and --max-expansions at their defaults", param="index")
     grid = load_map(map_file, resolution=resolution, safety=safety)
     if index is not None:
+        from skyroute.search.prepared import load_index
+
         result = load_index(index, grid).plan(s, t)
     else:
         result = plan(grid, s, t, algorithm=opts.algorithm, connectivity=opts.connectivity,
@@ -103,6 +104,8 @@ def prepare_command(
         help="Metres per cell for .csv walls (as for plan).")] = 1.0,
 ) -> None:
     """Build a map's index once for fast exact queries ('skyroute plan MAP --index ...')."""
+    from skyroute.search.prepared import prepare
+
     grid = load_map(map_file, resolution=resolution, safety=safety)
     index = prepare(grid, method=method)
     written = index.save(out)

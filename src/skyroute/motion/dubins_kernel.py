@@ -21,14 +21,28 @@ from numba import njit
 
 TWO_PI = 2 * math.pi
 WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
-@njit(cache=True)
-def _m2p(a):
-    """:func:`_mod2pi` for one angle."""
-    if a < 0 and a > -1e-12:
-        return 0.0
-    m = a - TWO_PI * math.floor(a / TWO_PI)
-    return 0.0 if TWO_PI - m < 1e-12 else m
 
+
+@njit(cache=True, inline="always")
+def _m2p(a):
+    """:func:`_mod2pi` for one angle. Angles in [-4 pi, 4 pi) (all but a caller's own
+    headings far from 0) are wrapped by adds instead of a division and a floor: the same
+    value to an ulp (a - 2 pi floor(a / 2 pi) is a + 4 pi, a + 2 pi, a or a - 2 pi)."""
+    if a < 0:
+        if a > -1e-12:
+            return 0.0
+        if a >= -2 * TWO_PI:
+            a += TWO_PI
+            if a < 0:
+                a += TWO_PI
+        else:
+            a -= TWO_PI * math.floor(a / TWO_PI)
+    elif a >= TWO_PI:
+        if a < 2 * TWO_PI:
+            a -= TWO_PI
+        else:
+            a -= TWO_PI * math.floor(a / TWO_PI)
+    return 0.0 if TWO_PI - a < 1e-12 else a
 
 
 TURNS = np.array([[1 if c == "L" else -1 if c == "R" else 0 for c in w] for w in WORDS],
@@ -88,14 +102,20 @@ def words(sx, sy, sth, gx, gy, gth, r):
 @njit(cache=True, inline="always")
 def shortest_length(sx, sy, sth, gx, gy, gth, r):
     """Length of the shortest Dubins path (metres): :func:`words` without its arrays
-    (the search calls this for every node it generates)."""
+    (the search calls this for every node it generates, the batch for every query).
+
+    The same closed forms with less trigonometry: cos(a - b) from the sines and cosines
+    at hand (as OMPL does), the two atan2 of LSR and RSL as one atan2 of their angle
+    difference (only its value modulo 2 pi matters), LSL's and RSR's tangent angles
+    shared with the CCC words. Equal to the six words of :func:`words` to ~1e-14 (tests).
+    """
     dx, dy = gx - sx, gy - sy
     d = math.sqrt(dx * dx + dy * dy) / r
     phi = math.atan2(dy, dx)
     a = _m2p(sth - phi)
     b = _m2p(gth - phi)
     sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
-    cab = math.cos(a - b)
+    cab = ca * cb + sa * sb
     dd = d * d
     t_lsl = math.atan2(cb - ca, d + sa - sb)
     t_rsr = math.atan2(ca - cb, d - sa + sb)
@@ -109,12 +129,15 @@ def shortest_length(sx, sy, sth, gx, gy, gth, r):
     p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
     if p2 >= 0:
         p = math.sqrt(p2)
-        tmp = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
-        best = min(best, _m2p(tmp - a) + p + _m2p(tmp - _m2p(b)))
+        # atan2(y, x) - atan2(-2, p), as one atan2 (angle difference, modulo 2 pi)
+        y, x = -ca - cb, d + sa + sb
+        tmp = math.atan2(y * p + 2 * x, x * p - 2 * y)
+        best = min(best, _m2p(tmp - a) + p + _m2p(tmp - b))
     p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
     if p2 >= 0:
         p = math.sqrt(p2)
-        tmp = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
+        y, x = ca + cb, d - sa - sb  # atan2(y, x) - atan2(2, p)
+        tmp = math.atan2(y * p - 2 * x, x * p + 2 * y)
         best = min(best, _m2p(a - tmp) + p + _m2p(b - tmp))
     c = (6.0 - dd + 2 * cab + 2 * d * (sa - sb)) / 8.0  # RLR
     if abs(c) <= 1:

@@ -16,7 +16,6 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
-from scipy import ndimage
 
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
@@ -126,6 +125,8 @@ class PreparedGrid:
 
 def build_arrays(blocked: np.ndarray) -> dict:
     """The subgoal graph's arrays for a (H, W) blocked array (see subgoal_build)."""
+    from scipy import ndimage  # imported here: a plain 'skyroute plan' must not pay for it
+
     h, w = blocked.shape
     Wp = w + 2
     padded = np.ones((h + 2, w + 2), np.uint8)

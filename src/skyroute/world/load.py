@@ -4,16 +4,18 @@ from __future__ import annotations
 
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError, check_choice, renamed
-from skyroute.geo import FRAME_ALIASES, FRAMES
 from skyroute.world.grid import Grid
-from skyroute.world.image import read_image, read_npy
-from skyroute.world.movingai import read_map
-from skyroute.world.segments import rasterize_segments, read_segments
-from skyroute.world.world import World
+
+if TYPE_CHECKING:
+    from skyroute.world.world import World
+
+# Each reader is imported when its kind of file is read: a .map needs neither shapely
+# (walls, worlds) nor pyproj (frames) nor numba's wall kernel.
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".pgm", ".tif", ".tiff")
 
@@ -62,15 +64,23 @@ def load_map(path: str | Path, *, resolution: float | None = None, safety: float
     p = resolve_map_path(path)
     suffix = p.suffix.lower()
     if suffix == ".csv":
+        from skyroute.world.segments import rasterize_segments, read_segments
+
         return rasterize_segments(read_segments(p), resolution=resolution, safety=safety,
                                   name=p.name)
     if suffix == ".map":
+        from skyroute.world.movingai import read_map
+
         grid = read_map(p)
         if resolution != 1.0:
             grid = Grid(grid.blocked, resolution, grid.origin, name=grid.name)
     elif suffix in IMAGE_SUFFIXES:
+        from skyroute.world.image import read_image
+
         grid = read_image(p, resolution=resolution)
     elif suffix == ".npy":
+        from skyroute.world.image import read_npy
+
         grid = read_npy(p, resolution=resolution)
     else:
         raise InputFormatError(p, f"unknown map type {suffix!r}; valid: .map, .csv, .npy, "
@@ -94,6 +104,7 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
     content, already in hand (an upload); ``path`` then only names it and its suffix
     tells the format.
     """
+    from skyroute.geo import FRAME_ALIASES, FRAMES
     from skyroute.world.colliders import read_colliders
     from skyroute.world.geojson_world import parse_boundary, read_geojson_world
 
@@ -123,6 +134,8 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
 def _with_boundary(world: World, lonlat_box) -> World:
     """Attach a lon/lat boundary to a metres world (projected around its home)."""
     import shapely
+
+    from skyroute.world.world import World
 
     return World(world.obstacles, world.floors, world.ceilings, world.names,
                  shapely.transform(lonlat_box, world.plane_from_lonlat), world.frame,

@@ -1,0 +1,76 @@
+"""A Typer group whose commands are imported when they are used.
+
+Typer builds every command from its function's signature, so registering a command
+imports its module, and with it what the command runs: ``skyroute plan`` would load
+SQLAlchemy, pydantic, scipy and shapely for the commands it does not run. Here each
+command is a loader (a light function that imports the command's module in its body);
+the group calls it when the command is run, or listed in ``--help``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, MutableMapping
+
+import typer
+import typer.main
+from typer.core import TyperGroup
+
+# A loader returns a command function or a Typer sub-application.
+Loader = Callable[[], Callable | typer.Typer]
+
+
+def to_click(name: str, obj: Callable | typer.Typer):
+    """The click command Typer would build for ``obj`` registered as ``name``."""
+    host = typer.Typer(add_completion=False)
+    if isinstance(obj, typer.Typer):
+        host.add_typer(obj, name=name)
+        return typer.main.get_command(host).commands[name]
+    host.command(name)(obj)
+    return typer.main.get_command(host)
+
+
+class LazyCommands(MutableMapping):
+    """The group's commands by name, the loaders' first (each built on first lookup), then
+    the ones built already; in that order, whatever has been built since."""
+
+    def __init__(self, built: MutableMapping, loaders: dict[str, Loader]):
+        self._built = dict(built)
+        self._loaders = {k: v for k, v in loaders.items() if k not in built}
+        self._order = [*self._loaders, *self._built]
+
+    def __getitem__(self, name):
+        if name not in self._built:
+            self._built[name] = to_click(name, self._loaders.pop(name)())
+        return self._built[name]
+
+    def __setitem__(self, name, command):
+        if name not in self._order:
+            self._order.append(name)
+        self._loaders.pop(name, None)
+        self._built[name] = command
+
+    def __delitem__(self, name):
+        if self._loaders.pop(name, None) is None:
+            del self._built[name]
+        self._order.remove(name)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(list(self._order))
+
+    def __len__(self) -> int:
+        return len(self._order)
+
+
+def lazy_group(loaders: dict[str, Loader]) -> type[TyperGroup]:
+    """A :class:`TyperGroup` class (for ``typer.Typer(cls=...)``) that adds ``loaders``'
+    commands, listed first, to the ones registered on the app."""
+
+    class LazyGroup(TyperGroup):
+        def __init__(self, **attrs):
+            super().__init__(**attrs)
+            self.commands = LazyCommands(self.commands, loaders)
+
+        def list_commands(self, ctx) -> list[str]:
+            return list(self.commands)
+
+    return LazyGroup

@@ -1,0 +1,83 @@
+"""What a cold ``skyroute plan`` on a grid imports: its own path, not the other commands'.
+
+The start-up of a one-query command is mostly imports (docs/benchmarks.md, section 3).
+These tests pin the module names a grid plan loads, never its time.
+"""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import skyroute
+from skyroute import lazy
+
+SRC = Path(skyroute.__file__).resolve().parents[1]
+
+# Libraries a grid plan does not use. Not listed, as others import them on this path:
+# scipy and scipy.linalg (numba's CPU target probes scipy's BLAS when its first kernel
+# loads), yaml (numba's config), pydantic (Typer converts every option with it).
+HEAVY = ("shapely", "sqlalchemy", "alembic", "matplotlib", "pyproj", "fastapi", "starlette",
+         "uvicorn", "httpx", "dask", "distributed", "PIL", "networkx", "pandas", "ompl",
+         "scipy.ndimage", "scipy.sparse", "scipy.spatial", "scipy.optimize")
+# skyroute's packages and modules that other commands (or World plans) need.
+OTHERS = ("skyroute.roadmap", "skyroute.motion", "skyroute.delivery", "skyroute.fleet",
+          "skyroute.jobs", "skyroute.bench", "skyroute.service", "skyroute.io.plot",
+          "skyroute.world.world", "skyroute.world.segments", "skyroute.world.image",
+          "skyroute.geo", "skyroute.cli.bench_cmd", "skyroute.cli.fleet_cmd",
+          "skyroute.cli.deliver_cmd", "skyroute.cli.db_cmd", "skyroute.cli.world_cmd",
+          "skyroute.cli.fly_cmd", "skyroute.cli.serve_cmd", "skyroute.cli.data_cmd")
+
+
+def imported_by(*args: str) -> tuple[set[str], str]:
+    """The modules a fresh ``python -X importtime -m skyroute ARGS`` imports, and stdout."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [str(SRC), *filter(None, [os.environ.get("PYTHONPATH")])]))
+    proc = subprocess.run([sys.executable, "-X", "importtime", "-m", "skyroute", *args],
+                          capture_output=True, text=True, env=env, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    names = {line.rsplit("|", 1)[1].strip() for line in proc.stderr.splitlines()
+             if line.startswith("import time:") and "|" in line}
+    assert "skyroute.search.astar" in names  # the parse saw the imports
+    return names, proc.stdout
+
+
+def loaded(names: set[str], prefixes: tuple[str, ...]) -> list[str]:
+    return sorted(n for n in names if any(n == p or n.startswith(p + ".") for p in prefixes))
+
+
+def test_grid_plan_imports_neither_heavy_libraries_nor_other_commands():
+    names, out = imported_by("plan", "den312d", "--start", "50,76", "--goal", "60,13",
+                             "--json")
+    assert json.loads(out)["cost"] == pytest.approx(112.55634918, abs=1e-8)
+    assert loaded(names, HEAVY) == []
+    assert loaded(names, OTHERS) == []
+
+
+def test_public_names_resolve_lazily_and_completely():
+    assert sorted(skyroute.__all__) == sorted(skyroute._HOME)
+    for name in skyroute.__all__:
+        value = getattr(skyroute, name)
+        assert getattr(value, "__name__", name) == name
+    assert set(skyroute.__all__) <= set(dir(skyroute))
+    with pytest.raises(AttributeError, match="nope"):
+        skyroute.nope  # noqa: B018
+    import skyroute.world as world
+
+    assert sorted(world.__all__) == sorted(world._HOME)
+    assert world.World is skyroute.World and world.load_map is skyroute.load_map
+
+
+def test_lazy_exports_import_on_first_use(monkeypatch):
+    import types
+
+    pkg = types.ModuleType("fake_pkg")
+    monkeypatch.setitem(sys.modules, "fake_pkg", pkg)
+    getattr_, dir_ = lazy.exports("fake_pkg", {"dumps": "json"})
+    assert getattr_("dumps") is json.dumps and pkg.dumps is json.dumps  # cached
+    assert "dumps" in dir_()
+    with pytest.raises(AttributeError, match="loads"):
+        getattr_("loads")
