@@ -16,12 +16,13 @@ from numba import njit
 
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
+from skyroute.search.canonical import START
 from skyroute.search.moves import COSTS, MDX, MDY, SQRT2_M1, h_of, offsets
-from skyroute.search.trace import trace
+from skyroute.search.trace import trace_moves
 
 
 @njit(cache=True)
-def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, ints,
+def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, floats, ints,
                  keys):
     """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier, path).
 
@@ -31,12 +32,12 @@ def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, i
     not inline them here, and the calls cost 1.2-1.8x in time (docs/architecture.md).
     """
     g = floats[0]
-    parent, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
+    entered, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
     hk = keys
     offs = offsets(Wp)
     gx, gy = goal % Wp, goal // Wp
     g[start] = 0.0
-    parent[start] = start
+    entered[start] = START
     touched[0] = start
     nt = 1
     f0 = weight * h_of(hkind, abs(start % Wp - gx), abs(start // Wp - gy))
@@ -80,7 +81,7 @@ def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, i
             break
         expanded += 1
         gc = g[c]
-        m = mask[c]
+        m = succ[entered[c], mask[c]]
         cx = c % Wp - gx
         cy = c // Wp - gy
         for k in range(8):  # the mask holds the connectivity: no diagonal bits when 4
@@ -101,7 +102,7 @@ def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, i
             else:
                 i = st - 1
             g[n] = gn
-            parent[n] = c
+            entered[n] = k
             dx = abs(cx + MDX[k])
             dy = abs(cy + MDY[k])
             if hkind == 1:  # octile, written out: the common case
@@ -128,5 +129,5 @@ def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, i
             max_frontier = size
     heap.reset(state, touched, nt)
     if code == FOUND:
-        return code, expanded, max_frontier, trace(parent, start, goal)
+        return code, expanded, max_frontier, trace_moves(entered, offs, start, goal)
     return code, expanded, max_frontier, np.empty(0, np.int64)
