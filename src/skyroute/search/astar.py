@@ -2,7 +2,9 @@
 
 4- or 8-connected; orthogonal steps cost 1, diagonal sqrt 2. Heuristics: 0 none
 (Dijkstra), 1 octile, 2 Euclidean, 3 Manhattan (admissible only 4-connected); ``weight``
->= 1 inflates h (weighted A*, cost at most ``weight`` x optimal). Each cell is expanded
+>= 1 inflates h (weighted A*, cost at most ``weight`` x optimal). On 8-connected grids without
+corner cutting only canonical successors are generated (:mod:`skyroute.search.canonical`),
+which skips most neighbours a parent already reached. Each cell is expanded
 at most once: a closed cell is never reopened, which is exact for a consistent heuristic
 and weight 1. Legal moves come from a per-cell bit mask built once per grid
 (:meth:`SearchSpace.move_mask`), and h from the expanded cell's coordinates, so the
@@ -27,9 +29,12 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier, path).
 
     floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`; its ``state``
-    row must be all zeros on entry and is all zeros again on return. The heap
-    operations of :mod:`skyroute.search.heap` are written out in this loop: numba does
-    not inline them here, and the calls cost 1.2-1.8x in time (docs/architecture.md).
+    row must be all zeros on entry and is all zeros again on return; ``ints[0]`` receives
+    each reached cell's entering move. ``succ``: the successor table of
+    :mod:`skyroute.search.canonical` for the move rule. The open list is the 4-ary
+    indexed heap of :func:`skyroute.search.heap.push4` / ``pop4``, written out in this
+    loop: as calls (even inlined by numba) they cost about 10% more here, as binary-heap
+    calls 1.2-1.8x (docs/architecture.md).
     """
     g = floats[0]
     entered, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
@@ -57,16 +62,20 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
             lk = hk[size]
             i = 0
             while True:
-                b = 2 * i + 1
+                b = 4 * i + 1
                 if b >= size:
                     break
-                if b + 1 < size and hk[b + 1] < hk[b]:
-                    b += 1
-                if hk[b] >= lk:
+                kb = hk[b]
+                e = min(b + 4, size)
+                for j in range(b + 1, e):
+                    if hk[j] < kb:
+                        kb = hk[j]
+                        b = j
+                if kb >= lk:
                     break
                 moved = hc[b]
                 hc[i] = moved
-                hk[i] = hk[b]
+                hk[i] = kb
                 state[moved] = i + 1
                 i = b
             hc[i] = last
@@ -113,7 +122,7 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
                 (heap.TIE_MAX - min(int(gn * 4.0), heap.TIE_MAX))
             # push or decrease-key (hole sifts up)
             while i > 0:
-                p = (i - 1) >> 1
+                p = (i - 1) >> 2
                 kp = hk[p]
                 if key >= kp:
                     break
