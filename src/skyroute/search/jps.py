@@ -20,10 +20,12 @@ from numba import njit
 
 from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
-from skyroute.search.moves import h_of
+from skyroute.search.canonical import START
+from skyroute.search.moves import MDX, MDY, h_of, offsets
 from skyroute.search.trace import trace
 
-# Straight directions: 0 east (+x), 1 west (-x), 2 south (+y), 3 north (-y).
+# Straight directions: 0 east (+x), 1 west (-x), 2 south (+y), 3 north (-y), as moves 0-3.
+MOVE_OF = np.array([7, 3, 6, 1, -1, 0, 5, 2, 4], np.int64)  # (sy+1)*3 + sx+1 -> move k
 
 
 @njit(cache=True)
@@ -76,33 +78,15 @@ def _straight(table, c, cx, cy, dirn, gx, gy, goal, Wp):
     return -1
 
 
-@njit(cache=True)
-def _diagonal(blk, table, c, cx, cy, sx, sy, gx, gy, goal, Wp):
-    """Scan from c diagonally by (sx, sy) in {-1, 1}^2; return a jump point or -1."""
-    dx = sx
-    dy = sy * Wp
-    hdir = 0 if sx > 0 else 1
-    vdir = 2 if sy > 0 else 3
-    while True:
-        if blk[c + dx] or blk[c + dy] or blk[c + dx + dy]:
-            return -1
-        c += dx + dy
-        cx += sx
-        cy += sy
-        if c == goal:
-            return c
-        if _straight(table, c, cx, cy, hdir, gx, gy, goal, Wp) >= 0 or \
-                _straight(table, c, cx, cy, vdir, gx, gy, goal, Wp) >= 0:
-            return c
-
-
-@njit(cache=True)
-def _relax(n, c, Wp, gx, gy, g, parent, state, touched, nt, hc, hk, size):
-    """Offer jump point n reached from c; return (heap size, touched count)."""
+@njit(cache=True, inline="always")
+def _relax(n, c, gc, cx, cy, gx, gy, Wp, g, parent, state, touched, nt, hc, hk, size):
+    """Offer jump point n, reached from c (diagonal steps first, then straight); return
+    (heap size, touched count)."""
     st = state[n]
     if st < 0:
         return size, nt
-    gn = g[c] + h_of(1, abs(n % Wp - c % Wp), abs(n // Wp - c // Wp))
+    nx, ny = n % Wp, n // Wp
+    gn = gc + h_of(1, abs(nx - cx), abs(ny - cy))
     if st == 0:
         touched[nt] = n
         nt += 1
@@ -110,8 +94,8 @@ def _relax(n, c, Wp, gx, gy, g, parent, state, touched, nt, hc, hk, size):
         return size, nt
     g[n] = gn
     parent[n] = c
-    fn = gn + h_of(1, abs(n % Wp - gx), abs(n // Wp - gy))
-    return heap.push(hc, hk, state, size, n, heap.key(fn, gn)), nt
+    fn = gn + h_of(1, abs(nx - gx), abs(ny - gy))
+    return heap.push4(hc, hk, state, size, n, heap.key(fn, gn)), nt
 
 
 @njit(cache=True)
@@ -120,74 +104,83 @@ def _sign(v):
 
 
 @njit(cache=True)
-def jps_kernel(blk, table, Wp, start, goal, max_expansions, floats, ints, keys):
+def _entering_move(c, p, Wp):
+    """The move by which c was entered from jump point p: the last leg of p's
+    diagonal-first route to c (START when c is the start)."""
+    if p == c:
+        return START
+    dx, dy = c % Wp - p % Wp, c // Wp - p // Wp
+    adx, ady = abs(dx), abs(dy)
+    sx = _sign(dx) if adx >= ady else 0
+    sy = _sign(dy) if ady >= adx else 0
+    return MOVE_OF[(sy + 1) * 3 + sx + 1]
+
+
+@njit(cache=True)
+def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints, keys):
     """Search from flat ``start`` to ``goal``.
 
-    Returns (status, expanded, max_frontier, path) with ``path`` every flat cell.
-    floats, ints, keys: the workspace of :meth:`SearchSpace.workspace` (its ``state`` row all
-    zeros on entry and on return).
+    ``mask``: the 8-connected, no-corner-cutting move mask; ``succ``: the canonical
+    successor table (:mod:`skyroute.search.canonical`, the same pruning rules); ``table``:
+    :func:`jump_tables`. Returns (status, expanded, max_frontier, path) with ``path``
+    every flat cell. floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`
+    (its ``state`` row all zeros on entry and on return).
     """
     g = floats[0]
     parent, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
     hk = keys
+    offs = offsets(Wp)
     gx, gy = goal % Wp, goal // Wp
     g[start] = 0.0
     parent[start] = start
     touched[0] = start
     nt = 1
     f0 = h_of(1, abs(start % Wp - gx), abs(start // Wp - gy))
-    size = heap.push(hc, hk, state, 0, start, heap.key(f0, 0.0))
+    size = heap.push4(hc, hk, state, 0, start, heap.key(f0, 0.0))
     expanded = 0
     max_frontier = 1
     code = -1
     while size > 0:
-        c, size = heap.pop(hc, hk, state, size)
+        c, size = heap.pop4(hc, hk, state, size)
         code = stop_code(c, goal, expanded, max_expansions)
         if code >= 0:
             break
         expanded += 1
         cx, cy = c % Wp, c // Wp
-        p = parent[c]
-        sx = _sign(cx - p % Wp)
-        sy = _sign(cy - p // Wp)
+        gc = g[c]
+        m = succ[_entering_move(c, parent[c], Wp), mask[c]]
         for k in range(8):
-            # successor directions allowed by the pruning rules
+            if not (m >> k) & 1:
+                continue
             if k < 4:
-                dirn = k
-                if p != c:
-                    if sx != 0 and sy != 0:  # diagonal arrival: its two straight parts
-                        ok = (dirn == (0 if sx > 0 else 1)) or (dirn == (2 if sy > 0 else 3))
-                    elif sy == 0:  # horizontal arrival
-                        if dirn < 2:
-                            ok = dirn == (0 if sx > 0 else 1)
-                        else:  # perpendicular: only when forced
-                            s = Wp if dirn == 2 else -Wp
-                            ok = blk[c + s] == 0 and blk[c - sx + s] != 0
-                    elif dirn >= 2:  # vertical arrival
-                        ok = dirn == (2 if sy > 0 else 3)
-                    else:
-                        s = 1 if dirn == 0 else -1
-                        ok = blk[c + s] == 0 and blk[c - sy * Wp + s] != 0
-                    if not ok:
-                        continue
-                j = _straight(table, c, cx, cy, dirn, gx, gy, goal, Wp)
-            else:
-                ddx = 1 if k == 4 or k == 6 else -1
-                ddy = 1 if k < 6 else -1
-                if p != c:
-                    if sx != 0 and sy != 0:
-                        ok = ddx == sx and ddy == sy
-                    elif sy == 0:  # horizontal: the diagonal beside a forced side
-                        ok = ddx == sx and blk[c + ddy * Wp] == 0 and \
-                            blk[c - sx + ddy * Wp] != 0
-                    else:
-                        ok = ddy == sy and blk[c + ddx] == 0 and blk[c - sy * Wp + ddx] != 0
-                    if not ok:
-                        continue
-                j = _diagonal(blk, table, c, cx, cy, ddx, ddy, gx, gy, goal, Wp)
-            if j >= 0:
-                size, nt = _relax(j, c, Wp, gx, gy, g, parent, state, touched, nt, hc, hk,
-                                  size)
+                j = _straight(table, c, cx, cy, k, gx, gy, goal, Wp)
+                if j >= 0:
+                    size, nt = _relax(j, c, gc, cx, cy, gx, gy, Wp, g, parent, state,
+                                      touched, nt, hc, hk, size)
+                continue
+            # Diagonal: every straight jump point seen from the diagonal is a successor
+            # of c itself (the diagonal cell in between is not queued: arrived at
+            # diagonally, it would only continue these same three scans).
+            sx, sy = MDX[k], MDY[k]
+            hdir = 0 if sx > 0 else 1
+            vdir = 2 if sy > 0 else 3
+            d, dx, dy = c, cx, cy
+            while (mask[d] >> k) & 1:
+                d += offs[k]
+                dx += sx
+                dy += sy
+                if d == goal:
+                    size, nt = _relax(d, c, gc, cx, cy, gx, gy, Wp, g, parent, state,
+                                      touched, nt, hc, hk, size)
+                    break
+                j = _straight(table, d, dx, dy, hdir, gx, gy, goal, Wp)
+                if j >= 0:
+                    size, nt = _relax(j, c, gc, cx, cy, gx, gy, Wp, g, parent, state,
+                                      touched, nt, hc, hk, size)
+                j = _straight(table, d, dx, dy, vdir, gx, gy, goal, Wp)
+                if j >= 0:
+                    size, nt = _relax(j, c, gc, cx, cy, gx, gy, Wp, g, parent, state,
+                                      touched, nt, hc, hk, size)
         if size > max_frontier:
             max_frontier = size
     code = heap.finish(code, state, touched, nt)
@@ -198,7 +191,8 @@ def jps_kernel(blk, table, Wp, start, goal, max_expansions, floats, ints, keys):
 
 @njit(cache=True)
 def fill(points, Wp):
-    """Expand a chain of jump points (straight or diagonal runs) into every cell."""
+    """Expand a chain of jump points into every cell: each leg takes its diagonal steps
+    first, then its straight ones (the route the scans took)."""
     total = 1
     for i in range(1, len(points)):
         a, b = points[i - 1], points[i]
@@ -208,10 +202,13 @@ def fill(points, Wp):
     k = 1
     for i in range(1, len(points)):
         a, b = points[i - 1], points[i]
-        step = _sign(b % Wp - a % Wp) + _sign(b // Wp - a // Wp) * Wp
+        dx, dy = b % Wp - a % Wp, b // Wp - a // Wp
+        diag = min(abs(dx), abs(dy))
+        step = _sign(dx) + _sign(dy) * Wp
+        straight = _sign(dx) if abs(dx) > abs(dy) else _sign(dy) * Wp
         c = a
-        while c != b:
-            c += step
+        for s in range(max(abs(dx), abs(dy))):
+            c += step if s < diag else straight
             out[k] = c
             k += 1
     return out
