@@ -55,37 +55,33 @@ def jump_tables(blk, Wp):
     return table
 
 
-@njit(cache=True)
-def _straight(table, c, cx, cy, dirn, gx, gy, goal, Wp):
-    """Jump point (or the goal) reached from c in straight direction ``dirn``, or -1."""
+@njit(cache=True, inline="always")
+def _steps(table, c, cx, cy, dirn, gx, gy):
+    """Steps from c in straight direction ``dirn`` to the goal or the first jump point,
+    whichever comes first; 0 when the scan meets a wall first."""
     v = table[c, dirn]
     reach = v if v > 0 else -v
-    if reach == 0:
-        return -1
     if dirn == 0:
         if cy == gy and 0 < gx - cx <= reach:
-            return goal
+            return gx - cx
     elif dirn == 1:
         if cy == gy and 0 < cx - gx <= reach:
-            return goal
+            return cx - gx
     elif dirn == 2:
         if cx == gx and 0 < gy - cy <= reach:
-            return goal
+            return gy - cy
     elif cx == gx and 0 < cy - gy <= reach:
-        return goal
-    if v > 0:
-        return c + v * (1, -1, Wp, -Wp)[dirn]
-    return -1
+        return cy - gy
+    return v if v > 0 else 0
 
 
 @njit(cache=True, inline="always")
-def _relax(n, c, gc, cx, cy, gx, gy, Wp, g, parent, state, touched, nt, hc, hk, size):
-    """Offer jump point n, reached from c (diagonal steps first, then straight); return
-    (heap size, touched count)."""
+def _relax(n, nx, ny, c, gc, cx, cy, gx, gy, g, parent, state, touched, nt, hc, hk, size):
+    """Offer jump point n = (nx, ny), reached from c (diagonal steps first, then
+    straight); return (heap size, touched count)."""
     st = state[n]
     if st < 0:
         return size, nt
-    nx, ny = n % Wp, n // Wp
     gn = gc + h_of(1, abs(nx - cx), abs(ny - cy))
     if st == 0:
         touched[nt] = n
@@ -152,16 +148,17 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
         for k in range(8):
             if not (m >> k) & 1:
                 continue
+            sx, sy = MDX[k], MDY[k]
             if k < 4:
-                j = _straight(table, c, cx, cy, k, gx, gy, goal, Wp)
-                if j >= 0:
-                    size, nt = _relax(j, c, gc, cx, cy, gx, gy, Wp, g, parent, state,
-                                      touched, nt, hc, hk, size)
+                v = _steps(table, c, cx, cy, k, gx, gy)
+                if v:
+                    size, nt = _relax(c + v * offs[k], cx + v * sx, cy + v * sy, c, gc, cx,
+                                      cy, gx, gy, g, parent, state, touched, nt, hc, hk,
+                                      size)
                 continue
             # Diagonal: every straight jump point seen from the diagonal is a successor
             # of c itself (the diagonal cell in between is not queued: arrived at
             # diagonally, it would only continue these same three scans).
-            sx, sy = MDX[k], MDY[k]
             hdir = 0 if sx > 0 else 1
             vdir = 2 if sy > 0 else 3
             d, dx, dy = c, cx, cy
@@ -170,17 +167,17 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
                 dx += sx
                 dy += sy
                 if d == goal:
-                    size, nt = _relax(d, c, gc, cx, cy, gx, gy, Wp, g, parent, state,
+                    size, nt = _relax(d, dx, dy, c, gc, cx, cy, gx, gy, g, parent, state,
                                       touched, nt, hc, hk, size)
                     break
-                j = _straight(table, d, dx, dy, hdir, gx, gy, goal, Wp)
-                if j >= 0:
-                    size, nt = _relax(j, c, gc, cx, cy, gx, gy, Wp, g, parent, state,
-                                      touched, nt, hc, hk, size)
-                j = _straight(table, d, dx, dy, vdir, gx, gy, goal, Wp)
-                if j >= 0:
-                    size, nt = _relax(j, c, gc, cx, cy, gx, gy, Wp, g, parent, state,
-                                      touched, nt, hc, hk, size)
+                v = _steps(table, d, dx, dy, hdir, gx, gy)
+                if v:
+                    size, nt = _relax(d + v * sx, dx + v * sx, dy, c, gc, cx, cy, gx, gy, g,
+                                      parent, state, touched, nt, hc, hk, size)
+                v = _steps(table, d, dx, dy, vdir, gx, gy)
+                if v:
+                    size, nt = _relax(d + v * sy * Wp, dx, dy + v * sy, c, gc, cx, cy, gx,
+                                      gy, g, parent, state, touched, nt, hc, hk, size)
         if size > max_frontier:
             max_frontier = size
     code = heap.finish(code, state, touched, nt)
