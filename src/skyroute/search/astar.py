@@ -19,7 +19,7 @@ from numba import njit
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
 from skyroute.search.canonical import START
-from skyroute.search.moves import COSTS, MDX, MDY, SQRT2_M1, h_of, offsets
+from skyroute.search.moves import COSTS, MDX, MDY, SQRT2_M1, h_of, offsets, xy
 from skyroute.search.trace import trace_moves
 
 
@@ -40,6 +40,7 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     entered, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
     hk = keys
     offs = offsets(Wp)
+    inv = 1.0 / Wp
     gx, gy = goal % Wp, goal // Wp
     g[start] = 0.0
     entered[start] = START
@@ -91,8 +92,9 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
         expanded += 1
         gc = g[c]
         m = succ[entered[c], mask[c]]
-        cx = c % Wp - gx
-        cy = c // Wp - gy
+        cx, cy = xy(c, Wp, inv)
+        cx -= gx
+        cy -= gy
         for k in range(8):  # the mask holds the connectivity: no diagonal bits when 4
             if not (m >> k) & 1:
                 continue

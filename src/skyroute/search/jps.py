@@ -21,11 +21,10 @@ from numba import njit
 from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
 from skyroute.search.canonical import START
-from skyroute.search.moves import MDX, MDY, h_of, offsets
+from skyroute.search.moves import MDX, MDY, h_of, offsets, xy
 from skyroute.search.trace import trace
 
 # Straight directions: 0 east (+x), 1 west (-x), 2 south (+y), 3 north (-y), as moves 0-3.
-MOVE_OF = np.array([7, 3, 6, 1, -1, 0, 5, 2, 4], np.int64)  # (sy+1)*3 + sx+1 -> move k
 
 
 @njit(cache=True)
@@ -56,10 +55,11 @@ def jump_tables(blk, Wp):
 
 
 @njit(cache=True, inline="always")
-def _steps(table, c, cx, cy, dirn, gx, gy):
-    """Steps from c in straight direction ``dirn`` to the goal or the first jump point,
-    whichever comes first; 0 when the scan meets a wall first."""
-    v = table[c, dirn]
+def _steps(v, dirn, cx, cy, gx, gy):
+    """Steps from (cx, cy) in straight direction ``dirn``, whose jump-table entry is
+    ``v``, to the goal or the first jump point, whichever comes first; 0 when the scan
+    meets a wall first. Scalars only: array arguments would cost numba two atomic
+    reference-count updates per call, which dominated the kernel's time."""
     reach = v if v > 0 else -v
     if dirn == 0:
         if cy == gy and 0 < gx - cx <= reach:
@@ -75,41 +75,9 @@ def _steps(table, c, cx, cy, dirn, gx, gy):
     return v if v > 0 else 0
 
 
-@njit(cache=True, inline="always")
-def _relax(n, nx, ny, c, gc, cx, cy, gx, gy, g, parent, state, touched, nt, hc, hk, size):
-    """Offer jump point n = (nx, ny), reached from c (diagonal steps first, then
-    straight); return (heap size, touched count)."""
-    st = state[n]
-    if st < 0:
-        return size, nt
-    gn = gc + h_of(1, abs(nx - cx), abs(ny - cy))
-    if st == 0:
-        touched[nt] = n
-        nt += 1
-    elif gn >= g[n]:
-        return size, nt
-    g[n] = gn
-    parent[n] = c
-    fn = gn + h_of(1, abs(nx - gx), abs(ny - gy))
-    return heap.push4(hc, hk, state, size, n, heap.key(fn, gn)), nt
-
-
 @njit(cache=True)
 def _sign(v):
     return (v > 0) - (v < 0)
-
-
-@njit(cache=True)
-def _entering_move(c, p, Wp):
-    """The move by which c was entered from jump point p: the last leg of p's
-    diagonal-first route to c (START when c is the start)."""
-    if p == c:
-        return START
-    dx, dy = c % Wp - p % Wp, c // Wp - p // Wp
-    adx, ady = abs(dx), abs(dy)
-    sx = _sign(dx) if adx >= ady else 0
-    sy = _sign(dy) if ady >= adx else 0
-    return MOVE_OF[(sy + 1) * 3 + sx + 1]
 
 
 @njit(cache=True)
@@ -121,40 +89,78 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
     :func:`jump_tables`. Returns (status, expanded, max_frontier, path) with ``path``
     every flat cell. floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`
     (its ``state`` row all zeros on entry and on return).
+
+    An expansion first lists its jump points (cell, x, y, entering move) in ``found``,
+    then relaxes them in one loop. The 4-ary heap of :func:`heap.push4` / ``pop4`` is
+    written out, as in the A* kernel: no call in the loop takes an array.
     """
     g = floats[0]
-    parent, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
+    parent, state, touched, hc, entered = ints[0], ints[1], ints[2], ints[3], ints[4]
     hk = keys
     offs = offsets(Wp)
-    gx, gy = goal % Wp, goal // Wp
+    inv = 1.0 / Wp
+    gx, gy = xy(goal, Wp, inv)
+    found = np.empty((8 * (Wp + len(mask) // Wp) + 8, 4), np.int64)
     g[start] = 0.0
     parent[start] = start
+    entered[start] = START
     touched[0] = start
     nt = 1
-    f0 = h_of(1, abs(start % Wp - gx), abs(start // Wp - gy))
-    size = heap.push4(hc, hk, state, 0, start, heap.key(f0, 0.0))
+    sx0, sy0 = xy(start, Wp, inv)
+    hc[0] = start
+    hk[0] = heap.key(h_of(1, abs(sx0 - gx), abs(sy0 - gy)), 0.0)
+    state[start] = 1
+    size = 1
     expanded = 0
     max_frontier = 1
     code = -1
     while size > 0:
-        c, size = heap.pop4(hc, hk, state, size)
+        # pop the minimum (hole sifts down) and close it
+        c = hc[0]
+        size -= 1
+        if size > 0:
+            last = hc[size]
+            lk = hk[size]
+            i = 0
+            while True:
+                b = 4 * i + 1
+                if b >= size:
+                    break
+                kb = hk[b]
+                for j in range(b + 1, min(b + 4, size)):
+                    if hk[j] < kb:
+                        kb = hk[j]
+                        b = j
+                if kb >= lk:
+                    break
+                moved = hc[b]
+                hc[i] = moved
+                hk[i] = kb
+                state[moved] = i + 1
+                i = b
+            hc[i] = last
+            hk[i] = lk
+            state[last] = i + 1
+        state[c] = -1
         code = stop_code(c, goal, expanded, max_expansions)
         if code >= 0:
             break
         expanded += 1
-        cx, cy = c % Wp, c // Wp
-        gc = g[c]
-        m = succ[_entering_move(c, parent[c], Wp), mask[c]]
+        cx, cy = xy(c, Wp, inv)
+        m = succ[entered[c], mask[c]]
+        nf = 0
         for k in range(8):
             if not (m >> k) & 1:
                 continue
             sx, sy = MDX[k], MDY[k]
             if k < 4:
-                v = _steps(table, c, cx, cy, k, gx, gy)
+                v = _steps(table[c, k], k, cx, cy, gx, gy)
                 if v:
-                    size, nt = _relax(c + v * offs[k], cx + v * sx, cy + v * sy, c, gc, cx,
-                                      cy, gx, gy, g, parent, state, touched, nt, hc, hk,
-                                      size)
+                    found[nf, 0] = c + v * offs[k]
+                    found[nf, 1] = cx + v * sx
+                    found[nf, 2] = cy + v * sy
+                    found[nf, 3] = k
+                    nf += 1
                 continue
             # Diagonal: every straight jump point seen from the diagonal is a successor
             # of c itself (the diagonal cell in between is not queued: arrived at
@@ -167,17 +173,61 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
                 dx += sx
                 dy += sy
                 if d == goal:
-                    size, nt = _relax(d, dx, dy, c, gc, cx, cy, gx, gy, g, parent, state,
-                                      touched, nt, hc, hk, size)
+                    found[nf, 0] = d
+                    found[nf, 1] = dx
+                    found[nf, 2] = dy
+                    found[nf, 3] = k
+                    nf += 1
                     break
-                v = _steps(table, d, dx, dy, hdir, gx, gy)
+                v = _steps(table[d, hdir], hdir, dx, dy, gx, gy)
                 if v:
-                    size, nt = _relax(d + v * sx, dx + v * sx, dy, c, gc, cx, cy, gx, gy, g,
-                                      parent, state, touched, nt, hc, hk, size)
-                v = _steps(table, d, dx, dy, vdir, gx, gy)
+                    found[nf, 0] = d + v * sx
+                    found[nf, 1] = dx + v * sx
+                    found[nf, 2] = dy
+                    found[nf, 3] = hdir
+                    nf += 1
+                v = _steps(table[d, vdir], vdir, dx, dy, gx, gy)
                 if v:
-                    size, nt = _relax(d + v * sy * Wp, dx, dy + v * sy, c, gc, cx, cy, gx,
-                                      gy, g, parent, state, touched, nt, hc, hk, size)
+                    found[nf, 0] = d + v * sy * Wp
+                    found[nf, 1] = dx
+                    found[nf, 2] = dy + v * sy
+                    found[nf, 3] = vdir
+                    nf += 1
+        gc = g[c]
+        for q in range(nf):
+            n = found[q, 0]
+            st = state[n]
+            if st < 0:
+                continue
+            nx, ny = found[q, 1], found[q, 2]
+            gn = gc + h_of(1, abs(nx - cx), abs(ny - cy))
+            if st == 0:
+                touched[nt] = n
+                nt += 1
+                i = size
+                size += 1
+            elif gn >= g[n]:
+                continue
+            else:
+                i = st - 1
+            g[n] = gn
+            parent[n] = c
+            entered[n] = found[q, 3]
+            key = heap.key(gn + h_of(1, abs(nx - gx), abs(ny - gy)), gn)
+            # push or decrease-key (hole sifts up)
+            while i > 0:
+                p = (i - 1) >> 2
+                kp = hk[p]
+                if key >= kp:
+                    break
+                moved = hc[p]
+                hc[i] = moved
+                hk[i] = kp
+                state[moved] = i + 1
+                i = p
+            hc[i] = n
+            hk[i] = key
+            state[n] = i + 1
         if size > max_frontier:
             max_frontier = size
     code = heap.finish(code, state, touched, nt)

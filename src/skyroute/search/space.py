@@ -74,7 +74,7 @@ class SearchSpace:
 
     def workspace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(floats, ints, keys), allocated once: F rows g, h (float64); I rows parent, state,
-        touched, heap cell (int32); K heap keys (int64). Few arrays, because numba's
+        touched, heap cell, entering move (int32); K heap keys (int64). Few arrays, because numba's
         dispatch costs about a microsecond per array argument.
 
         ``state`` (``ints[1]``) is all zeros between queries: every kernel clears the cells
@@ -82,7 +82,7 @@ class SearchSpace:
         """
         if self._ws is None:
             n = self.n
-            ints = np.empty((4, n), np.int32)
+            ints = np.empty((5, n), np.int32)
             ints[1] = 0
             self._ws = (np.empty((2, n)), ints, np.empty(n, np.int64))
         return self._ws
