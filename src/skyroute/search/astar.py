@@ -18,7 +18,7 @@ from numba import njit
 
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
-from skyroute.search.canonical import START
+from skyroute.search.canonical import LOWEST, START
 from skyroute.search.moves import COSTS, MDX, MDY, SQRT2_M1, h_of, offsets, xy
 from skyroute.search.trace import trace_moves
 
@@ -95,9 +95,9 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
         cx, cy = xy(c, Wp, inv)
         cx -= gx
         cy -= gy
-        for k in range(8):  # the mask holds the connectivity: no diagonal bits when 4
-            if not (m >> k) & 1:
-                continue
+        while m:  # the mask holds the connectivity: no diagonal bits when 4
+            k = LOWEST[m]
+            m &= m - 1
             n = c + offs[k]
             st = state[n]
             if st < 0:

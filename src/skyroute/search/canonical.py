@@ -59,5 +59,10 @@ def successor_table(canonical: bool) -> np.ndarray:
     return table
 
 
+#: the lowest set bit's index of each byte: kernels walk a move set bit by bit, not
+#: testing all 8 moves (each test a branch that random obstacles make unpredictable)
+LOWEST = np.array([(m & -m).bit_length() - 1 for m in range(256)], np.int64)
+LOWEST.setflags(write=False)
+
 CANONICAL = successor_table(True)
 EVERY = successor_table(False)
