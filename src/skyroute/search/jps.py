@@ -20,7 +20,7 @@ from numba import njit
 
 from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
-from skyroute.search.canonical import START
+from skyroute.search.canonical import LOWEST, START
 from skyroute.search.moves import MDX, MDY, h_of, offsets, xy
 from skyroute.search.trace import trace
 
@@ -149,9 +149,9 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
         cx, cy = xy(c, Wp, inv)
         m = succ[entered[c], mask[c]]
         nf = 0
-        for k in range(8):
-            if not (m >> k) & 1:
-                continue
+        while m:
+            k = LOWEST[m]
+            m &= m - 1
             sx, sy = MDX[k], MDY[k]
             if k < 4:
                 v = _steps(table[c, k], k, cx, cy, gx, gy)
