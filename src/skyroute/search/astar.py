@@ -4,7 +4,9 @@
 (Dijkstra), 1 octile, 2 Euclidean, 3 Manhattan (admissible only 4-connected); ``weight``
 >= 1 inflates h (weighted A*, cost at most ``weight`` x optimal). On 8-connected grids without
 corner cutting only canonical successors are generated (:mod:`skyroute.search.canonical`),
-which skips most neighbours a parent already reached. Each cell is expanded
+which skips most neighbours a parent already reached. A new successor with its
+parent's f (the common case along a good line) is expanded next without a trip through
+the heap. Each cell is expanded
 at most once: a closed cell is never reopened, which is exact for a consistent heuristic
 and weight 1. Legal moves come from a per-cell bit mask built once per grid
 (:meth:`SearchSpace.move_mask`), and h from the expanded cell's coordinates, so the
@@ -54,35 +56,48 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     expanded = 0
     max_frontier = 1
     code = NO_PATH
-    while size > 0:
-        # pop the minimum (hole sifts down) and close it
-        c = hc[0]
-        size -= 1
-        if size > 0:
-            last = hc[size]
-            lk = hk[size]
-            i = 0
-            while True:
-                b = 4 * i + 1
-                if b >= size:
-                    break
-                kb = hk[b]
-                e = min(b + 4, size)
-                for j in range(b + 1, e):
-                    if hk[j] < kb:
-                        kb = hk[j]
-                        b = j
-                if kb >= lk:
-                    break
-                moved = hc[b]
-                hc[i] = moved
-                hk[i] = kb
-                state[moved] = i + 1
-                i = b
-            hc[i] = last
-            hk[i] = lk
-            state[last] = i + 1
+    # A new successor whose f equals the expanded cell's is expanded next without
+    # passing through the heap: nothing open has a smaller f (consistent h, weight 1).
+    can_hold = weight == 1.0 and (hkind == 1 or hkind == 2)
+    held = -1
+    held_key = 0
+    while True:
+        if held >= 0:
+            c = held
+            ck = held_key
+            held = -1
+        elif size > 0:
+            # pop the minimum (hole sifts down) and close it
+            c = hc[0]
+            ck = hk[0]
+            size -= 1
+            if size > 0:
+                last = hc[size]
+                lk = hk[size]
+                i = 0
+                while True:
+                    b = 4 * i + 1
+                    if b >= size:
+                        break
+                    kb = hk[b]
+                    for j in range(b + 1, min(b + 4, size)):
+                        if hk[j] < kb:
+                            kb = hk[j]
+                            b = j
+                    if kb >= lk:
+                        break
+                    moved = hc[b]
+                    hc[i] = moved
+                    hk[i] = kb
+                    state[moved] = i + 1
+                    i = b
+                hc[i] = last
+                hk[i] = lk
+                state[last] = i + 1
+        else:
+            break
         state[c] = -1
+        cf = ck >> heap.TIE_BITS
         if c == goal:
             code = FOUND
             break
@@ -122,6 +137,17 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
                 hn = h_of(hkind, dx, dy)
             key = (int((gn + weight * hn) * heap.F_SCALE + 0.5) << heap.TIE_BITS) | \
                 (heap.TIE_MAX - min(int(gn * 4.0), heap.TIE_MAX))
+            if st == 0 and can_hold and key >> heap.TIE_BITS == cf:
+                if held < 0:  # hold n: it takes no heap slot
+                    held = n
+                    held_key = key
+                    state[n] = 1
+                    size -= 1
+                    continue
+                if key < held_key:  # hold n, push the one held before into n's slot
+                    n, held = held, n
+                    key, held_key = held_key, key
+                    state[held] = 1
             # push or decrease-key (hole sifts up)
             while i > 0:
                 p = (i - 1) >> 2
@@ -136,8 +162,8 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
             hc[i] = n
             hk[i] = key
             state[n] = i + 1
-        if size > max_frontier:
-            max_frontier = size
+        if size + (held >= 0) > max_frontier:
+            max_frontier = size + (held >= 0)
     heap.reset(state, touched, nt)
     if code == FOUND:
         return code, expanded, max_frontier, trace_moves(entered, offs, start, goal)
