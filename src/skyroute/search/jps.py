@@ -114,34 +114,45 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
     expanded = 0
     max_frontier = 1
     code = -1
-    while size > 0:
-        # pop the minimum (hole sifts down) and close it
-        c = hc[0]
-        size -= 1
-        if size > 0:
-            last = hc[size]
-            lk = hk[size]
-            i = 0
-            while True:
-                b = 4 * i + 1
-                if b >= size:
-                    break
-                kb = hk[b]
-                for j in range(b + 1, min(b + 4, size)):
-                    if hk[j] < kb:
-                        kb = hk[j]
-                        b = j
-                if kb >= lk:
-                    break
-                moved = hc[b]
-                hc[i] = moved
-                hk[i] = kb
-                state[moved] = i + 1
-                i = b
-            hc[i] = last
-            hk[i] = lk
-            state[last] = i + 1
+    held = -1  # a new jump point with its parent's f: expanded next, as in A*
+    held_key = 0
+    while True:
+        if held >= 0:
+            c = held
+            ck = held_key
+            held = -1
+        elif size > 0:
+            # pop the minimum (hole sifts down) and close it
+            c = hc[0]
+            ck = hk[0]
+            size -= 1
+            if size > 0:
+                last = hc[size]
+                lk = hk[size]
+                i = 0
+                while True:
+                    b = 4 * i + 1
+                    if b >= size:
+                        break
+                    kb = hk[b]
+                    for j in range(b + 1, min(b + 4, size)):
+                        if hk[j] < kb:
+                            kb = hk[j]
+                            b = j
+                    if kb >= lk:
+                        break
+                    moved = hc[b]
+                    hc[i] = moved
+                    hk[i] = kb
+                    state[moved] = i + 1
+                    i = b
+                hc[i] = last
+                hk[i] = lk
+                state[last] = i + 1
+        else:
+            break
         state[c] = -1
+        cf = ck >> heap.TIE_BITS
         code = stop_code(c, goal, expanded, max_expansions)
         if code >= 0:
             break
@@ -214,6 +225,17 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
             parent[n] = c
             entered[n] = found[q, 3]
             key = heap.key(gn + h_of(1, abs(nx - gx), abs(ny - gy)), gn)
+            if st == 0 and key >> heap.TIE_BITS == cf:
+                if held < 0:  # hold n: it takes no heap slot
+                    held = n
+                    held_key = key
+                    state[n] = 1
+                    size -= 1
+                    continue
+                if key < held_key:  # hold n, push the one held before into n's slot
+                    n, held = held, n
+                    key, held_key = held_key, key
+                    state[held] = 1
             # push or decrease-key (hole sifts up)
             while i > 0:
                 p = (i - 1) >> 2
@@ -228,8 +250,8 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
             hc[i] = n
             hk[i] = key
             state[n] = i + 1
-        if size > max_frontier:
-            max_frontier = size
+        if size + (held >= 0) > max_frontier:
+            max_frontier = size + (held >= 0)
     code = heap.finish(code, state, touched, nt)
     if code == FOUND:
         return code, expanded, max_frontier, fill(trace(parent, start, goal), Wp)
