@@ -24,6 +24,8 @@ from skyroute.search.canonical import LOWEST, START
 from skyroute.search.moves import COSTS, MDX, MDY, SQRT2_M1, h_of, offsets, xy
 from skyroute.search.trace import trace_moves
 
+ON_LEVEL = np.iinfo(np.int32).max  # state of a cell on the equal-f stack
+
 
 @njit(cache=True)
 def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, floats, ints,
@@ -39,7 +41,7 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     calls 1.2-1.8x (docs/architecture.md).
     """
     g = floats[0]
-    entered, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
+    entered, state, touched, hc, level = ints[0], ints[1], ints[2], ints[3], ints[4]
     hk = keys
     offs = offsets(Wp)
     inv = 1.0 / Wp
@@ -56,16 +58,17 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     expanded = 0
     max_frontier = 1
     code = NO_PATH
-    # A new successor whose f equals the expanded cell's is expanded next without
-    # passing through the heap: nothing open has a smaller f (consistent h, weight 1).
+    # New successors whose f equals the expanded cell's go on a stack (``level``), not
+    # the heap, and are expanded before the heap's next pop: nothing open has a smaller
+    # f (consistent h, weight 1). Last in, first out: the deepest first, as the g
+    # tie-break in the heap keys.
     can_hold = weight == 1.0 and (hkind == 1 or hkind == 2)
-    held = -1
-    held_key = 0
+    nl = 0
+    ck = keys[0]
     while True:
-        if held >= 0:
-            c = held
-            ck = held_key
-            held = -1
+        if nl > 0:
+            nl -= 1
+            c = level[nl]
         elif size > 0:
             # pop the minimum (hole sifts down) and close it
             c = hc[0]
@@ -97,7 +100,7 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
         else:
             break
         state[c] = -1
-        cf = ck >> heap.TIE_BITS
+        cf = ck >> heap.TIE_BITS  # unchanged while the stack of equal f empties
         if c == goal:
             code = FOUND
             break
@@ -121,14 +124,12 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
             if st == 0:
                 touched[nt] = n
                 nt += 1
-                i = size
-                size += 1
             elif gn >= g[n]:
                 continue
-            else:
-                i = st - 1
             g[n] = gn
             entered[n] = k
+            if st == ON_LEVEL:  # an equal cost by another float sum: already queued
+                continue
             dx = abs(cx + MDX[k])
             dy = abs(cy + MDY[k])
             if hkind == 1:  # octile, written out: the common case
@@ -137,17 +138,16 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
                 hn = h_of(hkind, dx, dy)
             key = (int((gn + weight * hn) * heap.F_SCALE + 0.5) << heap.TIE_BITS) | \
                 (heap.TIE_MAX - min(int(gn * 4.0), heap.TIE_MAX))
-            if st == 0 and can_hold and key >> heap.TIE_BITS == cf:
-                if held < 0:  # hold n: it takes no heap slot
-                    held = n
-                    held_key = key
-                    state[n] = 1
-                    size -= 1
+            if st == 0:
+                if can_hold and key >> heap.TIE_BITS == cf:
+                    level[nl] = n
+                    nl += 1
+                    state[n] = ON_LEVEL
                     continue
-                if key < held_key:  # hold n, push the one held before into n's slot
-                    n, held = held, n
-                    key, held_key = held_key, key
-                    state[held] = 1
+                i = size
+                size += 1
+            else:
+                i = st - 1
             # push or decrease-key (hole sifts up)
             while i > 0:
                 p = (i - 1) >> 2
@@ -162,8 +162,8 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
             hc[i] = n
             hk[i] = key
             state[n] = i + 1
-        if size + (held >= 0) > max_frontier:
-            max_frontier = size + (held >= 0)
+        if size + nl > max_frontier:
+            max_frontier = size + nl
     heap.reset(state, touched, nt)
     if code == FOUND:
         return code, expanded, max_frontier, trace_moves(entered, offs, start, goal)
