@@ -20,6 +20,7 @@ from numba import njit
 
 from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
+from skyroute.search.astar import ON_LEVEL
 from skyroute.search.canonical import LOWEST, START
 from skyroute.search.moves import MDX, MDY, h_of, offsets, xy
 from skyroute.search.trace import trace
@@ -96,6 +97,7 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
     """
     g = floats[0]
     parent, state, touched, hc, entered = ints[0], ints[1], ints[2], ints[3], ints[4]
+    level = ints[5]
     hk = keys
     offs = offsets(Wp)
     inv = 1.0 / Wp
@@ -114,13 +116,12 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
     expanded = 0
     max_frontier = 1
     code = -1
-    held = -1  # a new jump point with its parent's f: expanded next, as in A*
-    held_key = 0
+    nl = 0  # new jump points with their parent's f: a stack expanded first, as in A*
+    ck = hk[0]
     while True:
-        if held >= 0:
-            c = held
-            ck = held_key
-            held = -1
+        if nl > 0:
+            nl -= 1
+            c = level[nl]
         elif size > 0:
             # pop the minimum (hole sifts down) and close it
             c = hc[0]
@@ -215,27 +216,24 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
             if st == 0:
                 touched[nt] = n
                 nt += 1
-                i = size
-                size += 1
             elif gn >= g[n]:
                 continue
-            else:
-                i = st - 1
             g[n] = gn
             parent[n] = c
             entered[n] = found[q, 3]
+            if st == ON_LEVEL:  # an equal cost by another float sum: already queued
+                continue
             key = heap.key(gn + h_of(1, abs(nx - gx), abs(ny - gy)), gn)
-            if st == 0 and key >> heap.TIE_BITS == cf:
-                if held < 0:  # hold n: it takes no heap slot
-                    held = n
-                    held_key = key
-                    state[n] = 1
-                    size -= 1
+            if st == 0:
+                if key >> heap.TIE_BITS == cf:
+                    level[nl] = n
+                    nl += 1
+                    state[n] = ON_LEVEL
                     continue
-                if key < held_key:  # hold n, push the one held before into n's slot
-                    n, held = held, n
-                    key, held_key = held_key, key
-                    state[held] = 1
+                i = size
+                size += 1
+            else:
+                i = st - 1
             # push or decrease-key (hole sifts up)
             while i > 0:
                 p = (i - 1) >> 2
@@ -250,8 +248,8 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
             hc[i] = n
             hk[i] = key
             state[n] = i + 1
-        if size + (held >= 0) > max_frontier:
-            max_frontier = size + (held >= 0)
+        if size + nl > max_frontier:
+            max_frontier = size + nl
     code = heap.finish(code, state, touched, nt)
     if code == FOUND:
         return code, expanded, max_frontier, fill(trace(parent, start, goal), Wp)

@@ -79,15 +79,15 @@ class SearchSpace:
 
     def workspace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(floats, ints, keys), allocated once: F rows g, h (float64); I rows parent, state,
-        touched, heap cell, entering move (int32); K heap keys (int64). Few arrays, because numba's
-        dispatch costs about a microsecond per array argument.
+        touched, heap cell, entering move, equal-f stack (int32); K heap keys (int64). Few
+        arrays, because numba's dispatch costs about a microsecond per array argument.
 
         ``state`` (``ints[1]``) is all zeros between queries: every kernel clears the cells
         it touched (listed in ``ints[2]``) before it returns, so no query pays for the grid.
         """
         if self._ws is None:
             n = self.n
-            ints = np.empty((5, n), np.int32)
+            ints = np.empty((6, n), np.int32)
             ints[1] = 0
             self._ws = (np.empty((2, n)), ints, np.empty(n, np.int64))
         return self._ws
