@@ -35,10 +35,10 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`; its ``state``
     row must be all zeros on entry and is all zeros again on return; ``ints[0]`` receives
     each reached cell's entering move. ``succ``: the successor table of
-    :mod:`skyroute.search.canonical` for the move rule. The open list is the 4-ary
-    indexed heap of :func:`skyroute.search.heap.push4` / ``pop4``, written out in this
-    loop: as calls (even inlined by numba) they cost about 10% more here, as binary-heap
-    calls 1.2-1.8x (docs/architecture.md).
+    :mod:`skyroute.search.canonical` for the move rule. The open list is a 4-ary form of
+    :mod:`skyroute.search.heap`, written out in this loop: as calls (even inlined by
+    numba) its operations cost about 10% more here, binary-heap calls 1.2-1.8x
+    (docs/architecture.md).
     """
     g = floats[0]
     entered, state, touched, hc, level = ints[0], ints[1], ints[2], ints[3], ints[4]

@@ -9,6 +9,11 @@ The heap shares the searches' per-cell ``state`` array: ``state[c] = i + 1`` whi
 in heap slot i, so improving a node is a decrease-key, not a duplicate entry; 0 means
 never seen and -1 closed (``pop`` closes what it returns). Sifting moves a hole, writing
 each level once.
+
+The A* and JPS kernels write out a 4-ary form of this heap in their loops (children of
+slot i at 4i+1..4i+4, parent (i-1) >> 2: half the levels per pop), because numba
+wraps every call that takes an array in atomic reference-count updates
+(docs/architecture.md); the same keys and the same ``state`` convention.
 """
 
 from __future__ import annotations
@@ -82,63 +87,6 @@ def pop(hc, hk, state, size):
                 break
         _put(hc, hk, state, i, last, lk)
     return int(top), size
-
-
-@njit(cache=True, inline="always")
-def push4(hc, hk, state, size, cell, k):
-    """:func:`push` on a 4-ary heap (children of slot i at 4i+1..4i+4): half the levels
-    of a binary heap, so a pop reads fewer scattered slots; inlined into the kernel."""
-    i = state[cell] - 1
-    if i < 0:
-        i = size
-        size += 1
-    while i > 0:
-        p = (i - 1) >> 2
-        kp = hk[p]
-        if k >= kp:
-            break
-        moved = hc[p]
-        hc[i] = moved
-        hk[i] = kp
-        state[moved] = i + 1
-        i = p
-    hc[i] = cell
-    hk[i] = k
-    state[cell] = i + 1
-    return size
-
-
-@njit(cache=True, inline="always")
-def pop4(hc, hk, state, size):
-    """:func:`pop` on the 4-ary heap of :func:`push4`: remove the minimum and close it;
-    return (cell, new size)."""
-    top = hc[0]
-    state[top] = CLOSED
-    size -= 1
-    if size > 0:
-        last = hc[size]
-        lk = hk[size]
-        i = 0
-        while True:
-            b = 4 * i + 1
-            if b >= size:
-                break
-            kb = hk[b]
-            for j in range(b + 1, min(b + 4, size)):
-                if hk[j] < kb:
-                    kb = hk[j]
-                    b = j
-            if kb >= lk:
-                break
-            moved = hc[b]
-            hc[i] = moved
-            hk[i] = kb
-            state[moved] = i + 1
-            i = b
-        hc[i] = last
-        hk[i] = lk
-        state[last] = i + 1
-    return top, size
 
 
 @njit(cache=True)

@@ -1,10 +1,13 @@
 """Jump Point Search, 8-connected, without corner cutting (MovingAI's move rule).
 
 Harabor & Grastien's pruning for the no-corner-cutting model ("Improving Jump Point
-Search", ICAPS 2014): a diagonal move has no forced neighbours and stops where one of
-its two straight scans finds a jump point; a straight move stops at the goal or where
-a side cell is free while the cell behind it is blocked, which forces the perpendicular
-step and the diagonal beside it.
+Search", ICAPS 2014): a diagonal move has no forced neighbours; a straight move stops at
+the goal or where a side cell is free while the cell behind it is blocked, which forces
+the perpendicular step and the diagonal beside it. The pruning reads the canonical
+successor table shared with A* (:mod:`skyroute.search.canonical`). As in that paper, a
+diagonal scan queues no intermediate jump points: every straight jump point its two
+straight scans find from a diagonal cell is a successor of the expanded cell itself
+(reached diagonal steps first), and the diagonal scan goes on to the wall.
 
 Straight scans are answered in O(1) from a table built once per grid (the JPS+ idea):
 for each cell and each of the 4 straight directions, the steps to the first cell with a
@@ -92,8 +95,8 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
     (its ``state`` row all zeros on entry and on return).
 
     An expansion first lists its jump points (cell, x, y, entering move) in ``found``,
-    then relaxes them in one loop. The 4-ary heap of :func:`heap.push4` / ``pop4`` is
-    written out, as in the A* kernel: no call in the loop takes an array.
+    then relaxes them in one loop. The heap is the A* kernel's 4-ary one, written out:
+    no call in the loop takes an array.
     """
     g = floats[0]
     parent, state, touched, hc, entered = ints[0], ints[1], ints[2], ints[3], ints[4]
