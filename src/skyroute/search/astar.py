@@ -2,7 +2,11 @@
 
 4- or 8-connected; orthogonal steps cost 1, diagonal sqrt 2. Heuristics: 0 none
 (Dijkstra), 1 octile, 2 Euclidean, 3 Manhattan (admissible only 4-connected); ``weight``
->= 1 inflates h (weighted A*, cost at most ``weight`` x optimal). Each cell is expanded
+>= 1 inflates h (weighted A*, cost at most ``weight`` x optimal). On 8-connected grids without
+corner cutting only canonical successors are generated (:mod:`skyroute.search.canonical`),
+which skips most neighbours a parent already reached. A new successor with its
+parent's f (the common case along a good line) is expanded next without a trip through
+the heap. Each cell is expanded
 at most once: a closed cell is never reopened, which is exact for a consistent heuristic
 and weight 1. Legal moves come from a per-cell bit mask built once per grid
 (:meth:`SearchSpace.move_mask`), and h from the expanded cell's coordinates, so the
@@ -16,27 +20,34 @@ from numba import njit
 
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
-from skyroute.search.moves import COSTS, MDX, MDY, SQRT2_M1, h_of, offsets
-from skyroute.search.trace import trace
+from skyroute.search.canonical import LOWEST, START
+from skyroute.search.moves import COSTS, MDX, MDY, SQRT2_M1, h_of, offsets, xy
+from skyroute.search.trace import trace_moves
+
+ON_LEVEL = np.iinfo(np.int32).max  # state of a cell on the equal-f stack
 
 
 @njit(cache=True)
-def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, ints,
+def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, floats, ints,
                  keys):
     """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier, path).
 
     floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`; its ``state``
-    row must be all zeros on entry and is all zeros again on return. The heap
-    operations of :mod:`skyroute.search.heap` are written out in this loop: numba does
-    not inline them here, and the calls cost 1.2-1.8x in time (docs/architecture.md).
+    row must be all zeros on entry and is all zeros again on return; ``ints[0]`` receives
+    each reached cell's entering move. ``succ``: the successor table of
+    :mod:`skyroute.search.canonical` for the move rule. The open list is a 4-ary form of
+    :mod:`skyroute.search.heap`, written out in this loop: as calls (even inlined by
+    numba) its operations cost about 10% more here, binary-heap calls 1.2-1.8x
+    (docs/architecture.md).
     """
     g = floats[0]
-    parent, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
+    entered, state, touched, hc, level = ints[0], ints[1], ints[2], ints[3], ints[4]
     hk = keys
     offs = offsets(Wp)
+    inv = 1.0 / Wp
     gx, gy = goal % Wp, goal // Wp
     g[start] = 0.0
-    parent[start] = start
+    entered[start] = START
     touched[0] = start
     nt = 1
     f0 = weight * h_of(hkind, abs(start % Wp - gx), abs(start // Wp - gy))
@@ -47,31 +58,49 @@ def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, i
     expanded = 0
     max_frontier = 1
     code = NO_PATH
-    while size > 0:
-        # pop the minimum (hole sifts down) and close it
-        c = hc[0]
-        size -= 1
-        if size > 0:
-            last = hc[size]
-            lk = hk[size]
-            i = 0
-            while True:
-                b = 2 * i + 1
-                if b >= size:
-                    break
-                if b + 1 < size and hk[b + 1] < hk[b]:
-                    b += 1
-                if hk[b] >= lk:
-                    break
-                moved = hc[b]
-                hc[i] = moved
-                hk[i] = hk[b]
-                state[moved] = i + 1
-                i = b
-            hc[i] = last
-            hk[i] = lk
-            state[last] = i + 1
+    # New successors whose f equals the expanded cell's go on a stack (``level``), not
+    # the heap, and are expanded before the heap's next pop: nothing open has a smaller
+    # f (consistent h, weight 1). Last in, first out: the deepest first, as the g
+    # tie-break in the heap keys.
+    can_hold = weight == 1.0 and (hkind == 1 or hkind == 2)
+    nl = 0
+    ck = keys[0]
+    while True:
+        if nl > 0:
+            nl -= 1
+            c = level[nl]
+        elif size > 0:
+            # pop the minimum (hole sifts down) and close it
+            c = hc[0]
+            ck = hk[0]
+            size -= 1
+            if size > 0:
+                last = hc[size]
+                lk = hk[size]
+                i = 0
+                while True:
+                    b = 4 * i + 1
+                    if b >= size:
+                        break
+                    kb = hk[b]
+                    for j in range(b + 1, min(b + 4, size)):
+                        if hk[j] < kb:
+                            kb = hk[j]
+                            b = j
+                    if kb >= lk:
+                        break
+                    moved = hc[b]
+                    hc[i] = moved
+                    hk[i] = kb
+                    state[moved] = i + 1
+                    i = b
+                hc[i] = last
+                hk[i] = lk
+                state[last] = i + 1
+        else:
+            break
         state[c] = -1
+        cf = ck >> heap.TIE_BITS  # unchanged while the stack of equal f empties
         if c == goal:
             code = FOUND
             break
@@ -80,12 +109,13 @@ def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, i
             break
         expanded += 1
         gc = g[c]
-        m = mask[c]
-        cx = c % Wp - gx
-        cy = c // Wp - gy
-        for k in range(8):  # the mask holds the connectivity: no diagonal bits when 4
-            if not (m >> k) & 1:
-                continue
+        m = succ[entered[c], mask[c]]
+        cx, cy = xy(c, Wp, inv)
+        cx -= gx
+        cy -= gy
+        while m:  # the mask holds the connectivity: no diagonal bits when 4
+            k = LOWEST[m]
+            m &= m - 1
             n = c + offs[k]
             st = state[n]
             if st < 0:
@@ -94,14 +124,12 @@ def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, i
             if st == 0:
                 touched[nt] = n
                 nt += 1
-                i = size
-                size += 1
             elif gn >= g[n]:
                 continue
-            else:
-                i = st - 1
             g[n] = gn
-            parent[n] = c
+            entered[n] = k
+            if st == ON_LEVEL:  # an equal cost by another float sum: already queued
+                continue
             dx = abs(cx + MDX[k])
             dy = abs(cy + MDY[k])
             if hkind == 1:  # octile, written out: the common case
@@ -110,9 +138,19 @@ def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, i
                 hn = h_of(hkind, dx, dy)
             key = (int((gn + weight * hn) * heap.F_SCALE + 0.5) << heap.TIE_BITS) | \
                 (heap.TIE_MAX - min(int(gn * 4.0), heap.TIE_MAX))
+            if st == 0:
+                if can_hold and key >> heap.TIE_BITS == cf:
+                    level[nl] = n
+                    nl += 1
+                    state[n] = ON_LEVEL
+                    continue
+                i = size
+                size += 1
+            else:
+                i = st - 1
             # push or decrease-key (hole sifts up)
             while i > 0:
-                p = (i - 1) >> 1
+                p = (i - 1) >> 2
                 kp = hk[p]
                 if key >= kp:
                     break
@@ -124,9 +162,9 @@ def astar_kernel(mask, Wp, start, goal, hkind, weight, max_expansions, floats, i
             hc[i] = n
             hk[i] = key
             state[n] = i + 1
-        if size > max_frontier:
-            max_frontier = size
+        if size + nl > max_frontier:
+            max_frontier = size + nl
     heap.reset(state, touched, nt)
     if code == FOUND:
-        return code, expanded, max_frontier, trace(parent, start, goal)
+        return code, expanded, max_frontier, trace_moves(entered, offs, start, goal)
     return code, expanded, max_frontier, np.empty(0, np.int64)

