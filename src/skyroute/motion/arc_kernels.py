@@ -30,6 +30,7 @@ import shapely
 from numba import njit
 
 from skyroute.motion.zone_kernels import crosses, zone_arrays
+from skyroute.world.edge_buckets import bucket_edges
 from skyroute.world.geometry import point_segment_dist2
 from skyroute.world.world import World
 
@@ -83,26 +84,8 @@ def _build(edges: np.ndarray, cell: float) -> EdgeIndex:
     if len(edges) == 0:
         return EdgeIndex(edges.reshape(0, 4), np.zeros(2, np.int64), np.zeros(0, np.int64),
                          0.0, 0.0, cell, 1, 1, 1e-9, np.zeros((1, 1)))
-    lo = np.minimum(edges[:, :2], edges[:, 2:]).min(0)
-    hi = np.maximum(edges[:, :2], edges[:, 2:]).max(0)
-    eps = 1e-9 * max(1.0, float((hi - lo).max()))
-    x0, y0 = lo - cell
-    nx = int((hi[0] - x0) // cell) + 2
-    ny = int((hi[1] - y0) // cell) + 2
-    ex0 = np.floor((np.minimum(edges[:, 0], edges[:, 2]) - eps - x0) / cell).astype(np.int64)
-    ex1 = np.floor((np.maximum(edges[:, 0], edges[:, 2]) + eps - x0) / cell).astype(np.int64)
-    ey0 = np.floor((np.minimum(edges[:, 1], edges[:, 3]) - eps - y0) / cell).astype(np.int64)
-    ey1 = np.floor((np.maximum(edges[:, 1], edges[:, 3]) + eps - y0) / cell).astype(np.int64)
-    buckets, ids = [], []
-    for i in range(len(edges)):
-        gx, gy = np.meshgrid(np.arange(ex0[i], ex1[i] + 1), np.arange(ey0[i], ey1[i] + 1))
-        b = (gy * nx + gx).ravel()
-        buckets.append(b)
-        ids.append(np.full(len(b), i, np.int64))
-    b = np.concatenate(buckets)
-    order = np.argsort(b, kind="stable")
-    items = np.concatenate(ids)[order]
-    start = np.searchsorted(b[order], np.arange(nx * ny + 1)).astype(np.int64)
+    eps = 1e-9 * max(1.0, float(np.ptp(edges[:, [0, 2]])), float(np.ptp(edges[:, [1, 3]])))
+    start, items, x0, y0, nx, ny = bucket_edges(edges, cell, eps)
     clear = _clearance(edges, start, items, float(x0), float(y0), cell, nx, ny)
     return EdgeIndex(edges, start, items, float(x0), float(y0), cell, nx, ny, eps, clear)
 

@@ -30,6 +30,7 @@ import numpy as np
 import shapely
 from numba import njit
 
+from skyroute.world.edge_buckets import bucket_edges
 from skyroute.world.geometry import point_segment_dist2
 
 FREE, BLOCKED, UNSURE = 0, 1, 2
@@ -77,42 +78,8 @@ def edge_index(polygons: np.ndarray) -> EdgeIndex:
     extent = float(max((hi - lo).max(), 1e-300))
     eps = 1e-9 * max(extent, np.abs(np.r_[lo, hi]).max())
     cell = max(extent / max(1.0, math.sqrt(len(edges) / 2.0)), 16 * eps)
-    x0, y0 = float(lo[0] - cell), float(lo[1] - cell)
-    nx = int((hi[0] - x0) // cell) + 2
-    ny = int((hi[1] - y0) // cell) + 2
-    start, items = _bucket(edges, x0, y0, cell, nx, ny, eps)
+    start, items, x0, y0, nx, ny = bucket_edges(edges, cell, eps)
     return EdgeIndex(edges, owner, first, start, items, x0, y0, float(cell), nx, ny, eps)
-
-
-@njit(cache=True)
-def _cells(edges, e, x0, y0, cell, eps):
-    """The cell ranges (c0, c1, r0, r1) of edge e's box grown by eps."""
-    return (int((min(edges[e, 0], edges[e, 2]) - eps - x0) // cell),
-            int((max(edges[e, 0], edges[e, 2]) + eps - x0) // cell),
-            int((min(edges[e, 1], edges[e, 3]) - eps - y0) // cell),
-            int((max(edges[e, 1], edges[e, 3]) + eps - y0) // cell))
-
-
-@njit(cache=True)
-def _bucket(edges, x0, y0, cell, nx, ny, eps):
-    """CSR buckets: every cell an edge's box (grown by eps) overlaps lists the edge."""
-    count = np.zeros(nx * ny + 1, np.int64)
-    for e in range(edges.shape[0]):
-        c0, c1, r0, r1 = _cells(edges, e, x0, y0, cell, eps)
-        for r in range(r0, r1 + 1):
-            for c in range(c0, c1 + 1):
-                count[r * nx + c + 1] += 1
-    start = np.cumsum(count)
-    items = np.empty(start[-1], np.int64)
-    fill = start[:-1].copy()
-    for e in range(edges.shape[0]):
-        c0, c1, r0, r1 = _cells(edges, e, x0, y0, cell, eps)
-        for r in range(r0, r1 + 1):
-            for c in range(c0, c1 + 1):
-                b = r * nx + c
-                items[fill[b]] = e
-                fill[b] += 1
-    return start, items
 
 
 @njit(cache=True, inline="always")
