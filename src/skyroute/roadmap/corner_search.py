@@ -15,6 +15,7 @@ from numba import njit
 
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search.heap import pop_plain, push_plain
+from skyroute.search.trace import trace
 
 
 @njit(cache=True)
@@ -77,14 +78,4 @@ def corner_astar(corners, indptr, indices, weights, start_ids, start_len, goal_l
         frontier = max(frontier, size)
     if code != FOUND:
         return code, np.empty(0, np.int64), np.inf, expanded, frontier
-    m = 1
-    v = T
-    while v != S:
-        v = parent[v]
-        m += 1
-    path = np.empty(m, np.int64)
-    v = T
-    for k in range(m - 1, -1, -1):
-        path[k] = v
-        v = parent[v]
-    return code, path, g[T], expanded, frontier
+    return code, trace(parent, S, T), g[T], expanded, frontier
