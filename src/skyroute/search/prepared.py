@@ -21,7 +21,7 @@ from scipy import ndimage
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search.subgoal_build import clearances, link, subgoal_ids
-from skyroute.search.subgoal_query import subgoal_query
+from skyroute.search.subgoal_query import WS_ROWS, heap_capacity, subgoal_query
 from skyroute.world.grid import Grid, check_cell
 
 METHODS = ("subgoal",)
@@ -57,10 +57,13 @@ class PreparedGrid:
         sg = np.full(self._blk.size, -1, np.int32)
         sg[cells] = np.arange(cells.size, dtype=np.int32)
         self._sg = sg
-        m = cells.size + 2
-        ws = np.zeros((8, m), np.int64)
-        self._args = (self._blk, sg, cells, arrays["clr"], arrays["offs"], arrays["nbr"],
-                      arrays["label"], ws, np.zeros(m), self.Wp)
+        m = cells.size
+        ws = np.zeros((WS_ROWS, m + 3), np.int64)
+        ws[3, :m], ws[4, :m] = cells % self.Wp, cells // self.Wp
+        cap = heap_capacity(m, arrays["nbr"].size)
+        self._args = (self._blk, sg, arrays["clr"], arrays["offs"], arrays["nbr"],
+                      arrays["label"], ws, np.zeros(m + 2), np.zeros((2, cap)),
+                      np.zeros(cap, np.int64), self.Wp)
 
     @property
     def subgoals(self) -> int:

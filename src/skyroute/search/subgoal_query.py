@@ -16,7 +16,7 @@ import numpy as np
 from numba import njit
 
 from skyroute.result import FOUND, NO_PATH
-from skyroute.search import heap
+from skyroute.search import subgoal_heap as sgheap
 from skyroute.search.subgoal_build import DX, DY, direct_subgoals, step
 
 SQRT2 = math.sqrt(2.0)
@@ -24,9 +24,9 @@ SQRT2_M1 = SQRT2 - 1.0
 
 
 @njit(cache=True, inline="always")
-def _octile(a, b, Wp):
-    dx = abs(a % Wp - b % Wp)
-    dy = abs(a // Wp - b // Wp)
+def _oct(dx, dy):
+    """Octile length of a (dx, dy) offset."""
+    dx, dy = abs(dx), abs(dy)
     return max(dx, dy) + SQRT2_M1 * min(dx, dy)
 
 
@@ -123,14 +123,26 @@ def _to_xy(flat, Wp):
     return out, length
 
 
+WS_ROWS = 7  # parent, mark, goal mark, x, y, start list, goal list
+
+
+def heap_capacity(nodes: int, edges: int) -> int:
+    """Entries the lazy heap may need: one per relaxation, so one per edge, one per
+    start and goal connection (each at most one per subgoal) and the start itself."""
+    return edges + 2 * nodes + 4
+
+
 @njit(cache=True)
-def subgoal_query(blk, sg, cells, clr, offs, nbr, label, ws, gs, Wp, s, t):
+def subgoal_query(blk, sg, clr, offs, nbr, label, ws, gs, hfg, hn, Wp, s, t):
     """One exact query from flat cell s to flat cell t.
 
-    ``Wp`` is the padded row length; ``ws`` (8, m + 2) int64 and ``gs`` (m + 2) float64
-    are the workspace: rows parent, state, heap cells, heap keys, start list, goal list,
-    goal flags, seen; the state and flag rows are zero between queries. Returns (code,
-    path (K, 2), cost, expanded, max_frontier).
+    ``Wp`` is the padded row length; m subgoals. ``ws`` (WS_ROWS, m + 3) int64 holds per
+    node: parent, mark, goal mark, x, y (subgoals' filled once, columns m and m + 1 are
+    the start and goal), then the start and goal connection lists; ``ws[0, m + 2]`` counts
+    queries, so marks tell seen (2q) and closed (2q + 1) in query q and nothing is reset
+    between queries. ``gs`` (m + 2) float64 is g; ``hfg`` (2, cap) and ``hn`` (cap) the
+    lazy heap (:func:`heap_capacity`). Returns (code, path (K, 2), cost, expanded,
+    max_frontier).
     """
     if label[s] != label[t] or label[s] < 0:
         return NO_PATH, np.empty((0, 2)), math.inf, 0, 0
@@ -138,70 +150,72 @@ def subgoal_query(blk, sg, cells, clr, offs, nbr, label, ws, gs, Wp, s, t):
         hops = np.array([s, t], np.int64) if s != t else np.array([s], np.int64)
         path, cost = _to_xy(_cells_path(blk, hops, Wp), Wp)
         return FOUND, path, cost, 0, 0
-    m = cells.size
-    S, G = m, m + 1
-    parent, state, hc, hk = ws[0], ws[1], ws[2], ws[3]
-    slist, glist, gflag = ws[4], ws[5], ws[6]
-    ns = direct_subgoals(blk, sg, clr, s, Wp, slist, 0)
-    ng = direct_subgoals(blk, sg, clr, t, Wp, glist, 0)
+    m = ws.shape[1] - 3
+    # A start or goal that is itself a subgoal is that node; otherwise it is node m
+    # (start) or m + 1 (goal), joined to the subgoals its scan reaches.
+    S = sg[s] if sg[s] >= 0 else m
+    G = sg[t] if sg[t] >= 0 else m + 1
+    parent, mark, gmark, xs, ys = ws[0], ws[1], ws[2], ws[3], ws[4]
+    slist, glist = ws[5], ws[6]
+    hf, hg = hfg[0], hfg[1]
+    q = ws[0, m + 2] + 1
+    ws[0, m + 2] = q
+    seen, closed = 2 * q, 2 * q + 1
+    xs[S], ys[S], xs[G], ys[G] = s % Wp, s // Wp, t % Wp, t // Wp
+    tx, ty = xs[G], ys[G]
+    ns = direct_subgoals(blk, sg, clr, s, Wp, slist, 0) if m == S else 0
+    ng = direct_subgoals(blk, sg, clr, t, Wp, glist, 0) if m + 1 == G else 0
     for i in range(ng):
-        gflag[glist[i]] = 1
-    seen = ws[7]  # nodes given a state, cleared before returning
-    nseen = 1
-    seen[0] = S
+        gmark[glist[i]] = q
     gs[S] = 0.0
-    size = heap.push(hc, hk, state, 0, S, heap.key(_octile(s, t, Wp), 0.0))
+    mark[S] = seen
+    size = sgheap.push(hf, hg, hn, 0, _oct(xs[S] - tx, ys[S] - ty), 0.0, S)
     expanded = 0
     frontier = 1
     code = NO_PATH
-    goal_node = -1
     while size > 0:
-        u, size = heap.pop(hc, hk, state, size)
-        cu = s if u == S else (t if u == G else cells[u])
-        if cu == t:
+        u, size = sgheap.pop(hf, hg, hn, size)
+        if mark[u] == closed:
+            continue  # an outdated entry of a node already expanded
+        mark[u] = closed
+        if u == G:
             code = FOUND
-            goal_node = u
             break
         expanded += 1
-        if u == S:
+        ux, uy, gu = xs[u], ys[u], gs[u]
+        if u == m:
             lo, hi = 0, ns
         else:
             lo, hi = offs[u], offs[u + 1]
-        extra = 1 if u < m and gflag[u] else 0
-        for j in range(lo, hi + extra):
+        to_goal = u < m and gmark[u] == q
+        for j in range(lo, hi + (1 if to_goal else 0)):
             if j == hi:
-                v = G
-                cv = t
+                v = m + 1
             else:
-                v = slist[j] if u == S else nbr[j]
-                cv = cells[v]
-            st = state[v]
-            if st == heap.CLOSED:
+                v = slist[j] if u == m else nbr[j]
+            mv = mark[v]
+            if mv == closed:
                 continue
-            gv = gs[u] + _octile(cu, cv, Wp)
-            if st == 0:
-                seen[nseen] = v
-                nseen += 1
-            elif gv >= gs[v]:
+            vx, vy = xs[v], ys[v]
+            gv = gu + _oct(vx - ux, vy - uy)
+            if mv == seen and gv >= gs[v]:
                 continue
+            mark[v] = seen
             gs[v] = gv
             parent[v] = u
-            size = heap.push(hc, hk, state, size, v, heap.key(gv + _octile(cv, t, Wp), gv))
+            size = sgheap.push(hf, hg, hn, size, gv + _oct(vx - tx, vy - ty), gv, v)
             frontier = max(frontier, size)
-    for i in range(ng):
-        gflag[glist[i]] = 0
-    heap.reset(state, seen, nseen)
     if code != FOUND:
         return NO_PATH, np.empty((0, 2)), math.inf, expanded, frontier
     count = 1
-    v = goal_node
+    v = G
     while v != S:
         v = parent[v]
         count += 1
     hops = np.empty(count, np.int64)
-    v = goal_node
+    v = G
     for i in range(count - 1, -1, -1):
-        hops[i] = s if v == S else (t if v == G else cells[v])
+        hops[i] = ys[v] * Wp + xs[v]
         if i:
             v = parent[v]
     path, cost = _to_xy(_cells_path(blk, hops, Wp), Wp)
