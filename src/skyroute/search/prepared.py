@@ -21,12 +21,13 @@ from scipy import ndimage
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search.subgoal_build import clearances, link, subgoal_ids
+from skyroute.search.subgoal_landmarks import landmark_distances
 from skyroute.search.subgoal_query import WS_ROWS, heap_capacity, subgoal_query
 from skyroute.world.grid import Grid, check_cell
 
 METHODS = ("subgoal",)
-FORMAT_VERSION = 1
-INDEX_ARRAYS = ("cells", "clr", "offs", "nbr", "label")
+FORMAT_VERSION = 2
+INDEX_ARRAYS = ("cells", "clr", "offs", "nbr", "label", "lmd")
 _new = object.__new__
 
 
@@ -57,13 +58,13 @@ class PreparedGrid:
         sg = np.full(self._blk.size, -1, np.int32)
         sg[cells] = np.arange(cells.size, dtype=np.int32)
         self._sg = sg
-        m = cells.size
+        m, lmd = cells.size, arrays["lmd"]
         ws = np.zeros((WS_ROWS, m + 3), np.int64)
         ws[3, :m], ws[4, :m] = cells % self.Wp, cells // self.Wp
         cap = heap_capacity(m, arrays["nbr"].size)
         self._args = (self._blk, sg, arrays["clr"], arrays["offs"], arrays["nbr"],
-                      arrays["label"], ws, np.zeros(m + 2), np.zeros((2, cap)),
-                      np.zeros(cap, np.int64), self.Wp)
+                      arrays["label"], lmd, np.zeros((3, lmd.shape[1])), ws,
+                      np.zeros(m + 2), np.zeros((2, cap)), np.zeros(cap, np.int64), self.Wp)
 
     @property
     def subgoals(self) -> int:
@@ -141,7 +142,9 @@ def build_arrays(blocked: np.ndarray) -> dict:
     # regions under 8-connected moves are exactly the 4-connected ones.
     lab, _ = ndimage.label(padded == 0)
     label = (lab.ravel() - 1).astype(np.int32)
-    return {"cells": cells, "clr": clr, "offs": offs, "nbr": nbr, "label": label}
+    lmd = landmark_distances(cells, offs, nbr, label[cells], Wp)
+    return {"cells": cells, "clr": clr, "offs": offs, "nbr": nbr, "label": label,
+            "lmd": lmd}
 
 
 def prepare(grid: Grid, *, method: str = "subgoal") -> PreparedGrid:

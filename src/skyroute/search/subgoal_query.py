@@ -21,6 +21,8 @@ from skyroute.search.subgoal_build import DX, DY, direct_subgoals, step
 
 SQRT2 = math.sqrt(2.0)
 SQRT2_M1 = SQRT2 - 1.0
+F32_ERR = 2.0 ** -23  # twice float32's relative rounding
+ACTIVE = 16  # landmarks a query uses at most (of the index's up to 64)
 
 
 @njit(cache=True, inline="always")
@@ -88,34 +90,31 @@ def _walk(blk, a, b, Wp, out, at, forward):
 
 
 @njit(cache=True)
-def _cells_path(blk, hops, Wp):
-    """Flat cells of the hop sequence; each hop walked diagonal-first from its tail, or
-    else from its head (one of the two is the scan that found the edge)."""
+def _path(blk, hops, nh, Wp):
+    """The (K, 2) float (x, y) cells of the first ``nh`` hops and their summed step
+    lengths (as the grid searches sum them). Each hop is walked diagonal-first from its
+    tail, or else from its head (one of the two is the scan that found the edge); the
+    flat cells go into column 0 first and become (x, y) in place: one allocation."""
     total = 1
-    for i in range(len(hops) - 1):
+    for i in range(nh - 1):
         a, b = hops[i], hops[i + 1]
         total += max(abs(a % Wp - b % Wp), abs(a // Wp - b // Wp))
-    flat = np.empty(total, np.int64)
+    out = np.empty((total, 2))
+    flat = out[:, 0]
     flat[0] = hops[0]
     at = 1
-    for i in range(len(hops) - 1):
+    for i in range(nh - 1):
         a, b = hops[i], hops[i + 1]
         steps = max(abs(a % Wp - b % Wp), abs(a // Wp - b // Wp))
         if not _walk(blk, a, b, Wp, flat, at, True):
             _walk(blk, b, a, Wp, flat, at + steps - 1, False)  # ends on a
             flat[at + steps - 1] = b
         at += steps
-    return flat
-
-
-@njit(cache=True)
-def _to_xy(flat, Wp):
-    """(K, 2) float (x, y) cells and the summed step lengths (as the grid searches)."""
-    out = np.empty((len(flat), 2))
     length = 0.0
-    for i in range(len(flat)):
-        out[i, 0] = flat[i] % Wp - 1
-        out[i, 1] = flat[i] // Wp - 1
+    for i in range(total):
+        c = int(out[i, 0])
+        out[i, 0] = c % Wp - 1
+        out[i, 1] = c // Wp - 1
         if i:
             dx = out[i, 0] - out[i - 1, 0]
             dy = out[i, 1] - out[i - 1, 1]
@@ -123,7 +122,51 @@ def _to_xy(flat, Wp):
     return out, length
 
 
-WS_ROWS = 7  # parent, mark, goal mark, x, y, start list, goal list
+@njit(cache=True, inline="always")
+def _landmarks_to(lmd, xs, ys, ends, n, node, x, y, d):
+    """Fill ``d`` with each landmark's distance to a query end: ``node`` itself when it
+    is a subgoal, else the cell (x, y) joined to the ``n`` subgoals of ``ends``; inf
+    when unreachable."""
+    m, k = lmd.shape
+    for j in range(k):
+        d[j] = lmd[node, j] if node < m else np.inf
+    for i in range(n):
+        g = ends[i]
+        c = _oct(xs[g] - x, ys[g] - y)
+        for j in range(k):
+            d[j] = min(d[j], lmd[g, j] + c)
+
+
+@njit(cache=True)
+def _active(lmd, xs, ys, slist, ns, S, glist, ng, G, tx, ty, lw, act):
+    """Landmark distances to the goal into ``lw[1]``; the landmarks the query uses into
+    ``act``; return their count. All that reach the goal, or with more than ACTIVE the
+    ACTIVE whose bound is largest at the start (ALT's usual choice: each costs time on
+    every push)."""
+    k = lmd.shape[1]
+    ds, dg, score = lw[0], lw[1], lw[2]
+    _landmarks_to(lmd, xs, ys, glist, ng, G, tx, ty, dg)
+    if k > ACTIVE:
+        _landmarks_to(lmd, xs, ys, slist, ns, S, xs[S], ys[S], ds)
+    na = 0
+    for j in range(k):
+        score[j] = -1.0
+        if dg[j] < np.inf:
+            score[j] = abs(ds[j] - dg[j]) if k > ACTIVE else 0.0
+            act[na] = j
+            na += 1
+    if na <= ACTIVE:
+        return na
+    for a in range(ACTIVE):  # partial selection sort: the ACTIVE largest scores
+        best = a
+        for b in range(a + 1, na):
+            if score[act[b]] > score[act[best]]:
+                best = b
+        act[a], act[best] = act[best], act[a]
+    return ACTIVE
+
+
+WS_ROWS = 8  # parent, mark, goal mark, x, y, start list, goal list, landmarks
 
 
 def heap_capacity(nodes: int, edges: int) -> int:
@@ -133,22 +176,26 @@ def heap_capacity(nodes: int, edges: int) -> int:
 
 
 @njit(cache=True)
-def subgoal_query(blk, sg, clr, offs, nbr, label, ws, gs, hfg, hn, Wp, s, t):
+def subgoal_query(blk, sg, clr, offs, nbr, label, lmd, lw, ws, gs, hfg, hn, Wp, s, t):
     """One exact query from flat cell s to flat cell t.
 
     ``Wp`` is the padded row length; m subgoals. ``ws`` (WS_ROWS, m + 3) int64 holds per
     node: parent, mark, goal mark, x, y (subgoals' filled once, columns m and m + 1 are
     the start and goal), then the start and goal connection lists; ``ws[0, m + 2]`` counts
     queries, so marks tell seen (2q) and closed (2q + 1) in query q and nothing is reset
-    between queries. ``gs`` (m + 2) float64 is g; ``hfg`` (2, cap) and ``hn`` (cap) the
+    between queries. ``lmd`` (m, k) holds landmark distances (see subgoal_landmarks; the
+    heuristic is the largest of their bounds and the octile distance; ``lw`` (3, k) float64
+    is their scratch). ``gs`` (m + 2)
+    float64 is g; ``hfg`` (2, cap) and ``hn`` (cap) the
     lazy heap (:func:`heap_capacity`). Returns (code, path (K, 2), cost, expanded,
     max_frontier).
     """
     if label[s] != label[t] or label[s] < 0:
         return NO_PATH, np.empty((0, 2)), math.inf, 0, 0
     if s == t or goal_direct(clr, s, t, Wp) or goal_direct(clr, t, s, Wp):
-        hops = np.array([s, t], np.int64) if s != t else np.array([s], np.int64)
-        path, cost = _to_xy(_cells_path(blk, hops, Wp), Wp)
+        hops = ws[5]
+        hops[0], hops[1] = s, t
+        path, cost = _path(blk, hops, 2 if s != t else 1, Wp)
         return FOUND, path, cost, 0, 0
     m = ws.shape[1] - 3
     # A start or goal that is itself a subgoal is that node; otherwise it is node m
@@ -167,6 +214,9 @@ def subgoal_query(blk, sg, clr, offs, nbr, label, ws, gs, hfg, hn, Wp, s, t):
     ng = direct_subgoals(blk, sg, clr, t, Wp, glist, 0) if m + 1 == G else 0
     for i in range(ng):
         gmark[glist[i]] = q
+    act = ws[7]
+    na = _active(lmd, xs, ys, slist, ns, S, glist, ng, G, tx, ty, lw, act)
+    dg = lw[1]
     gs[S] = 0.0
     mark[S] = seen
     size = sgheap.push(hf, hg, hn, 0, _oct(xs[S] - tx, ys[S] - ty), 0.0, S)
@@ -203,7 +253,14 @@ def subgoal_query(blk, sg, clr, offs, nbr, label, ws, gs, hfg, hn, Wp, s, t):
             mark[v] = seen
             gs[v] = gv
             parent[v] = u
-            size = sgheap.push(hf, hg, hn, size, gv + _oct(vx - tx, vy - ty), gv, v)
+            h = _oct(vx - tx, vy - ty)
+            if v < m:
+                for a in range(na):
+                    dv = np.float64(lmd[v, act[a]])
+                    # lmd is float32, each value within 2**-24 of its own size of the
+                    # true distance: take that off so the bound stays a lower bound
+                    h = max(h, abs(dv - dg[act[a]]) - (dv + dg[act[a]]) * F32_ERR)
+            size = sgheap.push(hf, hg, hn, size, gv + h, gv, v)
             frontier = max(frontier, size)
     if code != FOUND:
         return NO_PATH, np.empty((0, 2)), math.inf, expanded, frontier
@@ -212,11 +269,11 @@ def subgoal_query(blk, sg, clr, offs, nbr, label, ws, gs, hfg, hn, Wp, s, t):
     while v != S:
         v = parent[v]
         count += 1
-    hops = np.empty(count, np.int64)
+    hops = slist  # the start's list is spent: reuse it for the hops
     v = G
     for i in range(count - 1, -1, -1):
         hops[i] = ys[v] * Wp + xs[v]
         if i:
             v = parent[v]
-    path, cost = _to_xy(_cells_path(blk, hops, Wp), Wp)
+    path, cost = _path(blk, hops, count, Wp)
     return FOUND, path, cost, expanded, frontier
