@@ -23,11 +23,12 @@ from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search.subgoal_build import clearances, link, subgoal_ids
 from skyroute.search.subgoal_landmarks import landmark_distances
 from skyroute.search.subgoal_query import WS_ROWS, heap_capacity, subgoal_query
+from skyroute.search.subgoal_table import distance_table, table_query
 from skyroute.world.grid import Grid, check_cell
 
 METHODS = ("subgoal",)
 FORMAT_VERSION = 2
-INDEX_ARRAYS = ("cells", "clr", "offs", "nbr", "label", "lmd")
+INDEX_ARRAYS = ("cells", "clr", "offs", "nbr", "label", "lmd", "dist", "pred")
 _new = object.__new__
 
 
@@ -59,12 +60,20 @@ class PreparedGrid:
         sg[cells] = np.arange(cells.size, dtype=np.int32)
         self._sg = sg
         m, lmd = cells.size, arrays["lmd"]
-        ws = np.zeros((WS_ROWS, m + 3), np.int64)
-        ws[3, :m], ws[4, :m] = cells % self.Wp, cells // self.Wp
-        cap = heap_capacity(m, arrays["nbr"].size)
-        self._args = (self._blk, sg, arrays["clr"], arrays["offs"], arrays["nbr"],
-                      arrays["label"], lmd, np.zeros((3, lmd.shape[1])), ws,
-                      np.zeros(m + 2), np.zeros((2, cap)), np.zeros(cap, np.int64), self.Wp)
+        if arrays["dist"].size:  # a small graph: its all-pairs table answers
+            self._kernel = table_query
+            self._args = (self._blk, sg, arrays["clr"], arrays["label"], cells,
+                          arrays["dist"], arrays["pred"], np.zeros((3, m + 2), np.int64),
+                          self.Wp)
+        else:
+            ws = np.zeros((WS_ROWS, m + 3), np.int64)
+            ws[3, :m], ws[4, :m] = cells % self.Wp, cells // self.Wp
+            cap = heap_capacity(m, arrays["nbr"].size)
+            self._kernel = subgoal_query
+            self._args = (self._blk, sg, arrays["clr"], arrays["offs"], arrays["nbr"],
+                          arrays["label"], lmd, np.zeros((3, lmd.shape[1])), ws,
+                          np.zeros(m + 2), np.zeros((2, cap)), np.zeros(cap, np.int64),
+                          self.Wp)
 
     @property
     def subgoals(self) -> int:
@@ -104,7 +113,7 @@ class PreparedGrid:
         s = self._flat(start, "start")
         t = self._flat(goal, "goal")
         t0 = time.perf_counter()
-        code, path, cost, expanded, frontier = subgoal_query(*self._args, s, t)
+        code, path, cost, expanded, frontier = self._kernel(*self._args, s, t)
         seconds = time.perf_counter() - t0
         # PlanResult's frozen __init__ costs several microseconds, a large share of a
         # small map's query: fill the instance's fields directly (same type, same data).
@@ -142,9 +151,11 @@ def build_arrays(blocked: np.ndarray) -> dict:
     # regions under 8-connected moves are exactly the 4-connected ones.
     lab, _ = ndimage.label(padded == 0)
     label = (lab.ravel() - 1).astype(np.int32)
-    lmd = landmark_distances(cells, offs, nbr, label[cells], Wp)
+    dist, pred = distance_table(cells, offs, nbr, Wp)
+    # with a table the landmarks would go unused
+    lmd = landmark_distances(cells, offs, nbr, label[cells], Wp, 0 if dist.size else None)
     return {"cells": cells, "clr": clr, "offs": offs, "nbr": nbr, "label": label,
-            "lmd": lmd}
+            "lmd": lmd, "dist": dist, "pred": pred}
 
 
 def prepare(grid: Grid, *, method: str = "subgoal") -> PreparedGrid:

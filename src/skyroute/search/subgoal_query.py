@@ -166,6 +166,20 @@ def _active(lmd, xs, ys, slist, ns, S, glist, ng, G, tx, ty, lw, act):
     return ACTIVE
 
 
+@njit(cache=True, inline="always")
+def direct_answer(blk, clr, label, hops, Wp, s, t):
+    """(code, path, cost) when no graph search is needed: different free regions (no
+    path), or start and goal the same or directly h-reachable (the straight octile
+    path); code -1 otherwise. ``hops`` is scratch for two cells."""
+    if label[s] != label[t] or label[s] < 0:
+        return NO_PATH, np.empty((0, 2)), math.inf
+    if s == t or goal_direct(clr, s, t, Wp) or goal_direct(clr, t, s, Wp):
+        hops[0], hops[1] = s, t
+        path, cost = _path(blk, hops, 2 if s != t else 1, Wp)
+        return FOUND, path, cost
+    return -1, np.empty((0, 2)), math.inf
+
+
 WS_ROWS = 8  # parent, mark, goal mark, x, y, start list, goal list, landmarks
 
 
@@ -190,13 +204,9 @@ def subgoal_query(blk, sg, clr, offs, nbr, label, lmd, lw, ws, gs, hfg, hn, Wp, 
     lazy heap (:func:`heap_capacity`). Returns (code, path (K, 2), cost, expanded,
     max_frontier).
     """
-    if label[s] != label[t] or label[s] < 0:
-        return NO_PATH, np.empty((0, 2)), math.inf, 0, 0
-    if s == t or goal_direct(clr, s, t, Wp) or goal_direct(clr, t, s, Wp):
-        hops = ws[5]
-        hops[0], hops[1] = s, t
-        path, cost = _path(blk, hops, 2 if s != t else 1, Wp)
-        return FOUND, path, cost, 0, 0
+    code, path, cost = direct_answer(blk, clr, label, ws[5], Wp, s, t)
+    if code >= 0:
+        return code, path, cost, 0, 0
     m = ws.shape[1] - 3
     # A start or goal that is itself a subgoal is that node; otherwise it is node m
     # (start) or m + 1 (goal), joined to the subgoals its scan reaches.
