@@ -3,9 +3,14 @@
 Cells of different connected components have no path: the labels answer at once. Start
 and goal otherwise connect to the subgoals they reach directly (the same bounded scan as
 the build, which also notices when the goal itself is directly h-reachable: then the
-answer is the octile distance). A* with the octile heuristic runs on the graph plus the
-two query nodes; each edge then expands into its cells, diagonal steps first from the
-end its scan started at. The cost is the sum of the steps, as the grid searches sum it.
+answer is the octile distance). A* runs on the graph plus the two query nodes, its
+heuristic the larger of the octile distance and the landmark bounds (see
+:mod:`skyroute.search.subgoal_landmarks`); each edge then expands into its cells,
+diagonal steps first from the end its scan started at. The cost is the sum of the steps,
+as the grid searches sum it. Per-node state is stamped per query (no reset), node
+coordinates are kept (no divisions in the loop) and the heap is inlined: on small graphs
+the whole query is microseconds. Graphs small enough for an all-pairs table skip the
+search altogether (:mod:`skyroute.search.subgoal_table`).
 """
 
 from __future__ import annotations
@@ -199,8 +204,7 @@ def subgoal_query(blk, sg, clr, offs, nbr, label, lmd, lw, ws, gs, hfg, hn, Wp, 
     queries, so marks tell seen (2q) and closed (2q + 1) in query q and nothing is reset
     between queries. ``lmd`` (m, k) holds landmark distances (see subgoal_landmarks; the
     heuristic is the largest of their bounds and the octile distance; ``lw`` (3, k) float64
-    is their scratch). ``gs`` (m + 2)
-    float64 is g; ``hfg`` (2, cap) and ``hn`` (cap) the
+    is their scratch). ``gs`` (m + 2) float64 is g; ``hfg`` (2, cap) and ``hn`` (cap) the
     lazy heap (:func:`heap_capacity`). Returns (code, path (K, 2), cost, expanded,
     max_frontier).
     """
