@@ -137,6 +137,17 @@ class PreparedGrid:
         return path
 
 
+def z_order(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Morton codes of non-negative (x, y) below 2**16: the bits of x and y interleaved."""
+    def spread(v):
+        v = v.astype(np.uint64) & 0xFFFF
+        v = (v | (v << 8)) & 0x00FF00FF
+        v = (v | (v << 4)) & 0x0F0F0F0F
+        v = (v | (v << 2)) & 0x33333333
+        return (v | (v << 1)) & 0x55555555
+    return spread(x) | (spread(y) << np.uint64(1))
+
+
 def build_arrays(blocked: np.ndarray) -> dict:
     """The subgoal graph's arrays for a (H, W) blocked array (see subgoal_build)."""
     h, w = blocked.shape
@@ -145,6 +156,10 @@ def build_arrays(blocked: np.ndarray) -> dict:
     padded[1:-1, 1:-1] = blocked
     blk = padded.ravel()
     sg, cells = subgoal_ids(blk, Wp)
+    # number the subgoals along a Z-order curve: a node's graph neighbours then sit
+    # near it in every per-node array (landmark rows above all), not a row apart
+    cells = cells[np.argsort(z_order(cells % Wp, cells // Wp), kind="stable")]
+    sg[cells] = np.arange(cells.size, dtype=np.int32)
     clr = clearances(blk, sg, Wp)
     offs, nbr = link(blk, sg, cells, clr, Wp)
     # Without corner cutting a diagonal step needs both side cells free, so the free
