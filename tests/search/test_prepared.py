@@ -12,8 +12,10 @@ from hypothesis import strategies as st
 
 import skyroute
 from skyroute.cli.app import main
+from skyroute.search import subgoal_table
 from skyroute.search.prepared import FORMAT_VERSION, build_arrays
 from skyroute.search.subgoal_landmarks import landmark_count, landmark_distances
+from skyroute.search.subgoal_query import subgoal_query
 from skyroute.world.movingai import read_map, read_scen
 from tests.conftest import movingai_pairs
 from tests.search.checks import assert_grid_path_legal
@@ -81,6 +83,25 @@ def test_prepared_costs_equal_dijkstra(q):
         assert tuple(got.path[0]) == s and tuple(got.path[-1]) == t
     else:
         assert got.path.shape == (0, 2) and got.cost == np.inf
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_query())
+def test_landmark_search_costs_equal_dijkstra(q):
+    # graphs this small answer from the all-pairs table: switch it off to check the
+    # landmark A* (larger maps reach it by themselves: Paris_1_512's every line above)
+    blocked, s, t = q
+    grid = skyroute.Grid(blocked)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(subgoal_table, "TABLE_MAX", 0)
+        index = skyroute.prepare(grid)
+    assert index._kernel is subgoal_query
+    want = skyroute.plan(grid, s, t, algorithm="dijkstra")
+    got = index.plan(s, t)
+    assert got.status == want.status
+    if want.found:
+        assert got.cost == pytest.approx(want.cost, abs=1e-9)
+        assert assert_grid_path_legal(blocked, got.path) == pytest.approx(got.cost, abs=1e-9)
 
 
 def test_every_pair_of_a_corridor_maze_matches_dijkstra():
