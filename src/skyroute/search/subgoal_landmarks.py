@@ -12,8 +12,6 @@ free region), and their distances come from scipy's Dijkstra over the graph at b
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
 
 MOST_LANDMARKS = 64
 
@@ -38,6 +36,10 @@ def landmark_distances(cells: np.ndarray, offs: np.ndarray, nbr: np.ndarray,
     """(m, count) float32 graph distances from ``count`` landmarks (default
     :func:`landmark_count`) to every subgoal, inf where unreachable. ``region`` is
     each subgoal's free-region label: the landmarks go to the largest region."""
+    # imported here: answering from a saved index needs no scipy
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra
+
     m = cells.size
     count = landmark_count(m) if count is None else min(count, m)
     out = np.empty((m, count), np.float32)

@@ -14,8 +14,6 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
 
 from skyroute.result import FOUND, NO_PATH
 from skyroute.search.subgoal_build import direct_subgoals
@@ -30,6 +28,10 @@ def distance_table(cells: np.ndarray, offs: np.ndarray, nbr: np.ndarray,
     """(dist (m, m) float64, pred (m, m) int16) for a graph of at most TABLE_MAX
     subgoals: ``pred[a, b]`` is b's predecessor on a shortest a -> b path (-1: none);
     two empty (0, 0) arrays for a larger graph."""
+    # imported here: answering from a saved index needs no scipy
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra
+
     m = cells.size
     if m == 0 or m > TABLE_MAX:
         return np.empty((0, 0)), np.empty((0, 0), np.int16)
