@@ -12,7 +12,10 @@ from hypothesis import strategies as st
 
 import skyroute
 from skyroute.cli.app import main
-from skyroute.search.prepared import FORMAT_VERSION
+from skyroute.search import subgoal_table
+from skyroute.search.prepared import FORMAT_VERSION, build_arrays
+from skyroute.search.subgoal_landmarks import landmark_count, landmark_distances
+from skyroute.search.subgoal_query import subgoal_query
 from skyroute.world.movingai import read_map, read_scen
 from tests.conftest import movingai_pairs
 from tests.search.checks import assert_grid_path_legal
@@ -82,6 +85,25 @@ def test_prepared_costs_equal_dijkstra(q):
         assert got.path.shape == (0, 2) and got.cost == np.inf
 
 
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_query())
+def test_landmark_search_costs_equal_dijkstra(q):
+    # graphs this small answer from the all-pairs table: switch it off to check the
+    # landmark A* (larger maps reach it by themselves: Paris_1_512's every line above)
+    blocked, s, t = q
+    grid = skyroute.Grid(blocked)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(subgoal_table, "TABLE_MAX", 0)
+        index = skyroute.prepare(grid)
+    assert index._kernel is subgoal_query
+    want = skyroute.plan(grid, s, t, algorithm="dijkstra")
+    got = index.plan(s, t)
+    assert got.status == want.status
+    if want.found:
+        assert got.cost == pytest.approx(want.cost, abs=1e-9)
+        assert assert_grid_path_legal(blocked, got.path) == pytest.approx(got.cost, abs=1e-9)
+
+
 def test_every_pair_of_a_corridor_maze_matches_dijkstra():
     # one-cell corridors, dead ends and starts right beside walls: all pairs
     rows = ["....#.....",
@@ -98,6 +120,29 @@ def test_every_pair_of_a_corridor_maze_matches_dijkstra():
             want = skyroute.plan(grid, s, t, algorithm="dijkstra")
             got = index.plan(s, t)
             assert got.status == want.status and got.cost == pytest.approx(want.cost)
+
+
+def test_landmark_distances_are_the_grids_optima():
+    # the landmark bound is admissible only because the subgoal graph's distances are
+    # the grid's: check a sample against Dijkstra on the grid, through the float32 store
+    grid = skyroute.load_map("den312d")
+    arrays = build_arrays(grid.blocked)
+    cells, Wp = arrays["cells"], grid.width + 2
+    assert arrays["lmd"].shape == (179, 0)  # a small map: the table answers instead
+    lmd = landmark_distances(cells, arrays["offs"], arrays["nbr"],
+                             arrays["label"][cells], Wp)
+    assert lmd.shape == (cells.size, landmark_count(cells.size)) == (179, 8)
+    xy = [(int(c % Wp) - 1, int(c // Wp) - 1) for c in cells]
+    rng = np.random.default_rng(7)
+    for j in range(lmd.shape[1]):
+        landmark = int(np.flatnonzero(lmd[:, j] == 0)[0])
+        for v in rng.choice(cells.size, size=8, replace=False):
+            want = skyroute.plan(grid, xy[landmark], xy[v], algorithm="dijkstra")
+            if want.found:
+                assert lmd[v, j] == pytest.approx(want.cost, rel=2**-23)
+            else:
+                assert lmd[v, j] == np.inf
+    assert landmark_count(100_000) == 64 and landmark_count(3) == 3
 
 
 def test_no_path_across_components_is_answered_from_the_labels():

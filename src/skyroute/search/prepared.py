@@ -20,12 +20,14 @@ import numpy as np
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search.subgoal_build import clearances, link, subgoal_ids
-from skyroute.search.subgoal_query import subgoal_query
+from skyroute.search.subgoal_landmarks import landmark_distances
+from skyroute.search.subgoal_query import WS_ROWS, heap_capacity, subgoal_query
+from skyroute.search.subgoal_table import distance_table, table_query
 from skyroute.world.grid import Grid, check_cell
 
 METHODS = ("subgoal",)
-FORMAT_VERSION = 1
-INDEX_ARRAYS = ("cells", "clr", "offs", "nbr", "label")
+FORMAT_VERSION = 2
+INDEX_ARRAYS = ("cells", "clr", "offs", "nbr", "label", "lmd", "dist", "pred")
 _new = object.__new__
 
 
@@ -56,10 +58,21 @@ class PreparedGrid:
         sg = np.full(self._blk.size, -1, np.int32)
         sg[cells] = np.arange(cells.size, dtype=np.int32)
         self._sg = sg
-        m = cells.size + 2
-        ws = np.zeros((8, m), np.int64)
-        self._args = (self._blk, sg, cells, arrays["clr"], arrays["offs"], arrays["nbr"],
-                      arrays["label"], ws, np.zeros(m), self.Wp)
+        m, lmd = cells.size, arrays["lmd"]
+        if arrays["dist"].size:  # a small graph: its all-pairs table answers
+            self._kernel = table_query
+            self._args = (self._blk, sg, arrays["clr"], arrays["label"], cells,
+                          arrays["dist"], arrays["pred"], np.zeros((3, m + 2), np.int64),
+                          self.Wp)
+        else:
+            ws = np.zeros((WS_ROWS, m + 3), np.int64)
+            ws[3, :m], ws[4, :m] = cells % self.Wp, cells // self.Wp
+            cap = heap_capacity(m, arrays["nbr"].size)
+            self._kernel = subgoal_query
+            self._args = (self._blk, sg, arrays["clr"], arrays["offs"], arrays["nbr"],
+                          arrays["label"], lmd, np.zeros((3, lmd.shape[1])), ws,
+                          np.zeros(m + 2), np.zeros((2, cap)), np.zeros(cap, np.int64),
+                          self.Wp)
 
     @property
     def subgoals(self) -> int:
@@ -99,7 +112,7 @@ class PreparedGrid:
         s = self._flat(start, "start")
         t = self._flat(goal, "goal")
         t0 = time.perf_counter()
-        code, path, cost, expanded, frontier = subgoal_query(*self._args, s, t)
+        code, path, cost, expanded, frontier = self._kernel(*self._args, s, t)
         seconds = time.perf_counter() - t0
         # PlanResult's frozen __init__ costs several microseconds, a large share of a
         # small map's query: fill the instance's fields directly (same type, same data).
@@ -123,6 +136,17 @@ class PreparedGrid:
         return path
 
 
+def z_order(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Morton codes of non-negative (x, y) below 2**16: the bits of x and y interleaved."""
+    def spread(v):
+        v = v.astype(np.uint64) & 0xFFFF
+        v = (v | (v << 8)) & 0x00FF00FF
+        v = (v | (v << 4)) & 0x0F0F0F0F
+        v = (v | (v << 2)) & 0x33333333
+        return (v | (v << 1)) & 0x55555555
+    return spread(x) | (spread(y) << np.uint64(1))
+
+
 def build_arrays(blocked: np.ndarray) -> dict:
     """The subgoal graph's arrays for a (H, W) blocked array (see subgoal_build)."""
     from scipy import ndimage  # imported here: a plain 'skyroute plan' must not pay for it
@@ -133,13 +157,21 @@ def build_arrays(blocked: np.ndarray) -> dict:
     padded[1:-1, 1:-1] = blocked
     blk = padded.ravel()
     sg, cells = subgoal_ids(blk, Wp)
+    # number the subgoals along a Z-order curve: a node's graph neighbours then sit
+    # near it in every per-node array (landmark rows above all), not a row apart
+    cells = cells[np.argsort(z_order(cells % Wp, cells // Wp), kind="stable")]
+    sg[cells] = np.arange(cells.size, dtype=np.int32)
     clr = clearances(blk, sg, Wp)
     offs, nbr = link(blk, sg, cells, clr, Wp)
     # Without corner cutting a diagonal step needs both side cells free, so the free
     # regions under 8-connected moves are exactly the 4-connected ones.
     lab, _ = ndimage.label(padded == 0)
     label = (lab.ravel() - 1).astype(np.int32)
-    return {"cells": cells, "clr": clr, "offs": offs, "nbr": nbr, "label": label}
+    dist, pred = distance_table(cells, offs, nbr, Wp)
+    # with a table the landmarks would go unused
+    lmd = landmark_distances(cells, offs, nbr, label[cells], Wp, 0 if dist.size else None)
+    return {"cells": cells, "clr": clr, "offs": offs, "nbr": nbr, "label": label,
+            "lmd": lmd, "dist": dist, "pred": pred}
 
 
 def prepare(grid: Grid, *, method: str = "subgoal") -> PreparedGrid:

@@ -1,0 +1,89 @@
+"""All-pairs distances over a small subgoal graph: prepared queries without a search.
+
+On small maps a query's graph search is most of its few microseconds. With m subgoals,
+a table of the m x m graph distances (scipy's Dijkstra from every subgoal, with its
+predecessor matrix for the hops) turns a query into a minimum over the start's and the
+goal's direct subgoals: ``oct(s, a) + D[a, b] + oct(b, t)``. The table is exact (graph
+distances equal the grid's), and kept only while it is small: ``TABLE_MAX`` subgoals
+(2048: 32 MB of float64 distances and 8 MB of int16 predecessors at most).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from skyroute.result import FOUND, NO_PATH
+from skyroute.search.subgoal_build import direct_subgoals
+from skyroute.search.subgoal_landmarks import edge_lengths
+from skyroute.search.subgoal_query import _oct, _path, direct_answer
+
+TABLE_MAX = 2048
+
+
+def distance_table(cells: np.ndarray, offs: np.ndarray, nbr: np.ndarray,
+                   Wp: int) -> tuple[np.ndarray, np.ndarray]:
+    """(dist (m, m) float64, pred (m, m) int16) for a graph of at most TABLE_MAX
+    subgoals: ``pred[a, b]`` is b's predecessor on a shortest a -> b path (-1: none);
+    two empty (0, 0) arrays for a larger graph."""
+    # imported here: answering from a saved index needs no scipy
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    m = cells.size
+    if m == 0 or m > TABLE_MAX:
+        return np.empty((0, 0)), np.empty((0, 0), np.int16)
+    graph = csr_matrix((edge_lengths(cells, offs, nbr, Wp), nbr, offs), shape=(m, m))
+    dist, pred = dijkstra(graph, return_predecessors=True)
+    return dist, np.where(pred < 0, -1, pred).astype(np.int16)
+
+
+@njit(cache=True)
+def table_query(blk, sg, clr, label, cells, dist, pred, ws, Wp, s, t):
+    """One exact query from flat cell s to flat cell t through the table; ``ws`` (3,
+    m + 2) int64 is scratch (start list, goal list, hops). Returns the same tuple as
+    :func:`~skyroute.search.subgoal_query.subgoal_query` (``expanded`` counts the
+    (start, goal) subgoal pairs tried)."""
+    code, path, cost = direct_answer(blk, clr, label, ws[2], Wp, s, t)
+    if code >= 0:
+        return code, path, cost, 0, 0
+    slist, glist, hops = ws[0], ws[1], ws[2]
+    if sg[s] >= 0:
+        slist[0], ns = sg[s], 1
+    else:
+        ns = direct_subgoals(blk, sg, clr, s, Wp, slist, 0)
+    if sg[t] >= 0:
+        glist[0], ng = sg[t], 1
+    else:
+        ng = direct_subgoals(blk, sg, clr, t, Wp, glist, 0)
+    sx, sy, tx, ty = s % Wp, s // Wp, t % Wp, t // Wp
+    best, ba, bb = math.inf, -1, -1
+    for j in range(ng):  # goal side first: its octile part is shared by the inner loop
+        b = glist[j]
+        cb = _oct(cells[b] % Wp - tx, cells[b] // Wp - ty)
+        for i in range(ns):
+            a = slist[i]
+            c = dist[a, b] + cb + _oct(cells[a] % Wp - sx, cells[a] // Wp - sy)
+            if c < best:
+                best, ba, bb = c, a, b
+    if ba < 0:
+        return NO_PATH, np.empty((0, 2)), math.inf, ns * ng, 0
+    n = 0  # the hops t, b ... a, s backwards (t or s left out when it is b or a itself)
+    if cells[bb] != t:
+        hops[n] = t
+        n += 1
+    v = bb
+    while True:
+        hops[n] = cells[v]
+        n += 1
+        if v == ba:
+            break
+        v = pred[ba, v]
+    if cells[ba] != s:
+        hops[n] = s
+        n += 1
+    hops[:n] = hops[:n][::-1].copy()
+    path, cost = _path(blk, hops, n, Wp)
+    return FOUND, path, cost, ns * ng, 0
