@@ -170,3 +170,17 @@ def test_runway_approach_and_loiter():
     # anticlockwise: heading is the radius direction plus 90 degrees
     ang = np.arctan2(circle[:, 1] - 4, circle[:, 0] - 3)
     np.testing.assert_allclose(np.cos(circle[:, 2] - ang - math.pi / 2), 1.0, atol=1e-9)
+
+
+@pytest.mark.parametrize("turns", [0, 1, -2, 10])
+def test_the_start_pose_as_goal_is_length_zero(turns):
+    # the batch kernel forms cos(a - b) from sines and cosines: at d = 0 it rounds to
+    # 1 - ulp, which once dropped the zero-length word and answered a full circle
+    rng = np.random.default_rng(turns + 5)
+    th = rng.uniform(-4, 4, 400)
+    xy = rng.uniform(-20, 20, (400, 2))
+    s = np.c_[xy, th]
+    g = np.c_[xy, th + 2 * math.pi * turns]
+    for r in (0.3, 1.0, 4.0):
+        assert np.all(D.lengths(s, g, r) == 0.0)
+        assert D.shortest_path(tuple(s[0]), tuple(g[0]), r).length == pytest.approx(0, abs=1e-9)

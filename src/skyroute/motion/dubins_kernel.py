@@ -114,6 +114,10 @@ def shortest_length(sx, sy, sth, gx, gy, gth, r):
     phi = math.atan2(dy, dx)
     a = _m2p(sth - phi)
     b = _m2p(gth - phi)
+    if d == 0.0 and _m2p(a - b) < 1e-12:
+        # the goal is the start pose: cab below would round to 1 - ulp and drop the
+        # zero-length LSR word, leaving only full circles (OMPL special-cases it too)
+        return 0.0
     sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
     cab = ca * cb + sa * sb
     dd = d * d
