@@ -2,6 +2,7 @@
 
 import json
 
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -44,7 +45,11 @@ def test_bench_jobs_runs_a_range(monkeypatch, capsys, tmp_path, leg_cache):
     assert "3 delivery days" in text
 
 
-def test_bench_jobs_bad_runs_is_one_line(monkeypatch, capsys):
-    code, _, err = run(monkeypatch, capsys, "bench", "jobs", "--data", str(EXAMPLE),
-                       "--runs", "ray:2")
-    assert code == 2 and "--runs 'ray:2'" in err and "Traceback" not in err
+@pytest.mark.parametrize(("flag", "value"), [("--runs", "ray:2"), ("--simulate", "2,x"),
+                                             ("--simulate", "0")])
+def test_bench_jobs_bad_options_are_one_line(monkeypatch, capsys, tmp_path, flag, value):
+    out = tmp_path / "jobs.json"
+    code, _, err = run(monkeypatch, capsys, "bench", "jobs", "--data", str(EXAMPLE), flag,
+                       value, "--json", str(out))
+    assert code == 2 and f"{flag} {value!r}" in err and "Traceback" not in err
+    assert not out.exists()

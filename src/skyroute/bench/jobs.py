@@ -48,6 +48,15 @@ def parse_runs(text: str) -> list[tuple[str, int]]:
     return runs
 
 
+def parse_counts(text: str) -> list[int]:
+    """``1,2,4`` -> [1, 2, 4]: worker counts to simulate (``''``: none)."""
+    parts = [p.strip() for p in text.split(",") if p.strip()]
+    if not all(p.isdigit() and int(p) >= 1 for p in parts):
+        raise OptionError(f"--simulate {text!r}: expected worker counts >= 1, e.g. 1,2,4,8",
+                          param="simulate")
+    return [int(p) for p in parts]
+
+
 def makespan(durations: list[float], workers: int, overhead: float = 0.0) -> float:
     """Finish time of tasks taken in order by ``workers`` workers, each the next task as
     soon as it is free; every task costs ``overhead`` more."""

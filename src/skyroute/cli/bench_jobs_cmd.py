@@ -13,7 +13,6 @@ from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli.bench_cmd import bench_app
-from skyroute.cli.parse import parse_list
 from skyroute.cli.tables import progress_bar, wide_console
 from skyroute.errors import OptionError
 from skyroute.files import write_atomic
@@ -43,14 +42,14 @@ def bench_jobs_command(
         None,
 ) -> None:
     """Time a range of delivery days on each executor; simulate more workers."""
-    from skyroute.bench.jobs import bench_jobs, parse_runs
+    from skyroute.bench.jobs import bench_jobs, parse_counts, parse_runs
     from skyroute.bench.jobs import simulate as simulated
 
     d0, d1 = _day(first, "--from"), _day(last, "--to")
     if d1 < d0:
         raise OptionError(f"--to {d1} is before --from {d0}")
     plan = parse_runs(runs)
-    counts = [int(n) for n in parse_list(simulate)] if simulate.strip() else []
+    counts = parse_counts(simulate)
     n_days = (d1 - d0).days + 1
     with progress_bar(Console(stderr=True)) as progress:
         task = progress.add_task("days", total=n_days * len(plan))
