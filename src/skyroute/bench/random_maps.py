@@ -65,7 +65,8 @@ def octile_graph(blocked: np.ndarray):
 
 def far_queries(grid: Grid, count: int, seed: int = 0) -> Scenario:
     """``count`` queries between cells of the largest free region at octile distance
-    >= side / 2, with optima from scipy's Dijkstra, as a ``Scenario``."""
+    >= side / 2 (where the region holds no such pair, the farthest of 1000 tried), with
+    optima from scipy's Dijkstra, as a ``Scenario``."""
     blocked = grid.blocked
     h, w = blocked.shape
     graph = octile_graph(blocked)
@@ -80,13 +81,15 @@ def far_queries(grid: Grid, count: int, seed: int = 0) -> Scenario:
     want = max(w, h) / 2
     starts, goals = [], []
     for _ in range(count):
+        best = (-1.0, 0, 0)  # a small region may hold no far pair: keep the farthest tried
         for _tries in range(1000):
             a, b = rng.choice(cells, 2, replace=False)
             dx, dy = abs(a % w - b % w), abs(a // w - b // w)
-            if max(dx, dy) + (SQRT2 - 1) * min(dx, dy) >= want:
+            best = max(best, (max(dx, dy) + (SQRT2 - 1) * min(dx, dy), a, b))
+            if best[0] >= want:
                 break
-        starts.append(a)
-        goals.append(b)
+        starts.append(best[1])
+        goals.append(best[2])
     starts, goals = np.array(starts), np.array(goals)
     dist = dijkstra(graph, directed=False, indices=starts)
     optimal = dist[np.arange(count), goals]
