@@ -68,7 +68,9 @@ def plot_world_path(world: World, result: PlanResult, start, goal, path: str | P
     if edges is not None and len(edges):
         from matplotlib.collections import LineCollection
 
-        ax.add_collection(LineCollection(edges, colors="tab:cyan", linewidths=0.3, alpha=0.5))
+        ax.add_collection(LineCollection(edges, colors="tab:cyan", linewidths=0.3, alpha=0.5,
+                                         label=f"{result.algorithm} graph "
+                                               f"({len(edges):,} edges)"))
     if result.found:
         p = world.to_plane(result.path, "path")
         ax.plot(p[:, 0], p[:, 1], "-o", color="tab:blue", lw=1.8, ms=3, label="path")
@@ -77,7 +79,7 @@ def plot_world_path(world: World, result: PlanResult, start, goal, path: str | P
     unit = "deg" if world.plane == "degrees" else "m"
     cost = f"{result.cost:.6g} {unit}" if result.found else result.status.value
     ax.set_title(f"{world.name}: {result.algorithm}, {cost}", fontsize=10)
-    finish_axes(ax, world)
+    finish_axes(ax, world, legend_below=edges is not None and len(edges) > 0)
     return save_figure(fig, path, dpi=dpi)
 
 
@@ -103,10 +105,15 @@ def draw_world(ax, world: World) -> None:
         ax.plot(x, y, "--", color="tab:orange", lw=1.2, label="boundary")
 
 
-def finish_axes(ax, world: World) -> None:
-    """Axis names, true proportions (degrees squeezed by cos latitude), a legend."""
+def finish_axes(ax, world: World, *, legend_below: bool = False) -> None:
+    """Axis names, true proportions (degrees squeezed by cos latitude), a legend (below
+    the axes when lines cover the whole map and no place inside is free)."""
     ax.set_xlabel("longitude" if world.plane == "degrees" else "east (m)")
     ax.set_ylabel("latitude" if world.plane == "degrees" else "north (m)")
     ax.set_aspect("equal" if world.plane == "metres" else
                   1 / np.cos(np.radians(np.mean(ax.get_ylim()))))
-    ax.legend(loc="best", fontsize=8, framealpha=0.9)
+    if legend_below:
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=4, fontsize=8,
+                  frameon=False)
+    else:
+        ax.legend(loc="best", fontsize=8, framealpha=0.9)
