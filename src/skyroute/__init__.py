@@ -12,7 +12,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from skyroute.blas_probe import defer
 from skyroute.lazy import exports
+
+defer()  # numba's first kernel load need not import scipy.linalg
 
 if TYPE_CHECKING:  # the real imports, for readers and type checkers
     from skyroute.caches import clear_caches

@@ -18,10 +18,12 @@ from skyroute import lazy
 SRC = Path(skyroute.__file__).resolve().parents[1]
 
 # Libraries a grid plan does not use. Not listed, as others import them on this path:
-# scipy and scipy.linalg (numba's CPU target probes scipy's BLAS when its first kernel
-# loads), yaml (numba's config), pydantic (Typer converts every option with it).
-HEAVY = ("shapely", "sqlalchemy", "alembic", "matplotlib", "pyproj", "fastapi", "starlette",
-         "uvicorn", "httpx", "dask", "distributed", "PIL", "networkx", "pandas", "ompl",
+# scipy's top package (numba's import), yaml (numba's config), pydantic (Typer converts
+# every option with it). scipy.linalg is listed: numba's BLAS probe would import it
+# whole, and skyroute.blas_probe defers that probe.
+HEAVY = ("shapely", "scipy.linalg", "sqlalchemy", "alembic", "matplotlib", "pyproj",
+         "fastapi", "starlette", "uvicorn", "httpx", "dask", "distributed", "PIL", "networkx",
+         "pandas", "ompl",
          "scipy.ndimage", "scipy.sparse", "scipy.spatial", "scipy.optimize")
 # skyroute's packages and modules that other commands (or World plans) need.
 OTHERS = ("skyroute.roadmap", "skyroute.motion", "skyroute.delivery", "skyroute.fleet",
