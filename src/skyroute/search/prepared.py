@@ -73,6 +73,7 @@ class PreparedGrid:
                           arrays["label"], lmd, np.zeros((3, lmd.shape[1])), ws,
                           np.zeros(m + 2), np.zeros((2, cap)), np.zeros(cap, np.int64),
                           self.Wp)
+        self._call = entry_point(self._kernel, self._args)
 
     @property
     def subgoals(self) -> int:
@@ -90,16 +91,8 @@ class PreparedGrid:
         return int(sum(a.nbytes for a in self._args[:-1]))
 
     def _flat(self, cell, what: str) -> int:
-        try:
-            x, y = cell
-        except (TypeError, ValueError):
-            x = y = None
-        if type(x) is int and type(y) is int and 0 <= x < self.width \
-                and 0 <= y < self.height:
-            c = (y + 1) * self.Wp + x + 1
-            if not self._blk[c]:
-                return c
-        x, y = check_cell(self.grid, cell, what)  # raises QueryError with the reason
+        """The padded flat index of a free cell; a QueryError naming ``what`` else."""
+        x, y = check_cell(self.grid, cell, what)
         return (y + 1) * self.Wp + x + 1
 
     def plan(self, start, goal) -> PlanResult:
@@ -109,10 +102,21 @@ class PreparedGrid:
         no_path (at once, from component labels, when they lie in different free
         regions), ``path`` every cell, ``cost``; ``expanded`` counts graph nodes.
         """
-        s = self._flat(start, "start")
-        t = self._flat(goal, "goal")
+        # The common case inline (two plain int pairs on free cells): on small maps each
+        # microsecond of Python is a tenth of the query. Anything else goes to _flat.
+        w, h, Wp, blk = self.width, self.height, self.Wp, self._blk
+        try:
+            (x, y), (u, v) = start, goal
+        except (TypeError, ValueError):
+            x = None
+        if type(x) is int and type(y) is int and type(u) is int and type(v) is int \
+                and 0 <= x < w and 0 <= y < h and 0 <= u < w and 0 <= v < h \
+                and not blk[(y + 1) * Wp + x + 1] and not blk[(v + 1) * Wp + u + 1]:
+            s, t = (y + 1) * Wp + x + 1, (v + 1) * Wp + u + 1
+        else:
+            s, t = self._flat(start, "start"), self._flat(goal, "goal")
         t0 = time.perf_counter()
-        code, path, cost, expanded, frontier = self._kernel(*self._args, s, t)
+        code, path, cost, expanded, frontier = self._call(*self._args, s, t)
         seconds = time.perf_counter() - t0
         # PlanResult's frozen __init__ costs several microseconds, a large share of a
         # small map's query: fill the instance's fields directly (same type, same data).
@@ -134,6 +138,18 @@ class PreparedGrid:
             np.savez(f, **meta, **{k: self._arrays[k] for k in INDEX_ARRAYS})
         tmp.replace(path)
         return path
+
+
+def entry_point(kernel, args: tuple):
+    """The compiled entry of ``kernel`` for exactly ``args``' types and two int cells.
+
+    A dispatcher call types all its arguments on every call (about 1 us for a prepared
+    query's dozen arrays, a tenth of a small map's query); the index's arrays never
+    change, so their overload is resolved once (numba's cache loads it) and called
+    directly."""
+    from numba import typeof, types
+
+    return kernel.compile((*(typeof(a) for a in args), types.int64, types.int64))
 
 
 def z_order(x: np.ndarray, y: np.ndarray) -> np.ndarray:
