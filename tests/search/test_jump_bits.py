@@ -1,0 +1,54 @@
+"""JPS's block-based straight scans against a cell-by-cell scan written from the rule:
+a scan stops before a blocked cell, or on a free cell whose side cell is free while the
+side cell behind it is blocked (a forced neighbour without corner cutting)."""
+
+import numpy as np
+import pytest
+
+import skyroute
+from skyroute.search.jump_bits import jump, jump_bits
+from skyroute.search.space import SearchSpace
+
+STEP = ((1, 0), (-1, 0), (0, 1), (0, -1))  # east, west, south, north
+
+
+def scan(free, x, y, dirn):
+    """Steps to the first jump point, or minus the free steps to the wall."""
+    dx, dy = STEP[dirn]
+    sides = ((0, 1), (0, -1)) if dy == 0 else ((1, 0), (-1, 0))
+    steps = 0
+    while True:
+        x, y = x + dx, y + dy
+        if not free[y, x]:
+            return -steps
+        steps += 1
+        for sx, sy in sides:
+            if free[y + sy, x + sx] and not free[y + sy - dy, x + sx - dx]:
+                return steps
+
+
+@pytest.mark.parametrize("w, h, share, seed", [
+    (7, 5, 0.2, 0), (62, 3, 0.0, 1), (63, 66, 0.1, 2), (64, 64, 0.3, 3),
+    (130, 9, 0.05, 4), (9, 130, 0.05, 5), (200, 70, 0.4, 6)])
+def test_block_scans_equal_a_cell_by_cell_scan(w, h, share, seed):
+    # widths and heights on both sides of the 64-cell words (padded: +2)
+    blocked = np.random.default_rng(seed).random((h, w)) < share
+    space = SearchSpace(skyroute.Grid(blocked))
+    Wp = space.Wp
+    bits = jump_bits(space.blocked, Wp)
+    nw, nh = (Wp + 63) // 64, (h + 2 + 63) // 64
+    free = space.blocked.reshape(h + 2, Wp) == 0
+    for y, x in np.argwhere(free):
+        for dirn in range(4):
+            assert jump(bits, nw, nh, dirn, x, y) == scan(free, x, y, dirn), (x, y, dirn)
+
+
+def test_a_jump_across_words_and_a_wall_at_once():
+    blocked = np.zeros((3, 150), bool)
+    blocked[0, 140] = True  # forced neighbour for an eastward scan along row 1 at x = 141
+    space = SearchSpace(skyroute.Grid(blocked))
+    bits = jump_bits(space.blocked, space.Wp)
+    # padded coordinates: cell (x, y) is (x + 1, y + 1)
+    assert jump(bits, 3, 1, 0, 1, 2) == 141  # east from (0, 1) to (141, 1)
+    assert jump(bits, 3, 1, 1, 1, 2) == 0  # west: the border at once
+    assert jump(bits, 3, 1, 3, 1, 2) == -1  # north: one free cell, then the border
