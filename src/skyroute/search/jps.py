@@ -35,9 +35,10 @@ from skyroute.search.trace import trace
 @njit(cache=True, inline="always")
 def _steps(v, dirn, cx, cy, gx, gy):
     """Steps from (cx, cy) in straight direction ``dirn``, whose block scan
-    (:func:`jump_bits.jump`) gave ``v``, to the goal or the first jump point, whichever comes first; 0 when the scan
-    meets a wall first. Scalars only: array arguments would cost numba two atomic
-    reference-count updates per call, which dominated the kernel's time."""
+    (:func:`jump_bits.jump`) gave ``v``, to the goal or the first jump point, whichever
+    comes first; 0 when the scan meets a wall first. Scalars only: array arguments
+    would cost numba two atomic reference-count updates per call, which dominated the
+    kernel's time."""
     reach = v if v > 0 else -v
     if dirn == 0:
         if cy == gy and 0 < gx - cx <= reach:
@@ -64,9 +65,10 @@ def jps_kernel(mask, succ, bits, Wp, start, goal, max_expansions, floats, ints, 
 
     ``mask``: the 8-connected, no-corner-cutting move mask; ``succ``: the canonical
     successor table (:mod:`skyroute.search.canonical`, the same pruning rules); ``bits``:
-    the scan rows of :func:`jump_bits.jump_bits`. Returns (status, expanded, max_frontier, path) with ``path``
-    every flat cell. floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`
-    (its ``state`` row all zeros on entry and on return).
+    the scan rows of :func:`jump_bits.jump_bits`. Returns (status, expanded,
+    max_frontier, path) with ``path`` every flat cell. floats, ints, keys: the
+    workspace of :meth:`SearchSpace.workspace` (its ``state`` row all zeros on entry and
+    on return).
 
     An expansion first lists its jump points (cell, x, y, entering move) in ``found``,
     then relaxes them in one loop. The heap is the A* kernel's 4-ary one, written out:
