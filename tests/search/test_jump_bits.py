@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import skyroute
-from skyroute.search.jump_bits import jump, jump_bits
+from skyroute.search.jump_bits import jump, jump_bits, layout
 from skyroute.search.space import SearchSpace
 
 STEP = ((1, 0), (-1, 0), (0, 1), (0, -1))  # east, west, south, north
@@ -36,11 +36,11 @@ def test_block_scans_equal_a_cell_by_cell_scan(w, h, share, seed):
     space = SearchSpace(skyroute.Grid(blocked))
     Wp = space.Wp
     bits = jump_bits(space.blocked, Wp)
-    nw, nh = (Wp + 63) // 64, (h + 2 + 63) // 64
+    nw, nh, cols = layout(Wp, space.n)
     free = space.blocked.reshape(h + 2, Wp) == 0
     for y, x in np.argwhere(free):
         for dirn in range(4):
-            assert jump(bits, nw, nh, dirn, x, y) == scan(free, x, y, dirn), (x, y, dirn)
+            assert jump(bits, nw, nh, cols, dirn, x, y) == scan(free, x, y, dirn), (x, y, dirn)
 
 
 def test_a_jump_across_words_and_a_wall_at_once():
@@ -48,7 +48,8 @@ def test_a_jump_across_words_and_a_wall_at_once():
     blocked[0, 140] = True  # forced neighbour for an eastward scan along row 1 at x = 141
     space = SearchSpace(skyroute.Grid(blocked))
     bits = jump_bits(space.blocked, space.Wp)
+    nw, nh, cols = layout(space.Wp, space.n)
     # padded coordinates: cell (x, y) is (x + 1, y + 1)
-    assert jump(bits, 3, 1, 0, 1, 2) == 141  # east from (0, 1) to (141, 1)
-    assert jump(bits, 3, 1, 1, 1, 2) == 0  # west: the border at once
-    assert jump(bits, 3, 1, 3, 1, 2) == -1  # north: one free cell, then the border
+    assert jump(bits, nw, nh, cols, 0, 1, 2) == 141  # east from (0, 1) to (141, 1)
+    assert jump(bits, nw, nh, cols, 1, 1, 2) == 0  # west: the border at once
+    assert jump(bits, nw, nh, cols, 3, 1, 2) == -1  # north: one free cell, then the border

@@ -25,7 +25,7 @@ from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
 from skyroute.search.astar import ON_LEVEL
 from skyroute.search.canonical import LOWEST, START
-from skyroute.search.jump_bits import jump
+from skyroute.search.jump_bits import jump, layout
 from skyroute.search.moves import MDX, MDY, h_of, offsets, xy
 from skyroute.search.trace import trace
 
@@ -81,7 +81,7 @@ def jps_kernel(mask, succ, bits, Wp, start, goal, max_expansions, floats, ints, 
     offs = offsets(Wp)
     inv = 1.0 / Wp
     gx, gy = xy(goal, Wp, inv)
-    nw, nh = (Wp + 63) // 64, (len(mask) // Wp + 63) // 64
+    nw, nh, cols = layout(Wp, len(mask))
     found = np.empty((8 * (Wp + len(mask) // Wp) + 8, 4), np.int64)
     g[start] = 0.0
     parent[start] = start
@@ -146,7 +146,7 @@ def jps_kernel(mask, succ, bits, Wp, start, goal, max_expansions, floats, ints, 
             m &= m - 1
             sx, sy = MDX[k], MDY[k]
             if k < 4:
-                v = _steps(jump(bits, nw, nh, k, cx, cy), k, cx, cy, gx, gy)
+                v = _steps(jump(bits, nw, nh, cols, k, cx, cy), k, cx, cy, gx, gy)
                 if v:
                     found[nf, 0] = c + v * offs[k]
                     found[nf, 1] = cx + v * sx
@@ -171,14 +171,14 @@ def jps_kernel(mask, succ, bits, Wp, start, goal, max_expansions, floats, ints, 
                     found[nf, 3] = k
                     nf += 1
                     break
-                v = _steps(jump(bits, nw, nh, hdir, dx, dy), hdir, dx, dy, gx, gy)
+                v = _steps(jump(bits, nw, nh, cols, hdir, dx, dy), hdir, dx, dy, gx, gy)
                 if v:
                     found[nf, 0] = d + v * sx
                     found[nf, 1] = dx + v * sx
                     found[nf, 2] = dy
                     found[nf, 3] = hdir
                     nf += 1
-                v = _steps(jump(bits, nw, nh, vdir, dx, dy), vdir, dx, dy, gx, gy)
+                v = _steps(jump(bits, nw, nh, cols, vdir, dx, dy), vdir, dx, dy, gx, gy)
                 if v:
                     found[nf, 0] = d + v * sy * Wp
                     found[nf, 1] = dx
