@@ -143,7 +143,7 @@ def _search(space: SearchSpace, s: int, t: int, o: GridOptions):
         code, exp, front, flat = bfs_kernel(blk, Wp, s, t, o.max_expansions, floats, ints)
     elif o.algorithm == "jps":
         code, exp, front, flat = jps_kernel(space.move_mask(8, False), CANONICAL,
-                                            space.jump_bits(), Wp, s, t,
+                                            space.jump_table(), Wp, s, t,
                                             o.max_expansions, floats, ints, keys)
     else:
         mask = space.move_mask(o.connectivity, o.corner_cutting)

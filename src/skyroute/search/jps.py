@@ -9,11 +9,11 @@ diagonal scan queues no intermediate jump points: every straight jump point its 
 straight scans find from a diagonal cell is a successor of the expanded cell itself
 (reached diagonal steps first), and the diagonal scan goes on to the wall.
 
-Straight scans are block-based (the same paper): rows packed 64 cells to a word, built
-once per grid (:mod:`skyroute.search.jump_bits`), answer the steps to the first jump
-point or wall with a count of trailing zeros per word. Only the goal depends on the
-query: a scan also stops on it when it lies on the ray within reach. Costs are octile,
-equal to A*'s; the path returned is every cell, as for A*.
+Straight scans are answered in O(1) from a table built once per grid (the JPS+ idea):
+for each cell and each of the 4 straight directions, the steps to the first cell with a
+forced neighbour, or minus the free steps to the wall when none comes first. Only the
+goal depends on the query: a scan also stops on it when it lies on the ray within
+reach. Costs are octile, equal to A*'s; the path returned is every cell, as for A*.
 """
 
 from __future__ import annotations
@@ -25,20 +25,45 @@ from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
 from skyroute.search.astar import ON_LEVEL
 from skyroute.search.canonical import LOWEST, START
-from skyroute.search.jump_bits import jump, layout
 from skyroute.search.moves import MDX, MDY, h_of, offsets, xy
 from skyroute.search.trace import trace
 
 # Straight directions: 0 east (+x), 1 west (-x), 2 south (+y), 3 north (-y), as moves 0-3.
 
 
+@njit(cache=True)
+def jump_tables(blk, Wp):
+    """An (n, 4) int32 table for the padded grid ``blk``: for each cell and straight
+    direction, the steps to the first cell with a forced neighbour if one comes before
+    the wall, else minus the free steps to the wall (0: blocked at once)."""
+    n = blk.size
+    table = np.zeros((n, 4), np.int32)
+    for dirn in range(4):
+        d = (1, -1, Wp, -Wp)[dirn]
+        side = Wp if dirn < 2 else 1
+        # visit cells so that c + d is done before c
+        first, step = (n - 1, -1) if dirn == 0 or dirn == 2 else (0, 1)
+        for i in range(n):
+            c = first + step * i
+            nb = c + d
+            if nb < 0 or nb >= n or blk[c] or blk[nb]:
+                continue
+            if (blk[nb + side] == 0 and blk[nb - d + side] != 0) or \
+                    (blk[nb - side] == 0 and blk[nb - d - side] != 0):
+                table[c, dirn] = 1
+            elif table[nb, dirn] > 0:
+                table[c, dirn] = table[nb, dirn] + 1
+            else:
+                table[c, dirn] = table[nb, dirn] - 1
+    return table
+
+
 @njit(cache=True, inline="always")
 def _steps(v, dirn, cx, cy, gx, gy):
-    """Steps from (cx, cy) in straight direction ``dirn``, whose block scan
-    (:func:`jump_bits.jump`) gave ``v``, to the goal or the first jump point, whichever
-    comes first; 0 when the scan meets a wall first. Scalars only: array arguments
-    would cost numba two atomic reference-count updates per call, which dominated the
-    kernel's time."""
+    """Steps from (cx, cy) in straight direction ``dirn``, whose jump-table entry is
+    ``v``, to the goal or the first jump point, whichever comes first; 0 when the scan
+    meets a wall first. Scalars only: array arguments would cost numba two atomic
+    reference-count updates per call, which dominated the kernel's time."""
     reach = v if v > 0 else -v
     if dirn == 0:
         if cy == gy and 0 < gx - cx <= reach:
@@ -60,15 +85,14 @@ def _sign(v):
 
 
 @njit(cache=True)
-def jps_kernel(mask, succ, bits, Wp, start, goal, max_expansions, floats, ints, keys):
+def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints, keys):
     """Search from flat ``start`` to ``goal``.
 
     ``mask``: the 8-connected, no-corner-cutting move mask; ``succ``: the canonical
-    successor table (:mod:`skyroute.search.canonical`, the same pruning rules); ``bits``:
-    the scan rows of :func:`jump_bits.jump_bits`. Returns (status, expanded,
-    max_frontier, path) with ``path`` every flat cell. floats, ints, keys: the
-    workspace of :meth:`SearchSpace.workspace` (its ``state`` row all zeros on entry and
-    on return).
+    successor table (:mod:`skyroute.search.canonical`, the same pruning rules); ``table``:
+    :func:`jump_tables`. Returns (status, expanded, max_frontier, path) with ``path``
+    every flat cell. floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`
+    (its ``state`` row all zeros on entry and on return).
 
     An expansion first lists its jump points (cell, x, y, entering move) in ``found``,
     then relaxes them in one loop. The heap is the A* kernel's 4-ary one, written out:
@@ -81,7 +105,6 @@ def jps_kernel(mask, succ, bits, Wp, start, goal, max_expansions, floats, ints, 
     offs = offsets(Wp)
     inv = 1.0 / Wp
     gx, gy = xy(goal, Wp, inv)
-    nw, nh, cols = layout(Wp, len(mask))
     found = np.empty((8 * (Wp + len(mask) // Wp) + 8, 4), np.int64)
     g[start] = 0.0
     parent[start] = start
@@ -146,7 +169,7 @@ def jps_kernel(mask, succ, bits, Wp, start, goal, max_expansions, floats, ints, 
             m &= m - 1
             sx, sy = MDX[k], MDY[k]
             if k < 4:
-                v = _steps(jump(bits, nw, nh, cols, k, cx, cy), k, cx, cy, gx, gy)
+                v = _steps(table[c, k], k, cx, cy, gx, gy)
                 if v:
                     found[nf, 0] = c + v * offs[k]
                     found[nf, 1] = cx + v * sx
@@ -171,14 +194,14 @@ def jps_kernel(mask, succ, bits, Wp, start, goal, max_expansions, floats, ints, 
                     found[nf, 3] = k
                     nf += 1
                     break
-                v = _steps(jump(bits, nw, nh, cols, hdir, dx, dy), hdir, dx, dy, gx, gy)
+                v = _steps(table[d, hdir], hdir, dx, dy, gx, gy)
                 if v:
                     found[nf, 0] = d + v * sx
                     found[nf, 1] = dx + v * sx
                     found[nf, 2] = dy
                     found[nf, 3] = hdir
                     nf += 1
-                v = _steps(jump(bits, nw, nh, cols, vdir, dx, dy), vdir, dx, dy, gx, gy)
+                v = _steps(table[d, vdir], vdir, dx, dy, gx, gy)
                 if v:
                     found[nf, 0] = d + v * sy * Wp
                     found[nf, 1] = dx
