@@ -31,6 +31,10 @@ SETTLE = 60  # witness searches: nodes settled at most
 SIM_HOPS = 3  # the same while only estimating a priority
 SIM_SETTLE = 30
 BUDGET = 120_000_000  # edges the witness searches may scan (Boston_0_256: 86 million)
+# Graphs with nodes x (mean degree)^2 above this are not tried (the attempt would only
+# cost time): measured, Boston_0_256 0.67e6 and random 512 at 30% 1.04e6 contract in
+# 86 and 98 million scans; random 20% 1.95e6 and Paris_1_512 2.5e6 need 1054 and 684.
+DENSE = 1_500_000
 HEAP_CAP = 1 << 14  # witness heap entries; a search that would need more gives up
 EPS = 1e-9  # a witness this much longer still counts (lengths a + b sqrt2 differ by far more)
 
@@ -317,11 +321,13 @@ def hierarchy(cells: np.ndarray, offs: np.ndarray, nbr: np.ndarray, Wp: int,
     :func:`contract`), ``ch_core`` (each node's core number, -1 if contracted) and the
     core's all-pairs ``ch_dist`` (float64) and ``ch_pred`` (int16), from scipy. None when
     the contraction would scan more than BUDGET edges (dense graphs: the build would take
-    too long)."""
+    too long), or without trying when nodes x mean degree squared exceeds DENSE."""
     # imported here: answering from a saved index needs no scipy
     from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import dijkstra
 
+    if nbr.size ** 2 > DENSE * max(cells.size, 1):
+        return None
     length = edge_lengths(cells, offs, nbr, Wp)
     uo, un, uw, um, rank, _ = contract(cells.size, offs, nbr, length, HOPS, SETTLE,
                                     SIM_HOPS, SIM_SETTLE, core, BUDGET)
