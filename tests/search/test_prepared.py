@@ -136,7 +136,6 @@ def test_hierarchy_every_pair_of_a_room_map():
     blocked[::8, :] = blocked[:, ::8] = True
     blocked[4::8, ::8] = blocked[::8, 4::8] = False
     blocked[[0, -1], :] = blocked[:, [0, -1]] = False
-    grid = skyroute.Grid(blocked)
     free = [(int(x), int(y)) for y, x in np.argwhere(~blocked)][::7]
     for core in (0, 16):
         index = _forced(blocked, core, subgoal_contract.BUDGET)
@@ -154,7 +153,7 @@ def test_hierarchy_index_round_trip(tmp_path):
     loaded = skyroute.load_index(index.save(tmp_path / "r.idx"), grid)
     assert loaded.accelerator == "hierarchy"
     free = [(int(x), int(y)) for y, x in np.argwhere(~blocked)]
-    for s, t in zip(free[::5], free[::-7]):
+    for s, t in zip(free[::5], free[::-7], strict=False):
         a, b = index.plan(s, t), loaded.plan(s, t)
         assert a.cost == b.cost and np.array_equal(a.path, b.path)
 
