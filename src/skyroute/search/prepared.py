@@ -51,7 +51,10 @@ class PreparedGrid:
     """A grid with its subgoal graph: ``plan(start, goal)`` answers exact octile queries.
 
     ``build_seconds`` is how long :func:`prepare` took (0 for a loaded index); ``nbytes``
-    counts the index arrays and the query workspace.
+    counts the index arrays and the query workspace; ``accelerator`` names what answers
+    on the graph: "table" (<= 2048 subgoals), "hierarchy" (a contraction hierarchy with
+    a table for its core) or "landmarks" (A* with landmark bounds, for graphs too dense
+    to contract in time).
     """
 
     def __init__(self, grid: Grid, arrays: dict, *, method: str = "subgoal",

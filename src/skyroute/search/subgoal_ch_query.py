@@ -7,11 +7,15 @@ answer, the start's and the goal's direct subgoals, joined at their octile dista
 then runs Dijkstra upward from the start's subgoals and upward from the goal's, one
 settled node at a time from whichever side has the smaller key. A node both sides have
 reached is a meeting; a side stops once its smallest key reaches the best meeting.
-Stall-on-demand: a node that a higher neighbour already reaches more cheaply is not
-expanded (its key is not its distance). The meeting node's two parent chains unpack,
-shortcut by shortcut, into subgoal hops, and those into cells as in
-:func:`skyroute.search.subgoal_query._path`. The graph is undirected, so both sides
-use the same upward edges. Per-node state is stamped per query; nothing is reset.
+Neither side goes on from a core node (the nodes left uncontracted): the core's table
+joins each core node the start side settled to each the goal side settled, and the
+best of those sums and the meetings is the optimum (Geisberger's core-based CH, with a
+table for the core). Stall-on-demand: a node that a higher neighbour already reaches
+more cheaply is not expanded (its key is not its distance). The parent chains, the
+table's predecessors between the two core nodes, then each shortcut unpack into
+subgoal hops, and those into cells as in :func:`skyroute.search.subgoal_query._path`.
+The graph is undirected, so both sides use the same upward edges. Per-node state is
+stamped per query; nothing is reset.
 """
 
 from __future__ import annotations

@@ -17,6 +17,13 @@ count, never exactness. The order is lazy (Geisberger's "lazy updates"): the nex
 priority, edge difference plus contracted neighbours, is recomputed when it comes to the
 top and it goes back if it is no longer the smallest; its neighbours are recomputed
 after each contraction.
+
+Contraction stops at a core of as many nodes as the all-pairs table holds (2048): the
+last nodes are the costliest to contract (on grid-like graphs the remaining graph
+grows dense) and the table answers between them without a search. Dense subgoal
+graphs (Paris_1_512, random maps at 10-20%) would take 7-17 s to contract to that core
+on the shared machine: they are not tried, or the contraction gives up at a budget of
+edge scans, and the landmark A* answers there.
 """
 
 from __future__ import annotations
