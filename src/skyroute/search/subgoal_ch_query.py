@@ -180,10 +180,6 @@ def ch_query(blk, sg, clr, label, cells, uo, un, uw, um, cid, cnodes, dtab, ptab
         gu = g[u]
         if omark[u] >= seen and gu + og[u] < best:
             best, meet = gu + og[u], u
-        if cid[u] >= 0:  # a core node: the table goes on from here
-            ents[side, nent[side]] = u
-            nent[side] += 1
-            continue
         stalled = False
         for j in range(uo[u], uo[u + 1]):
             w = un[j]
@@ -191,6 +187,10 @@ def ch_query(blk, sg, clr, label, cells, uo, un, uw, um, cid, cnodes, dtab, ptab
                 stalled = True
                 break
         if stalled:
+            continue  # a core node too: the table joins through w no longer
+        if cid[u] >= 0:  # a core node: the table goes on from here
+            ents[side, nent[side]] = u
+            nent[side] += 1
             continue
         expanded += 1
         size = sizes[side]
