@@ -12,8 +12,9 @@ from hypothesis import strategies as st
 
 import skyroute
 from skyroute.cli.app import main
-from skyroute.search import subgoal_table
+from skyroute.search import subgoal_contract, subgoal_table
 from skyroute.search.prepared import FORMAT_VERSION, build_arrays
+from skyroute.search.subgoal_ch_query import ch_query
 from skyroute.search.subgoal_landmarks import landmark_count, landmark_distances
 from skyroute.search.subgoal_query import subgoal_query
 from skyroute.world.movingai import read_map, read_scen
@@ -85,23 +86,76 @@ def test_prepared_costs_equal_dijkstra(q):
         assert got.path.shape == (0, 2) and got.cost == np.inf
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(random_query())
-def test_landmark_search_costs_equal_dijkstra(q):
-    # graphs this small answer from the all-pairs table: switch it off to check the
-    # landmark A* (larger maps reach it by themselves: Paris_1_512's every line above)
-    blocked, s, t = q
-    grid = skyroute.Grid(blocked)
+def _forced(blocked, table_max, budget):
+    """An index of ``blocked`` built with the table limit (and so the hierarchy's core
+    size) and the contraction budget set: graphs this small reach the hierarchy or the
+    landmark A* only so (larger maps reach them by themselves: Boston_0_256's and
+    Paris_1_512's every line above)."""
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(subgoal_table, "TABLE_MAX", 0)
-        index = skyroute.prepare(grid)
-    assert index._kernel is subgoal_query
-    want = skyroute.plan(grid, s, t, algorithm="dijkstra")
+        mp.setattr(subgoal_table, "TABLE_MAX", table_max)
+        mp.setattr(subgoal_contract, "BUDGET", budget)
+        return skyroute.prepare(skyroute.Grid(blocked))
+
+
+def _check_against_dijkstra(index, blocked, s, t):
+    want = skyroute.plan(index.grid, s, t, algorithm="dijkstra")
     got = index.plan(s, t)
     assert got.status == want.status
     if want.found:
         assert got.cost == pytest.approx(want.cost, abs=1e-9)
         assert assert_grid_path_legal(blocked, got.path) == pytest.approx(got.cost, abs=1e-9)
+        assert tuple(got.path[0]) == s and tuple(got.path[-1]) == t
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_query())
+def test_landmark_search_costs_equal_dijkstra(q):
+    blocked, s, t = q
+    index = _forced(blocked, 0, -1)  # no table, no hierarchy
+    assert index._kernel is subgoal_query and index.accelerator == "landmarks"
+    _check_against_dijkstra(index, blocked, s, t)
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_query(), st.sampled_from([0, 1, 4, 12]))
+def test_hierarchy_costs_equal_dijkstra(q, core):
+    # core 0: every node contracted, the two upward searches alone meet; else the
+    # core's table joins them (a core of one node: every path through it)
+    blocked, s, t = q
+    index = _forced(blocked, core, subgoal_contract.BUDGET)
+    if index.subgoals > core:
+        assert index._kernel is ch_query and index.accelerator == "hierarchy"
+        assert int((index._arrays["ch_core"] >= 0).sum()) == core
+    _check_against_dijkstra(index, blocked, s, t)
+
+
+def test_hierarchy_every_pair_of_a_room_map():
+    # rooms and doors: long shortcuts unpack through several levels; all pairs of a
+    # sample against Dijkstra, with and without a core, after a save and load
+    blocked = np.zeros((33, 33), bool)
+    blocked[::8, :] = blocked[:, ::8] = True
+    blocked[4::8, ::8] = blocked[::8, 4::8] = False
+    blocked[[0, -1], :] = blocked[:, [0, -1]] = False
+    free = [(int(x), int(y)) for y, x in np.argwhere(~blocked)][::7]
+    for core in (0, 16):
+        index = _forced(blocked, core, subgoal_contract.BUDGET)
+        assert index.accelerator == "hierarchy"
+        for s in free:
+            for t in free[::3]:
+                _check_against_dijkstra(index, blocked, s, t)
+
+
+def test_hierarchy_index_round_trip(tmp_path):
+    blocked = np.random.default_rng(3).random((40, 40)) < 0.25
+    grid = skyroute.Grid(blocked)
+    index = _forced(blocked, 8, subgoal_contract.BUDGET)
+    assert index.accelerator == "hierarchy"
+    loaded = skyroute.load_index(index.save(tmp_path / "r.idx"), grid)
+    assert loaded.accelerator == "hierarchy"
+    free = [(int(x), int(y)) for y, x in np.argwhere(~blocked)]
+    for s, t in zip(free[::5], free[::-7], strict=False):
+        a, b = index.plan(s, t), loaded.plan(s, t)
+        assert a.cost == b.cost and np.array_equal(a.path, b.path)
 
 
 def test_every_pair_of_a_corridor_maze_matches_dijkstra():

@@ -96,7 +96,8 @@ def _prepared(grid: Grid, info: dict) -> Callable:
     index = prepare(grid)  # first build: loads the compiled kernels from numba's cache
     index = prepare(grid)
     info.update(build_seconds=index.build_seconds, index_bytes=index.nbytes,
-                subgoals=index.subgoals, edges=index.edges)
+                subgoals=index.subgoals, edges=index.edges,
+                accelerator=index.accelerator)
 
     def run(s, t):
         r = index.plan(s, t)

@@ -19,15 +19,24 @@ import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
+from skyroute.search import subgoal_table
 from skyroute.search.subgoal_build import clearances, link, subgoal_ids
+from skyroute.search.subgoal_ch_query import WS_ROWS as CH_WS_ROWS
+from skyroute.search.subgoal_ch_query import ch_query
+from skyroute.search.subgoal_contract import hierarchy
 from skyroute.search.subgoal_landmarks import landmark_distances
 from skyroute.search.subgoal_query import WS_ROWS, heap_capacity, subgoal_query
 from skyroute.search.subgoal_table import distance_table, table_query
 from skyroute.world.grid import Grid, check_cell
 
 METHODS = ("subgoal",)
-FORMAT_VERSION = 2
-INDEX_ARRAYS = ("cells", "clr", "offs", "nbr", "label", "lmd", "dist", "pred")
+FORMAT_VERSION = 3
+CH_ARRAYS = ("ch_offs", "ch_nbr", "ch_len", "ch_mid", "ch_core", "ch_dist", "ch_pred")
+INDEX_ARRAYS = ("cells", "clr", "offs", "nbr", "label", "lmd", "dist", "pred", *CH_ARRAYS)
+NO_HIERARCHY = {"ch_offs": np.empty(0, np.int64), "ch_nbr": np.empty(0, np.int32),
+                "ch_len": np.empty(0), "ch_mid": np.empty(0, np.int32),
+                "ch_core": np.empty(0, np.int32), "ch_dist": np.empty((0, 0)),
+                "ch_pred": np.empty((0, 0), np.int16)}
 _new = object.__new__
 
 
@@ -42,7 +51,10 @@ class PreparedGrid:
     """A grid with its subgoal graph: ``plan(start, goal)`` answers exact octile queries.
 
     ``build_seconds`` is how long :func:`prepare` took (0 for a loaded index); ``nbytes``
-    counts the index arrays and the query workspace.
+    counts the index arrays and the query workspace; ``accelerator`` names what answers
+    on the graph: "table" (<= 2048 subgoals), "hierarchy" (a contraction hierarchy with
+    a table for its core) or "landmarks" (A* with landmark bounds, for graphs too dense
+    to contract in time).
     """
 
     def __init__(self, grid: Grid, arrays: dict, *, method: str = "subgoal",
@@ -60,11 +72,22 @@ class PreparedGrid:
         self._sg = sg
         m, lmd = cells.size, arrays["lmd"]
         if arrays["dist"].size:  # a small graph: its all-pairs table answers
+            self.accelerator = "table"
             self._kernel = table_query
             self._args = (self._blk, sg, arrays["clr"], arrays["label"], cells,
                           arrays["dist"], arrays["pred"], np.zeros((3, m + 2), np.int64),
                           self.Wp)
+        elif arrays["ch_offs"].size:  # a contraction hierarchy answers
+            self.accelerator = "hierarchy"
+            cid = arrays["ch_core"]
+            self._kernel = ch_query
+            self._args = (self._blk, sg, arrays["clr"], arrays["label"], cells,
+                          *(arrays[k] for k in CH_ARRAYS[:4]), cid,
+                          np.flatnonzero(cid >= 0).astype(np.int32), arrays["ch_dist"],
+                          arrays["ch_pred"], np.zeros((CH_WS_ROWS, m + 2), np.int64),
+                          np.zeros((2, m)), np.zeros((2, m)), self.Wp)
         else:
+            self.accelerator = "landmarks"
             ws = np.zeros((WS_ROWS, m + 3), np.int64)
             ws[3, :m], ws[4, :m] = cells % self.Wp, cells // self.Wp
             cap = heap_capacity(m, arrays["nbr"].size)
@@ -184,10 +207,15 @@ def build_arrays(blocked: np.ndarray) -> dict:
     lab, _ = ndimage.label(padded == 0)
     label = (lab.ravel() - 1).astype(np.int32)
     dist, pred = distance_table(cells, offs, nbr, Wp)
-    # with a table the landmarks would go unused
-    lmd = landmark_distances(cells, offs, nbr, label[cells], Wp, 0 if dist.size else None)
+    # larger graphs: a hierarchy contracted down to a core the size of a table, unless
+    # the graph is too dense to contract in time; then A* with landmarks
+    ch = None
+    if not dist.size and cells.size:
+        ch = hierarchy(cells, offs, nbr, Wp, subgoal_table.TABLE_MAX)
+    lmd = landmark_distances(cells, offs, nbr, label[cells], Wp,
+                             0 if dist.size or ch else None)
     return {"cells": cells, "clr": clr, "offs": offs, "nbr": nbr, "label": label,
-            "lmd": lmd, "dist": dist, "pred": pred}
+            "lmd": lmd, "dist": dist, "pred": pred, **(ch or NO_HIERARCHY)}
 
 
 def prepare(grid: Grid, *, method: str = "subgoal") -> PreparedGrid:

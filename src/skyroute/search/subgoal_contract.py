@@ -1,0 +1,352 @@
+"""Contract a subgoal graph into a contraction hierarchy (Geisberger et al. 2008), compiled.
+
+Large subgoal graphs (random maps: 60-90 thousand subgoals) are too big for an all-pairs
+table, and A* over them, even with landmarks, expands about a thousand nodes a query. A
+contraction hierarchy orders the nodes and removes them one at a time, lowest first: when
+node v goes, every pair (u, w) of its remaining neighbours whose shortest path may run
+u -> v -> w gets a shortcut edge u - w of that length, unless a *witness* search (Dijkstra
+from u without v, bounded in length, settled nodes and hops) finds a path no longer. Every
+shortest path then has an up-down form (ranks rising, then falling), so a query is two
+small upward Dijkstras (see :mod:`skyroute.search.subgoal_ch_query`). This is Uras &
+Koenig's SUB-CH idea: the hierarchy sits on top of the subgoal graph, not the grid.
+
+The graph is undirected (h-reachability is symmetric and edge costs are octile
+distances), so one upward edge list per node serves both directions. A bounded witness
+search that gives up only adds shortcuts, so the limits trade build time and shortcut
+count, never exactness. The order is lazy (Geisberger's "lazy updates"): the next node's
+priority, edge difference plus contracted neighbours, is recomputed when it comes to the
+top and it goes back if it is no longer the smallest; its neighbours are recomputed
+after each contraction.
+
+Contraction stops at a core of as many nodes as the all-pairs table holds (2048): the
+last nodes are the costliest to contract (on grid-like graphs the remaining graph
+grows dense) and the table answers between them without a search. Dense subgoal
+graphs (Paris_1_512, random maps at 10-20%) would take 7-17 s to contract to that core
+on the shared machine: they are not tried, or the contraction gives up at a budget of
+edge scans, and the landmark A* answers there.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from skyroute.search.subgoal_landmarks import edge_lengths
+
+HOPS = 6  # witness searches: edges at most
+SETTLE = 60  # witness searches: nodes settled at most
+SIM_HOPS = 3  # the same while only estimating a priority
+SIM_SETTLE = 30
+BUDGET = 120_000_000  # edges the witness searches may scan (Boston_0_256: 86 million)
+# Graphs with nodes x (mean degree)^2 above this are not tried (the attempt would only
+# cost time): measured, Boston_0_256 0.67e6 and random 512 at 30% 1.04e6 contract in
+# 86 and 98 million scans; random 20% 1.95e6 and Paris_1_512 2.5e6 need 1054 and 684.
+DENSE = 1_500_000
+HEAP_CAP = 1 << 14  # witness heap entries; a search that would need more gives up
+EPS = 1e-9  # a witness this much longer still counts (lengths a + b sqrt2 differ by far more)
+
+
+@njit(cache=True, inline="always")
+def _hpush(hk, hn, size, k, node):
+    """Lazy binary heap push (float keys, smallest first); return the new size."""
+    i = size
+    while i > 0:
+        p = (i - 1) >> 1
+        if hk[p] <= k:
+            break
+        hk[i], hn[i] = hk[p], hn[p]
+        i = p
+    hk[i], hn[i] = k, node
+    return size + 1
+
+
+@njit(cache=True, inline="always")
+def _hpop(hk, hn, size):
+    """Remove the smallest entry; return (key, node, new size)."""
+    k0, top = hk[0], hn[0]
+    size -= 1
+    if size > 0:
+        k, node = hk[size], hn[size]
+        i = 0
+        while True:
+            b = 2 * i + 1
+            if b >= size:
+                break
+            if b + 1 < size and hk[b + 1] < hk[b]:
+                b += 1
+            if hk[b] >= k:
+                break
+            hk[i], hn[i] = hk[b], hn[b]
+            i = b
+        hk[i], hn[i] = k, node
+    return k0, top, size
+
+
+@njit(cache=True)
+def _shortcuts(v, st, ln, to, wt, wd, wstamp, whop, tmark, tvia, stamp, hk, hn, hops,
+               settle, su, sw, sd):
+    """The shortcuts that contracting v needs: (su, sw, sd)[:count] pairs and lengths;
+    returns (count, stamp after the searches, edges scanned). The working graph holds
+    live nodes only.
+
+    The witness search from u stops as soon as every target w has a path no longer
+    than u - v - w (on dense subgoal graphs often the direct edge u - w: no search
+    beyond u's own edges), or at its limits."""
+    d, s0 = ln[v], st[v]
+    count = work = 0
+    for i in range(d - 1):
+        u = to[s0 + i]
+        stamp += 1
+        bound = 0.0
+        for j in range(i + 1, d):
+            w = to[s0 + j]
+            via = wt[s0 + i] + wt[s0 + j]
+            bound = max(bound, via)
+            tmark[w], tvia[w] = stamp, via + EPS
+        left = d - 1 - i  # targets without a witness yet
+        wd[u], wstamp[u], whop[u] = 0.0, stamp, 0
+        wd[v], wstamp[v] = -1.0, stamp  # v is no way through: "seen" shorter than any
+        size = _hpush(hk, hn, 0, 0.0, u)
+        settled = 0
+        while size > 0 and left > 0:
+            k, x, size = _hpop(hk, hn, size)
+            if k > wd[x]:
+                continue  # outdated entry
+            if k > bound:
+                break
+            settled += 1
+            if settled > settle:
+                break
+            hx = whop[x] + 1
+            work += ln[x]
+            for j in range(st[x], st[x] + ln[x]):
+                y = to[j]
+                nd = k + wt[j]
+                if nd > bound + EPS:
+                    continue
+                if wstamp[y] == stamp and nd >= wd[y]:
+                    continue  # also v, whose distance is negative
+                wd[y], wstamp[y], whop[y] = nd, stamp, hx
+                if tmark[y] == stamp and nd <= tvia[y]:
+                    tmark[y] = 0  # witnessed
+                    left -= 1
+                if hx < hops and size < hk.size:  # a node at the hop limit is not
+                    size = _hpush(hk, hn, size, nd, y)  # expanded: needs no entry
+        for j in range(i + 1, d):
+            w = to[s0 + j]
+            via = wt[s0 + i] + wt[s0 + j]
+            if wstamp[w] == stamp and wd[w] <= via + EPS:
+                continue
+            su[count], sw[count], sd[count] = u, w, via
+            count += 1
+    return count, stamp, work
+
+
+@njit(cache=True)
+def _grow(a, n):
+    """``a``, or a copy with room for at least n entries (twice as many)."""
+    if n <= a.size:
+        return a
+    b = np.empty(2 * n, a.dtype)
+    b[:a.size] = a
+    return b
+
+
+@njit(cache=True)
+def contract(m, offs, nbr, length, hops, settle, sim_hops, sim_settle, core, budget):
+    """Contract the CSR graph (``length`` per edge, taken as undirected) down to ``core``
+    uncontracted nodes.
+
+    Returns the upward graph as CSR: (offsets (m + 1) int64, head int32, length float64,
+    middle node int32 (-1 for an edge of the subgoal graph itself)), each contracted
+    node's edges to the nodes contracted after it and each core node's edges to the
+    other core nodes; each node's rank (-1 in the core); the edges the witness searches
+    scanned. Once they scanned more than ``budget`` it gives up: the arrays are empty.
+    """
+    # the working graph: per node a slice [st, st + ln) of a pool with room for cp entries
+    deg = np.zeros(m, np.int64)
+    for u in range(m):
+        for j in range(offs[u], offs[u + 1]):
+            deg[u] += 1
+            deg[nbr[j]] += 1
+    st = np.empty(m, np.int64)
+    ln = np.zeros(m, np.int64)
+    cp = np.empty(m, np.int64)
+    end = 0
+    for u in range(m):
+        st[u], cp[u] = end, max(8, deg[u])
+        end += cp[u]
+    to = np.empty(2 * end, np.int32)
+    wt = np.empty(2 * end, np.float64)
+    mid = np.empty(2 * end, np.int32)
+    for u in range(m):
+        for j in range(offs[u], offs[u + 1]):
+            for side in range(2):
+                a, b = (u, nbr[j]) if side == 0 else (nbr[j], u)
+                found = a == b
+                for e in range(st[a], st[a] + ln[a]):
+                    found = found or to[e] == b
+                if not found:
+                    e = st[a] + ln[a]
+                    to[e], wt[e], mid[e] = b, length[j], -1
+                    ln[a] += 1
+    tmark = np.zeros(m, np.int64)
+    tvia = np.zeros(m, np.float64)
+    deleted = np.zeros(m, np.int64)
+    rank = np.full(m, -1, np.int64)
+    wd = np.zeros(m, np.float64)
+    wstamp = np.zeros(m, np.int64)
+    whop = np.zeros(m, np.int64)
+    hk = np.empty(HEAP_CAP, np.float64)
+    hn = np.empty(HEAP_CAP, np.int64)
+    nb = np.empty(16, np.int64)
+    su = np.empty(64, np.int64)
+    sw = np.empty(64, np.int64)
+    sd = np.empty(64, np.float64)
+    stamp = work = 0
+    # the upward edges, appended per node as it leaves the working graph
+    up_st = np.zeros(m, np.int64)
+    up_ln = np.zeros(m, np.int64)
+    uto = np.empty(2 * nbr.size + 64, np.int32)
+    uwt = np.empty(uto.size, np.float64)
+    umid = np.empty(uto.size, np.int32)
+    uend = 0
+    # the priority queue: lazy, an entry is current when its key equals prio[v]
+    prio = np.zeros(m, np.float64)
+    qk = np.empty(2 * m + 16, np.float64)
+    qn = np.empty(2 * m + 16, np.int64)
+    qs = 0
+    for v in range(m):
+        n2 = ln[v] * ln[v]
+        su, sw, sd = _grow(su, n2), _grow(sw, n2), _grow(sd, n2)
+        count, stamp, w = _shortcuts(v, st, ln, to, wt, wd, wstamp, whop, tmark, tvia, stamp,
+                                  hk, hn, sim_hops, sim_settle, su, sw, sd)
+        work += w
+        prio[v] = count - ln[v]
+        qs = _hpush(qk, qn, qs, prio[v], v)
+    order = 0
+    while qs > 0 and order < m - core:
+        if work > budget:
+            e0 = np.empty(0, np.int64)
+            return e0, np.empty(0, np.int32), np.empty(0), np.empty(0, np.int32), e0, work
+        k, v, qs = _hpop(qk, qn, qs)
+        if rank[v] >= 0 or k != prio[v]:
+            continue
+        d = ln[v]
+        su, sw, sd = _grow(su, d * d), _grow(sw, d * d), _grow(sd, d * d)
+        count, stamp, w = _shortcuts(v, st, ln, to, wt, wd, wstamp, whop, tmark, tvia, stamp,
+                                  hk, hn, hops, settle, su, sw, sd)
+        work += w
+        p = count - d + deleted[v]
+        if qs > 0 and p > qk[0]:
+            prio[v] = p  # no longer the smallest: back into the queue
+            qk, qn = _grow(qk, qs + 1), _grow(qn, qs + 1)
+            qs = _hpush(qk, qn, qs, p, v)
+            continue
+        # contract v: its edges become its upward edges and leave its neighbours' lists
+        rank[v] = order
+        order += 1
+        uto, uwt, umid = _grow(uto, uend + d), _grow(uwt, uend + d), _grow(umid, uend + d)
+        up_st[v], up_ln[v] = uend, d
+        nb = _grow(nb, d)
+        for j in range(d):
+            e = st[v] + j
+            uto[uend], uwt[uend], umid[uend] = to[e], wt[e], mid[e]
+            uend += 1
+            u = to[e]
+            nb[j] = u
+            for f in range(st[u], st[u] + ln[u]):
+                if to[f] == v:
+                    last = st[u] + ln[u] - 1
+                    to[f], wt[f], mid[f] = to[last], wt[last], mid[last]
+                    ln[u] -= 1
+                    break
+            deleted[u] += 1
+        ln[v] = 0
+        for i in range(count):
+            for side in range(2):
+                a, b = (su[i], sw[i]) if side == 0 else (sw[i], su[i])
+                found = False
+                for e in range(st[a], st[a] + ln[a]):
+                    if to[e] == b:
+                        found = True
+                        if sd[i] < wt[e]:
+                            wt[e], mid[e] = sd[i], v
+                        break
+                if found:
+                    continue
+                if ln[a] == cp[a]:  # full: move to the pool's end with twice the room
+                    to, wt, mid = _grow(to, end + 2 * cp[a]), _grow(wt, end + 2 * cp[a]), \
+                        _grow(mid, end + 2 * cp[a])
+                    n = ln[a]
+                    to[end:end + n] = to[st[a]:st[a] + n]
+                    wt[end:end + n] = wt[st[a]:st[a] + n]
+                    mid[end:end + n] = mid[st[a]:st[a] + n]
+                    st[a], cp[a] = end, 2 * cp[a]
+                    end += cp[a]
+                e = st[a] + ln[a]
+                to[e], wt[e], mid[e] = b, sd[i], v
+                ln[a] += 1
+        # the neighbours: a fresh priority each
+        for i in range(d if sim_settle > 0 else 0):
+            u = nb[i]
+            n = ln[u]
+            su, sw, sd = _grow(su, n * n), _grow(sw, n * n), _grow(sd, n * n)
+            c2, stamp, w = _shortcuts(u, st, ln, to, wt, wd, wstamp, whop, tmark, tvia, stamp,
+                                   hk, hn, sim_hops, sim_settle, su, sw, sd)
+            work += w
+            prio[u] = c2 - n + deleted[u]
+            qk, qn = _grow(qk, qs + 1), _grow(qn, qs + 1)
+            qs = _hpush(qk, qn, qs, prio[u], u)
+    # the core: nodes left uncontracted keep their edges among themselves
+    for v in range(m):
+        if rank[v] < 0:
+            d = ln[v]
+            uto, uwt, umid = _grow(uto, uend + d), _grow(uwt, uend + d), _grow(umid, uend + d)
+            up_st[v], up_ln[v] = uend, d
+            for e in range(st[v], st[v] + d):
+                uto[uend], uwt[uend], umid[uend] = to[e], wt[e], mid[e]
+                uend += 1
+    uo = np.zeros(m + 1, np.int64)
+    for v in range(m):
+        uo[v + 1] = uo[v] + up_ln[v]
+    un = np.empty(uo[m], np.int32)
+    uw = np.empty(uo[m], np.float64)
+    um = np.empty(uo[m], np.int32)
+    for v in range(m):
+        a, n = up_st[v], up_ln[v]
+        un[uo[v]:uo[v] + n] = uto[a:a + n]
+        uw[uo[v]:uo[v] + n] = uwt[a:a + n]
+        um[uo[v]:uo[v] + n] = umid[a:a + n]
+    return uo, un, uw, um, rank, work
+
+
+def hierarchy(cells: np.ndarray, offs: np.ndarray, nbr: np.ndarray, Wp: int,
+              core: int) -> dict | None:
+    """The index arrays of a hierarchy over a subgoal graph, contracted down to ``core``
+    nodes: the upward graph ``ch_offs``, ``ch_nbr``, ``ch_len``, ``ch_mid`` (see
+    :func:`contract`), ``ch_core`` (each node's core number, -1 if contracted) and the
+    core's all-pairs ``ch_dist`` (float64) and ``ch_pred`` (int16), from scipy. None when
+    the contraction would scan more than BUDGET edges (dense graphs: the build would take
+    too long), or without trying when nodes x mean degree squared exceeds DENSE."""
+    # imported here: answering from a saved index needs no scipy
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    if nbr.size ** 2 > DENSE * max(cells.size, 1):
+        return None
+    length = edge_lengths(cells, offs, nbr, Wp)
+    uo, un, uw, um, rank, _ = contract(cells.size, offs, nbr, length, HOPS, SETTLE,
+                                    SIM_HOPS, SIM_SETTLE, core, BUDGET)
+    if uo.size == 0:
+        return None
+    cnodes = np.flatnonzero(rank < 0)
+    k = cnodes.size
+    cid = np.full(rank.size, -1, np.int32)
+    cid[cnodes] = np.arange(k, dtype=np.int32)
+    src = np.repeat(np.arange(k), uo[cnodes + 1] - uo[cnodes])
+    idx = np.concatenate([np.arange(uo[v], uo[v + 1]) for v in cnodes] + [[]]).astype(int)
+    graph = csr_matrix((uw[idx], (src, cid[un[idx]])), shape=(k, k))
+    dist, pred = dijkstra(graph, return_predecessors=True)
+    return {"ch_offs": uo, "ch_nbr": un, "ch_len": uw, "ch_mid": um, "ch_core": cid,
+            "ch_dist": dist, "ch_pred": np.where(pred < 0, -1, pred).astype(np.int16)}
