@@ -1,5 +1,5 @@
-"""``python -m skyroute`` runs the CLI."""
+"""``python -m skyroute`` runs the CLI, as the ``skyroute`` program does."""
 
-from skyroute.cli.app import main
+from skyroute.cli.app import console
 
-main()
+console()

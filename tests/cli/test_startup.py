@@ -83,3 +83,46 @@ def test_lazy_exports_import_on_first_use(monkeypatch):
     assert "dumps" in dir_()
     with pytest.raises(AttributeError, match="loads"):
         getattr_("loads")
+
+
+def run_program(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    """``python -m skyroute ARGS`` (the program's own entry, quick exit included)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [str(SRC), *filter(None, [os.environ.get("PYTHONPATH")])]))
+    return subprocess.run([sys.executable, "-m", "skyroute", *args], capture_output=True,
+                          text=True, env=env, cwd=cwd, check=False)
+
+
+def test_quick_exit_keeps_output_files_and_exit_codes(tmp_path):
+    # a QUICK_EXIT command ends without Python's teardown: what it printed and wrote
+    # must all be there, and its exit code must be the command's
+    proc = run_program("plan", "den312d", "--start", "50,76", "--goal", "60,13", "--json",
+                       "--geojson", str(tmp_path / "p.geojson"), "--plot",
+                       str(tmp_path / "p.png"))
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout)["cost"] == pytest.approx(112.55634918, abs=1e-8)
+    assert json.loads((tmp_path / "p.geojson").read_text())["type"] == "FeatureCollection"
+    assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    bad = run_program("plan", "den312d", "--start", "0,0", "--goal", "60,13")
+    assert bad.returncode == 2
+    assert bad.stderr.startswith("skyroute: error:") and len(bad.stderr.splitlines()) == 1
+    usage = run_program("plan", "den312d", "--start", "50,76")  # --goal missing
+    assert usage.returncode == 2 and "goal" in usage.stderr
+
+
+def test_only_quick_exit_commands_skip_the_teardown():
+    # an atexit handler runs in Python's teardown: after 'db --help' it must, after
+    # 'plan' (a QUICK_EXIT command) it must not
+    def teardown_ran(*args: str) -> bool:
+        script = ("import atexit, sys; atexit.register(lambda: print('teardown', "
+                  f"file=sys.stderr)); sys.argv = ['skyroute', *{list(args)!r}]; "
+                  "from skyroute.cli.app import console; console()")
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+            [str(SRC), *filter(None, [os.environ.get("PYTHONPATH")])]))
+        proc = subprocess.run([sys.executable, "-c", script], capture_output=True,
+                              text=True, env=env, check=False)
+        assert proc.returncode == 0, proc.stderr
+        return "teardown" in proc.stderr
+
+    assert teardown_ran("db", "--help")
+    assert not teardown_ran("plan", "den312d", "--start", "50,76", "--goal", "60,13")

@@ -2,11 +2,14 @@
 
 Every command is registered by a loader that imports its module when the command runs
 (:mod:`skyroute.cli.lazy_group`), so each command pays only for its own imports:
-``skyroute plan`` on a grid loads numpy, numba, Typer and Rich, not SQLAlchemy, pydantic,
-scipy or shapely (tests/cli/test_startup.py).
+``skyroute plan`` on a grid loads numpy, numba and Typer (with the pydantic it converts
+options with), not SQLAlchemy, scipy.linalg or shapely (tests/cli/test_startup.py).
 """
 
 from __future__ import annotations
+
+import os
+import sys
 
 import typer
 
@@ -129,5 +132,33 @@ def maps_command() -> None:
 
 
 def main() -> None:
-    """Console entry point."""
+    """Run the CLI on ``sys.argv``; ends in SystemExit (tests call this)."""
     run_cli(app)
+
+
+# Commands that leave no processes, pools, servers, connections or temporary files
+# behind when they return: the program may end them without Python's teardown.
+QUICK_EXIT = frozenset({"plan", "prepare", "maps"})
+
+
+def console() -> None:
+    """The ``skyroute`` program: :func:`main`, then, after a QUICK_EXIT command, the
+    process ends at once (``os._exit`` after flushing stdout and stderr). With numba's
+    compiler loaded, Python's own teardown of the modules takes about 0.3 s, a quarter of
+    a one-query command (docs/benchmarks.md section 3); the command's files are written
+    and closed by then."""
+    try:
+        main()
+    except SystemExit as done:
+        if len(sys.argv) < 2 or sys.argv[1] not in QUICK_EXIT:
+            raise
+        code = done.code
+        if code is not None and not isinstance(code, int):
+            print(code, file=sys.stderr)
+            code = 1
+        try:
+            sys.stdout.flush()
+            sys.stderr.flush()
+        except (OSError, ValueError):  # a closed pipe: nothing left to say
+            code = code or 1
+        os._exit(code or 0)
