@@ -18,7 +18,7 @@ it (:mod:`skyroute.search.subgoal_taut`, a local test on v's cell) are no shorte
 they need neither a shortcut nor a witness search. The order is lazy (Geisberger's "lazy
 updates"): the next node's priority, edge difference plus contracted neighbours, is
 recomputed when it comes to the top and it goes back if it is no longer the smallest;
-its neighbours' priorities only count the contracted neighbour.
+its neighbours are re-estimated after each contraction.
 
 Contraction stops at a core of as many nodes as the all-pairs table holds (2048): the
 last nodes are the costliest to contract (on grid-like graphs the remaining graph
@@ -34,18 +34,21 @@ import numpy as np
 from numba import njit
 
 from skyroute.search.subgoal_landmarks import edge_lengths
+from skyroute.search.subgoal_table import all_pairs
 from skyroute.search.subgoal_taut import edge_first_steps, free_around, shorten_table
 
 HOPS = 6  # witness searches: edges at most
-SETTLE = 120  # witness searches: nodes settled at most (60: 10% more scans on random 20%)
-SIM_HOPS = 3  # the same while estimating the first priorities
+SETTLE = 60  # witness searches: nodes settled at most
+SIM_HOPS = 3  # the same while only estimating a priority
 SIM_SETTLE = 30
-BUDGET = 300_000_000  # edges the witness searches may scan (random 512 at 20%: 181 million)
-# Graphs with nodes x (mean degree)^2 above this are not tried (the attempt would only
-# cost time): measured with the tautness test, Boston_0_256 (0.67e6), random 512 at 30%
-# (1.04e6), random 20% (1.95e6) and Paris_1_512 (2.5e6) contract in 4, 21, 181 and 25
-# million scans; random 10% and random512-10-0 (3.2e6) need 1.3 billion.
-DENSE = 2_600_000
+BUDGET = 120_000_000  # edges the witness searches may scan (random 512 at 30%: 86 million)
+# Graphs with nodes x (mean degree)^2 above this are not tried. Measured with the
+# tautness test: Boston_0_256 (0.67e6) and random 512 at 30% (1.04e6) contract in 17 and
+# 86 million edge scans (86 and 98 without it); random 20% (1.95e6) in 947 million, or
+# in 181 million with cheaper neighbour updates, but its build then takes 4.7-6.5 s (over
+# the 5 s budget); Paris_1_512 (2.5e6) in 441 (25) million, its queries no faster than
+# the landmark A*'s; random 10% and random512-10-0 (3.2e6) need 1.3 billion or more.
+DENSE = 1_500_000
 HEAP_CAP = 1 << 14  # witness heap entries; a search that would need more gives up
 SHORTEN = shorten_table()
 EPS = 1e-9  # a witness this much longer still counts (lengths a + b sqrt2 differ by far more)
@@ -309,12 +312,18 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
                 e = st[a] + ln[a]
                 to[e], wt[e], mid[e], dm[e] = b, sd[i], v, first
                 ln[a] += 1
-        # the neighbours: one more contracted neighbour each (lazy updates re-evaluate
-        # a node's shortcuts when it comes to the top; re-simulating every neighbour
-        # here cost 4-5 times the contraction's own searches on the random maps)
+        # the neighbours: a fresh priority each (counting only the contracted neighbour
+        # and leaving the rest to the lazy updates cuts random 20%'s scans from 947 to
+        # 181 million, but Boston_0_256's queries were 10-30% slower: kept)
         for i in range(d):
             u = nb[i]
-            prio[u] += 1
+            n = ln[u]
+            su, sw, sd = _grow(su, n * n), _grow(sw, n * n), _grow(sd, n * n)
+            c2, stamp, w = _shortcuts(u, st, ln, to, wt, dm, free, table, wd, wstamp, whop,
+                                      tmark, tvia, stamp, hk, hn, sim_hops, sim_settle, su,
+                                      sw, sd)
+            work += w
+            prio[u] = c2 - n + deleted[u]
             qk, qn = _grow(qk, qs + 1), _grow(qn, qs + 1)
             qs = _hpush(qk, qn, qs, prio[u], u)
     # the core: nodes left uncontracted keep their edges among themselves
@@ -345,13 +354,9 @@ def hierarchy(blk: np.ndarray, cells: np.ndarray, offs: np.ndarray, nbr: np.ndar
     """The index arrays of a hierarchy over a subgoal graph, contracted down to ``core``
     nodes: the upward graph ``ch_offs``, ``ch_nbr``, ``ch_len``, ``ch_mid`` (see
     :func:`contract`), ``ch_core`` (each node's core number, -1 if contracted) and the
-    core's all-pairs ``ch_dist`` (float64) and ``ch_pred`` (int16), from scipy. None when
+    core's all-pairs ``ch_dist`` (float64) and ``ch_pred`` (int16). None when
     the contraction would scan more than BUDGET edges (dense graphs: the build would take
     too long), or without trying when nodes x mean degree squared exceeds DENSE."""
-    # imported here: answering from a saved index needs no scipy
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import dijkstra
-
     if nbr.size ** 2 > DENSE * max(cells.size, 1):
         return None
     length = edge_lengths(cells, offs, nbr, Wp)
@@ -365,9 +370,10 @@ def hierarchy(blk: np.ndarray, cells: np.ndarray, offs: np.ndarray, nbr: np.ndar
     k = cnodes.size
     cid = np.full(rank.size, -1, np.int32)
     cid[cnodes] = np.arange(k, dtype=np.int32)
-    src = np.repeat(np.arange(k), uo[cnodes + 1] - uo[cnodes])
+    # the core's own graph (each core node's edges lead to core nodes) and its table
+    coffs = np.zeros(k + 1, np.int64)
+    coffs[1:] = np.cumsum(uo[cnodes + 1] - uo[cnodes])
     idx = np.concatenate([np.arange(uo[v], uo[v + 1]) for v in cnodes] + [[]]).astype(int)
-    graph = csr_matrix((uw[idx], (src, cid[un[idx]])), shape=(k, k))
-    dist, pred = dijkstra(graph, return_predecessors=True)
+    dist, pred = all_pairs(coffs, cid[un[idx]], uw[idx])
     return {"ch_offs": uo, "ch_nbr": un, "ch_len": uw, "ch_mid": um, "ch_core": cid,
-            "ch_dist": dist, "ch_pred": np.where(pred < 0, -1, pred).astype(np.int16)}
+            "ch_dist": dist, "ch_pred": pred}
