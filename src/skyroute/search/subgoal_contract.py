@@ -41,13 +41,13 @@ HOPS = 6  # witness searches: edges at most
 SETTLE = 60  # witness searches: nodes settled at most
 SIM_HOPS = 3  # the same while only estimating a priority
 SIM_SETTLE = 30
-BUDGET = 120_000_000  # edges the witness searches may scan (random 512 at 30%: 86 million)
-# Graphs with nodes x (mean degree)^2 above this are not tried. Measured with the
-# tautness test: Boston_0_256 (0.67e6) and random 512 at 30% (1.04e6) contract in 17 and
-# 86 million edge scans (86 and 98 without it); random 20% (1.95e6) in 947 million, or
-# in 181 million with cheaper neighbour updates, but its build then takes 4.7-6.5 s (over
-# the 5 s budget); Paris_1_512 (2.5e6) in 441 (25) million, its queries no faster than
-# the landmark A*'s; random 10% and random512-10-0 (3.2e6) need 1.3 billion or more.
+BUDGET = 120_000_000  # edges the witness searches may scan (random 512 at 30%: 96 million)
+# Graphs with nodes x (mean degree)^2 above this are not tried. Boston_0_256 (0.67e6) and
+# random 512 at 30% (1.04e6) contract in 75 and 96 million edge scans (86 and 98 without
+# the tautness test). Random 20% (1.95e6) needs 947 million with the test also in the
+# priorities, 181 million with cheaper neighbour updates too, but then builds in 4.7-6.5 s
+# (over the 5 s budget); Paris_1_512 (2.5e6) 441 (25) million, its queries no faster than
+# the landmark A*'s; random 10% and random512-10-0 (3.2e6) 1.3 billion or more.
 DENSE = 1_500_000
 HEAP_CAP = 1 << 14  # witness heap entries; a search that would need more gives up
 SHORTEN = shorten_table()
@@ -210,6 +210,9 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
                     to[e], wt[e], mid[e] = b, length[j], -1
                     dm[e] = fwd[j] if side == 0 else back[j]
                     ln[a] += 1
+    # priority estimates ignore the tautness test: pruned pairs made nodes look cheap,
+    # and that order slowed Boston_0_256's queries by about 30%
+    unpruned = np.zeros_like(table)
     tmark = np.zeros(m, np.int64)
     tvia = np.zeros(m, np.float64)
     deleted = np.zeros(m, np.int64)
@@ -240,7 +243,7 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
     for v in range(m):
         n2 = ln[v] * ln[v]
         su, sw, sd = _grow(su, n2), _grow(sw, n2), _grow(sd, n2)
-        count, stamp, w = _shortcuts(v, st, ln, to, wt, dm, free, table, wd, wstamp, whop,
+        count, stamp, w = _shortcuts(v, st, ln, to, wt, dm, free, unpruned, wd, wstamp, whop,
                                      tmark, tvia, stamp, hk, hn, sim_hops, sim_settle, su, sw, sd)
         work += w
         prio[v] = count - ln[v]
@@ -319,7 +322,7 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
             u = nb[i]
             n = ln[u]
             su, sw, sd = _grow(su, n * n), _grow(sw, n * n), _grow(sd, n * n)
-            c2, stamp, w = _shortcuts(u, st, ln, to, wt, dm, free, table, wd, wstamp, whop,
+            c2, stamp, w = _shortcuts(u, st, ln, to, wt, dm, free, unpruned, wd, wstamp, whop,
                                       tmark, tvia, stamp, hk, hn, sim_hops, sim_settle, su,
                                       sw, sd)
             work += w
