@@ -281,3 +281,30 @@ def test_cli_prepare_then_plan_with_index(monkeypatch, capsys, tmp_path):
                         "--goal", "2,2", "--index", str(idx))
     assert code == 2 and err.strip().endswith("Berlin_1_256.map is 256x256")
     assert len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_compiled_all_pairs_equal_scipy(seed):
+    """The hierarchy's core table (subgoal_table.all_pairs) against scipy's Dijkstra on
+    random directed graphs with unreachable pairs; predecessors lie on shortest paths."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    from skyroute.search.subgoal_table import all_pairs
+
+    rng = np.random.default_rng(seed)
+    n = 60
+    mat = csr_matrix(np.where(rng.random((n, n)) < 0.06, rng.integers(1, 9, (n, n)) +
+                              rng.random((n, n)), 0.0))
+    dist, pred = all_pairs(mat.indptr.astype(np.int64), mat.indices, mat.data)
+    want = dijkstra(mat)
+    assert np.isinf(want).any()
+    np.testing.assert_allclose(dist, want, rtol=0, atol=1e-9)
+    dense = mat.toarray()
+    for s in range(n):
+        for v in range(n):
+            if v == s or np.isinf(want[s, v]):
+                assert pred[s, v] == -1
+            else:
+                p = pred[s, v]
+                assert dense[p, v] > 0 and dist[s, p] + dense[p, v] == pytest.approx(dist[s, v])

@@ -211,7 +211,7 @@ def build_arrays(blocked: np.ndarray) -> dict:
     # the graph is too dense to contract in time; then A* with landmarks
     ch = None
     if not dist.size and cells.size:
-        ch = hierarchy(cells, offs, nbr, Wp, subgoal_table.TABLE_MAX)
+        ch = hierarchy(blk, cells, offs, nbr, Wp, subgoal_table.TABLE_MAX)
     lmd = landmark_distances(cells, offs, nbr, label[cells], Wp,
                              0 if dist.size or ch else None)
     return {"cells": cells, "clr": clr, "offs": offs, "nbr": nbr, "label": label,

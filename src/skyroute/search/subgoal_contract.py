@@ -13,17 +13,19 @@ Koenig's SUB-CH idea: the hierarchy sits on top of the subgoal graph, not the gr
 The graph is undirected (h-reachability is symmetric and edge costs are octile
 distances), so one upward edge list per node serves both directions. A bounded witness
 search that gives up only adds shortcuts, so the limits trade build time and shortcut
-count, never exactness. The order is lazy (Geisberger's "lazy updates"): the next node's
-priority, edge difference plus contracted neighbours, is recomputed when it comes to the
-top and it goes back if it is no longer the smallest; its neighbours are recomputed
-after each contraction.
+count, never exactness. Pairs whose turn at v always has a strictly shorter way around
+it (:mod:`skyroute.search.subgoal_taut`, a local test on v's cell) are no shortest path:
+they need neither a shortcut nor a witness search. The order is lazy (Geisberger's "lazy
+updates"): the next node's priority, edge difference plus contracted neighbours, is
+recomputed when it comes to the top and it goes back if it is no longer the smallest;
+its neighbours are re-estimated after each contraction.
 
 Contraction stops at a core of as many nodes as the all-pairs table holds (2048): the
 last nodes are the costliest to contract (on grid-like graphs the remaining graph
-grows dense) and the table answers between them without a search. Dense subgoal
-graphs (Paris_1_512, random maps at 10-20%) would take 7-17 s to contract to that core
-on the shared machine: they are not tried, or the contraction gives up at a budget of
-edge scans, and the landmark A* answers there.
+grows dense) and the table answers between them without a search. The densest subgoal
+graphs (random maps at 10%: 1.3 billion edge scans, 20 s to reach that core) are not
+tried, or the contraction gives up at a budget of edge scans, and the landmark A*
+answers there.
 """
 
 from __future__ import annotations
@@ -32,17 +34,23 @@ import numpy as np
 from numba import njit
 
 from skyroute.search.subgoal_landmarks import edge_lengths
+from skyroute.search.subgoal_table import all_pairs
+from skyroute.search.subgoal_taut import edge_first_steps, free_around, shorten_table
 
 HOPS = 6  # witness searches: edges at most
 SETTLE = 60  # witness searches: nodes settled at most
 SIM_HOPS = 3  # the same while only estimating a priority
 SIM_SETTLE = 30
-BUDGET = 120_000_000  # edges the witness searches may scan (Boston_0_256: 86 million)
-# Graphs with nodes x (mean degree)^2 above this are not tried (the attempt would only
-# cost time): measured, Boston_0_256 0.67e6 and random 512 at 30% 1.04e6 contract in
-# 86 and 98 million scans; random 20% 1.95e6 and Paris_1_512 2.5e6 need 1054 and 684.
+BUDGET = 120_000_000  # edges the witness searches may scan (random 512 at 30%: 96 million)
+# Graphs with nodes x (mean degree)^2 above this are not tried. Boston_0_256 (0.67e6) and
+# random 512 at 30% (1.04e6) contract in 75 and 96 million edge scans (86 and 98 without
+# the tautness test). Random 20% (1.95e6) needs 947 million with the test also in the
+# priorities, 181 million with cheaper neighbour updates too, but then builds in 4.7-6.5 s
+# (over the 5 s budget); Paris_1_512 (2.5e6) 441 (25) million, its queries no faster than
+# the landmark A*'s; random 10% and random512-10-0 (3.2e6) 1.3 billion or more.
 DENSE = 1_500_000
 HEAP_CAP = 1 << 14  # witness heap entries; a search that would need more gives up
+SHORTEN = shorten_table()
 EPS = 1e-9  # a witness this much longer still counts (lengths a + b sqrt2 differ by far more)
 
 
@@ -83,27 +91,35 @@ def _hpop(hk, hn, size):
 
 
 @njit(cache=True)
-def _shortcuts(v, st, ln, to, wt, wd, wstamp, whop, tmark, tvia, stamp, hk, hn, hops,
-               settle, su, sw, sd):
-    """The shortcuts that contracting v needs: (su, sw, sd)[:count] pairs and lengths;
-    returns (count, stamp after the searches, edges scanned). The working graph holds
-    live nodes only.
+def _shortcuts(v, st, ln, to, wt, dm, free, table, wd, wstamp, whop, tmark, tvia, stamp,
+               hk, hn, hops, settle, su, sw, sd):
+    """The shortcuts that contracting v needs: (su, sw, sd)[:count] the positions of the
+    two neighbours in v's edge list and the length; returns (count, stamp after the
+    searches, edges scanned). The working graph holds live nodes only; ``dm`` is each
+    edge's first step directions (see :mod:`skyroute.search.subgoal_taut`).
 
-    The witness search from u stops as soon as every target w has a path no longer
-    than u - v - w (on dense subgoal graphs often the direct edge u - w: no search
-    beyond u's own edges), or at its limits."""
+    A pair whose turn at v always shortens locally needs neither a shortcut nor a
+    witness. The witness search from u stops as soon as every remaining target w has a
+    path no longer than u - v - w (on dense subgoal graphs often the direct edge u - w:
+    no search beyond u's own edges), or at its limits."""
     d, s0 = ln[v], st[v]
+    fv = free[v]
     count = work = 0
     for i in range(d - 1):
         u = to[s0 + i]
         stamp += 1
         bound = 0.0
+        left = 0  # targets without a witness yet
         for j in range(i + 1, d):
+            if table[dm[s0 + i], dm[s0 + j]] & fv:
+                continue  # never a shortest path: u - v - w shortens at v
             w = to[s0 + j]
             via = wt[s0 + i] + wt[s0 + j]
             bound = max(bound, via)
             tmark[w], tvia[w] = stamp, via + EPS
-        left = d - 1 - i  # targets without a witness yet
+            left += 1
+        if left == 0:
+            continue
         wd[u], wstamp[u], whop[u] = 0.0, stamp, 0
         wd[v], wstamp[v] = -1.0, stamp  # v is no way through: "seen" shorter than any
         size = _hpush(hk, hn, 0, 0.0, u)
@@ -134,10 +150,9 @@ def _shortcuts(v, st, ln, to, wt, wd, wstamp, whop, tmark, tvia, stamp, hk, hn, 
                     size = _hpush(hk, hn, size, nd, y)  # expanded: needs no entry
         for j in range(i + 1, d):
             w = to[s0 + j]
-            via = wt[s0 + i] + wt[s0 + j]
-            if wstamp[w] == stamp and wd[w] <= via + EPS:
-                continue
-            su[count], sw[count], sd[count] = u, w, via
+            if tmark[w] != stamp:
+                continue  # pruned or witnessed
+            su[count], sw[count], sd[count] = i, j, wt[s0 + i] + wt[s0 + j]
             count += 1
     return count, stamp, work
 
@@ -153,9 +168,12 @@ def _grow(a, n):
 
 
 @njit(cache=True)
-def contract(m, offs, nbr, length, hops, settle, sim_hops, sim_settle, core, budget):
+def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hops, sim_settle,
+             core, budget):
     """Contract the CSR graph (``length`` per edge, taken as undirected) down to ``core``
-    uncontracted nodes.
+    uncontracted nodes. ``fwd``, ``back`` are each edge's first steps from either end,
+    ``free`` the nodes' free neighbours and ``table`` the shortening table of
+    :mod:`skyroute.search.subgoal_taut`.
 
     Returns the upward graph as CSR: (offsets (m + 1) int64, head int32, length float64,
     middle node int32 (-1 for an edge of the subgoal graph itself)), each contracted
@@ -179,6 +197,7 @@ def contract(m, offs, nbr, length, hops, settle, sim_hops, sim_settle, core, bud
     to = np.empty(2 * end, np.int32)
     wt = np.empty(2 * end, np.float64)
     mid = np.empty(2 * end, np.int32)
+    dm = np.empty(2 * end, np.uint8)  # per edge: the directions of its first step
     for u in range(m):
         for j in range(offs[u], offs[u + 1]):
             for side in range(2):
@@ -189,7 +208,11 @@ def contract(m, offs, nbr, length, hops, settle, sim_hops, sim_settle, core, bud
                 if not found:
                     e = st[a] + ln[a]
                     to[e], wt[e], mid[e] = b, length[j], -1
+                    dm[e] = fwd[j] if side == 0 else back[j]
                     ln[a] += 1
+    # priority estimates ignore the tautness test: pruned pairs made nodes look cheap,
+    # and that order slowed Boston_0_256's queries by about 30%
+    unpruned = np.zeros_like(table)
     tmark = np.zeros(m, np.int64)
     tvia = np.zeros(m, np.float64)
     deleted = np.zeros(m, np.int64)
@@ -200,6 +223,7 @@ def contract(m, offs, nbr, length, hops, settle, sim_hops, sim_settle, core, bud
     hk = np.empty(HEAP_CAP, np.float64)
     hn = np.empty(HEAP_CAP, np.int64)
     nb = np.empty(16, np.int64)
+    nbdm = np.empty(16, np.uint8)  # per neighbour u of v: the first step of u -> v
     su = np.empty(64, np.int64)
     sw = np.empty(64, np.int64)
     sd = np.empty(64, np.float64)
@@ -219,8 +243,8 @@ def contract(m, offs, nbr, length, hops, settle, sim_hops, sim_settle, core, bud
     for v in range(m):
         n2 = ln[v] * ln[v]
         su, sw, sd = _grow(su, n2), _grow(sw, n2), _grow(sd, n2)
-        count, stamp, w = _shortcuts(v, st, ln, to, wt, wd, wstamp, whop, tmark, tvia, stamp,
-                                  hk, hn, sim_hops, sim_settle, su, sw, sd)
+        count, stamp, w = _shortcuts(v, st, ln, to, wt, dm, free, unpruned, wd, wstamp, whop,
+                                     tmark, tvia, stamp, hk, hn, sim_hops, sim_settle, su, sw, sd)
         work += w
         prio[v] = count - ln[v]
         qs = _hpush(qk, qn, qs, prio[v], v)
@@ -234,8 +258,8 @@ def contract(m, offs, nbr, length, hops, settle, sim_hops, sim_settle, core, bud
             continue
         d = ln[v]
         su, sw, sd = _grow(su, d * d), _grow(sw, d * d), _grow(sd, d * d)
-        count, stamp, w = _shortcuts(v, st, ln, to, wt, wd, wstamp, whop, tmark, tvia, stamp,
-                                  hk, hn, hops, settle, su, sw, sd)
+        count, stamp, w = _shortcuts(v, st, ln, to, wt, dm, free, table, wd, wstamp, whop,
+                                     tmark, tvia, stamp, hk, hn, hops, settle, su, sw, sd)
         work += w
         p = count - d + deleted[v]
         if qs > 0 and p > qk[0]:
@@ -248,7 +272,7 @@ def contract(m, offs, nbr, length, hops, settle, sim_hops, sim_settle, core, bud
         order += 1
         uto, uwt, umid = _grow(uto, uend + d), _grow(uwt, uend + d), _grow(umid, uend + d)
         up_st[v], up_ln[v] = uend, d
-        nb = _grow(nb, d)
+        nb, nbdm = _grow(nb, d), _grow(nbdm, d)
         for j in range(d):
             e = st[v] + j
             uto[uend], uwt[uend], umid[uend] = to[e], wt[e], mid[e]
@@ -257,43 +281,50 @@ def contract(m, offs, nbr, length, hops, settle, sim_hops, sim_settle, core, bud
             nb[j] = u
             for f in range(st[u], st[u] + ln[u]):
                 if to[f] == v:
+                    nbdm[j] = dm[f]
                     last = st[u] + ln[u] - 1
-                    to[f], wt[f], mid[f] = to[last], wt[last], mid[last]
+                    to[f], wt[f], mid[f], dm[f] = to[last], wt[last], mid[last], dm[last]
                     ln[u] -= 1
                     break
             deleted[u] += 1
         ln[v] = 0
         for i in range(count):
             for side in range(2):
-                a, b = (su[i], sw[i]) if side == 0 else (sw[i], su[i])
+                p, q = (su[i], sw[i]) if side == 0 else (sw[i], su[i])
+                a, b, first = nb[p], nb[q], nbdm[p]
                 found = False
                 for e in range(st[a], st[a] + ln[a]):
                     if to[e] == b:
                         found = True
                         if sd[i] < wt[e]:
-                            wt[e], mid[e] = sd[i], v
+                            wt[e], mid[e], dm[e] = sd[i], v, first
                         break
                 if found:
                     continue
                 if ln[a] == cp[a]:  # full: move to the pool's end with twice the room
-                    to, wt, mid = _grow(to, end + 2 * cp[a]), _grow(wt, end + 2 * cp[a]), \
-                        _grow(mid, end + 2 * cp[a])
+                    grown = end + 2 * cp[a]
+                    to, wt = _grow(to, grown), _grow(wt, grown)
+                    mid, dm = _grow(mid, grown), _grow(dm, grown)
                     n = ln[a]
                     to[end:end + n] = to[st[a]:st[a] + n]
                     wt[end:end + n] = wt[st[a]:st[a] + n]
                     mid[end:end + n] = mid[st[a]:st[a] + n]
+                    dm[end:end + n] = dm[st[a]:st[a] + n]
                     st[a], cp[a] = end, 2 * cp[a]
                     end += cp[a]
                 e = st[a] + ln[a]
-                to[e], wt[e], mid[e] = b, sd[i], v
+                to[e], wt[e], mid[e], dm[e] = b, sd[i], v, first
                 ln[a] += 1
-        # the neighbours: a fresh priority each
-        for i in range(d if sim_settle > 0 else 0):
+        # the neighbours: a fresh priority each (counting only the contracted neighbour
+        # and leaving the rest to the lazy updates cuts random 20%'s scans from 947 to
+        # 181 million, but Boston_0_256's queries were 10-30% slower: kept)
+        for i in range(d):
             u = nb[i]
             n = ln[u]
             su, sw, sd = _grow(su, n * n), _grow(sw, n * n), _grow(sd, n * n)
-            c2, stamp, w = _shortcuts(u, st, ln, to, wt, wd, wstamp, whop, tmark, tvia, stamp,
-                                   hk, hn, sim_hops, sim_settle, su, sw, sd)
+            c2, stamp, w = _shortcuts(u, st, ln, to, wt, dm, free, unpruned, wd, wstamp, whop,
+                                      tmark, tvia, stamp, hk, hn, sim_hops, sim_settle, su,
+                                      sw, sd)
             work += w
             prio[u] = c2 - n + deleted[u]
             qk, qn = _grow(qk, qs + 1), _grow(qn, qs + 1)
@@ -321,32 +352,31 @@ def contract(m, offs, nbr, length, hops, settle, sim_hops, sim_settle, core, bud
     return uo, un, uw, um, rank, work
 
 
-def hierarchy(cells: np.ndarray, offs: np.ndarray, nbr: np.ndarray, Wp: int,
-              core: int) -> dict | None:
+def hierarchy(blk: np.ndarray, cells: np.ndarray, offs: np.ndarray, nbr: np.ndarray,
+              Wp: int, core: int) -> dict | None:
     """The index arrays of a hierarchy over a subgoal graph, contracted down to ``core``
     nodes: the upward graph ``ch_offs``, ``ch_nbr``, ``ch_len``, ``ch_mid`` (see
     :func:`contract`), ``ch_core`` (each node's core number, -1 if contracted) and the
-    core's all-pairs ``ch_dist`` (float64) and ``ch_pred`` (int16), from scipy. None when
+    core's all-pairs ``ch_dist`` (float64) and ``ch_pred`` (int16). None when
     the contraction would scan more than BUDGET edges (dense graphs: the build would take
     too long), or without trying when nodes x mean degree squared exceeds DENSE."""
-    # imported here: answering from a saved index needs no scipy
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import dijkstra
-
     if nbr.size ** 2 > DENSE * max(cells.size, 1):
         return None
     length = edge_lengths(cells, offs, nbr, Wp)
-    uo, un, uw, um, rank, _ = contract(cells.size, offs, nbr, length, HOPS, SETTLE,
-                                    SIM_HOPS, SIM_SETTLE, core, BUDGET)
+    fwd, back = edge_first_steps(blk, Wp, cells, offs, nbr)
+    uo, un, uw, um, rank, _ = contract(cells.size, offs, nbr, length, fwd, back,
+                                       free_around(cells, blk, Wp), SHORTEN, HOPS, SETTLE,
+                                       SIM_HOPS, SIM_SETTLE, core, BUDGET)
     if uo.size == 0:
         return None
     cnodes = np.flatnonzero(rank < 0)
     k = cnodes.size
     cid = np.full(rank.size, -1, np.int32)
     cid[cnodes] = np.arange(k, dtype=np.int32)
-    src = np.repeat(np.arange(k), uo[cnodes + 1] - uo[cnodes])
+    # the core's own graph (each core node's edges lead to core nodes) and its table
+    coffs = np.zeros(k + 1, np.int64)
+    coffs[1:] = np.cumsum(uo[cnodes + 1] - uo[cnodes])
     idx = np.concatenate([np.arange(uo[v], uo[v + 1]) for v in cnodes] + [[]]).astype(int)
-    graph = csr_matrix((uw[idx], (src, cid[un[idx]])), shape=(k, k))
-    dist, pred = dijkstra(graph, return_predecessors=True)
+    dist, pred = all_pairs(coffs, cid[un[idx]], uw[idx])
     return {"ch_offs": uo, "ch_nbr": un, "ch_len": uw, "ch_mid": um, "ch_core": cid,
-            "ch_dist": dist, "ch_pred": np.where(pred < 0, -1, pred).astype(np.int16)}
+            "ch_dist": dist, "ch_pred": pred}

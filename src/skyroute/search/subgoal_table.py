@@ -87,3 +87,62 @@ def table_query(blk, sg, clr, label, cells, dist, pred, ws, Wp, s, t):
     hops[:n] = hops[:n][::-1].copy()
     path, cost = _path(blk, hops, n, Wp)
     return FOUND, path, cost, ns * ng, 0
+
+
+@njit(cache=True)
+def all_pairs(offs, nbr, length):
+    """(dist (n, n) float64, pred (n, n) int16) of a CSR graph with n <= 32767 nodes, by
+    a compiled Dijkstra from every node (-1: no predecessor), its heap indexed (a node
+    moves up when its distance drops: at most n entries)."""
+    n = offs.size - 1
+    dist = np.full((n, n), np.inf)
+    pred = np.full((n, n), -1, np.int16)
+    hk = np.empty(n)
+    hn = np.empty(n, np.int64)
+    pos = np.full(n, -1, np.int64)  # heap slot, -1 outside, -2 settled (per source)
+    for s in range(n):
+        d, p = dist[s], pred[s]
+        pos[:] = -1
+        d[s] = 0.0
+        hk[0], hn[0], pos[s] = 0.0, s, 0
+        size = 1
+        while size > 0:
+            u, k = hn[0], hk[0]
+            pos[u] = -2
+            size -= 1
+            if size > 0:  # the last entry sifts down from the top
+                lk, lv = hk[size], hn[size]
+                i = 0
+                while True:
+                    b = 2 * i + 1
+                    if b >= size:
+                        break
+                    if b + 1 < size and hk[b + 1] < hk[b]:
+                        b += 1
+                    if hk[b] >= lk:
+                        break
+                    hk[i], hn[i] = hk[b], hn[b]
+                    pos[hn[i]] = i
+                    i = b
+                hk[i], hn[i] = lk, lv
+                pos[lv] = i
+            for j in range(offs[u], offs[u + 1]):
+                v = nbr[j]
+                nd = k + length[j]
+                if nd >= d[v]:
+                    continue
+                d[v], p[v] = nd, u
+                i = pos[v]
+                if i < 0:
+                    i = size
+                    size += 1
+                while i > 0:  # sift up
+                    q = (i - 1) >> 1
+                    if hk[q] <= nd:
+                        break
+                    hk[i], hn[i] = hk[q], hn[q]
+                    pos[hn[i]] = i
+                    i = q
+                hk[i], hn[i] = nd, v
+                pos[v] = i
+    return dist, pred
