@@ -33,6 +33,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from skyroute.search.heap import pop_plain, push_plain
 from skyroute.search.subgoal_landmarks import edge_lengths
 from skyroute.search.subgoal_table import all_pairs
 from skyroute.search.subgoal_taut import edge_first_steps, free_around, shorten_table
@@ -52,42 +53,6 @@ DENSE = 1_500_000
 HEAP_CAP = 1 << 14  # witness heap entries; a search that would need more gives up
 SHORTEN = shorten_table()
 EPS = 1e-9  # a witness this much longer still counts (lengths a + b sqrt2 differ by far more)
-
-
-@njit(cache=True, inline="always")
-def _hpush(hk, hn, size, k, node):
-    """Lazy binary heap push (float keys, smallest first); return the new size."""
-    i = size
-    while i > 0:
-        p = (i - 1) >> 1
-        if hk[p] <= k:
-            break
-        hk[i], hn[i] = hk[p], hn[p]
-        i = p
-    hk[i], hn[i] = k, node
-    return size + 1
-
-
-@njit(cache=True, inline="always")
-def _hpop(hk, hn, size):
-    """Remove the smallest entry; return (key, node, new size)."""
-    k0, top = hk[0], hn[0]
-    size -= 1
-    if size > 0:
-        k, node = hk[size], hn[size]
-        i = 0
-        while True:
-            b = 2 * i + 1
-            if b >= size:
-                break
-            if b + 1 < size and hk[b + 1] < hk[b]:
-                b += 1
-            if hk[b] >= k:
-                break
-            hk[i], hn[i] = hk[b], hn[b]
-            i = b
-        hk[i], hn[i] = k, node
-    return k0, top, size
 
 
 @njit(cache=True)
@@ -122,10 +87,13 @@ def _shortcuts(v, st, ln, to, wt, dm, free, table, wd, wstamp, whop, tmark, tvia
             continue
         wd[u], wstamp[u], whop[u] = 0.0, stamp, 0
         wd[v], wstamp[v] = -1.0, stamp  # v is no way through: "seen" shorter than any
-        size = _hpush(hk, hn, 0, 0.0, u)
+        push_plain(hk, hn, 0, 0.0, u)
+        size = 1
         settled = 0
         while size > 0 and left > 0:
-            k, x, size = _hpop(hk, hn, size)
+            k = hk[0]
+            x = pop_plain(hk, hn, size)
+            size = size - 1
             if k > wd[x]:
                 continue  # outdated entry
             if k > bound:
@@ -147,7 +115,8 @@ def _shortcuts(v, st, ln, to, wt, dm, free, table, wd, wstamp, whop, tmark, tvia
                     tmark[y] = 0  # witnessed
                     left -= 1
                 if hx < hops and size < hk.size:  # a node at the hop limit is not
-                    size = _hpush(hk, hn, size, nd, y)  # expanded: needs no entry
+                    push_plain(hk, hn, size, nd, y)  # expanded: needs no entry
+                    size = size + 1
         for j in range(i + 1, d):
             w = to[s0 + j]
             if tmark[w] != stamp:
@@ -247,13 +216,16 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
                                      tmark, tvia, stamp, hk, hn, sim_hops, sim_settle, su, sw, sd)
         work += w
         prio[v] = count - ln[v]
-        qs = _hpush(qk, qn, qs, prio[v], v)
+        push_plain(qk, qn, qs, prio[v], v)
+        qs = qs + 1
     order = 0
     while qs > 0 and order < m - core:
         if work > budget:
             e0 = np.empty(0, np.int64)
             return e0, np.empty(0, np.int32), np.empty(0), np.empty(0, np.int32), e0, work
-        k, v, qs = _hpop(qk, qn, qs)
+        k = qk[0]
+        v = pop_plain(qk, qn, qs)
+        qs = qs - 1
         if rank[v] >= 0 or k != prio[v]:
             continue
         d = ln[v]
@@ -265,7 +237,8 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
         if qs > 0 and p > qk[0]:
             prio[v] = p  # no longer the smallest: back into the queue
             qk, qn = _grow(qk, qs + 1), _grow(qn, qs + 1)
-            qs = _hpush(qk, qn, qs, p, v)
+            push_plain(qk, qn, qs, p, v)
+            qs = qs + 1
             continue
         # contract v: its edges become its upward edges and leave its neighbours' lists
         rank[v] = order
@@ -328,7 +301,8 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
             work += w
             prio[u] = c2 - n + deleted[u]
             qk, qn = _grow(qk, qs + 1), _grow(qn, qs + 1)
-            qs = _hpush(qk, qn, qs, prio[u], u)
+            push_plain(qk, qn, qs, prio[u], u)
+            qs = qs + 1
     # the core: nodes left uncontracted keep their edges among themselves
     for v in range(m):
         if rank[v] < 0:
