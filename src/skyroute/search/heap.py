@@ -168,3 +168,43 @@ def grow_zeroed(a, n):
     b = np.zeros(max(2 * a.shape[0], n), a.dtype)
     b[:a.shape[0]] = a
     return b
+
+
+@njit(cache=True, inline="always")
+def indexed_up(hk, hn, pos, i, k, v):
+    """Indexed binary heap (float keys ``hk``, nodes ``hn``, each node's slot in ``pos``):
+    move entry (k, v), to be written at slot i, up to its place."""
+    while i > 0:
+        p = (i - 1) >> 1
+        if hk[p] <= k:
+            break
+        hk[i], hn[i] = hk[p], hn[p]
+        pos[hn[i]] = i
+        i = p
+    hk[i], hn[i] = k, v
+    pos[v] = i
+
+
+@njit(cache=True, inline="always")
+def indexed_pop(hk, hn, pos, size):
+    """Remove the first entry of an indexed heap (see :func:`indexed_up`); return (its
+    node, the new size). The removed node's ``pos`` is left for the caller."""
+    top = hn[0]
+    size -= 1
+    if size > 0:
+        k, v = hk[size], hn[size]
+        i = 0
+        while True:
+            b = 2 * i + 1
+            if b >= size:
+                break
+            if b + 1 < size and hk[b + 1] < hk[b]:
+                b += 1
+            if hk[b] >= k:
+                break
+            hk[i], hn[i] = hk[b], hn[b]
+            pos[hn[i]] = i
+            i = b
+        hk[i], hn[i] = k, v
+        pos[v] = i
+    return top, size

@@ -26,50 +26,13 @@ import numpy as np
 from numba import njit
 
 from skyroute.result import FOUND, NO_PATH
+from skyroute.search.heap import indexed_pop, indexed_up
 from skyroute.search.subgoal_build import direct_subgoals
 from skyroute.search.subgoal_query import _oct, _path, direct_answer
 
 STALL_EPS = 1e-9  # stall only on a strictly shorter way (float sums of equal paths differ)
 WS_ROWS = 12  # per side (0, 1): mark, parent, heap position, heap nodes; start, goal
 # lists; each side's core nodes reached
-
-
-@njit(cache=True, inline="always")
-def _up(hk, hn, pos, i, k, v):
-    """Move heap entry (k, v), to be written at slot i, up to its place."""
-    while i > 0:
-        p = (i - 1) >> 1
-        if hk[p] <= k:
-            break
-        hk[i], hn[i] = hk[p], hn[p]
-        pos[hn[i]] = i
-        i = p
-    hk[i], hn[i] = k, v
-    pos[v] = i
-
-
-@njit(cache=True, inline="always")
-def _pop(hk, hn, pos, size):
-    """Remove the first entry of the indexed heap; return (its node, new size)."""
-    top = hn[0]
-    size -= 1
-    if size > 0:
-        k, v = hk[size], hn[size]
-        i = 0
-        while True:
-            b = 2 * i + 1
-            if b >= size:
-                break
-            if b + 1 < size and hk[b + 1] < hk[b]:
-                b += 1
-            if hk[b] >= k:
-                break
-            hk[i], hn[i] = hk[b], hn[b]
-            pos[hn[i]] = i
-            i = b
-        hk[i], hn[i] = k, v
-        pos[v] = i
-    return top, size
 
 
 @njit(cache=True, inline="always")
@@ -155,10 +118,10 @@ def ch_query(blk, sg, clr, label, cells, uo, un, uw, um, cid, cnodes, dtab, ptab
                 if d >= g[v]:
                     continue
                 g[v] = d
-                _up(k, hn, pos, pos[v], d, v)
+                indexed_up(k, hn, pos, pos[v], d, v)
             else:
                 mark[v], g[v], par[v] = seen, d, -1
-                _up(k, hn, pos, size, d, v)
+                indexed_up(k, hn, pos, size, d, v)
                 size += 1
         sizes[side] = size
     best, meet = math.inf, -1
@@ -175,7 +138,7 @@ def ch_query(blk, sg, clr, label, cells, uo, un, uw, um, cid, cnodes, dtab, ptab
         mark, par, pos, hn, g, k = ws[4 * side], ws[4 * side + 1], ws[4 * side + 2], \
             ws[4 * side + 3], gs[side], hk[side]
         omark, og = ws[4 - 4 * side], gs[1 - side]
-        u, sizes[side] = _pop(k, hn, pos, sizes[side])
+        u, sizes[side] = indexed_pop(k, hn, pos, sizes[side])
         mark[u] = closed
         gu = g[u]
         if omark[u] >= seen and gu + og[u] < best:
@@ -204,10 +167,10 @@ def ch_query(blk, sg, clr, label, cells, uo, un, uw, um, cid, cnodes, dtab, ptab
                 if d >= g[w]:
                     continue
                 g[w], par[w] = d, j
-                _up(k, hn, pos, pos[w], d, w)
+                indexed_up(k, hn, pos, pos[w], d, w)
             else:
                 mark[w], g[w], par[w] = seen, d, j
-                _up(k, hn, pos, size, d, w)
+                indexed_up(k, hn, pos, size, d, w)
                 size += 1
         sizes[side] = size
         frontier = max(frontier, sizes[0] + sizes[1])

@@ -16,6 +16,7 @@ import numpy as np
 from numba import njit
 
 from skyroute.result import FOUND, NO_PATH
+from skyroute.search.heap import indexed_pop, indexed_up
 from skyroute.search.subgoal_build import direct_subgoals
 from skyroute.search.subgoal_landmarks import edge_lengths
 from skyroute.search.subgoal_query import _oct, _path, direct_answer
@@ -109,23 +110,7 @@ def all_pairs(offs, nbr, length):
         while size > 0:
             u, k = hn[0], hk[0]
             pos[u] = -2
-            size -= 1
-            if size > 0:  # the last entry sifts down from the top
-                lk, lv = hk[size], hn[size]
-                i = 0
-                while True:
-                    b = 2 * i + 1
-                    if b >= size:
-                        break
-                    if b + 1 < size and hk[b + 1] < hk[b]:
-                        b += 1
-                    if hk[b] >= lk:
-                        break
-                    hk[i], hn[i] = hk[b], hn[b]
-                    pos[hn[i]] = i
-                    i = b
-                hk[i], hn[i] = lk, lv
-                pos[lv] = i
+            u, size = indexed_pop(hk, hn, pos, size)
             for j in range(offs[u], offs[u + 1]):
                 v = nbr[j]
                 nd = k + length[j]
@@ -136,13 +121,5 @@ def all_pairs(offs, nbr, length):
                 if i < 0:
                     i = size
                     size += 1
-                while i > 0:  # sift up
-                    q = (i - 1) >> 1
-                    if hk[q] <= nd:
-                        break
-                    hk[i], hn[i] = hk[q], hn[q]
-                    pos[hn[i]] = i
-                    i = q
-                hk[i], hn[i] = nd, v
-                pos[v] = i
+                indexed_up(hk, hn, pos, i, nd, v)
     return dist, pred
