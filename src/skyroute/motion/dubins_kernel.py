@@ -104,70 +104,55 @@ def shortest_length(sx, sy, sth, gx, gy, gth, r):
     """Length of the shortest Dubins path (metres): :func:`words` without its arrays
     (the search calls this for every node it generates, the batch for every query).
 
-    The same closed forms with less trigonometry. They are written in the frame of the
-    bearing phi from start to goal (a = sth - phi, b = gth - phi); here phi is never
-    formed: its cosine and sine are dx / |g - s| and dy / |g - s|, sin a and cos a come
-    from the start heading's by the angle-difference formulas, and each tangent angle is
-    one atan2 of its vector turned back by phi, so that arcs are differences of world
-    headings (t - a = (t + phi) - sth). That saves one atan2 of five. Also: cos(a - b)
-    from the sines and cosines at hand (as OMPL does), the two atan2 of LSR and RSL as
-    one atan2 of their angle difference (only its value modulo 2 pi matters), LSL's and
-    RSR's tangent angles shared with the CCC words. Equal to the six words of
-    :func:`words` to ~1e-14 (tests).
+    The same closed forms with less trigonometry: cos(a - b) from the sines and cosines
+    at hand (as OMPL does), the two atan2 of LSR and RSL as one atan2 of their angle
+    difference (only its value modulo 2 pi matters), LSL's and RSR's tangent angles
+    shared with the CCC words. Equal to the six words of :func:`words` to ~1e-14 (tests).
     """
     dx, dy = gx - sx, gy - sy
-    e = math.sqrt(dx * dx + dy * dy)
-    d = e / r
-    if e > 0.0:
-        cf, sf = dx / e, dy / e  # cos and sin of the bearing phi
-    else:
-        cf, sf = 1.0, 0.0  # atan2(0, 0) = 0
-    if d == 0.0 and _m2p(sth - gth) < 1e-12:
+    d = math.sqrt(dx * dx + dy * dy) / r
+    phi = math.atan2(dy, dx)
+    a = _m2p(sth - phi)
+    b = _m2p(gth - phi)
+    if d == 0.0 and _m2p(a - b) < 1e-12:
         # the goal is the start pose: cab below would round to 1 - ulp and drop the
         # zero-length LSR word, leaving only full circles (OMPL special-cases it too)
         return 0.0
-    ss, cs, sg, cg = math.sin(sth), math.cos(sth), math.sin(gth), math.cos(gth)
-    sa, ca = ss * cf - cs * sf, cs * cf + ss * sf  # sin and cos of a = sth - phi
-    sb, cb = sg * cf - cg * sf, cg * cf + sg * sf
+    sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
     cab = ca * cb + sa * sb
     dd = d * d
-    # tangent angles t + phi: atan2 of (x, y) turned by phi
-    y, x = cb - ca, d + sa - sb
-    t_lsl = math.atan2(x * sf + y * cf, x * cf - y * sf)
-    y, x = ca - cb, d - sa + sb
-    t_rsr = math.atan2(x * sf + y * cf, x * cf - y * sf)
+    t_lsl = math.atan2(cb - ca, d + sa - sb)
+    t_rsr = math.atan2(ca - cb, d - sa + sb)
     best = math.inf
     p2 = 2 + dd - 2 * cab + 2 * d * (sa - sb)  # LSL
     if p2 >= 0:
-        best = min(best, _m2p(t_lsl - sth) + math.sqrt(p2) + _m2p(gth - t_lsl))
+        best = min(best, _m2p(t_lsl - a) + math.sqrt(p2) + _m2p(b - t_lsl))
     p2 = 2 + dd - 2 * cab + 2 * d * (sb - sa)  # RSR
     if p2 >= 0:
-        best = min(best, _m2p(sth - t_rsr) + math.sqrt(p2) + _m2p(t_rsr - gth))
+        best = min(best, _m2p(a - t_rsr) + math.sqrt(p2) + _m2p(t_rsr - b))
     p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
     if p2 >= 0:
         p = math.sqrt(p2)
         # atan2(y, x) - atan2(-2, p), as one atan2 (angle difference, modulo 2 pi)
         y, x = -ca - cb, d + sa + sb
-        y, x = y * p + 2 * x, x * p - 2 * y
-        tmp = math.atan2(x * sf + y * cf, x * cf - y * sf)
-        best = min(best, _m2p(tmp - sth) + p + _m2p(tmp - gth))
+        tmp = math.atan2(y * p + 2 * x, x * p - 2 * y)
+        best = min(best, _m2p(tmp - a) + p + _m2p(tmp - b))
     p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
     if p2 >= 0:
         p = math.sqrt(p2)
         y, x = ca + cb, d - sa - sb  # atan2(y, x) - atan2(2, p)
-        y, x = y * p - 2 * x, x * p + 2 * y
-        tmp = math.atan2(x * sf + y * cf, x * cf - y * sf)
-        best = min(best, _m2p(sth - tmp) + p + _m2p(gth - tmp))
+        tmp = math.atan2(y * p - 2 * x, x * p + 2 * y)
+        best = min(best, _m2p(a - tmp) + p + _m2p(b - tmp))
     c = (6.0 - dd + 2 * cab + 2 * d * (sa - sb)) / 8.0  # RLR
     if abs(c) <= 1:
         p = _m2p(TWO_PI - math.acos(c))
-        t = _m2p(sth - t_rsr + p / 2)
-        best = min(best, t + p + _m2p(sth - gth - t + p))
+        t = _m2p(a - t_rsr + p / 2)
+        best = min(best, t + p + _m2p(a - b - t + p))
     c = (6.0 - dd + 2 * cab + 2 * d * (sb - sa)) / 8.0  # LRL
     if abs(c) <= 1:
         p = _m2p(TWO_PI - math.acos(c))
-        t = _m2p(t_lsl - sth + p / 2)
-        best = min(best, t + p + _m2p(gth - sth - t + p))
+        t = _m2p(-a + t_lsl + p / 2)
+        best = min(best, t + p + _m2p(_m2p(b) - a - t + p))
     return best * r
 
 
