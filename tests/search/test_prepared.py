@@ -94,7 +94,7 @@ def _forced(blocked, table_max, budget):
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(subgoal_table, "TABLE_MAX", table_max)
         mp.setattr(subgoal_contract, "BUDGET", budget)
-        return skyroute.prepare(skyroute.Grid(blocked))
+        return skyroute.prepare(skyroute.Grid(blocked), method="subgoal")
 
 
 def _check_against_dijkstra(index, blocked, s, t):

@@ -96,8 +96,9 @@ def _prepared(grid: Grid, info: dict) -> Callable:
     index = prepare(grid)  # first build: loads the compiled kernels from numba's cache
     index = prepare(grid)
     info.update(build_seconds=index.build_seconds, index_bytes=index.nbytes,
-                subgoals=index.subgoals, edges=index.edges,
-                accelerator=index.accelerator)
+                subgoals=index.subgoals, edges=index.edges, pivots=index.pivots,
+                accelerator=index.accelerator, index=index.describe(),
+                candidates_us={k: v * 1e6 for k, v in index.candidates.items()})
 
     def run(s, t):
         r = index.plan(s, t)

@@ -94,8 +94,8 @@ def _fmt(v, spec):
 def _table(rep: dict, peers: list[str]) -> Table:
     prep = rep.get("prepared")
     caption = (f"prepared: built in {prep['build_seconds']:.3f} s, "
-               f"{prep['index_bytes'] / 1e6:.1f} MB (arrays' nbytes), {prep['subgoals']} "
-               f"subgoals, {prep['edges']} edges, {prep['accelerator']}" if prep else None)
+               f"{prep['index_bytes'] / 1e6:.1f} MB (arrays' nbytes), {prep['index']}"
+               if prep else None)
     t = Table(title=f"{rep['map']} ({rep['size'][0]}x{rep['size'][1]}): "
                     f"{rep['queries']} of {rep['scen_lines']} scenario lines", caption=caption)
     for col in ("runner", "median ms", "M exp/s", "matched", "cost/opt mean", "cost/opt max"):

@@ -97,7 +97,9 @@ def prepare_command(
         "A grid map file (as for 'skyroute plan') or the name of a bundled map."))],
     out: Annotated[Path, typer.Option("-o", "--out", help="Write the index here (.npz "
                                       "format), e.g. MAP.idx.")],
-    method: Annotated[str, typer.Option(help="Index kind: subgoal.")] = "subgoal",
+    method: Annotated[str, typer.Option(
+        help="Index kind: auto (the faster of the two on sample queries), subgoal or "
+             "jump.")] = "auto",
     safety: Annotated[float, typer.Option(
         help="Block cells within this many metres of an obstacle (as for plan).")] = 0.0,
     resolution: Annotated[float, typer.Option(
@@ -109,6 +111,5 @@ def prepare_command(
     grid = load_map(map_file, resolution=resolution, safety=safety)
     index = prepare(grid, method=method)
     written = index.save(out)
-    Console().print(f"{grid.name}: {index.method} index, {index.subgoals} subgoals, "
-                    f"{index.edges} edges, built in {index.build_seconds:.3f} s, "
+    Console().print(f"{grid.name}: {index.describe()}, built in {index.build_seconds:.3f} s, "
                     f"{written.stat().st_size / 1e6:.2f} MB -> {written}")

@@ -14,7 +14,7 @@ from skyroute.result import STATUS_OF_CODE, PlanResult, Status
 from skyroute.search.astar import astar_kernel
 from skyroute.search.bfs import bfs_kernel
 from skyroute.search.canonical import CANONICAL, EVERY
-from skyroute.search.jps import jps_kernel
+from skyroute.search.jps import NO_PIVOTS, jps_kernel
 from skyroute.search.moves import HEURISTICS
 from skyroute.search.prune import PRUNE_MODES, prune_collinear, prune_los
 from skyroute.search.space import SearchSpace, space_of, to_cells
@@ -144,7 +144,8 @@ def _search(space: SearchSpace, s: int, t: int, o: GridOptions):
     elif o.algorithm == "jps":
         code, exp, front, flat = jps_kernel(space.move_mask(8, False), CANONICAL,
                                             space.jump_table(), Wp, s, t,
-                                            o.max_expansions, floats, ints, keys)
+                                            o.max_expansions, floats, ints, keys,
+                                            NO_PIVOTS)
     else:
         mask = space.move_mask(o.connectivity, o.corner_cutting)
         hkind = HEURISTICS[o.heuristic]

@@ -28,6 +28,8 @@ from skyroute.search.canonical import LOWEST, START
 from skyroute.search.moves import MDX, MDY, h_of, offsets, xy
 from skyroute.search.trace import trace
 
+NO_PIVOTS = np.empty((0, 0))  # online JPS: the octile heuristic alone
+
 # Straight directions: 0 east (+x), 1 west (-x), 2 south (+y), 3 north (-y), as moves 0-3.
 
 
@@ -85,14 +87,16 @@ def _sign(v):
 
 
 @njit(cache=True)
-def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints, keys):
+def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints, keys, piv):
     """Search from flat ``start`` to ``goal``.
 
     ``mask``: the 8-connected, no-corner-cutting move mask; ``succ``: the canonical
     successor table (:mod:`skyroute.search.canonical`, the same pruning rules); ``table``:
     :func:`jump_tables`. Returns (status, expanded, max_frontier, path) with ``path``
     every flat cell. floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`
-    (its ``state`` row all zeros on entry and on return).
+    (its ``state`` row all zeros on entry and on return). ``piv``: (cells, P) distances
+    from P pivots (:mod:`skyroute.search.pivots`) whose differential bounds sharpen the
+    octile heuristic; (0, 0) for the octile distance alone.
 
     An expansion first lists its jump points (cell, x, y, entering move) in ``found``,
     then relaxes them in one loop. The heap is the A* kernel's 4-ary one, written out:
@@ -105,6 +109,10 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
     offs = offsets(Wp)
     inv = 1.0 / Wp
     gx, gy = xy(goal, Wp, inv)
+    npiv = piv.shape[1]
+    dt = np.empty(npiv)  # the goal's pivot distances
+    for p in range(npiv):
+        dt[p] = piv[goal, p]
     found = np.empty((8 * (Wp + len(mask) // Wp) + 8, 4), np.int64)
     g[start] = 0.0
     parent[start] = start
@@ -226,7 +234,12 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
             entered[n] = found[q, 3]
             if st == ON_LEVEL:  # an equal cost by another float sum: already queued
                 continue
-            key = heap.key(gn + h_of(1, abs(nx - gx), abs(ny - gy)), gn)
+            hn = h_of(1, abs(nx - gx), abs(ny - gy))
+            for p in range(npiv):  # differential bounds (NaN, never larger, off region)
+                bound = abs(piv[n, p] - dt[p])
+                if bound > hn:
+                    hn = bound
+            key = heap.key(gn + hn, gn)
             if st == 0:
                 if key >> heap.TIE_BITS == cf:
                     level[nl] = n

@@ -20,6 +20,9 @@ import numpy as np
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search import subgoal_table
+from skyroute.search.canonical import CANONICAL
+from skyroute.search.pivots import jump_query, pivot_distances
+from skyroute.search.space import space_of, workspace
 from skyroute.search.subgoal_build import clearances, link, subgoal_ids
 from skyroute.search.subgoal_ch_query import WS_ROWS as CH_WS_ROWS
 from skyroute.search.subgoal_ch_query import ch_query
@@ -29,10 +32,13 @@ from skyroute.search.subgoal_query import WS_ROWS, heap_capacity, subgoal_query
 from skyroute.search.subgoal_table import distance_table, table_query
 from skyroute.world.grid import Grid, check_cell
 
-METHODS = ("subgoal",)
+METHODS = ("auto", "subgoal", "jump")
 FORMAT_VERSION = 3
 CH_ARRAYS = ("ch_offs", "ch_nbr", "ch_len", "ch_mid", "ch_core", "ch_dist", "ch_pred")
-INDEX_ARRAYS = ("cells", "clr", "offs", "nbr", "label", "lmd", "dist", "pred", *CH_ARRAYS)
+INDEX_ARRAYS = {"subgoal": ("cells", "clr", "offs", "nbr", "label", "lmd", "dist", "pred",
+                            *CH_ARRAYS),
+                "jump": ("label", "piv")}
+SAMPLE = 32  # query pairs that "auto" times each candidate index on
 NO_HIERARCHY = {"ch_offs": np.empty(0, np.int64), "ch_nbr": np.empty(0, np.int32),
                 "ch_len": np.empty(0), "ch_mid": np.empty(0, np.int32),
                 "ch_core": np.empty(0, np.int32), "ch_dist": np.empty((0, 0)),
@@ -48,24 +54,37 @@ def grid_digest(blocked: np.ndarray) -> str:
 
 
 class PreparedGrid:
-    """A grid with its subgoal graph: ``plan(start, goal)`` answers exact octile queries.
+    """A grid with its index: ``plan(start, goal)`` answers exact octile queries.
 
-    ``build_seconds`` is how long :func:`prepare` took (0 for a loaded index); ``nbytes``
-    counts the index arrays and the query workspace; ``accelerator`` names what answers
-    on the graph: "table" (<= 2048 subgoals), "hierarchy" (a contraction hierarchy with
-    a table for its core) or "landmarks" (A* with landmark bounds, for graphs too dense
-    to contract in time).
+    ``method`` is the index kind: "subgoal" (a subgoal graph) or "jump" (JPS with the
+    differential bounds of 16 pivots). ``build_seconds`` is how long :func:`prepare`
+    took (0 for a loaded index); ``nbytes`` counts the index arrays and the query
+    workspace; ``accelerator`` names what answers: for a subgoal graph "table" (<= 2048
+    subgoals), "hierarchy" (a contraction hierarchy with a table for its core) or
+    "landmarks" (A* with landmark bounds, for graphs too dense to contract in time); for
+    the other kind "jump". ``candidates`` holds what :func:`prepare`'s "auto" measured
+    (seconds per sample query of each kind), empty when it did not choose.
     """
 
     def __init__(self, grid: Grid, arrays: dict, *, method: str = "subgoal",
                  build_seconds: float = 0.0) -> None:
         self.grid, self.method, self.build_seconds = grid, method, build_seconds
+        self.candidates: dict[str, float] = {}
         self.width, self.height = grid.width, grid.height
         self.Wp = grid.width + 2
         padded = np.ones((grid.height + 2, grid.width + 2), np.uint8)
         padded[1:-1, 1:-1] = grid.blocked
         self._blk = padded.ravel()
         self._arrays = arrays
+        if method == "jump":
+            space = space_of(grid)
+            self.accelerator = "jump"
+            self._kernel = jump_query
+            self._args = (space.move_mask(8, False), CANONICAL, space.jump_table(),
+                          arrays["label"], arrays["piv"], *workspace(self._blk.size),
+                          self.Wp)
+            self._call = entry_point(self._kernel, self._args)
+            return
         cells = arrays["cells"]
         sg = np.full(self._blk.size, -1, np.int32)
         sg[cells] = np.arange(cells.size, dtype=np.int32)
@@ -100,13 +119,25 @@ class PreparedGrid:
 
     @property
     def subgoals(self) -> int:
-        """How many subgoals (graph nodes) the index holds."""
-        return int(self._arrays["cells"].size)
+        """How many subgoals (graph nodes) the index holds (0 for a "jump" index)."""
+        return int(self._arrays["cells"].size) if "cells" in self._arrays else 0
 
     @property
     def edges(self) -> int:
-        """How many directed edges the graph holds."""
-        return int(self._arrays["nbr"].size)
+        """How many directed edges the graph holds (0 for a "jump" index)."""
+        return int(self._arrays["nbr"].size) if "nbr" in self._arrays else 0
+
+    @property
+    def pivots(self) -> int:
+        """How many pivots bound a "jump" index's heuristic (0 for a subgoal graph)."""
+        return int(self._arrays["piv"].shape[1]) if "piv" in self._arrays else 0
+
+    def describe(self) -> str:
+        """One line: the index kind and its size."""
+        if self.method == "jump":
+            return f"jump index, {self.pivots} pivots"
+        return (f"subgoal index ({self.accelerator}), {self.subgoals} subgoals, "
+                f"{self.edges} edges")
 
     @property
     def nbytes(self) -> int:
@@ -158,7 +189,7 @@ class PreparedGrid:
                 "digest": np.array(grid_digest(self.grid.blocked))}
         tmp = path.with_name(path.name + ".tmp")
         with open(tmp, "wb") as f:
-            np.savez(f, **meta, **{k: self._arrays[k] for k in INDEX_ARRAYS})
+            np.savez(f, **meta, **{k: self._arrays[k] for k in INDEX_ARRAYS[self.method]})
         tmp.replace(path)
         return path
 
@@ -186,10 +217,23 @@ def z_order(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return spread(x) | (spread(y) << np.uint64(1))
 
 
-def build_arrays(blocked: np.ndarray) -> dict:
-    """The subgoal graph's arrays for a (H, W) blocked array (see subgoal_build)."""
+def region_labels(blocked: np.ndarray) -> np.ndarray:
+    """Each padded flat cell's free region (-1 blocked) for a (H, W) blocked array."""
     from scipy import ndimage  # imported here: a plain 'skyroute plan' must not pay for it
 
+    padded = np.ones((blocked.shape[0] + 2, blocked.shape[1] + 2), np.uint8)
+    padded[1:-1, 1:-1] = blocked
+    # Without corner cutting a diagonal step needs both side cells free, so the free
+    # regions under 8-connected moves are exactly the 4-connected ones.
+    lab, _ = ndimage.label(padded == 0)
+    return (lab.ravel() - 1).astype(np.int32)
+
+
+def build_arrays(blocked: np.ndarray, label: np.ndarray | None = None) -> dict:
+    """The subgoal graph's arrays for a (H, W) blocked array (see subgoal_build) and its
+    :func:`region_labels` (computed when not given)."""
+    if label is None:
+        label = region_labels(blocked)
     h, w = blocked.shape
     Wp = w + 2
     padded = np.ones((h + 2, w + 2), np.uint8)
@@ -202,10 +246,6 @@ def build_arrays(blocked: np.ndarray) -> dict:
     sg[cells] = np.arange(cells.size, dtype=np.int32)
     clr = clearances(blk, sg, Wp)
     offs, nbr = link(blk, sg, cells, clr, Wp)
-    # Without corner cutting a diagonal step needs both side cells free, so the free
-    # regions under 8-connected moves are exactly the 4-connected ones.
-    lab, _ = ndimage.label(padded == 0)
-    label = (lab.ravel() - 1).astype(np.int32)
     dist, pred = distance_table(cells, offs, nbr, Wp)
     # larger graphs: a hierarchy contracted down to a core the size of a table, unless
     # the graph is too dense to contract in time; then A* with landmarks
@@ -218,11 +258,37 @@ def build_arrays(blocked: np.ndarray) -> dict:
             "lmd": lmd, "dist": dist, "pred": pred, **(ch or NO_HIERARCHY)}
 
 
-def prepare(grid: Grid, *, method: str = "subgoal") -> PreparedGrid:
+def sample_pairs(label: np.ndarray, count: int = SAMPLE) -> np.ndarray:
+    """(count, 2) flat cell pairs drawn (seeded) from the largest free region."""
+    free = label >= 0
+    if not free.any():
+        return np.empty((0, 2), np.int64)
+    region = np.flatnonzero(label == np.argmax(np.bincount(label[free])))
+    return np.random.default_rng(0).choice(region, size=(count, 2))
+
+
+def per_query_seconds(index: PreparedGrid, pairs: np.ndarray, rounds: int = 3) -> float:
+    """The best of ``rounds`` mean times of ``index``'s compiled query over ``pairs``."""
+    call, args = index._call, index._args
+    best = np.inf
+    for _ in range(rounds):
+        t0 = time.perf_counter()
+        for s, t in pairs.tolist():
+            call(*args, s, t)
+        best = min(best, (time.perf_counter() - t0) / max(len(pairs), 1))
+    return best
+
+
+def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
     """Build a reusable index of ``grid`` for repeated exact queries.
 
     ``method`` "subgoal": a simple subgoal graph (Uras, Koenig & Hernandez 2013) with
-    component labels; see docs/benchmarks.md section 12 for why this one.
+    component labels, answered by an all-pairs table, a contraction hierarchy or A*
+    with landmarks; "jump": JPS whose octile heuristic is sharpened by the exact
+    distances from 16 pivots (a differential heuristic: 128 bytes a cell); "auto" (the
+    default) builds the subgoal graph, keeps it when its table answers (small maps),
+    and otherwise builds both and keeps the one that answers 32 seeded sample queries
+    faster (``candidates`` holds the times). docs/benchmarks.md section 12 says why.
 
     Examples
     --------
@@ -238,8 +304,23 @@ def prepare(grid: Grid, *, method: str = "subgoal") -> PreparedGrid:
         raise OptionError(f"grid must be a skyroute Grid, got {type(grid).__name__}",
                           param="grid")
     t0 = time.perf_counter()
-    arrays = build_arrays(np.asarray(grid.blocked, dtype=bool))
-    return PreparedGrid(grid, arrays, method=method, build_seconds=time.perf_counter() - t0)
+    blocked = np.asarray(grid.blocked, dtype=bool)
+    label = region_labels(blocked)
+    built = []
+    if method != "jump":
+        built.append(PreparedGrid(grid, build_arrays(blocked, label), method="subgoal"))
+    if method == "jump" or (method == "auto" and built[0].accelerator != "table"):
+        space = space_of(grid)
+        piv = pivot_distances(space.move_mask(8, False), label, space.Wp)
+        built.append(PreparedGrid(grid, {"label": label, "piv": piv}, method="jump"))
+    index = built[0]
+    if len(built) > 1:  # auto: the faster on the same sample
+        pairs = sample_pairs(label)
+        times = {b.method: per_query_seconds(b, pairs) for b in built}
+        index = min(built, key=lambda b: times[b.method])
+        index.candidates = times
+    index.build_seconds = time.perf_counter() - t0
+    return index
 
 
 def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
@@ -254,7 +335,10 @@ def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
     except (OSError, ValueError, zipfile.BadZipFile):
         raise InputFormatError(path, "not a skyroute index (an .npz file written by "
                                "'skyroute prepare')") from None
-    missing = [k for k in ("version", "method", "shape", "digest", *INDEX_ARRAYS)
+    method = str(data["method"]) if "method" in data else ""
+    if method not in INDEX_ARRAYS:
+        raise InputFormatError(path, f"not a skyroute index: method {method!r}")
+    missing = [k for k in ("version", "shape", "digest", *INDEX_ARRAYS[method])
                if k not in data]
     if missing:
         raise InputFormatError(path, f"not a skyroute index: missing {', '.join(missing)}")
@@ -268,6 +352,4 @@ def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
     if str(data["digest"]) != grid_digest(grid.blocked):
         raise InputFormatError(path, f"index is stale or for another map: {grid.name}'s "
                                "blocked cells differ; rebuild it with 'skyroute prepare'")
-    method = str(data["method"])
-    check_choice("method", method, METHODS)
-    return PreparedGrid(grid, {k: data[k] for k in INDEX_ARRAYS}, method=method)
+    return PreparedGrid(grid, {k: data[k] for k in INDEX_ARRAYS[method]}, method=method)

@@ -86,11 +86,16 @@ class SearchSpace:
         it touched (listed in ``ints[2]``) before it returns, so no query pays for the grid.
         """
         if self._ws is None:
-            n = self.n
-            ints = np.empty((6, n), np.int32)
-            ints[1] = 0
-            self._ws = (np.empty((2, n)), ints, np.empty(n, np.int64))
+            self._ws = workspace(self.n)
         return self._ws
+
+
+def workspace(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A fresh (floats, ints, keys) search workspace for n padded cells (see
+    :meth:`SearchSpace.workspace`), its ``state`` row zero."""
+    ints = np.empty((6, n), np.int32)
+    ints[1] = 0
+    return np.empty((2, n)), ints, np.empty(n, np.int64)
 
 
 @njit(cache=True)

@@ -1,0 +1,147 @@
+"""Prepared "jump" indexes (JPS with pivot bounds) and prepare's "auto" choice: exact
+optima against the MovingAI scenarios and Dijkstra, pivot distances against scipy, the
+.npz round trip and the CLI."""
+
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+
+import skyroute
+from skyroute.bench.random_maps import octile_graph
+from skyroute.cli.app import main
+from skyroute.search.pivots import pivot_distances
+from skyroute.search.prepared import region_labels
+from skyroute.search.space import space_of
+from skyroute.world.movingai import read_map, read_scen
+from tests.conftest import movingai_pairs
+from tests.search.checks import assert_grid_path_legal
+from tests.search.test_prepared import random_query
+
+PAIRS = movingai_pairs()
+
+
+def _check_lines(index, grid, scen, lines):
+    for i in lines:
+        s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
+        r = index.plan(s, t)
+        assert r.found, (grid.name, i)
+        assert scen.matches(int(i), r.cost), (grid.name, i, r.cost, scen.optimal[i])
+        assert tuple(r.path[0]) == s and tuple(r.path[-1]) == t
+        assert assert_grid_path_legal(grid.blocked, r.path) == pytest.approx(r.cost, abs=1e-9)
+
+
+@pytest.mark.parametrize("name", sorted(skyroute.bundled_maps()))
+def test_every_line_of_the_bundled_scenarios(name):
+    path = skyroute.bundled_maps()[name]
+    grid, scen = read_map(path), read_scen(path.with_name(path.name + ".scen"))
+    index = skyroute.prepare(grid, method="jump")
+    assert index.accelerator == "jump" and index.pivots == 16
+    _check_lines(index, grid, scen, range(len(scen)))
+
+
+@pytest.mark.shared_data
+@pytest.mark.parametrize("map_path, scen_path", PAIRS, ids=[m.stem for m, _ in PAIRS])
+def test_sampled_lines_of_the_shared_scenarios(map_path, scen_path):
+    grid, scen = read_map(map_path), read_scen(scen_path)
+    rng = np.random.default_rng(20261124)
+    lines = rng.choice(len(scen), size=min(40, len(scen)), replace=False)
+    _check_lines(skyroute.prepare(grid, method="jump"), grid, scen, [*lines, len(scen) - 1])
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_query())
+def test_jump_costs_equal_dijkstra(q):
+    # several free regions: pivots lie in the largest only, so queries elsewhere run on
+    # the octile bound alone (a pivot's distance there is inf, its bound NaN)
+    blocked, s, t = q
+    grid = skyroute.Grid(blocked)
+    want = skyroute.plan(grid, s, t, algorithm="dijkstra")
+    got = skyroute.prepare(grid, method="jump").plan(s, t)
+    assert got.status == want.status
+    if want.found:
+        assert got.cost == pytest.approx(want.cost, abs=1e-9)
+        assert assert_grid_path_legal(blocked, got.path) == pytest.approx(got.cost, abs=1e-9)
+        assert tuple(got.path[0]) == s and tuple(got.path[-1]) == t
+    else:
+        assert got.path.shape == (0, 2) and got.cost == np.inf and got.expanded == 0
+
+
+@pytest.mark.parametrize("share", [0.0, 0.2, 0.35])
+def test_pivot_distances_equal_scipy(share):
+    from scipy.sparse.csgraph import dijkstra
+
+    blocked = np.random.default_rng(11).random((40, 60)) < share
+    blocked[:, 30] = True  # two regions: pivots go to the larger
+    blocked[5:, 30] = share > 0.3  # the wall has a gap unless the map is dense
+    grid = skyroute.Grid(blocked)
+    space = space_of(grid)
+    label = region_labels(blocked)
+    piv = pivot_distances(space.move_mask(8, False), label, space.Wp, 6)
+    assert piv.shape == (space.n, 6)
+    h, w = blocked.shape
+    cells = np.arange(h * w)
+    flat = (cells // w + 1) * space.Wp + cells % w + 1  # unpadded -> padded
+    graph = octile_graph(blocked)
+    sources = [int(np.flatnonzero(piv[:, j] == 0)[0]) for j in range(6)]
+    assert len(set(sources)) == 6
+    largest = np.argmax(np.bincount(label[label >= 0]))
+    assert all(label[p] == largest for p in sources)
+    for j, p in enumerate(sources):
+        src = (p // space.Wp - 1) * w + p % space.Wp - 1
+        want = dijkstra(graph, directed=False, indices=src)
+        np.testing.assert_allclose(piv[flat, j], want, rtol=0, atol=1e-9)
+        assert np.isinf(piv[space.blocked == 1, j]).all()
+
+
+def test_auto_keeps_the_faster_and_the_table_without_timing(tmp_path):
+    small = skyroute.load_map("den312d")
+    index = skyroute.prepare(small)
+    assert index.method == "subgoal" and index.accelerator == "table"
+    assert index.candidates == {}
+    path = skyroute.bundled_maps()["Paris_1_512"]
+    grid, scen = read_map(path), read_scen(path.with_name(path.name + ".scen"))
+    index = skyroute.prepare(grid)
+    assert set(index.candidates) == {"subgoal", "jump"}
+    assert index.candidates[index.method] == min(index.candidates.values())
+    jump = skyroute.prepare(grid, method="jump")
+    loaded = skyroute.load_index(jump.save(tmp_path / "paris.idx"), grid)
+    assert loaded.method == "jump" and loaded.pivots == 16 and loaded.subgoals == 0
+    for i in (0, len(scen) // 2, len(scen) - 1):
+        s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
+        a, b = jump.plan(s, t), loaded.plan(s, t)
+        assert a.algorithm == b.algorithm == "jump"
+        assert a.cost == b.cost and np.array_equal(a.path, b.path)
+        assert scen.matches(i, a.cost)
+
+
+def test_a_foreign_method_in_an_index_is_refused(tmp_path):
+    grid = skyroute.load_map("den312d")
+    path = skyroute.prepare(grid, method="jump").save(tmp_path / "d.idx")
+    with np.load(path) as z:
+        data = dict(z)
+    data["method"] = np.array("cpd")
+    bad = tmp_path / "bad.idx"
+    with open(bad, "wb") as f:
+        np.savez(f, **data)
+    with pytest.raises(skyroute.InputFormatError, match=r"bad.idx: not a skyroute index: "
+                                                         r"method 'cpd'"):
+        skyroute.load_index(bad, grid)
+
+
+def test_cli_prepare_jump(monkeypatch, capsys, tmp_path):
+    idx = tmp_path / "den.idx"
+    monkeypatch.setattr(sys, "argv", ["skyroute", "prepare", "den312d", "-o", str(idx),
+                                      "--method", "jump"])
+    with pytest.raises(SystemExit) as e:
+        main()
+    out = capsys.readouterr().out
+    assert e.value.code in (0, None) and "jump index, 16 pivots" in out
+    monkeypatch.setattr(sys, "argv", ["skyroute", "plan", "den312d", "--start", "50,76",
+                                      "--goal", "60,13", "--index", str(idx), "--json"])
+    with pytest.raises(SystemExit) as e:
+        main()
+    out = capsys.readouterr().out
+    assert e.value.code in (0, None) and '"algorithm": "jump"' in out
+    assert '"cost": 112.556349' in out
