@@ -18,44 +18,26 @@ import numpy as np
 from numba import njit
 
 from skyroute.result import FOUND, NO_PATH
-from skyroute.search import heap
+from skyroute.search.astar import astar_kernel
+from skyroute.search.canonical import CANONICAL
 from skyroute.search.jps import jps_kernel
-from skyroute.search.moves import COSTS, offsets
-from skyroute.search.space import to_cells
+from skyroute.search.space import to_cells, workspace
 
 MAX_EXPANSIONS = 1 << 62
 PIVOTS = 16  # 16 x 8 bytes a cell: 34 MB for 512 x 512 (section 12 of the benchmarks)
 
 
-@njit(cache=True)
-def distances_from(mask, Wp, source, out, col):
-    """Dijkstra from flat cell ``source`` over the move mask (8-connected, no corner
-    cutting); ``out[:, col]`` receives each cell's distance (inf: unreachable). The
-    heap's keys are quantised to 2**-20 cells, which cannot reorder the settling: every
-    step costs at least 1."""
-    n = mask.size
-    offs = offsets(Wp)
-    state = np.zeros(n, np.int32)
-    hc = np.empty(n, np.int32)
-    hk = np.empty(n, np.int64)
-    for c in range(n):
-        out[c, col] = math.inf
-    out[source, col] = 0.0
-    size = heap.push(hc, hk, state, 0, source, heap.key(0.0, 0.0))
-    while size > 0:
-        c, size = heap.pop(hc, hk, state, size)
-        dc = out[c, col]
-        m = mask[c]
-        for k in range(8):
-            if not (m >> k) & 1:
-                continue
-            nb = c + offs[k]
-            if state[nb] < 0:
-                continue
-            d = dc + COSTS[k]
-            if d < out[nb, col]:
-                out[nb, col] = d
-                size = heap.push(hc, hk, state, size, nb, heap.key(d, 0.0))
+def distances_from(mask: np.ndarray, Wp: int, source: int, ws: tuple) -> np.ndarray:
+    """Each padded cell's distance from flat cell ``source`` (inf: unreachable): the
+    A* kernel as Dijkstra (h = 0, canonical successors, which keep an optimal path to
+    every cell) run to exhaustion towards the blocked border cell 0; every cell it
+    touched was expanded, with its final g. ``ws``: a :func:`space.workspace`."""
+    floats, ints, keys = ws
+    _, expanded, _, _ = astar_kernel(mask, CANONICAL, Wp, source, 0, 0, 1.0, MAX_EXPANSIONS,
+                                     floats, ints, keys)
+    out = np.full(mask.size, np.inf)
+    reached = ints[2][:expanded]
+    out[reached] = floats[0][reached]
     return out
 
 
@@ -71,11 +53,11 @@ def pivot_distances(mask: np.ndarray, label: np.ndarray, Wp: int,
     region = np.flatnonzero(label == largest)
     count = min(count, region.size)
     out = np.empty((mask.size, count))
-    seed = np.empty((mask.size, 1))
-    nearest = distances_from(mask, Wp, int(region[0]), seed, 0)[:, 0]
+    ws = workspace(mask.size)
+    nearest = distances_from(mask, Wp, int(region[0]), ws)
     for j in range(count):
         p = int(region[np.argmax(nearest[region])])
-        distances_from(mask, Wp, p, out, j)
+        out[:, j] = distances_from(mask, Wp, p, ws)
         nearest = np.minimum(nearest, out[:, j])
     return out
 
