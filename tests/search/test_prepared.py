@@ -22,18 +22,22 @@ from tests.conftest import movingai_pairs
 from tests.search.checks import assert_grid_path_legal
 
 PAIRS = movingai_pairs()
-PER_MAP = 40
 
 
-def _check_scenario(grid, scen, lines):
+def _check_scenario(grid, scen, lines, walk_every=1):
+    """Every line's cost is the optimum and its path runs from start to goal; every
+    ``walk_every``-th path is also walked cell by cell (legal steps summing to the cost:
+    the slow part on long maze paths)."""
     index = skyroute.prepare(grid)
-    for i in lines:
+    for n, i in enumerate(lines):
         s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
         r = index.plan(s, t)
         assert r.found, (grid.name, i)
         assert scen.matches(int(i), r.cost), (grid.name, i, r.cost, scen.optimal[i])
         assert tuple(r.path[0]) == s and tuple(r.path[-1]) == t
-        assert assert_grid_path_legal(grid.blocked, r.path) == pytest.approx(r.cost, abs=1e-9)
+        if n % walk_every == 0:
+            walked = assert_grid_path_legal(grid.blocked, r.path)
+            assert walked == pytest.approx(r.cost, abs=1e-9)
 
 
 @pytest.mark.parametrize("name", sorted(skyroute.bundled_maps()))
@@ -45,11 +49,11 @@ def test_every_line_of_the_bundled_scenarios(name):
 
 @pytest.mark.shared_data
 @pytest.mark.parametrize("map_path, scen_path", PAIRS, ids=[m.stem for m, _ in PAIRS])
-def test_sampled_lines_of_the_shared_scenarios(map_path, scen_path):
+def test_every_line_of_the_shared_scenarios(map_path, scen_path):
+    # the default index ("auto": table, hierarchy, landmarks or jump, whichever the map
+    # gets) on all 29,655 lines of the 18 maps
     grid, scen = read_map(map_path), read_scen(scen_path)
-    rng = np.random.default_rng(20261123)
-    lines = rng.choice(len(scen), size=min(PER_MAP, len(scen)), replace=False)
-    _check_scenario(grid, scen, [*lines, len(scen) - 1])  # the longest bucket too
+    _check_scenario(grid, scen, range(len(scen)), walk_every=16)
 
 
 @st.composite
