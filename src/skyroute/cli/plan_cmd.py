@@ -109,7 +109,9 @@ def prepare_command(
     from skyroute.search.prepared import prepare
 
     grid = load_map(map_file, resolution=resolution, safety=safety)
-    index = prepare(grid, method=method)
+    with Console(stderr=True).status(f"Preparing {grid.name} (the first run also compiles "
+                                     "the kernels: a minute or two)"):
+        index = prepare(grid, method=method)
     written = index.save(out)
     Console().print(f"{grid.name}: {index.describe()}, built in {index.build_seconds:.3f} s, "
                     f"{written.stat().st_size / 1e6:.2f} MB -> {written}")
