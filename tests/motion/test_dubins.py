@@ -197,3 +197,16 @@ def test_a_goal_a_hair_ahead_is_reached_straight():
     ref = np.where(np.isnan(w[:, 0]), np.inf, w.sum(axis=1)).min() * r
     assert ref == pytest.approx(d, rel=1e-6)
     assert D.lengths([s], [g], r)[0] == pytest.approx(ref, rel=1e-6)
+
+
+def test_a_goal_a_rounding_error_away_with_the_same_heading():
+    # hypothesis found it: the goal 1.4e-45 from the start, the same heading; the
+    # compiled cos(a - b) (a sum of products) rounded to 1 - ulp and dropped the
+    # vanishing LSR word, answering a full circle where the numpy words answer 5e-23
+    s = (-1.401298464324817e-45, -1.401298464324817e-45, 2.0)
+    g = (-1.401298464324817e-45, 0.0, 2.0)
+    w = D._words(np.array([s]), np.array([g]), 1.0)[0]
+    ref = np.where(np.isnan(w[:, 0]), np.inf, w.sum(axis=1)).min()
+    assert ref < 1e-20
+    assert D.lengths([s], [g], 1.0)[0] == pytest.approx(ref, abs=1e-30)
+    assert D.shortest_path(s, g, 1.0).length == pytest.approx(ref, abs=1e-30)

@@ -119,7 +119,10 @@ def shortest_length(sx, sy, sth, gx, gy, gth, r):
         # zero-length LSR word, leaving only full circles (OMPL special-cases it too)
         return 0.0
     sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
-    cab = ca * cb + sa * sb
+    # cos(a - b) rounds to 1 exactly for |a - b| < 1e-8, as the numpy words' cos does;
+    # the sum of products may round to 1 - ulp, which drops a vanishing LSR or RSL word
+    # when the goal lies a rounding error from the start (d ~ 1e-45): full circles
+    cab = 1.0 if abs(a - b) < 1e-8 else ca * cb + sa * sb
     dd = d * d
     t_lsl = math.atan2(cb - ca, d + sa - sb)
     t_rsr = math.atan2(ca - cb, d - sa + sb)
