@@ -3,8 +3,8 @@
 numba calls glibc one value at a time; a loop that calls it cannot be turned into SIMD
 code. These are the fdlibm polynomials (sin/cos kernels, atan with its table of
 atan(0.5), atan(1) and their low parts) with every branch written as a select, so LLVM
-can run 4 queries per AVX2 instruction. Accurate to a few ulp (absolute error below
-4e-16 on the ranges used; tests against :mod:`math`); for finite arguments only.
+can run 4 queries per AVX2 instruction. Accurate to a few ulp (absolute error within
+4.5e-16, 2 ulp of pi; tests against :mod:`math`); for finite arguments only.
 """
 
 from __future__ import annotations
