@@ -7,9 +7,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from numba import njit
 
 from skyroute import OptionError
 from skyroute.motion import dubins as D  # noqa: N812
+from skyroute.motion.dubins_kernel import shortest_length
 
 try:  # OMPL is the reference for the comparison only; every other test runs without it
     import ompl.base as ob
@@ -94,7 +96,8 @@ def test_kernels_are_compiled_without_fastmath():
     # lengths by 3e-14 and gained 2 %; not worth that risk.
     from skyroute.motion import dubins_kernel
 
-    for kernel in (D._lengths_kernel, dubins_kernel.shortest_length, dubins_kernel.words):
+    for kernel in (D._lengths_kernel, dubins_kernel.shortest_length,
+                   dubins_kernel.shortest_length_simd, dubins_kernel.words):
         assert not kernel.targetoptions.get("fastmath"), kernel
 
 
@@ -210,3 +213,63 @@ def test_a_goal_a_rounding_error_away_with_the_same_heading():
     assert ref < 1e-20
     assert D.lengths([s], [g], 1.0)[0] == pytest.approx(ref, abs=1e-30)
     assert D.shortest_path(s, g, 1.0).length == pytest.approx(ref, abs=1e-30)
+
+
+@njit
+def _scalar_lengths(s, g, r):
+    """The per-node kernel (branches, libm) over a batch, one query at a time."""
+    out = np.empty(len(s))
+    for i in range(len(s)):
+        out[i] = shortest_length(s[i, 0], s[i, 1], s[i, 2], g[i, 0], g[i, 1], g[i, 2], r)
+    return out
+
+
+def _degenerate_poses(rng, n):
+    """Goals on the start pose, a hair ahead or behind, on the turning circles, with
+    headings equal, opposite or a quarter turn apart: where p2 and c sit on 0 and +-1."""
+    s = np.c_[rng.uniform(-5, 5, (n, 2)), rng.choice([0.0, math.pi / 2, -math.pi, 0.875], n)]
+    kind = rng.integers(0, 5, n)
+    dist = np.choose(kind, [np.zeros(n), np.full(n, 6e-8), rng.uniform(0, 4, n),
+                            np.full(n, 2.0), np.full(n, 4.0)])
+    bearing = s[:, 2] + rng.choice([0.0, math.pi, math.pi / 2, -math.pi / 2], n)
+    turn = rng.choice([0.0, math.pi, math.pi / 2, 2 * math.pi, -4 * math.pi], n)
+    g = np.c_[s[:, 0] + dist * np.cos(bearing), s[:, 1] + dist * np.sin(bearing),
+              s[:, 2] + turn]
+    return s, g
+
+
+@pytest.mark.parametrize("span, turns", [(10.0, 1.0), (1.5, 1.0), (0.01, 1.0), (10.0, 20.0)])
+def test_branch_free_batch_kernel_is_the_per_node_kernel(span, turns):
+    # the batch runs shortest_length_simd (own polynomials, all six words, selects);
+    # the search runs shortest_length (libm, branches): one length, to rounding
+    s, g = random_poses(np.random.default_rng(17), 50_000, span, turns)
+    np.testing.assert_allclose(D.lengths(s, g, 1.0), _scalar_lengths(s, g, 1.0),
+                               rtol=0, atol=1e-12)
+
+
+def test_branch_free_batch_kernel_on_degenerate_poses():
+    # against the two references that share our 1e-12 angle snapping (OMPL snaps turns
+    # within 5e-7, so it reaches a goal 6e-8 behind straight, where we loop)
+    s, g = _degenerate_poses(np.random.default_rng(23), 20_000)
+    for r in (0.5, 1.0, 2.0):
+        ours = D.lengths(s, g, r)
+        np.testing.assert_allclose(ours, _scalar_lengths(s, g, r), rtol=0, atol=1e-9)
+        w = D._words(s, g, r)
+        ref = np.where(np.isnan(w[..., 0]), np.inf, w.sum(axis=2)).min(axis=1) * r
+        np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("n", [0, 1, 511, 512, 513, 2049])
+def test_batch_blocks_cover_every_query(n):
+    s, g = random_poses(np.random.default_rng(n), n)
+    out = D.lengths(s, g, 1.5)
+    assert out.shape == (n,)
+    np.testing.assert_allclose(out, _scalar_lengths(s, g, 1.5), rtol=0, atol=1e-12)
+
+
+def test_batch_takes_strided_and_non_contiguous_poses():
+    s, g = random_poses(np.random.default_rng(31), 3000)
+    both = np.c_[s, g]  # (N, 6): starts and goals are column slices of one array
+    np.testing.assert_array_equal(D.lengths(both[:, :3], both[:, 3:], 1.2),
+                                  D.lengths(s, g, 1.2))
+    np.testing.assert_array_equal(D.lengths(s[::2], g[::2], 1.2), D.lengths(s, g, 1.2)[::2])
