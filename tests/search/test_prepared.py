@@ -24,11 +24,12 @@ from tests.search.checks import assert_grid_path_legal
 PAIRS = movingai_pairs()
 
 
-def _check_scenario(grid, scen, lines, walk_every=1):
-    """Every line's cost is the optimum and its path runs from start to goal; every
-    ``walk_every``-th path is also walked cell by cell (legal steps summing to the cost:
-    the slow part on long maze paths)."""
-    index = skyroute.prepare(grid)
+def _check_scenario(grid, scen, lines, walk_every=1, method="auto"):
+    """Through an index of ``method``: every line's cost is the optimum and its path
+    runs from start to goal; every ``walk_every``-th path is also walked cell by cell
+    (legal steps summing to the cost: the slow part on long maze paths). Returns the
+    index."""
+    index = skyroute.prepare(grid, method=method)
     for n, i in enumerate(lines):
         s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
         r = index.plan(s, t)
@@ -38,6 +39,7 @@ def _check_scenario(grid, scen, lines, walk_every=1):
         if n % walk_every == 0:
             walked = assert_grid_path_legal(grid.blocked, r.path)
             assert walked == pytest.approx(r.cost, abs=1e-9)
+    return index
 
 
 @pytest.mark.parametrize("name", sorted(skyroute.bundled_maps()))

@@ -16,29 +16,17 @@ from skyroute.search.prepared import region_labels
 from skyroute.search.space import space_of
 from skyroute.world.movingai import read_map, read_scen
 from tests.conftest import movingai_pairs
-from tests.search.checks import assert_grid_path_legal
-from tests.search.test_prepared import random_query
+from tests.search.test_prepared import _check_against_dijkstra, _check_scenario, random_query
 
 PAIRS = movingai_pairs()
-
-
-def _check_lines(index, grid, scen, lines):
-    for i in lines:
-        s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
-        r = index.plan(s, t)
-        assert r.found, (grid.name, i)
-        assert scen.matches(int(i), r.cost), (grid.name, i, r.cost, scen.optimal[i])
-        assert tuple(r.path[0]) == s and tuple(r.path[-1]) == t
-        assert assert_grid_path_legal(grid.blocked, r.path) == pytest.approx(r.cost, abs=1e-9)
 
 
 @pytest.mark.parametrize("name", sorted(skyroute.bundled_maps()))
 def test_every_line_of_the_bundled_scenarios(name):
     path = skyroute.bundled_maps()[name]
     grid, scen = read_map(path), read_scen(path.with_name(path.name + ".scen"))
-    index = skyroute.prepare(grid, method="jump")
+    index = _check_scenario(grid, scen, range(len(scen)), method="jump")
     assert index.accelerator == "jump" and index.pivots == 16
-    _check_lines(index, grid, scen, range(len(scen)))
 
 
 @pytest.mark.shared_data
@@ -47,7 +35,7 @@ def test_sampled_lines_of_the_shared_scenarios(map_path, scen_path):
     grid, scen = read_map(map_path), read_scen(scen_path)
     rng = np.random.default_rng(20261124)
     lines = rng.choice(len(scen), size=min(40, len(scen)), replace=False)
-    _check_lines(skyroute.prepare(grid, method="jump"), grid, scen, [*lines, len(scen) - 1])
+    _check_scenario(grid, scen, [*lines, len(scen) - 1], method="jump")
 
 
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -56,15 +44,10 @@ def test_jump_costs_equal_dijkstra(q):
     # several free regions: pivots lie in the largest only, so queries elsewhere run on
     # the octile bound alone (a pivot's distance there is inf, its bound NaN)
     blocked, s, t = q
-    grid = skyroute.Grid(blocked)
-    want = skyroute.plan(grid, s, t, algorithm="dijkstra")
-    got = skyroute.prepare(grid, method="jump").plan(s, t)
-    assert got.status == want.status
-    if want.found:
-        assert got.cost == pytest.approx(want.cost, abs=1e-9)
-        assert assert_grid_path_legal(blocked, got.path) == pytest.approx(got.cost, abs=1e-9)
-        assert tuple(got.path[0]) == s and tuple(got.path[-1]) == t
-    else:
+    index = skyroute.prepare(skyroute.Grid(blocked), method="jump")
+    _check_against_dijkstra(index, blocked, s, t)
+    got = index.plan(s, t)
+    if not got.found:  # only across regions (the labels): at once, nothing expanded
         assert got.path.shape == (0, 2) and got.cost == np.inf and got.expanded == 0
 
 
