@@ -24,6 +24,7 @@ items must pickle: ``fn`` a module-level function, the items plain data.
 
 from __future__ import annotations
 
+import gc
 import logging
 import multiprocessing
 import os
@@ -143,6 +144,11 @@ class DaskExecutor(_Executor):
                                 "(pip install 'dask[distributed]')") from None
         self.address = address
         self._cluster = None
+        # A Client left to the garbage collector (one whose connection failed is left in
+        # a reference cycle) closes itself in __del__, taking distributed's class-wide
+        # LoopRunner lock; collected while a new Client starts under that lock, it
+        # deadlocks the process (seen in the test suite). Finalise such leftovers now.
+        gc.collect()
         if address is None:
             self._cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
                                          threads_per_worker=1, processes=True,
