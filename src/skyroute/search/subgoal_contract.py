@@ -49,6 +49,13 @@ BUDGET = 120_000_000  # edges the witness searches may scan (random 512 at 30%: 
 # priorities, 181 million with cheaper neighbour updates too, but then builds in 4.7-6.5 s
 # (over the 5 s budget); Paris_1_512 (2.5e6) 441 (25) million, its queries no faster than
 # the landmark A*'s; random 10% and random512-10-0 (3.2e6) 1.3 billion or more.
+# Round 6 (docs/benchmarks.md section 12): with these limits 958 of random 20%'s 1,036
+# million scans are the neighbours' re-estimates, 64 million the contraction's own.
+# One-hop estimates (Geisberger's early limit) with the test in them: 191 million, 3.6 s
+# for the contraction and a 5.1 s build on a loaded VM (queries 1.6x faster than the
+# jump index's); on random 10% 20 billion (the order collapses). Weaker contraction
+# witnesses densify the graph (settle 20, hops 3: 1.07 billion); an indexed order heap,
+# smaller witness state, priority weights and degree-dependent estimates did not pay.
 DENSE = 1_500_000
 HEAP_CAP = 1 << 14  # witness heap entries; a search that would need more gives up
 SHORTEN = shorten_table()

@@ -1,7 +1,7 @@
 """All-pairs distances over a small subgoal graph: prepared queries without a search.
 
 On small maps a query's graph search is most of its few microseconds. With m subgoals,
-a table of the m x m graph distances (scipy's Dijkstra from every subgoal, with its
+a table of the m x m graph distances (a compiled Dijkstra from every subgoal, with its
 predecessor matrix for the hops) turns a query into a minimum over the start's and the
 goal's direct subgoals: ``oct(s, a) + D[a, b] + oct(b, t)``. The table is exact (graph
 distances equal the grid's), and kept only while it is small: ``TABLE_MAX`` subgoals
@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from skyroute.result import FOUND, NO_PATH
 from skyroute.search.heap import indexed_pop, indexed_up
@@ -29,17 +29,10 @@ def distance_table(cells: np.ndarray, offs: np.ndarray, nbr: np.ndarray,
     """(dist (m, m) float64, pred (m, m) int16) for a graph of at most TABLE_MAX
     subgoals: ``pred[a, b]`` is b's predecessor on a shortest a -> b path (-1: none);
     two empty (0, 0) arrays for a larger graph."""
-    # imported here: answering from a saved index needs no scipy
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import dijkstra
-
     m = cells.size
     if m == 0 or m > TABLE_MAX:
         return np.empty((0, 0)), np.empty((0, 0), np.int16)
-    graph = csr_matrix((edge_lengths(cells, offs, nbr, Wp), nbr, offs), shape=(m, m))
-    dist, pred = dijkstra(graph, return_predecessors=True)
-    return dist, np.where(pred < 0, -1, pred).astype(np.int16)
-
+    return all_pairs(offs, nbr, edge_lengths(cells, offs, nbr, Wp))
 
 @njit(cache=True)
 def table_query(blk, sg, clr, label, cells, dist, pred, ws, Wp, s, t):
@@ -89,19 +82,19 @@ def table_query(blk, sg, clr, label, cells, dist, pred, ws, Wp, s, t):
     path, cost = _path(blk, hops, n, Wp)
     return FOUND, path, cost, ns * ng, 0
 
+ROW_SETS = 8  # all_pairs: sets of sources, shared out among numba's threads
+
 
 @njit(cache=True)
-def all_pairs(offs, nbr, length):
-    """(dist (n, n) float64, pred (n, n) int16) of a CSR graph with n <= 32767 nodes, by
-    a compiled Dijkstra from every node (-1: no predecessor), its heap indexed (a node
-    moves up when its distance drops: at most n entries)."""
+def _rows(offs, nbr, length, dist, pred, first, step):
+    """Dijkstra from the sources first, first + step, ... into their rows of ``dist`` and
+    ``pred``, with one indexed heap (a node moves up when its distance drops: at most n
+    entries)."""
     n = offs.size - 1
-    dist = np.full((n, n), np.inf)
-    pred = np.full((n, n), -1, np.int16)
     hk = np.empty(n)
     hn = np.empty(n, np.int64)
     pos = np.full(n, -1, np.int64)  # heap slot, -1 outside, -2 settled (per source)
-    for s in range(n):
+    for s in range(first, n, step):
         d, p = dist[s], pred[s]
         pos[:] = -1
         d[s] = 0.0
@@ -122,4 +115,17 @@ def all_pairs(offs, nbr, length):
                     i = size
                     size += 1
                 indexed_up(hk, hn, pos, i, nd, v)
+
+
+@njit(cache=True, parallel=True)
+def all_pairs(offs, nbr, length):
+    """(dist (n, n) float64, pred (n, n) int16) of a CSR graph with n <= 32767 nodes, by
+    a compiled Dijkstra from every node (-1: no predecessor). The rows are independent:
+    numba's threads take ROW_SETS interleaved sets of sources (the same table on any
+    thread count)."""
+    n = offs.size - 1
+    dist = np.full((n, n), np.inf)
+    pred = np.full((n, n), -1, np.int16)
+    for t in prange(ROW_SETS):
+        _rows(offs, nbr, length, dist, pred, np.int64(t), np.int64(ROW_SETS))
     return dist, pred
