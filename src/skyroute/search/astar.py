@@ -44,6 +44,14 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     entered, state, touched, hc, level = ints[0], ints[1], ints[2], ints[3], ints[4]
     hk = keys
     offs = offsets(Wp)
+    # Cells are unsigned in the loop: numba indexes with a signed integer through a
+    # wrap-around test for negative indices, and these loads are most of an expansion
+    # (5-6% faster on random 512 maps, the same expansions; docs/benchmarks.md s. 11).
+    # Negative offsets wrap modulo 2**64, so c + uoffs[k] is still the neighbour.
+    uoffs = np.empty(8, np.uint64)
+    for k in range(8):
+        uoffs[k] = np.uint64(offs[k])
+    ugoal = np.uint64(goal)
     inv = 1.0 / Wp
     gx, gy = goal % Wp, goal // Wp
     g[start] = 0.0
@@ -68,10 +76,10 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     while True:
         if nl > 0:
             nl -= 1
-            c = level[nl]
+            c = np.uint64(level[nl])
         elif size > 0:
             # pop the minimum (hole sifts down) and close it
-            c = hc[0]
+            c = np.uint64(hc[0])
             ck = hk[0]
             size -= 1
             if size > 0:
@@ -101,7 +109,7 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
             break
         state[c] = -1
         cf = ck >> heap.TIE_BITS  # unchanged while the stack of equal f empties
-        if c == goal:
+        if c == ugoal:
             code = FOUND
             break
         if expanded >= max_expansions:
@@ -110,13 +118,13 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
         expanded += 1
         gc = g[c]
         m = succ[entered[c], mask[c]]
-        cx, cy = xy(c, Wp, inv)
+        cx, cy = xy(np.int64(c), Wp, inv)
         cx -= gx
         cy -= gy
         while m:  # the mask holds the connectivity: no diagonal bits when 4
             k = LOWEST[m]
             m &= m - 1
-            n = c + offs[k]
+            n = c + uoffs[k]
             st = state[n]
             if st < 0:
                 continue
