@@ -25,6 +25,7 @@ from skyroute.search.moves import COSTS, MDX, MDY, SQRT2_M1, h_of, offsets, xy
 from skyroute.search.trace import trace_moves
 
 ON_LEVEL = np.iinfo(np.int32).max  # state of a cell on the equal-f stack
+U0, U1, U2, U4 = np.uint64(0), np.uint64(1), np.uint64(2), np.uint64(4)  # unsigned constants
 
 
 @njit(cache=True)
@@ -44,10 +45,12 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     entered, state, touched, hc, level = ints[0], ints[1], ints[2], ints[3], ints[4]
     hk = keys
     offs = offsets(Wp)
-    # Cells are unsigned in the loop: numba indexes with a signed integer through a
-    # wrap-around test for negative indices, and these loads are most of an expansion
-    # (5-6% faster on random 512 maps, the same expansions; docs/benchmarks.md s. 11).
-    # Negative offsets wrap modulo 2**64, so c + uoffs[k] is still the neighbour.
+    # Cells and heap slots are unsigned in the loop: numba indexes with a signed integer
+    # through a wrap-around test for negative indices, and these loads are most of an
+    # expansion (about 18% less kernel time on random 512 maps, the same expansions;
+    # docs/benchmarks.md section 11). Negative offsets wrap modulo 2**64, so c +
+    # uoffs[k] is still the neighbour; constants are U0..U4, since numba types a sum of
+    # a signed and an unsigned integer as a float.
     uoffs = np.empty(8, np.uint64)
     for k in range(8):
         uoffs[k] = np.uint64(offs[k])
@@ -83,28 +86,32 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
             ck = hk[0]
             size -= 1
             if size > 0:
-                last = hc[size]
-                lk = hk[size]
-                i = 0
+                usz = np.uint64(size)
+                last = np.uint64(hc[usz])
+                lk = hk[usz]
+                i = U0
                 while True:
-                    b = 4 * i + 1
-                    if b >= size:
+                    b = U4 * i + U1
+                    if b >= usz:
                         break
                     kb = hk[b]
-                    for j in range(b + 1, min(b + 4, size)):
+                    e = min(b + U4, usz)
+                    j = b + U1
+                    while j < e:
                         if hk[j] < kb:
                             kb = hk[j]
                             b = j
+                        j += U1
                     if kb >= lk:
                         break
-                    moved = hc[b]
+                    moved = np.uint64(hc[b])
                     hc[i] = moved
                     hk[i] = kb
-                    state[moved] = i + 1
+                    state[moved] = i + U1
                     i = b
                 hc[i] = last
                 hk[i] = lk
-                state[last] = i + 1
+                state[last] = i + U1
         else:
             break
         state[c] = -1
@@ -152,24 +159,24 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
                     nl += 1
                     state[n] = ON_LEVEL
                     continue
-                i = size
+                i = np.uint64(size)
                 size += 1
             else:
-                i = st - 1
+                i = np.uint64(st - 1)
             # push or decrease-key (hole sifts up)
-            while i > 0:
-                p = (i - 1) >> 2
+            while i > U0:
+                p = (i - U1) >> U2
                 kp = hk[p]
                 if key >= kp:
                     break
-                moved = hc[p]
+                moved = np.uint64(hc[p])
                 hc[i] = moved
                 hk[i] = kp
-                state[moved] = i + 1
+                state[moved] = i + U1
                 i = p
             hc[i] = n
             hk[i] = key
-            state[n] = i + 1
+            state[n] = i + U1
         if size + nl > max_frontier:
             max_frontier = size + nl
     heap.reset(state, touched, nt)
