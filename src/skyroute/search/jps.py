@@ -23,7 +23,7 @@ from numba import njit
 
 from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
-from skyroute.search.astar import ON_LEVEL
+from skyroute.search.astar import ON_LEVEL, U0, U1, U2, U4
 from skyroute.search.canonical import LOWEST, START
 from skyroute.search.moves import MDX, MDY, h_of, offsets, xy
 from skyroute.search.trace import trace
@@ -138,29 +138,33 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
             c = hc[0]
             ck = hk[0]
             size -= 1
-            if size > 0:
-                last = hc[size]
-                lk = hk[size]
-                i = 0
+            if size > 0:  # slots unsigned, as in the A* kernel
+                usz = np.uint64(size)
+                last = np.uint64(hc[usz])
+                lk = hk[usz]
+                i = U0
                 while True:
-                    b = 4 * i + 1
-                    if b >= size:
+                    b = U4 * i + U1
+                    if b >= usz:
                         break
                     kb = hk[b]
-                    for j in range(b + 1, min(b + 4, size)):
+                    e = min(b + U4, usz)
+                    j = b + U1
+                    while j < e:
                         if hk[j] < kb:
                             kb = hk[j]
                             b = j
+                        j += U1
                     if kb >= lk:
                         break
-                    moved = hc[b]
+                    moved = np.uint64(hc[b])
                     hc[i] = moved
                     hk[i] = kb
-                    state[moved] = i + 1
+                    state[moved] = i + U1
                     i = b
                 hc[i] = last
                 hk[i] = lk
-                state[last] = i + 1
+                state[last] = i + U1
         else:
             break
         state[c] = -1
@@ -218,7 +222,7 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
                     nf += 1
         gc = g[c]
         for q in range(nf):
-            n = found[q, 0]
+            n = np.uint64(found[q, 0])
             st = state[n]
             if st < 0:
                 continue
@@ -235,8 +239,8 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
             if st == ON_LEVEL:  # an equal cost by another float sum: already queued
                 continue
             hn = h_of(1, abs(nx - gx), abs(ny - gy))
-            for p in range(npiv):  # differential bounds (NaN, never larger, off region)
-                bound = abs(piv[n, p] - dt[p])
+            for pv in range(npiv):  # differential bounds (NaN, never larger, off region)
+                bound = abs(piv[n, pv] - dt[pv])
                 if bound > hn:
                     hn = bound
             key = heap.key(gn + hn, gn)
@@ -246,24 +250,24 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
                     nl += 1
                     state[n] = ON_LEVEL
                     continue
-                i = size
+                i = np.uint64(size)
                 size += 1
             else:
-                i = st - 1
+                i = np.uint64(st - 1)
             # push or decrease-key (hole sifts up)
-            while i > 0:
-                p = (i - 1) >> 2
+            while i > U0:
+                p = (i - U1) >> U2
                 kp = hk[p]
                 if key >= kp:
                     break
-                moved = hc[p]
+                moved = np.uint64(hc[p])
                 hc[i] = moved
                 hk[i] = kp
-                state[moved] = i + 1
+                state[moved] = i + U1
                 i = p
             hc[i] = n
             hk[i] = key
-            state[n] = i + 1
+            state[n] = i + U1
         if size + nl > max_frontier:
             max_frontier = size + nl
     code = heap.finish(code, state, touched, nt)
