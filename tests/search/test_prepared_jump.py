@@ -128,3 +128,11 @@ def test_cli_prepare_jump(monkeypatch, capsys, tmp_path):
     out = capsys.readouterr().out
     assert e.value.code in (0, None) and '"algorithm": "jump"' in out
     assert '"cost": 112.556349' in out
+
+
+def test_a_grid_without_free_cells_gets_no_pivots():
+    grid = skyroute.Grid(np.ones((4, 5), bool))
+    index = skyroute.prepare(grid, method="jump")
+    assert index.pivots == 0
+    with pytest.raises(skyroute.QueryError, match="blocked"):
+        index.plan((0, 0), (4, 3))

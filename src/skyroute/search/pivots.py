@@ -41,16 +41,23 @@ def distances_from(mask: np.ndarray, Wp: int, source: int, ws: tuple) -> np.ndar
     return out
 
 
+def largest_region(label: np.ndarray) -> np.ndarray:
+    """The flat cells of the largest free region (``label``: each padded cell's region,
+    -1 blocked); empty when no cell is free."""
+    free = label >= 0
+    if not free.any():
+        return np.empty(0, np.int64)
+    return np.flatnonzero(label == np.argmax(np.bincount(label[free])))
+
+
 def pivot_distances(mask: np.ndarray, label: np.ndarray, Wp: int,
                     count: int = PIVOTS) -> np.ndarray:
     """(cells, count) float64 distances from ``count`` pivots chosen farthest first in
-    the largest free region (``label``: each padded cell's region, -1 blocked); inf
-    where a pivot cannot reach. (cells, 0) when the grid has no free cell."""
-    free = label >= 0
-    if not free.any():
+    the largest free region (:func:`largest_region`); inf where a pivot cannot reach.
+    (cells, 0) when the grid has no free cell."""
+    region = largest_region(label)
+    if not region.size:
         return np.empty((mask.size, 0))
-    largest = np.argmax(np.bincount(label[free]))
-    region = np.flatnonzero(label == largest)
     count = min(count, region.size)
     out = np.empty((mask.size, count))
     ws = workspace(mask.size)

@@ -21,7 +21,7 @@ from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search import subgoal_table
 from skyroute.search.canonical import CANONICAL
-from skyroute.search.pivots import jump_query, pivot_distances
+from skyroute.search.pivots import jump_query, largest_region, pivot_distances
 from skyroute.search.space import space_of, workspace
 from skyroute.search.subgoal_build import clearances, link, subgoal_ids
 from skyroute.search.subgoal_ch_query import WS_ROWS as CH_WS_ROWS
@@ -260,10 +260,9 @@ def build_arrays(blocked: np.ndarray, label: np.ndarray | None = None) -> dict:
 
 def sample_pairs(label: np.ndarray, count: int = SAMPLE) -> np.ndarray:
     """(count, 2) flat cell pairs drawn (seeded) from the largest free region."""
-    free = label >= 0
-    if not free.any():
+    region = largest_region(label)
+    if not region.size:
         return np.empty((0, 2), np.int64)
-    region = np.flatnonzero(label == np.argmax(np.bincount(label[free])))
     return np.random.default_rng(0).choice(region, size=(count, 2))
 
 
