@@ -18,12 +18,12 @@ from skyroute import lazy
 SRC = Path(skyroute.__file__).resolve().parents[1]
 
 # Libraries a grid plan does not use. Not listed, as others import them on this path:
-# scipy's top package (numba's import), yaml (numba's config), pydantic (Typer converts
-# every option with it). scipy.linalg is listed: numba's BLAS probe would import it
-# whole, and skyroute.blas_probe defers that probe.
+# scipy's top package (numba's import), yaml (numba's config). scipy.linalg is listed:
+# numba's BLAS probe would import it whole, and skyroute.blas_probe defers that probe;
+# pydantic too: Typer 0.29 converts every option with it (pyproject pins Typer < 0.29).
 HEAVY = ("shapely", "scipy.linalg", "sqlalchemy", "alembic", "matplotlib", "pyproj",
          "fastapi", "starlette", "uvicorn", "httpx", "dask", "distributed", "PIL", "networkx",
-         "pandas", "ompl",
+         "pandas", "ompl", "pydantic",
          "scipy.ndimage", "scipy.sparse", "scipy.spatial", "scipy.optimize")
 # skyroute's packages and modules that other commands (or World plans) need.
 OTHERS = ("skyroute.roadmap", "skyroute.motion", "skyroute.delivery", "skyroute.fleet",

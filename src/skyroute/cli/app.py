@@ -2,8 +2,8 @@
 
 Every command is registered by a loader that imports its module when the command runs
 (:mod:`skyroute.cli.lazy_group`), so each command pays only for its own imports:
-``skyroute plan`` on a grid loads numpy, numba and Typer (with the pydantic it converts
-options with), not SQLAlchemy, scipy.linalg or shapely (tests/cli/test_startup.py).
+``skyroute plan`` on a grid loads numpy, numba, Typer and Rich, not pydantic, SQLAlchemy,
+scipy.linalg or shapely (tests/cli/test_startup.py).
 """
 
 from __future__ import annotations
