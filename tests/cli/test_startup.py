@@ -57,6 +57,13 @@ def test_grid_plan_imports_neither_heavy_libraries_nor_other_commands():
     assert json.loads(out)["cost"] == pytest.approx(112.55634918, abs=1e-8)
     assert loaded(names, HEAVY) == []
     assert loaded(names, OTHERS) == []
+    assert loaded(names, ("rich",)) == []  # JSON output needs no Rich
+
+
+def test_grid_plan_table_output_loads_rich_but_not_its_progress_bars():
+    names, out = imported_by("plan", "den312d", "--start", "50,76", "--goal", "60,13")
+    assert "112.556349" in out and "found" in out
+    assert "rich.table" in names and loaded(names, ("rich.progress",)) == []
 
 
 def test_public_names_resolve_lazily_and_completely():

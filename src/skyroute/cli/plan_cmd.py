@@ -7,7 +7,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 
 from skyroute.cli.parse import parse_cell
 from skyroute.cli.tables import result_table
@@ -86,6 +85,8 @@ def plan_command(
     if as_json:
         typer.echo(json.dumps(result.to_dict()))
     else:
+        from rich.console import Console
+
         files = (("plot", plot), ("geojson", geojson)) if result.found else ()
         Console().print(result_table(f"{grid.name}: {result.algorithm}", result, files=files))
     if not result.found:
@@ -106,6 +107,8 @@ def prepare_command(
         help="Metres per cell for .csv walls (as for plan).")] = 1.0,
 ) -> None:
     """Build a map's index once for fast exact queries ('skyroute plan MAP --index ...')."""
+    from rich.console import Console
+
     from skyroute.search.prepared import prepare
 
     grid = load_map(map_file, resolution=resolution, safety=safety)

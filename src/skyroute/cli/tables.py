@@ -3,16 +3,21 @@ the progress bar of long runs."""
 
 from __future__ import annotations
 
-from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
-from rich.table import Table
+from typing import TYPE_CHECKING
 
 from skyroute.result import PlanResult
+
+if TYPE_CHECKING:  # Rich is imported on use: `skyroute plan --json` prints without it
+    from rich.console import Console
+    from rich.progress import Progress
+    from rich.table import Table
 
 
 def result_table(title: str, result: PlanResult, *, unit: str = "",
                  files: tuple[tuple[str, object], ...] = ()) -> Table:
     """Status, cost, waypoints, statistics and written files of one result."""
+    from rich.table import Table
+
     table = Table(title=title, show_header=False)
     table.add_column(style="bold")
     table.add_column()
@@ -36,6 +41,8 @@ def result_table(title: str, result: PlanResult, *, unit: str = "",
 def wide_console() -> Console:
     """Stdout for wide tables: at least 160 columns when it is a file or a pipe (where
     Rich would otherwise wrap every cell at 80)."""
+    from rich.console import Console
+
     out = Console()
     return out if out.is_terminal else Console(width=160)
 
@@ -43,5 +50,13 @@ def wide_console() -> Console:
 def progress_bar(console: Console) -> Progress:
     """The progress bar of a long run (description, bar, done/total, time left), on
     ``console`` (stderr), gone when finished."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
     return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                     TimeRemainingColumn(), console=console, transient=True)
