@@ -151,6 +151,27 @@ def test_hierarchy_every_pair_of_a_room_map():
                 _check_against_dijkstra(index, blocked, s, t)
 
 
+def test_hierarchy_is_the_same_on_one_thread_and_on_two():
+    # the priority estimates run on numba's threads, each with its own scratch: the
+    # order, and so every array of the index, must not depend on the thread count
+    import numba
+
+    blocked = np.random.default_rng(5).random((96, 96)) < 0.3
+    before = numba.get_num_threads()
+    built = []
+    try:
+        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            numba.set_num_threads(threads)
+            built.append(_forced(blocked, 8, subgoal_contract.BUDGET))
+    finally:
+        numba.set_num_threads(before)
+    one, two = built
+    assert one.accelerator == two.accelerator == "hierarchy" and one.subgoals > 500
+    assert one._arrays.keys() == two._arrays.keys()
+    for key, arr in one._arrays.items():
+        assert arr.dtype == two._arrays[key].dtype and np.array_equal(arr, two._arrays[key])
+
+
 def test_hierarchy_index_round_trip(tmp_path):
     blocked = np.random.default_rng(3).random((40, 40)) < 0.25
     grid = skyroute.Grid(blocked)

@@ -18,7 +18,10 @@ it (:mod:`skyroute.search.subgoal_taut`, a local test on v's cell) are no shorte
 they need neither a shortcut nor a witness search. The order is lazy (Geisberger's "lazy
 updates"): the next node's priority, edge difference plus contracted neighbours, is
 recomputed when it comes to the top and it goes back if it is no longer the smallest;
-its neighbours are re-estimated after each contraction.
+its neighbours are re-estimated after each contraction. The estimates (every node's at
+the start, the neighbours' after each contraction: most of the witness searches) only
+read the working graph, so they run on two of numba's threads, each with its own
+scratch; the order, and so the index, is the same on any thread count.
 
 Contraction stops at a core of as many nodes as the all-pairs table holds (2048): the
 last nodes are the costliest to contract (on grid-like graphs the remaining graph
@@ -31,7 +34,7 @@ answers there.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from skyroute.search.heap import pop_plain, push_plain
 from skyroute.search.subgoal_landmarks import edge_lengths
@@ -60,6 +63,8 @@ DENSE = 1_500_000
 HEAP_CAP = 1 << 14  # witness heap entries; a search that would need more gives up
 SHORTEN = shorten_table()
 EPS = 1e-9  # a witness this much longer still counts (lengths a + b sqrt2 differ by far more)
+WORKERS = 2  # priority estimates run on this many threads, each with its own scratch
+SERIAL = 2  # fewer nodes to estimate than this: one thread (a parallel launch costs more)
 
 
 @njit(cache=True)
@@ -134,12 +139,52 @@ def _shortcuts(v, st, ln, to, wt, dm, free, table, wd, wstamp, whop, tmark, tvia
 
 
 @njit(cache=True)
+def _estimate_range(nodes, first, stop, step, w, st, ln, to, wt, dm, free, table, deleted,
+                    wd, wstamp, whop, tmark, tvia, stamps, hk, hn, hops, settle, su, sw, sd,
+                    out, work):
+    """Priorities of nodes[first:stop:step] into ``out`` with worker w's scratch rows:
+    shortcuts a simulated contraction would add, minus edges removed, plus contracted
+    neighbours (``deleted``)."""
+    for i in range(first, stop, step):
+        u = nodes[i]
+        count, stamps[w], scanned = _shortcuts(u, st, ln, to, wt, dm, free, table, wd[w],
+                                               wstamp[w], whop[w], tmark[w], tvia[w],
+                                               stamps[w], hk[w], hn[w], hops, settle,
+                                               su[w], sw[w], sd[w])
+        out[i] = count - ln[u] + deleted[u]
+        work[w] += scanned
+
+
+@njit(cache=True, parallel=True)
+def _estimate_parallel(nodes, k, st, ln, to, wt, dm, free, table, deleted, wd, wstamp,
+                       whop, tmark, tvia, stamps, hk, hn, hops, settle, su, sw, sd, out,
+                       work):
+    """:func:`_estimate_range` over nodes[:k], interleaved among WORKERS threads. The
+    estimates only read the working graph, and each worker marks its searches in its
+    own scratch rows, so the priorities are those of one thread."""
+    for w in prange(WORKERS):
+        _estimate_range(nodes, w, k, WORKERS, w, st, ln, to, wt, dm, free, table, deleted,
+                        wd, wstamp, whop, tmark, tvia, stamps, hk, hn, hops, settle, su, sw,
+                        sd, out, work)
+
+
+@njit(cache=True)
 def _grow(a, n):
     """``a``, or a copy with room for at least n entries (twice as many)."""
     if n <= a.size:
         return a
     b = np.empty(2 * n, a.dtype)
     b[:a.size] = a
+    return b
+
+
+@njit(cache=True)
+def _grow_rows(a, n):
+    """``a`` (rows, k), or a copy with room for at least n entries a row (twice as many)."""
+    if n <= a.shape[1]:
+        return a
+    b = np.empty((a.shape[0], 2 * n), a.dtype)
+    b[:, :a.shape[1]] = a
     return b
 
 
@@ -189,21 +234,25 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
     # priority estimates ignore the tautness test: pruned pairs made nodes look cheap,
     # and that order slowed Boston_0_256's queries by about 30%
     unpruned = np.zeros_like(table)
-    tmark = np.zeros(m, np.int64)
-    tvia = np.zeros(m, np.float64)
+    # witness-search scratch, a row per worker (row 0 also contracts)
+    tmark = np.zeros((WORKERS, m), np.int64)
+    tvia = np.zeros((WORKERS, m), np.float64)
+    wd = np.zeros((WORKERS, m), np.float64)
+    wstamp = np.zeros((WORKERS, m), np.int64)
+    whop = np.zeros((WORKERS, m), np.int64)
+    hk = np.empty((WORKERS, HEAP_CAP), np.float64)
+    hn = np.empty((WORKERS, HEAP_CAP), np.int64)
+    su = np.empty((WORKERS, 64), np.int64)
+    sw = np.empty((WORKERS, 64), np.int64)
+    sd = np.empty((WORKERS, 64), np.float64)
+    stamps = np.zeros(WORKERS, np.int64)
+    scans = np.zeros(WORKERS, np.int64)
     deleted = np.zeros(m, np.int64)
     rank = np.full(m, -1, np.int64)
-    wd = np.zeros(m, np.float64)
-    wstamp = np.zeros(m, np.int64)
-    whop = np.zeros(m, np.int64)
-    hk = np.empty(HEAP_CAP, np.float64)
-    hn = np.empty(HEAP_CAP, np.int64)
     nb = np.empty(16, np.int64)
     nbdm = np.empty(16, np.uint8)  # per neighbour u of v: the first step of u -> v
-    su = np.empty(64, np.int64)
-    sw = np.empty(64, np.int64)
-    sd = np.empty(64, np.float64)
-    stamp = work = 0
+    est = np.empty(16, np.float64)  # the neighbours' new priorities
+    work = 0
     # the upward edges, appended per node as it leaves the working graph
     up_st = np.zeros(m, np.int64)
     up_ln = np.zeros(m, np.int64)
@@ -216,18 +265,19 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
     qk = np.empty(2 * m + 16, np.float64)
     qn = np.empty(2 * m + 16, np.int64)
     qs = 0
+    n2 = 0
     for v in range(m):
-        n2 = ln[v] * ln[v]
-        su, sw, sd = _grow(su, n2), _grow(sw, n2), _grow(sd, n2)
-        count, stamp, w = _shortcuts(v, st, ln, to, wt, dm, free, unpruned, wd, wstamp, whop,
-                                     tmark, tvia, stamp, hk, hn, sim_hops, sim_settle, su, sw, sd)
-        work += w
-        prio[v] = count - ln[v]
+        n2 = max(n2, ln[v] * ln[v])
+    su, sw, sd = _grow_rows(su, n2), _grow_rows(sw, n2), _grow_rows(sd, n2)
+    _estimate_parallel(np.arange(m), m, st, ln, to, wt, dm, free, unpruned, deleted, wd,
+                       wstamp, whop, tmark, tvia, stamps, hk, hn, sim_hops, sim_settle, su, sw,
+                       sd, prio, scans)
+    for v in range(m):
         push_plain(qk, qn, qs, prio[v], v)
         qs = qs + 1
     order = 0
     while qs > 0 and order < m - core:
-        if work > budget:
+        if work + scans.sum() > budget:
             e0 = np.empty(0, np.int64)
             return e0, np.empty(0, np.int32), np.empty(0), np.empty(0, np.int32), e0, work
         k = qk[0]
@@ -236,9 +286,10 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
         if rank[v] >= 0 or k != prio[v]:
             continue
         d = ln[v]
-        su, sw, sd = _grow(su, d * d), _grow(sw, d * d), _grow(sd, d * d)
-        count, stamp, w = _shortcuts(v, st, ln, to, wt, dm, free, table, wd, wstamp, whop,
-                                     tmark, tvia, stamp, hk, hn, hops, settle, su, sw, sd)
+        su, sw, sd = _grow_rows(su, d * d), _grow_rows(sw, d * d), _grow_rows(sd, d * d)
+        count, stamps[0], w = _shortcuts(v, st, ln, to, wt, dm, free, table, wd[0], wstamp[0],
+                                         whop[0], tmark[0], tvia[0], stamps[0], hk[0], hn[0],
+                                         hops, settle, su[0], sw[0], sd[0])
         work += w
         p = count - d + deleted[v]
         if qs > 0 and p > qk[0]:
@@ -268,16 +319,17 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
                     break
             deleted[u] += 1
         ln[v] = 0
+        su0, sw0, sd0 = su[0], sw[0], sd[0]
         for i in range(count):
             for side in range(2):
-                p, q = (su[i], sw[i]) if side == 0 else (sw[i], su[i])
+                p, q = (su0[i], sw0[i]) if side == 0 else (sw0[i], su0[i])
                 a, b, first = nb[p], nb[q], nbdm[p]
                 found = False
                 for e in range(st[a], st[a] + ln[a]):
                     if to[e] == b:
                         found = True
-                        if sd[i] < wt[e]:
-                            wt[e], mid[e], dm[e] = sd[i], v, first
+                        if sd0[i] < wt[e]:
+                            wt[e], mid[e], dm[e] = sd0[i], v, first
                         break
                 if found:
                     continue
@@ -293,20 +345,27 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
                     st[a], cp[a] = end, 2 * cp[a]
                     end += cp[a]
                 e = st[a] + ln[a]
-                to[e], wt[e], mid[e], dm[e] = b, sd[i], v, first
+                to[e], wt[e], mid[e], dm[e] = b, sd0[i], v, first
                 ln[a] += 1
         # the neighbours: a fresh priority each (counting only the contracted neighbour
         # and leaving the rest to the lazy updates cuts random 20%'s scans from 947 to
         # 181 million, but Boston_0_256's queries were 10-30% slower: kept)
+        n2 = 0
+        for i in range(d):
+            n2 = max(n2, ln[nb[i]] * ln[nb[i]])
+        su, sw, sd = _grow_rows(su, n2), _grow_rows(sw, n2), _grow_rows(sd, n2)
+        est = _grow(est, d)
+        if d < SERIAL:
+            _estimate_range(nb, 0, d, 1, 0, st, ln, to, wt, dm, free, unpruned, deleted, wd,
+                            wstamp, whop, tmark, tvia, stamps, hk, hn, sim_hops, sim_settle,
+                            su, sw, sd, est, scans)
+        else:
+            _estimate_parallel(nb, d, st, ln, to, wt, dm, free, unpruned, deleted, wd, wstamp,
+                               whop, tmark, tvia, stamps, hk, hn, sim_hops, sim_settle, su, sw,
+                               sd, est, scans)
         for i in range(d):
             u = nb[i]
-            n = ln[u]
-            su, sw, sd = _grow(su, n * n), _grow(sw, n * n), _grow(sd, n * n)
-            c2, stamp, w = _shortcuts(u, st, ln, to, wt, dm, free, unpruned, wd, wstamp, whop,
-                                      tmark, tvia, stamp, hk, hn, sim_hops, sim_settle, su,
-                                      sw, sd)
-            work += w
-            prio[u] = c2 - n + deleted[u]
+            prio[u] = est[i]
             qk, qn = _grow(qk, qs + 1), _grow(qn, qs + 1)
             push_plain(qk, qn, qs, prio[u], u)
             qs = qs + 1
@@ -330,7 +389,7 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
         un[uo[v]:uo[v] + n] = uto[a:a + n]
         uw[uo[v]:uo[v] + n] = uwt[a:a + n]
         um[uo[v]:uo[v] + n] = umid[a:a + n]
-    return uo, un, uw, um, rank, work
+    return uo, un, uw, um, rank, work + scans.sum()
 
 
 def hierarchy(blk: np.ndarray, cells: np.ndarray, offs: np.ndarray, nbr: np.ndarray,
