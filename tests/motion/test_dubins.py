@@ -94,10 +94,10 @@ def test_kernels_are_compiled_without_fastmath():
     # contracted arithmetic can move p2 by ~1e-16 and so the root by ~1e-8 there, past
     # the 1e-9 agreement with OMPL. Measured on 1M random queries: fastmath changed the
     # lengths by 3e-14 and gained 2 %; not worth that risk.
-    from skyroute.motion import dubins_kernel
+    from skyroute.motion import dubins_batch, dubins_kernel
 
-    for kernel in (D._lengths_kernel, dubins_kernel.shortest_length,
-                   dubins_kernel.shortest_length_simd, dubins_kernel.words):
+    for kernel in (dubins_batch.lengths_kernel, dubins_batch._block, dubins_batch._atan2_all,
+                   dubins_kernel.shortest_length, dubins_kernel.words):
         assert not kernel.targetoptions.get("fastmath"), kernel
 
 
@@ -240,7 +240,7 @@ def _degenerate_poses(rng, n):
 
 @pytest.mark.parametrize("span, turns", [(10.0, 1.0), (1.5, 1.0), (0.01, 1.0), (10.0, 20.0)])
 def test_branch_free_batch_kernel_is_the_per_node_kernel(span, turns):
-    # the batch runs shortest_length_simd (own polynomials, all six words, selects);
+    # the batch runs dubins_batch (own polynomials, all six words, selects, in stages);
     # the search runs shortest_length (libm, branches): one length, to rounding
     s, g = random_poses(np.random.default_rng(17), 50_000, span, turns)
     np.testing.assert_allclose(D.lengths(s, g, 1.0), _scalar_lengths(s, g, 1.0),

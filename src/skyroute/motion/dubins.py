@@ -21,11 +21,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, prange
 
 from skyroute.errors import OptionError
 from skyroute.motion import dubins_kernel
-from skyroute.motion.dubins_kernel import WORDS, shortest_length_simd
+from skyroute.motion.dubins_batch import lengths_kernel
+from skyroute.motion.dubins_kernel import WORDS
 from skyroute.motion.tour import TourResult, tour  # noqa: F401  (skyroute.motion.dubins.tour)
 from skyroute.result import Status
 
@@ -103,24 +103,7 @@ def lengths(starts, goals, radius: float) -> np.ndarray:
     g = np.ascontiguousarray(goals, dtype=np.float64).reshape(-1, 3)
     if s.shape != g.shape:
         raise OptionError(f"starts {s.shape} and goals {g.shape} must have the same shape")
-    return _lengths_kernel(s, g, float(radius))
-
-
-@njit(cache=True, parallel=True, error_model="numpy")
-def _lengths_kernel(s, g, r):
-    """The shortest of the six closed forms for every query, across cores
-    (:func:`skyroute.motion.dubins_kernel.shortest_length_simd`, inlined).
-
-    The (N, 3) C-contiguous poses are read as flat arrays: at the constant stride 3
-    LLVM vectorises the loop (4 queries per AVX2 instruction); through the 2-d indexing
-    the row stride is a run-time value and it does not."""
-    n = s.shape[0]
-    sf, gf = s.reshape(-1), g.reshape(-1)
-    out = np.empty(n)
-    for i in prange(n):
-        out[i] = shortest_length_simd(sf[3 * i], sf[3 * i + 1], sf[3 * i + 2],
-                                      gf[3 * i], gf[3 * i + 1], gf[3 * i + 2], r)
-    return out
+    return lengths_kernel(s, g, float(radius))
 
 
 @dataclass(frozen=True)

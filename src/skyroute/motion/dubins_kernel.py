@@ -2,7 +2,7 @@
 
 :mod:`skyroute.motion.dubins` evaluates the six words in numpy for many queries and
 :func:`~skyroute.motion.dubins.lengths` compiles only the shortest length
-(:func:`shortest_length_simd`, branch-free so that its loop vectorises). A search that
+(:mod:`.dubins_batch`, branch-free so that its loops vectorise). A search that
 tries analytic expansions needs the words themselves (which word, its three piece
 lengths) for one query at a time without leaving compiled code: :func:`words` gives all
 six, the same closed forms and the same angle snapping as :func:`dubins._words` (tested
@@ -19,8 +19,6 @@ import math
 
 import numpy as np
 from numba import njit
-
-from skyroute.motion import trig
 
 TWO_PI = 2 * math.pi
 WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
@@ -102,27 +100,6 @@ def words(sx, sy, sth, gx, gy, gth, r):
     return out, total
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _wrap(a):
-    """:func:`_m2p` without branches (selects, so that a loop of it vectorises): the
-    same value for every a (both of its ways are computed, one is kept)."""
-    u = a + (TWO_PI if a < 0.0 else 0.0) - (TWO_PI if a >= TWO_PI else 0.0)
-    u = u + (TWO_PI if u < 0.0 else 0.0)
-    w = a - TWO_PI * np.floor(a / TWO_PI)
-    u = u if (a >= -2 * TWO_PI) & (a < 2 * TWO_PI) else w
-    u = 0.0 if (a < 0.0) & (a > -1e-12) else u
-    return 0.0 if TWO_PI - u < 1e-12 else u
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _wrap_near(a):
-    """:func:`_wrap` for a in [-4 pi, 4 pi) (sums of angles already wrapped): adds only."""
-    u = a + (TWO_PI if a < 0.0 else 0.0) - (TWO_PI if a >= TWO_PI else 0.0)
-    u = u + (TWO_PI if u < 0.0 else 0.0)
-    u = 0.0 if (a < 0.0) & (a > -1e-12) else u
-    return 0.0 if TWO_PI - u < 1e-12 else u
-
-
 @njit(cache=True, inline="always")
 def shortest_length(sx, sy, sth, gx, gy, gth, r):
     """Length of the shortest Dubins path (metres): :func:`words` without its arrays
@@ -133,7 +110,7 @@ def shortest_length(sx, sy, sth, gx, gy, gth, r):
     difference (only its value modulo 2 pi matters), LSL's and RSR's tangent angles
     shared with the CCC words. Equal to the six words of :func:`words` to ~1e-14 (tests).
     Branches skip the words that do not exist: one query at a time this is faster than
-    :func:`shortest_length_simd`, which a loop of queries runs 4 at a time.
+    :mod:`.dubins_batch`, which runs a loop of queries 4 at a time.
     """
     dx, dy = gx - sx, gy - sy
     d = math.sqrt(dx * dx + dy * dy) / r
@@ -183,60 +160,6 @@ def shortest_length(sx, sy, sth, gx, gy, gth, r):
         t = _m2p(-a + t_lsl + p / 2)
         best = min(best, t + p + _m2p(_m2p(b) - a - t + p))
     return best * r
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def shortest_length_simd(sx, sy, sth, gx, gy, gth, r):
-    """:func:`shortest_length` for a loop over many queries (the batch): the same
-    closed forms and sharing. No branches and no libm calls (:mod:`.trig`): all six
-    words are evaluated and a missing one is inf, so a loop of queries vectorises.
-    Equal to :func:`shortest_length` to ~1e-14 (tests).
-    """
-    dx, dy = gx - sx, gy - sy
-    d = math.sqrt(dx * dx + dy * dy) / r
-    phi = trig.atan2(dy, dx)
-    a = _wrap(sth - phi)
-    b = _wrap(gth - phi)
-    sa, ca = trig.sincos(a)
-    sb, cb = trig.sincos(b)
-    cab = 1.0 if abs(a - b) < 1e-8 else ca * cb + sa * sb  # as shortest_length: a select
-    dd = d * d
-    t_lsl = trig.atan2(cb - ca, d + sa - sb)
-    t_rsr = trig.atan2(ca - cb, d - sa + sb)
-    inf = math.inf
-    p2 = 2 + dd - 2 * cab + 2 * d * (sa - sb)  # LSL
-    w = _wrap_near(t_lsl - a) + math.sqrt(max(p2, 0.0)) + _wrap_near(b - t_lsl)
-    best = w if p2 >= 0 else inf
-    p2 = 2 + dd - 2 * cab + 2 * d * (sb - sa)  # RSR
-    w = _wrap_near(a - t_rsr) + math.sqrt(max(p2, 0.0)) + _wrap_near(t_rsr - b)
-    best = min(best, w if p2 >= 0 else inf)
-    p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
-    p = math.sqrt(max(p2, 0.0))
-    # atan2(y, x) - atan2(-2, p), as one atan2 (angle difference, modulo 2 pi)
-    y, x = -ca - cb, d + sa + sb
-    tmp = trig.atan2(y * p + 2 * x, x * p - 2 * y)
-    w = _wrap_near(tmp - a) + p + _wrap_near(tmp - b)
-    best = min(best, w if p2 >= 0 else inf)
-    p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
-    p = math.sqrt(max(p2, 0.0))
-    y, x = ca + cb, d - sa - sb  # atan2(y, x) - atan2(2, p)
-    tmp = trig.atan2(y * p - 2 * x, x * p + 2 * y)
-    w = _wrap_near(a - tmp) + p + _wrap_near(b - tmp)
-    best = min(best, w if p2 >= 0 else inf)
-    c = (6.0 - dd + 2 * cab + 2 * d * (sa - sb)) / 8.0  # RLR
-    p = _wrap_near(TWO_PI - trig.acos(min(max(c, -1.0), 1.0)))
-    t = _wrap_near(a - t_rsr + p / 2)
-    w = t + p + _wrap_near(a - b - t + p)
-    best = min(best, w if abs(c) <= 1 else inf)
-    c = (6.0 - dd + 2 * cab + 2 * d * (sb - sa)) / 8.0  # LRL
-    p = _wrap_near(TWO_PI - trig.acos(min(max(c, -1.0), 1.0)))
-    t = _wrap_near(-a + t_lsl + p / 2)
-    w = t + p + _wrap_near(b - a - t + p)
-    best = min(best, w if abs(c) <= 1 else inf)
-    # the goal is the start pose: cab above rounds to 1 - ulp and drops the zero-length
-    # LSR word, leaving only full circles (OMPL special-cases it too)
-    same = (d == 0.0) & (_wrap_near(a - b) < 1e-12)
-    return 0.0 if same else best * r
 
 
 @njit(cache=True)
