@@ -24,7 +24,7 @@ TWO_PI = 2 * math.pi
 WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _m2p(a):
     """:func:`_mod2pi` for one angle. Angles in [-4 pi, 4 pi) (all but a caller's own
     headings far from 0) are wrapped by adds instead of a division and a floor: the same

@@ -82,7 +82,7 @@ def edge_index(polygons: np.ndarray) -> EdgeIndex:
     return EdgeIndex(edges, owner, first, start, items, x0, y0, float(cell), nx, ny, eps)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _two_sum(a, b):
     """a + b as x + y exactly (Knuth)."""
     x = a + b
@@ -91,7 +91,7 @@ def _two_sum(a, b):
     return x, (a - av) + (b - bv)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _two_product(a, b):
     """a * b as x + y exactly (Dekker's split, no FMA needed)."""
     x = a * b

@@ -156,7 +156,7 @@ def grow(a, n):
     if n <= a.shape[0]:
         return a
     b = np.empty(max(2 * a.shape[0], n), a.dtype)
-    b[:a.shape[0]] = a
+    _copy_into(b, a)
     return b
 
 
@@ -166,8 +166,17 @@ def grow_zeroed(a, n):
     if n <= a.shape[0]:
         return a
     b = np.zeros(max(2 * a.shape[0], n), a.dtype)
-    b[:a.shape[0]] = a
+    _copy_into(b, a)
     return b
+
+
+@njit(cache=True, inline="always")
+def _copy_into(b, a):
+    """b[:len(a)] = a as a loop: numba's slice assignment checks shapes with an error
+    message built from them, and compiling that formatting costs seconds the first time
+    in a process (docs/benchmarks.md section 3)."""
+    for i in range(a.shape[0]):
+        b[i] = a[i]
 
 
 @njit(cache=True, inline="always")

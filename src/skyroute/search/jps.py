@@ -60,7 +60,7 @@ def jump_tables(blk, Wp):
     return table
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _steps(v, dirn, cx, cy, gx, gy):
     """Steps from (cx, cy) in straight direction ``dirn``, whose jump-table entry is
     ``v``, to the goal or the first jump point, whichever comes first; 0 when the scan

@@ -42,7 +42,7 @@ def h_of(kind, dx, dy):
     return 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def xy(c, Wp, inv):
     """(x, y) of flat index c on rows of ``Wp`` cells, ``inv`` = 1 / Wp: a float multiply
     instead of two 64-bit integer divisions, which cost more than the rest of an A*

@@ -28,7 +28,7 @@ XC = tuple(0 if dx > 0 else 1 for dx in DX)
 YC = tuple(2 if dy > 0 else 3 for dy in DY)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step(k, Wp):
     """Flat offset of move k on a padded grid of row length Wp."""
     return DY[k] * Wp + DX[k]

@@ -30,7 +30,7 @@ F32_ERR = 2.0 ** -23  # twice float32's relative rounding
 ACTIVE = 16  # landmarks a query uses at most (of the index's up to 64)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _oct(dx, dy):
     """Octile length of a (dx, dy) offset."""
     dx, dy = abs(dx), abs(dy)

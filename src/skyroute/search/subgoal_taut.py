@@ -37,7 +37,7 @@ DIRS = ((1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1))
 ALWAYS = 256  # in the shortening table: some pair of steps shortens on any grid
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _bit(sx, sy):
     """The mask bit of unit step (sx, sy), each in -1, 0, 1 and not both 0."""
     if sy == 0:
