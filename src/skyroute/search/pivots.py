@@ -19,6 +19,7 @@ from numba import njit
 
 from skyroute.result import FOUND, NO_PATH
 from skyroute.search.astar import astar_kernel
+from skyroute.search.cache_lines import aligned_empty
 from skyroute.search.canonical import CANONICAL
 from skyroute.search.jps import jps_kernel
 from skyroute.search.space import to_cells, workspace
@@ -59,7 +60,7 @@ def pivot_distances(mask: np.ndarray, label: np.ndarray, Wp: int,
     if not region.size:
         return np.empty((mask.size, 0))
     count = min(count, region.size)
-    out = np.empty((mask.size, count))
+    out = aligned_empty((mask.size, count))  # rows on cache lines: see cache_lines
     ws = workspace(mask.size)
     nearest = distances_from(mask, Wp, int(region[0]), ws)
     for j in range(count):

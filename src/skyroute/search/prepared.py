@@ -20,6 +20,7 @@ import numpy as np
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search import subgoal_table
+from skyroute.search.cache_lines import line_aligned
 from skyroute.search.canonical import CANONICAL
 from skyroute.search.pivots import jump_query, largest_region, pivot_distances
 from skyroute.search.space import space_of, workspace
@@ -80,6 +81,7 @@ class PreparedGrid:
             space = space_of(grid)
             self.accelerator = "jump"
             self._kernel = jump_query
+            arrays["piv"] = line_aligned(arrays["piv"])  # a loaded index: copied once
             self._args = (space.move_mask(8, False), CANONICAL, space.jump_table(),
                           arrays["label"], arrays["piv"], *workspace(self._blk.size),
                           self.Wp)
