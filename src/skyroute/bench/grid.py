@@ -4,8 +4,9 @@ All runners answer the same queries in one process, interleaved (the order rotat
 query, so drift in machine speed spreads evenly), after one untimed warm-up query each.
 Times are wall clock around one call: ``skyroute.plan`` for ours (validation included),
 ``PreparedGrid.plan`` for the ``prepared`` runner (its index is built once per map, timed
-apart as ``build_seconds``, its size the arrays' ``nbytes``), the peer's query function
-for a peer (its one-off set-up is not timed).
+apart as ``build_seconds``, its size the arrays' ``nbytes``), the peer's own query call
+for a peer (its one-off set-up is not timed). What the bench does with an answer (the
+peer path's octile cost, reading a result's fields) happens after the clock stops.
 """
 
 from __future__ import annotations
@@ -84,15 +85,23 @@ class RunnerStats:
         }
 
 
-def _ours(grid: Grid, algorithm: str) -> Callable:
+# A runner is (query, score): query(s, t) is the timed call, score(answer) turns its
+# answer into (cost or None, expanded, search seconds) after the clock has stopped.
+Runner = tuple[Callable, Callable]
+
+
+def _score_result(r) -> tuple:
+    return r.cost if r.found else None, r.expanded, r.seconds
+
+
+def _ours(grid: Grid, algorithm: str) -> Runner:
     def run(s, t):
-        r = plan(grid, s, t, algorithm=algorithm)
-        return r.cost if r.found else None, r.expanded, r.seconds
+        return plan(grid, s, t, algorithm=algorithm)
 
-    return run
+    return run, _score_result
 
 
-def _prepared(grid: Grid, info: dict) -> Callable:
+def _prepared(grid: Grid, info: dict) -> Runner:
     index = prepare(grid)  # first build: loads the compiled kernels from numba's cache
     index = prepare(grid)
     info.update(build_seconds=index.build_seconds, index_bytes=index.nbytes,
@@ -100,21 +109,17 @@ def _prepared(grid: Grid, info: dict) -> Callable:
                 accelerator=index.accelerator, index=index.describe(),
                 candidates_us={k: v * 1e6 for k, v in index.candidates.items()})
 
-    def run(s, t):
-        r = index.plan(s, t)
-        return r.cost if r.found else None, r.expanded, r.seconds
-
-    return run
+    return index.plan, _score_result
 
 
-def _peer(grid: Grid, name: str) -> Callable:
-    query = PEERS[name].prepare(grid)
+def _peer(grid: Grid, name: str) -> Runner:
+    peer = PEERS[name]
 
-    def run(s, t):
-        cells = query(s, t)
+    def score(answer):
+        cells = peer.cells(answer)
         return (None if cells is None else octile_cost(cells)), 0, 0.0
 
-    return run
+    return peer.prepare(grid), score
 
 
 def bench_map(map_path: Path, scen_path: Path, *, per_map: int, algorithms: Sequence[str],
@@ -151,22 +156,23 @@ def bench_queries(grid: Grid, scen: Scenario, label: str, *, per_map: int,
     rng = np.random.default_rng(seed)
     n = len(scen) if per_map <= 0 else min(per_map, len(scen))
     idx = np.sort(rng.choice(len(scen), size=n, replace=False))
-    runners = [(RunnerStats(a, False), _ours(grid, a)) for a in algorithms]
+    runners = [(RunnerStats(a, False), *_ours(grid, a)) for a in algorithms]
     info: dict = {}
     if prepared:
-        runners.append((RunnerStats("prepared", False), _prepared(grid, info)))
-    runners += [(RunnerStats(p, True), _peer(grid, p)) for p in peers]
+        runners.append((RunnerStats("prepared", False), *_prepared(grid, info)))
+    runners += [(RunnerStats(p, True), *_peer(grid, p)) for p in peers]
     first = idx[0]
-    for _, run in runners:  # warm-up: compile, caches
-        run(tuple(scen.starts[first].tolist()), tuple(scen.goals[first].tolist()))
+    for _, run, score in runners:  # warm-up: compile, caches
+        score(run(tuple(scen.starts[first].tolist()), tuple(scen.goals[first].tolist())))
     for q, i in enumerate(idx):
         s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
         opt = float(scen.optimal[i])
         for k in range(len(runners)):
-            stats, run = runners[(k + q) % len(runners)]
+            stats, run, score = runners[(k + q) % len(runners)]
             t0 = time.perf_counter()
-            cost, expanded, search_s = run(s, t)
+            answer = run(s, t)
             stats.times.append(time.perf_counter() - t0)
+            cost, expanded, search_s = score(answer)
             stats.expanded += expanded
             stats.search_seconds += search_s
             if cost is None:
@@ -176,7 +182,7 @@ def bench_queries(grid: Grid, scen: Scenario, label: str, *, per_map: int,
             stats.matched += bool(scen.matches(int(i), cost))
         if on_query:
             on_query()
-    rows = [s.row() for s, _ in runners]
+    rows = [r[0].row() for r in runners]
     for row in rows:
         row["speedup_vs"] = {
             p["runner"]: p["median_ms"] / row["median_ms"]

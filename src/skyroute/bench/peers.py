@@ -1,8 +1,9 @@
 """Peer grid planners a user might otherwise pick, behind one small interface.
 
 Each peer builds what it needs from a Grid once (not timed) and then answers queries
-with a list of (x, y) cells or None. Peers are optional (``skyroute[bench]``); one that
-is not installed is reported, not fatal.
+in its own form, as a user of that library would get them; ``cells`` turns an answer
+into an array of (x, y) cells or None, outside the timed call. Peers are optional
+(``skyroute[bench]``); one that is not installed is reported, not fatal.
 """
 
 from __future__ import annotations
@@ -15,17 +16,19 @@ import numpy as np
 
 from skyroute.world.grid import Grid
 
-Query = Callable[[tuple[int, int], tuple[int, int]], "np.ndarray | None"]
+Query = Callable[[tuple[int, int], tuple[int, int]], object]
 
 
 @dataclass(frozen=True)
 class Peer:
-    """A peer: its name, what problem it solves, and how to prepare it for a grid."""
+    """A peer: its name, what problem it solves, how to prepare it for a grid and how
+    to read its answer as (x, y) cells (None: no path)."""
 
     name: str
     module: str
     note: str
     prepare: Callable[[Grid], Query]
+    cells: Callable[[object], np.ndarray | None]
 
 
 def _pyastar2d(grid: Grid) -> Query:
@@ -34,10 +37,14 @@ def _pyastar2d(grid: Grid) -> Query:
     weights = np.where(grid.blocked, np.inf, 1.0).astype(np.float32)
 
     def query(s, t):
-        p = pyastar2d.astar_path(weights, (s[1], s[0]), (t[1], t[0]), allow_diagonal=True)
-        return None if p is None else p[:, ::-1]
+        return pyastar2d.astar_path(weights, (s[1], s[0]), (t[1], t[0]), allow_diagonal=True)
 
     return query
+
+
+def _rows_cols(path) -> np.ndarray | None:
+    """pyastar2d's (row, col) path as (x, y) cells."""
+    return None if path is None else path[:, ::-1]
 
 
 def _pathfinding(grid: Grid) -> Query:
@@ -50,10 +57,14 @@ def _pathfinding(grid: Grid) -> Query:
 
     def query(s, t):
         pf.cleanup()
-        path, _ = finder.find_path(pf.node(*s), pf.node(*t), pf)
-        return np.array([(n.x, n.y) for n in path]) if path else None
+        return finder.find_path(pf.node(*s), pf.node(*t), pf)[0]
 
     return query
+
+
+def _nodes(path) -> np.ndarray | None:
+    """python-pathfinding's list of nodes as (x, y) cells."""
+    return np.array([(n.x, n.y) for n in path]) if path else None
 
 
 def _networkx(grid: Grid) -> Query:
@@ -82,20 +93,25 @@ def _networkx(grid: Grid) -> Query:
 
     def query(s, t):
         try:
-            return np.array(nx.astar_path(G, tuple(s), tuple(t), heuristic=octile))
+            return nx.astar_path(G, tuple(s), tuple(t), heuristic=octile)
         except nx.NetworkXNoPath:
             return None
 
     return query
 
 
+def _tuples(path) -> np.ndarray | None:
+    """A list of (x, y) node tuples as cells."""
+    return None if path is None else np.array(path)
+
+
 PEERS = {
     "pyastar2d": Peer("pyastar2d", "pyastar2d", "C++ A*; cuts corners, diagonal cost 1",
-                      _pyastar2d),
+                      _pyastar2d, _rows_cols),
     "pathfinding": Peer("pathfinding", "pathfinding", "python-pathfinding AStarFinder, "
-                        "no corner cutting", _pathfinding),
+                        "no corner cutting", _pathfinding, _nodes),
     "networkx": Peer("networkx", "networkx", "networkx astar_path on the move graph "
-                     "(graph build not timed)", _networkx),
+                     "(graph build not timed)", _networkx, _tuples),
 }
 
 
