@@ -87,6 +87,19 @@ def test_bad_queries_raise(algorithm, start, goal, words):
         skyroute.plan(skyroute.Grid(b), start, goal, algorithm=algorithm)
 
 
+@pytest.mark.parametrize("algorithm", ALGS)
+def test_cells_as_numpy_ints_or_lists_plan_as_tuples(algorithm):
+    # plain int pairs take plan's inline check; anything else goes through check_cell
+    b = np.zeros((6, 6), bool)
+    b[2, 1:5] = True
+    grid = skyroute.Grid(b)
+    want = skyroute.plan(grid, (0, 0), (5, 5), algorithm=algorithm)
+    for s, t in (([0, 0], [5, 5]), (np.array([0, 0]), np.array([5, 5])),
+                 ((np.int32(0), np.int64(0)), (5, 5)), ((False, False), (5, 5))):
+        got = skyroute.plan(grid, s, t, algorithm=algorithm)
+        assert got.cost == want.cost and np.array_equal(got.path, want.path)
+
+
 @pytest.mark.parametrize("options, words", [
     ({"algorithm": "dstar"}, "choose one of 'bfs', 'dijkstra', 'astar', 'jps'"),
     ({"connectivity": 6}, "connectivity=6 is not valid; choose one of 4, 8"),
@@ -165,13 +178,17 @@ def test_setup_is_timed_apart_from_the_search(algorithm, monkeypatch):
     from skyroute.search import grid_plan
 
     clock = [0.0]
-    kernel = grid_plan._search
+    runner = grid_plan._runner
 
-    def search(space, s, t, opts):
-        clock[0] += 100.0 if s == t else 1.0
-        return kernel(space, s, t, opts)
+    def timed_runner(space, opts):
+        run = runner(space, opts)
 
-    monkeypatch.setattr(grid_plan, "_search", search)
+        def search(s, t):
+            clock[0] += 100.0 if s == t else 1.0
+            return run(s, t)
+        return search
+
+    monkeypatch.setattr(grid_plan, "_runner", timed_runner)
     monkeypatch.setattr(grid_plan, "time", types.SimpleNamespace(perf_counter=lambda: clock[0]))
     rng = np.random.default_rng(5)
     grid = skyroute.Grid(rng.random((60, 60)) < 0.2)

@@ -14,12 +14,13 @@ from skyroute.result import STATUS_OF_CODE, PlanResult, Status
 from skyroute.search.astar import astar_kernel
 from skyroute.search.bfs import bfs_kernel
 from skyroute.search.canonical import CANONICAL, EVERY
+from skyroute.search.entry_points import entry_point
 from skyroute.search.jps import NO_PIVOTS, jps_kernel
 from skyroute.search.moves import HEURISTICS
 from skyroute.search.prune import PRUNE_MODES, prune_collinear, prune_los
 from skyroute.search.space import SearchSpace, space_of, to_cells
 from skyroute.search.theta import theta_kernel
-from skyroute.world.grid import Grid, check_cell
+from skyroute.world.grid import Grid
 
 GRID_ALGORITHMS = ("bfs", "dijkstra", "astar", "jps", "theta", "lazy_theta")
 ANY_ANGLE = ("theta", "lazy_theta")
@@ -104,21 +105,21 @@ def plan_grid(grid: Grid, start: tuple[int, int], goal: tuple[int, int],
     builds or loads - move masks, JPS's jump table, the workspace, compiled kernels from
     numba's cache - is timed apart and reported as ``extra["setup_seconds"]``.
     """
-    start = check_cell(grid, start, "start")
-    goal = check_cell(grid, goal, "goal")
     space = space_of(grid)
-    t_setup = time.perf_counter()
-    s, t = space.index(start), space.index(goal)
-    fresh = opts not in space.prepared
-    if fresh:
-        _finish(space, *_search(space, s, s, opts), opts)  # start == start: loads, builds
-        space.prepared.add(opts)
+    s, t = space.flat_pair(start, goal)
+    run = space.runners.get(opts)
+    extra = {}
+    if run is None:
+        t_setup = time.perf_counter()
+        run = _runner(space, opts)
+        _finish(space, *run(s, s), opts)  # start == start: loads, builds, warms
+        space.runners[opts] = run
+        extra["setup_seconds"] = time.perf_counter() - t_setup
     t0 = time.perf_counter()
-    result = _finish(space, *_search(space, s, t, opts), opts)
+    code, expanded, frontier, los, flat = run(s, t)
     seconds = time.perf_counter() - t0
-    extra = {"setup_seconds": t0 - t_setup} if fresh else {}
-    return PlanResult(result[0], result[1], result[2], result[3], result[4], result[5],
-                      seconds, opts.algorithm, extra)
+    return PlanResult.of_search(*_finish(space, code, expanded, frontier, los, flat, opts),
+                                seconds, opts.algorithm, extra)
 
 
 def _finish(space: SearchSpace, code, expanded, frontier, los, flat, opts: GridOptions):
@@ -135,26 +136,41 @@ def _finish(space: SearchSpace, code, expanded, frontier, los, flat, opts: GridO
     return Status.FOUND, path, length, expanded, frontier, los
 
 
-def _search(space: SearchSpace, s: int, t: int, o: GridOptions):
+def _runner(space: SearchSpace, o: GridOptions):
+    """``run(s, t) -> (code, expanded, max_frontier, los_checks, flat path)`` for one
+    option set on one grid: its kernel's compiled entry with every argument but the two
+    cells bound, so a query pays neither the dispatcher's typing of a dozen arguments
+    nor the choice of kernel."""
     blk, Wp = space.blocked, space.Wp
     floats, ints, keys = space.workspace()
-    los = 0
     if o.algorithm == "bfs":
-        code, exp, front, flat = bfs_kernel(blk, Wp, s, t, o.max_expansions, floats, ints)
-    elif o.algorithm == "jps":
-        code, exp, front, flat = jps_kernel(space.move_mask(8, False), CANONICAL,
-                                            space.jump_table(), Wp, s, t,
-                                            o.max_expansions, floats, ints, keys,
-                                            NO_PIVOTS)
-    else:
-        mask = space.move_mask(o.connectivity, o.corner_cutting)
-        hkind = HEURISTICS[o.heuristic]
-        if o.algorithm in ANY_ANGLE:
-            code, exp, front, los, flat = theta_kernel(
-                blk, mask, Wp, s, t, hkind, o.weight, o.max_expansions,
-                o.algorithm == "lazy_theta", floats, ints, keys)
-        else:
-            succ = CANONICAL if o.connectivity == 8 and not o.corner_cutting else EVERY
-            code, exp, front, flat = astar_kernel(mask, succ, Wp, s, t, hkind, o.weight,
-                                                  o.max_expansions, floats, ints, keys)
-    return code, exp, front, los, flat
+        call = entry_point(bfs_kernel, blk, Wp, 0, 0, o.max_expansions, floats, ints)
+
+        def run(s, t):
+            code, exp, front, flat = call(blk, Wp, s, t, o.max_expansions, floats, ints)
+            return code, exp, front, 0, flat
+        return run
+    if o.algorithm == "jps":
+        args = (space.move_mask(8, False), CANONICAL, space.jump_table(), Wp)
+        tail = (o.max_expansions, floats, ints, keys, NO_PIVOTS)
+        call = entry_point(jps_kernel, *args, 0, 0, *tail)
+
+        def run(s, t):
+            code, exp, front, flat = call(*args, s, t, *tail)
+            return code, exp, front, 0, flat
+        return run
+    mask = space.move_mask(o.connectivity, o.corner_cutting)
+    hkind = HEURISTICS[o.heuristic]
+    if o.algorithm in ANY_ANGLE:
+        tail = (hkind, o.weight, o.max_expansions, o.algorithm == "lazy_theta", floats,
+                ints, keys)
+        call = entry_point(theta_kernel, blk, mask, Wp, 0, 0, *tail)
+        return lambda s, t: call(blk, mask, Wp, s, t, *tail)
+    succ = CANONICAL if o.connectivity == 8 and not o.corner_cutting else EVERY
+    tail = (hkind, o.weight, o.max_expansions, floats, ints, keys)
+    call = entry_point(astar_kernel, mask, succ, Wp, 0, 0, *tail)
+
+    def run(s, t):
+        code, exp, front, flat = call(mask, succ, Wp, s, t, *tail)
+        return code, exp, front, 0, flat
+    return run

@@ -22,6 +22,7 @@ from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search import subgoal_table
 from skyroute.search.cache_lines import line_aligned
 from skyroute.search.canonical import CANONICAL
+from skyroute.search.entry_points import entry_point
 from skyroute.search.pivots import jump_query, largest_region, pivot_distances
 from skyroute.search.space import space_of, workspace
 from skyroute.search.subgoal_build import clearances, link, subgoal_ids
@@ -31,7 +32,7 @@ from skyroute.search.subgoal_contract import hierarchy
 from skyroute.search.subgoal_landmarks import landmark_distances
 from skyroute.search.subgoal_query import WS_ROWS, heap_capacity, subgoal_query
 from skyroute.search.subgoal_table import distance_table, table_query
-from skyroute.world.grid import Grid, check_cell
+from skyroute.world.grid import Grid
 
 METHODS = ("auto", "subgoal", "jump")
 FORMAT_VERSION = 3
@@ -44,7 +45,6 @@ NO_HIERARCHY = {"ch_offs": np.empty(0, np.int64), "ch_nbr": np.empty(0, np.int32
                 "ch_len": np.empty(0), "ch_mid": np.empty(0, np.int32),
                 "ch_core": np.empty(0, np.int32), "ch_dist": np.empty((0, 0)),
                 "ch_pred": np.empty((0, 0), np.int16)}
-_new = object.__new__
 
 
 def grid_digest(blocked: np.ndarray) -> str:
@@ -71,21 +71,17 @@ class PreparedGrid:
                  build_seconds: float = 0.0) -> None:
         self.grid, self.method, self.build_seconds = grid, method, build_seconds
         self.candidates: dict[str, float] = {}
-        self.width, self.height = grid.width, grid.height
-        self.Wp = grid.width + 2
-        padded = np.ones((grid.height + 2, grid.width + 2), np.uint8)
-        padded[1:-1, 1:-1] = grid.blocked
-        self._blk = padded.ravel()
+        self._space = space = space_of(grid)
+        self.Wp, self._blk = space.Wp, space.blocked
         self._arrays = arrays
         if method == "jump":
-            space = space_of(grid)
             self.accelerator = "jump"
             self._kernel = jump_query
             arrays["piv"] = line_aligned(arrays["piv"])  # a loaded index: copied once
             self._args = (space.move_mask(8, False), CANONICAL, space.jump_table(),
                           arrays["label"], arrays["piv"], *workspace(self._blk.size),
                           self.Wp)
-            self._call = entry_point(self._kernel, self._args)
+            self._call = entry_point(self._kernel, *self._args, 0, 0)
             return
         cells = arrays["cells"]
         sg = np.full(self._blk.size, -1, np.int32)
@@ -117,7 +113,7 @@ class PreparedGrid:
                           arrays["label"], lmd, np.zeros((3, lmd.shape[1])), ws,
                           np.zeros(m + 2), np.zeros((2, cap)), np.zeros(cap, np.int64),
                           self.Wp)
-        self._call = entry_point(self._kernel, self._args)
+        self._call = entry_point(self._kernel, *self._args, 0, 0)
 
     @property
     def subgoals(self) -> int:
@@ -146,11 +142,6 @@ class PreparedGrid:
         """Bytes of the index arrays, the padded grid and the query workspace."""
         return int(sum(a.nbytes for a in self._args[:-1]))
 
-    def _flat(self, cell, what: str) -> int:
-        """The padded flat index of a free cell; a QueryError naming ``what`` else."""
-        x, y = check_cell(self.grid, cell, what)
-        return (y + 1) * self.Wp + x + 1
-
     def plan(self, start, goal) -> PlanResult:
         """The exact octile path from cell ``start`` to ``goal``, both (x, y).
 
@@ -158,54 +149,24 @@ class PreparedGrid:
         no_path (at once, from component labels, when they lie in different free
         regions), ``path`` every cell, ``cost``; ``expanded`` counts graph nodes.
         """
-        # The common case inline (two plain int pairs on free cells): on small maps each
-        # microsecond of Python is a tenth of the query. Anything else goes to _flat.
-        w, h, Wp, blk = self.width, self.height, self.Wp, self._blk
-        try:
-            (x, y), (u, v) = start, goal
-        except (TypeError, ValueError):
-            x = None
-        if type(x) is int and type(y) is int and type(u) is int and type(v) is int \
-                and 0 <= x < w and 0 <= y < h and 0 <= u < w and 0 <= v < h \
-                and not blk[(y + 1) * Wp + x + 1] and not blk[(v + 1) * Wp + u + 1]:
-            s, t = (y + 1) * Wp + x + 1, (v + 1) * Wp + u + 1
-        else:
-            s, t = self._flat(start, "start"), self._flat(goal, "goal")
+        s, t = self._space.flat_pair(start, goal)
         t0 = time.perf_counter()
         code, path, cost, expanded, frontier = self._call(*self._args, s, t)
         seconds = time.perf_counter() - t0
-        # PlanResult's frozen __init__ costs several microseconds, a large share of a
-        # small map's query: fill the instance's fields directly (same type, same data).
-        r = _new(PlanResult)
-        r.__dict__.update(status=STATUS_OF_CODE[code], path=path, cost=cost,
-                          expanded=expanded, max_frontier=frontier, los_checks=0,
-                          seconds=seconds, algorithm=self.method, extra={},
-                          path_lonlat=None)
-        return r
+        return PlanResult.of_search(STATUS_OF_CODE[code], path, cost, expanded, frontier,
+                                    0, seconds, self.method, {})
 
     def save(self, path: str | Path) -> Path:
         """Write the index as ``.npz`` beside the map; return the path written."""
         path = Path(path)
         meta = {"version": np.int64(FORMAT_VERSION), "method": np.array(self.method),
-                "shape": np.array([self.height, self.width], np.int64),
+                "shape": np.array([self.grid.height, self.grid.width], np.int64),
                 "digest": np.array(grid_digest(self.grid.blocked))}
         tmp = path.with_name(path.name + ".tmp")
         with open(tmp, "wb") as f:
             np.savez(f, **meta, **{k: self._arrays[k] for k in INDEX_ARRAYS[self.method]})
         tmp.replace(path)
         return path
-
-
-def entry_point(kernel, args: tuple):
-    """The compiled entry of ``kernel`` for exactly ``args``' types and two int cells.
-
-    A dispatcher call types all its arguments on every call (about 1 us for a prepared
-    query's dozen arrays, a tenth of a small map's query); the index's arrays never
-    change, so their overload is resolved once (numba's cache loads it) and called
-    directly."""
-    from numba import typeof, types
-
-    return kernel.compile((*(typeof(a) for a in args), types.int64, types.int64))
 
 
 def z_order(x: np.ndarray, y: np.ndarray) -> np.ndarray:
