@@ -42,4 +42,8 @@ def test_bench_world_runs_end_to_end(early_process):
     assert rows["prm, shortcut"]["length_ratio"] >= 1.0 - 1e-9
     if ompl_available():
         assert rows["ompl RRTConnect"]["exact"] and rows["ompl RRTConnect"]["raw_ratio"] >= 1.0
+        simplified = rows["ompl RRTConnect, simplified"]  # timed with its simplification
+        assert simplified["seconds"] == pytest.approx(rows["ompl RRTConnect"]["seconds"] +
+                                                      simplified["simplify_seconds"])
+        assert simplified["simplified_ratio"] >= 1.0 - 1e-9
     assert "leaked" not in err

@@ -95,10 +95,38 @@ def run_skyroute(world: World, start, goal, radius: float) -> dict:
             "status": r.status.value}
 
 
+def dubins_checker(world: World) -> Callable[[object], bool]:
+    """OMPL's state validity callback for a ``DubinsStateSpace``: strictly inside the
+    boundary and outside every obstacle (the prepared union). It runs inside OMPL's timed
+    solve, so when the boundary is the bounds rectangle (``boundary_is_bounds``), four
+    comparisons replace the polygon test; some test must stay, as OMPL checks states
+    along Dubins curves, which can swing outside its bounds."""
+    from skyroute.bench.world import boundary_is_bounds
+
+    union = shapely.unary_union(world.obstacles)
+    shapely.prepare(union)
+    if boundary_is_bounds(world):
+        xmin, ymin, xmax, ymax = world.bounds
+
+        def valid_box(state) -> bool:
+            x, y = state.getX(), state.getY()
+            return xmin < x < xmax and ymin < y < ymax and \
+                not shapely.contains_xy(union, x, y)
+        return valid_box
+    inside = shapely.Polygon(world.boundary)
+    shapely.prepare(inside)
+
+    def valid(state) -> bool:
+        x, y = state.getX(), state.getY()
+        return bool(shapely.contains_xy(inside, x, y)) and not shapely.contains_xy(union, x, y)
+    return valid
+
+
 def run_ompl(world: World, start, goal, radius: float, planner: str,
              seconds: float) -> dict:
     """One OMPL solve in a DubinsStateSpace: time, exact solution or not, raw and
-    simplified lengths, and exact validity of both paths."""
+    simplified lengths, exact validity of both paths, and ``simplifySolution()``'s time
+    (``simplify_seconds``; not in ``seconds``)."""
     from ompl import base as ob
     from ompl import geometric as og
     from ompl import util as ou
@@ -106,19 +134,10 @@ def run_ompl(world: World, start, goal, radius: float, planner: str,
     from skyroute.bench.world import ompl_bounds
 
     ou.setLogLevel(ou.LOG_NONE)
-    union = shapely.unary_union(world.obstacles)
-    shapely.prepare(union)
-    inside = shapely.Polygon(world.boundary)
-    shapely.prepare(inside)
     space = ob.DubinsStateSpace(radius)
     space.setBounds(ompl_bounds(ob, world))
     ss = og.SimpleSetup(space)
-
-    def valid(state) -> bool:
-        x, y = state.getX(), state.getY()
-        return bool(shapely.contains_xy(inside, x, y)) and not shapely.contains_xy(union, x, y)
-
-    ss.setStateValidityChecker(valid)
+    ss.setStateValidityChecker(dubins_checker(world))
     s, g = space.allocState(), space.allocState()
     s.setX(start[0]), s.setY(start[1]), s.setYaw(start[2])
     g.setX(goal[0]), g.setY(goal[1]), g.setYaw(goal[2])
@@ -131,7 +150,7 @@ def run_ompl(world: World, start, goal, radius: float, planner: str,
            "found": str(status) == "Exact solution" and ss.haveExactSolutionPath()}
     if not row["found"]:
         return {**row, "length": None, "valid": None, "simplified": None,
-                "simplified_valid": None}
+                "simplified_valid": None, "simplify_seconds": None}
 
     def states():
         p = ss.getSolutionPath()
@@ -141,7 +160,9 @@ def run_ompl(world: World, start, goal, radius: float, planner: str,
 
     length, pts = states()
     row.update(length=length, valid=dubins_chain_free(world, pts, radius))
+    t0 = time.perf_counter()
     ss.simplifySolution()
+    row["simplify_seconds"] = time.perf_counter() - t0
     slength, spts = states()
     row.update(simplified=slength, simplified_valid=dubins_chain_free(world, spts, radius))
     return row

@@ -61,29 +61,17 @@ def ompl_available() -> bool:
 
 
 def run_ompl(world: World, start, goal, planner: str, seconds: float) -> dict:
-    """One OMPL solve: raw and simplified lengths, time, exact validity."""
+    """One OMPL solve: raw and simplified lengths, exact validity of both, the solve's
+    time (``seconds``) and ``simplifySolution()``'s (``simplify_seconds``)."""
     from ompl import base as ob
     from ompl import geometric as og
     from ompl import util as ou
 
     ou.setLogLevel(ou.LOG_NONE)
-    union = shapely.unary_union(world.obstacles)
-    shapely.prepare(union)
-    inside = world.boundary
-    if inside is not None:
-        inside = shapely.Polygon(inside)
-        shapely.prepare(inside)
     space = ob.RealVectorStateSpace(2)
     space.setBounds(ompl_bounds(ob, world))
     ss = og.SimpleSetup(space)
-
-    def valid(state) -> bool:
-        x, y = state[0], state[1]
-        if inside is not None and not shapely.contains_xy(inside, x, y):
-            return False
-        return not shapely.contains_xy(union, x, y)
-
-    ss.setStateValidityChecker(valid)
+    ss.setStateValidityChecker(ompl_checker(world))
     s, g = space.allocState(), space.allocState()
     s[0], s[1] = float(start[0]), float(start[1])
     g[0], g[1] = float(goal[0]), float(goal[1])
@@ -96,18 +84,35 @@ def run_ompl(world: World, start, goal, planner: str, seconds: float) -> dict:
     out = {"runner": f"ompl {planner}", "seconds": seconds, "exact": str(solved) ==
            "Exact solution"}
     if not out["exact"]:
-        return {**out, "raw": None, "simplified": None, "valid": None}
+        return {**out, "raw": None, "simplified": None, "valid": None,
+                "simplify_seconds": None}
     path = ss.getSolutionPath()
     raw = path.length()
     raw_pts = np.array([(path.getState(i)[0], path.getState(i)[1])
                         for i in range(path.getStateCount())])
+    t0 = time.perf_counter()
     ss.simplifySolution()
+    out["simplify_seconds"] = time.perf_counter() - t0
     path = ss.getSolutionPath()
     pts = np.array([(path.getState(i)[0], path.getState(i)[1])
                     for i in range(path.getStateCount())])
     return {**out, "raw": raw, "simplified": path.length(),
             "valid": path_exactly_free(world, pts),
             "raw_valid": path_exactly_free(world, raw_pts)}
+
+
+def ompl_rows(run: dict) -> list[dict]:
+    """:func:`run_ompl`'s result as table rows, each time beside the path it made: the
+    solve (raw path) and, when solved, "<runner>, simplified", timed as solve plus
+    ``simplifySolution()`` (as "prm, shortcut" times our search and shortcutting)."""
+    solve = {"runner": run["runner"], "seconds": run["seconds"], "exact": run["exact"],
+             "raw": run["raw"], "valid": run.get("raw_valid")}
+    if run["simplified"] is None:
+        return [solve]
+    return [solve, {"runner": f"{run['runner']}, simplified",
+                    "seconds": run["seconds"] + run["simplify_seconds"],
+                    "simplify_seconds": run["simplify_seconds"],
+                    "simplified": run["simplified"], "valid": run["valid"]}]
 
 
 def run_ours(world: World, start, goal, other: tuple | None = None) -> list[dict]:
@@ -154,7 +159,7 @@ def bench_query(world: World, start, goal, *, seconds: float, planners: tuple,
     optimum = rows[1]["length"]
     if ompl_available():
         for planner in planners:
-            rows.append(run_ompl(world, start, goal, planner, seconds))
+            rows += ompl_rows(run_ompl(world, start, goal, planner, seconds))
             if on_step:
                 on_step()
         reached = None
@@ -230,6 +235,37 @@ def city_queries(world: World, count: int, rng: np.random.Generator, *,
             "no_path_pairs": len(n), "no_path_median_ms": float(np.median(n)) if len(n)
             else None, "no_path_max_ms": float(n.max()) if len(n) else None,
             "corners": len(graph.corners)}
+
+
+def boundary_is_bounds(world: World) -> bool:
+    """The world's boundary is exactly its bounds rectangle (which OMPL's state space is
+    given), so a state sampled or interpolated on a straight line inside those bounds is
+    inside the boundary too."""
+    return world.boundary is not None and \
+        shapely.Polygon(world.boundary).equals(shapely.box(*world.bounds))
+
+
+def ompl_checker(world: World) -> Callable[[object], bool]:
+    """OMPL's state validity callback for a ``RealVectorStateSpace(2)`` over
+    :func:`ompl_bounds`: outside every obstacle (the prepared union) and inside the
+    boundary. It runs inside OMPL's timed solve, so the boundary test is left out when
+    :func:`boundary_is_bounds`: OMPL samples and interpolates (straight lines) only inside
+    its bounds. Only a state exactly on their edge then passes, and every returned path
+    is re-checked with the exact segment test."""
+    union = shapely.unary_union(world.obstacles)
+    shapely.prepare(union)
+    if world.boundary is None or boundary_is_bounds(world):
+        def valid(state) -> bool:
+            return not shapely.contains_xy(union, state[0], state[1])
+        return valid
+    inside = shapely.Polygon(world.boundary)
+    shapely.prepare(inside)
+
+    def valid_inside(state) -> bool:
+        x, y = state[0], state[1]
+        return bool(shapely.contains_xy(inside, x, y)) and \
+            not shapely.contains_xy(union, x, y)
+    return valid_inside
 
 
 def ompl_bounds(ob, world: World):
