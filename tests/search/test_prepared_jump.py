@@ -11,7 +11,8 @@ from hypothesis import HealthCheck, given, settings
 import skyroute
 from skyroute.bench.random_maps import octile_graph
 from skyroute.cli.app import main
-from skyroute.search.pivots import pivot_distances
+from skyroute.search import prepared, subgoal_contract, subgoal_table
+from skyroute.search.pivots import DENSE_PIVOTS, PIVOTS, pivot_distances
 from skyroute.search.prepared import region_labels
 from skyroute.search.space import space_of
 from skyroute.world.movingai import read_map, read_scen
@@ -26,7 +27,7 @@ def test_every_line_of_the_bundled_scenarios(name):
     path = skyroute.bundled_maps()[name]
     grid, scen = read_map(path), read_scen(path.with_name(path.name + ".scen"))
     index = _check_scenario(grid, scen, range(len(scen)), method="jump")
-    assert index.accelerator == "jump" and index.pivots == 16
+    assert index.accelerator == "jump" and index.pivots == DENSE_PIVOTS
 
 
 @pytest.mark.shared_data
@@ -90,7 +91,7 @@ def test_auto_keeps_the_faster_and_the_table_without_timing(tmp_path):
     assert index.candidates[index.method] == min(index.candidates.values())
     jump = skyroute.prepare(grid, method="jump")
     loaded = skyroute.load_index(jump.save(tmp_path / "paris.idx"), grid)
-    assert loaded.method == "jump" and loaded.pivots == 16 and loaded.subgoals == 0
+    assert loaded.method == "jump" and loaded.pivots == DENSE_PIVOTS and loaded.subgoals == 0
     for i in (0, len(scen) // 2, len(scen) - 1):
         s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
         a, b = jump.plan(s, t), loaded.plan(s, t)
@@ -120,7 +121,7 @@ def test_cli_prepare_jump(monkeypatch, capsys, tmp_path):
     with pytest.raises(SystemExit) as e:
         main()
     out = capsys.readouterr().out
-    assert e.value.code in (0, None) and "jump index, 16 pivots" in out
+    assert e.value.code in (0, None) and "jump index, 24 pivots" in out
     monkeypatch.setattr(sys, "argv", ["skyroute", "plan", "den312d", "--start", "50,76",
                                       "--goal", "60,13", "--index", str(idx), "--json"])
     with pytest.raises(SystemExit) as e:
@@ -136,3 +137,28 @@ def test_a_grid_without_free_cells_gets_no_pivots():
     assert index.pivots == 0
     with pytest.raises(skyroute.QueryError, match="blocked"):
         index.plan((0, 0), (4, 3))
+
+
+@pytest.mark.parametrize("contracts, pivots", [(True, PIVOTS), (False, DENSE_PIVOTS)])
+def test_auto_gives_the_jump_index_more_pivots_where_nothing_was_contracted(
+        monkeypatch, contracts, pivots):
+    # rooms and doors, 33 x 33: with no table, the subgoal graph contracts (its
+    # hierarchy took the build's time: 16 pivots) or, with no contraction budget, only
+    # the landmark A* answers it (24 pivots, a tenth faster on random maps)
+    blocked = np.zeros((33, 33), bool)
+    blocked[::8, :] = blocked[:, ::8] = True
+    blocked[4::8, ::8] = blocked[::8, 4::8] = False
+    monkeypatch.setattr(subgoal_table, "TABLE_MAX", 0)
+    monkeypatch.setattr(subgoal_contract, "BUDGET",
+                        subgoal_contract.BUDGET if contracts else -1)
+    asked = []
+
+    def recording(mask, label, Wp, count):
+        asked.append(count)
+        return pivot_distances(mask, label, Wp, count)
+
+    monkeypatch.setattr(prepared, "pivot_distances", recording)
+    index = skyroute.prepare(skyroute.Grid(blocked))
+    assert asked == [pivots] and set(index.candidates) == {"subgoal", "jump"}
+    if index.method == "subgoal":  # auto kept the graph: answered as the rule assumed
+        assert index.accelerator == ("hierarchy" if contracts else "landmarks")

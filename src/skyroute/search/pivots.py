@@ -7,7 +7,7 @@ the grid cells rather than on a graph). It sharpens the octile guess most where 
 wind round scattered obstacles, which is where an online search expands most. The
 pivots are chosen farthest first within the largest free region; the distances are
 float64 (as exact as the octile distance) and node-major, so one node's bounds share
-one or two cache lines.
+two (16 pivots) or three (24) cache lines.
 """
 
 from __future__ import annotations
@@ -26,6 +26,10 @@ from skyroute.search.space import to_cells, workspace
 
 MAX_EXPANSIONS = 1 << 62
 PIVOTS = 16  # 16 x 8 bytes a cell: 34 MB for 512 x 512 (section 12 of the benchmarks)
+# Where no contraction hierarchy was built (graphs too dense to contract, the jump index
+# alone), the build has time for more pivots: 24 (51 MB for 512 x 512) answer random
+# 512 maps at 10-20% blocked about a tenth faster (section 12, round 9).
+DENSE_PIVOTS = 24
 
 
 def distances_from(mask: np.ndarray, Wp: int, source: int, ws: tuple) -> np.ndarray:

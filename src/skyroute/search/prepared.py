@@ -23,7 +23,7 @@ from skyroute.search import subgoal_table
 from skyroute.search.cache_lines import line_aligned
 from skyroute.search.canonical import CANONICAL
 from skyroute.search.entry_points import entry_point
-from skyroute.search.pivots import jump_query, largest_region, pivot_distances
+from skyroute.search.pivots import DENSE_PIVOTS, PIVOTS, jump_query, largest_region, pivot_distances
 from skyroute.search.space import space_of, workspace
 from skyroute.search.subgoal_build import clearances, link, subgoal_ids
 from skyroute.search.subgoal_ch_query import WS_ROWS as CH_WS_ROWS
@@ -58,7 +58,7 @@ class PreparedGrid:
     """A grid with its index: ``plan(start, goal)`` answers exact octile queries.
 
     ``method`` is the index kind: "subgoal" (a subgoal graph) or "jump" (JPS with the
-    differential bounds of 16 pivots). ``build_seconds`` is how long :func:`prepare`
+    differential bounds of 16 or 24 pivots). ``build_seconds`` is how long :func:`prepare`
     took (0 for a loaded index); ``nbytes`` counts the index arrays and the query
     workspace; ``accelerator`` names what answers: for a subgoal graph "table" (<= 2048
     subgoals), "hierarchy" (a contraction hierarchy with a table for its core) or
@@ -247,10 +247,11 @@ def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
     ``method`` "subgoal": a simple subgoal graph (Uras, Koenig & Hernandez 2013) with
     component labels, answered by an all-pairs table, a contraction hierarchy or A*
     with landmarks; "jump": JPS whose octile heuristic is sharpened by the exact
-    distances from 16 pivots (a differential heuristic: 128 bytes a cell); "auto" (the
+    distances from 24 pivots (a differential heuristic: 192 bytes a cell); "auto" (the
     default) builds the subgoal graph, keeps it when its table answers (small maps),
     and otherwise builds both and keeps the one that answers 32 seeded sample queries
-    faster (``candidates`` holds the times). docs/benchmarks.md section 12 says why.
+    faster (``candidates`` holds the times); its jump index has 16 pivots where the
+    subgoal graph was contracted into a hierarchy (that build took the time), else 24. docs/benchmarks.md section 12 says why.
 
     Examples
     --------
@@ -273,7 +274,9 @@ def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
         built.append(PreparedGrid(grid, build_arrays(blocked, label), method="subgoal"))
     if method == "jump" or (method == "auto" and built[0].accelerator != "table"):
         space = space_of(grid)
-        piv = pivot_distances(space.move_mask(8, False), label, space.Wp)
+        contracted = built and built[0].accelerator == "hierarchy"
+        piv = pivot_distances(space.move_mask(8, False), label, space.Wp,
+                              PIVOTS if contracted else DENSE_PIVOTS)
         built.append(PreparedGrid(grid, {"label": label, "piv": piv}, method="jump"))
     index = built[0]
     if len(built) > 1:  # auto: the faster on the same sample
