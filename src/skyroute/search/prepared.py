@@ -251,7 +251,8 @@ def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
     default) builds the subgoal graph, keeps it when its table answers (small maps),
     and otherwise builds both and keeps the one that answers 32 seeded sample queries
     faster (``candidates`` holds the times); its jump index has 16 pivots where the
-    subgoal graph was contracted into a hierarchy (that build took the time), else 24. docs/benchmarks.md section 12 says why.
+    subgoal graph was contracted into a hierarchy (that build took the time), else 24.
+    docs/benchmarks.md section 12 says why.
 
     Examples
     --------
