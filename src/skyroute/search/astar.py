@@ -22,7 +22,7 @@ from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
 from skyroute.search.canonical import LOWEST, START
 from skyroute.search.moves import COSTS, MDX, MDY, SQRT2_M1, h_of, offsets, xy
-from skyroute.search.trace import trace_moves
+from skyroute.search.trace import to_cells, trace_moves
 
 ON_LEVEL = np.iinfo(np.int32).max  # state of a cell on the equal-f stack
 U0, U1, U2, U4 = np.uint64(0), np.uint64(1), np.uint64(2), np.uint64(4)  # unsigned constants
@@ -31,7 +31,8 @@ U0, U1, U2, U4 = np.uint64(0), np.uint64(1), np.uint64(2), np.uint64(4)  # unsig
 @njit(cache=True)
 def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, floats, ints,
                  keys):
-    """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier, path).
+    """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier,
+    path, length): ``path`` the (x, y) cells, empty unless found (:func:`to_cells`).
 
     floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`; its ``state``
     row must be all zeros on entry and is all zeros again on return; ``ints[0]`` receives
@@ -181,5 +182,6 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
             max_frontier = size + nl
     heap.reset(state, touched, nt)
     if code == FOUND:
-        return code, expanded, max_frontier, trace_moves(entered, offs, start, goal)
-    return code, expanded, max_frontier, np.empty(0, np.int64)
+        path, length = to_cells(trace_moves(entered, offs, start, goal), Wp)
+        return code, expanded, max_frontier, path, length
+    return code, expanded, max_frontier, np.empty((0, 2)), np.inf

@@ -7,12 +7,13 @@ from numba import njit
 
 from skyroute.result import FOUND, NO_PATH, stop_code
 from skyroute.search.heap import reset
-from skyroute.search.trace import trace
+from skyroute.search.trace import to_cells, trace
 
 
 @njit(cache=True)
 def bfs_kernel(blk, Wp, start, goal, max_expansions, floats, ints):
-    """FIFO search over the 4 orthogonal moves; return (status, expanded, max_frontier, path).
+    """FIFO search over the 4 orthogonal moves; return (status, expanded, max_frontier,
+    path, length), ``path`` the (x, y) cells (empty unless found).
 
     floats, ints: the workspace of :meth:`SearchSpace.workspace` (its ``state`` row all
     zeros on entry and on return). The queue doubles as the list of touched cells; ``g``
@@ -51,5 +52,6 @@ def bfs_kernel(blk, Wp, start, goal, max_expansions, floats, ints):
         code = NO_PATH
     reset(state, queue, tail)
     if code == FOUND:
-        return code, expanded, max_frontier, trace(parent, start, goal)
-    return code, expanded, max_frontier, np.empty(0, np.int64)
+        path, length = to_cells(trace(parent, start, goal), Wp)
+        return code, expanded, max_frontier, path, length
+    return code, expanded, max_frontier, np.empty((0, 2)), np.inf

@@ -10,7 +10,7 @@ from functools import lru_cache
 import numpy as np
 
 from skyroute.errors import OptionError, check_choice
-from skyroute.result import STATUS_OF_CODE, PlanResult, Status
+from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search.astar import astar_kernel
 from skyroute.search.bfs import bfs_kernel
 from skyroute.search.canonical import CANONICAL, EVERY
@@ -18,8 +18,9 @@ from skyroute.search.entry_points import entry_point
 from skyroute.search.jps import NO_PIVOTS, jps_kernel
 from skyroute.search.moves import HEURISTICS
 from skyroute.search.prune import PRUNE_MODES, prune_collinear, prune_los
-from skyroute.search.space import SearchSpace, space_of, to_cells
+from skyroute.search.space import SearchSpace, space_of
 from skyroute.search.theta import theta_kernel
+from skyroute.search.trace import to_cells
 from skyroute.world.grid import Grid
 
 GRID_ALGORITHMS = ("bfs", "dijkstra", "astar", "jps", "theta", "lazy_theta")
@@ -116,28 +117,28 @@ def plan_grid(grid: Grid, start: tuple[int, int], goal: tuple[int, int],
         space.runners[opts] = run
         extra["setup_seconds"] = time.perf_counter() - t_setup
     t0 = time.perf_counter()
-    code, expanded, frontier, los, flat = run(s, t)
+    answer = run(s, t)
     seconds = time.perf_counter() - t0
-    return PlanResult.of_search(*_finish(space, code, expanded, frontier, los, flat, opts),
-                                seconds, opts.algorithm, extra)
+    return PlanResult.of_search(*_finish(space, *answer, opts), seconds, opts.algorithm,
+                                extra)
 
 
-def _finish(space: SearchSpace, code, expanded, frontier, los, flat, opts: GridOptions):
-    """(status, path, cost, expanded, max_frontier, los_checks) after pruning."""
-    if code != 0:
-        return STATUS_OF_CODE[code], np.empty((0, 2)), math.inf, expanded, frontier, los
-    if opts.prune == "collinear":
+def _finish(space: SearchSpace, code, expanded, frontier, los, path, cost,
+            opts: GridOptions):
+    """(status, path, cost, expanded, max_frontier, los_checks), pruned as ``opts`` asks
+    (the kernels return every cell; pruning works on their flat indices)."""
+    if code == 0 and opts.prune != "none":
+        flat = ((path[:, 1] + 1) * space.Wp + path[:, 0] + 1).astype(np.int64)
         flat = prune_collinear(flat, space.Wp)
-    elif opts.prune == "los":
-        flat = prune_collinear(flat, space.Wp)
-        flat, checks = prune_los(space.blocked, space.Wp, flat)
-        los += checks
-    path, length = to_cells(flat, space.Wp)
-    return Status.FOUND, path, length, expanded, frontier, los
+        if opts.prune == "los":
+            flat, checks = prune_los(space.blocked, space.Wp, flat)
+            los += checks
+        path, cost = to_cells(flat, space.Wp)
+    return STATUS_OF_CODE[code], path, cost, expanded, frontier, los
 
 
 def _runner(space: SearchSpace, o: GridOptions):
-    """``run(s, t) -> (code, expanded, max_frontier, los_checks, flat path)`` for one
+    """``run(s, t) -> (code, expanded, max_frontier, los_checks, path, length)`` for one
     option set on one grid: its kernel's compiled entry with every argument but the two
     cells bound, so a query pays neither the dispatcher's typing of a dozen arguments
     nor the choice of kernel."""
@@ -147,8 +148,9 @@ def _runner(space: SearchSpace, o: GridOptions):
         call = entry_point(bfs_kernel, blk, Wp, 0, 0, o.max_expansions, floats, ints)
 
         def run(s, t):
-            code, exp, front, flat = call(blk, Wp, s, t, o.max_expansions, floats, ints)
-            return code, exp, front, 0, flat
+            code, exp, front, path, length = call(blk, Wp, s, t, o.max_expansions, floats,
+                                                  ints)
+            return code, exp, front, 0, path, length
         return run
     if o.algorithm == "jps":
         args = (space.move_mask(8, False), CANONICAL, space.jump_table(), Wp)
@@ -156,8 +158,8 @@ def _runner(space: SearchSpace, o: GridOptions):
         call = entry_point(jps_kernel, *args, 0, 0, *tail)
 
         def run(s, t):
-            code, exp, front, flat = call(*args, s, t, *tail)
-            return code, exp, front, 0, flat
+            code, exp, front, path, length = call(*args, s, t, *tail)
+            return code, exp, front, 0, path, length
         return run
     mask = space.move_mask(o.connectivity, o.corner_cutting)
     hkind = HEURISTICS[o.heuristic]
@@ -171,6 +173,6 @@ def _runner(space: SearchSpace, o: GridOptions):
     call = entry_point(astar_kernel, mask, succ, Wp, 0, 0, *tail)
 
     def run(s, t):
-        code, exp, front, flat = call(mask, succ, Wp, s, t, *tail)
-        return code, exp, front, 0, flat
+        code, exp, front, path, length = call(mask, succ, Wp, s, t, *tail)
+        return code, exp, front, 0, path, length
     return run

@@ -27,7 +27,7 @@ from skyroute.search.astar import ON_LEVEL, U0, U1, U2, U4
 from skyroute.search.cache_lines import prefetch_row
 from skyroute.search.canonical import LOWEST, START
 from skyroute.search.moves import MDX, MDY, h_of, offsets, xy
-from skyroute.search.trace import trace
+from skyroute.search.trace import to_cells, trace
 
 NO_PIVOTS = np.empty((0, 0))  # online JPS: the octile heuristic alone
 
@@ -93,9 +93,10 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
 
     ``mask``: the 8-connected, no-corner-cutting move mask; ``succ``: the canonical
     successor table (:mod:`skyroute.search.canonical`, the same pruning rules); ``table``:
-    :func:`jump_tables`. Returns (status, expanded, max_frontier, path) with ``path``
-    every flat cell. floats, ints, keys: the workspace of :meth:`SearchSpace.workspace`
-    (its ``state`` row all zeros on entry and on return). ``piv``: (cells, P) distances
+    :func:`jump_tables`. Returns (status, expanded, max_frontier, path, length) with
+    ``path`` every cell as (x, y), empty unless found. floats, ints, keys: the workspace
+    of :meth:`SearchSpace.workspace` (its ``state`` row all zeros on entry and on
+    return). ``piv``: (cells, P) distances
     from P pivots (:mod:`skyroute.search.pivots`) whose differential bounds sharpen the
     octile heuristic; (0, 0) for the octile distance alone.
 
@@ -279,8 +280,9 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
             max_frontier = size + nl
     code = heap.finish(code, state, touched, nt)
     if code == FOUND:
-        return code, expanded, max_frontier, fill(trace(parent, start, goal), Wp)
-    return code, expanded, max_frontier, np.empty(0, np.int64)
+        path, length = to_cells(fill(trace(parent, start, goal), Wp), Wp)
+        return code, expanded, max_frontier, path, length
+    return code, expanded, max_frontier, np.empty((0, 2)), np.inf
 
 
 @njit(cache=True)

@@ -17,12 +17,12 @@ import math
 import numpy as np
 from numba import njit
 
-from skyroute.result import FOUND, NO_PATH
+from skyroute.result import NO_PATH
 from skyroute.search.astar import astar_kernel
 from skyroute.search.cache_lines import aligned_empty
 from skyroute.search.canonical import CANONICAL
 from skyroute.search.jps import jps_kernel
-from skyroute.search.space import to_cells, workspace
+from skyroute.search.space import workspace
 
 MAX_EXPANSIONS = 1 << 62
 PIVOTS = 16  # 16 x 8 bytes a cell: 34 MB for 512 x 512 (section 12 of the benchmarks)
@@ -38,8 +38,8 @@ def distances_from(mask: np.ndarray, Wp: int, source: int, ws: tuple) -> np.ndar
     every cell) run to exhaustion towards the blocked border cell 0; every cell it
     touched was expanded, with its final g. ``ws``: a :func:`space.workspace`."""
     floats, ints, keys = ws
-    _, expanded, _, _ = astar_kernel(mask, CANONICAL, Wp, source, 0, 0, 1.0, MAX_EXPANSIONS,
-                                     floats, ints, keys)
+    _, expanded, _, _, _ = astar_kernel(mask, CANONICAL, Wp, source, 0, 0, 1.0,
+                                        MAX_EXPANSIONS, floats, ints, keys)
     out = np.full(mask.size, np.inf)
     reached = ints[2][:expanded]
     out[reached] = floats[0][reached]
@@ -81,9 +81,6 @@ def jump_query(mask, succ, table, label, piv, floats, ints, keys, Wp, s, t):
     (k, 2) cells, cost, expanded, max_frontier), as the subgoal queries do."""
     if label[s] != label[t]:
         return NO_PATH, np.empty((0, 2)), math.inf, 0, 0
-    code, expanded, frontier, flat = jps_kernel(mask, succ, table, Wp, s, t, MAX_EXPANSIONS,
-                                                floats, ints, keys, piv)
-    if code != FOUND:  # not reached: the labels put both ends in one region
-        return code, np.empty((0, 2)), math.inf, expanded, frontier
-    path, cost = to_cells(flat, Wp)
-    return code, path, cost, expanded, frontier
+    code, expanded, frontier, path, cost = jps_kernel(mask, succ, table, Wp, s, t,
+                                                      MAX_EXPANSIONS, floats, ints, keys, piv)
+    return code, path, cost, expanded, frontier  # not found: the labels put both in one region

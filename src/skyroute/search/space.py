@@ -11,11 +11,9 @@ with ``Wp = width + 2``. Built once per grid and cached (plan once, query many):
 
 from __future__ import annotations
 
-import math
 import weakref
 
 import numpy as np
-from numba import njit
 
 from skyroute.caches import register
 from skyroute.search.jps import jump_tables
@@ -118,21 +116,6 @@ def workspace(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ints = np.empty((6, n), np.int32)
     ints[1] = 0
     return np.empty((2, n)), ints, np.empty(n, np.int64)
-
-
-@njit(cache=True)
-def to_cells(flat, Wp):
-    """(K, 2) float (x, y) cells of flat indices, and the polyline's Euclidean length."""
-    out = np.empty((len(flat), 2))
-    length = 0.0
-    for i in range(len(flat)):
-        out[i, 0] = flat[i] % Wp - 1
-        out[i, 1] = flat[i] // Wp - 1
-        if i:
-            dx = out[i, 0] - out[i - 1, 0]
-            dy = out[i, 1] - out[i - 1, 1]
-            length += math.sqrt(dx * dx + dy * dy)
-    return out, length
 
 
 _SPACES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

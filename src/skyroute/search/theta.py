@@ -21,7 +21,7 @@ from skyroute.result import FOUND, stop_code
 from skyroute.search import heap
 from skyroute.search.los import line_of_sight
 from skyroute.search.moves import COSTS, heuristic, move_ok, offsets
-from skyroute.search.trace import trace
+from skyroute.search.trace import to_cells, trace
 
 
 @njit(cache=True)
@@ -34,7 +34,8 @@ def _dist(a, b, Wp):
 @njit(cache=True)
 def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy,
                  floats, ints, keys):
-    """Return (status, expanded, max_frontier, los_checks, path of flat cells).
+    """Return (status, expanded, max_frontier, los_checks, path, length): ``path`` the
+    (x, y) cells (empty unless found).
 
     floats, ints, keys: the workspace of :meth:`SearchSpace.workspace` (its ``state`` row all
     zeros on entry and on return).
@@ -112,5 +113,6 @@ def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy
             max_frontier = size
     code = heap.finish(code, state, touched, nt)
     if code == FOUND:
-        return code, expanded, max_frontier, los, trace(parent, start, goal)
-    return code, expanded, max_frontier, los, np.empty(0, np.int64)
+        path, length = to_cells(trace(parent, start, goal), Wp)
+        return code, expanded, max_frontier, los, path, length
+    return code, expanded, max_frontier, los, np.empty((0, 2)), np.inf

@@ -1,6 +1,9 @@
-"""Read a path back out of a parent array (compiled, shared by every grid search)."""
+"""Read a path back out of a parent array, as flat cells and as (x, y) cells with its
+length (compiled, shared by every grid search)."""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numba import njit
@@ -39,3 +42,19 @@ def trace_moves(moves, offs, start, goal):
         if i:
             c -= offs[moves[c]]
     return out
+
+
+@njit(cache=True)
+def to_cells(flat, Wp):
+    """(K, 2) float (x, y) cells of flat indices, and the polyline's Euclidean length."""
+    out = np.empty((len(flat), 2))
+    length = 0.0
+    for i in range(len(flat)):
+        out[i, 0] = flat[i] % Wp - 1
+        out[i, 1] = flat[i] // Wp - 1
+        if i:
+            dx = out[i, 0] - out[i - 1, 0]
+            dy = out[i, 1] - out[i - 1, 1]
+            length += math.sqrt(dx * dx + dy * dy)
+    return out, length
+
