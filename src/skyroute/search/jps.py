@@ -96,9 +96,9 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
     :func:`jump_tables`. Returns (status, expanded, max_frontier, path, length) with
     ``path`` every cell as (x, y), empty unless found. floats, ints, keys: the workspace
     of :meth:`SearchSpace.workspace` (its ``state`` row all zeros on entry and on
-    return). ``piv``: (cells, P) distances
-    from P pivots (:mod:`skyroute.search.pivots`) whose differential bounds sharpen the
-    octile heuristic; (0, 0) for the octile distance alone.
+    return). ``piv``: (cells, P) distances from P pivots (:mod:`skyroute.search.pivots`)
+    whose differential bounds sharpen the octile heuristic; (0, 0) for the octile
+    distance alone.
 
     An expansion first lists its jump points (cell, x, y, entering move) in ``found``,
     prefetches their ``state``, ``g`` and pivot rows (cache misses on large maps, now

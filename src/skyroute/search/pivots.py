@@ -83,4 +83,5 @@ def jump_query(mask, succ, table, label, piv, floats, ints, keys, Wp, s, t):
         return NO_PATH, np.empty((0, 2)), math.inf, 0, 0
     code, expanded, frontier, path, cost = jps_kernel(mask, succ, table, Wp, s, t,
                                                       MAX_EXPANSIONS, floats, ints, keys, piv)
-    return code, path, cost, expanded, frontier  # not found: the labels put both in one region
+    # same labels, so the kernel reaches t; were it not, its path is empty and cost inf
+    return code, path, cost, expanded, frontier
