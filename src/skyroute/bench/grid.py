@@ -4,7 +4,8 @@ All runners answer the same queries in one process, interleaved (the order rotat
 query, so drift in machine speed spreads evenly), after one untimed warm-up query each.
 Times are wall clock around one call: ``skyroute.plan`` for ours (validation included),
 ``PreparedGrid.plan`` for the ``prepared`` runner (its index is built once per map, timed
-apart as ``build_seconds``, its size the arrays' ``nbytes``), the peer's own query call
+apart as ``build_seconds``, its size the arrays' ``nbytes``, the build's peak resident
+memory from a fresh process as ``build_peak_bytes``), the peer's own query call
 for a peer (its one-off set-up is not timed). What the bench does with an answer (the
 peer path's octile cost, reading a result's fields) happens after the clock stops.
 """
@@ -19,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from skyroute.bench.build_memory import build_peak_bytes
 from skyroute.bench.peers import PEERS, available, octile_cost
 from skyroute.bench.random_maps import far_queries, parse_random, random_grid
 from skyroute.errors import InputFormatError, OptionError, check_choice
@@ -105,6 +107,7 @@ def _prepared(grid: Grid, info: dict) -> Runner:
     index = prepare(grid)  # first build: loads the compiled kernels from numba's cache
     index = prepare(grid)
     info.update(build_seconds=index.build_seconds, index_bytes=index.nbytes,
+                build_peak_bytes=build_peak_bytes(grid.blocked),
                 subgoals=index.subgoals, edges=index.edges, pivots=index.pivots,
                 accelerator=index.accelerator, index=index.describe(),
                 candidates_us={k: v * 1e6 for k, v in index.candidates.items()})

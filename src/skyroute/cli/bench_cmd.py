@@ -41,7 +41,8 @@ def bench_grid(
              "scipy. Alone, only these maps run.")] = None,
     prepared: Annotated[bool, typer.Option(
         "--prepared", help="Also a prepared index per map (skyroute.prepare): its build "
-                           "seconds and bytes, and its queries as one more runner.")] = False,
+                           "seconds, peak memory and bytes, and its queries as one more "
+                           "runner.")] = False,
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] =
         None,
 ) -> None:
@@ -93,9 +94,10 @@ def _fmt(v, spec):
 
 def _table(rep: dict, peers: list[str]) -> Table:
     prep = rep.get("prepared")
-    caption = (f"prepared: built in {prep['build_seconds']:.3f} s, "
-               f"{prep['index_bytes'] / 1e6:.1f} MB (arrays' nbytes), {prep['index']}"
-               if prep else None)
+    caption = (f"prepared: built in {prep['build_seconds']:.3f} s, peak "
+               f"{_fmt(prep['build_peak_bytes'] and prep['build_peak_bytes'] / 1e6, '.1f')} "
+               f"MB resident, {prep['index_bytes'] / 1e6:.1f} MB (arrays' nbytes), "
+               f"{prep['index']}" if prep else None)
     t = Table(title=f"{rep['map']} ({rep['size'][0]}x{rep['size'][1]}): "
                     f"{rep['queries']} of {rep['scen_lines']} scenario lines", caption=caption)
     for col in ("runner", "median ms", "M exp/s", "matched", "cost/opt mean", "cost/opt max"):
