@@ -170,6 +170,18 @@ def grow_zeroed(a, n):
     return b
 
 
+@njit(cache=True)
+def grow_rows(a, n):
+    """:func:`grow` for each row of a (rows, k) array: ``a`` when a row holds at least
+    ``n`` entries, else a copy whose rows are twice as long (or ``n``)."""
+    if n <= a.shape[1]:
+        return a
+    b = np.empty((a.shape[0], max(2 * a.shape[1], n)), a.dtype)
+    for r in range(a.shape[0]):
+        _copy_into(b[r], a[r])
+    return b
+
+
 @njit(cache=True, inline="always")
 def _copy_into(b, a):
     """b[:len(a)] = a as a loop: numba's slice assignment checks shapes with an error

@@ -36,7 +36,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from skyroute.search.heap import pop_plain, push_plain
+from skyroute.search.heap import grow, grow_rows, pop_plain, push_plain
 from skyroute.search.subgoal_landmarks import edge_lengths
 from skyroute.search.subgoal_table import all_pairs
 from skyroute.search.subgoal_taut import edge_first_steps, free_around, shorten_table
@@ -169,26 +169,6 @@ def _estimate_parallel(nodes, k, st, ln, to, wt, dm, free, table, deleted, wd, w
 
 
 @njit(cache=True)
-def _grow(a, n):
-    """``a``, or a copy with room for at least n entries (twice as many)."""
-    if n <= a.size:
-        return a
-    b = np.empty(2 * n, a.dtype)
-    b[:a.size] = a
-    return b
-
-
-@njit(cache=True)
-def _grow_rows(a, n):
-    """``a`` (rows, k), or a copy with room for at least n entries a row (twice as many)."""
-    if n <= a.shape[1]:
-        return a
-    b = np.empty((a.shape[0], 2 * n), a.dtype)
-    b[:, :a.shape[1]] = a
-    return b
-
-
-@njit(cache=True)
 def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hops, sim_settle,
              core, budget):
     """Contract the CSR graph (``length`` per edge, taken as undirected) down to ``core``
@@ -268,7 +248,7 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
     n2 = 0
     for v in range(m):
         n2 = max(n2, ln[v] * ln[v])
-    su, sw, sd = _grow_rows(su, n2), _grow_rows(sw, n2), _grow_rows(sd, n2)
+    su, sw, sd = grow_rows(su, n2), grow_rows(sw, n2), grow_rows(sd, n2)
     _estimate_parallel(np.arange(m), m, st, ln, to, wt, dm, free, unpruned, deleted, wd,
                        wstamp, whop, tmark, tvia, stamps, hk, hn, sim_hops, sim_settle, su, sw,
                        sd, prio, scans)
@@ -286,7 +266,7 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
         if rank[v] >= 0 or k != prio[v]:
             continue
         d = ln[v]
-        su, sw, sd = _grow_rows(su, d * d), _grow_rows(sw, d * d), _grow_rows(sd, d * d)
+        su, sw, sd = grow_rows(su, d * d), grow_rows(sw, d * d), grow_rows(sd, d * d)
         count, stamps[0], w = _shortcuts(v, st, ln, to, wt, dm, free, table, wd[0], wstamp[0],
                                          whop[0], tmark[0], tvia[0], stamps[0], hk[0], hn[0],
                                          hops, settle, su[0], sw[0], sd[0])
@@ -294,16 +274,16 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
         p = count - d + deleted[v]
         if qs > 0 and p > qk[0]:
             prio[v] = p  # no longer the smallest: back into the queue
-            qk, qn = _grow(qk, qs + 1), _grow(qn, qs + 1)
+            qk, qn = grow(qk, qs + 1), grow(qn, qs + 1)
             push_plain(qk, qn, qs, p, v)
             qs = qs + 1
             continue
         # contract v: its edges become its upward edges and leave its neighbours' lists
         rank[v] = order
         order += 1
-        uto, uwt, umid = _grow(uto, uend + d), _grow(uwt, uend + d), _grow(umid, uend + d)
+        uto, uwt, umid = grow(uto, uend + d), grow(uwt, uend + d), grow(umid, uend + d)
         up_st[v], up_ln[v] = uend, d
-        nb, nbdm = _grow(nb, d), _grow(nbdm, d)
+        nb, nbdm = grow(nb, d), grow(nbdm, d)
         for j in range(d):
             e = st[v] + j
             uto[uend], uwt[uend], umid[uend] = to[e], wt[e], mid[e]
@@ -335,13 +315,11 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
                     continue
                 if ln[a] == cp[a]:  # full: move to the pool's end with twice the room
                     grown = end + 2 * cp[a]
-                    to, wt = _grow(to, grown), _grow(wt, grown)
-                    mid, dm = _grow(mid, grown), _grow(dm, grown)
-                    n = ln[a]
-                    to[end:end + n] = to[st[a]:st[a] + n]
-                    wt[end:end + n] = wt[st[a]:st[a] + n]
-                    mid[end:end + n] = mid[st[a]:st[a] + n]
-                    dm[end:end + n] = dm[st[a]:st[a] + n]
+                    to, wt = grow(to, grown), grow(wt, grown)
+                    mid, dm = grow(mid, grown), grow(dm, grown)
+                    for j in range(ln[a]):  # a loop: see heap._copy_into
+                        to[end + j], wt[end + j] = to[st[a] + j], wt[st[a] + j]
+                        mid[end + j], dm[end + j] = mid[st[a] + j], dm[st[a] + j]
                     st[a], cp[a] = end, 2 * cp[a]
                     end += cp[a]
                 e = st[a] + ln[a]
@@ -353,8 +331,8 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
         n2 = 0
         for i in range(d):
             n2 = max(n2, ln[nb[i]] * ln[nb[i]])
-        su, sw, sd = _grow_rows(su, n2), _grow_rows(sw, n2), _grow_rows(sd, n2)
-        est = _grow(est, d)
+        su, sw, sd = grow_rows(su, n2), grow_rows(sw, n2), grow_rows(sd, n2)
+        est = grow(est, d)
         if d < SERIAL:
             _estimate_range(nb, 0, d, 1, 0, st, ln, to, wt, dm, free, unpruned, deleted, wd,
                             wstamp, whop, tmark, tvia, stamps, hk, hn, sim_hops, sim_settle,
@@ -366,14 +344,14 @@ def contract(m, offs, nbr, length, fwd, back, free, table, hops, settle, sim_hop
         for i in range(d):
             u = nb[i]
             prio[u] = est[i]
-            qk, qn = _grow(qk, qs + 1), _grow(qn, qs + 1)
+            qk, qn = grow(qk, qs + 1), grow(qn, qs + 1)
             push_plain(qk, qn, qs, prio[u], u)
             qs = qs + 1
     # the core: nodes left uncontracted keep their edges among themselves
     for v in range(m):
         if rank[v] < 0:
             d = ln[v]
-            uto, uwt, umid = _grow(uto, uend + d), _grow(uwt, uend + d), _grow(umid, uend + d)
+            uto, uwt, umid = grow(uto, uend + d), grow(uwt, uend + d), grow(umid, uend + d)
             up_st[v], up_ln[v] = uend, d
             for e in range(st[v], st[v] + d):
                 uto[uend], uwt[uend], umid[uend] = to[e], wt[e], mid[e]

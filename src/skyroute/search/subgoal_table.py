@@ -78,7 +78,8 @@ def table_query(blk, sg, clr, label, cells, dist, pred, ws, Wp, s, t):
     if cells[ba] != s:
         hops[n] = s
         n += 1
-    hops[:n] = hops[:n][::-1].copy()
+    for i in range(n // 2):  # reversed in place (a slice assignment compiles for seconds)
+        hops[i], hops[n - 1 - i] = hops[n - 1 - i], hops[i]
     path, cost = _path(blk, hops, n, Wp)
     return FOUND, path, cost, ns * ng, 0
 
