@@ -38,7 +38,7 @@ def build_peak_bytes(blocked: np.ndarray, method: str = "auto") -> int | None:
     if proc.returncode != 0:
         last = (proc.stderr.strip().splitlines() or ["no output"])[-1]
         raise RuntimeError(f"build memory: the measuring process failed: {last}")
-    return json.loads(proc.stdout)["peak_bytes"]
+    return json.loads(proc.stdout.strip().splitlines()[-1])["peak_bytes"]  # the last line
 
 
 def _status_kb(field: str) -> int:
