@@ -37,3 +37,18 @@ def test_bench_grid_prepared_reports_build_time_peak_and_bytes(monkeypatch, caps
     assert prep["build_peak_bytes"] > 0
     assert f"peak {prep['build_peak_bytes'] / 1e6:.1f} MB resident" in " ".join(out.split())
     assert out.count("3/3") == 3  # astar, jps and the index match scipy's optimum
+
+
+def test_bench_grid_goes_on_when_the_measuring_process_fails(monkeypatch, capsys):
+    import skyroute.bench.grid as grid_mod
+    from tests.cli.test_cli import run
+
+    def fail(blocked):
+        raise RuntimeError("build memory: the measuring process failed: MemoryError")
+
+    monkeypatch.setattr(grid_mod, "build_peak_bytes", fail)
+    code, out, err = run(monkeypatch, capsys, "bench", "grid", "--random", "32:0.2",
+                         "--per-map", "2", "--peers", "", "--prepared")
+    assert code == 0, err
+    assert "measuring process failed: MemoryError" in err and "Traceback" not in err
+    assert "peak - MB resident" in " ".join(out.split())

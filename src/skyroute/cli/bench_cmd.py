@@ -76,6 +76,9 @@ def bench_grid(
                                         on_query=lambda: progress.advance(task)))
     out = Console()
     for rep in reports:
+        if rep.get("prepared", {}).get("build_peak_error"):
+            console.print(f"[yellow]{rep['map']}: {rep['prepared']['build_peak_error']}"
+                          "[/yellow]")
         out.print(_table(rep, have))
     if json_out:
         doc = {"settings": {"maps": str(folder), "per_map": per_map, "random": randoms,
