@@ -78,10 +78,17 @@ class PlanResult:
         microsecond, a tenth of a small map's query. Same type, same fields, the same
         object ``__init__`` would make."""
         r = _new(cls)
-        r.__dict__.update(status=status, path=path, cost=cost, expanded=expanded,
-                          max_frontier=max_frontier, los_checks=los_checks,
-                          seconds=seconds, algorithm=algorithm, extra=extra,
-                          path_lonlat=None)
+        d = r.__dict__  # item by item: no keyword dict to build first (0.48 -> 0.33 us)
+        d["status"] = status
+        d["path"] = path
+        d["cost"] = cost
+        d["expanded"] = expanded
+        d["max_frontier"] = max_frontier
+        d["los_checks"] = los_checks
+        d["seconds"] = seconds
+        d["algorithm"] = algorithm
+        d["extra"] = extra
+        d["path_lonlat"] = None
         return r
 
     @property
