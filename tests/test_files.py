@@ -30,3 +30,32 @@ def test_a_failed_write_leaves_no_file(tmp_path):
     with pytest.raises(TypeError):
         write_atomic(tmp_path / "x.bin", 123)  # not bytes nor str
     assert list(tmp_path.iterdir()) == []
+
+
+def test_open_atomic_streams_and_renames(tmp_path):
+    from skyroute.files import open_atomic
+
+    target = tmp_path / "deep" / "index.npz"
+    with open_atomic(target) as f:
+        f.write(b"abc")
+        assert not target.exists()  # nothing at the path until the block ends
+    assert target.read_bytes() == b"abc"
+    assert sorted(x.name for x in target.parent.iterdir()) == ["index.npz"]
+
+
+def test_an_unwritable_path_is_one_error_naming_it(tmp_path):
+    from skyroute.errors import SkyrouteError
+    from skyroute.files import open_atomic
+
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    message = r"file/sub/out\.bin: cannot write: .*/file is not a folder"
+    with pytest.raises(SkyrouteError, match=message):
+        write_atomic(blocker / "sub" / "out.bin", b"data")  # a file where a folder must be
+    folder = tmp_path / "folder"
+    folder.mkdir()
+    # the target itself a folder: the rename fails
+    with pytest.raises(SkyrouteError, match=r"folder: cannot write"), open_atomic(folder) as f:
+        f.write(b"data")
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["file", "folder"]
+    assert list(folder.iterdir()) == []

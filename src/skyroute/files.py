@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import BinaryIO
 
 from skyroute.errors import SkyrouteError
 
@@ -19,23 +22,37 @@ def _umask() -> int:
 _MODE = 0o666 & ~_umask()
 
 
-def write_atomic(path: str | Path, data: bytes | str) -> Path:
-    """Write ``data`` to a temporary file beside ``path``, then rename it into place.
-
-    A crash or error midway leaves no half-written file. Parent folders are created.
+@contextmanager
+def open_atomic(path: str | Path) -> Iterator[BinaryIO]:
+    """A binary file to write ``path`` through: a temporary file beside it, renamed into
+    place when the block ends, removed if it raises. Parent folders are created. A
+    folder that cannot be made or a file that cannot be written (no permission, a full
+    disk, ``path`` a folder) is a SkyrouteError naming ``path``; nothing is left behind.
     """
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except (FileExistsError, NotADirectoryError):  # a file where a folder must be
+        blocker = next(p for p in path.parents if p.exists())
+        raise SkyrouteError(f"{path}: cannot write: {blocker} is not a folder") from None
     except OSError as exc:
         raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
     try:
         with os.fdopen(fd, "wb") as f:
-            f.write(data.encode() if isinstance(data, str) else data)
+            yield f
         os.chmod(tmp, _MODE)
         os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    return path
+
+
+def write_atomic(path: str | Path, data: bytes | str) -> Path:
+    """Write ``data`` to ``path`` whole or not at all (:func:`open_atomic`)."""
+    with open_atomic(path) as f:
+        f.write(data.encode() if isinstance(data, str) else data)
+    return Path(path)

@@ -310,6 +310,16 @@ def test_cli_prepare_then_plan_with_index(monkeypatch, capsys, tmp_path):
     assert len(err.strip().splitlines()) == 1
 
 
+def test_cli_prepare_to_an_unwritable_path_is_one_line(monkeypatch, capsys, tmp_path):
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("x")
+    out_path = blocker / "den312d.idx"
+    code, _, err = _run(monkeypatch, capsys, "prepare", "den312d", "-o", str(out_path))
+    assert code == 2 and "Traceback" not in err
+    assert err.strip() == f"skyroute: error: {out_path}: cannot write: {blocker} is not a folder"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["not-a-folder"]
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_compiled_all_pairs_equal_scipy(seed):
     """The hierarchy's core table (subgoal_table.all_pairs) against scipy's Dijkstra on

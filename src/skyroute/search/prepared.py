@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError, check_choice
+from skyroute.files import open_atomic
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search import subgoal_table
 from skyroute.search.cache_lines import line_aligned
@@ -162,10 +163,8 @@ class PreparedGrid:
         meta = {"version": np.int64(FORMAT_VERSION), "method": np.array(self.method),
                 "shape": np.array([self.grid.height, self.grid.width], np.int64),
                 "digest": np.array(grid_digest(self.grid.blocked))}
-        tmp = path.with_name(path.name + ".tmp")
-        with open(tmp, "wb") as f:
+        with open_atomic(path) as f:  # whole or not at all; a bad folder is one line
             np.savez(f, **meta, **{k: self._arrays[k] for k in INDEX_ARRAYS[self.method]})
-        tmp.replace(path)
         return path
 
 
