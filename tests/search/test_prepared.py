@@ -249,6 +249,11 @@ def test_start_equals_goal_and_bad_queries():
         index.plan((50, 76), (0, 0))
     with pytest.raises(skyroute.OptionError, match="method"):
         skyroute.prepare(grid, method="cpd")
+    for bad in ((50.5, 76), (1, 2, 3), None):
+        with pytest.raises(skyroute.QueryError, match=r"start .* must be two integers"):
+            index.plan(bad, (60, 13))
+        with pytest.raises(skyroute.QueryError, match=r"start .* must be two integers"):
+            skyroute.plan(grid, bad, (60, 13))
 
 
 def test_save_load_round_trip_and_refusals(tmp_path):
@@ -270,6 +275,8 @@ def test_save_load_round_trip_and_refusals(tmp_path):
     junk.write_text("not an index")
     with pytest.raises(skyroute.InputFormatError, match=r"junk.idx: not a skyroute index"):
         skyroute.load_index(junk, grid)
+    with pytest.raises(skyroute.OptionError, match="grid must be a skyroute Grid, got str"):
+        skyroute.load_index(path, "den312d")
     with np.load(path) as z:
         data = dict(z)
     data["version"] = np.int64(FORMAT_VERSION + 1)

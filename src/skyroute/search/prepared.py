@@ -291,6 +291,9 @@ def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
 def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
     """Read an index written by :meth:`PreparedGrid.save` for ``grid``; an unreadable,
     outdated or foreign index is an InputFormatError naming the file."""
+    if not isinstance(grid, Grid):
+        raise OptionError(f"grid must be a skyroute Grid, got {type(grid).__name__}",
+                          param="grid")
     path = Path(path)
     try:
         with np.load(path, allow_pickle=False) as z:
