@@ -75,6 +75,12 @@ def test_no_path_exits_1_and_writes_nothing(monkeypatch, capsys, tmp_path):
     (["plan", *QUERY, "--clearance", "-1"], "--safety -1.0"),
     (["bench", "grid", "--map", "nomap", "--peers", ""], "--map nomap not found"),
     (["bench", "grid", "--algorithms", "astar,zzz", "--peers", ""], "--algorithm 'zzz'"),
+    (["bench", "grid", "--per-map", "-3"], "'--per-map': -3 is not in the range x>=0"),
+    (["bench", "world", "--worlds", "-1"], "'--worlds': -1 is not in the range x>=0"),
+    (["bench", "world", "--city-queries", "-2"], "'--city-queries': -2 is not in the range"),
+    (["bench", "world", "--no-path", "-2"], "'--no-path': -2 is not in the range x>=0"),
+    (["bench", "motion", "--curvature", "--tours", "-1"], "'--tours': -1 is not in the"),
+    (["bench", "motion", "--max-expansions", "0"], "0 is not in the range x>=1"),
 ])
 def test_bad_input_is_one_line_and_exit_2(monkeypatch, capsys, tmp_path, args, words):
     monkeypatch.chdir(tmp_path)

@@ -28,7 +28,7 @@ def bench_grid(
     map_names: Annotated[list[str] | None, typer.Option(
         "--map", help="Only this map (repeatable), e.g. den312d.")] = None,
     per_map: Annotated[int, typer.Option(
-        help="Scenario lines sampled per map (0 = all).")] = 20,
+        min=0, help="Scenario lines sampled per map (0 = all).")] = 20,
     algorithms: Annotated[str, typer.Option(help="Comma-separated skyroute algorithms.")] =
         "astar,jps",
     peers: Annotated[str, typer.Option(help="Comma-separated peers: pyastar2d, pathfinding, "

@@ -33,17 +33,17 @@ from skyroute.world.load import load_world
 
 @bench_app.command("world")
 def bench_world(
-    worlds: Annotated[int, typer.Option(help="Random 20-rectangle worlds.")] = 5,
+    worlds: Annotated[int, typer.Option(min=0, help="Random 20-rectangle worlds.")] = 5,
     seed: Annotated[int, typer.Option(help="Seed of the first world and its query.")] = 0,
     city: Annotated[Path | None, typer.Option(
         help="Also a colliders.csv city (at --altitude, with --safety).")] = None,
     altitude: Annotated[float, typer.Option(help="City altitude (m).")] = 5.0,
     safety: Annotated[float, typer.Option(help="City safety margin (m).")] = 5.0,
     city_queries_n: Annotated[int, typer.Option(
-        "--city-queries", help="Random far pairs timed on the city's graph once built.")]
+        "--city-queries", min=0, help="Random far pairs timed on the city's graph once built.")]
         = 30,
     no_path: Annotated[int, typer.Option(
-        help="City pairs in different free regions to time (no path).")] = 5,
+        min=0, help="City pairs in different free regions to time (no path).")] = 5,
     seconds: Annotated[float, typer.Option(
         "--seconds", "--budget", help="Seconds per OMPL solve (--budget: old name).")] = 1.0,
     planners: Annotated[str, typer.Option(help="OMPL planners, comma-separated.")] =
@@ -131,7 +131,7 @@ def bench_motion(
     curvature: Annotated[bool, typer.Option(
         "--curvature", help="Hybrid A* vs OMPL RRT*/BIT* on seeded worlds (and --city), "
                             "then Dubins tours vs nearest-first.")] = False,
-    worlds: Annotated[int, typer.Option(help="--curvature: seeded random worlds.")] = 10,
+    worlds: Annotated[int, typer.Option(min=0, help="--curvature: seeded random worlds.")] = 10,
     seed: Annotated[int, typer.Option(help="--curvature: seed of worlds and queries.")] = 0,
     budgets: Annotated[str, typer.Option(
         help="--curvature: OMPL seconds per solve, comma-separated.")] = "1,5",
@@ -139,12 +139,12 @@ def bench_motion(
         help="--curvature: also plan on this colliders city (10 m altitude, 2 m safety).")]
         = None,
     tours: Annotated[int, typer.Option(
-        help="--curvature: seeded 10-target tour instances (0: none).")] = 20,
+        min=0, help="--curvature: seeded 10-target tour instances (0: none).")] = 20,
     dubins: Annotated[bool, typer.Option(
         "--dubins", help="Only the Dubins batch against OMPL (100k and 1M queries, 1 and 2 "
                          "threads); needs no --data.")] = False,
     max_expansions: Annotated[int, typer.Option(
-        "--max-expansions", "--budget",
+        "--max-expansions", "--budget", min=1,
         help="plan_moves expansions per leg (--budget: old name).")] = 200_000,
     merge: Annotated[float, typer.Option(help="plan_moves merge lattice (degrees).")] =
         MERGE,
