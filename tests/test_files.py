@@ -59,3 +59,12 @@ def test_an_unwritable_path_is_one_error_naming_it(tmp_path):
         f.write(b"data")
     assert sorted(x.name for x in tmp_path.iterdir()) == ["file", "folder"]
     assert list(folder.iterdir()) == []
+
+
+def test_a_dangling_link_in_the_way_is_named(tmp_path):
+    from skyroute.errors import SkyrouteError
+
+    link = tmp_path / "link"
+    link.symlink_to(tmp_path / "gone")
+    with pytest.raises(SkyrouteError, match=r"cannot write: .*/link is not a folder"):
+        write_atomic(link / "out.bin", b"data")

@@ -28,13 +28,14 @@ def open_atomic(path: str | Path) -> Iterator[BinaryIO]:
     place when the block ends, removed if it raises. Parent folders are created. A
     folder that cannot be made or a file that cannot be written (no permission, a full
     disk, ``path`` a folder) is a SkyrouteError naming ``path``; nothing is left behind.
+    The block should only write the file: an OSError raised in it is reported as such.
     """
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     except (FileExistsError, NotADirectoryError):  # a file where a folder must be
-        blocker = next(p for p in path.parents if p.exists())
+        blocker = next(p for p in path.parents if os.path.lexists(p))
         raise SkyrouteError(f"{path}: cannot write: {blocker} is not a folder") from None
     except OSError as exc:
         raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None

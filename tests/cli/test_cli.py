@@ -81,6 +81,7 @@ def test_no_path_exits_1_and_writes_nothing(monkeypatch, capsys, tmp_path):
     (["bench", "world", "--no-path", "-2"], "'--no-path': -2 is not in the range x>=0"),
     (["bench", "motion", "--curvature", "--tours", "-1"], "'--tours': -1 is not in the"),
     (["bench", "motion", "--max-expansions", "0"], "0 is not in the range x>=1"),
+    (["bench", "motion", "--curvature", "--budgets", "0,1"], "every budget must be > 0"),
 ])
 def test_bad_input_is_one_line_and_exit_2(monkeypatch, capsys, tmp_path, args, words):
     monkeypatch.chdir(tmp_path)
