@@ -267,7 +267,9 @@ def test_save_load_round_trip_and_refusals(tmp_path):
     # the same shape, one cell changed: stale
     changed = grid.blocked.copy()
     changed[76, 50] = True
-    with pytest.raises(skyroute.InputFormatError, match=r"den312d.idx: index is stale"):
+    with pytest.raises(skyroute.InputFormatError,
+                       match=r"den312d.idx: index does not match .*stale, another map, "
+                             r"or another --safety"):
         skyroute.load_index(path, skyroute.Grid(changed))
     with pytest.raises(skyroute.InputFormatError, match="index is for a 65x81 map"):
         skyroute.load_index(path, skyroute.load_map("Berlin_1_256"))

@@ -318,6 +318,7 @@ def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
         raise InputFormatError(path, f"index is for a {w}x{h} map, {grid.name} is "
                                f"{grid.width}x{grid.height}")
     if str(data["digest"]) != grid_digest(grid.blocked):
-        raise InputFormatError(path, f"index is stale or for another map: {grid.name}'s "
-                               "blocked cells differ; rebuild it with 'skyroute prepare'")
+        raise InputFormatError(path, f"index does not match {grid.name}'s blocked cells "
+                               "(stale, another map, or another --safety or --resolution); "
+                               "rebuild it with 'skyroute prepare'")
     return PreparedGrid(grid, {k: data[k] for k in INDEX_ARRAYS[method]}, method=method)
