@@ -289,6 +289,24 @@ def test_save_load_round_trip_and_refusals(tmp_path):
         skyroute.load_index(old, grid)
 
 
+@pytest.mark.parametrize("method", ["auto", "jump"])
+def test_an_index_pickles_and_answers_alike(method):
+    import pickle
+
+    grid = skyroute.load_map("den312d")
+    index = skyroute.prepare(grid, method=method)
+    copy = pickle.loads(pickle.dumps(index))
+    assert (copy.method, copy.accelerator, copy.pivots, copy.subgoals) == \
+        (index.method, index.accelerator, index.pivots, index.subgoals)
+    assert copy.build_seconds == index.build_seconds and copy.candidates == index.candidates
+    scen = read_scen(skyroute.bundled_maps()["den312d"].with_suffix(".map.scen"))
+    for i in range(0, len(scen), 37):
+        s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
+        a, b = index.plan(s, t), copy.plan(s, t)
+        assert a.cost == b.cost and np.array_equal(a.path, b.path)
+        assert scen.matches(i, b.cost)
+
+
 def _run(monkeypatch, capsys, *args):
     monkeypatch.setattr(sys, "argv", ["skyroute", *args])
     with pytest.raises(SystemExit) as exit_info:

@@ -157,6 +157,13 @@ class PreparedGrid:
         return PlanResult.of_search(STATUS_OF_CODE[code], path, cost, expanded, frontier,
                                     0, seconds, self.method, {})
 
+    def __reduce__(self) -> tuple:
+        """Pickled as the grid and the index arrays (its compiled entry and workspace are
+        made anew where it is unpickled), so an index can go to other processes, e.g. Dask
+        workers."""
+        return _unpickled, (self.grid, self._arrays, self.method, self.build_seconds,
+                            self.candidates)
+
     def save(self, path: str | Path) -> Path:
         """Write the index as ``.npz`` beside the map; return the path written."""
         path = Path(path)
@@ -166,6 +173,13 @@ class PreparedGrid:
         with open_atomic(path) as f:  # whole or not at all; a bad folder is one line
             np.savez(f, **meta, **{k: self._arrays[k] for k in INDEX_ARRAYS[self.method]})
         return path
+
+
+def _unpickled(grid: Grid, arrays: dict, method: str, build_seconds: float,
+               candidates: dict) -> PreparedGrid:
+    index = PreparedGrid(grid, arrays, method=method, build_seconds=build_seconds)
+    index.candidates = candidates
+    return index
 
 
 def z_order(x: np.ndarray, y: np.ndarray) -> np.ndarray:
