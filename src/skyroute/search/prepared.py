@@ -254,6 +254,12 @@ def per_query_seconds(index: PreparedGrid, pairs: np.ndarray, rounds: int = 3) -
     return best
 
 
+def _require_grid(grid) -> None:
+    if not isinstance(grid, Grid):
+        raise OptionError(f"grid must be a skyroute Grid, got {type(grid).__name__}",
+                          param="grid")
+
+
 def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
     """Build a reusable index of ``grid`` for repeated exact queries.
 
@@ -277,9 +283,7 @@ def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
     ('found', 112.55634919, 109)
     """
     check_choice("method", method, METHODS)
-    if not isinstance(grid, Grid):
-        raise OptionError(f"grid must be a skyroute Grid, got {type(grid).__name__}",
-                          param="grid")
+    _require_grid(grid)
     t0 = time.perf_counter()
     blocked = np.asarray(grid.blocked, dtype=bool)
     label = region_labels(blocked)
@@ -305,9 +309,7 @@ def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
 def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
     """Read an index written by :meth:`PreparedGrid.save` for ``grid``; an unreadable,
     outdated or foreign index is an InputFormatError naming the file."""
-    if not isinstance(grid, Grid):
-        raise OptionError(f"grid must be a skyroute Grid, got {type(grid).__name__}",
-                          param="grid")
+    _require_grid(grid)
     path = Path(path)
     try:
         with np.load(path, allow_pickle=False) as z:
