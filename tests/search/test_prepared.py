@@ -13,7 +13,8 @@ from hypothesis import strategies as st
 import skyroute
 from skyroute.cli.app import main
 from skyroute.search import subgoal_contract, subgoal_table
-from skyroute.search.prepared import FORMAT_VERSION, build_arrays
+from skyroute.search.index_file import FORMAT_VERSION
+from skyroute.search.prepared import build_arrays
 from skyroute.search.subgoal_ch_query import ch_query
 from skyroute.search.subgoal_landmarks import landmark_count, landmark_distances
 from skyroute.search.subgoal_query import subgoal_query

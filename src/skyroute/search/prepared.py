@@ -10,20 +10,18 @@ blocked cells); ``load_index`` refuses an index built for another map.
 
 from __future__ import annotations
 
-import hashlib
 import time
-import zipfile
 from pathlib import Path
 
 import numpy as np
 
-from skyroute.errors import InputFormatError, OptionError, check_choice
-from skyroute.files import open_atomic
+from skyroute.errors import OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search import subgoal_table
 from skyroute.search.cache_lines import line_aligned
 from skyroute.search.canonical import CANONICAL
 from skyroute.search.entry_points import entry_point
+from skyroute.search.index_file import CH_ARRAYS, read_index, write_index
 from skyroute.search.pivots import DENSE_PIVOTS, PIVOTS, jump_query, largest_region, pivot_distances
 from skyroute.search.space import space_of, workspace
 from skyroute.search.subgoal_build import clearances, link, subgoal_ids
@@ -36,23 +34,11 @@ from skyroute.search.subgoal_table import distance_table, table_query
 from skyroute.world.grid import Grid
 
 METHODS = ("auto", "subgoal", "jump")
-FORMAT_VERSION = 3
-CH_ARRAYS = ("ch_offs", "ch_nbr", "ch_len", "ch_mid", "ch_core", "ch_dist", "ch_pred")
-INDEX_ARRAYS = {"subgoal": ("cells", "clr", "offs", "nbr", "label", "lmd", "dist", "pred",
-                            *CH_ARRAYS),
-                "jump": ("label", "piv")}
 SAMPLE = 32  # query pairs that "auto" times each candidate index on
 NO_HIERARCHY = {"ch_offs": np.empty(0, np.int64), "ch_nbr": np.empty(0, np.int32),
                 "ch_len": np.empty(0), "ch_mid": np.empty(0, np.int32),
                 "ch_core": np.empty(0, np.int32), "ch_dist": np.empty((0, 0)),
                 "ch_pred": np.empty((0, 0), np.int16)}
-
-
-def grid_digest(blocked: np.ndarray) -> str:
-    """sha256 of a blocked array's shape and packed bits: names the map an index is for."""
-    h = hashlib.sha256(f"{blocked.shape[0]}x{blocked.shape[1]}:".encode())
-    h.update(np.packbits(np.ascontiguousarray(blocked, dtype=bool)).tobytes())
-    return h.hexdigest()
 
 
 class PreparedGrid:
@@ -167,11 +153,8 @@ class PreparedGrid:
     def save(self, path: str | Path) -> Path:
         """Write the index as ``.npz`` beside the map; return the path written."""
         path = Path(path)
-        meta = {"version": np.int64(FORMAT_VERSION), "method": np.array(self.method),
-                "shape": np.array([self.grid.height, self.grid.width], np.int64),
-                "digest": np.array(grid_digest(self.grid.blocked))}
-        with open_atomic(path) as f:  # whole or not at all; a bad folder is one line
-            np.savez(f, **meta, **{k: self._arrays[k] for k in INDEX_ARRAYS[self.method]})
+        write_index(path, self.method, np.asarray(self.grid.blocked, dtype=bool),
+                    self._arrays)
         return path
 
 
@@ -310,31 +293,5 @@ def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
     """Read an index written by :meth:`PreparedGrid.save` for ``grid``; an unreadable,
     outdated or foreign index is an InputFormatError naming the file."""
     _require_grid(grid)
-    path = Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
-    except FileNotFoundError:
-        raise InputFormatError(path, "no such index file") from None
-    except (OSError, ValueError, zipfile.BadZipFile):
-        raise InputFormatError(path, "not a skyroute index (an .npz file written by "
-                               "'skyroute prepare')") from None
-    method = str(data["method"]) if "method" in data else ""
-    if method not in INDEX_ARRAYS:
-        raise InputFormatError(path, f"not a skyroute index: method {method!r}")
-    missing = [k for k in ("version", "shape", "digest", *INDEX_ARRAYS[method])
-               if k not in data]
-    if missing:
-        raise InputFormatError(path, f"not a skyroute index: missing {', '.join(missing)}")
-    if int(data["version"]) != FORMAT_VERSION:
-        raise InputFormatError(path, f"index format {int(data['version'])}, this skyroute "
-                               f"reads {FORMAT_VERSION}; rebuild it with 'skyroute prepare'")
-    h, w = (int(v) for v in data["shape"])
-    if (w, h) != (grid.width, grid.height):
-        raise InputFormatError(path, f"index is for a {w}x{h} map, {grid.name} is "
-                               f"{grid.width}x{grid.height}")
-    if str(data["digest"]) != grid_digest(grid.blocked):
-        raise InputFormatError(path, f"index does not match {grid.name}'s blocked cells "
-                               "(stale, another map, or another --safety or --resolution); "
-                               "rebuild it with 'skyroute prepare'")
-    return PreparedGrid(grid, {k: data[k] for k in INDEX_ARRAYS[method]}, method=method)
+    method, arrays = read_index(Path(path), np.asarray(grid.blocked, dtype=bool), grid.name)
+    return PreparedGrid(grid, arrays, method=method)

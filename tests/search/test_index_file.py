@@ -1,0 +1,87 @@
+"""A prepared index's file: whatever is wrong with it is one InputFormatError naming the
+file, before any array reaches a compiled query (which would read out of bounds)."""
+
+import numpy as np
+import pytest
+
+import skyroute
+
+
+@pytest.fixture(scope="module")
+def den312d():
+    grid = skyroute.load_map("den312d")
+    return grid, {m: skyroute.prepare(grid, method=m) for m in ("subgoal", "jump")}
+
+
+def _rewrite(src, dst, **changes):
+    with np.load(src) as z:
+        data = dict(z)
+    data.update(changes)
+    with open(dst, "wb") as f:
+        np.savez(f, **data)
+    return dst
+
+
+@pytest.mark.parametrize("method", ["subgoal", "jump"])
+def test_a_written_index_reads_back_and_answers_alike(den312d, tmp_path, method):
+    grid, built = den312d
+    path = built[method].save(tmp_path / "d.idx")
+    loaded = skyroute.load_index(path, grid)
+    a, b = built[method].plan((50, 76), (60, 13)), loaded.plan((50, 76), (60, 13))
+    assert (loaded.method, loaded.accelerator) == (built[method].method,
+                                                   built[method].accelerator)
+    assert a.cost == b.cost and np.array_equal(a.path, b.path)
+
+
+@pytest.mark.parametrize("method, changes, message", [
+    ("subgoal", {"version": np.array([3, 3])}, "'version' is not one integer"),
+    ("subgoal", {"method": np.array(["subgoal"])}, "'method' is not one string"),
+    ("subgoal", {"digest": np.int64(7)}, "'digest' is not one string"),
+    ("subgoal", {"shape": np.array([81, 65, 1])}, "'shape' is not two integers"),
+    ("subgoal", {"nbr": np.zeros(5, np.int64)}, "'nbr' is a 1-D int64 array, not 1-D int32"),
+    ("subgoal", {"dist": np.zeros(5)}, "'dist' is a 1-D float64 array, not 2-D"),
+    ("subgoal", {"label": np.zeros(7, np.int32)}, "'label' does not cover the map"),
+    ("subgoal", {"offs": np.zeros(3, np.int64)}, "arrays' sizes do not fit together"),
+    ("jump", {"piv": np.zeros((10, 24))}, "'piv' does not cover the map"),
+    ("jump", {"piv": np.zeros((5561, 24), np.float32)},
+     "'piv' is a 2-D float32 array, not 2-D float64"),
+])
+def test_a_malformed_index_is_refused(den312d, tmp_path, method, changes, message):
+    grid, built = den312d
+    good = built[method].save(tmp_path / "good.idx")
+    bad = _rewrite(good, tmp_path / "bad.idx", **changes)
+    with pytest.raises(skyroute.InputFormatError, match=rf"bad.idx: .*{message}"):
+        skyroute.load_index(bad, grid)
+
+
+def test_graph_indices_out_of_range_are_refused(den312d, tmp_path):
+    grid, built = den312d
+    good = built["subgoal"].save(tmp_path / "good.idx")
+    with np.load(good) as z:
+        nbr, cells = z["nbr"].copy(), z["cells"].copy()
+    nbr[0] = cells.size  # one past the last subgoal
+    bad = _rewrite(good, tmp_path / "nbr.idx", nbr=nbr)
+    with pytest.raises(skyroute.InputFormatError, match="graph's indices are out of range"):
+        skyroute.load_index(bad, grid)
+    cells[3] = -1
+    bad = _rewrite(good, tmp_path / "cells.idx", cells=cells)
+    with pytest.raises(skyroute.InputFormatError, match="graph's indices are out of range"):
+        skyroute.load_index(bad, grid)
+
+
+def test_files_that_are_no_index_at_all(den312d, tmp_path):
+    grid, built = den312d
+    good = built["jump"].save(tmp_path / "good.idx")
+    data = good.read_bytes()
+    cases = {"half.idx": data[: len(data) // 2], "empty.idx": b"",
+             "text.idx": b"skyroute\n"}
+    for name, content in cases.items():
+        (tmp_path / name).write_bytes(content)
+    np.save(tmp_path / "plain.npy", np.zeros(3))
+    for name in (*cases, "plain.npy"):
+        with pytest.raises(skyroute.InputFormatError, match=rf"{name}: not a skyroute index"):
+            skyroute.load_index(tmp_path / name, grid)
+    with pytest.raises(skyroute.InputFormatError, match="a folder, not an index file"):
+        skyroute.load_index(tmp_path, grid)
+    with pytest.raises(skyroute.InputFormatError, match="no such index file"):
+        skyroute.load_index(tmp_path / "none.idx", grid)
