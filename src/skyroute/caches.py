@@ -1,8 +1,8 @@
 """Module-level caches (search spaces, rasters, roadmaps, leg tables, reflected tables)
 register how to clear themselves here; :func:`clear_caches` empties them all. Each cache
 is keyed by everything that changes its value (most by the Grid or World itself, held
-weakly, so it goes with the object). Caches kept on disk (delivery leg tables, city
-visibility graphs) live in :func:`cache_dir`."""
+weakly or by id with a finalizer, so it goes with the object). Caches kept on disk
+(delivery leg tables, city visibility graphs) live in :func:`cache_dir`."""
 
 from __future__ import annotations
 

@@ -1,9 +1,11 @@
-"""GridOptions: the cached hash keeps equal option sets interchangeable as dict keys."""
+"""GridOptions: the cached hash keeps equal option sets interchangeable as dict keys;
+a grid keeps one query call per option set."""
 
 import pickle
 from dataclasses import astuple
 
 import numpy as np
+import pytest
 
 import skyroute
 from skyroute.search.grid_plan import GridOptions, grid_options
@@ -32,6 +34,17 @@ def test_one_runner_per_option_set():
     first = skyroute.plan(grid, (0, 0), (5, 3), prune="los")
     again = skyroute.plan(grid, (0, 0), (5, 3), prune="los")
     assert "setup_seconds" in first.extra and "setup_seconds" not in again.extra
-    assert list(space_of(grid).runners) == [grid_options("astar", prune="los")]
+    opts = grid_options("astar", prune="los")
+    assert [entry[0] for entry in space_of(grid).runners.values()] == [opts]
+    assert list(space_of(grid).runners) == [id(opts)]
     assert again.path.tolist() == first.path.tolist() == [[0, 0], [5, 3]]
     assert again.cost == first.cost == np.hypot(5, 3)
+
+
+def test_a_cached_option_set_does_not_admit_equal_values_of_another_type():
+    grid = skyroute.Grid(np.zeros((4, 4), bool))
+    skyroute.plan(grid, (0, 0), (3, 3), max_expansions=5)
+    skyroute.plan(grid, (0, 0), (3, 3), max_expansions=1)
+    for bad in (5.0, True):  # equal to 5 and 1, so an untyped cache would hand those back
+        with pytest.raises(skyroute.OptionError, match="must be an integer"):
+            skyroute.plan(grid, (0, 0), (3, 3), max_expansions=bad)

@@ -65,7 +65,7 @@ def grid_options(algorithm: str = "astar", *, connectivity: int | None = None,
                                          weight, prune, max_expansions)
 
 
-@lru_cache(maxsize=256)
+@lru_cache(maxsize=256, typed=True)  # typed: 5.0 and True must not pass as 5 and 1
 def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, prune,
                   max_expansions) -> GridOptions:
     check_choice("algorithm", algorithm, GRID_ALGORITHMS)
@@ -119,15 +119,17 @@ def plan_grid(grid: Grid, start: tuple[int, int], goal: tuple[int, int],
     """
     space = space_of(grid)
     s, t = space.flat_pair(start, goal)
-    run = space.runners.get(opts)
+    entry = space.runners.get(id(opts))  # by id: GridOptions.__hash__ is a Python call
     extra = {}
-    if run is None:
+    if entry is not None:
+        run = entry[1]
+    else:
         t_setup = time.perf_counter()
         run = _runner(space, opts)
         path = run(s, s)[4]  # start == start: loads, builds, warms
         if opts.prune != "none":
             _pruned(space, path, 0, opts.prune)  # and the pruning kernels
-        space.runners[opts] = run
+        space.runners[id(opts)] = (opts, run)
         extra["setup_seconds"] = time.perf_counter() - t_setup
     t0 = time.perf_counter()
     code, expanded, frontier, los, path, cost = run(s, t)
