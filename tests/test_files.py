@@ -68,3 +68,16 @@ def test_a_dangling_link_in_the_way_is_named(tmp_path):
     link.symlink_to(tmp_path / "gone")
     with pytest.raises(SkyrouteError, match=r"cannot write: .*/link is not a folder"):
         write_atomic(link / "out.bin", b"data")
+
+
+def test_check_writable_fails_where_writing_would(tmp_path):
+    from skyroute.errors import SkyrouteError
+    from skyroute.files import check_writable
+
+    (tmp_path / "afile").write_text("x")
+    with pytest.raises(SkyrouteError, match=r"afile/r.json: cannot write: .*afile is not a folder"):
+        check_writable(tmp_path / "afile" / "r.json")
+    with pytest.raises(SkyrouteError, match="cannot write: it is a folder"):
+        check_writable(tmp_path)
+    out = check_writable(tmp_path / "new" / "r.json")
+    assert out.parent.is_dir() and list(out.parent.iterdir()) == []  # nothing left behind

@@ -31,14 +31,7 @@ def open_atomic(path: str | Path) -> Iterator[BinaryIO]:
     The block should only write the file: an OSError raised in it is reported as such.
     """
     path = Path(path)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    except (FileExistsError, NotADirectoryError):  # a file where a folder must be
-        blocker = next(p for p in path.parents if os.path.lexists(p))
-        raise SkyrouteError(f"{path}: cannot write: {blocker} is not a folder") from None
-    except OSError as exc:
-        raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    fd, tmp = _temp_beside(path)
     try:
         with os.fdopen(fd, "wb") as f:
             yield f
@@ -57,3 +50,28 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
     with open_atomic(path) as f:
         f.write(data.encode() if isinstance(data, str) else data)
     return Path(path)
+
+
+def check_writable(path: str | Path) -> Path:
+    """Fail now where :func:`open_atomic` would fail at the end of a long run: ``path``
+    a folder, a file where a folder must be, no permission. Creates missing parent
+    folders (as writing would) and leaves no file behind."""
+    path = Path(path)
+    if path.is_dir():
+        raise SkyrouteError(f"{path}: cannot write: it is a folder")
+    fd, tmp = _temp_beside(path)
+    os.close(fd)
+    os.unlink(tmp)
+    return path
+
+
+def _temp_beside(path: Path) -> tuple[int, str]:
+    """A new temporary file in ``path``'s folder (made if missing): (fd, its path)."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except (FileExistsError, NotADirectoryError):  # a file where a folder must be
+        blocker = next(p for p in path.parents if os.path.lexists(p))
+        raise SkyrouteError(f"{path}: cannot write: {blocker} is not a folder") from None
+    except OSError as exc:
+        raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
