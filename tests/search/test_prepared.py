@@ -334,8 +334,23 @@ def test_cli_prepare_then_plan_with_index(monkeypatch, capsys, tmp_path):
     assert code == 2 and "--index" in err and "Traceback" not in err
     code, _, err = _run(monkeypatch, capsys, "plan", "Berlin_1_256", "--start", "1,1",
                         "--goal", "2,2", "--index", str(idx))
-    assert code == 2 and err.strip().endswith("Berlin_1_256.map is 256x256")
+    assert code == 2 and err.strip().endswith(
+        "Berlin_1_256.map is 256x256 (another map, or another --safety or --resolution); "
+        "rebuild it with 'skyroute prepare'")
     assert len(err.strip().splitlines()) == 1
+
+
+def test_cli_prepare_refuses_to_write_over_its_map(monkeypatch, capsys, tmp_path):
+    victim = tmp_path / "den312d.map"
+    victim.write_bytes(skyroute.bundled_maps()["den312d"].read_bytes())
+    before = victim.read_bytes()
+    code, _, err = _run(monkeypatch, capsys, "prepare", str(victim), "-o", str(victim))
+    assert code == 2 and "is the map itself" in err and victim.read_bytes() == before
+    # a map whose every cell is blocked builds, with a note that it refuses every query
+    idx = tmp_path / "all.idx"
+    code, _, err = _run(monkeypatch, capsys, "prepare", str(victim), "-o", str(idx),
+                        "--safety", "1e9")
+    assert code in (0, None) and idx.exists() and "every cell of den312d.map is blocked" in err
 
 
 def test_cli_prepare_to_an_unwritable_path_is_one_line(monkeypatch, capsys, tmp_path):

@@ -1,7 +1,9 @@
 import numpy as np
 import pytest
+import shapely
 from PIL import Image
 
+import skyroute
 from skyroute import Grid, InputFormatError, OptionError, load_map
 from skyroute.world.segments import rasterize_segments
 
@@ -131,3 +133,18 @@ def test_npy_and_unknown_suffix(tmp_path):
 def test_missing_file_lists_bundled_maps(tmp_path):
     with pytest.raises(InputFormatError, match=r"no such file.*den312d"):
         load_map(tmp_path / "nothing.map")
+
+
+@pytest.mark.parametrize("segments, resolution", [
+    ([[0.0, 0.0, 10.0, 0.0]], 1e-7),  # a resolution meant in kilometres
+    ([[0.0, 0.0, 1e12, 0.0]], 1.0),  # one far-off coordinate
+])
+def test_a_raster_too_large_is_refused_before_it_is_allocated(segments, resolution):
+    from skyroute.world.grid import MAX_CELLS
+
+    with pytest.raises(OptionError, match=rf"above {MAX_CELLS:,}; use a coarser resolution"):
+        rasterize_segments(np.array(segments), resolution=resolution)
+    world = skyroute.World([shapely.LineString(np.reshape(segments, (2, 2))).buffer(0.5)],
+                           [0], [10], ("wall",), frame="enu")
+    with pytest.raises(OptionError, match="use a coarser resolution"):
+        world.rasterize(resolution)

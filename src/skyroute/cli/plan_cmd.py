@@ -11,7 +11,7 @@ import typer
 from skyroute.cli.parse import parse_cell
 from skyroute.cli.tables import result_table
 from skyroute.errors import OptionError
-from skyroute.files import write_atomic
+from skyroute.files import check_writable, write_atomic
 from skyroute.io.geojson import dumps, grid_path_geojson
 from skyroute.planner import plan
 from skyroute.search.grid_plan import GRID_ALGORITHMS, grid_options
@@ -111,7 +111,14 @@ def prepare_command(
 
     from skyroute.search.prepared import prepare
 
+    if Path(map_file).is_file() and out.resolve() == Path(map_file).resolve():
+        raise OptionError(f"-o {out} is the map itself; write the index to another path "
+                          "(e.g. MAP.idx)")
+    check_writable(out)  # before the build, which can take a while
     grid = load_map(map_file, resolution=resolution, safety=safety)
+    if grid.blocked.all():
+        Console(stderr=True).print(f"note: every cell of {grid.name} is blocked (--safety "
+                                   f"{safety:g}): the index will refuse every query")
     with Console(stderr=True).status(f"Preparing {grid.name} (the first run also compiles "
                                      "the kernels: a minute or two)"):
         index = prepare(grid, method=method)

@@ -79,7 +79,9 @@ def read_index(path: Path, blocked: np.ndarray, name: str) -> tuple[str, dict]:
     h, w = (int(v) for v in shape)
     if (h, w) != blocked.shape:
         raise InputFormatError(path, f"index is for a {w}x{h} map, {name} is "
-                               f"{blocked.shape[1]}x{blocked.shape[0]}")
+                               f"{blocked.shape[1]}x{blocked.shape[0]} (another map, or "
+                               "another --safety or --resolution); rebuild it with "
+                               "'skyroute prepare'")
     if _scalar(path, data, "digest", str) != grid_digest(blocked):
         raise InputFormatError(path, f"index does not match {name}'s blocked cells "
                                "(stale, another map, or another --safety or --resolution); "

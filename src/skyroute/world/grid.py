@@ -8,6 +8,7 @@ cell (x, y) covers ``[ox + x*s, ox + (x+1)*s) x [oy + y*s, oy + (y+1)*s)`` for o
 
 from __future__ import annotations
 
+import math
 import operator
 import warnings
 from dataclasses import dataclass, field
@@ -133,3 +134,19 @@ def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
     if grid.blocked[y, x]:
         raise QueryError(f"{what} ({x}, {y}) is on a blocked cell")
     return x, y
+
+
+MAX_CELLS = 1 << 26  # 8192 x 8192: a search keeps about 50 bytes a cell (3.4 GB here)
+
+
+def raster_shape(xspan: float, yspan: float, resolution: float) -> tuple[int, int]:
+    """(width, height) in cells of an xspan x yspan extent at ``resolution`` metres a
+    cell; an OptionError naming the size before anything is allocated when it is above
+    :data:`MAX_CELLS` (a small resolution or one far-off coordinate)."""
+    w, h = xspan / resolution, yspan / resolution
+    if not (math.isfinite(w) and math.isfinite(h) and max(1.0, w) * max(1.0, h) <= MAX_CELLS):
+        size = f"{w:.3g} x {h:.3g} cells" if math.isfinite(w * h) else "unbounded"
+        raise OptionError(f"resolution={resolution:g} over a {xspan:.6g} x {yspan:.6g} extent "
+                          f"makes {size}, above {MAX_CELLS:,}; use a coarser resolution",
+                          param="resolution")
+    return max(1, math.ceil(w)), max(1, math.ceil(h))

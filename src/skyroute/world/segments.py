@@ -15,7 +15,7 @@ from numba import njit
 
 from skyroute.errors import InputFormatError, OptionError
 from skyroute.world.geometry import point_segment_dist2
-from skyroute.world.grid import Grid
+from skyroute.world.grid import Grid, raster_shape
 
 
 def read_segments(path: str | Path) -> np.ndarray:
@@ -65,8 +65,7 @@ def rasterize_segments(segments: np.ndarray, *, resolution: float, safety: float
         xs, ys = seg[:, [0, 2]], seg[:, [1, 3]]
         bounds = (xs.min() - pad, ys.min() - pad, xs.max() + pad, ys.max() + pad)
     xmin, ymin, xmax, ymax = (float(b) for b in bounds)
-    width = max(1, math.ceil((xmax - xmin) / resolution))
-    height = max(1, math.ceil((ymax - ymin) / resolution))
+    width, height = raster_shape(xmax - xmin, ymax - ymin, resolution)
     blocked = np.zeros((height, width), dtype=np.bool_)
     _rasterize(seg, xmin, ymin, resolution, safety, blocked)
     return Grid(blocked, resolution, (xmin, ymin), name=name)

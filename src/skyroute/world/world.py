@@ -32,7 +32,7 @@ from skyroute.geo import (
     heading_to_plane,
     lonlat_to_enu,
 )
-from skyroute.world.grid import Grid
+from skyroute.world.grid import Grid, raster_shape
 from skyroute.world.points import as_points
 
 
@@ -406,8 +406,7 @@ class World:
             raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
         w = self.at(altitude)
         xmin, ymin, xmax, ymax = self.bounds if bounds is None else bounds
-        width = max(1, int(np.ceil((xmax - xmin) / resolution)))
-        height = max(1, int(np.ceil((ymax - ymin) / resolution)))
+        width, height = raster_shape(xmax - xmin, ymax - ymin, resolution)
         xs = xmin + (np.arange(width) + 0.5) * resolution
         ys = ymin + (np.arange(height) + 0.5) * resolution
         blocked = np.zeros((height, width), bool)
