@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import skyroute
+from tests.conftest import MOVINGAI
 
 
 @pytest.fixture(scope="module")
@@ -85,3 +86,43 @@ def test_files_that_are_no_index_at_all(den312d, tmp_path):
         skyroute.load_index(tmp_path, grid)
     with pytest.raises(skyroute.InputFormatError, match="no such index file"):
         skyroute.load_index(tmp_path / "none.idx", grid)
+
+
+def _with(path, key, change):
+    with np.load(path) as z:
+        a = z[key].copy()
+    change(a)
+    return a
+
+
+@pytest.mark.parametrize("key, change, message", [
+    ("pred", lambda a: a.__setitem__((0, 1), 32000), "graph's indices are out of range"),
+    ("pred", lambda a: a.__setitem__((0, 1), -5), "graph's indices are out of range"),
+    ("offs", lambda a: a.__setitem__(1, a[2] + 1), "graph's indices are out of range"),
+    ("label", lambda a: a.__setitem__(np.flatnonzero(a >= 0)[:50], 7),
+     "region labels or clearances do not fit"),
+    ("clr", lambda a: a.__setitem__((300, 0), 1000), "region labels or clearances do not fit"),
+])
+def test_index_values_that_do_not_fit_are_refused(den312d, tmp_path, key, change, message):
+    grid, built = den312d
+    good = built["subgoal"].save(tmp_path / "good.idx")
+    bad = _rewrite(good, tmp_path / "bad.idx", **{key: _with(good, key, change)})
+    with pytest.raises(skyroute.InputFormatError, match=rf"bad.idx: .*{message}"):
+        skyroute.load_index(bad, grid)
+
+
+@pytest.mark.shared_data
+def test_a_hierarchy_index_with_indices_out_of_range_is_refused(tmp_path):
+    """Boston_0_256's subgoal graph contracts into a hierarchy with a core table."""
+    grid = skyroute.load_map(MOVINGAI / "Boston_0_256.map")
+    index = skyroute.prepare(grid, method="subgoal")
+    assert index.accelerator == "hierarchy"
+    good = index.save(tmp_path / "good.idx")
+    assert skyroute.load_index(good, grid).accelerator == "hierarchy"
+    for key, value in (("ch_mid", 10**6), ("ch_nbr", -1), ("ch_core", 5000),
+                       ("ch_pred", 5000)):
+        arr = _with(good, key, lambda a, v=value: a.__setitem__(np.unravel_index(
+            int(np.argmax(a)), a.shape), v))
+        bad = _rewrite(good, tmp_path / f"{key}.idx", **{key: arr})
+        with pytest.raises(skyroute.InputFormatError, match="graph's indices are out of range"):
+            skyroute.load_index(bad, grid)

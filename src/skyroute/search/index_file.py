@@ -1,7 +1,11 @@
 """The prepared index's file: an ``.npz`` of the index arrays with a format version, the
-map's shape and a hash of its blocked cells, checked whole before any array reaches a
-compiled query (which does not check its indices: a foreign array would read out of
-bounds, not raise)."""
+map's shape and a hash of its blocked cells. Before any array reaches a compiled query
+(which does not check its indices) :func:`read_index` checks the metadata, every
+array's dtype and dimensions, the sizes that tie them together and the range of every
+index they hold; ``load_index`` then recomputes what the map determines (region labels,
+clearances) and compares. Distances and predecessor chains are trusted as written:
+load only indexes that skyroute wrote (as with a pickle, a file crafted to pass these
+checks could still give wrong answers or worse)."""
 
 from __future__ import annotations
 
@@ -126,10 +130,21 @@ def _malformed(arrays: dict, padded: int) -> str:
                 and ch.shape[0] == ch.shape[1] and arrays["ch_pred"].shape == ch.shape)
     if not sizes_ok:
         return "its arrays' sizes do not fit together"
-    cells, nbr = arrays["cells"], arrays["nbr"]
-    in_range = ((not m or (cells.min() >= 0 and cells.max() < padded))
-                and (not nbr.size or (nbr.min() >= 0 and nbr.max() < m))
-                and offs[0] == 0 and offs[-1] == nbr.size and bool(np.all(np.diff(offs) >= 0))
-                and (not ch_offs.size or (ch_offs[0] == 0
-                                          and ch_offs[-1] == arrays["ch_nbr"].size)))
+    k = ch.shape[0]
+    in_range = (_within(arrays["cells"], 0, padded) and _within(arrays["nbr"], 0, m)
+                and _within(arrays["pred"], -1, m) and _within(arrays["ch_nbr"], 0, m)
+                and _within(arrays["ch_mid"], -1, m) and _within(arrays["ch_core"], -1, k)
+                and _within(arrays["ch_pred"], -1, k)
+                and _offsets(offs, arrays["nbr"].size)
+                and (not ch_offs.size or _offsets(ch_offs, arrays["ch_nbr"].size)))
     return "" if in_range else "its graph's indices are out of range"
+
+
+def _within(a: np.ndarray, lo: int, hi: int) -> bool:
+    """Every value of ``a`` in [lo, hi)."""
+    return not a.size or (int(a.min()) >= lo and int(a.max()) < hi)
+
+
+def _offsets(offs: np.ndarray, total: int) -> bool:
+    """CSR offsets: from 0, never falling, ending at ``total``."""
+    return offs[0] == 0 and offs[-1] == total and bool(np.all(np.diff(offs) >= 0))

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from skyroute.errors import OptionError, check_choice
+from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search import subgoal_table
 from skyroute.search.cache_lines import line_aligned
@@ -176,12 +176,18 @@ def z_order(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return spread(x) | (spread(y) << np.uint64(1))
 
 
+def _padded(blocked: np.ndarray) -> np.ndarray:
+    """A (H, W) blocked array as uint8 with a blocked border one cell wide."""
+    padded = np.ones((blocked.shape[0] + 2, blocked.shape[1] + 2), np.uint8)
+    padded[1:-1, 1:-1] = blocked
+    return padded
+
+
 def region_labels(blocked: np.ndarray) -> np.ndarray:
     """Each padded flat cell's free region (-1 blocked) for a (H, W) blocked array."""
     from scipy import ndimage  # imported here: a plain 'skyroute plan' must not pay for it
 
-    padded = np.ones((blocked.shape[0] + 2, blocked.shape[1] + 2), np.uint8)
-    padded[1:-1, 1:-1] = blocked
+    padded = _padded(blocked)
     # Without corner cutting a diagonal step needs both side cells free, so the free
     # regions under 8-connected moves are exactly the 4-connected ones.
     lab, _ = ndimage.label(padded == 0)
@@ -193,11 +199,8 @@ def build_arrays(blocked: np.ndarray, label: np.ndarray | None = None) -> dict:
     :func:`region_labels` (computed when not given)."""
     if label is None:
         label = region_labels(blocked)
-    h, w = blocked.shape
-    Wp = w + 2
-    padded = np.ones((h + 2, w + 2), np.uint8)
-    padded[1:-1, 1:-1] = blocked
-    blk = padded.ravel()
+    Wp = blocked.shape[1] + 2
+    blk = _padded(blocked).ravel()
     sg, cells = subgoal_ids(blk, Wp)
     # number the subgoals along a Z-order curve: a node's graph neighbours then sit
     # near it in every per-node array (landmark rows above all), not a row apart
@@ -291,7 +294,28 @@ def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
 
 def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
     """Read an index written by :meth:`PreparedGrid.save` for ``grid``; an unreadable,
-    outdated or foreign index is an InputFormatError naming the file."""
+    outdated, malformed or foreign index is an InputFormatError naming the file.
+    Distances are trusted as written: load only indexes skyroute wrote (see
+    :mod:`skyroute.search.index_file`)."""
     _require_grid(grid)
-    method, arrays = read_index(Path(path), np.asarray(grid.blocked, dtype=bool), grid.name)
+    blocked = np.asarray(grid.blocked, dtype=bool)
+    method, arrays = read_index(Path(path), blocked, grid.name)
+    if not _fits_the_map(blocked, arrays):
+        raise InputFormatError(path, "not a skyroute index: its region labels or clearances "
+                               "do not fit the map; rebuild it with 'skyroute prepare'")
     return PreparedGrid(grid, arrays, method=method)
+
+
+def _fits_the_map(blocked: np.ndarray, arrays: dict) -> bool:
+    """Whether an index's arrays that the map determines (region labels; a subgoal
+    graph's clearances) are the map's own: recomputed in milliseconds, so a query never
+    walks or labels by numbers another map or a hand gave."""
+    label = region_labels(blocked)
+    if not np.array_equal(arrays["label"], label):
+        return False
+    if "clr" not in arrays:
+        return True
+    padded = _padded(blocked)
+    sg = np.full(padded.size, -1, np.int32)
+    sg[arrays["cells"]] = np.arange(arrays["cells"].size, dtype=np.int32)
+    return np.array_equal(arrays["clr"], clearances(padded.ravel(), sg, padded.shape[1]))
