@@ -9,7 +9,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import BinaryIO
 
-from skyroute.errors import SkyrouteError
+from skyroute.errors import OptionError, SkyrouteError
 
 
 def _umask() -> int:
@@ -50,6 +50,15 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
     with open_atomic(path) as f:
         f.write(data.encode() if isinstance(data, str) else data)
     return Path(path)
+
+
+def as_path(value: object, param: str) -> Path:
+    """``value`` as a Path when it is a str or path-like; an OptionError naming ``param``
+    otherwise (``Path(None)`` is a bare TypeError)."""
+    if not isinstance(value, str | os.PathLike):
+        raise OptionError(f"{param} must be a file path, got {type(value).__name__}",
+                          param=param)
+    return Path(value)
 
 
 def check_writable(path: str | Path) -> Path:

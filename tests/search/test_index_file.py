@@ -126,3 +126,11 @@ def test_a_hierarchy_index_with_indices_out_of_range_is_refused(tmp_path):
         bad = _rewrite(good, tmp_path / f"{key}.idx", **{key: arr})
         with pytest.raises(skyroute.InputFormatError, match="graph's indices are out of range"):
             skyroute.load_index(bad, grid)
+
+
+def test_a_path_that_is_no_path_is_an_option_error(den312d):
+    grid, built = den312d
+    with pytest.raises(skyroute.OptionError, match="path must be a file path, got NoneType"):
+        built["jump"].save(None)
+    with pytest.raises(skyroute.OptionError, match="path must be a file path, got int"):
+        skyroute.load_index(123, grid)

@@ -148,3 +148,13 @@ def test_a_raster_too_large_is_refused_before_it_is_allocated(segments, resoluti
                            [0], [10], ("wall",), frame="enu")
     with pytest.raises(OptionError, match="use a coarser resolution"):
         world.rasterize(resolution)
+
+
+def test_a_folder_is_not_a_map_and_does_not_hide_a_bundled_one(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "den312d").mkdir()
+    assert load_map("den312d").width == 65  # the bundled map, not the folder
+    with pytest.raises(InputFormatError, match="a folder, not a map file"):
+        load_map(tmp_path / "den312d")
+    with pytest.raises(InputFormatError, match="not a regular file"):
+        load_map("/dev/null")

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError, check_choice
+from skyroute.files import as_path
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search import subgoal_table
 from skyroute.search.cache_lines import line_aligned
@@ -151,8 +152,9 @@ class PreparedGrid:
                             self.candidates)
 
     def save(self, path: str | Path) -> Path:
-        """Write the index as ``.npz`` beside the map; return the path written."""
-        path = Path(path)
+        """Write the index to ``path`` (``.npz`` format, whatever its suffix), whole or not
+        at all; return the path written."""
+        path = as_path(path, "path")
         write_index(path, self.method, np.asarray(self.grid.blocked, dtype=bool),
                     self._arrays)
         return path
@@ -299,7 +301,7 @@ def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
     :mod:`skyroute.search.index_file`)."""
     _require_grid(grid)
     blocked = np.asarray(grid.blocked, dtype=bool)
-    method, arrays = read_index(Path(path), blocked, grid.name)
+    method, arrays = read_index(as_path(path, "path"), blocked, grid.name)
     if not _fits_the_map(blocked, arrays):
         raise InputFormatError(path, "not a skyroute index: its region labels or clearances "
                                "do not fit the map; rebuild it with 'skyroute prepare'")
