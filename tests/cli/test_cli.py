@@ -74,7 +74,7 @@ def test_no_path_exits_1_and_writes_nothing(monkeypatch, capsys, tmp_path):
     (["plan", *QUERY, "--bogus"], "No such option: --bogus"),
     (["plan", *QUERY, "--clearance", "-1"], "--safety -1.0"),
     (["bench", "grid", "--map", "nomap", "--peers", ""], "--map nomap not found"),
-    (["bench", "grid", "--algorithms", "astar,zzz", "--peers", ""], "--algorithm 'zzz'"),
+    (["bench", "grid", "--algorithms", "astar,zzz", "--peers", ""], "--algorithms 'zzz'"),
     (["bench", "grid", "--per-map", "-3"], "'--per-map': -3 is not in the range x>=0"),
     (["bench", "world", "--worlds", "-1"], "'--worlds': -1 is not in the range x>=0"),
     (["bench", "world", "--city-queries", "-2"], "'--city-queries': -2 is not in the range"),

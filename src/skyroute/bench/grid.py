@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.bench.build_memory import build_peak_bytes
-from skyroute.bench.peers import PEERS, available, octile_cost
+from skyroute.bench.peers import PEERS, available, octile_cost, skip_reason
 from skyroute.bench.random_maps import far_queries, parse_random, random_grid
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.planner import plan
@@ -48,7 +48,7 @@ def find_pairs(folder: str | Path, names: Sequence[str] = ()) -> list[tuple[Path
         if scen is not None:
             pairs[m.stem] = (m, scen)
     if names:
-        wanted = [n.removesuffix(".map") for n in names]
+        wanted = list(dict.fromkeys(n.removesuffix(".map") for n in names))  # once each
         unknown = [n for n in wanted if n not in pairs]
         if unknown:
             raise OptionError(f"names={', '.join(unknown)} not found in {folder}; "
@@ -129,18 +129,103 @@ def _peer(grid: Grid, name: str) -> Runner:
     return peer.prepare(grid), score
 
 
+@dataclass(frozen=True, eq=False)
+class Case:
+    """One map to bench, read and checked: its label, grid, scenario and how many of the
+    scenario's lines to sample (0: all)."""
+
+    label: str
+    grid: Grid
+    scen: Scenario
+    per_map: int
+
+    @property
+    def queries(self) -> int:
+        """How many queries each runner will answer on this map."""
+        return len(self.scen) if self.per_map <= 0 else min(self.per_map, len(self.scen))
+
+
+def load_case(map_path: Path, scen_path: Path, *, per_map: int) -> Case:
+    """Read a map and its scenario and check that every line can be run on it
+    (:func:`check_scenario`), so bad input fails before any timing."""
+    grid = read_map(map_path)
+    scen = read_scen(scen_path)
+    check_scenario(grid, scen, Path(map_path).name)
+    return Case(Path(map_path).name, grid, scen, per_map)
+
+
+def random_case(spec: str, *, per_map: int, seed: int) -> Case:
+    """A synthetic ``SIDE:SHARE`` map (numpy seed ``seed``) with ``per_map`` far queries
+    whose optima come from scipy; all of them are run."""
+    check_random_per_map(per_map)
+    side, share = parse_random(spec)
+    grid = random_grid(side, share, seed)
+    return Case(grid.name, grid, far_queries(grid, per_map, seed), 0)
+
+
+def check_random_per_map(per_map: int) -> None:
+    """A random map's queries are made, not sampled from a file: ``per_map=0`` (every
+    scenario line) cannot apply to it, so it is refused rather than guessed."""
+    if per_map <= 0:
+        raise OptionError(f"per_map={per_map} (every scenario line) has no meaning for random "
+                          "maps, which have no scenario file; give a count >= 1",
+                          param="per_map")
+
+
+def check_scenario(grid: Grid, scen: Scenario, map_name: str) -> None:
+    """Raise InputFormatError naming the .scen file and line unless the scenario is for
+    the grid's size and every line's start and goal lie on free cells of it."""
+    if (scen.width, scen.height) != (grid.width, grid.height):
+        raise InputFormatError(scen.path, f"scenario is for a {scen.width}x{scen.height} map, "
+                               f"{map_name} is {grid.width}x{grid.height}",
+                               line=scen_line(scen.path, 0))
+    bad_start, bad_goal = _off_free(grid, scen.starts), _off_free(grid, scen.goals)
+    if not (bad_start.any() or bad_goal.any()):
+        return
+    i = int(np.argmax(bad_start | bad_goal))
+    what, cells = ("start", scen.starts) if bad_start[i] else ("goal", scen.goals)
+    x, y = (int(v) for v in cells[i])
+    where = (f"lies outside {map_name} ({grid.width}x{grid.height})"
+             if not grid.in_bounds((x, y)) else f"is on a blocked cell of {map_name}")
+    raise InputFormatError(scen.path, f"{what} ({x}, {y}) {where}", line=scen_line(scen.path, i))
+
+
+def _off_free(grid: Grid, cells: np.ndarray) -> np.ndarray:
+    """Per (x, y) row of ``cells``: True where it is outside the grid or blocked."""
+    x, y = cells[:, 0], cells[:, 1]
+    inside = (x >= 0) & (x < grid.width) & (y >= 0) & (y < grid.height)
+    bad = ~inside
+    bad[inside] = grid.blocked[y[inside], x[inside]]
+    return bad
+
+
+def scen_line(path: Path, index: int) -> int | None:
+    """The file line of a scenario's ``index``-th query (blank lines are skipped when
+    reading, so it is counted again here; only on the error path). None if unreadable."""
+    try:
+        text = Path(path).read_bytes().decode("ascii", errors="replace")
+    except OSError:
+        return None
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    numbers = [n for n, line in enumerate(lines[1:], start=2) if line.strip()]
+    return numbers[index] if index < len(numbers) else None
+
+
+def bench_case(case: Case, *, algorithms: Sequence[str], peers: Sequence[str], seed: int,
+               prepared: bool = False, on_query: Callable[[], None] | None = None) -> dict:
+    """Run one checked map's queries through every runner; return its report."""
+    return bench_queries(case.grid, case.scen, case.label, per_map=case.per_map,
+                         algorithms=algorithms, peers=peers, seed=seed, prepared=prepared,
+                         on_query=on_query)
+
+
 def bench_map(map_path: Path, scen_path: Path, *, per_map: int, algorithms: Sequence[str],
               peers: Sequence[str], seed: int, prepared: bool = False,
               on_query: Callable[[], None] | None = None) -> dict:
     """Run one map's sampled queries through every runner (with ``prepared``, also
     through a prepared index); return its report."""
-    grid = read_map(map_path)
-    scen: Scenario = read_scen(scen_path)
-    if (scen.width, scen.height) != (grid.width, grid.height):
-        raise InputFormatError(scen_path, f"scenario is for a {scen.width}x{scen.height} map, "
-                               f"{map_path.name} is {grid.width}x{grid.height}")
-    return bench_queries(grid, scen, map_path.name, per_map=per_map, algorithms=algorithms,
-                         peers=peers, seed=seed, prepared=prepared, on_query=on_query)
+    return bench_case(load_case(map_path, scen_path, per_map=per_map), algorithms=algorithms,
+                      peers=peers, seed=seed, prepared=prepared, on_query=on_query)
 
 
 def bench_random(spec: str, *, per_map: int, algorithms: Sequence[str],
@@ -148,11 +233,8 @@ def bench_random(spec: str, *, per_map: int, algorithms: Sequence[str],
                  on_query: Callable[[], None] | None = None) -> dict:
     """A synthetic ``SIDE:SHARE`` map (numpy seed ``seed``) with ``per_map`` far queries
     whose optima come from scipy; its report as :func:`bench_map`'s."""
-    side, share = parse_random(spec)
-    grid = random_grid(side, share, seed)
-    scen = far_queries(grid, max(per_map, 1), seed)
-    return bench_queries(grid, scen, grid.name, per_map=0, algorithms=algorithms,
-                         peers=peers, seed=seed, prepared=prepared, on_query=on_query)
+    return bench_case(random_case(spec, per_map=per_map, seed=seed), algorithms=algorithms,
+                      peers=peers, seed=seed, prepared=prepared, on_query=on_query)
 
 
 def bench_queries(grid: Grid, scen: Scenario, label: str, *, per_map: int,
@@ -167,7 +249,8 @@ def bench_queries(grid: Grid, scen: Scenario, label: str, *, per_map: int,
     info: dict = {}
     if prepared:
         runners.append((RunnerStats("prepared", False), *_prepared(grid, info)))
-    runners += [(RunnerStats(p, True), *_peer(grid, p)) for p in peers]
+    skipped = {p: why for p in peers if (why := skip_reason(p, grid))}
+    runners += [(RunnerStats(p, True), *_peer(grid, p)) for p in peers if p not in skipped]
     first = idx[0]
     for _, run, score in runners:  # warm-up: compile, caches
         score(run(tuple(scen.starts[first].tolist()), tuple(scen.goals[first].tolist())))
@@ -197,27 +280,20 @@ def bench_queries(grid: Grid, scen: Scenario, label: str, *, per_map: int,
             and not row["peer"]}
     report = {"map": label, "scen": scen.path.name, "size": [grid.width, grid.height],
               "queries": int(n), "scen_lines": len(scen), "rows": rows}
+    if skipped:
+        report["skipped_peers"] = skipped
     if prepared:
         report["prepared"] = info
     return report
 
 
 def check_runners(algorithms: Sequence[str], peers: Sequence[str]) -> tuple[list, list, list]:
-    """Validate names; return (algorithms, installed peers, missing peers)."""
+    """Validate names; return (algorithms, installed peers, missing peers), each name once
+    in the order given."""
+    algorithms, peers = list(dict.fromkeys(algorithms)), list(dict.fromkeys(peers))
     for a in algorithms:
-        check_choice("algorithm", a, GRID_ALGORITHMS)
+        check_choice("algorithms", a, GRID_ALGORITHMS)
     for p in peers:
-        check_choice("peer", p, tuple(PEERS))
+        check_choice("peers", p, tuple(PEERS))
     have = [p for p in peers if available(p)]
-    return list(algorithms), have, [p for p in peers if p not in have]
-
-
-def count_queries(pairs: list[tuple[Path, Path]], per_map: int) -> int:
-    """Read every map and scenario (so bad input fails before a long run starts) and
-    return how many queries the run will make per runner, for a progress bar."""
-    total = 0
-    for map_path, scen_path in pairs:
-        read_map(map_path)
-        lines = len(read_scen(scen_path))
-        total += lines if per_map <= 0 else min(per_map, lines)
-    return total
+    return algorithms, have, [p for p in peers if p not in have]

@@ -29,6 +29,8 @@ class Peer:
     note: str
     prepare: Callable[[Grid], Query]
     cells: Callable[[object], np.ndarray | None]
+    max_cells: int | None = None  # larger maps are skipped: the peer would not fit in memory
+    bytes_per_cell: int = 0  # the measured memory that sets max_cells, for the note
 
 
 def _pyastar2d(grid: Grid) -> Query:
@@ -111,7 +113,9 @@ PEERS = {
     "pathfinding": Peer("pathfinding", "pathfinding", "python-pathfinding AStarFinder, "
                         "no corner cutting", _pathfinding, _nodes),
     "networkx": Peer("networkx", "networkx", "networkx astar_path on the move graph "
-                     "(graph build not timed)", _networkx, _tuples),
+                     "(graph build not timed)", _networkx, _tuples,
+                     # measured: 0.41 GB at 512x512, 2.0 at 1024, 6.1 at 2048, ~25 at 4096
+                     max_cells=2048 * 2048, bytes_per_cell=1500),
 }
 
 
@@ -120,6 +124,16 @@ def available(name: str) -> bool:
     import importlib.util
 
     return importlib.util.find_spec(PEERS[name].module) is not None
+
+
+def skip_reason(name: str, grid: Grid) -> str | None:
+    """Why the peer cannot run on ``grid`` (more cells than its memory allows), or None."""
+    peer = PEERS[name]
+    if peer.max_cells is None or grid.width * grid.height <= peer.max_cells:
+        return None
+    need = grid.width * grid.height * peer.bytes_per_cell / 1e9
+    return (f"{grid.width}x{grid.height} is over its limit of {peer.max_cells:,} cells "
+            f"(its graph would need about {need:.0f} GB)")
 
 
 def octile_cost(cells: np.ndarray) -> float:

@@ -20,6 +20,7 @@ from skyroute.world.grid import Grid
 from skyroute.world.movingai import Scenario
 
 SQRT2 = 2.0 ** 0.5
+ROWS_BYTES = 256 << 20  # scipy's distance rows held at once while finding the optima
 
 
 def parse_random(text: str) -> tuple[int, float]:
@@ -72,11 +73,11 @@ def far_queries(grid: Grid, count: int, seed: int = 0) -> Scenario:
     graph = octile_graph(blocked)
     _, labels = connected_components(graph, directed=False)
     labels = np.where(blocked.ravel(), -1, labels)
-    big = np.bincount(labels[labels >= 0]).argmax()
-    cells = np.flatnonzero(labels == big)
-    if len(cells) < 2:
+    sizes = np.bincount(labels[labels >= 0])
+    if sizes.size == 0 or sizes.max() < 2:  # no free cell at all, or only lone ones
         raise OptionError(f"{grid.name}: fewer than two free cells; lower the blocked share",
                           param="random")
+    cells = np.flatnonzero(labels == sizes.argmax())
     rng = np.random.default_rng(seed)
     want = max(w, h) / 2
     starts, goals = [], []
@@ -91,10 +92,20 @@ def far_queries(grid: Grid, count: int, seed: int = 0) -> Scenario:
         starts.append(best[1])
         goals.append(best[2])
     starts, goals = np.array(starts), np.array(goals)
-    dist = dijkstra(graph, directed=False, indices=starts)
-    optimal = dist[np.arange(count), goals]
+    optimal = _optima(graph, starts, goals)
     xy = lambda c: np.stack([c % w, c // w], axis=1).astype(np.int64)  # noqa: E731
     return Scenario(path=Path(f"{grid.name}.scen"), map_name=grid.name, width=w, height=h,
                     buckets=np.zeros(count, dtype=np.int64), starts=xy(starts),
                     goals=xy(goals), optimal=optimal,
                     tolerance=np.full(count, 1e-9))
+
+
+def _optima(graph, starts: np.ndarray, goals: np.ndarray) -> np.ndarray:
+    """scipy's Dijkstra distance from each start to its goal, a few starts at a time: one
+    distance row per start is a float per cell, 2.7 GB for 20 starts on a 4096x4096 map."""
+    step = max(1, ROWS_BYTES // (8 * graph.shape[0]))
+    parts = []
+    for i in range(0, len(starts), step):
+        dist = dijkstra(graph, directed=False, indices=starts[i:i + step])
+        parts.append(dist[np.arange(len(dist)), goals[i:i + step]])
+    return np.concatenate(parts)

@@ -12,10 +12,20 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
-from skyroute.bench.grid import bench_map, bench_random, check_runners, count_queries, find_pairs
+from skyroute.bench.grid import (
+    Case,
+    bench_case,
+    check_random_per_map,
+    check_runners,
+    find_pairs,
+    load_case,
+    random_case,
+)
+from skyroute.bench.peers import skip_reason
 from skyroute.bench.random_maps import parse_random
 from skyroute.cli.parse import parse_list
-from skyroute.files import write_atomic
+from skyroute.errors import OptionError
+from skyroute.files import check_writable, write_atomic
 from skyroute.world.load import bundled_maps
 
 bench_app = typer.Typer(help="Benchmarks against peer libraries.", no_args_is_help=True)
@@ -28,13 +38,16 @@ def bench_grid(
     map_names: Annotated[list[str] | None, typer.Option(
         "--map", help="Only this map (repeatable), e.g. den312d.")] = None,
     per_map: Annotated[int, typer.Option(
-        min=0, help="Scenario lines sampled per map (0 = all).")] = 20,
+        min=0, help="Scenario lines sampled per map (0 = all; with --random, give a count "
+                    ">= 1: a random map has no lines).")] = 20,
     algorithms: Annotated[str, typer.Option(help="Comma-separated skyroute algorithms.")] =
         "astar,jps",
     peers: Annotated[str, typer.Option(help="Comma-separated peers: pyastar2d, pathfinding, "
-                                       "networkx ('' for none).")] =
+                                       "networkx ('' for none). networkx is skipped, with a "
+                                       "note, on maps over 2048x2048 cells (its graph needs "
+                                       "about 1.5 KB a cell).")] =
         "pyastar2d,pathfinding,networkx",
-    seed: Annotated[int, typer.Option(help="Seed for sampling scenario lines.")] = 0,
+    seed: Annotated[int, typer.Option(min=0, help="Seed for sampling scenario lines.")] = 0,
     random: Annotated[list[str] | None, typer.Option(
         help="Also a synthetic SIDE:SHARE map (repeatable), e.g. 512:0.2: SHARE of the cells "
              "blocked at random (numpy --seed), --per-map far queries with optima from "
@@ -46,40 +59,34 @@ def bench_grid(
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the report here.")] =
         None,
 ) -> None:
-    """Run MovingAI scenarios through skyroute's planners and the installed peers."""
+    """Run MovingAI scenarios through skyroute's planners and the installed peers.
+
+    Every map and scenario is read and checked before any timing.
+    """
     folder = maps or next(iter(bundled_maps().values())).parent
     algs, have, missing = check_runners(parse_list(algorithms), parse_list(peers))
-    randoms = list(random or ())
-    for spec in randoms:
-        parse_random(spec)
+    if not (algs or have or prepared):
+        raise OptionError("nothing to run: give --algorithms, --peers or --prepared" +
+                          (f" (not installed: {', '.join(missing)})" if missing else ""))
+    randoms = _random_specs(random or (), per_map)
+    if json_out:
+        check_writable(json_out)
     only_random = randoms and maps is None and not map_names
     pairs = [] if only_random else find_pairs(folder, map_names or ())
-    total = count_queries(pairs, per_map) + len(randoms) * max(per_map, 1)
     console = Console(stderr=True)
     for p in missing:
         console.print(f"[yellow]peer {p} is not installed; skipped "
                       "(pip install 'skyroute[bench]')[/yellow]")
-    reports = []
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-               TimeRemainingColumn())
-    with Progress(*columns, console=console, transient=True) as progress:
-        task = progress.add_task("queries", total=total)
-        for map_path, scen_path in pairs:
-            progress.update(task, description=map_path.stem)
-            reports.append(bench_map(map_path, scen_path, per_map=per_map, algorithms=algs,
-                                     peers=have, seed=seed, prepared=prepared,
-                                     on_query=lambda: progress.advance(task)))
-        for spec in randoms:
-            progress.update(task, description=f"random {spec}")
-            reports.append(bench_random(spec, per_map=per_map, algorithms=algs, peers=have,
-                                        seed=seed, prepared=prepared,
-                                        on_query=lambda: progress.advance(task)))
+    cases = [load_case(m, s, per_map=per_map) for m, s in pairs]
+    cases += [random_case(spec, per_map=per_map, seed=seed) for spec in randoms]
+    _note_skipped_peers(console, cases, have, ours=bool(algs) or prepared)
+    reports = _run(console, cases, algorithms=algs, peers=have, seed=seed, prepared=prepared)
     out = Console()
     for rep in reports:
         if rep.get("prepared", {}).get("build_peak_error"):
             console.print(f"[yellow]{rep['map']}: {rep['prepared']['build_peak_error']}"
                           "[/yellow]")
-        out.print(_table(rep, have))
+        out.print(_table(rep))
     if json_out:
         doc = {"settings": {"maps": str(folder), "per_map": per_map, "random": randoms,
                             "prepared": prepared,
@@ -91,12 +98,50 @@ def bench_grid(
         write_atomic(json_out, json.dumps(doc, indent=1))
 
 
+def _random_specs(specs: list[str] | tuple, per_map: int) -> list[str]:
+    """The --random specs, each checked and each map once (as first given)."""
+    seen: dict[tuple, str] = {}
+    for spec in specs:
+        seen.setdefault(parse_random(spec), spec)
+    if seen:
+        check_random_per_map(per_map)
+    return list(seen.values())
+
+
+def _note_skipped_peers(console: Console, cases: list[Case], peers: list[str], *,
+                        ours: bool) -> None:
+    """Say, before the run, which peer each map is too large for; with no runner of
+    ``ours`` and no peer left for a map, refuse it."""
+    for case in cases:
+        skipped = {p: why for p in peers if (why := skip_reason(p, case.grid))}
+        if not ours and len(skipped) == len(peers):
+            raise OptionError(f"nothing to run on {case.label}: every peer is skipped there "
+                              f"({'; '.join(f'{p}: {w}' for p, w in skipped.items())}); give "
+                              "--algorithms or --prepared")
+        for p, why in skipped.items():
+            console.print(f"[yellow]peer {p} skipped on {case.label}: {why}[/yellow]")
+
+
+def _run(console: Console, cases: list[Case], **options) -> list[dict]:
+    """Bench every case under one progress bar; their reports."""
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+               TimeRemainingColumn())
+    reports = []
+    with Progress(*columns, console=console, transient=True) as progress:
+        task = progress.add_task("queries", total=sum(c.queries for c in cases))
+        for case in cases:
+            progress.update(task, description=case.label)
+            reports.append(bench_case(case, on_query=lambda: progress.advance(task), **options))
+    return reports
+
+
 def _fmt(v, spec):
     return "-" if v is None else format(v, spec)
 
 
-def _table(rep: dict, peers: list[str]) -> Table:
+def _table(rep: dict) -> Table:
     prep = rep.get("prepared")
+    peers = [row["runner"] for row in rep["rows"] if row["peer"]]
     caption = (f"prepared: built in {prep['build_seconds']:.3f} s, peak "
                f"{_fmt(prep['build_peak_bytes'] and prep['build_peak_bytes'] / 1e6, '.1f')} "
                f"MB resident, {prep['index_bytes'] / 1e6:.1f} MB (arrays' nbytes), "
