@@ -170,14 +170,37 @@ def run_ompl(world: World, start, goal, radius: float, planner: str,
 
 def city_world(path, *, altitude: float = 10.0, safety: float = 2.0) -> World:
     """A colliders city (e.g. ``examples/city.csv``) as a plane world inside a boundary
-    around its buildings, for OMPL's bounded state space."""
+    around its buildings, for OMPL's bounded state space. A city no building of which
+    counts at ``altitude`` is an OptionError on ``city`` (:func:`curvature_benchmark`'s
+    parameter; the altitude is fixed there)."""
+    from skyroute.bench.world import check_altitude, no_building_at
+    from skyroute.errors import OptionError
     from skyroute.world.load import load_world
 
-    city = load_world(path, altitude=altitude, safety=safety, frame="enu")
+    check_altitude(altitude)
+    whole = load_world(path, safety=safety, frame="enu")
+    city = whole.at(altitude)
+    if len(city.obstacles) == 0:
+        raise OptionError(f"city={path}: the benchmark flies at {altitude:g} m, and "
+                          f"{no_building_at(whole, altitude, safety)}", param="city")
     x0, y0, x1, y1 = city.bounds
     box = shapely.box(x0 - 20, y0 - 20, x1 + 20, y1 + 20)
     return World(city.obstacles, city.floors, city.ceilings, city.names, box, "enu",
                  city.home, f"{city.name} (boundary 20 m out)")
+
+
+def curvature_queries(worlds: int = 10, seed: int = 0, *, city=None,
+                      city_queries: int = 5) -> list[tuple]:
+    """(world, index, start, goal): one query per seeded world and ``city_queries`` on
+    the ``city`` colliders file when given, all drawn before any timing, so a city that
+    cannot be read or has no query fails first."""
+    cases = [(curvature_world(seed + w), np.random.default_rng([seed, w]), w)
+             for w in range(worlds)]
+    if city is not None:
+        cw = city_world(city)
+        cases += [(cw, np.random.default_rng([seed, 1000 + q]), q)
+                  for q in range(city_queries)]
+    return [(world, w, *query_poses(world, rng)) for world, rng, w in cases]
 
 
 def curvature_benchmark(worlds: int = 10, seed: int = 0, budgets: tuple = (1.0, 5.0), *,
@@ -185,20 +208,21 @@ def curvature_benchmark(worlds: int = 10, seed: int = 0, budgets: tuple = (1.0, 
                         city=None, city_queries: int = 5,
                         on_step: Callable[[dict], None] | None = None) -> list[dict]:
     """One query per seeded world (and ``city_queries`` on the ``city`` colliders file
-    when given); one row per planner run (``world``, ``runner``, ``budget``, ``seconds``,
-    ``found``, ``length``, ``valid``, ``ratio`` to the lower bound, ...). ``on_step`` is
-    called with each row as it is made."""
+    when given); one row per planner run (:func:`run_queries`)."""
+    return run_queries(curvature_queries(worlds, seed, city=city, city_queries=city_queries),
+                       budgets, planners=planners, radius=radius, on_step=on_step)
+
+
+def run_queries(queries: list[tuple], budgets: tuple = (1.0, 5.0), *,
+                planners: tuple = ("RRTstar", "BITstar"), radius: float = 5.0,
+                on_step: Callable[[dict], None] | None = None) -> list[dict]:
+    """One row per planner run on each of :func:`curvature_queries`' queries (``world``,
+    ``runner``, ``budget``, ``seconds``, ``found``, ``length``, ``valid``, ``ratio`` to
+    the lower bound, ...). ``on_step`` is called with each row as it is made."""
     from skyroute.bench.world import ompl_available
 
     rows = []
-    cases = [(curvature_world(seed + w), np.random.default_rng([seed, w]), w)
-             for w in range(worlds)]
-    if city is not None:
-        cw = city_world(city)
-        cases += [(cw, np.random.default_rng([seed, 1000 + q]), q)
-                  for q in range(city_queries)]
-    for world, rng, w in cases:
-        start, goal = query_poses(world, rng)
+    for world, w, start, goal in queries:
         bound = lower_bound(world, start, goal, radius)
         runs = [(run_skyroute, ())]
         if ompl_available():

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from skyroute.errors import InputFormatError, OptionError
+
 
 def dubins_speed(*, sizes=(100_000, 1_000_000), threads=(1, 2), repeats: int = 7,
                  seed: int = 0, radius: float = 1.7, ompl_calls: int = 5_000) -> dict:
@@ -101,17 +103,55 @@ def _timed(fn) -> float:
     return time.perf_counter() - t0
 
 
-def step_drone_pairs(data: Path, *, max_expansions: int, merge: float, on_pair=None) -> dict:
-    """plan_moves and follow (on a Theta* path) for every ordered pair of ILP places."""
-    from skyroute.motion.step_drone import follow, plan_moves
-    from skyroute.planner import plan
+ZONES = "website/buildings/no-fly-zones.geojson"
+CONFINEMENT = "testing/confinement-zone.geojson"
+PLACES = "testing/all.geojson"
+
+
+def load_ilp(data: str | Path) -> tuple:
+    """(world, places) of the ILP data folder ``data``: the no-fly zones inside the
+    confinement zone (degrees frame) and the named points of testing/all.geojson. Read
+    before any timing, so a wrong folder is an OptionError on ``data`` naming what is
+    missing, and a broken file an InputFormatError naming it."""
     from skyroute.world.load import load_world
 
-    world = load_world(data / "website/buildings/no-fly-zones.geojson", frame="degrees",
-                       boundary=data / "testing/confinement-zone.geojson")
-    doc = json.loads((data / "testing/all.geojson").read_text())
-    places = {f["properties"]["name"]: f["geometry"]["coordinates"] for f in doc["features"]
-              if f["geometry"]["type"] == "Point"}
+    data = Path(data)
+    if not data.is_dir():
+        raise OptionError(f"data={data}: no such folder", param="data")
+    for name in (ZONES, CONFINEMENT, PLACES):
+        if not (data / name).is_file():
+            raise OptionError(f"data={data}: no {name} in it (give the ILP data folder, with "
+                              "website/ and testing/)", param="data")
+    world = load_world(data / ZONES, frame="degrees", boundary=data / CONFINEMENT)
+    places = ilp_places(data / PLACES)
+    for name, point in places.items():  # a place in a zone fails here, not mid-run
+        world.check_point(point, f"{data / PLACES}: place {name!r}")
+    return world, places
+
+
+def ilp_places(path: Path) -> dict:
+    """{name: [lon, lat]} of the named Point features of a GeoJSON FeatureCollection."""
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        places = {f["properties"]["name"]: f["geometry"]["coordinates"]
+                  for f in doc["features"] if f["geometry"]["type"] == "Point"}
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise InputFormatError(path, f"cannot read: {exc}") from None
+    except (KeyError, TypeError, AttributeError):
+        raise InputFormatError(path, "expected a FeatureCollection of Point features with "
+                                     "a name property") from None
+    if len(places) < 2:
+        raise InputFormatError(path, f"{len(places)} named Point features; need 2 or more")
+    return places
+
+
+def step_drone_pairs(world, places: dict, *, max_expansions: int, merge: float,
+                     on_pair=None) -> dict:
+    """plan_moves and follow (on a Theta* path) for every ordered pair of ``places`` in
+    ``world`` (:func:`load_ilp`)."""
+    from skyroute.motion.step_drone import follow, plan_moves
+    from skyroute.planner import plan
+
     rows = []
     for a, b in itertools.permutations(places, 2):
         t0 = time.perf_counter()

@@ -19,6 +19,7 @@ from collections.abc import Callable
 import numpy as np
 import shapely
 
+from skyroute.errors import OptionError, SkyrouteError
 from skyroute.world.world import World
 
 OMPL_PLANNERS = ("PRM", "PRMstar", "RRTstar", "RRTConnect", "InformedRRTstar")
@@ -35,8 +36,42 @@ def random_rect_world(seed: int, *, count: int = 20, size: float = 100.0) -> Wor
                  shapely.box(0, 0, size, size), "enu", name=f"random-rects-{seed}")
 
 
+def check_altitude(altitude: float) -> None:
+    """An OptionError unless ``altitude`` is a finite number >= 0 (metres above ground)."""
+    if not (math.isfinite(altitude) and altitude >= 0):
+        raise OptionError(f"altitude={altitude!r} must be a finite number >= 0",
+                          param="altitude")
+
+
+def load_city(path, *, altitude: float, safety: float) -> World:
+    """A colliders city in the enu frame with the obstacles that count at ``altitude``.
+    An altitude no building reaches is an OptionError naming the file and the tallest
+    top: the empty world left would have no extent to plan in."""
+    from skyroute.world.load import load_world
+
+    check_altitude(altitude)
+    city = load_world(path, safety=safety, frame="enu")
+    world = city.at(altitude)
+    if len(world.obstacles) == 0:
+        raise OptionError(f"altitude={altitude:g}: {no_building_at(city, altitude, safety)}",
+                          param="altitude")
+    return world
+
+
+def no_building_at(city: World, altitude: float, safety: float) -> str:
+    """Why no obstacle of ``city`` (read with ``safety``) counts at ``altitude``: the
+    buildings are all lower, or (boxes off the ground) none spans it."""
+    top, low = float(city.ceilings.max()) - safety, float(city.floors.min()) + safety
+    if altitude >= top + safety:
+        grown = f"; {top + safety:g} m with the {safety:g} m safety margin" if safety else ""
+        return f"no building of {city.name} reaches {altitude:g} m (the tallest is " \
+               f"{top:g} m{grown})"
+    return f"no building of {city.name} spans {altitude:g} m (they span {low:g} to {top:g} m)"
+
+
 def free_pair(world: World, rng: np.random.Generator, min_dist: float) -> tuple:
-    """Two free points at least ``min_dist`` apart with a path between them."""
+    """Two free points at least ``min_dist`` apart with a path between them; none in
+    1000 draws (the world nearly all obstacle) is a SkyrouteError."""
     from skyroute.planner import plan
 
     xmin, ymin, xmax, ymax = world.bounds
@@ -45,7 +80,8 @@ def free_pair(world: World, rng: np.random.Generator, min_dist: float) -> tuple:
         if world.is_free(p).all() and math.dist(*p) >= min_dist and \
                 plan(world, p[0], p[1]).found:
             return p[0], p[1]
-    raise RuntimeError(f"no connected free pair found in {world.name}")
+    raise SkyrouteError(f"{world.name}: no two free points {min_dist:g} apart with a path "
+                        "between them in 1000 draws")
 
 
 def path_exactly_free(world: World, path: np.ndarray) -> bool:
@@ -185,7 +221,8 @@ def random_free_pair(world: World, rng: np.random.Generator, min_dist: float) ->
         p = rng.uniform([xmin, ymin], [xmax, ymax], size=(2, 2))
         if math.dist(*p) >= min_dist and world.is_free(p).all():
             return p[0], p[1]
-    raise RuntimeError(f"no free pair {min_dist:g} apart found in {world.name}")
+    raise SkyrouteError(f"{world.name}: no two free points {min_dist:g} apart in 100,000 "
+                        "draws")
 
 
 def city_queries(world: World, count: int, rng: np.random.Generator, *,

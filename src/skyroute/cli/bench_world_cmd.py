@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import sys
 import tempfile
@@ -18,17 +19,18 @@ from rich.table import Table
 from skyroute.bench.world import (
     OMPL_PLANNERS,
     bench_query,
+    check_altitude,
     city_queries,
     free_pair,
+    load_city,
     ompl_available,
     random_rect_world,
 )
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_list
-from skyroute.errors import OptionError, check_choice
-from skyroute.files import write_atomic
+from skyroute.errors import OptionError, SkyrouteError, check_choice
+from skyroute.files import check_writable, write_atomic
 from skyroute.motion.step_drone import MERGE
-from skyroute.world.load import load_world
 
 
 @bench_app.command("world")
@@ -52,11 +54,12 @@ def bench_world(
         None,
 ) -> None:
     """Path length relative to the visibility-graph optimum, and time, against OMPL."""
+    chosen = _check_world_options(worlds, city, altitude, seconds, planners, json_out)
     with tempfile.TemporaryDirectory() as cache:  # builds are timed cold, not from disk
         os.environ["SKYROUTE_CACHE"], old = cache, os.environ.get("SKYROUTE_CACHE")
         try:
             _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path,
-                         seconds, planners, json_out)
+                         seconds, chosen, json_out)
         finally:
             if old is None:
                 os.environ.pop("SKYROUTE_CACHE", None)
@@ -65,26 +68,62 @@ def bench_world(
     _exit_past_ompl()
 
 
-def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, seconds,
-                 planners, json_out) -> None:
+def _check_world_options(worlds, city, altitude, seconds, planners, json_out) -> tuple:
+    """The options that need no file read, checked before anything runs; the OMPL
+    planners chosen."""
     chosen = tuple(parse_list(planners))
     for p in chosen:
-        check_choice("planner", p, OMPL_PLANNERS)
+        check_choice("planners", p, OMPL_PLANNERS)
+    if worlds == 0 and city is None:
+        raise OptionError("--worlds 0 and no --city: nothing to run; give --worlds N or "
+                          "--city FILE")
+    check_altitude(altitude)
+    _positive("--seconds", seconds)
+    if json_out:
+        check_writable(json_out)
+    return chosen
+
+
+def _positive(flag: str, value: float) -> float:
+    """``value`` when it is a positive finite number, else an OptionError naming ``flag``."""
+    if not (math.isfinite(value) and value > 0):
+        raise OptionError(f"{flag} {value!r} must be a positive finite number")
+    return value
+
+
+def _world_cases(worlds, seed, city, altitude, safety) -> list[tuple]:
+    """(world, (start, goal), other query) for each random world and the city, all drawn
+    before any timing: a city too crowded for a query fails before the long work."""
+    cases = [random_rect_world(seed + i) for i in range(worlds)]
+    if city is not None:
+        cases.append(load_city(city, altitude=altitude, safety=safety))
+    out = []
+    for i, world in enumerate(cases):
+        rng = np.random.default_rng(seed + i)
+        size = max(world.bounds[2] - world.bounds[0], world.bounds[3] - world.bounds[1])
+        try:
+            out.append((world, free_pair(world, rng, 0.6 * size),
+                        free_pair(world, rng, 0.6 * size)))
+        except SkyrouteError:
+            if i < worlds:  # random worlds always have room
+                raise
+            raise SkyrouteError(f"--city {city}: no two far free points joined by a path at "
+                                f"--altitude {altitude:g} with --safety {safety:g}; try a "
+                                "smaller --safety or another --altitude") from None
+    return out
+
+
+def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, seconds,
+                 chosen, json_out) -> None:
     console = Console(stderr=True)
+    cases = _world_cases(worlds, seed, city, altitude, safety)
     if not ompl_available():
         console.print("[yellow]OMPL is not installed; skyroute only "
                       "(pip install 'skyroute[bench]')[/yellow]")
-    cases = [random_rect_world(seed + i) for i in range(worlds)]
-    if city is not None:
-        cases.append(load_world(city, altitude=altitude, safety=safety, frame="enu"))
     reports = []
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task("worlds", total=len(cases))
-        for i, world in enumerate(cases):
-            rng = np.random.default_rng(seed + i)
-            size = max(world.bounds[2] - world.bounds[0], world.bounds[3] - world.bounds[1])
-            s, g = free_pair(world, rng, 0.6 * size)
-            other = free_pair(world, rng, 0.6 * size)
+        for world, (s, g), other in cases:
             reports.append(bench_query(world, s, g, seconds=seconds, planners=chosen,
                                        rrt_budgets=(0.1, 0.3, 1.0, 3.0), other=other))
             progress.advance(task)
@@ -105,9 +144,9 @@ def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, 
         out.print(t)
     city_timing = None
     if city is not None and city_queries_n > 0:
-        c = city_timing = city_queries(cases[-1], city_queries_n, np.random.default_rng(seed),
-                                       no_path=no_path)
-        out.print(f"{cases[-1].name}: visibility graph of {c['corners']} corners built in "
+        c = city_timing = city_queries(cases[-1][0], city_queries_n,
+                                       np.random.default_rng(seed), no_path=no_path)
+        out.print(f"{cases[-1][0].name}: visibility graph of {c['corners']} corners built in "
                   f"{c['build_seconds']:.3f} s ({c['cached_build_seconds']:.3f} s from the "
                   f"disk cache); first query {c['first_seconds'] * 1e3:.1f} ms (with the "
                   f"build {c['first_with_build_seconds']:.3f} s); {city_queries_n} far pairs "
@@ -153,14 +192,22 @@ def bench_motion(
 ) -> None:
     """Dubins batch speed vs OMPL and step-drone fewest moves vs following a Theta* path
     (--data); Hybrid A* vs OMPL and Dubins tours (--curvature)."""
-    if curvature:
-        _bench_curvature(worlds, seed, budgets, city, tours, json_out)
-        return
-    if data is None and not dubins:
+    secs = _budgets(budgets)
+    _positive("--merge", merge)
+    if data is None and not (curvature or dubins):
         raise OptionError("bench motion needs --data DIR (the ILP data), --dubins or "
                           "--curvature")
-    from skyroute.bench.motion import dubins_speed, step_drone_pairs
+    if curvature and not (worlds or city or tours):
+        raise OptionError("--curvature with --worlds 0, --tours 0 and no --city: nothing to "
+                          "run")
+    from skyroute.bench.motion import dubins_speed, load_ilp, step_drone_pairs
 
+    ilp = load_ilp(data) if data is not None else None  # checked even where not used
+    if json_out:
+        check_writable(json_out)
+    if curvature:
+        _bench_curvature(worlds, seed, secs, city, tours, json_out)
+        return
     out = Console()
     d = dubins_speed()
     out.print(_dubins_table(d))
@@ -171,7 +218,7 @@ def bench_motion(
         return
     with Progress(console=Console(stderr=True), transient=True) as progress:
         task = progress.add_task("pairs", total=14 * 13)
-        r = step_drone_pairs(data, max_expansions=max_expansions, merge=merge,
+        r = step_drone_pairs(*ilp, max_expansions=max_expansions, merge=merge,
                              on_pair=lambda: progress.advance(task))
     both = sum(1 for x in r["rows"] if x["moves"] is not None and x["follow"] is not None)
     out.print(f"step drone over {r['pairs']} ordered pairs: plan_moves solved "
@@ -209,20 +256,26 @@ def _exit_past_ompl() -> None:
         os._exit(0)
 
 
-def _bench_curvature(worlds, seed, budgets, city, tours, json_out) -> None:
-    from skyroute.bench.curvature import curvature_benchmark, summary, tour_benchmark
-
+def _budgets(budgets: str) -> tuple[float, ...]:
+    """--budgets "1,5" -> (1.0, 5.0): OMPL seconds per solve, each positive and finite."""
     try:
         secs = tuple(float(b) for b in budgets.split(",") if b.strip())
     except ValueError:
         raise OptionError(f"--budgets {budgets!r}: expected seconds like 1,5") from None
-    if any(b <= 0 for b in secs):  # --worlds and --tours: bounded by their options
-        raise OptionError(f"--budgets {budgets!r}: every budget must be > 0 seconds")
+    if not all(math.isfinite(b) and b > 0 for b in secs):
+        raise OptionError(f"--budgets {budgets!r}: every budget must be > 0 seconds and "
+                          "finite")
+    return secs
+
+
+def _bench_curvature(worlds, seed, secs, city, tours, json_out) -> None:
+    from skyroute.bench.curvature import curvature_queries, run_queries, summary, tour_benchmark
+
+    queries = curvature_queries(worlds, seed, city=city)  # a bad --city fails here, first
     out = Console()
     with Progress(console=Console(stderr=True), transient=True) as progress:
         task = progress.add_task("planner runs", total=None)
-        rows = curvature_benchmark(worlds, seed, secs, city=city,
-                                   on_step=lambda r: progress.advance(task))
+        rows = run_queries(queries, secs, on_step=lambda r: progress.advance(task))
     summ = summary(rows)
     table = Table(title="turning radius 5 m: one query per world")
     for col in ("runner", "solved", "exactly free", "median ratio", "median ms", "p95 ms"):

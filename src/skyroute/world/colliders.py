@@ -29,15 +29,12 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
     plane is east/north metres around home at (lon0, lat0)). ``text``: the file's content,
     already in hand (an upload); ``path`` then only names it in errors."""
     path = Path(path)
-    try:
-        lines = (path.read_text() if text is None else text).splitlines()
+    try:  # utf-8-sig: Excel starts a saved CSV with a byte-order mark
+        text = path.read_text(encoding="utf-8-sig") if text is None else text
     except (OSError, UnicodeDecodeError) as exc:
         raise InputFormatError(path, f"cannot read: {exc}") from None
-    m = _HOME.match(lines[0]) if lines else None
-    if m is None:
-        got = lines[0][:60] if lines else "an empty file"
-        raise InputFormatError(path, f"expected 'lat0 <deg>, lon0 <deg>', got {got!r}", line=1)
-    lat0, lon0 = float(m.group(1)), float(m.group(2))
+    lines = text.removeprefix("\ufeff").splitlines()
+    lat0, lon0 = _home(path, lines[0] if lines else None)
     if not (-90 <= lat0 <= 90 and -180 <= lon0 <= 180):
         raise InputFormatError(path, f"home lat0 {lat0}, lon0 {lon0} is not a place", line=1)
     if len(lines) < 2 or lines[1].replace(" ", "") != HEADER:
@@ -66,3 +63,17 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
     names = tuple(f"box at line {n}" for n in range(3, 3 + len(rows)))
     return World(boxes, up - hu - s, up + hu + s, names, None, frame,
                  Home(lon0, lat0, 0.0), name=path.name)
+
+
+def _home(path: Path, line: str | None) -> tuple[float, float]:
+    """(lat0, lon0) from line 1, ``lat0 <deg>, lon0 <deg>`` (None: an empty file); the
+    pattern admits digits and dots, so "37.79.2480" still fails to convert."""
+    m = _HOME.match(line) if line is not None else None
+    try:
+        if m is None:
+            raise ValueError
+        return float(m.group(1)), float(m.group(2))
+    except ValueError:
+        got = "an empty file" if line is None else repr(line[:60])
+        raise InputFormatError(path, f"expected 'lat0 <deg>, lon0 <deg>', got {got}",
+                               line=1) from None

@@ -1,0 +1,42 @@
+"""colliders.csv home lines: a malformed number is an InputFormatError on line 1, and a
+byte-order mark (Excel writes one) is read past."""
+
+import pytest
+
+import skyroute
+from skyroute import InputFormatError
+from skyroute.world.colliders import read_colliders
+
+HEADER = "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ"
+HOME = "lat0 37.792480, lon0 -122.397450"
+BOXES = "10,0,5,2,3,5\n-20,20,40,5,5,40\n"
+
+
+@pytest.mark.parametrize("home", ["lat0 37.79.2480, lon0 -122.397450", "lat0 ., lon0 .",
+                                  "lat0 37.792480, lon0 -", "lat0 -, lon0 1..2"])
+def test_malformed_home_line_names_line_1(tmp_path, home):
+    path = tmp_path / "c.csv"
+    path.write_text(f"{home}\n{HEADER}\n{BOXES}")
+    with pytest.raises(InputFormatError) as err:
+        skyroute.load_world(path)
+    assert err.value.line == 1
+    assert str(err.value) == f"{path}:1: expected 'lat0 <deg>, lon0 <deg>', got {home!r}"
+
+
+def test_empty_file_names_line_1(tmp_path):
+    path = tmp_path / "c.csv"
+    path.write_text("")
+    with pytest.raises(InputFormatError, match="got an empty file") as err:
+        read_colliders(path)
+    assert err.value.line == 1
+
+
+def test_byte_order_mark_is_read_past(tmp_path):
+    plain, bom = tmp_path / "plain.csv", tmp_path / "bom.csv"
+    plain.write_text(f"{HOME}\n{HEADER}\n{BOXES}")
+    bom.write_bytes(b"\xef\xbb\xbf" + plain.read_bytes())
+    a, b = skyroute.load_world(plain, frame="enu"), skyroute.load_world(bom, frame="enu")
+    assert (b.home.lat, b.home.lon) == (a.home.lat, a.home.lon) == (37.79248, -122.39745)
+    assert list(b.obstacles) == list(a.obstacles)
+    text = read_colliders("upload.csv", text="\ufeff" + plain.read_text(), frame="enu")
+    assert list(text.obstacles) == list(a.obstacles)
