@@ -1,5 +1,5 @@
-"""GridOptions: the cached hash keeps equal option sets interchangeable as dict keys;
-a grid keeps one query call per option set."""
+"""GridOptions: equal option sets are interchangeable as dict keys, in this process and
+after pickling; a grid keeps one query call per option set."""
 
 import pickle
 from dataclasses import astuple
