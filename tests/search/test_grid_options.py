@@ -48,3 +48,29 @@ def test_a_cached_option_set_does_not_admit_equal_values_of_another_type():
     for bad in (5.0, True):  # equal to 5 and 1, so an untyped cache would hand those back
         with pytest.raises(skyroute.OptionError, match="must be an integer"):
             skyroute.plan(grid, (0, 0), (3, 3), max_expansions=bad)
+
+
+def test_equal_option_sets_share_one_runner():
+    from skyroute.search.grid_plan import plan_grid
+
+    grid = skyroute.Grid(np.zeros((6, 6), bool))
+    first = plan_grid(grid, (0, 0), (5, 3), grid_options("astar", max_expansions=7))
+    for other in (pickle.loads(pickle.dumps(grid_options("astar", max_expansions=7))),
+                  GridOptions(*astuple(grid_options("astar", max_expansions=7)))):
+        again = plan_grid(grid, (0, 0), (5, 3), other)
+        assert "setup_seconds" not in again.extra  # the runner of the equal set
+        assert again.cost == first.cost
+    assert len(space_of(grid).runners) == 1
+    w2, w20 = grid_options("astar", weight=2), grid_options("astar", weight=2.0)
+    assert w2 is w20  # the typed cache made two, the canonical set is one
+
+
+def test_clearing_caches_does_not_pile_up_finalizers():
+    import weakref
+
+    grid = skyroute.Grid(np.zeros((4, 4), bool))
+    before = len(weakref.finalize._registry)
+    for _ in range(50):
+        skyroute.clear_caches()
+        skyroute.plan(grid, (0, 0), (3, 3))
+    assert len(weakref.finalize._registry) - before <= 1

@@ -84,8 +84,18 @@ def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, pr
     elif isinstance(max_expansions, bool) or not isinstance(max_expansions, int | np.integer) \
             or max_expansions < 0:
         raise OptionError(f"max_expansions={max_expansions!r} must be an integer >= 0")
-    return GridOptions(algorithm, int(connectivity), bool(corner_cutting), heuristic,
-                       float(weight), prune, int(max_expansions))
+    return canonical(GridOptions(algorithm, int(connectivity), bool(corner_cutting),
+                                 heuristic, float(weight), prune, int(max_expansions)))
+
+
+_CANONICAL: dict[GridOptions, GridOptions] = {}  # one object per distinct option set
+
+
+def canonical(opts: GridOptions) -> GridOptions:
+    """The one object standing for every option set equal to ``opts``: a grid keeps its
+    query calls by that object's id, so equal sets share one (after the option cache
+    evicted a set, or for a set unpickled or made by hand)."""
+    return _CANONICAL.setdefault(opts, opts)
 
 
 def _default_h(algorithm: str, connectivity: int) -> str:
@@ -109,6 +119,9 @@ def plan_grid(grid: Grid, start: tuple[int, int], goal: tuple[int, int],
     space = space_of(grid)
     s, t = space.flat_pair(start, goal)
     entry = space.runners.get(id(opts))  # by id: GridOptions.__hash__ is a Python call
+    if entry is None:  # not the canonical object? (its id is the key when it is)
+        opts = canonical(opts)
+        entry = space.runners.get(id(opts))
     extra = {}
     if entry is not None:
         run = entry[1]

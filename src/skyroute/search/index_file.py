@@ -2,8 +2,9 @@
 map's shape and a hash of its blocked cells. Before any array reaches a compiled query
 (which does not check its indices) :func:`read_index` checks the metadata, every
 array's dtype and dimensions, the sizes that tie them together and the range of every
-index they hold; ``load_index`` then recomputes what the map determines (region labels,
-clearances) and compares. Distances and predecessor chains are trusted as written:
+index they hold; ``load_index`` then checks what the map determines against it (region
+labels: -1 exactly on blocked cells, one label across every free edge; clearances:
+recomputed). Distances and predecessor chains are trusted as written:
 load only indexes that skyroute wrote (as with a pickle, a file crafted to pass these
 checks could still give wrong answers or worse)."""
 
@@ -124,7 +125,8 @@ def _malformed(arrays: dict, padded: int) -> str:
                 and arrays["lmd"].shape[0] == m
                 and arrays["dist"].shape in ((m, m), (0, 0))
                 and arrays["pred"].shape == arrays["dist"].shape
-                and ch_offs.size in (0, m + 1) and arrays["ch_core"].size in (0, m)
+                and ch_offs.size in (0, m + 1)  # a hierarchy has every per-node array
+                and arrays["ch_core"].size == (m if ch_offs.size else 0)
                 and arrays["ch_nbr"].size == arrays["ch_len"].size
                 == arrays["ch_mid"].size
                 and ch.shape[0] == ch.shape[1] and arrays["ch_pred"].shape == ch.shape)

@@ -309,15 +309,21 @@ def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
 
 
 def _fits_the_map(blocked: np.ndarray, arrays: dict) -> bool:
-    """Whether an index's arrays that the map determines (region labels; a subgoal
-    graph's clearances) are the map's own: recomputed in milliseconds, so a query never
-    walks or labels by numbers another map or a hand gave."""
-    label = region_labels(blocked)
-    if not np.array_equal(arrays["label"], label):
+    """Whether an index's arrays that the map determines are the map's own, in
+    milliseconds: region labels -1 exactly on blocked cells and equal across every free
+    edge (so no free region is split: "no path" is never answered where one exists),
+    and a subgoal graph's clearances recomputed (so a query never walks by numbers
+    another map or a hand gave)."""
+    padded = _padded(blocked)
+    free, lab = padded == 0, arrays["label"].reshape(padded.shape)
+    if not np.array_equal(lab >= 0, free):
+        return False
+    across = free[:, 1:] & free[:, :-1], free[1:, :] & free[:-1, :]
+    if np.any(lab[:, 1:][across[0]] != lab[:, :-1][across[0]]) or \
+            np.any(lab[1:, :][across[1]] != lab[:-1, :][across[1]]):
         return False
     if "clr" not in arrays:
         return True
-    padded = _padded(blocked)
     sg = np.full(padded.size, -1, np.int32)
     sg[arrays["cells"]] = np.arange(arrays["cells"].size, dtype=np.int32)
     return np.array_equal(arrays["clr"], clearances(padded.ravel(), sg, padded.shape[1]))

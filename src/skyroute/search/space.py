@@ -126,6 +126,7 @@ def workspace(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 # 0.2-0.8 us of a 9 us query on a 32x32 map
 _SPACES: dict[int, SearchSpace] = {}
 register(_SPACES.clear)
+_WATCHED: weakref.WeakSet = weakref.WeakSet()  # grids with their finalizer (one each)
 
 
 def space_of(grid: Grid) -> SearchSpace:
@@ -133,5 +134,7 @@ def space_of(grid: Grid) -> SearchSpace:
     space = _SPACES.get(id(grid))
     if space is None:
         space = _SPACES[id(grid)] = SearchSpace(grid)
-        weakref.finalize(grid, _SPACES.pop, id(grid), None)
+        if grid not in _WATCHED:  # not again after clear_caches()
+            weakref.finalize(grid, _SPACES.pop, id(grid), None)
+            _WATCHED.add(grid)
     return space

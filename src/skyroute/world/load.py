@@ -27,10 +27,11 @@ def bundled_maps() -> dict[str, Path]:
 
 
 def resolve_map_path(path: str | Path) -> Path:
-    """``path`` itself when it is a file, else the bundled map of that name (a folder
-    of the same name in the working folder does not hide it)."""
+    """``path`` itself when it exists and is not a folder (a file, a pipe), else the
+    bundled map of that name (a folder of the same name in the working folder does not
+    hide it)."""
     p = Path(path)
-    if p.is_file():
+    if p.exists() and not p.is_dir():
         return p
     maps = bundled_maps()
     key = p.name[:-4] if p.name.endswith(".map") else p.name
@@ -38,8 +39,6 @@ def resolve_map_path(path: str | Path) -> Path:
         return maps[key]
     if p.is_dir():
         raise InputFormatError(p, "a folder, not a map file")
-    if p.exists():
-        raise InputFormatError(p, "not a regular file")
     raise InputFormatError(p, "no such file (bundled maps: " + ", ".join(maps) + ")")
 
 
