@@ -28,7 +28,7 @@ from skyroute.planner import plan
 from skyroute.search.grid_plan import GRID_ALGORITHMS
 from skyroute.search.prepared import prepare
 from skyroute.world.grid import Grid
-from skyroute.world.movingai import Scenario, read_map, read_scen
+from skyroute.world.movingai import Scenario, query_line, read_map, read_scen
 
 # Algorithms whose cost must equal the scenario's octile optimum.
 OPTIMAL = ("dijkstra", "astar", "jps")
@@ -178,7 +178,7 @@ def check_scenario(grid: Grid, scen: Scenario, map_name: str) -> None:
     if (scen.width, scen.height) != (grid.width, grid.height):
         raise InputFormatError(scen.path, f"scenario is for a {scen.width}x{scen.height} map, "
                                f"{map_name} is {grid.width}x{grid.height}",
-                               line=scen_line(scen.path, 0))
+                               line=query_line(scen.path, 0))
     bad_start, bad_goal = _off_free(grid, scen.starts), _off_free(grid, scen.goals)
     if not (bad_start.any() or bad_goal.any()):
         return
@@ -187,7 +187,7 @@ def check_scenario(grid: Grid, scen: Scenario, map_name: str) -> None:
     x, y = (int(v) for v in cells[i])
     where = (f"lies outside {map_name} ({grid.width}x{grid.height})"
              if not grid.in_bounds((x, y)) else f"is on a blocked cell of {map_name}")
-    raise InputFormatError(scen.path, f"{what} ({x}, {y}) {where}", line=scen_line(scen.path, i))
+    raise InputFormatError(scen.path, f"{what} ({x}, {y}) {where}", line=query_line(scen.path, i))
 
 
 def _off_free(grid: Grid, cells: np.ndarray) -> np.ndarray:
@@ -197,18 +197,6 @@ def _off_free(grid: Grid, cells: np.ndarray) -> np.ndarray:
     bad = ~inside
     bad[inside] = grid.blocked[y[inside], x[inside]]
     return bad
-
-
-def scen_line(path: Path, index: int) -> int | None:
-    """The file line of a scenario's ``index``-th query (blank lines are skipped when
-    reading, so it is counted again here; only on the error path). None if unreadable."""
-    try:
-        text = Path(path).read_bytes().decode("ascii", errors="replace")
-    except OSError:
-        return None
-    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
-    numbers = [n for n, line in enumerate(lines[1:], start=2) if line.strip()]
-    return numbers[index] if index < len(numbers) else None
 
 
 def bench_case(case: Case, *, algorithms: Sequence[str], peers: Sequence[str], seed: int,

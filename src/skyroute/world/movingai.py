@@ -124,6 +124,18 @@ class Scenario:
         return abs(cost - opt) <= self.tolerance[index] + 1e-6 * opt
 
 
+def query_line(path: str | Path, index: int) -> int | None:
+    """The file line of a ``.scen`` file's ``index``-th query, counted as
+    :func:`read_scen` counts it (blank lines skipped); for error messages. None when the
+    file cannot be read."""
+    try:
+        lines = _lines(Path(path))
+    except InputFormatError:
+        return None
+    numbers = [n for n, line in enumerate(lines[1:], start=2) if line.strip()]
+    return numbers[index] if index < len(numbers) else None
+
+
 def read_scen(path: str | Path) -> Scenario:
     """Read a MovingAI ``.scen`` file (``version 1``, 9 tab-separated columns)."""
     path = Path(path)
