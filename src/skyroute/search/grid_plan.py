@@ -9,6 +9,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from skyroute.caches import register
 from skyroute.errors import OptionError, check_choice
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search.astar import astar_kernel
@@ -89,6 +90,7 @@ def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, pr
 
 
 _CANONICAL: dict[GridOptions, GridOptions] = {}  # one object per distinct option set
+register(_CANONICAL.clear)  # cleared, equal sets still agree: the next one seen stands
 
 
 def canonical(opts: GridOptions) -> GridOptions:
