@@ -42,13 +42,18 @@ class PRM:
         rng = np.random.default_rng(self.seed)
         t0 = time.perf_counter()
         self.world = world.merged()
-        xmin, ymin, xmax, ymax = self.world.bounds
-        pts = np.empty((0, 2))
-        for _ in range(100):
-            batch = rng.uniform([xmin, ymin], [xmax, ymax], size=(2 * samples, 2))
-            pts = np.vstack([pts, batch[self.world.is_free(batch)]])
-            if len(pts) >= samples:
-                break
+        box = self.world.bounds
+        pts = _free_samples(self.world, box, samples, rng)
+        if len(pts) < 2 and world.boundary is None:
+            # the obstacles fill their own bounds: the free space is around them
+            x0, y0, x1, y1 = box
+            grow = max(x1 - x0, y1 - y0)
+            pts = _free_samples(self.world, (x0 - grow, y0 - grow, x1 + grow, y1 + grow),
+                                samples, rng)
+        if len(pts) < 2:
+            raise OptionError(f"PRM drew {len(pts)} free point(s) from the world's extent "
+                              "and needs at least 2: its free space is empty or too thin "
+                              "to sample", param="samples")
         self.points = pts[:samples]
         n = len(self.points)
         self.k = math.ceil(math.e * 1.5 * math.log(n)) if prm_star else neighbours
@@ -122,3 +127,16 @@ class PRM:
     def edge_segments(self) -> np.ndarray:
         """(E, 2, 2) plane segments of the roadmap's edges (for plots)."""
         return self.points[self.edges]
+
+
+def _free_samples(world: World, box: tuple, samples: int, rng) -> np.ndarray:
+    """Up to ``samples`` uniform free points of ``box`` (xmin, ymin, xmax, ymax), drawn in
+    at most 100 batches of ``2 * samples``."""
+    xmin, ymin, xmax, ymax = box
+    pts = np.empty((0, 2))
+    for _ in range(100):
+        batch = rng.uniform([xmin, ymin], [xmax, ymax], size=(2 * samples, 2))
+        pts = np.vstack([pts, batch[world.is_free(batch)]])
+        if len(pts) >= samples:
+            break
+    return pts

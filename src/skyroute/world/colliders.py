@@ -17,6 +17,7 @@ import shapely
 
 from skyroute.errors import InputFormatError
 from skyroute.geo import Home
+from skyroute.world.points import MAX_METRES
 from skyroute.world.world import World
 
 HEADER = "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ"
@@ -53,6 +54,9 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
                                    line=n) from None
         if not all(np.isfinite(vals)) or min(vals[3:]) <= 0:
             raise InputFormatError(path, "values must be finite and half sizes > 0", line=n)
+        if max(abs(vals[i]) + vals[i + 3] for i in range(3)) > MAX_METRES:
+            raise InputFormatError(path, f"the box reaches more than {MAX_METRES:.0e} m from "
+                                   "home", line=n)
         rows.append(vals)
     if not rows:
         raise InputFormatError(path, "no boxes after the header", line=3)

@@ -16,8 +16,9 @@ from pathlib import Path
 import numpy as np
 import shapely
 
-from skyroute.errors import InputFormatError, OptionError, check_choice
+from skyroute.errors import InputFormatError, OptionError, QueryError, check_choice
 from skyroute.geo import FRAME_ALIASES, FRAMES, Home, lonlat_to_enu
+from skyroute.world.points import check_places
 from skyroute.world.world import World
 
 
@@ -49,6 +50,10 @@ def _polygon(path: Path, i: int, feature: dict) -> tuple[shapely.Geometry, str]:
     if not shape.is_valid:
         raise InputFormatError(path, f"feature {i} ({name!r}) is not a valid polygon: "
                                f"{shapely.is_valid_reason(shape)}")
+    try:
+        check_places(shapely.get_coordinates(shape), "a vertex")
+    except QueryError as exc:
+        raise InputFormatError(path, f"feature {i} ({name!r}): {exc}") from None
     return shape, name
 
 
@@ -69,6 +74,10 @@ def parse_boundary(value: str | Path) -> shapely.Polygon:
                               "a GeoJSON file", param="boundary") from None
         if not (x0 < x1 and y0 < y1):
             raise OptionError(f"boundary={text!r}: min must be below max", param="boundary")
+        try:
+            check_places(np.array([[x0, y0], [x1, y1]]), "a corner")
+        except QueryError as exc:
+            raise OptionError(f"boundary={text!r}: {exc}", param="boundary") from None
         return shapely.box(x0, y0, x1, y1)
     path = Path(text)
     if not path.exists():

@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from skyroute.errors import InputFormatError, OptionError, check_choice, renamed
+from skyroute.errors import InputFormatError, OptionError, check_choice, real, renamed
+from skyroute.files import as_path
 from skyroute.world.grid import Grid
 
 if TYPE_CHECKING:
@@ -30,9 +31,12 @@ def resolve_map_path(path: str | Path) -> Path:
     """``path`` itself when it exists and is not a folder (a file, a pipe), else the
     bundled map of that name (a folder of the same name in the working folder does not
     hide it)."""
-    p = Path(path)
-    if p.exists() and not p.is_dir():
-        return p
+    p = as_path(path, "path")
+    try:
+        if p.exists() and not p.is_dir():
+            return p
+    except OSError as exc:  # e.g. a name longer than the file system allows
+        raise InputFormatError(p, f"cannot read: {exc.strerror}") from None
     maps = bundled_maps()
     key = p.name[:-4] if p.name.endswith(".map") else p.name
     if str(path) == p.name and key in maps:
@@ -62,9 +66,9 @@ def load_map(path: str | Path, *, resolution: float | None = None, safety: float
     (65, 81)
     """
     resolution = renamed("resolution", resolution, "cell_size", cell_size)
-    resolution = 1.0 if resolution is None else resolution
+    resolution = 1.0 if resolution is None else real("resolution", resolution)
     safety = renamed("safety", safety, "clearance", clearance)
-    safety = 0.0 if safety is None else safety
+    safety = 0.0 if safety is None else real("safety", safety)
     p = resolve_map_path(path)
     suffix = p.suffix.lower()
     if suffix == ".csv":
@@ -111,11 +115,16 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
     from skyroute.geo import FRAME_ALIASES, FRAMES
     from skyroute.world.colliders import read_colliders
     from skyroute.world.geojson_world import parse_boundary, read_geojson_world
+    from skyroute.world.points import MAX_METRES
 
     check_choice("frame", frame, (*FRAMES, *FRAME_ALIASES))
     frame = FRAME_ALIASES.get(frame, frame)
     if not (np.isfinite(safety) and safety >= 0):
         raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
+    most = 180.0 if frame == "degrees" else MAX_METRES
+    if safety > most:
+        raise OptionError(f"safety={safety!r} must be at most {most:g} "
+                          f"({'degrees' if frame == 'degrees' else 'metres'})", param="safety")
     p = Path(path)
     if text is None and not p.exists():
         raise InputFormatError(p, "no such file")

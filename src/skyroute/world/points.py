@@ -1,11 +1,17 @@
 """Reading points from callers: any array-like of numbers becomes a float (N, 2) array,
-and anything else a QueryError that names the argument."""
+and anything else a QueryError that names the argument; places on Earth and points of a
+local plane are checked against the ranges where the conversions hold."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from skyroute.errors import QueryError
+
+# A local plane (metres around a home) reaches at most this far in either axis: a
+# quarter of the way round the Earth, far beyond where a tangent plane means anything,
+# and small enough that buffering, rasterising and lon/lat conversions stay finite.
+MAX_METRES = 1e7
 
 
 def as_points(points, what: str, *, dims: int = 2) -> np.ndarray:
@@ -30,4 +36,25 @@ def as_points(points, what: str, *, dims: int = 2) -> np.ndarray:
                          f"got shape {np.shape(points)}")
     if not np.all(np.isfinite(p)):
         raise QueryError(f"{what} must be finite numbers, got {p.tolist()}")
+    return p
+
+
+def check_places(p: np.ndarray, what: str) -> np.ndarray:
+    """``p`` when every row is a (lon, lat) on Earth, else a QueryError naming ``what``."""
+    bad = (np.abs(p[:, 0]) > 180) | (np.abs(p[:, 1]) > 90)
+    if bad.any():
+        q = p[np.argmax(bad)]
+        raise QueryError(f"{what} ({q[0]:.7g}, {q[1]:.7g}) is not a place: expected "
+                         "(lon, lat) degrees, lon in [-180, 180], lat in [-90, 90]")
+    return p
+
+
+def check_metres(p: np.ndarray, what: str) -> np.ndarray:
+    """``p`` when every coordinate of a local plane lies within :data:`MAX_METRES` of
+    home, else a QueryError naming ``what``."""
+    bad = np.abs(p).max(axis=1) > MAX_METRES if len(p) else np.zeros(0, bool)
+    if bad.any():
+        q = p[np.argmax(bad)]
+        raise QueryError(f"{what} ({q[0]:.7g}, {q[1]:.7g}) lies more than {MAX_METRES:.0e} m "
+                         "from home: not a point of this world's local plane")
     return p

@@ -33,18 +33,7 @@ from skyroute.geo import (
     lonlat_to_enu,
 )
 from skyroute.world.grid import Grid, raster_shape
-from skyroute.world.points import as_points
-
-
-def _check_places(p: np.ndarray, what: str) -> np.ndarray:
-    """``p`` when every row is a (lon, lat) on Earth, else a QueryError naming ``what``."""
-    bad = (np.abs(p[:, 0]) > 180) | (np.abs(p[:, 1]) > 90)
-    if bad.any():
-        q = p[np.argmax(bad)]
-        raise QueryError(f"{what} ({q[0]:.7g}, {q[1]:.7g}) is not a place: expected "
-                         "(lon, lat) degrees, lon in [-180, 180], lat in [-90, 90]")
-    return p
-
+from skyroute.world.points import as_points, check_metres, check_places
 
 AXES = {"lonlat": ("lon", "lat"), "degrees": ("lon", "lat"), "ned": ("north", "east"),
         "enu": ("x", "y")}
@@ -110,9 +99,11 @@ class World:
         QueryError naming ``what``."""
         p = as_points(points, what)
         if self.frame == "ned":
-            return p[:, ::-1].copy()
+            return check_metres(p, what)[:, ::-1].copy()
+        if self.frame == "enu":
+            return check_metres(p, what)
         if self.frame in ("lonlat", "degrees"):
-            _check_places(p, what)
+            check_places(p, what)
         if self.frame == "lonlat":
             return lonlat_to_enu(p[:, 0], p[:, 1], 0.0, self.home)[:, :2] if len(p) else p
         return p
@@ -154,7 +145,7 @@ class World:
         """Points in the world's frame -> (N, 2) (lon, lat) degrees (unchanged, bit for
         bit, in the frames whose points are lon/lat)."""
         if self.frame in ("lonlat", "degrees"):
-            return _check_places(as_points(points, what), what)
+            return check_places(as_points(points, what), what)
         return self.plane_to_lonlat(self.to_plane(points, what))
 
     def in_frame(self, frame: str) -> World:
