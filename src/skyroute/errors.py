@@ -6,7 +6,9 @@ so the CLI can print it as one line.
 
 from __future__ import annotations
 
+import math
 import warnings
+from collections.abc import Hashable
 
 
 class SkyrouteError(Exception):
@@ -45,8 +47,13 @@ class OptionError(SkyrouteError, ValueError):
 
 
 def check_choice(name: str, value: object, choices: tuple) -> None:
-    """Raise :class:`OptionError` unless ``value`` is one of ``choices``."""
-    if value not in choices:
+    """Raise :class:`OptionError` unless ``value`` is one of ``choices`` (an array, which
+    compares element by element, never is)."""
+    try:
+        ok = isinstance(value, Hashable) and value in choices
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
         valid = ", ".join(repr(c) for c in choices)
         raise OptionError(f"{name}={value!r} is not valid; choose one of {valid}", param=name)
 
@@ -60,3 +67,14 @@ def renamed(new: str, value: object, old: str, old_value: object) -> object:
         raise OptionError(f"give {new} (or its old name {old}), not both", param=new)
     warnings.warn(f"{old}= is deprecated; use {new}=", DeprecationWarning, stacklevel=3)
     return old_value
+
+
+def real(name: str, value: object) -> float:
+    """``value`` as a finite float when it is a real number (not a bool, a string or an
+    array), else an :class:`OptionError` naming ``name``."""
+    import numbers
+
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) \
+            or not math.isfinite(value):
+        raise OptionError(f"{name}={value!r} must be a finite number", param=name)
+    return float(value)

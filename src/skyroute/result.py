@@ -43,7 +43,7 @@ def stop_code(c, goal, expanded, max_expansions):
     return -1
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class PlanResult:
     """What a planner found and what it cost to find it.
 
@@ -56,6 +56,9 @@ class PlanResult:
     expanded (for PRM: roadmap nodes Dijkstra settled up to the goal), ``max_frontier``
     the largest open list, ``los_checks`` line-of-sight (segment) tests, and ``seconds``
     the wall time of the search itself.
+
+    Results compare and hash by identity (each is the record of one run, and two runs
+    differ in ``seconds`` anyway): compare ``status``, ``cost`` and ``path`` instead.
     """
 
     status: Status
@@ -66,8 +69,8 @@ class PlanResult:
     los_checks: int = 0
     seconds: float = 0.0
     algorithm: str = ""
-    extra: dict = field(default_factory=dict, compare=False)
-    path_lonlat: np.ndarray | None = field(default=None, compare=False)
+    extra: dict = field(default_factory=dict)
+    path_lonlat: np.ndarray | None = None
 
     @classmethod
     def of_search(cls, status: Status, path: np.ndarray, cost: float, expanded: int,

@@ -74,3 +74,36 @@ def test_clearing_caches_does_not_pile_up_finalizers():
         skyroute.clear_caches()
         skyroute.plan(grid, (0, 0), (3, 3))
     assert len(weakref.finalize._registry) - before <= 1
+
+
+@pytest.mark.parametrize("kwargs,param", [
+    ({"connectivity": np.array([8])}, "connectivity"),
+    ({"corner_cutting": np.array([True, False])}, "corner_cutting"),
+    ({"corner_cutting": "yes"}, "corner_cutting"),
+    ({"prune": np.array(["los"])}, "prune"),
+    ({"heuristic": np.array(["octile"])}, "heuristic")])
+def test_array_options_are_option_errors(kwargs, param):
+    g = skyroute.Grid(np.zeros((3, 3), bool))
+    with pytest.raises(skyroute.OptionError) as err:
+        skyroute.plan(g, (0, 0), (2, 2), **kwargs)
+    assert err.value.param == param
+
+
+def test_numpy_scalars_are_options_like_their_values():
+    g = skyroute.Grid(np.zeros((3, 3), bool))
+    r = skyroute.plan(g, (0, 0), (2, 2), connectivity=np.int64(4), prune=np.str_("collinear"),
+                      corner_cutting=np.bool_(False))
+    assert r.found and r.cost == 4
+
+
+@pytest.mark.parametrize("budget", [2**63, 2**64, np.uint64(2**64 - 1)])
+def test_a_budget_beyond_int64_means_no_budget(budget):
+    g = skyroute.Grid(np.zeros((3, 3), bool))
+    assert grid_options(max_expansions=budget).max_expansions == np.iinfo(np.int64).max
+    assert skyroute.plan(g, (0, 0), (2, 2), max_expansions=budget).found
+
+
+def test_results_compare_by_identity_and_hash():
+    g = skyroute.Grid(np.zeros((3, 3), bool))
+    a, b = skyroute.plan(g, (0, 0), (2, 2)), skyroute.plan(g, (0, 0), (2, 2))
+    assert a == a and a != b and len({a, b}) == 2  # used to raise on the path arrays

@@ -1,3 +1,6 @@
+import copy
+import pickle
+
 import numpy as np
 import pytest
 import shapely
@@ -166,3 +169,61 @@ def test_a_folder_is_not_a_map_and_does_not_hide_a_bundled_one(tmp_path, monkeyp
     writer.start()
     assert load_map(fifo).width == 65
     writer.join()
+
+
+@pytest.mark.parametrize("copy_of", [copy.copy, copy.deepcopy,
+                                     lambda g: pickle.loads(pickle.dumps(g))])
+def test_a_copied_or_unpickled_grid_stays_read_only(copy_of):
+    # a writable copy could be changed under the search cache keyed by the grid and
+    # then planned through its new walls
+    g = copy_of(Grid(np.zeros((3, 5), bool), resolution=0.5, origin=(1.0, 2.0), name="g"))
+    assert not g.blocked.flags.writeable
+    assert (g.resolution, g.origin, g.name) == (0.5, (1.0, 2.0), "g")
+    with pytest.raises(ValueError):
+        g.blocked[:, 2] = True
+    assert skyroute.plan(g, (0, 1), (4, 1)).cost == 4
+
+
+@pytest.mark.parametrize("kwargs,param", [
+    ({"resolution": "1"}, "resolution"), ({"resolution": [1]}, "resolution"),
+    ({"resolution": True}, "resolution"), ({"origin": (1,)}, "origin"),
+    ({"origin": None}, "origin"), ({"origin": (float("nan"), 0.0)}, "origin"),
+    ({"origin": (0.0, float("inf"))}, "origin")])
+def test_grid_resolution_and_origin_are_checked(kwargs, param):
+    with pytest.raises(OptionError) as err:
+        Grid(np.zeros((3, 3)), **kwargs)
+    assert err.value.param == param
+
+
+@pytest.mark.parametrize("kwargs", [{"resolution": "2"}, {"safety": "1"}])
+def test_load_map_options_must_be_numbers(kwargs):
+    with pytest.raises(OptionError, match="must be a finite number"):
+        load_map("den312d", **kwargs)
+
+
+def test_load_map_path_errors_are_skyroute_errors(tmp_path):
+    with pytest.raises(InputFormatError, match="cannot read"):
+        load_map("x" * 300 + ".map")  # longer than a file name may be
+    with pytest.raises(OptionError, match="must be a file path"):
+        load_map(None)
+    np.save(tmp_path / "rec.npy", np.zeros((2, 2), dtype=[("a", "i4")]))
+    with pytest.raises(InputFormatError, match="numbers or booleans"):
+        load_map(tmp_path / "rec.npy")
+
+
+@pytest.mark.parametrize("suffix", [".png", ".tiff"])
+def test_a_16_bit_image_reads_as_its_8_bit_twin(tmp_path, suffix):
+    grey = np.array([[0, 40, 100, 127, 128, 200, 255]], np.uint8)
+    Image.fromarray(grey).save(tmp_path / "a8.png")
+    Image.fromarray(grey.astype(np.uint16) * 257).save(tmp_path / f"a16{suffix}")
+    with Image.open(tmp_path / f"a16{suffix}") as img:
+        assert img.mode.startswith("I")  # Pillow's 16-bit grey: the case under test
+    eight, sixteen = load_map(tmp_path / "a8.png"), load_map(tmp_path / f"a16{suffix}")
+    assert eight.blocked.tolist() == [[True, True, True, True, False, False, False]]
+    assert sixteen.blocked.tolist() == eight.blocked.tolist()
+
+
+def test_a_floating_point_image_is_refused(tmp_path):
+    Image.fromarray(np.zeros((2, 2), np.float32)).save(tmp_path / "f.tiff")
+    with pytest.raises(InputFormatError, match="floating-point image"):
+        load_map(tmp_path / "f.tiff")

@@ -62,6 +62,7 @@ def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, pr
     if connectivity is None:
         connectivity = 4 if algorithm == "bfs" else 8
     check_choice("connectivity", connectivity, (4, 8))
+    check_choice("corner_cutting", corner_cutting, (False, True))
     if algorithm == "bfs" and connectivity != 4:
         raise OptionError("algorithm='bfs' is 4-connected; use connectivity=4 or "
                           "algorithm='dijkstra' for 8-connected unit costs")
@@ -86,7 +87,8 @@ def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, pr
             or max_expansions < 0:
         raise OptionError(f"max_expansions={max_expansions!r} must be an integer >= 0")
     return canonical(GridOptions(algorithm, int(connectivity), bool(corner_cutting),
-                                 heuristic, float(weight), prune, int(max_expansions)))
+                                 heuristic, float(weight), prune,
+                                 min(int(max_expansions), NO_BUDGET)))  # >= 2**63: none
 
 
 _CANONICAL: dict[GridOptions, GridOptions] = {}  # one object per distinct option set

@@ -16,7 +16,7 @@ from functools import cached_property
 
 import numpy as np
 
-from skyroute.errors import OptionError, QueryError, renamed
+from skyroute.errors import OptionError, QueryError, real, renamed
 
 
 @dataclass(frozen=True, eq=False, init=False)
@@ -49,14 +49,24 @@ class Grid:
         arr = np.array(blocked, dtype=bool, copy=True)
         if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
             raise OptionError(f"blocked must be a non-empty 2-D array, got shape {arr.shape}")
-        if not (np.isfinite(resolution) and resolution > 0):
+        if real("resolution", resolution) <= 0:
             raise OptionError(f"resolution={resolution!r} must be a positive number",
                               param="resolution")
+        try:
+            ox, oy = origin
+        except (TypeError, ValueError):
+            raise OptionError(f"origin={origin!r} must be two numbers (x, y)",
+                              param="origin") from None
         arr.setflags(write=False)
         object.__setattr__(self, "blocked", arr)
         object.__setattr__(self, "resolution", float(resolution))
-        object.__setattr__(self, "origin", (float(origin[0]), float(origin[1])))
+        object.__setattr__(self, "origin", (real("origin", ox), real("origin", oy)))
         object.__setattr__(self, "name", name)
+
+    def __reduce__(self) -> tuple:
+        """Copied and pickled through the constructor, so the copy's array is read-only
+        too (a writable copy could change under the search caches keyed by the grid)."""
+        return Grid, (self.blocked, self.resolution, self.origin, self.name)
 
     @property
     def cell_size(self) -> float:
@@ -104,7 +114,7 @@ class Grid:
         """
         safety = renamed("safety", safety, "clearance", clearance)
         safety = 0.0 if safety is None else safety
-        if not (np.isfinite(safety) and safety >= 0):
+        if real("safety", safety) < 0:
             raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
         if safety == 0 or not self.blocked.any():
             return self

@@ -20,19 +20,35 @@ def from_array(array: np.ndarray, *, resolution: float = 1.0,
 def read_image(path: str | Path, *, resolution: float = 1.0, threshold: int = 128) -> Grid:
     """A Grid from an image: a pixel darker than ``threshold`` (0-255 grey) is blocked.
 
-    Transparent pixels count as free. Row 0 is the top of the image.
+    Transparent pixels count as free. Row 0 is the top of the image. 16-bit grey images
+    are scaled to 0-255 first (Pillow's RGBA conversion would clip them at 255, so
+    nearly every pixel would read as bright); floating-point images are refused.
     """
     from PIL import Image, UnidentifiedImageError
 
     path = Path(path)
     try:
         with Image.open(path) as img:
+            if img.mode.startswith("I"):  # 16-bit grey ("I;16", or "I" holding it)
+                return Grid(_sixteen_bit(path, np.asarray(img)) < threshold, resolution,
+                            name=path.name)
+            if img.mode == "F":
+                raise InputFormatError(path, "a floating-point image: save it as 8- or "
+                                       "16-bit grey, or as a .npy array")
             rgba = np.asarray(img.convert("RGBA"))
     except (OSError, UnidentifiedImageError) as exc:
         raise InputFormatError(path, f"cannot read as an image: {exc}") from None
     grey = rgba[..., :3].astype(np.float32) @ np.array([0.299, 0.587, 0.114], np.float32)
     blocked = (grey < threshold) & (rgba[..., 3] >= 128)
     return Grid(blocked, resolution, name=path.name)
+
+
+def _sixteen_bit(path: Path, pixels: np.ndarray) -> np.ndarray:
+    """16-bit grey pixels on the 0-255 scale (65535 -> 255)."""
+    if pixels.ndim != 2 or pixels.min(initial=0) < 0 or pixels.max(initial=0) > 65535:
+        raise InputFormatError(path, "an integer image beyond 16-bit grey: save it as 8- "
+                               "or 16-bit grey, or as a .npy array")
+    return pixels.astype(np.float32) / 257.0
 
 
 def read_npy(path: str | Path, *, resolution: float = 1.0) -> Grid:
@@ -44,4 +60,7 @@ def read_npy(path: str | Path, *, resolution: float = 1.0) -> Grid:
         raise InputFormatError(path, f"cannot read as a .npy array: {exc}") from None
     if arr.ndim != 2 or 0 in arr.shape:
         raise InputFormatError(path, f"expected a non-empty 2-D array, got shape {arr.shape}")
+    if arr.dtype.kind not in "biuf":
+        raise InputFormatError(path, f"expected an array of numbers or booleans, got dtype "
+                               f"{arr.dtype}")
     return from_array(arr, resolution=resolution, name=path.name)
