@@ -95,7 +95,8 @@ def test_tour_visits_every_target(monkeypatch, capsys, tmp_path):
     targets = tmp_path / "targets.csv"
     points = [(60.0, 30.0), (-60.0, 60.0), (0.0, -120.0), (-120.0, -60.0)]  # on streets
     targets.write_text("north,east\n" + "".join(f"{n},{e}\n" for n, e in points))
-    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,0", "--goal", "0,0",
+    # No --goal: a tour has none (it was a required option, exit 2 "Missing option").
+    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,0",
                           "--targets", str(targets), "--step", "0.5", "--json")
     assert code == 0, err
     doc = json.loads(text)
@@ -122,6 +123,15 @@ def test_bad_poses_are_one_line_exit_2(monkeypatch, capsys, tmp_path, args, word
     code, text, err = run(monkeypatch, capsys, *BASE[:-2], *args, "--out", str(out))
     assert code == 2 and err.count("\n") == 1 and words in err, err
     assert not out.exists() and text == ""
+
+
+@pytest.mark.parametrize("vehicle", ["dubins", "step"])
+def test_no_goal_and_no_targets_is_one_line_exit_2(monkeypatch, capsys, vehicle):
+    code, text, err = run(monkeypatch, capsys, "fly", CITY, "--frame", "ned", "--vehicle",
+                          vehicle, "--altitude", "10", "--start", "0,0")
+    assert code == 2 and text == ""
+    assert err == "skyroute: error: give --goal A,B (or --targets FILE with --vehicle " \
+                  "dubins)\n"
 
 
 def test_bad_targets_file_names_the_line(monkeypatch, capsys, tmp_path):
