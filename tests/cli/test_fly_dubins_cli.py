@@ -140,3 +140,23 @@ def test_bad_targets_file_names_the_line(monkeypatch, capsys, tmp_path):
     code, _, err = run(monkeypatch, capsys, *BASE, "--start", "0,0", "--goal", "0,0",
                        "--targets", str(targets))
     assert code == 2 and f"{targets}:2: expected two numbers" in err
+
+
+@pytest.mark.parametrize("extra", [["--goal", "120,-180"], ["--goal", "120,-180", "--planner",
+                                                            "waypoints"]])
+def test_plot_title_shows_the_reported_length(monkeypatch, capsys, tmp_path, extra):
+    # The title gave the sampled polyline's length (236.436 m against 236.451 in the table).
+    import matplotlib.axes
+
+    titles = []
+    set_title = matplotlib.axes.Axes.set_title
+    monkeypatch.setattr(matplotlib.axes.Axes, "set_title",
+                        lambda ax, label, *a, **k: titles.append(label) or
+                        set_title(ax, label, *a, **k))
+    png = tmp_path / "dubins.png"
+    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,90", *extra, "--step",
+                          "4", "--plot", str(png), "--json")
+    assert code == 0, err
+    length = json.loads(text)["metrics"]["length"]
+    assert titles == [f"city.csv: dubins, {length:.6g} m"]
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

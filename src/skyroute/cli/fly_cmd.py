@@ -138,8 +138,13 @@ def fly_command(
     if plot is not None and doc["reached"]:
         from skyroute.io.world_out import plot_world_path
 
-        plane = world.to_plane(xy)
-        length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
+        # The title shows the length the table and --json report (a Dubins path's
+        # exact arcs); only a vehicle without one is measured along the drawn polyline,
+        # which cuts the arcs between samples and comes out shorter.
+        length = doc["metrics"].get("length")
+        if length is None:
+            plane = world.to_plane(xy)
+            length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
         shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)
         plot_world_path(world, shown, a, xy[-1], plot)
     if as_json:
