@@ -94,3 +94,23 @@ def test_grid_planners_reach_goals_beyond_the_obstacles(city):
     world = skyroute.load_world(city, frame="enu", altitude=10, safety=2)
     r = skyroute.plan(world, (0, 0), (-180, 120), algorithm="astar")
     assert r.found and world.segments_free(r.path[:-1], r.path[1:]).all()
+
+
+def test_field_reports_length_like_the_other_vehicles(monkeypatch, capsys, city):
+    code, text, err = run(monkeypatch, capsys, "fly", city, "--frame", "local", "--vehicle",
+                          "field", "--start", "0,0", "--goal", "60,-40", "--altitude", "10",
+                          "--step", "1", "--json")
+    assert code == 0, err
+    doc = json.loads(text)
+    m = doc["metrics"]
+    # one name across vehicles (docs/cli.md); it was "distance" for the field alone
+    assert set(m) == {"length", "moves", "smoothness", "status", "reached", "escape_moves"}
+    world = skyroute.load_world(city, frame="local", altitude=10)
+    flown = np.diff(world.to_plane(np.array(doc["trajectory"])), axis=0)
+    assert m["length"] == pytest.approx(np.hypot(*flown.T).sum())
+    assert m["moves"] == len(doc["trajectory"]) - 1 and m["escape_moves"] >= 0
+    code, text, err = run(monkeypatch, capsys, "fly", city, "--frame", "local", "--vehicle",
+                          "field", "--start", "0,0", "--goal", "60,-40", "--altitude", "10")
+    assert code == 0, err
+    rows = {line.split("│")[1].strip() for line in text.splitlines() if line.count("│") == 3}
+    assert {"length", "escape_moves"} <= rows and "distance" not in rows

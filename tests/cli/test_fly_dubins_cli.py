@@ -95,7 +95,8 @@ def test_tour_visits_every_target(monkeypatch, capsys, tmp_path):
     targets = tmp_path / "targets.csv"
     points = [(60.0, 30.0), (-60.0, 60.0), (0.0, -120.0), (-120.0, -60.0)]  # on streets
     targets.write_text("north,east\n" + "".join(f"{n},{e}\n" for n, e in points))
-    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,0", "--goal", "0,0",
+    # No --goal: a tour has none (it was a required option, exit 2 "Missing option").
+    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,0",
                           "--targets", str(targets), "--step", "0.5", "--json")
     assert code == 0, err
     doc = json.loads(text)
@@ -124,9 +125,38 @@ def test_bad_poses_are_one_line_exit_2(monkeypatch, capsys, tmp_path, args, word
     assert not out.exists() and text == ""
 
 
+@pytest.mark.parametrize("vehicle", ["dubins", "step"])
+def test_no_goal_and_no_targets_is_one_line_exit_2(monkeypatch, capsys, vehicle):
+    code, text, err = run(monkeypatch, capsys, "fly", CITY, "--frame", "ned", "--vehicle",
+                          vehicle, "--altitude", "10", "--start", "0,0")
+    assert code == 2 and text == ""
+    assert err == "skyroute: error: give --goal A,B (or --targets FILE with --vehicle " \
+                  "dubins)\n"
+
+
 def test_bad_targets_file_names_the_line(monkeypatch, capsys, tmp_path):
     targets = tmp_path / "t.csv"
     targets.write_text("30,30\n30;x\n")
     code, _, err = run(monkeypatch, capsys, *BASE, "--start", "0,0", "--goal", "0,0",
                        "--targets", str(targets))
     assert code == 2 and f"{targets}:2: expected two numbers" in err
+
+
+@pytest.mark.parametrize("extra", [["--goal", "120,-180"], ["--goal", "120,-180", "--planner",
+                                                            "waypoints"]])
+def test_plot_title_shows_the_reported_length(monkeypatch, capsys, tmp_path, extra):
+    # The title gave the sampled polyline's length (236.436 m against 236.451 in the table).
+    import matplotlib.axes
+
+    titles = []
+    set_title = matplotlib.axes.Axes.set_title
+    monkeypatch.setattr(matplotlib.axes.Axes, "set_title",
+                        lambda ax, label, *a, **k: titles.append(label) or
+                        set_title(ax, label, *a, **k))
+    png = tmp_path / "dubins.png"
+    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,90", *extra, "--step",
+                          "4", "--plot", str(png), "--json")
+    assert code == 0, err
+    length = json.loads(text)["metrics"]["length"]
+    assert titles == [f"city.csv: dubins, {length:.6g} m"]
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

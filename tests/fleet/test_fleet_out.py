@@ -266,6 +266,15 @@ def test_write_run_with_plots(sim, rep, tmp_path):
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 30_000
     t = np.loadtxt(paths[2], delimiter=",", skiprows=1, usecols=0)
     assert np.array_equal(t % 5.0, np.zeros_like(t))
+    # nothing drawn reaches the image's edge: the legend beside the map (runways, gates)
+    # was cut off on the right, its border and "landing runway" label clipped
+    from PIL import Image
+
+    for p in paths[-2:]:
+        img = np.asarray(Image.open(p).convert("L"))
+        edges = np.concatenate([img[:2].ravel(), img[-2:].ravel(), img[:, :2].ravel(),
+                                img[:, -2:].ravel()])
+        assert (edges == 255).all(), p.name
 
 
 @pytest.mark.parametrize("step", [0, -1.0, math.nan, "1s"])

@@ -16,7 +16,7 @@ def test_plain_field_reaches_easy_and_medium(name):
     assert run.reached and run.escaped == 0
     assert world.segments_free(run.path[:-1], run.path[1:]).all()
     m = run.metrics()
-    assert m["moves"] == run.moves and m["distance"] >= math.dist(start, goal) - 0.5
+    assert m["moves"] == run.moves and m["length"] >= math.dist(start, goal) - 0.5
     assert 0 <= m["smoothness"] < 0.2  # nearly straight
 
 

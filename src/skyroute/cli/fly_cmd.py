@@ -31,7 +31,8 @@ EXIT_NOT_REACHED = 1
 def fly_command(
     world_file: wa.WorldFile,
     start: wa.StartPoint,
-    goal: wa.GoalPoint,
+    goal: Annotated[str | None, typer.Option(
+        "--goal", help="Same form as --start; required unless --targets is given.")] = None,
     vehicle: Annotated[str, typer.Option(help="step, dubins, lattice or field.")] = "step",
     frame: wa.Frame = None,
     altitude: wa.Altitude = None,
@@ -82,7 +83,8 @@ def fly_command(
     plot: Annotated[Path | None, typer.Option(help="Write a PNG map of the flight.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
-    """Fly from START to GOAL with a vehicle model; exit 1 when the goal is not reached.
+    """Fly from START to GOAL (or round --targets) with a vehicle model; exit 1 when the
+    goal is not reached.
 
     Points, headings and written trajectories are in --frame (headings in degrees); the
     step drone flies the ILP rules on the lon/lat plane whatever the frame, and writes
@@ -100,9 +102,13 @@ def fly_command(
         raise OptionError(f"--radius {radius!r} must be a number > 0")
     if targets is not None and vehicle != "dubins":
         raise OptionError("--targets: tours are flown by --vehicle dubins")
+    if goal is None and targets is None:
+        raise OptionError("give --goal A,B (or --targets FILE with --vehicle dubins)")
     frame = wa.frame_of(frame)
     *a, h0 = wa.parse_pose(start, "--start", wa.point_names(frame))
-    *b, h1 = wa.parse_pose(goal, "--goal", wa.point_names(frame))
+    # With --targets the goal is not used; when given it is still checked as a point.
+    *b, h1 = wa.parse_pose(goal, "--goal", wa.point_names(frame)) if goal is not None \
+        else (math.nan, math.nan, None)
     h0 = _one_heading(h0, start_heading, "start")
     h1 = _one_heading(h1, goal_heading, "goal")
     world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
@@ -132,8 +138,13 @@ def fly_command(
     if plot is not None and doc["reached"]:
         from skyroute.io.world_out import plot_world_path
 
-        plane = world.to_plane(xy)
-        length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
+        # The title shows the length the table and --json report (a Dubins path's
+        # exact arcs); only a vehicle without one is measured along the drawn polyline,
+        # which cuts the arcs between samples and comes out shorter.
+        length = doc["metrics"].get("length")
+        if length is None:
+            plane = world.to_plane(xy)
+            length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
         shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)
         plot_world_path(world, shown, a, xy[-1], plot)
     if as_json:

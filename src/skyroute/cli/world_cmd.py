@@ -9,6 +9,7 @@ from typing import Annotated
 import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape  # help is Rich markup: '[north, ...]' would read as a tag
 
 from skyroute.cli import world_args as wa
 from skyroute.cli.tables import result_table
@@ -44,7 +45,8 @@ def plan_world_command(
     samples: Annotated[int, typer.Option(help="PRM samples.")] = 1000,
     seed: Annotated[int, typer.Option(help="PRM random seed.")] = 0,
     waypoints_out: Annotated[Path | None, typer.Option(
-        "--waypoints", help="Write [[north, east, altitude, heading], ...] JSON here.")] = None,
+        "--waypoints", help=escape("Write [[north, east, altitude, heading], ...] JSON here."))] =
+        None,
     geojson: Annotated[Path | None, typer.Option(help="Write the path as lon/lat GeoJSON.")] =
         None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG map here.")] = None,

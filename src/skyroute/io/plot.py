@@ -45,11 +45,14 @@ def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
 
 
 def save_figure(fig, path: str | Path, *, dpi: int = 150) -> Path:
-    """Render a matplotlib figure to PNG, close it, and write the file whole."""
+    """Render a matplotlib figure to PNG (cropped to everything drawn, legends beside the
+    axes included), close it, and write the file whole."""
     import matplotlib.pyplot as plt
 
     buf = io.BytesIO()
     fig.tight_layout()
-    fig.savefig(buf, format="png", dpi=dpi)
+    # "tight" takes in what tight_layout leaves out: a legend placed beside the axes
+    # (fleet map.png, the day's map) was clipped at the image's right edge.
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
     plt.close(fig)
     return write_atomic(path, buf.getvalue())

@@ -58,7 +58,7 @@ class FieldRun:
 
 
     def metrics(self) -> dict:
-        return {"distance": self.distance, "moves": self.moves,
+        return {"length": self.distance, "moves": self.moves,
                 "smoothness": self.smoothness, "reached": self.reached,
                 "status": self.status.value,
                 "escape_moves": self.escaped}

@@ -1,0 +1,53 @@
+"""Every command's --help as Typer renders it (Rich markup): text in square brackets that
+a help string means literally must be shown, not read as a markup tag and dropped."""
+
+import pytest
+import typer.main
+from rich.text import Text
+from typer.testing import CliRunner
+
+from skyroute.cli.app import app
+
+
+def _commands(cmd, path=()):
+    yield path, cmd
+    if hasattr(cmd, "list_commands"):
+        for name in cmd.list_commands(None):
+            yield from _commands(cmd.get_command(None, name), (*path, name))
+
+
+COMMANDS = list(_commands(typer.main.get_command(app)))
+
+
+def _help_texts(cmd):
+    yield "help", cmd.help or ""
+    for p in cmd.params:
+        yield p.name, getattr(p, "help", None) or ""
+
+
+def test_walk_finds_nested_commands():
+    names = {" ".join(path) for path, _ in COMMANDS}
+    assert {"plan-world", "fly", "bench service", "fleet sweep", "db init"} <= names
+
+
+@pytest.mark.parametrize("path,cmd", COMMANDS, ids=[" ".join(p) or "skyroute" for p, _ in COMMANDS])
+def test_help_strings_survive_rich_markup(path, cmd):
+    # Typer shows each help string as Text.from_markup(help); a literal '[' must be
+    # escaped ('\\[' or rich.markup.escape), and then it renders as the text meant.
+    for name, text in _help_texts(cmd):
+        assert Text.from_markup(text).plain == text.replace("\\[", "["), (path, name, text)
+
+
+@pytest.mark.parametrize("path,cmd", COMMANDS, ids=[" ".join(p) or "skyroute" for p, _ in COMMANDS])
+def test_rendered_help_keeps_bracketed_text(path, cmd):
+    result = CliRunner().invoke(app, [*path, "--help"], env={"COLUMNS": "200",
+                                                             "TERMINAL_WIDTH": "200"})
+    assert result.exit_code == 0, result.output
+    assert "[, ...]" not in result.output
+
+
+def test_plan_world_help_shows_the_waypoint_format():
+    result = CliRunner().invoke(app, ["plan-world", "--help"], env={"COLUMNS": "200",
+                                                                    "TERMINAL_WIDTH": "200"})
+    assert result.exit_code == 0, result.output
+    assert "Write [[north, east, altitude, heading], ...] JSON here." in result.output
