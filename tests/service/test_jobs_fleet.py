@@ -132,6 +132,10 @@ def test_fleet_job_params(site_client, fake):
     ("/jobs/fleet", {"scenario": {"airports": [], "drones": 2, "packages": {
         "csv": "/etc/passwd"}}}, "scenario.packages.csv", "cannot name a file"),
     ("/jobs/fleet", {"preset": "seed-3x3", "hours": 23.5}, "hours", "refused by the runner"),
+    ("/jobs/fleet", {"scenario": {"packages": "x"}}, "scenario.packages",
+     "expected a mapping"),
+    ("/jobs/fleet", {"scenario": {"packages": [1]}}, "scenario.packages",
+     "expected a mapping"),
 ])
 def test_bad_job_input_is_422(site_client, fake, path, body, field, words):
     assert_problem(site_client.post(path, json=body, headers=AUTH), 422, field, words)

@@ -141,7 +141,11 @@ def post_fleet(body: FleetJob, res: ResourcesDep):
     from skyroute.fleet.scenario import Scenario, parse_scenario, preset
 
     if body.scenario is not None:
-        if (body.scenario.get("packages") or {}).get("csv") is not None:
+        packages = body.scenario.get("packages")
+        if packages is not None and not isinstance(packages, dict):
+            raise Problem(422, "scenario.packages: expected a mapping of package fields "
+                          "(rate_per_hour)", field="scenario.packages")
+        if (packages or {}).get("csv") is not None:
             raise Problem(422, "scenario.packages.csv: a posted scenario cannot name a "
                           "file on the server; give packages.rate_per_hour",
                           field="scenario.packages.csv")
