@@ -5,6 +5,7 @@ and every bad input as a 422 naming its field."""
 from __future__ import annotations
 
 import json
+import threading
 
 import numpy as np
 import pytest
@@ -187,3 +188,64 @@ def test_not_json_and_not_finite_are_422(client):
     r = client.post("/plan", content=b'{"map": "den312d", "start": [NaN, 1], "goal": [1, 1]}',
                     headers={**AUTH, "Content-Type": "application/json"})
     assert_problem(r, 422, "start[0]")
+
+
+class WatchedLock:
+    """The search slot, telling when a request starts to wait for it."""
+
+    def __init__(self):
+        self.lock = threading.Lock()
+        self.waiting = threading.Event()
+
+    def acquire(self, blocking=True, timeout=-1):
+        if blocking:
+            self.waiting.set()
+        return self.lock.acquire(blocking, timeout)
+
+    def release(self):
+        self.lock.release()
+
+    def __enter__(self):
+        self.acquire()
+
+    def __exit__(self, *exc):
+        self.release()
+
+
+def test_a_bundled_map_waits_for_the_search_slot_off_the_event_loop(client, monkeypatch):
+    """While another search holds the slot, a bundled-map query waits on a pool thread
+    and the loop goes on answering; when the slot is free it runs without a thread."""
+    from skyroute.service.routers import plan as plan_router
+
+    slot = WatchedLock()
+    hops = []
+    pool = plan_router.run_in_threadpool
+
+    async def counted(*args):
+        hops.append(args[0].__name__)
+        return await pool(*args)
+
+    monkeypatch.setattr(plan_router, "_SEARCH", slot)
+    monkeypatch.setattr(plan_router, "run_in_threadpool", counted)
+    want = client.post("/plan", json=DEN, headers=AUTH).json()
+    assert want["status"] == "found" and hops == []  # idle: the fast path
+
+    answers = {}
+    slot.lock.acquire()  # another search holds the slot
+    try:
+        planner = threading.Thread(target=lambda: answers.update(
+            plan=client.post("/plan", json=DEN, headers=AUTH)))
+        planner.start()
+        assert slot.waiting.wait(60), "the query never asked for the slot"
+        health = threading.Thread(target=lambda: answers.update(
+            health=client.get("/health")))
+        health.start()
+        health.join(60)  # a guard against a hung test, not a measure
+        assert answers.get("health") is not None and answers["health"].status_code == 200
+        assert "plan" not in answers  # still waiting for the slot
+    finally:
+        slot.lock.release()
+    planner.join(60)
+    r = answers["plan"]
+    assert r.status_code == 200 and hops == ["_timed"]
+    assert r.json()["path"] == want["path"] and "wait;dur=" in r.headers["server-timing"]

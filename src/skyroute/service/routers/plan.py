@@ -118,22 +118,33 @@ _SEARCH = threading.Lock()
 @router.post("/plan", response_model=PlanAnswer, dependencies=[Depends(require_token)],
              responses=responses(401, 403, 413, 422), summary="Plan one path")
 async def post_plan(body: PlanRequest, res: ResourcesDep) -> JSONResponse:
-    # A bundled map is read once and its search is bounded by the budget: it runs right
-    # here on the event loop (a thread hop and the GIL hand-overs cost more than the
-    # search on most queries). Uploads are parsed first, at any size up to the body
-    # limit, so they go to the thread pool and leave the loop free meanwhile.
-    if body.map is not None:
-        out, timing = _timed(body, res)
+    # A bundled map is read once and its search is bounded by the budget: when no other
+    # search holds the slot it runs right here on the event loop (a thread hop and the
+    # GIL hand-overs cost more than the search on most queries). The loop never waits
+    # for the slot: a busy slot sends the query to the thread pool, as uploads always go
+    # (they are parsed first, at any size up to the body limit).
+    t0 = time.perf_counter()
+    if body.map is not None and _SEARCH.acquire(blocking=False):
+        try:
+            out, timing = _search(body, res, t0)
+        finally:
+            _SEARCH.release()
     else:
-        out, timing = await run_in_threadpool(_timed, body, res)
+        out, timing = await run_in_threadpool(_timed, body, res, t0)
     return JSONResponse(out, headers={"Server-Timing": timing})
 
 
-def _timed(body: PlanRequest, res: Resources) -> tuple[dict, str]:
-    t0 = time.perf_counter()
+def _timed(body: PlanRequest, res: Resources, t0: float) -> tuple[dict, str]:
+    """Wait for the search slot (on a pool thread), then search."""
     with _SEARCH:
-        t1 = time.perf_counter()
-        out = _plan(body, res)
+        return _search(body, res, t0)
+
+
+def _search(body: PlanRequest, res: Resources, t0: float) -> tuple[dict, str]:
+    """The answer and its Server-Timing (the wait since ``t0``, the search); the caller
+    holds the slot."""
+    t1 = time.perf_counter()
+    out = _plan(body, res)
     t2 = time.perf_counter()
     return out, f"wait;dur={(t1 - t0) * 1e3:.3f}, plan;dur={(t2 - t1) * 1e3:.3f}"
 
