@@ -249,3 +249,32 @@ def test_a_bundled_map_waits_for_the_search_slot_off_the_event_loop(client, monk
     r = answers["plan"]
     assert r.status_code == 200 and hops == ["_timed"]
     assert r.json()["path"] == want["path"] and "wait;dur=" in r.headers["server-timing"]
+
+
+FAR_WEST = [-3.2216, 55.9430]  # free, about 2 km west of the city's obstacles
+
+
+@pytest.mark.parametrize("extra, words", [
+    # the obstacles alone make ~117k cells at 1 m; reaching start makes ~800k
+    ({"resolution": 1, "start": FAR_WEST}, "resolution=1 makes a raster of"),
+    # no resolution: the default one (~0.34 m here) makes ~1M cells
+    ({}, "(the default for this world) makes a raster of"),
+])
+def test_the_raster_limit_counts_the_raster_that_would_be_built(extra, words):
+    body = {**CITY_BODY, "world_text": CITY.read_text(), "algorithm": "astar", **extra}
+    with make_client(max_raster_cells=200_000) as c:
+        assert_problem(c.post("/plan", json=body, headers=AUTH), 422, "resolution", words)
+        ok = {**CITY_BODY, "world_text": CITY.read_text(), "algorithm": "astar",
+              "resolution": 1}
+        assert c.post("/plan", json=ok, headers=AUTH).json()["status"] == "found"
+
+
+def test_default_resolution_spans_the_points():
+    from skyroute.roadmap.raster import default_resolution
+
+    w = skyroute.load_world(CITY, altitude=10, safety=2)
+    x0, y0, x1, y1 = w.bounds
+    assert default_resolution(w) == max(x1 - x0, y1 - y0) / 1000
+    far = w.to_plane([FAR_WEST])[0]
+    inside = w.to_plane([CITY_LONLAT[0]])[0]
+    assert default_resolution(w, [far, inside]) == (x1 - far[0]) / 1000

@@ -28,9 +28,10 @@ _RASTERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 register(_RASTERS.clear)
 
 
-def default_resolution(world: World) -> float:
-    """About 1000 cells along the longer side of the world."""
-    xmin, ymin, xmax, ymax = world.bounds
+def default_resolution(world: World, points=()) -> float:
+    """About 1000 cells along the longer side of the world grown to hold ``points``
+    (plane points; the raster must reach start and goal)."""
+    xmin, ymin, xmax, ymax = world.extent_with(points) if len(points) else world.bounds
     return max(xmax - xmin, ymax - ymin) / 1000.0
 
 
@@ -38,7 +39,7 @@ def world_raster(world: World, s: np.ndarray, t: np.ndarray,
                  resolution: float | None) -> Grid:
     """The world's plane rasterised with a half-diagonal clearance, holding plane points
     ``s`` and ``t`` (built once per world, resolution and extent)."""
-    r = default_resolution(world) if resolution is None else float(resolution)
+    r = default_resolution(world, [s, t]) if resolution is None else float(resolution)
     if not (math.isfinite(r) and r > 0):
         raise OptionError(f"resolution={resolution!r} must be a positive number",
                           param="resolution")

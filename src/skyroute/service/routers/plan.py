@@ -9,6 +9,7 @@ raster sizes are capped too. Bad input is a 422 naming the field.
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from typing import Annotated, Literal
@@ -250,10 +251,22 @@ def _check_world_limits(body: PlanRequest, world, res: Resources) -> None:
     if algorithm == "prm" and body.samples > s.max_samples:
         raise Problem(422, f"samples={body.samples} is over this server's limit of "
                       f"{s.max_samples:,}", field="samples")
-    if algorithm not in ("prm", "visibility") and body.resolution is not None:
-        x0, y0, x1, y1 = world.bounds
-        cells = ((x1 - x0) / body.resolution + 1) * ((y1 - y0) / body.resolution + 1)
+    if algorithm not in ("prm", "visibility"):
+        cells, r = _raster_cells(body, world)
         if cells > s.max_raster_cells:
-            raise Problem(422, f"resolution={body.resolution:g} makes a raster of about "
-                          f"{cells:,.0f} cells; this server's limit is "
-                          f"{s.max_raster_cells:,}", field="resolution")
+            given = "" if body.resolution is not None else " (the default for this world)"
+            raise Problem(422, f"resolution={r:g}{given} makes a raster of {cells:,} "
+                          f"cells; this server's limit is {s.max_raster_cells:,}",
+                          field="resolution")
+
+
+def _raster_cells(body: PlanRequest, world) -> tuple[int, float]:
+    """The cells and resolution of the raster a grid algorithm will build: the world's
+    extent grown to hold start and goal with a margin of 4 cells, as
+    :func:`skyroute.roadmap.raster.world_raster` builds it."""
+    from skyroute.roadmap.raster import default_resolution
+
+    s, t = world.check_point(body.start, "start"), world.check_point(body.goal, "goal")
+    r = default_resolution(world, [s, t]) if body.resolution is None else body.resolution
+    x0, y0, x1, y1 = world.extent_with([s, t], margin=4 * r)
+    return max(1, math.ceil((x1 - x0) / r)) * max(1, math.ceil((y1 - y0) / r)), r
