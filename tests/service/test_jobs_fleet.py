@@ -115,6 +115,15 @@ def test_fleet_job_params(site_client, fake):
     assert params["scenario"] == scenario and params["airspace"] == "shared"
 
 
+def _seed3() -> dict:
+    from skyroute.fleet.scenario import preset
+
+    return preset("seed-3x3").model_dump(mode="json")
+
+
+SEED3 = _seed3()
+
+
 @pytest.mark.parametrize("path, body, field, words", [
     ("/jobs/deliver", {}, "body", "give date, or both from and to"),
     ("/jobs/deliver", {"date": DAY, "from": DAY}, "body", "give date, or both"),
@@ -132,6 +141,14 @@ def test_fleet_job_params(site_client, fake):
     ("/jobs/fleet", {"scenario": {"airports": [], "drones": 2, "packages": {
         "csv": "/etc/passwd"}}}, "scenario.packages.csv", "cannot name a file"),
     ("/jobs/fleet", {"preset": "seed-3x3", "hours": 23.5}, "hours", "refused by the runner"),
+    ("/jobs/fleet", {"scenario": {**SEED3, "packages": {"rate_per_hour": 1e9}}},
+     "scenario.packages.rate_per_hour", "over this server's limit"),
+    ("/jobs/fleet", {"scenario": {**SEED3, "drones": 10**7}}, "scenario.drones",
+     "over this server's limit of 1000"),
+    ("/jobs/fleet", {"scenario": {**SEED3, "airports": SEED3["airports"] * 34}},
+     "scenario.airports", "102 airports is over this server's limit of 100"),
+    ("/jobs/fleet", {"preset": "seed-3x3", "rate": 1e9, "hours": 0.01}, "rate",
+     "less than or equal"),
     ("/jobs/fleet", {"scenario": {"packages": "x"}}, "scenario.packages",
      "expected a mapping"),
     ("/jobs/fleet", {"scenario": {"packages": [1]}}, "scenario.packages",

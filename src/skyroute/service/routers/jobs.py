@@ -25,6 +25,9 @@ from skyroute.service.resources import Resources, ResourcesDep
 router = APIRouter(tags=["jobs"])
 MAX_DAYS = 3660
 MAX_HOURS = 24.0
+MAX_RATE = 1e5  # packages per hour, as `rate` or a scenario's packages.rate_per_hour
+MAX_DRONES = 1000  # the largest fleet `skyroute bench fleet` runs
+MAX_AIRPORTS = 100
 _SUBMIT = threading.Lock()
 
 
@@ -63,7 +66,7 @@ class FleetJob(BaseModel):
     seed: int = Field(0, ge=0, le=2**32 - 1)
     scheduler: Literal["seed", "optimal"] = "seed"
     airspace: Literal["layers", "shared"] | None = None
-    rate: float | None = Field(None, gt=0, le=1e5, description="Packages per hour "
+    rate: float | None = Field(None, gt=0, le=MAX_RATE, description="Packages per hour "
                                "(default: the scenario's).")
 
     @model_validator(mode="after")
@@ -149,12 +152,17 @@ def post_fleet(body: FleetJob, res: ResourcesDep):
             raise Problem(422, "scenario.packages.csv: a posted scenario cannot name a "
                           "file on the server; give packages.rate_per_hour",
                           field="scenario.packages.csv")
+        airports = body.scenario.get("airports")
+        if isinstance(airports, list) and len(airports) > MAX_AIRPORTS:
+            raise Problem(422, f"scenario.airports: {len(airports)} airports is over this "
+                          f"server's limit of {MAX_AIRPORTS}", field="scenario.airports")
         try:
             scenario: Scenario = parse_scenario(body.scenario, "scenario")
         except SkyrouteError as exc:
             text = str(exc).removeprefix("scenario: ")
             raise Problem(422, f"scenario.{text}", field="scenario." + text.split(":")[0]
                           ) from None
+        _check_caps(scenario)
     else:
         scenario = preset(body.preset)
     params = {**({"preset": body.preset} if body.preset else
@@ -163,6 +171,19 @@ def post_fleet(body: FleetJob, res: ResourcesDep):
               **({"airspace": body.airspace} if body.airspace else {}),
               **({"rate_per_hour": body.rate} if body.rate is not None else {})}
     return _submit(res, "fleet", params)
+
+
+def _check_caps(scenario) -> None:
+    """A posted scenario within the limits a preset's run keeps to (``rate``, a preset's
+    fleet): a 422 naming the field."""
+    if scenario.packages.rate_per_hour > MAX_RATE:
+        raise Problem(422, f"scenario.packages.rate_per_hour: "
+                      f"{scenario.packages.rate_per_hour:g} is over this server's limit of "
+                      f"{MAX_RATE:g} packages per hour",
+                      field="scenario.packages.rate_per_hour")
+    if scenario.drones > MAX_DRONES:
+        raise Problem(422, f"scenario.drones: {scenario.drones} drones is over this "
+                      f"server's limit of {MAX_DRONES}", field="scenario.drones")
 
 
 @router.get("/jobs/{job_id}", response_model=JobState, responses=responses(404, 503),
