@@ -190,10 +190,15 @@ def test_a_body_that_is_not_text_is_400(client):
     assert_problem(r, 400, words="cannot be read as JSON text")
 
 
-def test_not_json_and_not_finite_are_422(client):
-    r = client.post("/plan", content=b"{not json", headers={**AUTH, "Content-Type":
-                                                           "application/json"})
-    assert_problem(r, 422)
+@pytest.mark.parametrize("text", [b"{not json", b'{"map":"den312d",}', b"[1, 2"])
+def test_a_body_that_is_not_json_is_400(client, text):
+    r = client.post("/plan", content=text, headers={**AUTH, "Content-Type":
+                                                    "application/json"})
+    doc = assert_problem(r, 400, words="the request body cannot be read as JSON text")
+    assert "field" not in doc and "Expecting" in doc["detail"] and "at byte" in doc["detail"]
+
+
+def test_not_finite_is_422(client):
     r = client.post("/plan", content=b'{"map": "den312d", "start": [NaN, 1], "goal": [1, 1]}',
                     headers={**AUTH, "Content-Type": "application/json"})
     assert_problem(r, 422, "start[0]")
