@@ -129,6 +129,8 @@ SEED3 = _seed3()
     ("/jobs/deliver", {"date": DAY, "from": DAY}, "body", "give date, or both"),
     ("/jobs/deliver", {"from": "2024-01-02", "to": "2024-01-01"}, "body", "is before from"),
     ("/jobs/deliver", {"date": "2024-02-30"}, "date", "date"),
+    ("/jobs/deliver", {"date": 0}, "date", "YYYY-MM-DD"),
+    ("/jobs/deliver", {"from": 1704240000, "to": DAY}, "from", "YYYY-MM-DD"),
     ("/jobs/deliver", {"date": DAY, "method": "magic"}, "method", "'milp'"),
     ("/jobs/deliver", {"date": DAY, "jobs": 4}, "jobs", "Extra inputs"),
     ("/jobs/fleet", {}, "body", "exactly one of preset and scenario"),

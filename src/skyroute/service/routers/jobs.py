@@ -9,7 +9,6 @@ imported on first use; without it these endpoints answer 503. A server holds at 
 
 from __future__ import annotations
 
-import datetime as dt
 import threading
 from typing import Annotated, Any, Literal
 
@@ -19,6 +18,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from skyroute.errors import SkyrouteError
 from skyroute.service.auth import require_token
+from skyroute.service.dates import IsoDate
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import Resources, ResourcesDep
 
@@ -37,9 +37,9 @@ class DeliverJob(BaseModel):
 
     model_config = ConfigDict(extra="forbid", populate_by_name=True)
 
-    date: dt.date | None = None
-    from_: dt.date | None = Field(None, alias="from")
-    to: dt.date | None = None
+    date: IsoDate | None = None
+    from_: IsoDate | None = Field(None, alias="from")
+    to: IsoDate | None = None
     method: Literal["milp", "greedy"] = "milp"
 
     @model_validator(mode="after")
