@@ -1,5 +1,6 @@
 """GridOptions: equal option sets are interchangeable as dict keys, in this process and
-after pickling; a grid keeps one query call per option set."""
+after pickling; a grid keeps one query call per option set; a conflict names its
+option."""
 
 import pickle
 from dataclasses import astuple
@@ -107,3 +108,21 @@ def test_results_compare_by_identity_and_hash():
     g = skyroute.Grid(np.zeros((3, 3), bool))
     a, b = skyroute.plan(g, (0, 0), (2, 2)), skyroute.plan(g, (0, 0), (2, 2))
     assert a == a and a != b and len({a, b}) == 2  # used to raise on the path arrays
+
+
+@pytest.mark.parametrize("options, param", [
+    ({"algorithm": "dijkstra", "weight": 2}, "weight"),
+    ({"algorithm": "bfs", "weight": 2}, "weight"),
+    ({"algorithm": "astar", "weight": 0.5}, "weight"),
+    ({"algorithm": "bfs", "heuristic": "octile"}, "heuristic"),
+    ({"algorithm": "bfs", "connectivity": 8}, "connectivity"),
+    ({"algorithm": "jps", "weight": 2}, "weight"),
+    ({"algorithm": "jps", "heuristic": "manhattan"}, "heuristic"),
+    ({"algorithm": "jps", "connectivity": 4}, "connectivity"),
+    ({"algorithm": "jps", "corner_cutting": True}, "corner_cutting"),
+    ({"algorithm": "astar", "max_expansions": -1}, "max_expansions"),
+])
+def test_an_option_conflict_names_the_option(options, param):
+    with pytest.raises(skyroute.OptionError) as info:
+        grid_options(**options)
+    assert info.value.param == param

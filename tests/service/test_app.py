@@ -47,6 +47,15 @@ def test_unknown_path_and_method_are_problems(client):
     assert_problem(client.delete("/health"), 405, words="DELETE")
 
 
+@pytest.mark.parametrize("path", ["/plan", "/jobs/deliver", "/jobs/fleet"])
+@pytest.mark.parametrize("method", ["GET", "HEAD", "PUT", "PATCH", "DELETE", "OPTIONS"])
+def test_post_only_paths_allow_post(client, path, method):
+    r = client.request(method, path, headers=AUTH)
+    assert r.status_code == 405 and r.headers["allow"] == "POST"
+    if method != "HEAD":
+        assert_problem(r, 405, words=f"{method} is not allowed on {path}; use POST")
+
+
 def test_making_an_app_connects_to_nothing(tmp_path):
     """A store that cannot be opened fails the requests that need it (503), not the
     app: create_app and /health never touch it."""

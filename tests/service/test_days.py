@@ -118,6 +118,10 @@ def test_unknown_date_is_404(day_client, path):
 @pytest.mark.parametrize("path, field", [
     ("/days/2024-13-01", "date"), ("/days/yesterday/flightpath.geojson", "date"),
     ("/orders?date=2024-02-30", "date"), ("/orders", "date"),
+    # numbers and other spellings pydantic's lax dates would take: only YYYY-MM-DD
+    ("/orders?date=0", "date"), ("/orders?date=20240103", "date"),
+    ("/orders?date=2024-1-3", "date"), ("/orders?date=2024-01-03T00:00", "date"),
+    ("/days/1704240000", "date"), ("/days/1704240000/flightpath.geojson", "date"),
 ])
 def test_bad_date_is_422(day_client, path, field):
     assert_problem(day_client.get(path), 422, field)

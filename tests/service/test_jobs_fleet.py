@@ -115,11 +115,22 @@ def test_fleet_job_params(site_client, fake):
     assert params["scenario"] == scenario and params["airspace"] == "shared"
 
 
+def _seed3() -> dict:
+    from skyroute.fleet.scenario import preset
+
+    return preset("seed-3x3").model_dump(mode="json")
+
+
+SEED3 = _seed3()
+
+
 @pytest.mark.parametrize("path, body, field, words", [
     ("/jobs/deliver", {}, "body", "give date, or both from and to"),
     ("/jobs/deliver", {"date": DAY, "from": DAY}, "body", "give date, or both"),
     ("/jobs/deliver", {"from": "2024-01-02", "to": "2024-01-01"}, "body", "is before from"),
     ("/jobs/deliver", {"date": "2024-02-30"}, "date", "date"),
+    ("/jobs/deliver", {"date": 0}, "date", "YYYY-MM-DD"),
+    ("/jobs/deliver", {"from": 1704240000, "to": DAY}, "from", "YYYY-MM-DD"),
     ("/jobs/deliver", {"date": DAY, "method": "magic"}, "method", "'milp'"),
     ("/jobs/deliver", {"date": DAY, "jobs": 4}, "jobs", "Extra inputs"),
     ("/jobs/fleet", {}, "body", "exactly one of preset and scenario"),
@@ -132,6 +143,18 @@ def test_fleet_job_params(site_client, fake):
     ("/jobs/fleet", {"scenario": {"airports": [], "drones": 2, "packages": {
         "csv": "/etc/passwd"}}}, "scenario.packages.csv", "cannot name a file"),
     ("/jobs/fleet", {"preset": "seed-3x3", "hours": 23.5}, "hours", "refused by the runner"),
+    ("/jobs/fleet", {"scenario": {**SEED3, "packages": {"rate_per_hour": 1e9}}},
+     "scenario.packages.rate_per_hour", "over this server's limit"),
+    ("/jobs/fleet", {"scenario": {**SEED3, "drones": 10**7}}, "scenario.drones",
+     "over this server's limit of 1000"),
+    ("/jobs/fleet", {"scenario": {**SEED3, "airports": SEED3["airports"] * 34}},
+     "scenario.airports", "102 airports is over this server's limit of 100"),
+    ("/jobs/fleet", {"preset": "seed-3x3", "rate": 1e9, "hours": 0.01}, "rate",
+     "less than or equal"),
+    ("/jobs/fleet", {"scenario": {"packages": "x"}}, "scenario.packages",
+     "expected a mapping"),
+    ("/jobs/fleet", {"scenario": {"packages": [1]}}, "scenario.packages",
+     "expected a mapping"),
 ])
 def test_bad_job_input_is_422(site_client, fake, path, body, field, words):
     assert_problem(site_client.post(path, json=body, headers=AUTH), 422, field, words)

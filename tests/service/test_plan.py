@@ -5,6 +5,7 @@ and every bad input as a 422 naming its field."""
 from __future__ import annotations
 
 import json
+import threading
 
 import numpy as np
 import pytest
@@ -149,6 +150,15 @@ CITY_BODY = {"world_format": "colliders", "altitude": 10, "safety": 2,
     ({**DEN, "algorithm": "visibility"}, "algorithm", "choose one of"),
     ({**DEN, "weight": 0.5}, "weight", "greater than or equal to 1"),
     ({**DEN, "connectivity": 6}, "connectivity", "4 or 8"),
+    ({**DEN, "algorithm": "dijkstra", "weight": 2}, "weight", "takes no weight"),
+    ({**DEN, "algorithm": "bfs", "heuristic": "octile"}, "heuristic", "takes no heuristic"),
+    ({**DEN, "algorithm": "bfs", "connectivity": 8}, "connectivity", "is 4-connected"),
+    ({**DEN, "algorithm": "jps", "weight": 2}, "weight", "takes no weight"),
+    ({**DEN, "algorithm": "jps", "heuristic": "manhattan"}, "heuristic", "no heuristic"),
+    ({**DEN, "algorithm": "jps", "corner_cutting": True}, "corner_cutting",
+     "corner_cutting=False"),
+    ({**CITY_BODY, "algorithm": "dijkstra", "weight": 2, "resolution": 2}, "weight",
+     "takes no weight"),
     ({**DEN, "max_expansions": 0}, "max_expansions", "greater than or equal to 1"),
     ({**DEN, "corner_cuting": True}, "corner_cuting", "Extra inputs are not permitted"),
     ({"map_text": "type octile\nheight 1\nwidth 2\nmap\n.Q\n", "start": [0, 0],
@@ -180,10 +190,105 @@ def test_a_body_that_is_not_text_is_400(client):
     assert_problem(r, 400, words="cannot be read as JSON text")
 
 
-def test_not_json_and_not_finite_are_422(client):
-    r = client.post("/plan", content=b"{not json", headers={**AUTH, "Content-Type":
-                                                           "application/json"})
-    assert_problem(r, 422)
+@pytest.mark.parametrize("text", [b"{not json", b'{"map":"den312d",}', b"[1, 2"])
+def test_a_body_that_is_not_json_is_400(client, text):
+    r = client.post("/plan", content=text, headers={**AUTH, "Content-Type":
+                                                    "application/json"})
+    doc = assert_problem(r, 400, words="the request body cannot be read as JSON text")
+    assert "field" not in doc and "Expecting" in doc["detail"] and "at byte" in doc["detail"]
+
+
+def test_not_finite_is_422(client):
     r = client.post("/plan", content=b'{"map": "den312d", "start": [NaN, 1], "goal": [1, 1]}',
                     headers={**AUTH, "Content-Type": "application/json"})
     assert_problem(r, 422, "start[0]")
+
+
+class WatchedLock:
+    """The search slot, telling when a request starts to wait for it."""
+
+    def __init__(self):
+        self.lock = threading.Lock()
+        self.waiting = threading.Event()
+
+    def acquire(self, blocking=True, timeout=-1):
+        if blocking:
+            self.waiting.set()
+        return self.lock.acquire(blocking, timeout)
+
+    def release(self):
+        self.lock.release()
+
+    def __enter__(self):
+        self.acquire()
+
+    def __exit__(self, *exc):
+        self.release()
+
+
+def test_a_bundled_map_waits_for_the_search_slot_off_the_event_loop(client, monkeypatch):
+    """While another search holds the slot, a bundled-map query waits on a pool thread
+    and the loop goes on answering; when the slot is free it runs without a thread."""
+    from skyroute.service.routers import plan as plan_router
+
+    slot = WatchedLock()
+    hops = []
+    pool = plan_router.run_in_threadpool
+
+    async def counted(*args):
+        hops.append(args[0].__name__)
+        return await pool(*args)
+
+    monkeypatch.setattr(plan_router, "_SEARCH", slot)
+    monkeypatch.setattr(plan_router, "run_in_threadpool", counted)
+    want = client.post("/plan", json=DEN, headers=AUTH).json()
+    assert want["status"] == "found" and hops == []  # idle: the fast path
+
+    answers = {}
+    slot.lock.acquire()  # another search holds the slot
+    try:
+        planner = threading.Thread(target=lambda: answers.update(
+            plan=client.post("/plan", json=DEN, headers=AUTH)))
+        planner.start()
+        assert slot.waiting.wait(60), "the query never asked for the slot"
+        health = threading.Thread(target=lambda: answers.update(
+            health=client.get("/health")))
+        health.start()
+        health.join(60)  # a guard against a hung test, not a measure
+        assert answers.get("health") is not None and answers["health"].status_code == 200
+        assert "plan" not in answers  # still waiting for the slot
+    finally:
+        slot.lock.release()
+    planner.join(60)
+    r = answers["plan"]
+    assert r.status_code == 200 and hops == ["_timed"]
+    assert r.json()["path"] == want["path"] and "wait;dur=" in r.headers["server-timing"]
+
+
+FAR_WEST = [-3.2216, 55.9430]  # free, about 2 km west of the city's obstacles
+
+
+@pytest.mark.parametrize("extra, words", [
+    # the obstacles alone make ~117k cells at 1 m; reaching start makes ~800k
+    ({"resolution": 1, "start": FAR_WEST}, "resolution=1 makes a raster of"),
+    # no resolution: the default one (~0.34 m here) makes ~1M cells
+    ({}, "(the default for this world) makes a raster of"),
+])
+def test_the_raster_limit_counts_the_raster_that_would_be_built(extra, words):
+    body = {**CITY_BODY, "world_text": CITY.read_text(), "algorithm": "astar", **extra}
+    with make_client(max_raster_cells=200_000) as c:
+        assert_problem(c.post("/plan", json=body, headers=AUTH), 422, "resolution", words)
+        ok = {**CITY_BODY, "world_text": CITY.read_text(), "algorithm": "astar",
+              "resolution": 1}
+        assert c.post("/plan", json=ok, headers=AUTH).json()["status"] == "found"
+
+
+def test_default_resolution_spans_the_points():
+    from skyroute.roadmap.raster import default_resolution
+
+    w = skyroute.load_world(CITY, altitude=10, safety=2)
+    x0, y0, x1, y1 = w.bounds
+    assert default_resolution(w) == max(x1 - x0, y1 - y0) / 1000
+    far = w.to_plane([FAR_WEST])[0]
+    inside = w.to_plane([CITY_LONLAT[0]])[0]
+    assert default_resolution(w, [far, inside]) == (x1 - far[0]) / 1000

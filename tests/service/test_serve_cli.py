@@ -103,3 +103,39 @@ def test_bad_flags_are_one_line(monkeypatch, capsys, tmp_path, args, words):
     monkeypatch.delenv("SKYROUTE_TOKEN", raising=False)
     code, _, err = run(monkeypatch, capsys, "serve", *args)
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_serve_fails_the_jobs_a_stopped_server_left(monkeypatch, capsys, tmp_path):
+    """A job runs only in the process that took it: one left queued or running by a
+    server that stopped is failed when the next server starts, a finished one is kept."""
+    import uvicorn
+    from fastapi.testclient import TestClient
+
+    from skyroute.jobs import store
+    from skyroute.jobs.runner import ORPHANED
+    from skyroute.service.resources import make_engine
+
+    db = f"sqlite:///{tmp_path / 's.db'}"
+    eng = make_engine(db)
+    queued = store.create_job(eng, "fleet", {"preset": "seed-3x3"})
+    running = store.create_job(eng, "fleet", {"preset": "seed-3x3"})
+    store.set_progress(eng, running, 0.5)
+    done = store.create_job(eng, "fleet", {"preset": "seed-3x3"})
+    store.finish_job(eng, done, {"fleet_run": "r"})
+    eng.dispose()
+
+    served = []
+    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.append(app))
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SKYROUTE_TOKEN", "t0ken")
+    code, _, err = run(monkeypatch, capsys, "serve", "--db", db)
+    assert code in (0, None) and len(served) == 1, err
+    assert "2 job(s) left queued or running by a stopped server marked failed" in err
+    with TestClient(served[0]) as c:
+        for job_id in (queued, running):
+            job = c.get(f"/jobs/{job_id}").json()
+            assert job["state"] == "failed" and job["error"] == ORPHANED, job
+        job = c.get(f"/jobs/{done}").json()
+        assert job["state"] == "done" and job["result"] == {"fleet_run": "r"}
+    code, _, err = run(monkeypatch, capsys, "serve", "--db", db)  # nothing left to fail
+    assert len(served) == 2 and "job(s) left" not in err

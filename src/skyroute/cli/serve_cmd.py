@@ -74,7 +74,12 @@ def serve_command(
         raise OptionError(f"--port {port} must be 1..65535")
     if workers < 1:
         raise OptionError(f"--workers {workers} must be at least 1")
-    make_engine(db).dispose()  # the store opens and is migrated before anyone asks
+    engine = make_engine(db)  # the store opens and is migrated before anyone asks
+    orphans = _fail_orphans(engine)
+    engine.dispose()
+    if orphans:
+        typer.echo(f"{len(orphans)} job(s) left queued or running by a stopped server "
+                   "marked failed", err=True)
     token, where = read_token(token_file)
     try:
         settings = Settings(db_url=db, data_dir=data, source_url=source, dask_address=dask,
@@ -100,3 +105,13 @@ def serve_command(
         os.environ[SETTINGS_ENV] = settings.model_dump_json()
         uvicorn.run("skyroute.service.app:app_from_env", factory=True, workers=workers,
                     host=host, port=port, log_level=log_level)
+
+
+def _fail_orphans(engine) -> list[str]:
+    """Jobs a stopped server left unfinished, marked failed (none without skyroute.jobs):
+    once here, before any worker takes a job, so no live job is touched."""
+    try:
+        from skyroute.jobs.runner import fail_orphans
+    except ImportError:
+        return []
+    return fail_orphans(engine)

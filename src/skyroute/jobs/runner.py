@@ -25,8 +25,10 @@ for the one before it stays ``queued``. While a job runs it is ``running`` with 
 progress, the share of its tasks done (a fleet run is one task: 0, then 1). It ends
 ``done`` with its result, or ``failed`` with a one-line error: a SkyrouteError's message,
 else the exception's type and message; the traceback goes to the ``skyroute.jobs``
-logger, never into the store. The thread is a daemon: a job still running when the
-process ends stays ``running`` in the store.
+logger, never into the store. The thread is a daemon: a job still queued or running
+when the process ends is left so in the store until the next server starts:
+:func:`fail_orphans` (``skyroute serve`` calls it once, before its workers start) marks
+such jobs ``failed`` with :data:`ORPHANED`. One server (with its workers) per store.
 """
 
 from __future__ import annotations
@@ -58,6 +60,8 @@ KINDS = {
     "sweep": Kind(fleet.check_sweep_params, fleet.sweep_job),
 }
 
+ORPHANED = "the server stopped while this job ran; submit it again"
+
 _queue: queue.Queue = queue.Queue()
 _lock = threading.Lock()
 _thread: threading.Thread | None = None
@@ -79,6 +83,13 @@ def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
             _thread = threading.Thread(target=_work, name="skyroute-jobs", daemon=True)
             _thread.start()
     return job_id
+
+
+def fail_orphans(engine: sa.Engine) -> list[str]:
+    """Mark jobs left ``queued`` or ``running`` by a server that stopped as ``failed``
+    (:data:`ORPHANED`); their ids. Call it when a server starts, before it takes jobs:
+    a job runs only in the process that took it, so none of these will ever end."""
+    return store.fail_unfinished(engine, ORPHANED)
 
 
 def get(engine: sa.Engine, job_id: str) -> dict | None:

@@ -121,6 +121,18 @@ def fail_job(engine: sa.Engine, job_id: str, error: str) -> None:
                   .values(state="failed", error=line, updated=_now()))
 
 
+def fail_unfinished(engine: sa.Engine, error: str) -> list[str]:
+    """Mark every ``queued`` or ``running`` job ``failed`` with ``error``; their ids."""
+    jobs = _t(engine)["jobs"]
+    unfinished = jobs.c.state.in_(("queued", "running"))
+    with engine.begin() as c:
+        ids = [r[0] for r in c.execute(sa.select(jobs.c.id).where(unfinished))]
+        if ids:
+            c.execute(jobs.update().where(jobs.c.id.in_(ids), unfinished)
+                      .values(state="failed", error=error, updated=_now()))
+    return ids
+
+
 def get_job(engine: sa.Engine, job_id: str) -> dict | None:
     """``{"id", "kind", "params", "state", "progress", "result", "error", "created",
     "updated"}`` (times ISO 8601 UTC), or None for an unknown id."""

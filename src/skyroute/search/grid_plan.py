@@ -65,27 +65,32 @@ def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, pr
     check_choice("corner_cutting", corner_cutting, (False, True))
     if algorithm == "bfs" and connectivity != 4:
         raise OptionError("algorithm='bfs' is 4-connected; use connectivity=4 or "
-                          "algorithm='dijkstra' for 8-connected unit costs")
+                          "algorithm='dijkstra' for 8-connected unit costs",
+                          param="connectivity")
     if algorithm == "jps" and (connectivity != 8 or corner_cutting):
-        raise OptionError("algorithm='jps' needs connectivity=8 and corner_cutting=False")
+        raise OptionError("algorithm='jps' needs connectivity=8 and corner_cutting=False",
+                          param="connectivity" if connectivity != 8 else "corner_cutting")
     if heuristic is None:
         heuristic = _default_h(algorithm, connectivity)
     check_choice("heuristic", heuristic, tuple(HEURISTICS))
     if algorithm in ("bfs", "dijkstra", "jps") and heuristic != _default_h(algorithm,
                                                                              connectivity):
         raise OptionError(f"algorithm={algorithm!r} takes no heuristic option "
-                          f"(it uses {_default_h(algorithm, connectivity)!r})")
+                          f"(it uses {_default_h(algorithm, connectivity)!r})",
+                          param="heuristic")
     if not (isinstance(weight, int | float) and math.isfinite(weight) and weight >= 1.0):
-        raise OptionError(f"weight={weight!r} must be a number >= 1")
+        raise OptionError(f"weight={weight!r} must be a number >= 1", param="weight")
     if weight != 1.0 and algorithm in ("bfs", "dijkstra", "jps"):
-        raise OptionError(f"algorithm={algorithm!r} takes no weight; use 'astar'")
+        raise OptionError(f"algorithm={algorithm!r} takes no weight; use 'astar'",
+                          param="weight")
     prune = "none" if prune is None else prune
     check_choice("prune", prune, PRUNE_MODES)
     if max_expansions is None:
         max_expansions = NO_BUDGET
     elif isinstance(max_expansions, bool) or not isinstance(max_expansions, int | np.integer) \
             or max_expansions < 0:
-        raise OptionError(f"max_expansions={max_expansions!r} must be an integer >= 0")
+        raise OptionError(f"max_expansions={max_expansions!r} must be an integer >= 0",
+                          param="max_expansions")
     return canonical(GridOptions(algorithm, int(connectivity), bool(corner_cutting),
                                  heuristic, float(weight), prune,
                                  min(int(max_expansions), NO_BUDGET)))  # >= 2**63: none

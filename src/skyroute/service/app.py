@@ -10,7 +10,7 @@ from __future__ import annotations
 from contextlib import asynccontextmanager
 from pathlib import Path
 
-from fastapi import FastAPI
+from fastapi import APIRouter, FastAPI, Request
 from fastapi.staticfiles import StaticFiles
 
 import skyroute
@@ -31,6 +31,7 @@ from skyroute.service.routers import (
 from skyroute.service.settings import Settings
 
 STATIC = Path(__file__).parent / "static"
+POST_ONLY = ("/plan", "/jobs/deliver", "/jobs/fleet")
 
 DESCRIPTION = """Plan paths on grids and worlds, read stored delivery days, run delivery
 and fleet jobs. Reads are open; writes (`POST`) need `Authorization: Bearer TOKEN`.
@@ -52,12 +53,28 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.resources = Resources(settings)
     problems.install(app)
     problems.document(app)
+    app.include_router(_post_only(POST_ONLY))  # first: /jobs/fleet is not /jobs/{job_id}
     for module in (health, maps, days, orders, site, plan, jobs, fleet, fleet_packages):
         app.include_router(module.router)
     app.add_middleware(ServerTiming)  # inside the body limit: the body is in hand
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
     app.mount("/", StaticFiles(directory=STATIC, html=True), name="static")
     return app
+
+
+def _post_only(paths: tuple[str, ...]) -> APIRouter:
+    """Any other method on these POST-only paths: a 405 with ``Allow: POST`` (without it
+    the viewer mounted at ``/`` answers for them, 405 ``Allow: GET, HEAD`` or 404)."""
+    router = APIRouter(include_in_schema=False)
+
+    async def not_allowed(request: Request) -> None:
+        raise problems.Problem(405, f"{request.method} is not allowed on "
+                               f"{request.url.path}; use POST", headers={"Allow": "POST"})
+
+    for path in paths:
+        router.add_api_route(path, not_allowed, methods=["GET", "HEAD", "PUT", "PATCH",
+                                                         "DELETE", "OPTIONS"])
+    return router
 
 
 SETTINGS_ENV = "SKYROUTE_SERVICE_SETTINGS"

@@ -99,7 +99,16 @@ def _message(err: dict) -> str:
     return msg.removeprefix("Value error, ")
 
 
+NOT_JSON = "the request body cannot be read as JSON text (UTF-8)"
+
+
 async def _validation(request: Request, exc: RequestValidationError) -> JSONResponse:
+    bad = next((e for e in exc.errors() if e.get("type") == "json_invalid"), None)
+    if bad is not None:  # its loc is a byte offset, not a field: a 400, as for non-UTF-8
+        where = bad.get("loc", ())[-1:]
+        reason = (bad.get("ctx") or {}).get("error", "")
+        at = f" at byte {where[0]}" if where and isinstance(where[0], int) else ""
+        return problem_response(400, f"{NOT_JSON}: {reason or 'invalid JSON'}{at}")
     errors = [{"field": field_name(tuple(e.get("loc", ()))), "message": _message(e)}
               for e in exc.errors()]
     first = errors[0] if errors else {"field": "body", "message": "invalid input"}
@@ -120,7 +129,7 @@ async def _http(request: Request, exc: StarletteHTTPException) -> JSONResponse:
     if exc.status_code == 404 and detail == "Not Found":
         detail = f"no such resource: {request.url.path}"
     elif exc.status_code == 400 and detail == "There was an error parsing the body":
-        detail = "the request body cannot be read as JSON text (UTF-8)"
+        detail = NOT_JSON
     elif exc.status_code == 405:
         detail = f"{request.method} is not allowed on {request.url.path}"
     return problem_response(exc.status_code, detail, headers=getattr(exc, "headers", None))

@@ -33,7 +33,8 @@ class Settings(BaseModel):
     max_expansions: int = Field(2_000_000, gt=0, description="Search budget per POST /plan: "
                                 "a larger or missing max_expansions is capped to it.")
     max_raster_cells: int = Field(4_000_000, gt=0, description="Largest raster a grid "
-                                  "algorithm on a world may ask for (resolution).")
+                                  "algorithm on a world may build: its resolution (given "
+                                  "or default) over the world, start and goal.")
     max_samples: int = Field(20_000, gt=0, description="Largest PRM roadmap per request.")
     fresh_seconds: float = Field(1.0, ge=0, description="How long a file made from a "
                                  "stored day is served before the store is asked again "

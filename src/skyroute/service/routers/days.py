@@ -14,6 +14,7 @@ from fastapi import APIRouter, Path, Request, Response
 from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, Field
 
+from skyroute.service.dates import IsoDate
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import EngineDep, Resources, ResourcesDep
 
@@ -21,7 +22,7 @@ router = APIRouter(tags=["days"])
 GEOJSON = "application/geo+json"
 
 LonLat = Annotated[list[float], Field(min_length=2, max_length=2)]
-DayDate = Annotated[dt.date, Path(description="The day, YYYY-MM-DD.")]
+DayDate = Annotated[IsoDate, Path(description="The day, YYYY-MM-DD.")]
 
 
 class DaySummary(BaseModel):

@@ -9,7 +9,6 @@ imported on first use; without it these endpoints answer 503. A server holds at 
 
 from __future__ import annotations
 
-import datetime as dt
 import threading
 from typing import Annotated, Any, Literal
 
@@ -19,12 +18,16 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from skyroute.errors import SkyrouteError
 from skyroute.service.auth import require_token
+from skyroute.service.dates import IsoDate
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import Resources, ResourcesDep
 
 router = APIRouter(tags=["jobs"])
 MAX_DAYS = 3660
 MAX_HOURS = 24.0
+MAX_RATE = 1e5  # packages per hour, as `rate` or a scenario's packages.rate_per_hour
+MAX_DRONES = 1000  # the largest fleet `skyroute bench fleet` runs
+MAX_AIRPORTS = 100
 _SUBMIT = threading.Lock()
 
 
@@ -34,9 +37,9 @@ class DeliverJob(BaseModel):
 
     model_config = ConfigDict(extra="forbid", populate_by_name=True)
 
-    date: dt.date | None = None
-    from_: dt.date | None = Field(None, alias="from")
-    to: dt.date | None = None
+    date: IsoDate | None = None
+    from_: IsoDate | None = Field(None, alias="from")
+    to: IsoDate | None = None
     method: Literal["milp", "greedy"] = "milp"
 
     @model_validator(mode="after")
@@ -63,7 +66,7 @@ class FleetJob(BaseModel):
     seed: int = Field(0, ge=0, le=2**32 - 1)
     scheduler: Literal["seed", "optimal"] = "seed"
     airspace: Literal["layers", "shared"] | None = None
-    rate: float | None = Field(None, gt=0, le=1e5, description="Packages per hour "
+    rate: float | None = Field(None, gt=0, le=MAX_RATE, description="Packages per hour "
                                "(default: the scenario's).")
 
     @model_validator(mode="after")
@@ -141,16 +144,25 @@ def post_fleet(body: FleetJob, res: ResourcesDep):
     from skyroute.fleet.scenario import Scenario, parse_scenario, preset
 
     if body.scenario is not None:
-        if (body.scenario.get("packages") or {}).get("csv") is not None:
+        packages = body.scenario.get("packages")
+        if packages is not None and not isinstance(packages, dict):
+            raise Problem(422, "scenario.packages: expected a mapping of package fields "
+                          "(rate_per_hour)", field="scenario.packages")
+        if (packages or {}).get("csv") is not None:
             raise Problem(422, "scenario.packages.csv: a posted scenario cannot name a "
                           "file on the server; give packages.rate_per_hour",
                           field="scenario.packages.csv")
+        airports = body.scenario.get("airports")
+        if isinstance(airports, list) and len(airports) > MAX_AIRPORTS:
+            raise Problem(422, f"scenario.airports: {len(airports)} airports is over this "
+                          f"server's limit of {MAX_AIRPORTS}", field="scenario.airports")
         try:
             scenario: Scenario = parse_scenario(body.scenario, "scenario")
         except SkyrouteError as exc:
             text = str(exc).removeprefix("scenario: ")
             raise Problem(422, f"scenario.{text}", field="scenario." + text.split(":")[0]
                           ) from None
+        _check_caps(scenario)
     else:
         scenario = preset(body.preset)
     params = {**({"preset": body.preset} if body.preset else
@@ -159,6 +171,19 @@ def post_fleet(body: FleetJob, res: ResourcesDep):
               **({"airspace": body.airspace} if body.airspace else {}),
               **({"rate_per_hour": body.rate} if body.rate is not None else {})}
     return _submit(res, "fleet", params)
+
+
+def _check_caps(scenario) -> None:
+    """A posted scenario within the limits a preset's run keeps to (``rate``, a preset's
+    fleet): a 422 naming the field."""
+    if scenario.packages.rate_per_hour > MAX_RATE:
+        raise Problem(422, f"scenario.packages.rate_per_hour: "
+                      f"{scenario.packages.rate_per_hour:g} is over this server's limit of "
+                      f"{MAX_RATE:g} packages per hour",
+                      field="scenario.packages.rate_per_hour")
+    if scenario.drones > MAX_DRONES:
+        raise Problem(422, f"scenario.drones: {scenario.drones} drones is over this "
+                      f"server's limit of {MAX_DRONES}", field="scenario.drones")
 
 
 @router.get("/jobs/{job_id}", response_model=JobState, responses=responses(404, 503),

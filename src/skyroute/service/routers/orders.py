@@ -8,6 +8,7 @@ from typing import Annotated
 from fastapi import APIRouter, Query
 from pydantic import BaseModel
 
+from skyroute.service.dates import IsoDate
 from skyroute.service.problems import responses
 from skyroute.service.resources import EngineDep
 
@@ -24,7 +25,7 @@ class OrderOut(BaseModel):
 
 @router.get("/orders", response_model=list[OrderOut], responses=responses(422),
             summary="The stored orders of a day")
-def list_orders(date: Annotated[dt.date, Query(description="The day, YYYY-MM-DD.")],
+def list_orders(date: Annotated[IsoDate, Query(description="The day, YYYY-MM-DD.")],
                 eng: EngineDep) -> list[dict]:
     from skyroute.delivery.store import orders_between
 

@@ -9,6 +9,7 @@ raster sizes are capped too. Bad input is a 422 naming the field.
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from typing import Annotated, Literal
@@ -118,22 +119,33 @@ _SEARCH = threading.Lock()
 @router.post("/plan", response_model=PlanAnswer, dependencies=[Depends(require_token)],
              responses=responses(401, 403, 413, 422), summary="Plan one path")
 async def post_plan(body: PlanRequest, res: ResourcesDep) -> JSONResponse:
-    # A bundled map is read once and its search is bounded by the budget: it runs right
-    # here on the event loop (a thread hop and the GIL hand-overs cost more than the
-    # search on most queries). Uploads are parsed first, at any size up to the body
-    # limit, so they go to the thread pool and leave the loop free meanwhile.
-    if body.map is not None:
-        out, timing = _timed(body, res)
+    # A bundled map is read once and its search is bounded by the budget: when no other
+    # search holds the slot it runs right here on the event loop (a thread hop and the
+    # GIL hand-overs cost more than the search on most queries). The loop never waits
+    # for the slot: a busy slot sends the query to the thread pool, as uploads always go
+    # (they are parsed first, at any size up to the body limit).
+    t0 = time.perf_counter()
+    if body.map is not None and _SEARCH.acquire(blocking=False):
+        try:
+            out, timing = _search(body, res, t0)
+        finally:
+            _SEARCH.release()
     else:
-        out, timing = await run_in_threadpool(_timed, body, res)
+        out, timing = await run_in_threadpool(_timed, body, res, t0)
     return JSONResponse(out, headers={"Server-Timing": timing})
 
 
-def _timed(body: PlanRequest, res: Resources) -> tuple[dict, str]:
-    t0 = time.perf_counter()
+def _timed(body: PlanRequest, res: Resources, t0: float) -> tuple[dict, str]:
+    """Wait for the search slot (on a pool thread), then search."""
     with _SEARCH:
-        t1 = time.perf_counter()
-        out = _plan(body, res)
+        return _search(body, res, t0)
+
+
+def _search(body: PlanRequest, res: Resources, t0: float) -> tuple[dict, str]:
+    """The answer and its Server-Timing (the wait since ``t0``, the search); the caller
+    holds the slot."""
+    t1 = time.perf_counter()
+    out = _plan(body, res)
     t2 = time.perf_counter()
     return out, f"wait;dur={(t1 - t0) * 1e3:.3f}, plan;dur={(t2 - t1) * 1e3:.3f}"
 
@@ -239,10 +251,22 @@ def _check_world_limits(body: PlanRequest, world, res: Resources) -> None:
     if algorithm == "prm" and body.samples > s.max_samples:
         raise Problem(422, f"samples={body.samples} is over this server's limit of "
                       f"{s.max_samples:,}", field="samples")
-    if algorithm not in ("prm", "visibility") and body.resolution is not None:
-        x0, y0, x1, y1 = world.bounds
-        cells = ((x1 - x0) / body.resolution + 1) * ((y1 - y0) / body.resolution + 1)
+    if algorithm not in ("prm", "visibility"):
+        cells, r = _raster_cells(body, world)
         if cells > s.max_raster_cells:
-            raise Problem(422, f"resolution={body.resolution:g} makes a raster of about "
-                          f"{cells:,.0f} cells; this server's limit is "
-                          f"{s.max_raster_cells:,}", field="resolution")
+            given = "" if body.resolution is not None else " (the default for this world)"
+            raise Problem(422, f"resolution={r:g}{given} makes a raster of {cells:,} "
+                          f"cells; this server's limit is {s.max_raster_cells:,}",
+                          field="resolution")
+
+
+def _raster_cells(body: PlanRequest, world) -> tuple[int, float]:
+    """The cells and resolution of the raster a grid algorithm will build: the world's
+    extent grown to hold start and goal with a margin of 4 cells, as
+    :func:`skyroute.roadmap.raster.world_raster` builds it."""
+    from skyroute.roadmap.raster import default_resolution
+
+    s, t = world.check_point(body.start, "start"), world.check_point(body.goal, "goal")
+    r = default_resolution(world, [s, t]) if body.resolution is None else body.resolution
+    x0, y0, x1, y1 = world.extent_with([s, t], margin=4 * r)
+    return max(1, math.ceil((x1 - x0) / r)) * max(1, math.ceil((y1 - y0) / r)), r
