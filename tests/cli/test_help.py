@@ -51,3 +51,19 @@ def test_plan_world_help_shows_the_waypoint_format():
                                                                     "TERMINAL_WIDTH": "200"})
     assert result.exit_code == 0, result.output
     assert "Write [[north, east, altitude, heading], ...] JSON here." in result.output
+
+
+@pytest.mark.parametrize("path,cmd", COMMANDS, ids=[" ".join(p) or "skyroute" for p, _ in COMMANDS])
+def test_help_paragraphs_carry_no_hard_line_breaks(path, cmd):
+    # Typer keeps the breaks of every paragraph after the first and wraps again, so a
+    # docstring wrapped in the source printed lines broken mid-sentence
+    for paragraph in (cmd.help or "").split("\n\n"):
+        assert paragraph.startswith("\b") or "\n" not in paragraph, (path, paragraph)
+
+
+def test_fly_help_second_paragraph_reads_as_one():
+    result = CliRunner().invoke(app, ["fly", "--help"], env={"COLUMNS": "200",
+                                                             "TERMINAL_WIDTH": "200"})
+    assert result.exit_code == 0, result.output
+    assert ("Points, headings and written trajectories are in --frame (headings in degrees); "
+            "the step drone flies the ILP rules") in result.output

@@ -9,6 +9,7 @@ the group calls it when the command is run, or listed in ``--help``.
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable, Iterator, MutableMapping
 
 import typer
@@ -20,13 +21,34 @@ Loader = Callable[[], Callable | typer.Typer]
 
 
 def to_click(name: str, obj: Callable | typer.Typer):
-    """The click command Typer would build for ``obj`` registered as ``name``."""
+    """The click command Typer would build for ``obj`` registered as ``name``, its help
+    paragraphs unwrapped (:func:`unwrap`)."""
     host = typer.Typer(add_completion=False)
     if isinstance(obj, typer.Typer):
         host.add_typer(obj, name=name)
-        return typer.main.get_command(host).commands[name]
+        return _unwrapped(typer.main.get_command(host).commands[name])
     host.command(name)(obj)
-    return typer.main.get_command(host)
+    return _unwrapped(typer.main.get_command(host))
+
+
+def unwrap(text: str | None) -> str | None:
+    """A docstring's paragraphs each on one line. Typer's Rich help keeps the line breaks
+    of every paragraph after the first and then wraps again at the terminal's width, so a
+    docstring wrapped at 88 columns showed lines broken mid-sentence. A paragraph that
+    starts with ``\\b`` (click's "keep as written") is kept."""
+    if not text:
+        return text
+    paragraphs = inspect.cleandoc(text).split("\n\n")
+    return "\n\n".join(p if p.startswith("\b") else " ".join(p.split("\n"))
+                       for p in paragraphs)
+
+
+def _unwrapped(command):
+    """``command`` and its subcommands with their help unwrapped, in place."""
+    command.help = unwrap(command.help)
+    for sub in getattr(command, "commands", {}).values():
+        _unwrapped(sub)
+    return command
 
 
 class LazyCommands(MutableMapping):
