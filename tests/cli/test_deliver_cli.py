@@ -64,6 +64,8 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
      "--method 'magic' is not valid"),
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "nonsense"], "not a database URL"),
     (["data", "serve", "/nonexistent"], "not a data folder"),
+    (["data", "serve", EXAMPLE, "--port", "99999"], "is not in the range 0<=x<=65535"),
+    (["data", "serve", EXAMPLE, "--port", "-1"], "is not in the range 0<=x<=65535"),
 ])
 def test_bad_input_is_one_line(monkeypatch, capsys, tmp_path, args, words):
     monkeypatch.chdir(tmp_path)

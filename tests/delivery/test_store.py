@@ -107,3 +107,20 @@ def test_bad_urls_are_one_line_errors(tmp_path):
     e = store.connect(f"sqlite:///{tmp_path / 'empty.db'}")
     with pytest.raises(SkyrouteError, match="skyroute db init"):
         store.orders_between(e, DAY, DAY)
+
+
+def test_a_file_that_is_not_a_store_is_one_line(tmp_path):
+    path = tmp_path / "not.db"
+    path.write_text("garbage\n")
+    e = store.connect(f"sqlite:///{path}")  # SQLite opens lazily: the schema step finds it
+    with pytest.raises(SkyrouteError, match="not a usable store: file is not a database"):
+        store.init(e)
+
+
+def test_a_store_at_an_unknown_revision_is_one_line(tmp_path):
+    e = store.connect(f"sqlite:///{tmp_path / 'new.db'}")
+    store.init(e)
+    with e.begin() as conn:
+        conn.execute(sa.text("update alembic_version set version_num = '9999'"))
+    with pytest.raises(SkyrouteError, match=r"schema is unknown.*'9999'.*newer version"):
+        store.init(e)

@@ -40,7 +40,8 @@ def data_synth(
 @data_app.command("serve")
 def data_serve(
     folder: Annotated[Path, typer.Argument(metavar="DIR", help="A data folder (website/).")],
-    port: Annotated[int, typer.Option(help="TCP port.")] = 9898,
+    port: Annotated[int, typer.Option(min=0, max=65535, help="TCP port (0: any free "
+                                      "one).")] = 9898,
     host: Annotated[str, typer.Option(help="Address to listen on.")] = "127.0.0.1",
 ) -> None:
     """Serve DIR/website over HTTP until interrupted (read it with --source URL)."""

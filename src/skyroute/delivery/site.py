@@ -87,8 +87,11 @@ def _read_menus(source) -> tuple[tuple[tuple[str, str], ...], dict[str, tuple[in
             name, loc, items = str(shop["name"]), str(shop["location"]), shop["menu"]
             for it in items:
                 item, pence = str(it["item"]), it["pence"]
-                if not isinstance(pence, int) or pence < 0:
-                    raise ValueError(f"item {item!r}: pence must be a whole number >= 0")
+                # bool is an int to Python: true would be 1p; 2**63 and more overflow SQL
+                if isinstance(pence, bool) or not isinstance(pence, int) \
+                        or not 0 <= pence < 2**63:
+                    raise ValueError(f"item {item!r}: pence must be a whole number >= 0 "
+                                     "(below 2**63)")
                 if item in menu:
                     raise ValueError(f"item {item!r} is also on shop "
                                      f"{shops[menu[item][1]][0]!r}'s menu")

@@ -85,12 +85,22 @@ def init(engine: sa.Engine) -> str:
     from alembic import command
     from alembic.config import Config
     from alembic.runtime.migration import MigrationContext
+    from alembic.util.exc import CommandError
 
     cfg = Config()
     cfg.set_main_option("script_location", str(Path(__file__).parent / "migrations"))
-    with engine.begin() as conn:
-        cfg.attributes["connection"] = conn
-        command.upgrade(cfg, "head")
+    url = _safe(str(engine.url))
+    try:
+        with engine.begin() as conn:
+            cfg.attributes["connection"] = conn
+            command.upgrade(cfg, "head")
+    except sa.exc.DatabaseError as exc:  # e.g. a file that is not SQLite's
+        raise SkyrouteError(f"url={url}: not a usable store: "
+                            f"{str(exc.orig).strip().splitlines()[0]}", param="url") from None
+    except CommandError as exc:  # a revision this version does not know
+        raise SkyrouteError(f"url={url}: the store's schema is unknown to this skyroute "
+                            f"({exc}); was it written by a newer version?",
+                            param="url") from None
     for key in [k for k in _REFLECTED if k[0] == str(engine.url)]:
         del _REFLECTED[key]
     with engine.connect() as conn:
