@@ -114,3 +114,19 @@ def test_field_reports_length_like_the_other_vehicles(monkeypatch, capsys, city)
     assert code == 0, err
     rows = {line.split("│")[1].strip() for line in text.splitlines() if line.count("│") == 3}
     assert {"length", "escape_moves"} <= rows and "distance" not in rows
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--vehicle", "lattice", "--speed", "0"], "--speed 0.0 must be positive"),
+    (["--vehicle", "lattice", "--turn-rate", "0"], "--turn-rate 0.0 must be positive"),
+    (["--vehicle", "field", "--step", "0"], "--step 0.0 must be > 0"),
+    (["--vehicle", "field", "--sensor-range", "0"], "--sensor-range 0.0 must be > 0"),
+    (["--vehicle", "field", "--sensor-rays", "3"], "--sensor-rays 3 must be >= 4"),
+    (["--vehicle", "field", "--max-turn", "0"], "--max-turn 0.0 must be in (0, 180] degrees"),
+    (["--vehicle", "field", "--max-turn", "200"], "--max-turn 200.0 must be in (0, 180]"),
+])
+def test_each_vehicle_option_is_named_alone(monkeypatch, capsys, city, args, words):
+    # these were one message naming every option at once, in the library's units
+    code, _, err = run(monkeypatch, capsys, "fly", city, "--frame", "local", "--start",
+                       "0,0", "--goal", "50,50", *args)
+    assert code == 2 and words in err and err.count("\n") == 1, err

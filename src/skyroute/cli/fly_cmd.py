@@ -100,6 +100,8 @@ def fly_command(
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
     if not (math.isfinite(radius) and radius > 0):
         raise OptionError(f"--radius {radius!r} must be a number > 0")
+    if not 0 < max_turn <= 180:  # degrees here; the library's check speaks radians
+        raise OptionError(f"--max-turn {max_turn!r} must be in (0, 180] degrees")
     if targets is not None and vehicle != "dubins":
         raise OptionError("--targets: tours are flown by --vehicle dubins")
     if goal is None and targets is None:

@@ -151,10 +151,14 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
     convention; default towards the goal). Points come in and the run's path goes out in
     the world's frame; distances (``step``, ``sensor_range``) are plane units."""
     check_choice("mode", mode, MODES)
-    if not (step > 0 and sensor_range > 0 and sensor_rays >= 4 and tolerance > 0
-            and 0 < max_turn <= math.pi):
-        raise OptionError("step, sensor_range and tolerance must be > 0, sensor_rays >= 4 "
-                          "and 0 < max_turn <= pi")
+    for name, value, ok, rule in (
+            ("step", step, step > 0, "> 0"), ("sensor_range", sensor_range,
+                                               sensor_range > 0, "> 0"),
+            ("sensor_rays", sensor_rays, sensor_rays >= 4, ">= 4"),
+            ("tolerance", tolerance, tolerance > 0, "> 0"),
+            ("max_turn", max_turn, 0 < max_turn <= math.pi, "in (0, pi] radians")):
+        if not ok:
+            raise OptionError(f"{name}={value!r} must be {rule}", param=name)
     p = world.check_point(start, "start")
     t = world.check_point(goal, "goal")
     theta = math.atan2(*(t - p)[::-1]) if heading is None else \

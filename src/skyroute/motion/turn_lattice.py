@@ -137,8 +137,9 @@ def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
     (radians, from the x axis towards +y) snaps to the nearest lattice heading, or any.
     """
     check_choice("headings", headings, (8, 16))
-    if not (speed > 0 and turn_rate > 0):
-        raise OptionError(f"speed={speed!r} and turn_rate={turn_rate!r} must be positive")
+    for name, value in (("speed", speed), ("turn_rate", turn_rate)):
+        if not value > 0:
+            raise OptionError(f"{name}={value!r} must be positive", param=name)
     s = check_cell(grid, start, "start")
     t = check_cell(grid, goal, "goal")
     space = space_of(grid)
