@@ -35,3 +35,21 @@ def test_a_bad_price_names_the_file_and_item(tmp_path, pence):
 def test_a_whole_price_in_range_is_read(tmp_path, pence):
     site = load_site(_site_with_price(tmp_path, pence))
     assert pence in {p for p, _ in site.menu.values()}
+
+
+@pytest.mark.parametrize("field,value,words", [
+    ("item", 5, "an item's name must be a string"),
+    ("name", 7, "name and location must be strings"),
+    ("location", ["a", "b"], "name and location must be strings")])
+def test_names_must_be_strings(tmp_path, field, value, words):
+    # an item named 5 was read as "5", and the orders for it became invalid
+    site = _site_with_price(tmp_path, 100)
+    path = site.root / "website" / "menus" / "menus.json"
+    menus = json.loads(path.read_text())
+    if field == "item":
+        menus[0]["menu"][0]["item"] = value
+    else:
+        menus[0][field] = value
+    path.write_text(json.dumps(menus))
+    with pytest.raises(InputFormatError, match=words):
+        load_site(site)

@@ -84,9 +84,13 @@ def _read_menus(source) -> tuple[tuple[tuple[str, str], ...], dict[str, tuple[in
     shops, menu = [], {}
     for k, shop in enumerate(doc):
         try:
-            name, loc, items = str(shop["name"]), str(shop["location"]), shop["menu"]
+            name, loc, items = shop["name"], shop["location"], shop["menu"]
+            if not (isinstance(name, str) and isinstance(loc, str)):
+                raise ValueError("name and location must be strings")
             for it in items:
-                item, pence = str(it["item"]), it["pence"]
+                item, pence = it["item"], it["pence"]
+                if not isinstance(item, str):
+                    raise ValueError(f"item {item!r}: an item's name must be a string")
                 # bool is an int to Python: true would be 1p; 2**63 and more overflow SQL
                 if isinstance(pence, bool) or not isinstance(pence, int) \
                         or not 0 <= pence < 2**63:
