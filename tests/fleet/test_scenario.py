@@ -68,6 +68,12 @@ def test_toml_scenarios_load(tmp_path):
     (lambda y: y.replace("mode: layers", "mode: stacked"),
      "airspace.mode: Input should be 'layers' or 'shared'"),
     (lambda y: y + "  : [\n", "not YAML"),
+    (lambda y: y.replace("cruise_speed: 50.0", "cruise_speed: .inf"),
+     "drone.cruise_speed: Input should be a finite number"),
+    (lambda y: y.replace("heading_deg: 180.0", "heading_deg: .nan", 1),
+     "airports[0].landing.heading_deg: Input should be a finite number"),
+    (lambda y: y.replace("north: 273.9", "north: .nan", 1),
+     "airports[0].north: Input should be a finite number"),
 ])
 def test_bad_scenarios_name_the_field_and_the_file(tmp_path, edit, words):
     p = tmp_path / "bad.yaml"

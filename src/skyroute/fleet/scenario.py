@@ -34,7 +34,9 @@ MAX_GATE_DISTANCE = 500.0  # metres from an airport's position to a gate it plac
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # no NaN or infinity anywhere: a NaN position or an infinite speed passed the range
+    # checks and failed later with a message naming neither the file nor the field
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class Runway(_Strict):
