@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -93,3 +94,78 @@ def test_source_needs_stored_orders(monkeypatch, capsys, tmp_path):
     finally:
         server.shutdown()
         server.server_close()
+
+
+def _stored_rows(path) -> dict[str, int]:
+    """Rows per table of the SQLite store at ``path`` (none when there is no file)."""
+    import sqlite3
+
+    if not path.exists():
+        return {}
+    with sqlite3.connect(path) as c:
+        names = [r[0] for r in c.execute("select name from sqlite_master where type='table'"
+                                         " and name != 'alembic_version'")]
+        return {n: c.execute(f'select count(*) from "{n}"').fetchone()[0] for n in names}
+
+
+def _no_flying(*_args, **_kwargs):
+    raise AssertionError("a day was flown before its output files were checked")
+
+
+@pytest.mark.parametrize("dates, blocker, words", [
+    (["2024-01-01"], "file", "is not a folder"),  # --out names a regular file
+    (["2024-01-01"], "report-01-01-2024.json", "it is a folder"),
+    (["2024-01-01"], "drone-01-01-2024.png", "it is a folder"),
+    # a range: the second day's file is bad, so the first day is neither stored nor written
+    (["--from", "2024-01-01", "--to", "2024-01-02"], "report-02-01-2024.json",
+     "it is a folder"),
+    (["--from", "2024-01-01", "--to", "2024-01-02", "--plot"], "drone-02-01-2024.png",
+     "it is a folder"),
+])
+def test_bad_out_fails_before_flying_or_storing(monkeypatch, capsys, tmp_path, dates,
+                                                blocker, words):
+    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", _no_flying)
+    out = tmp_path / "out"
+    if blocker == "file":
+        out.write_text("keep me")
+    else:
+        (out / blocker).mkdir(parents=True)
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    code, _, err = run(monkeypatch, capsys, "deliver", *dates, "--data", EXAMPLE,
+                       "--db", f"sqlite:///{tmp_path / 'o.db'}", "--out", str(out))
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+    assert not any(_stored_rows(tmp_path / "o.db").values())
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before  # no file left behind
+    if blocker == "file":
+        assert out.read_text() == "keep me"
+
+
+@pytest.mark.skipif(not Path("/proc/sys").is_dir(), reason="needs Linux /proc")
+def test_out_that_cannot_be_made_fails_before_storing(monkeypatch, capsys, tmp_path):
+    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", _no_flying)
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", EXAMPLE,
+                       "--db", f"sqlite:///{tmp_path / 'o.db'}", "--out", "/proc/sys/foo")
+    assert code == 2 and "/proc/sys/foo/" in err and "cannot write" in err, err
+    assert not any(_stored_rows(tmp_path / "o.db").values())
+
+
+def test_bad_out_leaves_earlier_runs_stored(monkeypatch, capsys, tmp_path, fly_once):
+    db = tmp_path / "k.db"
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", EXAMPLE,
+                       "--db", f"sqlite:///{db}", "--out", str(tmp_path / "good"),
+                       "--no-plot", "--json")
+    assert code == 0, err
+    rows = _stored_rows(db)
+    assert rows["runs"] == 1 and rows["deliveries"] > 0
+    # --no-plot: the PNG's place is not checked (nothing will be written there)
+    (tmp_path / "bad" / "drone-01-01-2024.png").mkdir(parents=True)
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", EXAMPLE,
+                       "--db", f"sqlite:///{db}", "--out", str(tmp_path / "bad"),
+                       "--no-plot", "--json")
+    assert code == 0, err
+    (tmp_path / "bad" / "report-01-01-2024.json").unlink()
+    (tmp_path / "bad" / "report-01-01-2024.json").mkdir()
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", EXAMPLE,
+                       "--db", f"sqlite:///{db}", "--out", str(tmp_path / "bad"))
+    assert code == 2 and "report-01-01-2024.json: cannot write: it is a folder" in err
+    assert _stored_rows(db) == rows

@@ -94,3 +94,37 @@ def test_bench_case_times_and_checks_a_small_fleet():
     assert row["conflicts"] == 0 and row["lost"] == 0 and row["flights"] > 0
     assert row["sim_seconds"] > 0 and row["check_seconds"] > 0
     assert row["sim_seconds_per_wall_second"] == pytest.approx(1800 / row["wall_seconds"])
+
+
+def _no_run(*_args, **_kwargs):
+    raise AssertionError("the fleet was simulated before its output files were checked")
+
+
+@pytest.mark.parametrize("blocker, extra, words", [
+    ("tracks.csv", [], "tracks.csv: cannot write: it is a folder"),
+    ("report.json", [], "report.json: cannot write: it is a folder"),
+    ("fleet.geojson", [], "fleet.geojson: cannot write: it is a folder"),
+    ("timeline.png", ["--plot"], "timeline.png: cannot write: it is a folder"),
+    ("file", [], "is not a folder"),  # --out names a regular file
+])
+def test_bad_out_fails_before_simulating(monkeypatch, capsys, tmp_path, blocker, extra,
+                                         words):
+    monkeypatch.setattr("skyroute.fleet.simulate.run", _no_run)
+    out = tmp_path / "out"
+    if blocker == "file":
+        out.write_text("keep me")
+    else:
+        (out / blocker).mkdir(parents=True)
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    code, _, err = run(monkeypatch, capsys, "fleet", "simulate", "--preset", "seed-3x3",
+                       "--hours", "0.1", "--out", str(out), *extra)
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before  # nothing left behind
+
+
+def test_bad_out_without_the_plots_is_not_checked_for_them(monkeypatch, capsys, tmp_path):
+    (tmp_path / "map.png").mkdir()
+    code, _, err = run(monkeypatch, capsys, "fleet", "simulate", "--preset", "seed-3x3",
+                       "--hours", "0.1", "--out", str(tmp_path), "--json")
+    assert code in (0, 1), err
+    assert (tmp_path / "tracks.csv").is_file() and (tmp_path / "map.png").is_dir()

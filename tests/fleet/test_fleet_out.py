@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from skyroute.errors import OptionError
+from skyroute.errors import OptionError, SkyrouteError
 from skyroute.fleet import report, simulate
 from skyroute.fleet.flightplan import gate_position, ground_position
 from skyroute.fleet.scenario import preset
@@ -290,3 +290,11 @@ def test_a_report_that_is_not_json_is_an_option_error(sim, tmp_path):
         write_run(sim, {"served_share": math.nan}, tmp_path / "out")
     assert err.value.param == "rep"
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("blocker", ["tracks.csv", "fleet.geojson", "timeline.png"])
+def test_a_file_that_cannot_be_written_writes_none(sim, rep, tmp_path, blocker):
+    (tmp_path / blocker).mkdir()
+    with pytest.raises(SkyrouteError, match=f"{blocker}: cannot write: it is a folder"):
+        write_run(sim, rep, tmp_path, plot=True)
+    assert [p.name for p in tmp_path.iterdir()] == [blocker]

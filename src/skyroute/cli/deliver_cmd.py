@@ -59,7 +59,7 @@ def deliver_command(
     from skyroute.delivery.site import load_site
     from skyroute.delivery.source import open_source
     from skyroute.delivery.store import import_orders, order_dates
-    from skyroute.io.day_out import write_outputs
+    from skyroute.io.day_out import check_outputs, write_outputs
     from skyroute.jobs.deliver import days_between, run_days
 
     check_choice("method", method, METHODS)
@@ -72,6 +72,11 @@ def deliver_command(
     if d1 < d0:
         raise OptionError(f"--to {d1} is before --from {d0}")
     executor_kind(executor, dask, jobs)
+    draw = (day is not None) if plot is None else plot
+    # every file of every day checked before anything is flown or stored: a bad --out
+    # must not leave rows in the store or some of the days' files behind
+    check_outputs(out, [d0 + dt.timedelta(k) for k in range((d1 - d0).days + 1)],
+                  plot=draw)
     src = open_source(data, source)
     site = load_site(src)
     engine = open_store(db)
@@ -94,7 +99,6 @@ def deliver_command(
             progress.remove_task(task)
             days = progress.add_task("days", total=len(by_date))
             t0 = time.perf_counter()
-            draw = (day is not None) if plot is None else plot
 
             def finished(r: DayResult) -> None:
                 if out is not None:

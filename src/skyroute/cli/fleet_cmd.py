@@ -122,6 +122,10 @@ def simulate_command(
         raise OptionError("--plot needs --out DIR (the folder for map.png and timeline.png)")
     s = _with_separation(resolve_scenario(scenario, preset_name, airports, drones, area_km,
                                           seed), sep_horizontal, sep_vertical)
+    if out is not None:  # a bad --out fails before the run, not after it with some files
+        from skyroute.io.fleet_out import check_run_outputs
+
+        check_run_outputs(out, plot=plot)
     err = Console(stderr=True)
     with progress_bar(err) as progress:
         task = progress.add_task("simulated seconds", total=round(hours * 3600))

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.delivery.day import DayResult
-from skyroute.files import write_atomic
+from skyroute.files import check_writable, write_atomic
 
 
 def stem(date: dt.date) -> str:
@@ -75,12 +75,30 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
     return save_figure(fig, path)
 
 
+def output_paths(out: Path, date: dt.date, *, plot: bool = True) -> list[Path]:
+    """The files :func:`write_outputs` writes for ``date`` in ``out``, in that order:
+    GeoJSON, report and (with ``plot``) PNG."""
+    base = Path(out) / stem(date)
+    paths = [base.with_suffix(".geojson"), Path(out) / f"report-{date:%d-%m-%Y}.json"]
+    return [*paths, base.with_suffix(".png")] if plot else paths
+
+
+def check_outputs(out: Path, dates, *, plot: bool = True) -> list[Path]:
+    """Fail now, before any day is flown or stored, if a file :func:`write_outputs`
+    would write for one of ``dates`` cannot be written (:func:`skyroute.files.
+    check_writable`); the paths otherwise."""
+    paths = [p for d in dates for p in output_paths(out, d, plot=plot)]
+    for p in paths:
+        check_writable(p)
+    return paths
+
+
 def write_outputs(site, result: DayResult, out: Path, *, plot: bool = True) -> list[Path]:
-    """The day's GeoJSON, report and (optionally) PNG in ``out``."""
-    base = out / stem(result.date)
-    paths = [write_atomic(base.with_suffix(".geojson"), geojson(result, site.home)),
-             write_atomic(out / f"report-{result.date:%d-%m-%Y}.json",
-                          json.dumps(result.report(), indent=1))]
+    """The day's GeoJSON, report and (optionally) PNG in ``out``
+    (:func:`output_paths`)."""
+    paths = output_paths(out, result.date, plot=plot)
+    write_atomic(paths[0], geojson(result, site.home))
+    write_atomic(paths[1], json.dumps(result.report(), indent=1))
     if plot:
-        paths.append(plot_day(site, result, base.with_suffix(".png")))
+        paths[2] = plot_day(site, result, paths[2])
     return paths

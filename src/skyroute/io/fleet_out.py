@@ -50,7 +50,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import OptionError, SkyrouteError
-from skyroute.files import write_atomic
+from skyroute.files import check_writable, write_atomic
 from skyroute.fleet.flightplan import FlightPlan, gate_position, ground_position
 from skyroute.fleet.scenario import runway_ends
 from skyroute.fleet.simulate import WARMUP_SHARE, Simulation
@@ -70,6 +70,8 @@ _CODE = {"taxi_out": 0, "takeoff": 1, "climb": 2, "cruise": 3, "loiter": 4, "app
 _AIRBORNE = np.array([False, False, True, True, True, True, False, False])
 _DECIMALS = 3  # millimetres in tracks.csv
 _CHUNK = 1 << 18  # rows formatted at a time (bounds the memory of tracks_csv)
+RUN_FILES = ("report.json", "events.jsonl", "tracks.csv", "packages.csv", "fleet.geojson")
+PLOT_FILES = ("map.png", "timeline.png")
 _BY_AIRPORT = 12  # the timeline names airports up to this many
 
 
@@ -84,13 +86,31 @@ def write_run(sim: Simulation, rep: dict, out: str | Path, *, track_step: float 
         report_text = json.dumps(rep, indent=2, allow_nan=False) + "\n"
     except (TypeError, ValueError) as exc:
         raise OptionError(f"rep cannot be written as JSON: {exc}", param="rep") from None
-    paths = [write_atomic(out / "report.json", report_text),
-             write_atomic(out / "events.jsonl", events_jsonl(sim)),
-             write_atomic(out / "tracks.csv", _tracks_csv(sim, track_step)),
-             write_atomic(out / "packages.csv", packages_csv(sim)),
-             write_atomic(out / "fleet.geojson", dumps(fleet_geojson(sim)))]
+    paths = check_run_outputs(out, plot=plot)  # none written if one cannot be
+    write_atomic(paths[0], report_text)
+    write_atomic(paths[1], events_jsonl(sim))
+    write_atomic(paths[2], _tracks_csv(sim, track_step))
+    write_atomic(paths[3], packages_csv(sim))
+    write_atomic(paths[4], dumps(fleet_geojson(sim)))
     if plot:
-        paths += [plot_map(sim, out / "map.png"), plot_timeline(sim, out / "timeline.png")]
+        plot_map(sim, paths[5])
+        plot_timeline(sim, paths[6])
+    return paths
+
+
+def run_outputs(out: str | Path, *, plot: bool = False) -> list[Path]:
+    """The files :func:`write_run` writes into ``out``, in its order."""
+    names = RUN_FILES + (PLOT_FILES if plot else ())
+    return [Path(out) / n for n in names]
+
+
+def check_run_outputs(out: str | Path, *, plot: bool = False) -> list[Path]:
+    """Fail now, before a run is simulated, if a file :func:`write_run` would write into
+    ``out`` cannot be written (:func:`skyroute.files.check_writable`: a folder in its
+    place, a file where the folder must be, no permission); the paths otherwise."""
+    paths = run_outputs(out, plot=plot)
+    for p in paths:
+        check_writable(p)
     return paths
 
 
