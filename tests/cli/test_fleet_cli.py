@@ -9,6 +9,7 @@ import yaml
 
 from skyroute.bench.fleet import bench_case
 from skyroute.cli.fleet_cmd import parse_seeds
+from skyroute.errors import OptionError
 from skyroute.fleet.report import FIELDS
 from skyroute.fleet.scenario import load_scenario
 from skyroute.jobs.fleet import mean_ci
@@ -128,3 +129,22 @@ def test_bad_out_without_the_plots_is_not_checked_for_them(monkeypatch, capsys, 
                        "--hours", "0.1", "--out", str(tmp_path), "--json")
     assert code in (0, 1), err
     assert (tmp_path / "tracks.csv").is_file() and (tmp_path / "map.png").is_dir()
+
+
+@pytest.mark.parametrize("args", [
+    ("synth-city", "{tmp}/c.csv", "--seed", "-1"),
+    ("fleet", "simulate", "--preset", "seed-3x3", "--hours", "0.1", "--seed", "-1"),
+    ("fleet", "scenario", "--airports", "3", "--drones", "3", "--seed", "-1"),
+    ("fleet", "sweep", "--preset", "seed-3x3", "--seeds", "-1", "--hours", "0.1"),
+    ("fleet", "sweep", "--preset", "seed-3x3", "--seeds", "1,-2", "--hours", "0.1"),
+])
+def test_negative_seeds_are_one_line_errors(monkeypatch, capsys, tmp_path, args):
+    args = [a.format(tmp=tmp_path) for a in args]
+    code, _, err = run(monkeypatch, capsys, *args)
+    assert code == 2 and "--seed" in err and len(err.strip().splitlines()) == 1, err
+    assert "Traceback" not in err and not (tmp_path / "c.csv").exists()
+
+
+def test_parse_seeds_refuses_negatives():
+    with pytest.raises(OptionError, match="negative"):
+        parse_seeds("3,-1")

@@ -26,7 +26,7 @@ def bench_fleet(
              "airports/1 h).")] = None,
     scheduler: Annotated[str, typer.Option(help="seed or optimal.")] = "optimal",
     airspace: Annotated[str, typer.Option(help="layers or shared.")] = "shared",
-    seed: Annotated[int, typer.Option(help="Seed of the package stream.")] = 0,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of the package stream.")] = 0,
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the rows here.")] =
         None,
 ) -> None:

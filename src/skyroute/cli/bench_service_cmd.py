@@ -41,7 +41,7 @@ def bench_service(
              "postgresql+psycopg://postgres@127.0.0.1:5432/test).")] = None,
     date: Annotated[str | None, typer.Option(help="Day for flightpath (default: the "
                                                   "first stored day with moves).")] = None,
-    seed: Annotated[int, typer.Option(help="Seed of the drawn scenario lines.")] = 0,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of the drawn scenario lines.")] = 0,
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the rows here.")] =
         None,
 ) -> None:

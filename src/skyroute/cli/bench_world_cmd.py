@@ -36,7 +36,7 @@ from skyroute.motion.step_drone import MERGE
 @bench_app.command("world")
 def bench_world(
     worlds: Annotated[int, typer.Option(min=0, help="Random 20-rectangle worlds.")] = 5,
-    seed: Annotated[int, typer.Option(help="Seed of the first world and its query.")] = 0,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of the first world and its query.")] = 0,
     city: Annotated[Path | None, typer.Option(
         help="Also a colliders.csv city (at --altitude, with --safety).")] = None,
     altitude: Annotated[float, typer.Option(help="City altitude (m).")] = 5.0,
@@ -171,7 +171,7 @@ def bench_motion(
         "--curvature", help="Hybrid A* vs OMPL RRT*/BIT* on seeded worlds (and --city), "
                             "then Dubins tours vs nearest-first.")] = False,
     worlds: Annotated[int, typer.Option(min=0, help="--curvature: seeded random worlds.")] = 10,
-    seed: Annotated[int, typer.Option(help="--curvature: seed of worlds and queries.")] = 0,
+    seed: Annotated[int, typer.Option(min=0, help="--curvature: seed of worlds and queries.")] = 0,
     budgets: Annotated[str, typer.Option(
         help="--curvature: OMPL seconds per solve, comma-separated.")] = "1,5",
     city: Annotated[Path | None, typer.Option(

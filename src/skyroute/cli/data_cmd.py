@@ -23,7 +23,8 @@ def data_synth(
     orders_per_day: Annotated[int, typer.Option(help="Orders each day.")] = 12,
     customers: Annotated[int, typer.Option(help="Customers' delivery places.")] = 7,
     start: Annotated[str, typer.Option(help="First day, YYYY-MM-DD.")] = "2024-01-01",
-    seed: Annotated[int, typer.Option(help="Seed: the same seed writes the same files.")] = 1,
+    seed: Annotated[int, typer.Option(
+        min=0, help="Seed: the same seed writes the same files.")] = 1,
 ) -> None:
     """Write a synthetic data set in the ILP layout (website/, database/) in another town."""
     from skyroute.delivery.synth import synth

@@ -31,7 +31,7 @@ Drones = Annotated[int | None, typer.Option(help="Number of drones (overrides th
 AreaKm = Annotated[float, typer.Option(help="Side of the square the airports are spread over "
                                             "(generated scenarios).")]
 Hours = Annotated[float, typer.Option(help="Simulated hours.")]
-Seed = Annotated[int, typer.Option(help="Seed of the package stream (and of a generated "
+Seed = Annotated[int, typer.Option(min=0, help="Seed of the package stream (and of a generated "
                                         "scenario's layout).")]
 
 
@@ -218,6 +218,8 @@ def parse_seeds(text: str) -> list[int]:
         raise OptionError(f"--seeds {text!r}: expected seeds like 0-29 or 1,4,7") from None
     if not out:
         raise OptionError(f"--seeds {text!r}: no seed given")
+    if min(out) < 0:
+        raise OptionError(f"--seeds {text!r}: seed {min(out)} is negative; seeds are >= 0")
     return list(dict.fromkeys(out))
 
 

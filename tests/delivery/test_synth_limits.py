@@ -1,0 +1,63 @@
+"""``data synth`` finishes for any seed, and refuses what it cannot write (too many
+customers, dates past the calendar, negative seeds) in one line before writing a file."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+
+import pytest
+import shapely
+
+from skyroute.delivery.synth import synth
+from skyroute.errors import OptionError
+from skyroute.motion.step_drone import STEP
+from tests.cli.test_cli import run
+
+
+@pytest.mark.parametrize("seed", [2, 3, 7, 42])
+def test_synth_finishes_for_seeds_that_paint_themselves_in(tmp_path, seed):
+    # These seeds' random buildings leave no room for the sixth: the grid fallback places
+    # them, kept apart and inside the box like the random ones.
+    summary = synth(tmp_path, days=1, orders_per_day=2, seed=seed)
+    assert summary["zones"] == 6 and summary["customers"] == 7
+    fc = json.loads((tmp_path / "website" / "buildings" / "no-fly-zones.geojson").read_text())
+    zones = [shapely.Polygon(f["geometry"]["coordinates"][0]) for f in fc["features"]]
+    assert len(zones) == 6 and all(z.is_valid and z.area > 0 for z in zones)
+    assert all(a.distance(b) > 3 * STEP for i, a in enumerate(zones) for b in zones[i + 1:])
+    assert len((tmp_path / "database" / "orders.csv").read_text().splitlines()) == 3
+
+
+def test_synth_refuses_more_customers_than_fit_before_writing(monkeypatch, capsys, tmp_path):
+    out = tmp_path / "x"
+    code, _, err = run(monkeypatch, capsys, "data", "synth", str(out), "--customers",
+                       "100000")
+    assert code == 2 and "--customers 100000" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_synth_customers_that_fill_the_area_are_a_one_line_error(tmp_path):
+    # Under the packing bound, but more than random placement fits: an error, not a hang.
+    with pytest.raises(OptionError, match="customers") as info:
+        synth(tmp_path / "x", days=1, seed=1, customers=140)
+    assert info.value.param == "customers" and not (tmp_path / "x").exists()
+
+
+def test_synth_refuses_dates_past_the_calendar_before_writing(monkeypatch, capsys, tmp_path):
+    out = tmp_path / "x"
+    code, _, err = run(monkeypatch, capsys, "data", "synth", str(out), "--start",
+                       "9999-12-30", "--days", "5")
+    assert code == 2 and "--start 9999-12-30" in err and "--days 5" in err
+    assert len(err.strip().splitlines()) == 1 and not out.exists()
+    # The last day there is still works.
+    summary = synth(out, days=2, orders_per_day=1, start=dt.date(9999, 12, 30))
+    assert summary["last"] == "9999-12-31"
+
+
+def test_synth_refuses_a_negative_seed(monkeypatch, capsys, tmp_path):
+    code, _, err = run(monkeypatch, capsys, "data", "synth", str(tmp_path / "x"), "--seed",
+                       "-1")
+    assert code == 2 and "--seed" in err and len(err.strip().splitlines()) == 1
+    with pytest.raises(OptionError, match="seed=-1"):
+        synth(tmp_path / "y", seed=-1)
+    assert not (tmp_path / "x").exists() and not (tmp_path / "y").exists()
