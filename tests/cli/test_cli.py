@@ -150,3 +150,14 @@ def test_bench_malformed_scen_names_file_and_line(monkeypatch, capsys, tmp_path)
                          "--peers", "", "--json", str(out_json))
     assert code == 2 and f"{scen}:3: expected 9 tab-separated columns, got 7" in err
     assert err.count("\n") == 1 and not out_json.exists() and out == ""
+
+
+def out_blocked_by(tmp_path, blocker: str):
+    """An --out folder under ``tmp_path`` that cannot be written: ``"file"`` makes it a
+    regular file, any other name a folder of that name inside it (where a file must go)."""
+    out = tmp_path / "out"
+    if blocker == "file":
+        out.write_text("keep me")
+    else:
+        (out / blocker).mkdir(parents=True)
+    return out

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.cli.test_cli import run
+from tests.cli.test_cli import out_blocked_by, run
 from tests.conftest import ROOT
 
 EXAMPLE = str(ROOT / "examples" / "lunch")
@@ -125,11 +125,7 @@ def _no_flying(*_args, **_kwargs):
 def test_bad_out_fails_before_flying_or_storing(monkeypatch, capsys, tmp_path, dates,
                                                 blocker, words):
     monkeypatch.setattr("skyroute.jobs.deliver.plan_day", _no_flying)
-    out = tmp_path / "out"
-    if blocker == "file":
-        out.write_text("keep me")
-    else:
-        (out / blocker).mkdir(parents=True)
+    out = out_blocked_by(tmp_path, blocker)
     before = sorted(p.name for p in tmp_path.rglob("*"))
     code, _, err = run(monkeypatch, capsys, "deliver", *dates, "--data", EXAMPLE,
                        "--db", f"sqlite:///{tmp_path / 'o.db'}", "--out", str(out))

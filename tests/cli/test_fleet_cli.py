@@ -13,7 +13,7 @@ from skyroute.errors import OptionError
 from skyroute.fleet.report import FIELDS
 from skyroute.fleet.scenario import load_scenario
 from skyroute.jobs.fleet import mean_ci
-from tests.cli.test_cli import run
+from tests.cli.test_cli import out_blocked_by, run
 
 
 def test_simulate_json_and_files(monkeypatch, capsys, tmp_path):
@@ -111,11 +111,7 @@ def _no_run(*_args, **_kwargs):
 def test_bad_out_fails_before_simulating(monkeypatch, capsys, tmp_path, blocker, extra,
                                          words):
     monkeypatch.setattr("skyroute.fleet.simulate.run", _no_run)
-    out = tmp_path / "out"
-    if blocker == "file":
-        out.write_text("keep me")
-    else:
-        (out / blocker).mkdir(parents=True)
+    out = out_blocked_by(tmp_path, blocker)
     before = sorted(p.name for p in tmp_path.rglob("*"))
     code, _, err = run(monkeypatch, capsys, "fleet", "simulate", "--preset", "seed-3x3",
                        "--hours", "0.1", "--out", str(out), *extra)
