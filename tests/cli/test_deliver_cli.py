@@ -45,7 +45,7 @@ def test_range_prints_a_monthly_table(monkeypatch, capsys, tmp_path, fly_once):
 def test_db_init_and_import(monkeypatch, capsys, tmp_path):
     db = f"sqlite:///{tmp_path / 'i.db'}"
     code, out, _ = run(monkeypatch, capsys, "db", "init", "--db", db)
-    assert code == 0 and "revision 0002" in out
+    assert code == 0 and "revision 0003" in out
     code, out, _ = run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", db)
     assert code == 0 and "108 orders added" in " ".join(out.split())
     code, out, _ = run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", db)

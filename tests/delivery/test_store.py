@@ -45,7 +45,7 @@ def moves(n: int, label: str = "aaaaaaaa"):
 @pytest.fixture
 def engine(tmp_path):
     e = store.connect(f"sqlite:///{tmp_path / 'store.db'}")
-    assert store.init(e) == "0002"
+    assert store.init(e) == "0003"
     return e
 
 
@@ -53,7 +53,7 @@ def test_init_makes_the_issues_tables_and_is_repeatable(engine):
     insp = sa.inspect(engine)
     for table, cols in COLUMNS.items():
         assert [c["name"] for c in insp.get_columns(table)] == cols
-    assert store.init(engine) == "0002"  # again: nothing to do
+    assert store.init(engine) == "0003"  # again: nothing to do
 
 
 def test_import_is_idempotent(engine):

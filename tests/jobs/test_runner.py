@@ -7,6 +7,7 @@ from __future__ import annotations
 import time
 
 import pytest
+import sqlalchemy as sa
 
 from skyroute.errors import OptionError
 from skyroute.jobs import runner
@@ -97,3 +98,77 @@ def test_bad_params_are_refused_before_queueing(tmp_path, kind, params, words):
     assert words in str(err.value) and "\n" not in str(err.value)
     with engine.connect() as c:
         assert c.exec_driver_sql("select count(*) from jobs").scalar_one() == 0
+
+
+def test_two_servers_on_one_store_fail_only_the_orphans_of_dead_ones(tmp_path, monkeypatch):
+    """This process's job and a live server's job survive another server's start and
+    this process's heartbeat; a silent server's job and one without an owner do not."""
+    import datetime as dt
+    import threading
+
+    from skyroute.delivery.store import tables
+    from skyroute.jobs import store
+
+    release = threading.Event()
+
+    def hold(engine, job_id, params, *, executor, progress):
+        progress(0.5)
+        release.wait(60)
+        return {"held": True}
+
+    monkeypatch.setitem(runner.KINDS, "hold", runner.Kind(dict, hold))
+    engine = lunch_store(f"sqlite:///{tmp_path / 'two.db'}", ())
+    mine = runner.submit(engine, "hold", {}, executor=None)
+    try:
+        assert runner.get(engine, mine)["owner"] == runner.owner()
+        end = time.monotonic() + 60
+        while runner.get(engine, mine)["state"] != "running" and time.monotonic() < end:
+            time.sleep(0.01)
+        store.beat(engine, "other-server:1:a")  # another server, alive, with its job
+        other = store.create_job(engine, "fleet", {}, owner="other-server:1:a")
+        store.set_progress(engine, other, 0.2)
+        with engine.begin() as c:  # a server last heard of two DEAD_AFTERs ago
+            then = store.db_now(c) - dt.timedelta(seconds=2 * runner.DEAD_AFTER)
+            c.execute(tables(engine, ("servers",))["servers"].insert().values(
+                id="gone-server:2:b", started=then, heartbeat=then))
+        dead = store.create_job(engine, "fleet", {}, owner="gone-server:2:b")
+        store.set_progress(engine, dead, 0.7)
+        unowned = store.create_job(engine, "fleet", {})  # as a server before owners
+
+        assert sorted(runner.fail_orphans(engine)) == sorted([dead, unowned])  # a start
+        runner.heartbeat()  # nothing more to fail; this process beats
+        for job_id, state in ((mine, "running"), (other, "running"), (dead, "failed"),
+                              (unowned, "failed")):
+            job = runner.get(engine, job_id)
+            assert job["state"] == state, (job_id, job)
+        assert runner.get(engine, dead)["error"] == runner.ORPHANED
+        with engine.connect() as c:
+            servers = tables(engine, ("servers",))["servers"]
+            assert set(c.scalars(sa.select(servers.c.id))) == {runner.owner(),
+                                                               "other-server:1:a"}
+    finally:
+        release.set()
+    job = runner.wait(engine, mine, timeout=60)
+    assert (job["state"], job["result"]) == ("done", {"held": True})
+
+
+def test_reading_a_dead_servers_job_fails_it(tmp_path):
+    """Where no server has jobs to beat for, a job whose owner is silent is failed when
+    it is read; another live server's job is not."""
+    import datetime as dt
+
+    from skyroute.delivery.store import tables
+    from skyroute.jobs import store
+
+    engine = lunch_store(f"sqlite:///{tmp_path / 'read.db'}", ())
+    with engine.begin() as c:
+        then = store.db_now(c) - dt.timedelta(seconds=2 * runner.DEAD_AFTER)
+        c.execute(tables(engine, ("servers",))["servers"].insert().values(
+            id="gone-server:2:b", started=then, heartbeat=then))
+    dead = store.create_job(engine, "fleet", {}, owner="gone-server:2:b")
+    store.beat(engine, "other-server:1:a")
+    live = store.create_job(engine, "fleet", {}, owner="other-server:1:a")
+    assert store.get_job(engine, dead)["state"] == "queued"
+    job = runner.get(engine, dead)
+    assert (job["state"], job["error"]) == ("failed", runner.ORPHANED)
+    assert runner.get(engine, live)["state"] == "queued"

@@ -1,5 +1,6 @@
-"""The jobs and fleet_runs tables: migration 0002 (also over a 0001 store with its days),
-a job's life, fleet runs with their files, on SQLite and PostgreSQL alike."""
+"""The jobs, fleet_runs and servers tables: migrations 0002 and 0003 (also over a 0001
+store with its days and a 0002 store with its jobs), a job's life, orphans, fleet runs
+with their files, on SQLite and PostgreSQL alike."""
 
 from __future__ import annotations
 
@@ -15,10 +16,24 @@ from skyroute.jobs import store
 
 COLUMNS = {
     "jobs": ["id", "kind", "params", "state", "progress", "result", "error", "created",
-             "updated"],
+             "updated", "owner"],
     "fleet_runs": ["id", "job_id", "scenario", "params", "report", "events_jsonl",
                    "tracks_csv", "packages_csv", "fleet_geojson", "created"],
+    "servers": ["id", "started", "heartbeat"],
 }
+HEAD = "0003"
+
+
+def upgrade_to(engine, revision: str) -> None:
+    """The schema at ``revision`` by the shipped migrations, as an older skyroute left it."""
+    from alembic import command
+    from alembic.config import Config
+
+    cfg = Config()
+    cfg.set_main_option("script_location", str(Path(dstore.__file__).parent / "migrations"))
+    with engine.begin() as conn:
+        cfg.attributes["connection"] = conn
+        command.upgrade(cfg, revision)
 
 
 @pytest.fixture(params=["sqlite", "postgresql"])
@@ -26,37 +41,30 @@ def engine(request, tmp_path):
     url = (f"sqlite:///{tmp_path / 'jobs.db'}" if request.param == "sqlite"
            else request.getfixturevalue("pg_url"))
     e = dstore.connect(url)
-    assert dstore.init(e) == "0002"
+    assert dstore.init(e) == HEAD
     yield e
     e.dispose()
 
 
-def test_migration_makes_both_tables(engine):
+def test_migrations_make_the_tables(engine):
     insp = sa.inspect(engine)
     for table, cols in COLUMNS.items():
         assert [c["name"] for c in insp.get_columns(table)] == cols
-    assert dstore.init(engine) == "0002"  # again: nothing to do
+    assert dstore.init(engine) == HEAD  # again: nothing to do
 
 
 def test_upgrading_a_0001_store_keeps_its_days(tmp_path):
-    from alembic import command
-    from alembic.config import Config
-
     e = dstore.connect(f"sqlite:///{tmp_path / 'old.db'}")
-    cfg = Config()
-    cfg.set_main_option("script_location", str(Path(dstore.__file__).parent / "migrations"))
-    with e.begin() as conn:
-        cfg.attributes["connection"] = conn
-        command.upgrade(cfg, "0001")
+    upgrade_to(e, "0001")
     day = dt.date(2024, 1, 1)
     run = {"started": dt.datetime(2024, 1, 1), "finished": dt.datetime(2024, 1, 1),
            "moves": 0, "orders_placed": 0, "orders_delivered": 0, "orders_invalid": 0,
            "money_delivered": 0, "money_placed": 0, "settings": {}}
     dstore.write_day(e, day, run, [], [])
-    with pytest.raises(SkyrouteError, match=r"no table jobs, fleet_runs \(an older schema\); "
-                                            r"run 'skyroute db init'"):
+    with pytest.raises(SkyrouteError, match=r"no table jobs, fleet_runs, servers \(an "
+                                            r"older schema\); run 'skyroute db init'"):
         store.get_job(e, "x")
-    assert dstore.init(e) == "0002"
+    assert dstore.init(e) == HEAD
     assert store.get_job(e, "x") is None
     with e.connect() as c:
         assert c.execute(sa.text("select count(*) from runs")).scalar_one() == 1
@@ -105,3 +113,98 @@ def test_fleet_runs_keep_their_files_and_replace_on_the_same_id(engine):
     assert store.get_fleet_run(engine, "nope") is None
     with pytest.raises(OptionError, match="limit=0"):
         store.list_fleet_runs(engine, limit=0)
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def empty(request, tmp_path):
+    """An engine on an empty store: a new SQLite file, or the test PostgreSQL database
+    emptied."""
+    if request.param == "sqlite":
+        e = dstore.connect(f"sqlite:///{tmp_path / 'empty.db'}")
+    else:
+        e = dstore.connect(request.getfixturevalue("pg_url"))
+        with e.begin() as c:
+            for t in ("servers", "fleet_runs", "jobs", "runs", "flightpath", "deliveries",
+                      "order_details", "orders", "alembic_version"):
+                c.execute(sa.text(f"drop table if exists {t} cascade"))
+    yield e
+    e.dispose()
+
+
+def stale(engine, server: str, seconds: float) -> None:
+    """A server row whose last heartbeat was ``seconds`` ago (by the database's clock)."""
+    servers = dstore.tables(engine, ("servers",))["servers"]
+    with engine.begin() as c:
+        then = store.db_now(c) - dt.timedelta(seconds=seconds)
+        c.execute(servers.insert().values(id=server, started=then, heartbeat=then))
+
+
+def test_upgrading_a_0002_store_keeps_its_jobs(empty):
+    e = empty
+    upgrade_to(e, "0002")
+    jobs = sa.table("jobs", *(sa.column(n, sa.JSON if n in ("params", "result") else None)
+                              for n in COLUMNS["jobs"][:-1]))
+    t = dt.datetime(2024, 1, 1, 12)
+    rows = {state: {"id": f"job-{state}", "kind": "fleet", "params": {"preset": "seed-3x3"},
+                    "state": state, "progress": {"queued": 0.0, "running": 0.5}.get(state, 1.0),
+                    "result": {"fleet_run": "r"} if state == "done" else None,
+                    "error": "boom" if state == "failed" else None,
+                    "created": t, "updated": t}
+            for state in store.STATES}
+    with e.begin() as c:  # as a 0002 server wrote them
+        c.execute(jobs.insert(), list(rows.values()))
+    assert dstore.init(e) == HEAD
+    for state, row in rows.items():
+        job = store.get_job(e, row["id"])
+        assert job["owner"] is None and job["state"] == state
+        assert {k: job[k] for k in ("kind", "params", "progress", "result", "error")} == \
+            {k: row[k] for k in ("kind", "params", "progress", "result", "error")}
+        assert job["created"] == "2024-01-01T12:00:00+00:00"
+    # no owner: no live server runs them, so the unfinished ones are orphans
+    failed = store.fail_orphans(e, "gone", dead_after=60)
+    assert sorted(failed) == ["job-queued", "job-running"]
+    assert [store.get_job(e, f"job-{s}")["state"] for s in store.STATES] == \
+        ["failed", "failed", "done", "failed"]
+    assert store.get_job(e, "job-failed")["error"] == "boom"
+
+
+def test_orphans_are_the_jobs_of_silent_or_unknown_owners(engine):
+    store.beat(engine, "live")
+    stale(engine, "dead", 120)
+    stale(engine, "late", 30)  # silent, but not yet for dead_after
+    ids = {}
+    for name, owner, running in [("live_q", "live", False), ("live_r", "live", True),
+                                 ("late_r", "late", True), ("dead_q", "dead", False),
+                                 ("dead_r", "dead", True), ("none_q", None, False),
+                                 ("unknown_r", "never-beat", True)]:
+        ids[name] = store.create_job(engine, "fleet", {}, owner=owner)
+        if running:
+            store.set_progress(engine, ids[name], 0.5)
+    dead_done = store.create_job(engine, "fleet", {}, owner="dead")
+    store.finish_job(engine, dead_done, {})
+
+    failed = set(store.fail_orphans(engine, "orphaned", dead_after=60))
+    orphans = {ids[n] for n in ("dead_q", "dead_r", "none_q", "unknown_r")}
+    assert orphans <= failed  # PostgreSQL's database may hold other tests' jobs
+    for name, job_id in ids.items():
+        job = store.get_job(engine, job_id)
+        if job_id in orphans:
+            assert (job["state"], job["error"]) == ("failed", "orphaned"), name
+        else:
+            assert job_id not in failed and job["state"] in ("queued", "running"), name
+    assert store.get_job(engine, dead_done)["state"] == "done"
+    servers = dstore.tables(engine, ("servers",))["servers"]
+    with engine.connect() as c:
+        left = set(c.scalars(sa.select(servers.c.id)))
+    assert {"live", "late"} <= left and "dead" not in left  # silent servers forgotten
+    store.beat(engine, "dead")  # back after all: it beats again
+    assert set(store.fail_orphans(engine, "orphaned", dead_after=60)).isdisjoint(ids.values())
+    with pytest.raises(OptionError, match=r"dead_after=0 must be a number of seconds > 0"):
+        store.fail_orphans(engine, "orphaned", dead_after=0)
+
+
+def test_the_database_clock_is_utc_without_a_zone(engine):
+    with engine.connect() as c:
+        now = store.db_now(c)
+    here = dt.datetime.now(dt.UTC).replace(tzinfo=None)
+    assert now.tzinfo is None and abs(now - here) < dt.timedelta(hours=1)  # not local time

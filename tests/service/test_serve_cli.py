@@ -107,7 +107,8 @@ def test_bad_flags_are_one_line(monkeypatch, capsys, tmp_path, args, words):
 
 def test_serve_fails_the_jobs_a_stopped_server_left(monkeypatch, capsys, tmp_path):
     """A job runs only in the process that took it: one left queued or running by a
-    server that stopped is failed when the next server starts, a finished one is kept."""
+    server that stopped is failed when the next server starts, a finished one is kept,
+    and so is the job of another server still alive on the same store."""
     import uvicorn
     from fastapi.testclient import TestClient
 
@@ -122,6 +123,8 @@ def test_serve_fails_the_jobs_a_stopped_server_left(monkeypatch, capsys, tmp_pat
     store.set_progress(eng, running, 0.5)
     done = store.create_job(eng, "fleet", {"preset": "seed-3x3"})
     store.finish_job(eng, done, {"fleet_run": "r"})
+    store.beat(eng, "other-server:1:a")
+    live = store.create_job(eng, "fleet", {"preset": "seed-3x3"}, owner="other-server:1:a")
     eng.dispose()
 
     served = []
@@ -137,5 +140,6 @@ def test_serve_fails_the_jobs_a_stopped_server_left(monkeypatch, capsys, tmp_pat
             assert job["state"] == "failed" and job["error"] == ORPHANED, job
         job = c.get(f"/jobs/{done}").json()
         assert job["state"] == "done" and job["result"] == {"fleet_run": "r"}
+        assert c.get(f"/jobs/{live}").json()["state"] == "queued"
     code, _, err = run(monkeypatch, capsys, "serve", "--db", db)  # nothing left to fail
     assert len(served) == 2 and "job(s) left" not in err

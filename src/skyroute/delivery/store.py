@@ -8,7 +8,8 @@ Tables (the course's schemas plus the day and order of moves):
 - ``flightpath(delivery_date, seq, order_no, from_lon, from_lat, angle, to_lon, to_lat)``
 - ``runs(delivery_date, started, finished, moves, money_delivered, money_placed, ...)``
 
-and, from revision 0002, ``jobs`` and ``fleet_runs`` (:mod:`skyroute.jobs.store`).
+and, from revision 0002, ``jobs`` and ``fleet_runs`` (:mod:`skyroute.jobs.store`); from
+0003, ``jobs.owner`` and ``servers``.
 
 A SQLite file by default, PostgreSQL (or any SQLAlchemy URL) by ``--db``. The schema is
 made and upgraded by Alembic migrations shipped in the package (``db init`` runs them).

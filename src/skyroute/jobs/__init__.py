@@ -2,8 +2,8 @@
 
 - :mod:`~skyroute.jobs.executor`: ``open_executor("local" | "dask", address=, workers=)``,
   one ``map`` for both.
-- :mod:`~skyroute.jobs.store`: the ``jobs`` and ``fleet_runs`` tables (in the delivery
-  store, migration 0002).
+- :mod:`~skyroute.jobs.store`: the ``jobs``, ``fleet_runs`` and ``servers`` tables (in
+  the delivery store, migrations 0002 and 0003).
 - :mod:`~skyroute.jobs.deliver`: a range of delivery days, one task per day, each stored
   by its worker in one transaction.
 - :mod:`~skyroute.jobs.fleet`: fleet runs (stored in ``fleet_runs``) and sweeps.

@@ -4,7 +4,7 @@
 :class:`~skyroute.errors.OptionError` naming the field when one is wrong), records the job
 as ``queued`` and returns its id at once; ``get(engine, job_id)`` reads it back as
 ``{"id", "kind", "params", "state", "progress", "result", "error", "created",
-"updated"}`` (None for an unknown id).
+"updated", "owner"}`` (None for an unknown id).
 
 Kinds (:data:`KINDS`) and their parameters:
 
@@ -26,17 +26,31 @@ progress, the share of its tasks done (a fleet run is one task: 0, then 1). It e
 ``done`` with its result, or ``failed`` with a one-line error: a SkyrouteError's message,
 else the exception's type and message; the traceback goes to the ``skyroute.jobs``
 logger, never into the store. The thread is a daemon: a job still queued or running
-when the process ends is left so in the store until the next server starts:
-:func:`fail_orphans` (``skyroute serve`` calls it once, before its workers start) marks
-such jobs ``failed`` with :data:`ORPHANED`. One server (with its workers) per store.
+when the process ends is left so in the store, and is failed later as an orphan.
+
+Several servers (and each server's ``--workers`` processes) may share one store. Each
+job names its owner, the process that took it (:func:`owner`: host, process id and a
+random part). While a process has jobs queued or running it beats every
+:data:`HEARTBEAT_EVERY` seconds in the store's ``servers`` table and fails the orphans
+there (:func:`heartbeat`); :func:`fail_orphans` (also called by ``skyroute serve``
+before its workers start, and by :func:`get` on another owner's unfinished job) marks
+``failed`` with :data:`ORPHANED` the unfinished jobs whose owner has been silent for
+:data:`DEAD_AFTER` seconds, or that have no owner (jobs stored before owners were), and
+leaves the live servers' jobs alone. A process stalled
+for longer than that (or cut off from the store) has its jobs marked failed; one it
+finishes after all is then recorded ``done`` over the failure.
 """
 
 from __future__ import annotations
 
 import logging
+import math
+import os
 import queue
+import socket
 import threading
 import time
+import uuid
 from collections.abc import Callable
 from typing import NamedTuple
 
@@ -61,40 +75,95 @@ KINDS = {
 }
 
 ORPHANED = "the server stopped while this job ran; submit it again"
+HEARTBEAT_EVERY = 10.0  # seconds between a process's heartbeats while it has jobs
+DEAD_AFTER = 60.0  # seconds without a heartbeat after which an owner is dead
 
 _queue: queue.Queue = queue.Queue()
 _lock = threading.Lock()
 _thread: threading.Thread | None = None
+_beater: threading.Thread | None = None
 _pending = 0
+_stores: dict[str, list] = {}  # URL -> [engine, this process's unfinished jobs there]
+_owner: tuple[int, str] | None = None  # (pid, id)
+_reaped: dict[str, float] = {}  # URL -> when get() last failed orphans there (monotonic)
+
+
+def owner() -> str:
+    """This process's owner id, ``HOST:PID:RANDOM`` (made once per process; the random
+    part tells apart processes that reuse a host name and process id)."""
+    global _owner
+    if _owner is None or _owner[0] != os.getpid():
+        _owner = (os.getpid(), f"{socket.gethostname()[:60]}:{os.getpid()}:"
+                               f"{uuid.uuid4().hex[:12]}")
+    return _owner[1]
 
 
 def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
     """Check ``params``, record the job (``queued``) and queue it to run on
     ``executor`` (an open :func:`~skyroute.jobs.executor.open_executor`, which the
     caller keeps open and closes); the job's id."""
-    global _thread, _pending
+    global _thread, _beater, _pending
     check_choice("kind", kind, tuple(KINDS))
     params = KINDS[kind].check(params)
-    job_id = store.create_job(engine, kind, params)
+    me = owner()
+    store.beat(engine, me)  # alive before its job exists: no one fails it as an orphan
+    job_id = store.create_job(engine, kind, params, owner=me)
     with _lock:
         _pending += 1
+        _stores.setdefault(str(engine.url), [engine, 0])[1] += 1
         _queue.put((engine, job_id, kind, params, executor))
         if _thread is None or not _thread.is_alive():
             _thread = threading.Thread(target=_work, name="skyroute-jobs", daemon=True)
             _thread.start()
+        if _beater is None or not _beater.is_alive():
+            _beater = threading.Thread(target=_beat_forever, name="skyroute-jobs-beat",
+                                       daemon=True)
+            _beater.start()
     return job_id
 
 
 def fail_orphans(engine: sa.Engine) -> list[str]:
-    """Mark jobs left ``queued`` or ``running`` by a server that stopped as ``failed``
-    (:data:`ORPHANED`); their ids. Call it when a server starts, before it takes jobs:
-    a job runs only in the process that took it, so none of these will ever end."""
-    return store.fail_unfinished(engine, ORPHANED)
+    """Mark ``failed`` (:data:`ORPHANED`) the jobs left ``queued`` or ``running`` by
+    servers that stopped: owners silent for :data:`DEAD_AFTER` seconds, or none; their
+    ids. A job runs only in the process that took it, so none of these will ever end.
+    ``skyroute serve`` calls it at start; :func:`heartbeat` while jobs run."""
+    return store.fail_orphans(engine, ORPHANED, dead_after=DEAD_AFTER)
+
+
+def heartbeat() -> None:
+    """For each store where this process has jobs queued or running: beat, then fail
+    the orphans. The beat thread calls it every :data:`HEARTBEAT_EVERY` seconds; a store
+    that cannot be reached is logged and tried again next time."""
+    with _lock:
+        engines = [e for e, _ in _stores.values()]
+    for engine in engines:
+        try:
+            store.beat(engine, owner())
+            failed = fail_orphans(engine)
+        except Exception:
+            log.warning("heartbeat to %s failed", engine.url, exc_info=True)
+            continue
+        if failed:
+            log.warning("%d orphaned job(s) marked failed: %s", len(failed),
+                        ", ".join(failed))
 
 
 def get(engine: sa.Engine, job_id: str) -> dict | None:
-    """The job as :func:`skyroute.jobs.store.get_job` gives it; None for an unknown id."""
-    return store.get_job(engine, job_id)
+    """The job as :func:`skyroute.jobs.store.get_job` gives it; None for an unknown id.
+    Another owner's unfinished job is first checked for orphans (:func:`fail_orphans`,
+    at most once per :data:`HEARTBEAT_EVERY` seconds per store), so a job whose server
+    died is seen failed even where no server has jobs left to beat for."""
+    job = store.get_job(engine, job_id)
+    if job is None or job["state"] not in ("queued", "running") or job["owner"] == owner():
+        return job
+    url, now = str(engine.url), time.monotonic()
+    with _lock:
+        due = now - _reaped.get(url, -math.inf) >= HEARTBEAT_EVERY
+        if due:
+            _reaped[url] = now
+    if due and job_id in fail_orphans(engine):
+        job = store.get_job(engine, job_id)
+    return job
 
 
 def pending() -> int:
@@ -133,6 +202,16 @@ def _work() -> None:
         finally:
             with _lock:
                 _pending -= 1
+                held = _stores[str(engine.url)]
+                held[1] -= 1
+                if held[1] == 0:  # nothing of ours left there: stop beating to it
+                    del _stores[str(engine.url)]
+
+
+def _beat_forever() -> None:
+    while True:
+        time.sleep(HEARTBEAT_EVERY)
+        heartbeat()
 
 
 def _run(engine, job_id: str, kind: str, params: dict, executor) -> None:

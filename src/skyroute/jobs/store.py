@@ -1,9 +1,15 @@
 """Jobs and fleet runs in the SQL store of the delivery days (same database, same
-migrations: revision 0002 adds the two tables; ``skyroute db init`` upgrades to it).
+migrations: revision 0002 adds the jobs and fleet_runs tables, 0003 the jobs' owners and
+the servers; ``skyroute db init`` upgrades to the newest).
 
-- ``jobs(id, kind, params, state, progress, result, error, created, updated)``: ``state``
-  is ``queued``, ``running``, ``done`` or ``failed``; ``progress`` 0..1; ``params`` and
-  ``result`` JSON; ``error`` one line. Times are UTC.
+- ``jobs(id, kind, params, state, progress, result, error, created, updated, owner)``:
+  ``state`` is ``queued``, ``running``, ``done`` or ``failed``; ``progress`` 0..1;
+  ``params`` and ``result`` JSON; ``error`` one line. Times are UTC. ``owner`` is the id
+  of the server process that runs the job (None for jobs stored before revision 0003).
+- ``servers(id, started, heartbeat)``: the server processes that own jobs, each beating
+  (:func:`beat`) while it has jobs to run; times from the database's clock, so servers
+  on hosts whose clocks differ agree on who is silent. :func:`fail_orphans` fails the
+  unfinished jobs of owners silent for longer than ``dead_after``.
 - ``fleet_runs(id, job_id, scenario, params, report, events_jsonl, tracks_csv,
   packages_csv, fleet_geojson, created)``: a fleet run's ``report.json``,
   ``events.jsonl``, ``tracks.csv`` (bytes), ``packages.csv`` and ``fleet.geojson`` as
@@ -28,7 +34,7 @@ from skyroute.delivery.store import connect, tables
 from skyroute.errors import OptionError
 
 STATES = ("queued", "running", "done", "failed")
-TABLES = ("jobs", "fleet_runs")
+TABLES = ("jobs", "fleet_runs", "servers")
 
 
 _ENGINES: dict[str, sa.Engine] = {}
@@ -79,14 +85,16 @@ def json_safe(value):
     raise OptionError(f"{type(value).__name__} {value!r} cannot be stored as JSON")
 
 
-def create_job(engine: sa.Engine, kind: str, params: dict) -> str:
-    """Record a new job (``queued``, progress 0); its id (a UUID string)."""
+def create_job(engine: sa.Engine, kind: str, params: dict, *,
+               owner: str | None = None) -> str:
+    """Record a new job (``queued``, progress 0) run by the server ``owner`` (which
+    :func:`beat` first); its id (a UUID string)."""
     job_id = str(uuid.uuid4())
     now = _now()
     with engine.begin() as c:
         c.execute(_t(engine)["jobs"].insert().values(
             id=job_id, kind=kind, params=json_safe(params), state="queued", progress=0.0,
-            created=now, updated=now))
+            created=now, updated=now, owner=owner))
     return job_id
 
 
@@ -121,21 +129,53 @@ def fail_job(engine: sa.Engine, job_id: str, error: str) -> None:
                   .values(state="failed", error=line, updated=_now()))
 
 
-def fail_unfinished(engine: sa.Engine, error: str) -> list[str]:
-    """Mark every ``queued`` or ``running`` job ``failed`` with ``error``; their ids."""
-    jobs = _t(engine)["jobs"]
-    unfinished = jobs.c.state.in_(("queued", "running"))
+def db_now(conn: sa.Connection) -> dt.datetime:
+    """The database's clock, UTC without a time zone (as the store keeps times)."""
+    now = conn.execute(sa.select(sa.func.current_timestamp())).scalar_one()
+    if isinstance(now, str):  # a driver that leaves SQLite's text as it is
+        now = dt.datetime.fromisoformat(now)
+    if now.tzinfo is not None:
+        now = now.astimezone(dt.UTC).replace(tzinfo=None)
+    return now
+
+
+def beat(engine: sa.Engine, server: str) -> None:
+    """Record that the server process ``server`` is alive now (by the database's
+    clock), adding it to ``servers`` the first time (or again after
+    :func:`fail_orphans` removed it as silent)."""
+    servers = _t(engine)["servers"]
     with engine.begin() as c:
-        ids = [r[0] for r in c.execute(sa.select(jobs.c.id).where(unfinished))]
+        now = db_now(c)
+        if not c.execute(servers.update().where(servers.c.id == server)
+                         .values(heartbeat=now)).rowcount:
+            c.execute(servers.insert().values(id=server, started=now, heartbeat=now))
+
+
+def fail_orphans(engine: sa.Engine, error: str, *, dead_after: float) -> list[str]:
+    """Mark ``failed`` with ``error`` every ``queued`` or ``running`` job whose owner
+    has not beaten for ``dead_after`` seconds (or that has no owner), and forget those
+    servers; the jobs' ids. The live servers' jobs are left as they are."""
+    if not dead_after > 0:
+        raise OptionError(f"dead_after={dead_after!r} must be a number of seconds > 0",
+                          param="dead_after")
+    t = _t(engine)
+    jobs, servers = t["jobs"], t["servers"]
+    with engine.begin() as c:
+        cutoff = db_now(c) - dt.timedelta(seconds=dead_after)
+        alive = sa.select(servers.c.id).where(servers.c.heartbeat >= cutoff)
+        orphaned = sa.and_(jobs.c.state.in_(("queued", "running")),
+                           sa.or_(jobs.c.owner.is_(None), jobs.c.owner.not_in(alive)))
+        ids = [r[0] for r in c.execute(sa.select(jobs.c.id).where(orphaned))]
         if ids:
-            c.execute(jobs.update().where(jobs.c.id.in_(ids), unfinished)
+            c.execute(jobs.update().where(jobs.c.id.in_(ids), orphaned)
                       .values(state="failed", error=error, updated=_now()))
+        c.execute(servers.delete().where(servers.c.heartbeat < cutoff))
     return ids
 
 
 def get_job(engine: sa.Engine, job_id: str) -> dict | None:
     """``{"id", "kind", "params", "state", "progress", "result", "error", "created",
-    "updated"}`` (times ISO 8601 UTC), or None for an unknown id."""
+    "updated", "owner"}`` (times ISO 8601 UTC), or None for an unknown id."""
     jobs = _t(engine)["jobs"]
     with engine.connect() as c:
         r = c.execute(sa.select(jobs).where(jobs.c.id == str(job_id))).mappings().first()
@@ -143,7 +183,8 @@ def get_job(engine: sa.Engine, job_id: str) -> dict | None:
         return None
     return {"id": r["id"], "kind": r["kind"], "params": r["params"], "state": r["state"],
             "progress": r["progress"], "result": r["result"], "error": r["error"],
-            "created": _iso(r["created"]), "updated": _iso(r["updated"])}
+            "created": _iso(r["created"]), "updated": _iso(r["updated"]),
+            "owner": r["owner"]}
 
 
 def save_fleet_run(engine: sa.Engine, *, scenario: str, params: dict, report: dict,

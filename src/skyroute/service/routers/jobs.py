@@ -17,6 +17,7 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from skyroute.errors import SkyrouteError
+from skyroute.service.alternatives import exactly_one
 from skyroute.service.auth import require_token
 from skyroute.service.dates import IsoDate
 from skyroute.service.problems import Problem, responses
@@ -33,13 +34,19 @@ _SUBMIT = threading.Lock()
 
 class DeliverJob(BaseModel):
     """``{"date": D}`` for one day or ``{"from": D, "to": D}`` for a range, over the
-    orders already in the store (the site is the server's --data or --source)."""
+    orders already in the store (the site is the server's --data or --source). Give
+    ``date``, or both ``from`` and ``to`` (null counts as not given; the schema states
+    it as ``oneOf``)."""
 
-    model_config = ConfigDict(extra="forbid", populate_by_name=True)
+    model_config = ConfigDict(extra="forbid", populate_by_name=True,
+                              json_schema_extra=exactly_one("date", ("from", "to")))
 
-    date: IsoDate | None = None
-    from_: IsoDate | None = Field(None, alias="from")
-    to: IsoDate | None = None
+    date: IsoDate | None = Field(None, description="One day. Give date, or both from "
+                                 "and to.")
+    from_: IsoDate | None = Field(None, alias="from", description="The range's first day "
+                                  "(with to, without date).")
+    to: IsoDate | None = Field(None, description="The range's last day, not before from "
+                               "(with from, without date).")
     method: Literal["milp", "greedy"] = "milp"
 
     @model_validator(mode="after")
@@ -55,9 +62,12 @@ class DeliverJob(BaseModel):
 
 
 class FleetJob(BaseModel):
-    """A fleet run: a preset's or a posted scenario's drones for ``hours``."""
+    """A fleet run: a preset's or a posted scenario's drones for ``hours``. Give exactly
+    one of ``preset`` and ``scenario`` (null counts as not given; the schema states it
+    as ``oneOf``)."""
 
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False,
+                              json_schema_extra=exactly_one("preset", "scenario"))
 
     preset: Literal["seed-3x3", "seed-9x9", "seed-18x9"] | None = None
     scenario: dict[str, Any] | None = Field(None, description="A scenario (the fields of "

@@ -20,6 +20,7 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from skyroute.errors import InputFormatError, QueryError, SkyrouteError
+from skyroute.service.alternatives import exactly_one
 from skyroute.service.auth import require_token
 from skyroute.service.problems import Problem, from_skyrouteerror, responses
 from skyroute.service.resources import Resources, ResourcesDep
@@ -31,10 +32,13 @@ Algorithm = Literal["astar", "dijkstra", "bfs", "jps", "theta", "lazy_theta", "v
 Number = Annotated[float, Field(allow_inf_nan=False)]
 Point = tuple[Number, Number]
 Pair = Annotated[list[float], Field(min_length=2, max_length=2)]
+SOURCES = ("map", "map_text", "world_text")  # exactly one of them
 
 
 class PlanRequest(BaseModel):
-    """One planning query. Give exactly one of ``map``, ``map_text`` and ``world_text``.
+    """One planning query. Give exactly one of ``map``, ``map_text`` and ``world_text``
+    (null counts as not given), and ``world_format`` with ``world_text``; the schema
+    states it as ``oneOf``.
 
     On a map, ``start`` and ``goal`` are (x, y) cells (column, row) and the options are
     those of :func:`skyroute.plan` on a Grid. On a world they are points in ``frame``
@@ -42,12 +46,17 @@ class PlanRequest(BaseModel):
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False, json_schema_extra={
         "examples": [{"map": "den312d", "start": [50, 76], "goal": [60, 13],
-                      "algorithm": "astar"}]})
+                      "algorithm": "astar"}],
+        **exactly_one("map", "map_text", ("world_text", "world_format"),
+                      among=SOURCES)})
 
     map: str | None = Field(None, max_length=200, description="A bundled map's name "
-                            "(GET /maps).")
-    map_text: str | None = Field(None, description="A MovingAI .map file's text.")
-    world_text: str | None = Field(None, description="A world file's text.")
+                            "(GET /maps). Exactly one of map, map_text and world_text.")
+    map_text: str | None = Field(None, description="A MovingAI .map file's text. Exactly "
+                                 "one of map, map_text and world_text.")
+    world_text: str | None = Field(None, description="A world file's text, read as "
+                                   "world_format. Exactly one of map, map_text and "
+                                   "world_text.")
     world_format: Literal["colliders", "geojson"] | None = Field(
         None, description="How to read world_text: colliders (FCND colliders.csv) or "
         "geojson (zones). Required with world_text.")
@@ -79,7 +88,7 @@ class PlanRequest(BaseModel):
 
     @model_validator(mode="after")
     def _one_source(self) -> PlanRequest:
-        given = [k for k in ("map", "map_text", "world_text") if getattr(self, k) is not None]
+        given = [k for k in SOURCES if getattr(self, k) is not None]
         if len(given) != 1:
             raise ValueError("give exactly one of map, map_text and world_text"
                              + (f" (got {', '.join(given)})" if given else ""))
