@@ -294,3 +294,26 @@ def test_fleet_replay_moves_drones_with_the_slider(open_page, server, size):
     p.wait_for_function("Number(document.querySelector('#time').value) > 400")
     p.click("#play")  # pause for the picture
     pg.done("fleet")
+
+
+# -- defects found by using the pages (each test failed before its fix) -----------------
+
+def _wait_status(page, kind: str, timeout: int = 30_000) -> str:
+    page.wait_for_function(f"document.querySelector('#status').dataset.kind === '{kind}'"
+                           " && !document.querySelector('#run').disabled", timeout=timeout)
+    return page.inner_text("#status")
+
+
+def test_world_hides_the_cell_size_of_exact_planners(open_page):
+    """The Cell size field (grid algorithms only) was shown for every algorithm: the
+    style sheet's .field display beat the hidden attribute."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#algorithm').options.length > 0")
+    assert p.input_value("#algorithm") == "visibility"
+    assert not p.is_visible("#resolution")
+    p.select_option("#algorithm", "astar")
+    assert p.is_visible("#resolution")
+    p.select_option("#algorithm", "prm")
+    assert not p.is_visible("#resolution")
+    pg.done("world-fields")
