@@ -304,6 +304,61 @@ def _wait_status(page, kind: str, timeout: int = 30_000) -> str:
     return page.inner_text("#status")
 
 
+def _open_map(pg, name: str) -> None:
+    p = pg.page
+    p.wait_for_function("document.querySelector('#map-name').options.length > 1")
+    p.fill("#token", TOKEN)
+    p.select_option("#map-name", name)
+    p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{name}')")
+
+
+def _type_cells(p, start, goal) -> None:
+    for key, value in zip(("sx", "sy", "gx", "gy"), (*start, *goal), strict=True):
+        p.fill(f"#{key}", str(value))
+
+
+def test_planner_says_a_bad_start_once(open_page, api):
+    """A start on a wall is one sentence, not the same 422 once per algorithm."""
+    doc = api.get("/maps/den312d").json()
+    wall = next((x, y) for y, row in enumerate(doc["rows"]) for x, c in enumerate(row)
+                if c not in doc["passable"])
+    goal = _free_cells(doc["rows"], doc["passable"])[0]
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "den312d")
+    _type_cells(p, wall, goal)
+    p.press("#gy", "Enter")
+    text = _wait_status(p, "error")
+    assert text == f"Planning failed (422): start ({wall[0]}, {wall[1]}) is on a blocked cell.", text
+    assert p.locator("#results tbody tr").count() == 3  # each row still names its error
+    assert all("422" in e for e in pg.errors), pg.errors
+
+
+def test_planner_says_when_no_algorithm_finds_a_path(open_page, api):
+    """An unreachable goal is not a green "Planned ...: 0 found a path"."""
+    doc = api.get("/maps/Berlin_1_256").json()
+    rows, passable = doc["rows"], doc["passable"]
+
+    def blocked(x, y):
+        return not (0 <= y < len(rows) and 0 <= x < len(rows[y])) or rows[y][x] not in passable
+
+    island = next((x, y) for y, row in enumerate(rows) for x, c in enumerate(row)
+                  if c in passable and all(blocked(x + i, y + j) for i, j in
+                                           ((1, 0), (-1, 0), (0, 1), (0, -1))))
+    start = _free_cells(rows, passable)[0]
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "Berlin_1_256")
+    for name in ("jps", "theta"):
+        p.uncheck(f"#algorithms input[value={name}]")
+    _type_cells(p, start, island)
+    p.click("#run")
+    text = _wait_status(p, "error")
+    assert text.endswith("with 1 algorithm: none found a path."), text
+    assert p.locator("#results tbody tr").get_attribute("data-cost") == ""
+    pg.done("planner-no-path")
+
+
 def test_world_hides_the_cell_size_of_exact_planners(open_page):
     """The Cell size field (grid algorithms only) was shown for every algorithm: the
     style sheet's .field display beat the hidden attribute."""

@@ -231,11 +231,19 @@ async function plan() {
   }
   const errors = results.filter((r) => r.error);
   if (errors.length) {
-    say(status, errors.map((r) => explain(r.error, r.algorithm)).join(" "), "error");
+    // one sentence per distinct answer: a bad start is said once, not once per algorithm
+    const byText = new Map();
+    for (const r of errors) {
+      const text = explain(r.error, "Planning").replace(/^Planning /, "");
+      byText.set(text, [...(byText.get(text) || []), r.algorithm]);
+    }
+    const every = errors.length === results.length && byText.size === 1;
+    say(status, [...byText].map(([text, names]) =>
+      `${every ? "Planning" : names.join(", ")} ${text}${/[.!?]$/.test(text) ? "" : "."}`).join(" "), "error");
   } else {
     const found = results.filter((r) => r.answer.status === "found");
     say(status, `Planned (${start.join(", ")}) → (${goal.join(", ")}) with ${results.length} algorithm${results.length > 1 ? "s" : ""}: ` +
-      `${found.length} found a path.`, "ok");
+      `${found.length ? found.length : "none"} found a path.`, found.length ? "ok" : "error");
   }
   showResults();
   draw();
