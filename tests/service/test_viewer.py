@@ -359,6 +359,35 @@ def test_planner_says_when_no_algorithm_finds_a_path(open_page, api):
     pg.done("planner-no-path")
 
 
+def test_planner_typed_cells_drop_the_old_paths(open_page, api):
+    """Typing a new cell clears the last query's paths and table (they were drawn from
+    the old start, next to the new start's marker)."""
+    doc = api.get("/maps/den312d").json()
+    free = _free_cells(doc["rows"], doc["passable"])
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "den312d")
+    _type_cells(p, free[0], free[-1])
+    p.click("#run")
+    _wait_status(p, "ok")
+    assert p.locator("#results tbody tr").count() == 3
+    planned = p.evaluate("document.querySelector('#map').toDataURL()")
+    p.fill("#sx", str(free[1][0]))
+    p.fill("#sy", str(free[1][1]))
+    assert p.locator("#results tbody tr").count() == 0
+    assert "Press Plan" in p.inner_text("#status")
+    assert p.evaluate("document.querySelector('#map').toDataURL()") != planned
+    pg.done("planner-typed")
+
+
+def _load_city(pg) -> None:
+    p = pg.page
+    p.wait_for_function("document.querySelector('#algorithm').options.length > 0")
+    p.fill("#token", TOKEN)
+    p.set_input_files("#file", str(ROOT / "examples" / "city.csv"))
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('city.csv')")
+
+
 def test_world_hides_the_cell_size_of_exact_planners(open_page):
     """The Cell size field (grid algorithms only) was shown for every algorithm: the
     style sheet's .field display beat the hidden attribute."""
@@ -372,3 +401,28 @@ def test_world_hides_the_cell_size_of_exact_planners(open_page):
     p.select_option("#algorithm", "prm")
     assert not p.is_visible("#resolution")
     pg.done("world-fields")
+
+
+def test_world_error_leaves_no_old_path(open_page):
+    """A new start, then a refused plan: the old path, length and waypoints go (they
+    stayed, next to the new start's marker and the error)."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    _load_city(pg)
+    click_canvas(p, 0.05, 0.05)
+    click_canvas(p, 0.95, 0.95)
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('Found')",
+                        timeout=30_000)
+    assert p.inner_text("#r-status") == "found"
+    # the centre of the city's first box (north, east), inside it at any altitude
+    first = (ROOT / "examples" / "city.csv").read_text().splitlines()[2].split(",")
+    p.fill("#s0", first[0])
+    p.fill("#s1", first[1])
+    assert p.inner_text("#r-status") == "–"
+    assert p.is_disabled("#dl-waypoints")
+    p.click("#run")
+    text = _wait_status(p, "error")
+    assert "lies inside obstacle" in text, text
+    assert p.inner_text("#r-cost") == "–"
+    assert p.locator("#waypoints tbody tr").count() == 0
+    assert all("422" in e for e in pg.errors), pg.errors

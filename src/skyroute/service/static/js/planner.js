@@ -172,7 +172,17 @@ canvas.addEventListener("click", (ev) => {
   else say(status, `Start (${x}, ${y}); now click the goal.`, "info");
 });
 
-for (const id of ["sx", "sy", "gx", "gy"]) $(id).addEventListener("input", draw);
+// a typed cell is a new query: the paths of the old one go
+for (const id of ["sx", "sy", "gx", "gy"]) {
+  $(id).addEventListener("input", () => {
+    round++;
+    $("run").disabled = false;
+    results = [];
+    tbody.replaceChildren();
+    draw();
+    say(status, "Press Plan (or Enter) to plan with the typed cells.", "info");
+  });
+}
 
 $("form").addEventListener("submit", (ev) => {
   ev.preventDefault();

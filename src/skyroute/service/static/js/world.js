@@ -259,7 +259,17 @@ $("map").addEventListener("click", (ev) => {
   else say(status, "Start set; now click the goal.", "info");
 });
 
-for (const id of ["s0", "s1", "g0", "g1", "altitude", "safety"]) $(id).addEventListener("input", () => view.render());
+// a typed point, altitude or margin is a new query: the path of the old one goes
+for (const id of ["s0", "s1", "g0", "g1", "altitude", "safety"]) {
+  $(id).addEventListener("input", () => {
+    round++;
+    $("run").disabled = false;
+    answer = null;
+    clearResult();
+    view.render();
+    if (world) say(status, "Press Plan (or Enter) to plan again.", "info");
+  });
+}
 $("file").addEventListener("change", async () => {
   const f = $("file").files[0];
   if (!f) return;
@@ -295,6 +305,9 @@ async function plan() {
   if ($("altitude").value !== "") body.altitude = Number($("altitude").value);
   if (!$("resolution-field").hidden && $("resolution").value !== "") body.resolution = Number($("resolution").value);
   const mine = ++round;
+  answer = null; // what is shown is always the answer to the last request
+  clearResult();
+  view.render();
   $("run").disabled = true;
   say(status, `Planning with ${body.algorithm}…`, "busy");
   try {
