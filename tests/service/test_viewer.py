@@ -426,3 +426,26 @@ def test_world_error_leaves_no_old_path(open_page):
     assert p.inner_text("#r-cost") == "–"
     assert p.locator("#waypoints tbody tr").count() == 0
     assert all("422" in e for e in pg.errors), pg.errors
+
+
+def test_world_widens_the_view_to_typed_points(open_page):
+    """A start typed far outside the city is drawn after planning (the view kept the
+    city's box and the start marker was off the canvas)."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    _load_city(pg)
+    for key, value in (("s0", 3000), ("s1", 3000), ("g0", -172.5), ("g1", 270.5)):
+        p.fill(f"#{key}", str(value))
+    p.click("#run")
+    assert _wait_status(p, "ok").startswith("Found")
+    start_marker = p.evaluate("""() => {
+        const c = document.querySelector('#map');
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4) {
+          if (Math.abs(d[i] - 27) < 8 && Math.abs(d[i + 1] - 122) < 8 && Math.abs(d[i + 2] - 61) < 8) n++;
+        }
+        return n;
+    }""")
+    assert start_marker > 20, start_marker
+    pg.done("world-far")

@@ -315,6 +315,10 @@ async function plan() {
     if (mine !== round) return;
     answer = a;
     showResult();
+    // typed points may lie outside the world's box: widen the view to them and the path
+    const pts = [start, goal, ...(a.path || [])].map(toPlane);
+    const [x0, y0, x1, y1] = view.bounds;
+    if (pts.some(([x, y]) => x < x0 || x > x1 || y < y0 || y > y1)) view.setBounds(grow(bbox(pts, view.bounds), 0.04, 10));
     say(status, a.status === "found"
       ? `Found a path of ${fmt(a.cost, 1)} m through ${a.path.length} points.`
       : `No path: the planner answered ${a.status.replace("_", " ")}.`, a.status === "found" ? "ok" : "error");
