@@ -449,3 +449,16 @@ def test_world_widens_the_view_to_typed_points(open_page):
     }""")
     assert start_marker > 20, start_marker
     pg.done("world-far")
+
+
+def test_day_without_a_flight_says_so(open_page):
+    """A stored day without orders says there is nothing to play (it said "Press Play to
+    fly it" beside a disabled Play button); the legend names the grey customers."""
+    pg = open_page("/day.html#date=2024-02-01", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('2024-02-01')")
+    text = p.inner_text("#status")
+    assert "did not fly" in text and "Press Play" not in text, text
+    assert p.is_disabled("#play")
+    assert "customer not served" in p.inner_text(".legend")
+    pg.done("day-empty")
