@@ -462,3 +462,34 @@ def test_day_without_a_flight_says_so(open_page):
     assert p.is_disabled("#play")
     assert "customer not served" in p.inner_text(".legend")
     pg.done("day-empty")
+
+
+@pytest.mark.parametrize("page", ["planner", "world"])
+def test_plan_button_on_a_phone_shows_the_answer(open_page, page):
+    """At 390 px the form fills the screen and the map and status line are under it:
+    Plan (or a missing start) changed nothing in view. Now the status line comes up."""
+    pg = open_page(f"/{page}.html", "phone")
+    p = pg.page
+    if page == "planner":
+        _open_map(pg, "den312d")
+        cells = (("sx", 50), ("sy", 76), ("gx", 60), ("gy", 13))
+    else:
+        _load_city(pg)
+        cells = (("s0", 172), ("s1", -271), ("g0", -172), ("g1", 270))
+
+    def status_in_view() -> bool:
+        box = p.locator("#status").bounding_box()
+        return box["y"] >= 0 and box["y"] + box["height"] <= p.viewport_size["height"] + 1
+
+    p.evaluate("window.scrollTo(0, 0)")
+    p.click("#run")  # no start yet
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'error'")
+    assert "start and a goal" in p.inner_text("#status")
+    assert status_in_view()
+    for key, value in cells:
+        p.fill(f"#{key}", str(value))
+    p.evaluate("window.scrollTo(0, 0)")
+    p.click("#run")
+    _wait_status(p, "ok")
+    assert status_in_view()
+    pg.done(f"{page}-phone-plan")

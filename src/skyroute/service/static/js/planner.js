@@ -186,7 +186,9 @@ for (const id of ["sx", "sy", "gx", "gy"]) {
 
 $("form").addEventListener("submit", (ev) => {
   ev.preventDefault();
-  plan();
+  plan(); // says what it does (or what is missing) before its first wait
+  // on a phone's one column the map and its status line are under the form: bring them up
+  status.closest("figure").scrollIntoView({ block: "nearest" });
 });
 
 function chosen() {
