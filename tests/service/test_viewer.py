@@ -329,7 +329,8 @@ def test_planner_says_a_bad_start_once(open_page, api):
     _type_cells(p, wall, goal)
     p.press("#gy", "Enter")
     text = _wait_status(p, "error")
-    assert text == f"Planning failed (422): start ({wall[0]}, {wall[1]}) is on a blocked cell.", text
+    want = f"Planning failed (422): start ({wall[0]}, {wall[1]}) is on a blocked cell."
+    assert text == want, text
     assert p.locator("#results tbody tr").count() == 3  # each row still names its error
     assert all("422" in e for e in pg.errors), pg.errors
 
@@ -443,7 +444,8 @@ def test_world_widens_the_view_to_typed_points(open_page):
         const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
         let n = 0;
         for (let i = 0; i < d.length; i += 4) {
-          if (Math.abs(d[i] - 27) < 8 && Math.abs(d[i + 1] - 122) < 8 && Math.abs(d[i + 2] - 61) < 8) n++;
+          const near = (k, v) => Math.abs(d[i + k] - v) < 8;
+          if (near(0, 27) && near(1, 122) && near(2, 61)) n++;
         }
         return n;
     }""")
