@@ -294,3 +294,204 @@ def test_fleet_replay_moves_drones_with_the_slider(open_page, server, size):
     p.wait_for_function("Number(document.querySelector('#time').value) > 400")
     p.click("#play")  # pause for the picture
     pg.done("fleet")
+
+
+# -- defects found by using the pages (each test failed before its fix) -----------------
+
+def _wait_status(page, kind: str, timeout: int = 30_000) -> str:
+    page.wait_for_function(f"document.querySelector('#status').dataset.kind === '{kind}'"
+                           " && !document.querySelector('#run').disabled", timeout=timeout)
+    return page.inner_text("#status")
+
+
+def _open_map(pg, name: str) -> None:
+    p = pg.page
+    p.wait_for_function("document.querySelector('#map-name').options.length > 1")
+    p.fill("#token", TOKEN)
+    p.select_option("#map-name", name)
+    p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{name}')")
+
+
+def _type_cells(p, start, goal) -> None:
+    for key, value in zip(("sx", "sy", "gx", "gy"), (*start, *goal), strict=True):
+        p.fill(f"#{key}", str(value))
+
+
+def test_planner_says_a_bad_start_once(open_page, api):
+    """A start on a wall is one sentence, not the same 422 once per algorithm."""
+    doc = api.get("/maps/den312d").json()
+    wall = next((x, y) for y, row in enumerate(doc["rows"]) for x, c in enumerate(row)
+                if c not in doc["passable"])
+    goal = _free_cells(doc["rows"], doc["passable"])[0]
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "den312d")
+    _type_cells(p, wall, goal)
+    p.press("#gy", "Enter")
+    text = _wait_status(p, "error")
+    want = f"Planning failed (422): start ({wall[0]}, {wall[1]}) is on a blocked cell."
+    assert text == want, text
+    assert p.locator("#results tbody tr").count() == 3  # each row still names its error
+    assert all("422" in e for e in pg.errors), pg.errors
+
+
+def test_planner_says_when_no_algorithm_finds_a_path(open_page, api):
+    """An unreachable goal is not a green "Planned ...: 0 found a path"."""
+    doc = api.get("/maps/Berlin_1_256").json()
+    rows, passable = doc["rows"], doc["passable"]
+
+    def blocked(x, y):
+        return not (0 <= y < len(rows) and 0 <= x < len(rows[y])) or rows[y][x] not in passable
+
+    island = next((x, y) for y, row in enumerate(rows) for x, c in enumerate(row)
+                  if c in passable and all(blocked(x + i, y + j) for i, j in
+                                           ((1, 0), (-1, 0), (0, 1), (0, -1))))
+    start = _free_cells(rows, passable)[0]
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "Berlin_1_256")
+    for name in ("jps", "theta"):
+        p.uncheck(f"#algorithms input[value={name}]")
+    _type_cells(p, start, island)
+    p.click("#run")
+    text = _wait_status(p, "error")
+    assert text.endswith("with 1 algorithm: none found a path."), text
+    assert p.locator("#results tbody tr").get_attribute("data-cost") == ""
+    pg.done("planner-no-path")
+
+
+def test_planner_typed_cells_drop_the_old_paths(open_page, api):
+    """Typing a new cell clears the last query's paths and table (they were drawn from
+    the old start, next to the new start's marker)."""
+    doc = api.get("/maps/den312d").json()
+    free = _free_cells(doc["rows"], doc["passable"])
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "den312d")
+    _type_cells(p, free[0], free[-1])
+    p.click("#run")
+    _wait_status(p, "ok")
+    assert p.locator("#results tbody tr").count() == 3
+    planned = p.evaluate("document.querySelector('#map').toDataURL()")
+    p.fill("#sx", str(free[1][0]))
+    p.fill("#sy", str(free[1][1]))
+    assert p.locator("#results tbody tr").count() == 0
+    assert "Press Plan" in p.inner_text("#status")
+    assert p.evaluate("document.querySelector('#map').toDataURL()") != planned
+    pg.done("planner-typed")
+
+
+def _load_city(pg) -> None:
+    p = pg.page
+    p.wait_for_function("document.querySelector('#algorithm').options.length > 0")
+    p.fill("#token", TOKEN)
+    p.set_input_files("#file", str(ROOT / "examples" / "city.csv"))
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('city.csv')")
+
+
+def test_world_hides_the_cell_size_of_exact_planners(open_page):
+    """The Cell size field (grid algorithms only) was shown for every algorithm: the
+    style sheet's .field display beat the hidden attribute."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#algorithm').options.length > 0")
+    assert p.input_value("#algorithm") == "visibility"
+    assert not p.is_visible("#resolution")
+    p.select_option("#algorithm", "astar")
+    assert p.is_visible("#resolution")
+    p.select_option("#algorithm", "prm")
+    assert not p.is_visible("#resolution")
+    pg.done("world-fields")
+
+
+def test_world_error_leaves_no_old_path(open_page):
+    """A new start, then a refused plan: the old path, length and waypoints go (they
+    stayed, next to the new start's marker and the error)."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    _load_city(pg)
+    click_canvas(p, 0.05, 0.05)
+    click_canvas(p, 0.95, 0.95)
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('Found')",
+                        timeout=30_000)
+    assert p.inner_text("#r-status") == "found"
+    # the centre of the city's first box (north, east), inside it at any altitude
+    first = (ROOT / "examples" / "city.csv").read_text().splitlines()[2].split(",")
+    p.fill("#s0", first[0])
+    p.fill("#s1", first[1])
+    assert p.inner_text("#r-status") == "–"
+    assert p.is_disabled("#dl-waypoints")
+    p.click("#run")
+    text = _wait_status(p, "error")
+    assert "lies inside obstacle" in text, text
+    assert p.inner_text("#r-cost") == "–"
+    assert p.locator("#waypoints tbody tr").count() == 0
+    assert all("422" in e for e in pg.errors), pg.errors
+
+
+def test_world_widens_the_view_to_typed_points(open_page):
+    """A start typed far outside the city is drawn after planning (the view kept the
+    city's box and the start marker was off the canvas)."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    _load_city(pg)
+    for key, value in (("s0", 3000), ("s1", 3000), ("g0", -172.5), ("g1", 270.5)):
+        p.fill(f"#{key}", str(value))
+    p.click("#run")
+    assert _wait_status(p, "ok").startswith("Found")
+    start_marker = p.evaluate("""() => {
+        const c = document.querySelector('#map');
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4) {
+          const near = (k, v) => Math.abs(d[i + k] - v) < 8;
+          if (near(0, 27) && near(1, 122) && near(2, 61)) n++;
+        }
+        return n;
+    }""")
+    assert start_marker > 20, start_marker
+    pg.done("world-far")
+
+
+def test_day_without_a_flight_says_so(open_page):
+    """A stored day without orders says there is nothing to play (it said "Press Play to
+    fly it" beside a disabled Play button); the legend names the grey customers."""
+    pg = open_page("/day.html#date=2024-02-01", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('2024-02-01')")
+    text = p.inner_text("#status")
+    assert "did not fly" in text and "Press Play" not in text, text
+    assert p.is_disabled("#play")
+    assert "customer not served" in p.inner_text(".legend")
+    pg.done("day-empty")
+
+
+@pytest.mark.parametrize("page", ["planner", "world"])
+def test_plan_button_on_a_phone_shows_the_answer(open_page, page):
+    """At 390 px the form fills the screen and the map and status line are under it:
+    Plan (or a missing start) changed nothing in view. Now the status line comes up."""
+    pg = open_page(f"/{page}.html", "phone")
+    p = pg.page
+    if page == "planner":
+        _open_map(pg, "den312d")
+        cells = (("sx", 50), ("sy", 76), ("gx", 60), ("gy", 13))
+    else:
+        _load_city(pg)
+        cells = (("s0", 172), ("s1", -271), ("g0", -172), ("g1", 270))
+
+    def status_in_view() -> bool:
+        box = p.locator("#status").bounding_box()
+        return box["y"] >= 0 and box["y"] + box["height"] <= p.viewport_size["height"] + 1
+
+    p.evaluate("window.scrollTo(0, 0)")
+    p.click("#run")  # no start yet
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'error'")
+    assert "start and a goal" in p.inner_text("#status")
+    assert status_in_view()
+    for key, value in cells:
+        p.fill(f"#{key}", str(value))
+    p.evaluate("window.scrollTo(0, 0)")
+    p.click("#run")
+    _wait_status(p, "ok")
+    assert status_in_view()
+    pg.done(f"{page}-phone-plan")

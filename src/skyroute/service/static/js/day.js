@@ -132,8 +132,14 @@ async function load(date) {
 
   fillOrders();
   player.load(moves, 1);
-  say(status, `${date}: ${moves} moves, ${detail.report.orders_delivered} of ${detail.report.orders_placed} ` +
-    `orders delivered, ${fmt(detail.report.money_pct, 1)} % of the money. Press Play to fly it.`, "ok");
+  if (moves) {
+    say(status, `${date}: ${moves} moves, ${detail.report.orders_delivered} of ${detail.report.orders_placed} ` +
+      `orders delivered, ${fmt(detail.report.money_pct, 1)} % of the money. Press Play to fly it.`, "ok");
+  } else {
+    say(status, `${date}: the drone did not fly (${detail.report.orders_placed
+      ? `none of the ${detail.report.orders_placed} orders could be delivered` : "no orders were placed"}), ` +
+      "so there is nothing to play.", "info");
+  }
   $("s-final").textContent = `Report: ${detail.report.orders_invalid} invalid orders, ` +
     `${detail.report.moves_left} moves of battery left at the end.`;
 }

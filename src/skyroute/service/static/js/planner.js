@@ -172,11 +172,23 @@ canvas.addEventListener("click", (ev) => {
   else say(status, `Start (${x}, ${y}); now click the goal.`, "info");
 });
 
-for (const id of ["sx", "sy", "gx", "gy"]) $(id).addEventListener("input", draw);
+// a typed cell is a new query: the paths of the old one go
+for (const id of ["sx", "sy", "gx", "gy"]) {
+  $(id).addEventListener("input", () => {
+    round++;
+    $("run").disabled = false;
+    results = [];
+    tbody.replaceChildren();
+    draw();
+    say(status, "Press Plan (or Enter) to plan with the typed cells.", "info");
+  });
+}
 
 $("form").addEventListener("submit", (ev) => {
   ev.preventDefault();
-  plan();
+  plan(); // says what it does (or what is missing) before its first wait
+  // on a phone's one column the map and its status line are under the form: bring them up
+  status.closest("figure").scrollIntoView({ block: "nearest" });
 });
 
 function chosen() {
@@ -231,11 +243,19 @@ async function plan() {
   }
   const errors = results.filter((r) => r.error);
   if (errors.length) {
-    say(status, errors.map((r) => explain(r.error, r.algorithm)).join(" "), "error");
+    // one sentence per distinct answer: a bad start is said once, not once per algorithm
+    const byText = new Map();
+    for (const r of errors) {
+      const text = explain(r.error, "Planning").replace(/^Planning /, "");
+      byText.set(text, [...(byText.get(text) || []), r.algorithm]);
+    }
+    const every = errors.length === results.length && byText.size === 1;
+    say(status, [...byText].map(([text, names]) =>
+      `${every ? "Planning" : names.join(", ")} ${text}${/[.!?]$/.test(text) ? "" : "."}`).join(" "), "error");
   } else {
     const found = results.filter((r) => r.answer.status === "found");
     say(status, `Planned (${start.join(", ")}) → (${goal.join(", ")}) with ${results.length} algorithm${results.length > 1 ? "s" : ""}: ` +
-      `${found.length} found a path.`, "ok");
+      `${found.length ? found.length : "none"} found a path.`, found.length ? "ok" : "error");
   }
   showResults();
   draw();

@@ -259,7 +259,17 @@ $("map").addEventListener("click", (ev) => {
   else say(status, "Start set; now click the goal.", "info");
 });
 
-for (const id of ["s0", "s1", "g0", "g1", "altitude", "safety"]) $(id).addEventListener("input", () => view.render());
+// a typed point, altitude or margin is a new query: the path of the old one goes
+for (const id of ["s0", "s1", "g0", "g1", "altitude", "safety"]) {
+  $(id).addEventListener("input", () => {
+    round++;
+    $("run").disabled = false;
+    answer = null;
+    clearResult();
+    view.render();
+    if (world) say(status, "Press Plan (or Enter) to plan again.", "info");
+  });
+}
 $("file").addEventListener("change", async () => {
   const f = $("file").files[0];
   if (!f) return;
@@ -274,7 +284,9 @@ $("algorithm").addEventListener("change", () => {
 });
 $("form").addEventListener("submit", (ev) => {
   ev.preventDefault();
-  plan();
+  plan(); // says what it does (or what is missing) before its first wait
+  // on a phone's one column the map and its status line are under the form: bring them up
+  status.closest("figure").scrollIntoView({ block: "nearest" });
 });
 
 async function plan() {
@@ -295,6 +307,9 @@ async function plan() {
   if ($("altitude").value !== "") body.altitude = Number($("altitude").value);
   if (!$("resolution-field").hidden && $("resolution").value !== "") body.resolution = Number($("resolution").value);
   const mine = ++round;
+  answer = null; // what is shown is always the answer to the last request
+  clearResult();
+  view.render();
   $("run").disabled = true;
   say(status, `Planning with ${body.algorithm}…`, "busy");
   try {
@@ -302,6 +317,10 @@ async function plan() {
     if (mine !== round) return;
     answer = a;
     showResult();
+    // typed points may lie outside the world's box: widen the view to them and the path
+    const pts = [start, goal, ...(a.path || [])].map(toPlane);
+    const [x0, y0, x1, y1] = view.bounds;
+    if (pts.some(([x, y]) => x < x0 || x > x1 || y < y0 || y > y1)) view.setBounds(grow(bbox(pts, view.bounds), 0.04, 10));
     say(status, a.status === "found"
       ? `Found a path of ${fmt(a.cost, 1)} m through ${a.path.length} points.`
       : `No path: the planner answered ${a.status.replace("_", " ")}.`, a.status === "found" ? "ok" : "error");
