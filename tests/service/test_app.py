@@ -42,6 +42,21 @@ def test_health_docs_and_static_page(client):
     assert 'href="/docs"' in page.text and "POST /plan" in page.text
 
 
+@pytest.mark.parametrize("page", ["/docs", "/redoc"])
+def test_api_reference_needs_no_internet(client, page):
+    """Swagger UI and ReDoc load their scripts and styles from this server (FastAPI's
+    default pages fetch them from a CDN, and show a blank page offline)."""
+    import re
+
+    html = client.get(page).text
+    assert not re.findall(r"https?://", html), html
+    assets = re.findall(r'(?:src|href)="([^"]+)"', html)
+    assert any(a.endswith(".js") for a in assets), assets
+    for asset in assets:
+        r = client.get(asset)
+        assert r.status_code == 200 and len(r.content) > 0, asset
+
+
 def test_unknown_path_and_method_are_problems(client):
     assert_problem(client.get("/no/such/thing"), 404, words="/no/such/thing")
     assert_problem(client.delete("/health"), 405, words="DELETE")

@@ -495,3 +495,30 @@ def test_plan_button_on_a_phone_shows_the_answer(open_page, page):
     _wait_status(p, "ok")
     assert status_in_view()
     pg.done(f"{page}-phone-plan")
+
+
+def test_api_reference_renders_offline(browser, server):
+    """/docs (the nav's "API") draws the operations with every request to another host
+    refused, as on a server without internet."""
+    context = browser.new_context(viewport=VIEWPORTS["desktop"])
+    outside: list[str] = []
+
+    def route(r):
+        if r.request.url.startswith(server[0]):
+            r.continue_()
+        else:
+            outside.append(r.request.url)
+            r.abort()
+
+    context.route("**/*", route)
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    try:
+        page.goto(server[0] + "/docs")
+        page.wait_for_selector(".opblock", timeout=20_000)
+        paths = page.locator(".opblock-summary-path").all_inner_texts()
+        assert any("/plan" in p for p in paths), paths
+        assert not outside and not errors, (outside, errors)
+    finally:
+        context.close()

@@ -1,5 +1,6 @@
 """The app factory: ``create_app(settings)`` -> a FastAPI app with every router, the
-error handlers, the body limit, the timing header and the static viewer at ``/``.
+error handlers, the body limit, the timing header, the API reference at ``/docs`` and
+``/redoc`` (served from local files) and the static viewer at ``/``.
 
 Making the app opens nothing; the store, the site and the job executor open on first use
 (:mod:`skyroute.service.resources`) and close when the app shuts down.
@@ -12,6 +13,7 @@ from pathlib import Path
 
 from fastapi import APIRouter, FastAPI, Request
 from fastapi.staticfiles import StaticFiles
+from fastapi_offline import FastAPIOffline
 
 import skyroute
 from skyroute.service import problems
@@ -47,8 +49,10 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         yield
         app.state.resources.close()
 
-    app = FastAPI(title="skyroute", version=skyroute.__version__, description=DESCRIPTION,
-                  lifespan=lifespan)
+    # /docs and /redoc from files in the fastapi-offline package, not a CDN: a server
+    # in the field (no internet) still shows its API reference
+    app = FastAPIOffline(title="skyroute", version=skyroute.__version__,
+                         description=DESCRIPTION, lifespan=lifespan)
     app.state.settings = settings
     app.state.resources = Resources(settings)
     problems.install(app)
