@@ -67,3 +67,15 @@ def test_fly_help_second_paragraph_reads_as_one():
     assert result.exit_code == 0, result.output
     assert ("Points, headings and written trajectories are in --frame (headings in degrees); "
             "the step drone flies the ILP rules") in result.output
+
+
+@pytest.mark.parametrize("path,cmd", COMMANDS, ids=[" ".join(p) or "skyroute" for p, _ in COMMANDS])
+def test_usage_names_arguments_plainly(path, cmd):
+    # Typer 0.28 wrote a required argument in braces: "skyroute fly [OPTIONS] {WORLD}"
+    result = CliRunner().invoke(app, [*path, "--help"], env={"COLUMNS": "200",
+                                                             "TERMINAL_WIDTH": "200"})
+    usage = next(line for line in result.output.splitlines() if "Usage:" in line).split()
+    arguments = [p for p in cmd.params if p.param_type_name == "argument"]
+    assert usage[len(usage) - len(arguments):] == [
+        p.metavar if p.required else f"[{p.metavar.strip('[]')}]" for p in arguments]
+    assert not {"{", "}"} & set("".join(usage)), usage
