@@ -57,7 +57,8 @@ class PlainArgument(TyperArgument):
 def tidied(command):
     """``command`` and its subcommands, in place, as ``--help`` should show them: help
     paragraphs unwrapped (:func:`unwrap`), arguments named without braces
-    (:class:`PlainArgument`)."""
+    (:class:`PlainArgument`). Every command of the group passes here, however it was
+    added (:class:`LazyCommands`)."""
     command.help = unwrap(command.help)
     for param in command.params:
         if type(param) is TyperArgument:
@@ -72,7 +73,7 @@ class LazyCommands(MutableMapping):
     the ones built already; in that order, whatever has been built since."""
 
     def __init__(self, built: MutableMapping, loaders: dict[str, Loader]):
-        self._built = dict(built)
+        self._built = {name: tidied(command) for name, command in built.items()}
         self._loaders = {k: v for k, v in loaders.items() if k not in built}
         self._order = [*self._loaders, *self._built]
 
@@ -85,7 +86,7 @@ class LazyCommands(MutableMapping):
         if name not in self._order:
             self._order.append(name)
         self._loaders.pop(name, None)
-        self._built[name] = command
+        self._built[name] = tidied(command)
 
     def __delitem__(self, name):
         if self._loaders.pop(name, None) is None:
