@@ -7,10 +7,12 @@ import math
 import numpy as np
 import pytest
 import shapely
+import typer.main
 
 import skyroute
+from skyroute.cli.app import app
 from tests.cli.test_cli import run
-from tests.conftest import SHARED
+from tests.conftest import ROOT, SHARED
 
 ZONES = str(SHARED / "ilp2021" / "website" / "buildings" / "no-fly-zones.geojson")
 BOX = str(SHARED / "ilp2021" / "testing" / "confinement-zone.geojson")
@@ -130,3 +132,80 @@ def test_each_vehicle_option_is_named_alone(monkeypatch, capsys, city, args, wor
     code, _, err = run(monkeypatch, capsys, "fly", city, "--frame", "local", "--start",
                        "0,0", "--goal", "50,50", *args)
     assert code == 2 and words in err and err.count("\n") == 1, err
+
+
+CITY = str(ROOT / "examples" / "city.csv")
+NED = ["fly", CITY, "--frame", "ned", "--altitude", "10", "--start", "0,0", "--goal",
+       "120,-180"]
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--radius", "50"], "--vehicle step does not use --radius (for dubins)"),
+    (["--radius", "10"], "--vehicle step does not use --radius (for dubins)"),  # the default
+    (["--step", "2"], "--vehicle step does not use --step (for dubins and field)"),
+    (["--no-escape"], "--vehicle step does not use --no-escape (for field)"),
+    (["--radius", "5", "--speed", "2"],
+     "--vehicle step does not use --radius (for dubins) or --speed (for lattice)"),
+    (["--vehicle", "dubins", "--speed", "2"], "--vehicle dubins does not use --speed (for "
+                                              "lattice)"),
+    (["--vehicle", "dubins", "--field-mode", "arc"], "--vehicle dubins does not use "
+                                                     "--field-mode (for field)"),
+    (["--vehicle", "lattice", "--reverse"], "--vehicle lattice does not use --reverse (for "
+                                            "dubins)"),
+    (["--vehicle", "lattice", "--goal-heading", "90"], "--vehicle lattice does not use "
+                                                       "--goal-heading (for dubins)"),
+    (["--vehicle", "field", "--planner", "moves"], "--vehicle field does not use --planner "
+                                                   "(for step and dubins)"),
+    (["--vehicle", "field", "--targets", "t.csv"], "--vehicle field does not use --targets "
+                                                   "(for dubins)"),
+    (["--vehicle", "field", "--start-heading", "0"], "--vehicle field does not use "
+                                                     "--start-heading (for dubins and "
+                                                     "lattice)"),
+])
+def test_an_option_the_vehicle_does_not_use_is_an_error(monkeypatch, capsys, tmp_path, args,
+                                                        words):
+    # e.g. --radius with the step drone was silently ignored
+    out = tmp_path / "t.json"
+    code, text, err = run(monkeypatch, capsys, *NED, *args, "--out", str(out))
+    assert code == 2 and err == f"skyroute: error: {words}\n" and text == ""
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--start", "0,0,90", "--goal", "120,-180"],
+     "--start '0,0,90': --vehicle step does not use a start heading (for dubins and "
+     "lattice)"),
+    (["--vehicle", "field", "--start", "0,0,90", "--goal", "120,-180"],
+     "--vehicle field does not use a start heading"),
+    (["--vehicle", "lattice", "--start", "0,0", "--goal", "120,-180,90"],
+     "--goal '120,-180,90': --vehicle lattice does not use a goal heading (for dubins)"),
+])
+def test_a_typed_heading_the_vehicle_does_not_use_is_an_error(monkeypatch, capsys, args,
+                                                              words):
+    code, text, err = run(monkeypatch, capsys, *NED[:4], *args)
+    assert code == 2 and words in err and err.count("\n") == 1 and text == "", err
+
+
+def test_every_vehicle_option_is_an_option_of_fly_and_says_whom_it_is_for():
+    from skyroute.cli.fly_cmd import TAKEN_BY, VEHICLES
+
+    cmd = typer.main.get_command(app).get_command(None, "fly")
+    params = {p.name: p for p in cmd.params}
+    for name, takers in TAKEN_BY.items():
+        assert name in params and set(takers) < set(VEHICLES), name
+        assert params[name].help.startswith(", ".join(takers) + ": "), name
+
+
+def test_cli_md_lists_the_vehicle_options_as_the_table_does():
+    import re
+
+    from skyroute.cli.fly_cmd import TAKEN_BY
+
+    text = (ROOT / "docs" / "cli.md").read_text()
+    table = text[text.index("| option | vehicles |"):].split("\n\n")[0].splitlines()[2:]
+    listed = {}
+    for row in table:
+        flags, vehicles = row.strip("|").split("|")
+        for flag in re.findall(r"`--([a-z-]+)", flags):
+            listed[flag.replace("-", "_")] = tuple(re.findall(r"`([a-z]+)`", vehicles))
+    assert listed == TAKEN_BY

@@ -1,5 +1,9 @@
 """Every algorithm through the same battery of cases (as OMPL runs its planners)."""
 
+import collections
+import decimal
+import types
+
 import numpy as np
 import pytest
 
@@ -79,12 +83,44 @@ def test_budget_exhausted(algorithm):
     ((0, 0), (5, 4), "goal (5, 4) lies outside the 5x5 grid"),
     ((0.5, 0), (4, 4), "two integers"),
     ("ab", (4, 4), "two integers"),
+    # each fails plan's inline test in its own way (an array's truth value, a NaN
+    # Decimal's comparison, a float index), and check_cell names it
+    ((np.array([0, 1]), 0), (4, 4), "two integers"),
+    ((decimal.Decimal("NaN"), 0), (4, 4), "two integers"),
+    ((0, 0), (4.0, 4), "goal (4.0, 4) must be two integers"),
 ])
 def test_bad_queries_raise(algorithm, start, goal, words):
     b = np.zeros((5, 5), bool)
     b[1, 1] = True
     with pytest.raises(QueryError, match=words.replace("(", r"\(").replace(")", r"\)")):
         skyroute.plan(skyroute.Grid(b), start, goal, algorithm=algorithm)
+
+
+# keys, members or bytes that are free in-range ints: each passed as a cell
+NOT_CELLS = [({3: "x", 0: "y"}, "dict"), ({0: 0, 3: 0}.keys(), "dict_keys"),
+             ({0, 3}, "set"), (frozenset({0, 3}), "frozenset"),
+             (types.MappingProxyType({0: 0, 3: 0}), "mappingproxy"), (b"\x00\x03", "bytes")]
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+@pytest.mark.parametrize("cell, kind", NOT_CELLS, ids=[k for _, k in NOT_CELLS])
+def test_a_mapping_or_set_is_not_a_cell(algorithm, cell, kind):
+    grid = skyroute.Grid(np.zeros((5, 5), bool))
+    with pytest.raises(QueryError) as start:
+        skyroute.plan(grid, cell, (4, 4), algorithm=algorithm)
+    assert str(start.value) == f"start {cell!r} must be two integers (x, y), not a {kind}"
+    with pytest.raises(QueryError, match=rf"^goal .* must be two integers \(x, y\), not "
+                                         rf"a {kind}$"):
+        skyroute.plan(grid, [4, 4], cell, algorithm=algorithm)
+
+
+def test_a_mapping_or_set_is_not_a_cell_of_a_prepared_grid():
+    index = skyroute.prepare(skyroute.Grid(np.zeros((5, 5), bool)))
+    for cell, kind in NOT_CELLS:
+        with pytest.raises(QueryError, match=rf"^start .* not a {kind}$"):
+            index.plan(cell, (4, 4))
+        with pytest.raises(QueryError, match=rf"^goal .* not a {kind}$"):
+            index.plan((4, 4), cell)
 
 
 @pytest.mark.parametrize("algorithm", ALGS)
@@ -94,8 +130,10 @@ def test_cells_as_numpy_ints_or_lists_plan_as_tuples(algorithm):
     b[2, 1:5] = True
     grid = skyroute.Grid(b)
     want = skyroute.plan(grid, (0, 0), (5, 5), algorithm=algorithm)
+    cell = collections.namedtuple("Cell", "x y")
     for s, t in (([0, 0], [5, 5]), (np.array([0, 0]), np.array([5, 5])),
-                 ((np.int32(0), np.int64(0)), (5, 5)), ((False, False), (5, 5))):
+                 ((np.int32(0), np.int64(0)), (5, 5)), ((False, False), (5, 5)),
+                 (cell(0, 0), cell(5, 5))):
         got = skyroute.plan(grid, s, t, algorithm=algorithm)
         assert got.cost == want.cost and np.array_equal(got.path, want.path)
 

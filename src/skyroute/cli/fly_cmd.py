@@ -25,59 +25,96 @@ from skyroute.world.world import AXES
 
 VEHICLES = ("step", "dubins", "lattice", "field")
 PLANNERS = {"step": ("moves", "follow"), "dubins": ("hybrid", "waypoints")}  # default first
+# The vehicles that use each vehicle option (by parameter name); the other options apply
+# to every vehicle. An option given for a vehicle not listed is an error, never silently
+# ignored (_check_vehicle_options), and its --help starts with the vehicles listed here.
+TAKEN_BY = {
+    "planner": ("step", "dubins"),
+    "radius": ("dubins",),
+    "start_heading": ("dubins", "lattice"),
+    "goal_heading": ("dubins",),
+    "approach": ("dubins",),
+    "reverse": ("dubins",),
+    "max_expansions": ("dubins",),
+    "targets": ("dubins",),
+    "headings": ("lattice",),
+    "speed": ("lattice",),
+    "turn_rate": ("lattice",),
+    "resolution": ("lattice",),
+    "step": ("dubins", "field"),
+    "escape": ("field",),
+    "sensor_range": ("field",),
+    "sensor_rays": ("field",),
+    "field_mode": ("field",),
+    "max_turn": ("field",),
+}
 EXIT_NOT_REACHED = 1
 
 
+def _for(option: str, text: str) -> str:
+    """``option``'s help led by the vehicles that take it: ``"dubins: turning radius."``."""
+    return f"{', '.join(TAKEN_BY[option])}: {text}"
+
+
 def fly_command(
+    ctx: typer.Context,
     world_file: wa.WorldFile,
     start: wa.StartPoint,
     goal: Annotated[str | None, typer.Option(
         "--goal", help="Same form as --start; required unless --targets is given.")] = None,
-    vehicle: Annotated[str, typer.Option(help="step, dubins, lattice or field.")] = "step",
+    vehicle: Annotated[str, typer.Option(
+        help="step, dubins, lattice or field. An option whose help starts with vehicle "
+             "names is for those vehicles alone: given with another, it is an error.")] = \
+        "step",
     frame: wa.Frame = None,
     altitude: wa.Altitude = None,
     safety: wa.Safety = 0.0,
     boundary: wa.Boundary = None,
-    planner: Annotated[str | None, typer.Option(
-        help="step: moves (fewest moves, A*; default) or follow (round a Theta* path); "
-             "dubins: hybrid (Hybrid A* among the obstacles; default) or waypoints (Dubins "
-             "curves through the exact route's corners, which may cut them: reports "
-             "free).")] = None,
-    radius: Annotated[float, typer.Option(help="dubins: turning radius.")] = 10.0,
-    start_heading: Annotated[float | None, typer.Option(
-        help="dubins / lattice: start heading, degrees in the frame's convention "
-             "(clockwise from north in lonlat and ned; anticlockwise from east in enu and "
-             "degrees); or give it as --start A,B,HEADING. dubins: free when left out; "
-             "lattice: 0.")] = None,
-    goal_heading: Annotated[float | None, typer.Option(
-        help="dubins: heading at the goal (degrees), or --goal A,B,HEADING; free when left "
-             "out.")] = None,
-    approach: Annotated[float | None, typer.Option(
-        help="dubins: the goal is a runway threshold with its heading; end with a straight "
-             "final approach this long along it.")] = None,
+    planner: Annotated[str | None, typer.Option(help=_for(
+        "planner", "for step, moves (fewest moves, A*; the default) or follow (round a "
+                   "Theta* path); for dubins, hybrid (Hybrid A* among the obstacles; the "
+                   "default) or waypoints (Dubins curves through the exact route's "
+                   "corners, which may cut them: reports free)."))] = None,
+    radius: Annotated[float, typer.Option(help=_for("radius", "turning radius."))] = 10.0,
+    start_heading: Annotated[float | None, typer.Option(help=_for(
+        "start_heading", "start heading, degrees in the frame's convention (clockwise from "
+                         "north in lonlat and ned; anticlockwise from east in enu and "
+                         "degrees); or give it as --start A,B,HEADING. dubins: free when "
+                         "left out; lattice: 0."))] = None,
+    goal_heading: Annotated[float | None, typer.Option(help=_for(
+        "goal_heading", "heading at the goal (degrees), or --goal A,B,HEADING; free when "
+                        "left out."))] = None,
+    approach: Annotated[float | None, typer.Option(help=_for(
+        "approach", "the goal is a runway threshold with its heading; end with a straight "
+                    "final approach this long along it."))] = None,
     reverse: Annotated[bool, typer.Option(
-        "--reverse", help="dubins: the vehicle may also drive backwards (a car).")] = False,
-    max_expansions: Annotated[int | None, typer.Option(
-        help="dubins: Hybrid A*'s expansion budget (status budget_exhausted).")] = None,
-    targets: Annotated[Path | None, typer.Option(
-        help="dubins: visit these targets (a .csv or .json of A,B points in --frame) in the "
-             "shortest order from START; GOAL is not used.")] = None,
-    headings: Annotated[int, typer.Option(help="lattice: 8 or 16 headings.")] = 8,
-    speed: Annotated[float, typer.Option(help="lattice: metres (plane units) per second.")] =
-        1.0,
-    turn_rate: Annotated[float, typer.Option(help="lattice: degrees per second.")] = 90.0,
-    resolution: Annotated[float | None, typer.Option(help="lattice: cell size.")] = None,
-    step: Annotated[float, typer.Option(help="dubins: sampling step; field: move length.")] =
-        1.0,
-    escape: Annotated[bool, typer.Option(
-        help="field: follow a navigation function out of local minima.")] = True,
-    sensor_range: Annotated[float, typer.Option(help="field: sensor range.")] = 6.0,
-    sensor_rays: Annotated[int, typer.Option(help="field: sensor rays (density).")] = 36,
-    field_mode: Annotated[str, typer.Option(
-        help="field: step (jump along the force) or arc (turn-limited arcs, slower in "
-             "turns).")] = "step",
-    max_turn: Annotated[float, typer.Option(
-        help="field arc mode: largest heading change per move, degrees.")] = 45.0,
+        "--reverse", help=_for("reverse", "the vehicle may also drive backwards (a "
+                                          "car)."))] = False,
+    max_expansions: Annotated[int | None, typer.Option(help=_for(
+        "max_expansions", "Hybrid A*'s expansion budget (status budget_exhausted)."))] = None,
+    targets: Annotated[Path | None, typer.Option(help=_for(
+        "targets", "visit these targets (a .csv or .json of A,B points in --frame) in the "
+                   "shortest order from START; GOAL is not used."))] = None,
+    headings: Annotated[int, typer.Option(help=_for("headings", "8 or 16 headings."))] = 8,
+    speed: Annotated[float, typer.Option(help=_for(
+        "speed", "metres (plane units) per second."))] = 1.0,
+    turn_rate: Annotated[float, typer.Option(help=_for(
+        "turn_rate", "degrees per second."))] = 90.0,
+    resolution: Annotated[float | None, typer.Option(help=_for(
+        "resolution", "cell size."))] = None,
+    step: Annotated[float, typer.Option(help=_for(
+        "step", "sampling step (dubins) or move length (field)."))] = 1.0,
+    escape: Annotated[bool, typer.Option(help=_for(
+        "escape", "follow a navigation function out of local minima."))] = True,
+    sensor_range: Annotated[float, typer.Option(help=_for(
+        "sensor_range", "sensor range."))] = 6.0,
+    sensor_rays: Annotated[int, typer.Option(help=_for(
+        "sensor_rays", "sensor rays (density)."))] = 36,
+    field_mode: Annotated[str, typer.Option(help=_for(
+        "field_mode", "step (jump along the force) or arc (turn-limited arcs, slower in "
+                      "turns)."))] = "step",
+    max_turn: Annotated[float, typer.Option(help=_for(
+        "max_turn", "in arc mode, the largest heading change per move, degrees."))] = 45.0,
     out: Annotated[Path | None, typer.Option(help="Write moves or samples (.json, .csv, "
                                              ".geojson).")] = None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG map of the flight.")] = None,
@@ -91,19 +128,16 @@ def fly_command(
     its moves as ILP rows (from_lon, from_lat, angle, to_lon, to_lat).
     """
     check_choice("vehicle", vehicle, VEHICLES)
+    _check_vehicle_options(ctx, vehicle)
     if vehicle in PLANNERS:
         planner = planner or PLANNERS[vehicle][0]
         check_choice("planner", planner, PLANNERS[vehicle])
-    elif planner is not None:
-        raise OptionError(f"--planner {planner!r}: --vehicle {vehicle} has no planner choice")
     if out is not None and out.suffix.lower() not in (".json", ".csv", ".geojson"):
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
     if not (math.isfinite(radius) and radius > 0):
         raise OptionError(f"--radius {radius!r} must be a number > 0")
     if not 0 < max_turn <= 180:  # degrees here; the library's check speaks radians
         raise OptionError(f"--max-turn {max_turn!r} must be in (0, 180] degrees")
-    if targets is not None and vehicle != "dubins":
-        raise OptionError("--targets: tours are flown by --vehicle dubins")
     if goal is None and targets is None:
         raise OptionError("give --goal A,B (or --targets FILE with --vehicle dubins)")
     frame = wa.frame_of(frame)
@@ -111,6 +145,8 @@ def fly_command(
     # With --targets the goal is not used; when given it is still checked as a point.
     *b, h1 = wa.parse_pose(goal, "--goal", wa.point_names(frame)) if goal is not None \
         else (math.nan, math.nan, None)
+    _check_typed_heading(h0, start, "start", vehicle)
+    _check_typed_heading(h1, goal, "goal", vehicle)
     h0 = _one_heading(h0, start_heading, "start")
     h1 = _one_heading(h1, goal_heading, "goal")
     world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
@@ -160,6 +196,35 @@ def fly_command(
         Console().print(table)
     if not doc["reached"]:
         raise typer.Exit(EXIT_NOT_REACHED)
+
+
+def _check_vehicle_options(ctx: typer.Context, vehicle: str) -> None:
+    """An OptionError naming every option given on the command line (not left at its
+    default) that ``vehicle`` does not use, with the vehicles that do (TAKEN_BY)."""
+    stray = []
+    for param in ctx.command.params:
+        takers = TAKEN_BY.get(param.name)
+        if takers is None or vehicle in takers:
+            continue
+        # by name: Typer's vendored click has its own ParameterSource enum
+        source = ctx.get_parameter_source(param.name)
+        if source is None or source.name in ("DEFAULT", "DEFAULT_MAP"):
+            continue
+        value = ctx.params.get(param.name)
+        flag = param.secondary_opts[0] if value is False and param.secondary_opts \
+            else param.opts[0]  # --no-escape as typed
+        stray.append(f"{flag} (for {' and '.join(takers)})")
+    if stray:
+        raise OptionError(f"--vehicle {vehicle} does not use {' or '.join(stray)}")
+
+
+def _check_typed_heading(heading: float | None, text: str, what: str, vehicle: str) -> None:
+    """An OptionError when ``--start``/``--goal`` carries a heading ``vehicle`` does not
+    use (the heading options' TAKEN_BY)."""
+    takers = TAKEN_BY[f"{what}_heading"]
+    if heading is not None and vehicle not in takers:
+        raise OptionError(f"--{what} {text!r}: --vehicle {vehicle} does not use a {what} "
+                          f"heading (for {' and '.join(takers)})")
 
 
 def _one_heading(typed: float | None, option: float | None, what: str) -> float | None:

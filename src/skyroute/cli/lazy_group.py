@@ -14,21 +14,21 @@ from collections.abc import Callable, Iterator, MutableMapping
 
 import typer
 import typer.main
-from typer.core import TyperGroup
+from typer.core import TyperArgument, TyperGroup
 
 # A loader returns a command function or a Typer sub-application.
 Loader = Callable[[], Callable | typer.Typer]
 
 
 def to_click(name: str, obj: Callable | typer.Typer):
-    """The click command Typer would build for ``obj`` registered as ``name``, its help
-    paragraphs unwrapped (:func:`unwrap`)."""
+    """The click command Typer would build for ``obj`` registered as ``name``, tidied
+    (:func:`tidied`)."""
     host = typer.Typer(add_completion=False)
     if isinstance(obj, typer.Typer):
         host.add_typer(obj, name=name)
-        return _unwrapped(typer.main.get_command(host).commands[name])
+        return tidied(typer.main.get_command(host).commands[name])
     host.command(name)(obj)
-    return _unwrapped(typer.main.get_command(host))
+    return tidied(typer.main.get_command(host))
 
 
 def unwrap(text: str | None) -> str | None:
@@ -43,11 +43,28 @@ def unwrap(text: str | None) -> str | None:
                        for p in paragraphs)
 
 
-def _unwrapped(command):
-    """``command`` and its subcommands with their help unwrapped, in place."""
+class PlainArgument(TyperArgument):
+    """A positional argument whose usage line shows its metavar as written (``skyroute
+    fly [OPTIONS] WORLD``): Typer 0.28 writes a required one in braces, ``{WORLD}``."""
+
+    def make_metavar(self, ctx, *, usage: bool = False) -> str:
+        if usage and self.required:
+            var = self.metavar or (self.name or "").upper()
+            return var if self.nargs == 1 else f"{var}..."
+        return super().make_metavar(ctx, usage=usage)
+
+
+def tidied(command):
+    """``command`` and its subcommands, in place, as ``--help`` should show them: help
+    paragraphs unwrapped (:func:`unwrap`), arguments named without braces
+    (:class:`PlainArgument`). Every command of the group passes here, however it was
+    added (:class:`LazyCommands`)."""
     command.help = unwrap(command.help)
+    for param in command.params:
+        if type(param) is TyperArgument:
+            param.__class__ = PlainArgument  # the same object, one method overridden
     for sub in getattr(command, "commands", {}).values():
-        _unwrapped(sub)
+        tidied(sub)
     return command
 
 
@@ -56,7 +73,7 @@ class LazyCommands(MutableMapping):
     the ones built already; in that order, whatever has been built since."""
 
     def __init__(self, built: MutableMapping, loaders: dict[str, Loader]):
-        self._built = dict(built)
+        self._built = {name: tidied(command) for name, command in built.items()}
         self._loaders = {k: v for k, v in loaders.items() if k not in built}
         self._order = [*self._loaders, *self._built]
 
@@ -69,7 +86,7 @@ class LazyCommands(MutableMapping):
         if name not in self._order:
             self._order.append(name)
         self._loaders.pop(name, None)
-        self._built[name] = command
+        self._built[name] = tidied(command)
 
     def __delitem__(self, name):
         if self._loaders.pop(name, None) is None:

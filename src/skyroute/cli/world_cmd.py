@@ -103,7 +103,8 @@ def world_result_doc(world, result) -> dict:
 
 
 def synth_city_command(
-    out: Annotated[Path, typer.Argument(help="The colliders.csv file to write.")],
+    out: Annotated[Path, typer.Argument(metavar="OUT",
+                                        help="The colliders.csv file to write.")],
     seed: Annotated[int, typer.Option(min=0, help="Random seed.")] = 0,
     blocks: Annotated[int, typer.Option(help="Blocks along each side.")] = 6,
 ) -> None:

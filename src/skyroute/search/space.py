@@ -51,17 +51,25 @@ class SearchSpace:
 
         Two pairs of plain ints on free cells, the common case, are checked inline: on a
         small map each microsecond is a tenth of a query. Anything else goes through
-        :func:`~skyroute.world.grid.check_cell` for its message."""
+        :func:`~skyroute.world.grid.check_cell` for its message. Only sequences match
+        the patterns: a mapping or a set, unpacked, gave its keys or members as (x, y) in
+        no order. The type test is on the two flat indices, not the four coordinates:
+        they come out ints only from ints (bools too, which check_cell takes), and
+        coordinates that are no numbers fail the comparisons; together, no slower than
+        the four tests were."""
         w, h, Wp, blk = self.width, self.height, self.Wp, self._blocked_bytes
-        try:
-            (x, y), (u, v) = start, goal
-        except (TypeError, ValueError):
-            x = None
-        if type(x) is int and type(y) is int and type(u) is int and type(v) is int \
-                and 0 <= x < w and 0 <= y < h and 0 <= u < w and 0 <= v < h:
-            s, t = (y + 1) * Wp + x + 1, (v + 1) * Wp + u + 1
-            if not blk[s] and not blk[t]:
-                return s, t
+        match start:
+            case (x, y):
+                match goal:
+                    case (u, v):
+                        try:
+                            if 0 <= x < w and 0 <= y < h and 0 <= u < w and 0 <= v < h:
+                                s, t = (y + 1) * Wp + x + 1, (v + 1) * Wp + u + 1
+                                if type(s) is int and type(t) is int and not blk[s] \
+                                        and not blk[t]:
+                                    return s, t
+                        except Exception:  # an array, a NaN Decimal, ...: check_cell
+                            pass           # names it
         grid = self._grid()
         return self.index(check_cell(grid, start, "start")), \
             self.index(check_cell(grid, goal, "goal"))

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import operator
 import warnings
+from collections.abc import Mapping, Set
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -132,7 +133,12 @@ class Grid:
 
 
 def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
-    """(x, y) as ints, on the grid and free; else QueryError naming ``what``."""
+    """(x, y) as ints, on the grid and free; else QueryError naming ``what``. A mapping
+    or a set is refused (unpacking it gives its keys or members, in no (x, y) order), and
+    bytes (b"\\x01\\x02" unpacks to two ints)."""
+    if isinstance(cell, Mapping | Set | bytes | bytearray):
+        raise QueryError(f"{what} {cell!r} must be two integers (x, y), not a "
+                         f"{type(cell).__name__}")
     try:
         x, y = cell  # type: ignore[misc]
         x, y = operator.index(x), operator.index(y)
