@@ -124,8 +124,10 @@ def test_field_reports_length_like_the_other_vehicles(monkeypatch, capsys, city)
     (["--vehicle", "field", "--step", "0"], "--step 0.0 must be > 0"),
     (["--vehicle", "field", "--sensor-range", "0"], "--sensor-range 0.0 must be > 0"),
     (["--vehicle", "field", "--sensor-rays", "3"], "--sensor-rays 3 must be >= 4"),
-    (["--vehicle", "field", "--max-turn", "0"], "--max-turn 0.0 must be in (0, 180] degrees"),
-    (["--vehicle", "field", "--max-turn", "200"], "--max-turn 200.0 must be in (0, 180]"),
+    (["--vehicle", "field", "--field-mode", "arc", "--max-turn", "0"],
+     "--max-turn 0.0 must be in (0, 180] degrees"),
+    (["--vehicle", "field", "--field-mode", "arc", "--max-turn", "200"],
+     "--max-turn 200.0 must be in (0, 180]"),
 ])
 def test_each_vehicle_option_is_named_alone(monkeypatch, capsys, city, args, words):
     # these were one message naming every option at once, in the library's units
@@ -169,6 +171,35 @@ def test_an_option_the_vehicle_does_not_use_is_an_error(monkeypatch, capsys, tmp
     code, text, err = run(monkeypatch, capsys, *NED, *args, "--out", str(out))
     assert code == 2 and err == f"skyroute: error: {words}\n" and text == ""
     assert not out.exists()
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--vehicle", "field", "--max-turn", "30"], "--field-mode step does not use --max-turn"),
+    (["--vehicle", "dubins", "--planner", "waypoints", "--reverse", "--approach", "5"],
+     "--planner waypoints does not use --approach or --reverse"),
+    (["--vehicle", "dubins", "--planner", "waypoints", "--max-expansions", "9"],
+     "--planner waypoints does not use --max-expansions"),
+    (["--vehicle", "dubins", "--targets", "t.csv", "--planner", "hybrid", "--goal-heading",
+      "90"], "--targets does not use --planner or --goal-heading"),
+    (["--vehicle", "field", "--field-mode", "arcs"], "--field-mode 'arcs' is not valid"),
+])
+def test_an_option_the_mode_does_not_use_is_an_error(monkeypatch, capsys, tmp_path, args,
+                                                     words):
+    # e.g. --max-turn without --field-mode arc, or --reverse with --planner waypoints, was
+    # silently ignored
+    out = tmp_path / "t.json"
+    code, text, err = run(monkeypatch, capsys, *NED, *args, "--out", str(out))
+    assert code == 2 and err.startswith(f"skyroute: error: {words}") and text == "", err
+    assert err.count("\n") == 1 and not out.exists()
+
+
+def test_each_mode_table_entry_names_options_its_vehicle_takes():
+    from skyroute.cli.fly_cmd import MODE_FLAG, TAKEN_BY, UNUSED_IN_MODE
+
+    for (vehicle, mode), names in UNUSED_IN_MODE.items():
+        assert mode in MODE_FLAG
+        for name in names:
+            assert vehicle in TAKEN_BY[name], (vehicle, mode, name)
 
 
 @pytest.mark.parametrize("args, words", [

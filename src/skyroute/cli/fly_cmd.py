@@ -48,6 +48,16 @@ TAKEN_BY = {
     "field_mode": ("field",),
     "max_turn": ("field",),
 }
+# Options a vehicle takes but one of its modes does not (mode: the dubins vehicle's
+# --planner, or "targets" with --targets; the field's --field-mode): also errors when
+# given (_check_mode_options).
+UNUSED_IN_MODE = {
+    ("dubins", "targets"): ("planner", "goal_heading", "approach", "reverse"),
+    ("dubins", "waypoints"): ("approach", "reverse", "max_expansions"),
+    ("field", "step"): ("max_turn",),
+}
+MODE_FLAG = {"targets": "--targets", "waypoints": "--planner waypoints",
+             "step": "--field-mode step"}
 EXIT_NOT_REACHED = 1
 
 
@@ -132,6 +142,10 @@ def fly_command(
     if vehicle in PLANNERS:
         planner = planner or PLANNERS[vehicle][0]
         check_choice("planner", planner, PLANNERS[vehicle])
+    check_choice("field_mode", field_mode, ("step", "arc"))
+    mode = "targets" if vehicle == "dubins" and targets is not None else \
+        field_mode if vehicle == "field" else planner
+    _check_mode_options(ctx, vehicle, mode)
     if out is not None and out.suffix.lower() not in (".json", ".csv", ".geojson"):
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
     if not (math.isfinite(radius) and radius > 0):
@@ -201,10 +215,27 @@ def fly_command(
 def _check_vehicle_options(ctx: typer.Context, vehicle: str) -> None:
     """An OptionError naming every option given on the command line (not left at its
     default) that ``vehicle`` does not use, with the vehicles that do (TAKEN_BY)."""
-    stray = []
+    stray = [f"{flag} (for {' and '.join(TAKEN_BY[name])})"
+             for name, flag in _given(ctx, TAKEN_BY) if vehicle not in TAKEN_BY[name]]
+    if stray:
+        raise OptionError(f"--vehicle {vehicle} does not use {' or '.join(stray)}")
+
+
+def _check_mode_options(ctx: typer.Context, vehicle: str, mode: str | None) -> None:
+    """An OptionError naming every option given on the command line that ``vehicle``
+    takes but ignores in ``mode`` (UNUSED_IN_MODE)."""
+    unused = UNUSED_IN_MODE.get((vehicle, mode), ())
+    stray = [flag for name, flag in _given(ctx, unused)]
+    if stray:
+        raise OptionError(f"{MODE_FLAG[mode]} does not use {' or '.join(stray)}")
+
+
+def _given(ctx: typer.Context, names) -> list[tuple[str, str]]:
+    """(name, flag as typed) of each parameter in ``names`` given on the command line,
+    not left at its default."""
+    given = []
     for param in ctx.command.params:
-        takers = TAKEN_BY.get(param.name)
-        if takers is None or vehicle in takers:
+        if param.name not in names:
             continue
         # by name: Typer's vendored click has its own ParameterSource enum
         source = ctx.get_parameter_source(param.name)
@@ -213,9 +244,8 @@ def _check_vehicle_options(ctx: typer.Context, vehicle: str) -> None:
         value = ctx.params.get(param.name)
         flag = param.secondary_opts[0] if value is False and param.secondary_opts \
             else param.opts[0]  # --no-escape as typed
-        stray.append(f"{flag} (for {' and '.join(takers)})")
-    if stray:
-        raise OptionError(f"--vehicle {vehicle} does not use {' or '.join(stray)}")
+        given.append((param.name, flag))
+    return given
 
 
 def _check_typed_heading(heading: float | None, text: str, what: str, vehicle: str) -> None:
