@@ -144,3 +144,12 @@ def test_negative_seeds_are_one_line_errors(monkeypatch, capsys, tmp_path, args)
 def test_parse_seeds_refuses_negatives():
     with pytest.raises(OptionError, match="negative"):
         parse_seeds("3,-1")
+
+
+def test_bench_fleet_checks_its_json_path_before_running(monkeypatch, capsys, tmp_path):
+    monkeypatch.setattr("skyroute.cli.bench_fleet_cmd.bench_case", _no_run)
+    (tmp_path / "file").write_text("keep me")
+    code, _, err = run(monkeypatch, capsys, "bench", "fleet", "--case", "1", "--json",
+                       str(tmp_path / "file" / "rows.json"))
+    assert code == 2 and "rows.json: cannot write: " in err and "file is not a folder" in err
+    assert len(err.strip().splitlines()) == 1
