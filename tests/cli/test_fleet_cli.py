@@ -153,3 +153,13 @@ def test_bench_fleet_checks_its_json_path_before_running(monkeypatch, capsys, tm
                        str(tmp_path / "file" / "rows.json"))
     assert code == 2 and "rows.json: cannot write: " in err and "file is not a folder" in err
     assert len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--airports", "5", "--drones", "-1"], "--drones -1 must be >= 1"),
+    (["--airports", "1", "--drones", "3"], "--airports 1 must be >= 2"),
+])
+def test_scenario_names_the_bad_option(monkeypatch, capsys, args, words):
+    code, out, err = run(monkeypatch, capsys, "fleet", "scenario", *args)
+    assert code == 2 and out == "" and words in err and len(err.strip().splitlines()) == 1
+    assert "--airports" not in err or "--airports" in words  # --drones was named --airports

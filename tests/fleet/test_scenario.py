@@ -204,3 +204,16 @@ def test_explicit_gates_place_the_taxi_routes_and_round_trip(tmp_path):
     sim = run(s, hours=0.5, seed=2)
     assert sim.flights and all(fl.plan.origin_gate in (0, 1) for fl in sim.flights)
     check_continuous(sim.pieces())
+
+
+@pytest.mark.parametrize("kwargs, param, words", [
+    ({"airports": 3, "drones": -1}, "drones", "drones=-1 must be >= 1"),
+    ({"airports": 1, "drones": 3}, "airports", "airports=1 must be >= 2"),
+    ({"airports": 3, "drones": 3, "area_km": 0}, "area_km", "area_km=0 must be > 0"),
+])
+def test_generate_names_the_one_bad_argument(kwargs, param, words):
+    from skyroute.errors import OptionError
+
+    with pytest.raises(OptionError) as info:
+        sc.generate(**kwargs)
+    assert info.value.param == param and words in str(info.value)

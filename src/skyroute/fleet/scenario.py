@@ -241,9 +241,13 @@ def generate(airports: int, drones: int, *, area_km: float = 8.0, seed: int = 0,
              rate_per_hour: float | None = None) -> Scenario:
     """A valid scenario: ``airports`` spread over an ``area_km`` square (at least 1.5
     runways apart), runway headings seeded, ``drones`` drones."""
-    if airports < 2 or drones < 1 or not area_km > 0:
-        raise OptionError(f"airports={airports} must be >= 2, drones={drones} >= 1 and "
-                          f"area_km={area_km} > 0", param="airports")
+    # each argument named alone: a bad drone count was reported as airports=
+    if airports < 2:
+        raise OptionError(f"airports={airports} must be >= 2", param="airports")
+    if drones < 1:
+        raise OptionError(f"drones={drones} must be >= 1", param="drones")
+    if not area_km > 0:
+        raise OptionError(f"area_km={area_km} must be > 0", param="area_km")
     rng = np.random.default_rng(seed)
     size = area_km * 1000.0
     spacing = 900.0
