@@ -210,6 +210,9 @@ def test_scenario_names_the_bad_option(monkeypatch, capsys, args, words):
 
 
 @pytest.mark.parametrize("args, words", [
+    (["--seeds", "0-999999999"], "--seeds '0-999999999': 0-999999999 is 1,000,000,000 "
+                                 "seeds, over the limit of 1,000"),
+    (["--seeds", "0-500,1000-1999"], "over the limit of 1,000"),
     (["--rates", "30,1e12"], "--rates '30,1e12': 1e+12 is over the limit of 100,000"),
     (["--rates", "1e5", "--hours", "4"], "--rates 100000 with --hours 4 would spawn about "
                                          "4e+05 packages"),
@@ -219,6 +222,14 @@ def test_sweep_refuses_huge_values_before_running(monkeypatch, capsys, args, wor
     monkeypatch.setattr("skyroute.jobs.fleet.sweep", _no_run)
     code, out, err = run(monkeypatch, capsys, "fleet", "sweep", "--preset", "seed-3x3", *args)
     assert code == 2 and out == "" and words in err and len(err.strip().splitlines()) == 1
+
+
+def test_parse_seeds_refuses_a_long_range_before_making_it():
+    assert parse_seeds("0-999") == list(range(1000))
+    with pytest.raises(OptionError, match="over the limit of 1,000"):
+        parse_seeds("5-1005")
+    with pytest.raises(OptionError, match="1,000,000,000,000 seeds"):
+        parse_seeds("1-1000000000000")
 
 
 def test_bench_fleet_checks_its_json_path_before_running(monkeypatch, capsys, tmp_path):

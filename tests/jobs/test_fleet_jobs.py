@@ -104,6 +104,7 @@ def test_bad_fleet_params_name_the_field(params, words):
 
 
 @pytest.mark.parametrize("params, words", [
+    ({"seeds": list(range(1001))}, "seeds: 1,001 seeds is over the limit of 1,000"),
     ({"rates": [1e5], "hours": 4}, "rate_per_hour=100000 with hours=4 would spawn about 4e+05"),
     ({"hours": 1e9}, "hours=1e+09 is over the limit"),
 ])

@@ -19,6 +19,7 @@ from skyroute.fleet.limits import (
     MAX_HOURS,
     MAX_PACKAGES,
     MAX_RATE,
+    MAX_SEEDS,
     MAX_TRACK_ROWS,
     expected_packages,
     track_rows,
@@ -238,23 +239,30 @@ def scenario_command(
 def parse_seeds(text: str) -> list[int]:
     """``"0-29"``, ``"1,4,7"`` or a mix -> the seeds, in order, no repeats."""
     out: list[int] = []
-    try:
-        for part in (p.strip() for p in text.split(",") if p.strip()):
+    for part in (p.strip() for p in text.split(",") if p.strip()):
+        try:
             if "-" in part[1:]:
                 a, b = part.split("-", 1) if not part.startswith("-") else (part, "")
                 lo, hi = int(a), int(b)
                 if hi < lo:
                     raise ValueError
-                out += range(lo, hi + 1)
             else:
-                out.append(int(part))
-    except ValueError:
-        raise OptionError(f"--seeds {text!r}: expected seeds like 0-29 or 1,4,7") from None
+                lo = hi = int(part)
+        except ValueError:
+            raise OptionError(f"--seeds {text!r}: expected seeds like 0-29 or 1,4,7") from None
+        if hi - lo >= MAX_SEEDS:  # before the list is made: 0-999999999 filled memory
+            raise OptionError(f"--seeds {text!r}: {part} is {hi - lo + 1:,} seeds, over the "
+                              f"limit of {MAX_SEEDS:,}")
+        out += range(lo, hi + 1)
     if not out:
         raise OptionError(f"--seeds {text!r}: no seed given")
     if min(out) < 0:
         raise OptionError(f"--seeds {text!r}: seed {min(out)} is negative; seeds are >= 0")
-    return list(dict.fromkeys(out))
+    seeds = list(dict.fromkeys(out))
+    if len(seeds) > MAX_SEEDS:
+        raise OptionError(f"--seeds {text!r}: {len(seeds):,} seeds, over the limit of "
+                          f"{MAX_SEEDS:,}")
+    return seeds
 
 
 def _choices(text: str, option: str, valid: tuple[str, ...]) -> list[str]:

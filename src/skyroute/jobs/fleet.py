@@ -21,7 +21,7 @@ import sqlalchemy as sa
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.fleet.airspace import MODES
 from skyroute.fleet.dispatch import SCHEDULERS
-from skyroute.fleet.limits import check_run
+from skyroute.fleet.limits import MAX_SEEDS, check_run
 from skyroute.fleet.report import report
 from skyroute.fleet.scenario import Scenario, parse_scenario, preset
 from skyroute.fleet.simulate import run
@@ -230,6 +230,9 @@ def check_sweep_params(params: dict) -> dict:
     seeds = params.get("seeds", list(range(10)))
     if not isinstance(seeds, list | tuple) or not seeds:
         raise OptionError(f"seeds={seeds!r} must be a non-empty list", param="seeds")
+    if len(seeds) > MAX_SEEDS:
+        raise OptionError(f"seeds: {len(seeds):,} seeds is over the limit of {MAX_SEEDS:,}",
+                          param="seeds")
     out["seeds"] = list(dict.fromkeys(
         _number({"seeds": x}, "seeds", None, low=0, strict=False, integer=True)
         for x in seeds))
