@@ -239,3 +239,10 @@ def test_bench_fleet_checks_its_json_path_before_running(monkeypatch, capsys, tm
                        str(tmp_path / "file" / "rows.json"))
     assert code == 2 and "rows.json: cannot write: " in err and "file is not a folder" in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_a_flight_too_long_to_sample_is_one_line(monkeypatch, capsys, tmp_path):
+    path = _scenario_file(tmp_path, lambda d: d["drone"].update(turn_radius=1e12))
+    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", path, "--hours", "0.1")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert "would be airborne up to 4.54e+08 h with its loiters, over the limit of 12 h" in err

@@ -28,6 +28,7 @@ MAX_HOURS = 24.0 * 7  # simulated hours: a week
 MAX_PACKAGES = 1e5  # packages a run is expected to spawn (rate x hours): 7x the largest
 MAX_TRACK_ROWS = 2e7  # tracks.csv rows (drones x seconds / step): 0.85 GB, 3 GB of memory
 MAX_SEEDS = 1000  # seeds in one sweep (the documented sweeps use 30)
+MAX_FLIGHT_HOURS = 12.0  # airborne time of one flight, its loiters included
 
 
 def expected_packages(rate_per_hour: float, hours: float) -> float:
