@@ -79,5 +79,9 @@ def test_check_writable_fails_where_writing_would(tmp_path):
         check_writable(tmp_path / "afile" / "r.json")
     with pytest.raises(SkyrouteError, match="cannot write: it is a folder"):
         check_writable(tmp_path)
-    out = check_writable(tmp_path / "new" / "r.json")
-    assert out.parent.is_dir() and list(out.parent.iterdir()) == []  # nothing left behind
+    assert check_writable(tmp_path / "new" / "deeper" / "r.json").name == "r.json"
+    assert sorted(tmp_path.iterdir()) == [tmp_path / "afile"]  # no folder, no file left
+    (tmp_path / "ro").mkdir(mode=0o500)
+    if not os.access(tmp_path / "ro", os.W_OK):  # (root may write anywhere)
+        with pytest.raises(SkyrouteError, match=r"ro/new/r.json: cannot write: Permission"):
+            check_writable(tmp_path / "ro" / "new" / "r.json")

@@ -63,12 +63,17 @@ def as_path(value: object, param: str) -> Path:
 
 def check_writable(path: str | Path) -> Path:
     """Fail now where :func:`open_atomic` would fail at the end of a long run: ``path``
-    a folder, a file where a folder must be, no permission. Creates missing parent
-    folders (as writing would) and leaves no file behind."""
+    a folder, a file where a folder must be, no permission. Leaves nothing behind, no
+    file and no folder: missing parent folders are made by the write, and their nearest
+    existing one is tried instead (a command that failed after the check left an empty
+    ``--out`` folder it had made)."""
     path = Path(path)
     if path.is_dir():
         raise SkyrouteError(f"{path}: cannot write: it is a folder")
-    fd, tmp = _temp_beside(path)
+    here = next(p for p in path.parents if os.path.lexists(p))
+    if not here.is_dir():  # a file, or a link to nothing, where a folder must be
+        raise SkyrouteError(f"{path}: cannot write: {here} is not a folder")
+    fd, tmp = _temp_in(here, path)
     os.close(fd)
     os.unlink(tmp)
     return path
@@ -78,9 +83,18 @@ def _temp_beside(path: Path) -> tuple[int, str]:
     """A new temporary file in ``path``'s folder (made if missing): (fd, its path)."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        return tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     except (FileExistsError, NotADirectoryError):  # a file where a folder must be
         blocker = next(p for p in path.parents if os.path.lexists(p))
         raise SkyrouteError(f"{path}: cannot write: {blocker} is not a folder") from None
+    except OSError as exc:
+        raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    return _temp_in(path.parent, path)
+
+
+def _temp_in(folder: Path, path: Path) -> tuple[int, str]:
+    """A new temporary file for ``path`` in ``folder`` (which exists): (fd, its path); a
+    failure is a SkyrouteError naming ``path``."""
+    try:
+        return tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
     except OSError as exc:
         raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None

@@ -53,3 +53,16 @@ def test_bench_jobs_bad_options_are_one_line(monkeypatch, capsys, tmp_path, flag
                        value, "--json", str(out))
     assert code == 2 and f"{flag} {value!r}" in err and "Traceback" not in err
     assert not out.exists()
+
+
+def _no_bench(*_args, **_kwargs):
+    raise AssertionError("the days were timed before the --json path was checked")
+
+
+def test_bench_jobs_checks_its_json_path_before_running(monkeypatch, capsys, tmp_path):
+    monkeypatch.setattr("skyroute.bench.jobs.bench_jobs", _no_bench)
+    (tmp_path / "file").write_text("keep me")
+    code, _, err = run(monkeypatch, capsys, "bench", "jobs", "--data", str(EXAMPLE),
+                       "--runs", "local:1", "--json", str(tmp_path / "file" / "jobs.json"))
+    assert code == 2 and "jobs.json: cannot write: " in err and "file is not a folder" in err
+    assert len(err.strip().splitlines()) == 1

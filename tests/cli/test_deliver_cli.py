@@ -145,6 +145,17 @@ def test_out_that_cannot_be_made_fails_before_storing(monkeypatch, capsys, tmp_p
     assert not any(_stored_rows(tmp_path / "o.db").values())
 
 
+@pytest.mark.parametrize("data", ["missing", "empty"])
+def test_a_failed_deliver_leaves_no_out_folder_behind(monkeypatch, capsys, tmp_path, data):
+    (tmp_path / "empty").mkdir()
+    out = tmp_path / "new" / "out"
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data",
+                       str(tmp_path / data), "--db", f"sqlite:///{tmp_path / 'o.db'}",
+                       "--out", str(out))
+    assert code == 2 and data in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "new").exists()  # the check made it, the failure left it
+
+
 def test_bad_out_leaves_earlier_runs_stored(monkeypatch, capsys, tmp_path, fly_once):
     db = tmp_path / "k.db"
     code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", EXAMPLE,

@@ -144,3 +144,105 @@ def test_negative_seeds_are_one_line_errors(monkeypatch, capsys, tmp_path, args)
 def test_parse_seeds_refuses_negatives():
     with pytest.raises(OptionError, match="negative"):
         parse_seeds("3,-1")
+
+
+def _scenario_file(tmp_path, edit) -> str:
+    from skyroute.fleet.scenario import preset
+
+    data = preset("seed-3x3").model_dump()
+    edit(data)
+    p = tmp_path / "big.yaml"
+    p.write_text(yaml.safe_dump(data, sort_keys=False))
+    return str(p)
+
+
+@pytest.mark.parametrize("args, words", [
+    # a scenario file past a limit: named by file and field
+    (["{drones}"], "big.yaml: drones: 1e+09 drones is over the limit of 1,000"),
+    (["{rate}"], "big.yaml: packages.rate_per_hour: 1e+12 packages per hour is over the "
+                 "limit of 100,000"),
+    (["{far}"], "big.yaml: airports[2].north: 1e+12 m from home is over the limit of "
+                "100,000 m"),
+    # options past a limit
+    (["--preset", "seed-3x3", "--hours", "1e9"], "--hours 1e+09 is over the limit of 168"),
+    (["--preset", "seed-3x3", "--rate", "1e12"], "--rate 1e+12 is over the limit of 100,000"),
+    (["--preset", "seed-3x3", "--drones", "1000000000"], "--drones 1000000000 must be 1 to "
+                                                         "1,000"),
+    (["--airports", "101", "--drones", "3"], "--airports 101 must be 2 to 100"),
+    (["--airports", "3", "--drones", "3", "--area-km", "1e12"], "--area-km 1e+12 must be"),
+    # the work they multiply to
+    (["--preset", "seed-3x3", "--rate", "1e5", "--hours", "8"],
+     "--rate 100000 with --hours 8 would spawn about 8e+05 packages (limit 100,000); lower "
+     "--hours or --rate"),
+    (["{busy}", "--hours", "24"],
+     "--hours 24 at the scenario's 10000 packages/h would spawn about 2.4e+05 packages"),
+    (["--preset", "seed-3x3", "--hours", "8", "--track-step", "1e-6", "--out", "{tmp}/o"],
+     "--track-step 1e-06 with --hours 8 and 3 drones would write up to 8.6e+10 track rows "
+     "(limit 20,000,000); raise --track-step"),
+])
+def test_huge_values_are_refused_before_simulating(monkeypatch, capsys, tmp_path, args,
+                                                   words):
+    monkeypatch.setattr("skyroute.fleet.simulate.run", _no_run)
+    files = {"drones": lambda d: d.update(drones=10**9),
+             "rate": lambda d: d["packages"].update(rate_per_hour=1e12),
+             "far": lambda d: d["airports"][2].update(north=1e12),
+             "busy": lambda d: d["packages"].update(rate_per_hour=1e4)}
+    names = {}
+    for k, edit in files.items():
+        (tmp_path / k).mkdir()
+        names[k] = _scenario_file(tmp_path / k, edit)
+    args = [a.format(tmp=tmp_path, **names) for a in args]
+    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", *args)
+    assert code == 2 and out == "" and words in err, err
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--airports", "5", "--drones", "-1"], "--drones -1 must be 1 to 1,000"),
+    (["--airports", "5", "--drones", "1001"], "--drones 1001 must be 1 to 1,000"),
+    (["--airports", "1", "--drones", "3"], "--airports 1 must be 2 to 100"),
+    (["--airports", "3", "--drones", "3", "--rate", "1e12"], "--rate 1e+12 is over the limit"),
+])
+def test_scenario_names_the_bad_option(monkeypatch, capsys, args, words):
+    code, out, err = run(monkeypatch, capsys, "fleet", "scenario", *args)
+    assert code == 2 and out == "" and words in err and len(err.strip().splitlines()) == 1
+    assert "--airports" not in err or "--airports" in words  # --drones was named --airports
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--seeds", "0-999999999"], "--seeds '0-999999999': 0-999999999 is 1,000,000,000 "
+                                 "seeds, over the limit of 1,000"),
+    (["--seeds", "0-500,1000-1999"], "over the limit of 1,000"),
+    (["--rates", "30,1e12"], "--rates '30,1e12': 1e+12 is over the limit of 100,000"),
+    (["--rates", "1e5", "--hours", "4"], "--rates 100000 with --hours 4 would spawn about "
+                                         "4e+05 packages"),
+    (["--hours", "1e9"], "--hours 1e+09 is over the limit of 168"),
+])
+def test_sweep_refuses_huge_values_before_running(monkeypatch, capsys, args, words):
+    monkeypatch.setattr("skyroute.jobs.fleet.sweep", _no_run)
+    code, out, err = run(monkeypatch, capsys, "fleet", "sweep", "--preset", "seed-3x3", *args)
+    assert code == 2 and out == "" and words in err and len(err.strip().splitlines()) == 1
+
+
+def test_parse_seeds_refuses_a_long_range_before_making_it():
+    assert parse_seeds("0-999") == list(range(1000))
+    with pytest.raises(OptionError, match="over the limit of 1,000"):
+        parse_seeds("5-1005")
+    with pytest.raises(OptionError, match="1,000,000,000,000 seeds"):
+        parse_seeds("1-1000000000000")
+
+
+def test_bench_fleet_checks_its_json_path_before_running(monkeypatch, capsys, tmp_path):
+    monkeypatch.setattr("skyroute.cli.bench_fleet_cmd.bench_case", _no_run)
+    (tmp_path / "file").write_text("keep me")
+    code, _, err = run(monkeypatch, capsys, "bench", "fleet", "--case", "1", "--json",
+                       str(tmp_path / "file" / "rows.json"))
+    assert code == 2 and "rows.json: cannot write: " in err and "file is not a folder" in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_a_flight_too_long_to_sample_is_one_line(monkeypatch, capsys, tmp_path):
+    path = _scenario_file(tmp_path, lambda d: d["drone"].update(turn_radius=1e12))
+    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", path, "--hours", "0.1")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert "would be airborne up to 4.54e+08 h with its loiters, over the limit of 12 h" in err

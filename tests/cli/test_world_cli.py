@@ -69,3 +69,15 @@ def test_missing_home_line_is_one_line_exit_2(monkeypatch, capsys, tmp_path):
     code, _, err = run(monkeypatch, capsys, "plan-world", str(bad), "--start=0,0",
                        "--goal=1,1")
     assert code == 2 and f"{bad}:1: expected 'lat0 <deg>, lon0 <deg>'" in err
+
+
+@pytest.mark.parametrize("blocks, words", [
+    ("1000000000", "--blocks 1000000000 must be a whole number from 1 to 100"),
+    ("0", "--blocks 0 must be a whole number from 1 to 100"),
+])
+def test_synth_city_refuses_a_city_too_large_or_empty(monkeypatch, capsys, tmp_path, blocks,
+                                                      words):
+    out = tmp_path / "c.csv"
+    code, text, err = run(monkeypatch, capsys, "synth-city", str(out), "--blocks", blocks)
+    assert code == 2 and text == "" and words in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()

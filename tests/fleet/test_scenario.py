@@ -127,6 +127,16 @@ def _other_beside_first(d: dict) -> None:
     # the layout
     (_other_beside_first, "airports: A and B are 100 m apart, closer than a runway (600 m)"),
     (lambda d: d["airports"][2].update(id="A"), "airports: ids must be unique"),
+    # over the limits of skyroute.fleet.limits (each exhausted memory or ran for hours)
+    (lambda d: d.update(drones=10**9), "drones: 1e+09 drones is over the limit of 1,000"),
+    (lambda d: d["packages"].update(rate_per_hour=1e12),
+     "packages.rate_per_hour: 1e+12 packages per hour is over the limit of 100,000"),
+    (lambda d: d["airports"][2].update(north=1e12),
+     "airports[2].north: 1e+12 m from home is over the limit of 100,000 m"),
+    (lambda d: d.update(no_fly_zones=[{"points": [[0, 0], [0, 1e6], [1e3, 0]]}]),
+     "no_fly_zones[0].points[1][1]: 1e+06 m from home is over the limit of 100,000 m"),
+    (lambda d: d.update(airports=d["airports"] * 34),
+     "airports: 102 airports is over the limit of 100"),
 ])
 def test_bad_scenario_files_give_one_line_naming_the_field(tmp_path, edit, words):
     import yaml
@@ -204,3 +214,42 @@ def test_explicit_gates_place_the_taxi_routes_and_round_trip(tmp_path):
     sim = run(s, hours=0.5, seed=2)
     assert sim.flights and all(fl.plan.origin_gate in (0, 1) for fl in sim.flights)
     check_continuous(sim.pieces())
+
+
+def test_limits_are_inclusive_and_toml_floats_count_as_drones(tmp_path):
+    from skyroute.fleet.limits import MAX_DRONES, MAX_RATE
+
+    data = sc.preset("seed-3x3").model_dump()
+    data.update(drones=MAX_DRONES, packages={"rate_per_hour": MAX_RATE})
+    s = sc.parse_scenario(data)
+    assert s.drones == MAX_DRONES and s.packages.rate_per_hour == MAX_RATE
+    p = tmp_path / "s.toml"
+    p.write_text("drones = 1e9\n" + _toml_airports(data))  # TOML reads 1e9 as a float
+    with pytest.raises(InputFormatError, match=r"s.toml: drones: 1e\+09 drones is over"):
+        sc.load_scenario(p)
+
+
+def _toml_airports(data: dict) -> str:
+    lines = []
+    for a in data["airports"]:
+        lines += ["[[airports]]", f'id = "{a["id"]}"', f"north = {a['north']}",
+                  f"east = {a['east']}",
+                  f"landing = {{heading_deg = {a['landing']['heading_deg']}}}",
+                  f"takeoff = {{heading_deg = {a['takeoff']['heading_deg']}}}"]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize("kwargs, param, words", [
+    ({"airports": 3, "drones": -1}, "drones", "drones=-1 must be 1 to 1,000"),
+    ({"airports": 3, "drones": 1001}, "drones", "drones=1001 must be 1 to 1,000"),
+    ({"airports": 1, "drones": 3}, "airports", "airports=1 must be 2 to 100"),
+    ({"airports": 101, "drones": 3}, "airports", "airports=101 must be 2 to 100"),
+    ({"airports": 3, "drones": 3, "area_km": 1e12}, "area_km", "area_km=1e+12 must be"),
+    ({"airports": 3, "drones": 3, "rate_per_hour": 1e12}, "rate_per_hour", "<= 100,000"),
+])
+def test_generate_names_the_one_bad_argument(kwargs, param, words):
+    from skyroute.errors import OptionError
+
+    with pytest.raises(OptionError) as info:
+        sc.generate(**kwargs)
+    assert info.value.param == param and words in str(info.value)

@@ -415,3 +415,21 @@ def test_reservations_accept_what_is_far_apart_in_space_or_time():
     beside = Trajectory(1, 0.0, (200.0, 0.0, 80.0)).line(60.0, (0.0, 40.0, 0.0)).pieces()
     for b in (above, later, beside):
         assert res.clear(1, *samples(b, 1.0))
+
+
+@pytest.mark.parametrize("edit, words", [
+    (lambda d: d["drone"].update(turn_radius=1e12), "A -> B at 50 m would be airborne up to "
+                                                    "4.54e+08 h"),
+    (lambda d: d["airspace"].update(layer_step=1e9), "C -> A at 2e+09 m would be airborne"),
+    (lambda d: d["drone"].update(cruise_speed=0.001, landing_speed=0.0005),
+     "would be airborne up to 6.09e+03 h"),
+])
+def test_a_flight_airborne_too_long_is_refused_before_it_is_sampled(edit, words):
+    from skyroute.fleet.scenario import Scenario
+    from skyroute.fleet.simulate import SimulationError
+
+    data = preset("seed-3x3").model_dump()
+    edit(data)
+    with pytest.raises(SimulationError, match="over the limit of 12 h") as info:
+        run(Scenario.model_validate(data), hours=0.2, seed=0)
+    assert words in str(info.value)

@@ -87,10 +87,30 @@ def test_fleet_and_sweep_params_are_completed():
     ({"preset": "seed-3x3", "track_step": 0}, "track_step=0 must be a number > 0"),
     ({"preset": "seed-3x3", "scheduler": "fifo"}, "scheduler='fifo' is not valid"),
     ({"preset": "seed-3x3", "drones": 4}, "drones: unknown parameter of a fleet job"),
+    # past skyroute.fleet.limits, as on the command line
+    ({"preset": "seed-3x3", "hours": 1e9}, "hours=1e+09 is over the limit of 168"),
+    ({"preset": "seed-3x3", "rate_per_hour": 1e12}, "rate_per_hour=1e+12 is over the limit"),
+    ({"preset": "seed-3x3", "rate_per_hour": 1e5, "hours": 8},
+     "rate_per_hour=100000 with hours=8 would spawn about 8e+05 packages (limit 100,000)"),
+    ({"preset": "seed-3x3", "hours": 8, "track_step": 1e-6},
+     "track_step=1e-06 with hours=8 and 3 drones would write up to 8.6e+10 track rows"),
 ])
 def test_bad_fleet_params_name_the_field(params, words):
     from skyroute.errors import OptionError
 
     with pytest.raises(OptionError) as err:
         check_fleet_params(params)
+    assert words in str(err.value)
+
+
+@pytest.mark.parametrize("params, words", [
+    ({"seeds": list(range(1001))}, "seeds: 1,001 seeds is over the limit of 1,000"),
+    ({"rates": [1e5], "hours": 4}, "rate_per_hour=100000 with hours=4 would spawn about 4e+05"),
+    ({"hours": 1e9}, "hours=1e+09 is over the limit"),
+])
+def test_bad_sweep_params_past_the_limits(params, words):
+    from skyroute.errors import OptionError
+
+    with pytest.raises(OptionError) as err:
+        check_sweep_params({"preset": "seed-3x3", **params})
     assert words in str(err.value)

@@ -41,3 +41,15 @@ def test_flightpath_load_from_the_cli(monkeypatch, capsys, tmp_path, lunch):
 def test_bad_flags(monkeypatch, capsys, args, words):
     code, _, err = run(monkeypatch, capsys, "bench", "service", *args)
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_the_json_path_is_checked_before_the_load(monkeypatch, capsys, tmp_path):
+    def no_load(*_args, **_kwargs):
+        raise AssertionError("the service was loaded before the --json path was checked")
+
+    monkeypatch.setattr("skyroute.bench.service.bench_plan", no_load)
+    (tmp_path / "file").write_text("keep me")
+    code, _, err = run(monkeypatch, capsys, "bench", "service", "--requests", "10",
+                       "--json", str(tmp_path / "file" / "rows.json"))
+    assert code == 2 and "rows.json: cannot write: " in err and "file is not a folder" in err
+    assert len(err.strip().splitlines()) == 1

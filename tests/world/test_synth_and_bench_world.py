@@ -21,6 +21,16 @@ def test_synth_city_is_seeded_and_home_is_free(tmp_path):
     assert r.found and world.segments_free(r.path[:-1], r.path[1:]).all()
 
 
+@pytest.mark.parametrize("blocks", [0, 101, 10**9, 2.5, True])
+def test_synth_city_blocks_are_limited(blocks):
+    from skyroute.errors import OptionError
+    from skyroute.world.synth import MAX_BLOCKS
+
+    with pytest.raises(OptionError, match=f"must be a whole number from 1 to {MAX_BLOCKS}"):
+        synth_city(np.random.default_rng(0), blocks=blocks)
+    assert synth_city(np.random.default_rng(0), blocks=1).count("\n") >= 4
+
+
 def test_random_rect_worlds_are_seeded():
     a, b = random_rect_world(5), random_rect_world(5)
     assert len(a.obstacles) == 20

@@ -16,7 +16,7 @@ from skyroute.bench.fleet import CASES, bench_case
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.tables import wide_console
 from skyroute.errors import OptionError, check_choice
-from skyroute.files import write_atomic
+from skyroute.files import check_writable, write_atomic
 
 
 @bench_app.command("fleet")
@@ -37,6 +37,8 @@ def bench_fleet(
     for k in chosen:
         if not 1 <= k <= len(CASES):
             raise OptionError(f"--case {k} is not valid; choose 1 to {len(CASES)}")
+    if json_out:  # a bad path fails now, not after the runs
+        check_writable(json_out)
     err = Console(stderr=True)
     rows = []
     with Progress(TextColumn("{task.description}"), BarColumn(), TimeElapsedColumn(),

@@ -15,7 +15,7 @@ from rich.table import Table
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.tables import progress_bar, wide_console
 from skyroute.errors import OptionError
-from skyroute.files import write_atomic
+from skyroute.files import check_writable, write_atomic
 
 
 def _day(text: str, option: str) -> dt.date:
@@ -50,6 +50,8 @@ def bench_jobs_command(
         raise OptionError(f"--to {d1} is before --from {d0}")
     plan = parse_runs(runs)
     counts = parse_counts(simulate)
+    if json_out:  # a bad path fails now, not after the runs
+        check_writable(json_out)
     n_days = (d1 - d0).days + 1
     with progress_bar(Console(stderr=True)) as progress:
         task = progress.add_task("days", total=n_days * len(plan))

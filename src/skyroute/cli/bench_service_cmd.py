@@ -15,7 +15,7 @@ from rich.table import Table
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.tables import wide_console
 from skyroute.errors import OptionError, check_choice
-from skyroute.files import write_atomic
+from skyroute.files import check_writable, write_atomic
 
 LOADS = ("plan", "flightpath")
 
@@ -58,6 +58,8 @@ def bench_service(
     if min(clients, requests, workers, client_processes) < 1:
         raise OptionError("--clients, --requests, --workers and --client-processes must be "
                           "at least 1")
+    if json_out:  # a bad path fails now, not after the runs
+        check_writable(json_out)
     rows = []
     err = Console(stderr=True)
     for x in loads:

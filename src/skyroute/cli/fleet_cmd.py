@@ -14,6 +14,16 @@ from rich.table import Table
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
 from skyroute.cli.tables import progress_bar, wide_console
 from skyroute.errors import OptionError, check_choice
+from skyroute.fleet.limits import (
+    MAX_DRONES,
+    MAX_HOURS,
+    MAX_PACKAGES,
+    MAX_RATE,
+    MAX_SEEDS,
+    MAX_TRACK_ROWS,
+    expected_packages,
+    track_rows,
+)
 from skyroute.fleet.scenario import PRESETS, Scenario, generate, load_scenario, preset, to_yaml
 
 fleet_app = typer.Typer(help="Fixed-wing drones carry packages between airports: simulate, "
@@ -35,11 +45,35 @@ Seed = Annotated[int, typer.Option(min=0, help="Seed of the package stream (and 
                                         "scenario's layout).")]
 
 
-def _number(name: str, value: float | None, *, low: float, strict: bool) -> None:
+def _number(name: str, value: float | None, *, low: float, strict: bool,
+            high: float | None = None) -> None:
     ok = value is not None and math.isfinite(value) and (value > low if strict else value >= low)
     if value is not None and not ok:
         raise OptionError(f"--{name} {value!r} must be a number {'>' if strict else '>='} "
                           f"{low:g}")
+    if value is not None and high is not None and value > high:
+        raise OptionError(f"--{name} {value:g} is over the limit of {high:,g}")
+
+
+def check_work(s: Scenario, *, hours: float, rate: float | None,
+               track_step: float | None = None, rate_flag: str = "--rate") -> None:
+    """Refuse, before any work, a run whose packages (rate x hours) or tracks.csv rows
+    (drones x seconds / ``track_step``; None: no tracks written) are past the limits of
+    :mod:`skyroute.fleet.limits`, naming the options (or the scenario's rate)."""
+    if rate is not None or s.packages.csv is None:
+        r = s.packages.rate_per_hour if rate is None else rate
+        n = expected_packages(r, hours)
+        if n > MAX_PACKAGES:
+            what = (f"{rate_flag} {r:g} with --hours {hours:g}" if rate is not None else
+                    f"--hours {hours:g} at the scenario's {r:g} packages/h")
+            raise OptionError(f"{what} would spawn about {n:.2g} packages (limit "
+                              f"{MAX_PACKAGES:,g}); lower --hours or {rate_flag}")
+    if track_step is not None:
+        rows = track_rows(s.drones, hours, track_step)
+        if rows > MAX_TRACK_ROWS:
+            raise OptionError(f"--track-step {track_step:g} with --hours {hours:g} and "
+                              f"{s.drones} drones would write up to {rows:.2g} track rows "
+                              f"(limit {MAX_TRACK_ROWS:,.0f}); raise --track-step")
 
 
 def resolve_scenario(path: Path | None, preset_name: str | None, airports: int | None,
@@ -50,8 +84,8 @@ def resolve_scenario(path: Path | None, preset_name: str | None, airports: int |
     if len(given) != 1:
         raise OptionError("give exactly one of SCENARIO, --preset or --airports (with "
                           "--drones)")
-    if drones is not None and drones < 1:
-        raise OptionError(f"--drones {drones} must be at least 1")
+    if drones is not None and not 1 <= drones <= MAX_DRONES:
+        raise OptionError(f"--drones {drones} must be 1 to {MAX_DRONES:,}")
     if path is not None:
         s = load_scenario(path)
     elif preset_name is not None:
@@ -115,13 +149,14 @@ def simulate_command(
     check_choice("scheduler", scheduler, SCHEDULERS)
     if airspace is not None:
         check_choice("airspace", airspace, AIRSPACES)
-    _number("hours", hours, low=0, strict=True)
-    _number("rate", rate, low=0, strict=False)
+    _number("hours", hours, low=0, strict=True, high=MAX_HOURS)
+    _number("rate", rate, low=0, strict=False, high=MAX_RATE)
     _number("track-step", track_step, low=0, strict=True)
     if plot and out is None:
         raise OptionError("--plot needs --out DIR (the folder for map.png and timeline.png)")
     s = _with_separation(resolve_scenario(scenario, preset_name, airports, drones, area_km,
                                           seed), sep_horizontal, sep_vertical)
+    check_work(s, hours=hours, rate=rate, track_step=track_step if out is not None else None)
     if out is not None:  # a bad --out fails before the run, not after it with some files
         from skyroute.io.fleet_out import check_run_outputs
 
@@ -196,7 +231,7 @@ def scenario_command(
         help="Packages offered per hour (default 20 per airport).")] = None,
 ) -> None:
     """Print a valid scenario as YAML, every field with its default, ready to edit."""
-    _number("rate", rate, low=0, strict=False)
+    _number("rate", rate, low=0, strict=False, high=MAX_RATE)
     typer.echo(to_yaml(generate(airports, drones, area_km=area_km, seed=seed,
                                 rate_per_hour=rate)), nl=False)
 
@@ -204,23 +239,30 @@ def scenario_command(
 def parse_seeds(text: str) -> list[int]:
     """``"0-29"``, ``"1,4,7"`` or a mix -> the seeds, in order, no repeats."""
     out: list[int] = []
-    try:
-        for part in (p.strip() for p in text.split(",") if p.strip()):
+    for part in (p.strip() for p in text.split(",") if p.strip()):
+        try:
             if "-" in part[1:]:
                 a, b = part.split("-", 1) if not part.startswith("-") else (part, "")
                 lo, hi = int(a), int(b)
                 if hi < lo:
                     raise ValueError
-                out += range(lo, hi + 1)
             else:
-                out.append(int(part))
-    except ValueError:
-        raise OptionError(f"--seeds {text!r}: expected seeds like 0-29 or 1,4,7") from None
+                lo = hi = int(part)
+        except ValueError:
+            raise OptionError(f"--seeds {text!r}: expected seeds like 0-29 or 1,4,7") from None
+        if hi - lo >= MAX_SEEDS:  # before the list is made: 0-999999999 filled memory
+            raise OptionError(f"--seeds {text!r}: {part} is {hi - lo + 1:,} seeds, over the "
+                              f"limit of {MAX_SEEDS:,}")
+        out += range(lo, hi + 1)
     if not out:
         raise OptionError(f"--seeds {text!r}: no seed given")
     if min(out) < 0:
         raise OptionError(f"--seeds {text!r}: seed {min(out)} is negative; seeds are >= 0")
-    return list(dict.fromkeys(out))
+    seeds = list(dict.fromkeys(out))
+    if len(seeds) > MAX_SEEDS:
+        raise OptionError(f"--seeds {text!r}: {len(seeds):,} seeds, over the limit of "
+                          f"{MAX_SEEDS:,}")
+    return seeds
 
 
 def _choices(text: str, option: str, valid: tuple[str, ...]) -> list[str]:
@@ -243,6 +285,9 @@ def _rates(text: str | None) -> list[float | None]:
         raise OptionError(f"--rates {text!r}: expected numbers like 30,60,90") from None
     if not rates or not all(math.isfinite(r) and r >= 0 for r in rates):
         raise OptionError(f"--rates {text!r}: expected numbers >= 0 like 30,60,90")
+    if max(rates) > MAX_RATE:
+        raise OptionError(f"--rates {text!r}: {max(rates):g} is over the limit of "
+                          f"{MAX_RATE:,g} packages per hour")
     return rates
 
 
@@ -274,11 +319,13 @@ def sweep_command(
     spaces = _choices(airspace, "--airspace", AIRSPACES)
     rate_list = _rates(rates)
     seed_list = parse_seeds(seeds)
-    _number("hours", hours, low=0, strict=True)
+    _number("hours", hours, low=0, strict=True, high=MAX_HOURS)
     executor_kind(executor, dask, jobs)
     s = resolve_scenario(scenario, preset_name, airports, drones, area_km, 0)
     if scenario is not None and s.packages.csv is not None:
         raise OptionError("sweep runs Poisson streams; this scenario names a package CSV")
+    for r in rate_list:  # each run's packages (rate x hours) within the limit
+        check_work(s, hours=hours, rate=r, rate_flag="--rates")
     runs = len(scheds) * len(spaces) * len(rate_list) * len(seed_list)
     err = Console(stderr=True)
     with progress_bar(err) as progress:

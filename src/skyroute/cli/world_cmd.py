@@ -13,7 +13,6 @@ from rich.markup import escape  # help is Rich markup: '[north, ...]' would read
 
 from skyroute.cli import world_args as wa
 from skyroute.cli.tables import result_table
-from skyroute.errors import OptionError
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
@@ -111,7 +110,5 @@ def synth_city_command(
     """Write a synthetic city (random box buildings in street blocks) as colliders.csv."""
     from skyroute.world.synth import synth_city
 
-    if blocks < 1:
-        raise OptionError(f"--blocks {blocks} must be >= 1")
-    write_atomic(out, synth_city(np.random.default_rng(seed), blocks=blocks))
+    write_atomic(out, synth_city(np.random.default_rng(seed), blocks=blocks))  # checks blocks
     typer.echo(f"wrote {out}: {blocks}x{blocks} blocks, home (0, 0) on a street crossing")

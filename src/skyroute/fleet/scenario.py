@@ -14,10 +14,11 @@ from __future__ import annotations
 import math
 import tomllib
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
@@ -29,8 +30,33 @@ from pydantic import (
 )
 
 from skyroute.errors import InputFormatError, OptionError
+from skyroute.fleet.limits import (
+    MAX_AIRPORTS,
+    MAX_AREA_KM,
+    MAX_DISTANCE,
+    MAX_DRONES,
+    MAX_RATE,
+)
 
 MAX_GATE_DISTANCE = 500.0  # metres from an airport's position to a gate it places
+
+
+def _near_home(v: float) -> float:
+    # an airport 1e12 m away was accepted and its flights sampled every second
+    if abs(v) > MAX_DISTANCE:
+        raise ValueError(f"{v:g} m from home is over the limit of {MAX_DISTANCE:,g} m")
+    return v
+
+
+def _at_most(limit: float, what: str):
+    def check(v):
+        if v > limit:
+            raise ValueError(f"{v:g} {what} is over the limit of {limit:,g}")
+        return v
+    return AfterValidator(check)
+
+
+Metres = Annotated[float, AfterValidator(_near_home)]
 
 
 class _Strict(BaseModel):
@@ -56,8 +82,8 @@ class Airport(_Strict):
     """
 
     id: str = Field(min_length=1)
-    north: float
-    east: float
+    north: Metres
+    east: Metres
     landing: Runway
     takeoff: Runway
     gate_width: float = Field(default=30.0, gt=0, description="metres between gate centres")
@@ -110,7 +136,8 @@ class Drone(_Strict):
 class Packages(_Strict):
     """Where packages come from: a seeded Poisson stream or an explicit CSV."""
 
-    rate_per_hour: float = Field(default=60.0, ge=0)
+    rate_per_hour: Annotated[float, _at_most(MAX_RATE, "packages per hour")] = Field(
+        default=60.0, ge=0)
     csv: str | None = Field(default=None, description="t,from_airport,from_gate,"
                                                       "to_airport,to_gate")
 
@@ -130,7 +157,7 @@ class NoFlyZone(_Strict):
     """A polygon no drone may fly into: (north, east) metres, at least three corners."""
 
     name: str = Field(default="zone", min_length=1)
-    points: list[tuple[float, float]] = Field(min_length=3)
+    points: list[tuple[Metres, Metres]] = Field(min_length=3)
 
     @model_validator(mode="after")
     def _valid(self) -> NoFlyZone:
@@ -149,7 +176,7 @@ class Scenario(_Strict):
     home_lat: float = Field(default=50.8798, ge=-90, le=90)  # Leuven
     home_lon: float = Field(default=4.7005, ge=-180, le=180)
     airports: list[Airport] = Field(min_length=2)
-    drones: int = Field(default=3, ge=1)
+    drones: Annotated[int, _at_most(MAX_DRONES, "drones")] = Field(default=3, ge=1)
     handover_seconds: float = Field(default=15.0, ge=0, description="at a gate: unload, "
                                     "load")
     drone: Drone = Drone()
@@ -160,6 +187,8 @@ class Scenario(_Strict):
     @field_validator("airports")
     @classmethod
     def _layout(cls, airports: list[Airport]) -> list[Airport]:
+        if len(airports) > MAX_AIRPORTS:  # before the distance matrix of every pair
+            raise ValueError(f"{len(airports)} airports is over the limit of {MAX_AIRPORTS}")
         ids = [a.id for a in airports]
         if len(set(ids)) != len(ids):
             raise ValueError(f"ids must be unique, got {ids}")
@@ -240,10 +269,21 @@ def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
 def generate(airports: int, drones: int, *, area_km: float = 8.0, seed: int = 0,
              rate_per_hour: float | None = None) -> Scenario:
     """A valid scenario: ``airports`` spread over an ``area_km`` square (at least 1.5
-    runways apart), runway headings seeded, ``drones`` drones."""
-    if airports < 2 or drones < 1 or not area_km > 0:
-        raise OptionError(f"airports={airports} must be >= 2, drones={drones} >= 1 and "
-                          f"area_km={area_km} > 0", param="airports")
+    runways apart), runway headings seeded, ``drones`` drones; each within the limits of
+    :mod:`skyroute.fleet.limits`."""
+    # each argument named alone: a bad drone count was reported as airports=
+    if not 2 <= airports <= MAX_AIRPORTS:
+        raise OptionError(f"airports={airports} must be 2 to {MAX_AIRPORTS}",
+                          param="airports")
+    if not 1 <= drones <= MAX_DRONES:
+        raise OptionError(f"drones={drones} must be 1 to {MAX_DRONES:,}", param="drones")
+    if not (math.isfinite(area_km) and 0 < area_km <= MAX_AREA_KM):
+        raise OptionError(f"area_km={area_km:g} must be a number > 0 and <= {MAX_AREA_KM:,g}",
+                          param="area_km")
+    if rate_per_hour is not None and not (math.isfinite(rate_per_hour)
+                                          and 0 <= rate_per_hour <= MAX_RATE):
+        raise OptionError(f"rate_per_hour={rate_per_hour:g} must be a number >= 0 and <= "
+                          f"{MAX_RATE:,g}", param="rate_per_hour")
     rng = np.random.default_rng(seed)
     size = area_km * 1000.0
     spacing = 900.0

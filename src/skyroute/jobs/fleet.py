@@ -21,6 +21,7 @@ import sqlalchemy as sa
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.fleet.airspace import MODES
 from skyroute.fleet.dispatch import SCHEDULERS
+from skyroute.fleet.limits import MAX_SEEDS, check_run
 from skyroute.fleet.report import report
 from skyroute.fleet.scenario import Scenario, parse_scenario, preset
 from skyroute.fleet.simulate import run
@@ -205,6 +206,9 @@ def check_fleet_params(params: dict) -> dict:
     check_choice("airspace", out["airspace"], MODES)
     out["rate_per_hour"] = _number(params, "rate_per_hour", None, low=0, strict=False)
     out["track_step"] = _number(params, "track_step", 1.0, low=0, strict=True)
+    rate = out["rate_per_hour"]
+    check_run(drones=s.drones, hours=out["hours"], track_step=out["track_step"],
+              rate_per_hour=s.packages.rate_per_hour if rate is None else rate)
     return out
 
 
@@ -214,7 +218,7 @@ def check_sweep_params(params: dict) -> dict:
     scenario's), ``seeds`` (default 0..9), ``hours`` (default 1)."""
     _known(params, {"preset", "scenario", "schedulers", "airspaces", "rates", "seeds",
                     "hours"}, "sweep")
-    _, out = _scenario(params)
+    s, out = _scenario(params)
     out["schedulers"] = _list(params, "schedulers", SCHEDULERS, SCHEDULERS)
     out["airspaces"] = _list(params, "airspaces", MODES, MODES)
     rates = params.get("rates")
@@ -226,10 +230,15 @@ def check_sweep_params(params: dict) -> dict:
     seeds = params.get("seeds", list(range(10)))
     if not isinstance(seeds, list | tuple) or not seeds:
         raise OptionError(f"seeds={seeds!r} must be a non-empty list", param="seeds")
+    if len(seeds) > MAX_SEEDS:
+        raise OptionError(f"seeds: {len(seeds):,} seeds is over the limit of {MAX_SEEDS:,}",
+                          param="seeds")
     out["seeds"] = list(dict.fromkeys(
         _number({"seeds": x}, "seeds", None, low=0, strict=False, integer=True)
         for x in seeds))
     out["hours"] = _number(params, "hours", 1.0, low=0, strict=True)
+    for rate in rates or [s.packages.rate_per_hour]:
+        check_run(drones=s.drones, hours=out["hours"], rate_per_hour=rate)
     return out
 
 

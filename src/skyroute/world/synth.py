@@ -9,14 +9,23 @@ from __future__ import annotations
 
 import numpy as np
 
+from skyroute.errors import OptionError
 from skyroute.geo import Home
 
 DEFAULT_HOME = Home(-3.186874, 55.944494)  # Appleton Tower, Edinburgh
+# blocks along a side: 100 x 100 blocks are about 35,000 buildings over 6 km (the FCND
+# city has 3,845); 10**9 built text until memory ran out
+MAX_BLOCKS = 100
 
 
 def synth_city(rng: np.random.Generator, *, blocks: int = 6, block: float = 40.0,
                street: float = 20.0, home: Home = DEFAULT_HOME) -> str:
-    """Text of a colliders.csv city of ``blocks`` x ``blocks`` blocks around home."""
+    """Text of a colliders.csv city of ``blocks`` x ``blocks`` blocks around home
+    (``blocks`` 1 to :data:`MAX_BLOCKS`)."""
+    if isinstance(blocks, bool) or not isinstance(blocks, int | np.integer) \
+            or not 1 <= blocks <= MAX_BLOCKS:
+        raise OptionError(f"blocks={blocks!r} must be a whole number from 1 to {MAX_BLOCKS}",
+                          param="blocks")
     pitch = block + street
     lines = [f"lat0 {home.lat:.6f}, lon0 {home.lon:.6f}",
              "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ"]

@@ -17,6 +17,14 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from skyroute.errors import SkyrouteError
+from skyroute.fleet.limits import (
+    MAX_AIRPORTS,
+    MAX_PACKAGES,
+    MAX_RATE,
+    MAX_TRACK_ROWS,
+    expected_packages,
+    track_rows,
+)
 from skyroute.service.alternatives import exactly_one
 from skyroute.service.auth import require_token
 from skyroute.service.dates import IsoDate
@@ -25,10 +33,9 @@ from skyroute.service.resources import Resources, ResourcesDep
 
 router = APIRouter(tags=["jobs"])
 MAX_DAYS = 3660
-MAX_HOURS = 24.0
-MAX_RATE = 1e5  # packages per hour, as `rate` or a scenario's packages.rate_per_hour
-MAX_DRONES = 1000  # the largest fleet `skyroute bench fleet` runs
-MAX_AIRPORTS = 100
+MAX_HOURS = 24.0  # this server's own limit: a job holds a worker (fleet.limits allows more)
+# the size of a run (rate, drones, airports, packages, track rows) is limited where the
+# CLI's is: skyroute.fleet.limits, in the scenario model and the runner's checks
 _SUBMIT = threading.Lock()
 
 
@@ -163,18 +170,18 @@ def post_fleet(body: FleetJob, res: ResourcesDep):
                           "file on the server; give packages.rate_per_hour",
                           field="scenario.packages.csv")
         airports = body.scenario.get("airports")
-        if isinstance(airports, list) and len(airports) > MAX_AIRPORTS:
-            raise Problem(422, f"scenario.airports: {len(airports)} airports is over this "
-                          f"server's limit of {MAX_AIRPORTS}", field="scenario.airports")
+        if isinstance(airports, list) and len(airports) > MAX_AIRPORTS:  # before parsing
+            raise Problem(422, f"scenario.airports: {len(airports)} airports is over the "
+                          f"limit of {MAX_AIRPORTS}", field="scenario.airports")
         try:
             scenario: Scenario = parse_scenario(body.scenario, "scenario")
         except SkyrouteError as exc:
             text = str(exc).removeprefix("scenario: ")
             raise Problem(422, f"scenario.{text}", field="scenario." + text.split(":")[0]
                           ) from None
-        _check_caps(scenario)
     else:
         scenario = preset(body.preset)
+    _check_work(scenario, body)
     params = {**({"preset": body.preset} if body.preset else
                  {"scenario": scenario.model_dump(mode="json")}),
               "hours": body.hours, "seed": body.seed, "scheduler": body.scheduler,
@@ -183,17 +190,23 @@ def post_fleet(body: FleetJob, res: ResourcesDep):
     return _submit(res, "fleet", params)
 
 
-def _check_caps(scenario) -> None:
-    """A posted scenario within the limits a preset's run keeps to (``rate``, a preset's
-    fleet): a 422 naming the field."""
-    if scenario.packages.rate_per_hour > MAX_RATE:
-        raise Problem(422, f"scenario.packages.rate_per_hour: "
-                      f"{scenario.packages.rate_per_hour:g} is over this server's limit of "
-                      f"{MAX_RATE:g} packages per hour",
-                      field="scenario.packages.rate_per_hour")
-    if scenario.drones > MAX_DRONES:
-        raise Problem(422, f"scenario.drones: {scenario.drones} drones is over this "
-                      f"server's limit of {MAX_DRONES}", field="scenario.drones")
+def _check_work(scenario, body: FleetJob) -> None:
+    """The packages the run would spawn (rate x hours) and the track rows it would store
+    (drones x seconds, one a second) within :mod:`skyroute.fleet.limits`: a 422 naming
+    ``rate`` or ``hours`` (the runner checks the same, in its parameters' names)."""
+    rate = scenario.packages.rate_per_hour if body.rate is None else body.rate
+    n = expected_packages(rate, body.hours)
+    if n > MAX_PACKAGES:
+        field = "rate" if body.rate is not None else "hours"
+        where = "rate" if body.rate is not None else "the scenario's packages.rate_per_hour"
+        raise Problem(422, f"{field}: {rate:g} packages/h ({where}) for {body.hours:g} h "
+                      f"would spawn about {n:.2g} packages (limit {MAX_PACKAGES:,g}); lower "
+                      "rate or hours", field=field)
+    rows = track_rows(scenario.drones, body.hours, 1.0)
+    if rows > MAX_TRACK_ROWS:
+        raise Problem(422, f"hours: {scenario.drones} drones for {body.hours:g} h would store "
+                      f"up to {rows:.2g} track rows, one a second (limit "
+                      f"{MAX_TRACK_ROWS:,.0f}); lower hours or drones", field="hours")
 
 
 @router.get("/jobs/{job_id}", response_model=JobState, responses=responses(404, 503),
