@@ -59,6 +59,8 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
       EXAMPLE], "give a DATE, or both --from"),
     (["deliver", "--from", "2024-01-02", "--to", "2024-01-01", "--data", EXAMPLE],
      "is before --from"),
+    (["deliver", "--from", "2000-01-01", "--to", "2999-12-31", "--data", EXAMPLE],
+     "--from 2000-01-01 --to 2999-12-31 is 365,243 days, over the limit of 3,660"),
     (["deliver", "2024-01-01"], "give exactly one of --data DIR and --source URL"),
     (["deliver", "2024-01-01", "--source", "ftp://x"], "expected an http:// or https:// URL"),
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--method", "magic"],

@@ -55,6 +55,7 @@ def deliver_command(
     Stores deliveries and flightpath; writes drone-DD-MM-YYYY.geojson, a report, a map.
     """
     from skyroute.delivery.days import open_store, prepare_legs
+    from skyroute.delivery.limits import check_days
     from skyroute.delivery.orders import read_csv_orders
     from skyroute.delivery.site import load_site
     from skyroute.delivery.source import open_source
@@ -69,8 +70,7 @@ def deliver_command(
         raise OptionError("give a DATE, or both --from and --to")
     if day is not None:
         d0 = d1 = day
-    if d1 < d0:
-        raise OptionError(f"--to {d1} is before --from {d0}")
+    check_days(d0, d1, "--from", "--to")
     executor_kind(executor, dask, jobs)
     draw = (day is not None) if plot is None else plot
     # every file of every day checked before anything is flown or stored: a bad --out

@@ -16,6 +16,7 @@ from fastapi import APIRouter, Depends, Path
 from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from skyroute.delivery.limits import MAX_DAYS
 from skyroute.errors import SkyrouteError
 from skyroute.fleet.limits import (
     MAX_AIRPORTS,
@@ -32,7 +33,6 @@ from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import Resources, ResourcesDep
 
 router = APIRouter(tags=["jobs"])
-MAX_DAYS = 3660
 MAX_HOURS = 24.0  # this server's own limit: a job holds a worker (fleet.limits allows more)
 # the size of a run (rate, drones, airports, packages, track rows) is limited where the
 # CLI's is: skyroute.fleet.limits, in the scenario model and the runner's checks
