@@ -298,3 +298,48 @@ def test_a_file_that_cannot_be_written_writes_none(sim, rep, tmp_path, blocker):
     with pytest.raises(SkyrouteError, match=f"{blocker}: cannot write: it is a folder"):
         write_run(sim, rep, tmp_path, plot=True)
     assert [p.name for p in tmp_path.iterdir()] == [blocker]
+
+
+@pytest.fixture(scope="module")
+def late_run():
+    """A run holding a flight planned to leave after its end (113 flights, 112 flown)."""
+    sim = simulate.run(preset("seed-9x9"), hours=1, seed=0, scheduler="seed")
+    return sim, report.report(sim)
+
+
+def test_plot_titles_give_the_numbers_the_command_prints(late_run, tmp_path, monkeypatch):
+    """map.png counted every planned flight (1770 against the table's 1767) and
+    timeline.png the whole run's packages (192 of 246) where the table gives the
+    measured window's (182 of 219)."""
+    import skyroute.io.plot as plot_mod
+    from skyroute.io.fleet_out import plot_map, plot_timeline
+
+    sim, rep = late_run
+    assert len(sim.flights) != rep["flights"]  # the case this test is about
+    figures = []
+    real = plot_mod.save_figure
+    monkeypatch.setattr(plot_mod, "save_figure",
+                        lambda fig, path, **kw: figures.append(fig) or real(fig, path, **kw))
+    plot_map(sim, tmp_path / "map.png")
+    plot_timeline(sim, tmp_path / "timeline.png")
+    fleet_map, timeline = (f.axes[0] for f in figures)
+    assert fleet_map.get_title().endswith(f", {rep['flights']} flights")
+    assert (f"\n{rep['delivered']} of {rep['offered']} packages delivered after the 6 min "
+            "warm-up; ") in timeline.get_title()
+    # airport names: one each, none on another
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.text import Text
+
+    canvas = FigureCanvasAgg(figures[0])
+    canvas.draw()
+    names = [t for t in fleet_map.texts if t.get_text() in {a.id for a in sim.scenario.airports}]
+    assert sorted(t.get_text() for t in names) == sorted(a.id for a in sim.scenario.airports)
+    boxes = [Text.get_window_extent(t, canvas.get_renderer()) for t in names]
+    assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[:i])
+
+
+def test_durations_read_in_their_unit():
+    from skyroute.io.fleet_out import _duration
+
+    assert [_duration(s) for s in (30, 240, 720, 8640, 86400)] == [
+        "30 s", "4 min", "12 min", "2.4 h", "24 h"]

@@ -9,7 +9,6 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from skyroute.bench.grid import (
@@ -24,6 +23,7 @@ from skyroute.bench.grid import (
 from skyroute.bench.peers import skip_reason
 from skyroute.bench.random_maps import parse_random
 from skyroute.cli.parse import parse_list
+from skyroute.cli.tables import progress_bar
 from skyroute.errors import OptionError
 from skyroute.files import check_writable, write_atomic
 from skyroute.world.load import bundled_maps
@@ -124,10 +124,8 @@ def _note_skipped_peers(console: Console, cases: list[Case], peers: list[str], *
 
 def _run(console: Console, cases: list[Case], **options) -> list[dict]:
     """Bench every case under one progress bar; their reports."""
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-               TimeRemainingColumn())
     reports = []
-    with Progress(*columns, console=console, transient=True) as progress:
+    with progress_bar(console) as progress:
         task = progress.add_task("queries", total=sum(c.queries for c in cases))
         for case in cases:
             progress.update(task, description=case.label)

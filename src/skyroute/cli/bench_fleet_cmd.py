@@ -9,12 +9,11 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from skyroute.bench.fleet import CASES, bench_case
 from skyroute.cli.bench_cmd import bench_app
-from skyroute.cli.tables import wide_console
+from skyroute.cli.tables import progress_bar, wide_console
 from skyroute.errors import OptionError, check_choice
 from skyroute.files import check_writable, write_atomic
 
@@ -41,8 +40,7 @@ def bench_fleet(
         check_writable(json_out)
     err = Console(stderr=True)
     rows = []
-    with Progress(TextColumn("{task.description}"), BarColumn(), TimeElapsedColumn(),
-                  console=err, transient=True) as progress:
+    with progress_bar(err, elapsed=True) as progress:
         for k in chosen:
             name, airports, drones, area, hours, rate = CASES[k - 1]
             task = progress.add_task(name, total=round(hours * 3600))

@@ -13,7 +13,6 @@ from typing import Annotated
 import numpy as np
 import typer
 from rich.console import Console
-from rich.progress import Progress
 from rich.table import Table
 
 from skyroute.bench.world import (
@@ -28,6 +27,7 @@ from skyroute.bench.world import (
 )
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_list
+from skyroute.cli.tables import progress_bar
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 from skyroute.files import check_writable, write_atomic
 from skyroute.motion.step_drone import MERGE
@@ -121,7 +121,7 @@ def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, 
         console.print("[yellow]OMPL is not installed; skyroute only "
                       "(pip install 'skyroute[bench]')[/yellow]")
     reports = []
-    with Progress(console=console, transient=True) as progress:
+    with progress_bar(console) as progress:
         task = progress.add_task("worlds", total=len(cases))
         for world, (s, g), other in cases:
             reports.append(bench_query(world, s, g, seconds=seconds, planners=chosen,
@@ -216,7 +216,7 @@ def bench_motion(
             write_atomic(json_out, json.dumps({"dubins": d}, indent=1))
         _exit_past_ompl()
         return
-    with Progress(console=Console(stderr=True), transient=True) as progress:
+    with progress_bar(Console(stderr=True)) as progress:
         task = progress.add_task("pairs", total=14 * 13)
         r = step_drone_pairs(*ilp, max_expansions=max_expansions, merge=merge,
                              on_pair=lambda: progress.advance(task))
@@ -273,7 +273,7 @@ def _bench_curvature(worlds, seed, secs, city, tours, json_out) -> None:
 
     queries = curvature_queries(worlds, seed, city=city)  # a bad --city fails here, first
     out = Console()
-    with Progress(console=Console(stderr=True), transient=True) as progress:
+    with progress_bar(Console(stderr=True)) as progress:
         task = progress.add_task("planner runs", total=None)
         rows = run_queries(queries, secs, on_step=lambda r: progress.advance(task))
     summ = summary(rows)

@@ -162,18 +162,22 @@ def simulate_command(
 
         check_run_outputs(out, plot=plot)
     err = Console(stderr=True)
+    files: list[Path] = []
     with progress_bar(err) as progress:
         task = progress.add_task("simulated seconds", total=round(hours * 3600))
         sim = run(s, hours=hours, seed=seed, scheduler=scheduler, airspace=airspace,
                   rate_per_hour=rate, base=scenario.parent if scenario else None,
                   progress=lambda t: progress.update(task, completed=round(t)))
-        progress.update(task, description="separation check")
+        # the later phases have no count: a moving bar, not a full one at 0:00:00
+        progress.remove_task(task)
+        phase = progress.add_task("separation check", total=None)
         rep = report(sim)
-    files: list[Path] = []
-    if out is not None:
-        from skyroute.io.fleet_out import write_run
+        if out is not None:
+            from skyroute.io.fleet_out import write_run
 
-        files = write_run(sim, rep, out, track_step=track_step, plot=plot)
+            progress.update(phase, description=f"writing {out}" + (" and the maps"
+                                                                  if plot else ""))
+            files = write_run(sim, rep, out, track_step=track_step, plot=plot)
     if as_json:
         typer.echo(json.dumps(rep))
     else:
@@ -350,14 +354,18 @@ def _sweep_table(s: Scenario, hours: float, seeds: list[int], rows: list[dict]) 
                     f"{hours:g} h x {len(seeds)} seeds (mean ±95% CI)")
     for col in ("scheduler", "airspace", "offered/h", "delivered/h", "served %", "p95 s",
                 "max wait s", "loiters", "capacity/h", "conflicts", "lost"):
-        t.add_column(col, justify="right")
+        # On a narrow terminal a cell wraps before its "±" instead of losing its digits
+        # to "…"; the names keep their width.
+        name = col in ("scheduler", "airspace")
+        t.add_column(col, justify="right", no_wrap=name, min_width=7 if name else None,
+                     overflow="ellipsis" if name else "fold")
 
     def pm(r, m, spec, scale=1.0):
         v, ci = r[m], r[m + "_ci95"]
         if v is None or (isinstance(v, float) and math.isnan(v)):
             return "-"
         text = f"{v * scale:{spec}}"
-        return text if ci is None or math.isnan(ci) else f"{text}±{ci * scale:{spec}}"
+        return text if ci is None or math.isnan(ci) else f"{text} ±{ci * scale:{spec}}"
 
     for r in rows:
         t.add_row(r["scheduler"], r["airspace"], _fmt(r["rate_per_hour"], ".0f"),

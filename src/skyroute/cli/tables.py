@@ -47,16 +47,27 @@ def wide_console() -> Console:
     return out if out.is_terminal else Console(width=160)
 
 
-def progress_bar(console: Console) -> Progress:
-    """The progress bar of a long run (description, bar, done/total, time left), on
-    ``console`` (stderr), gone when finished."""
+def progress_bar(console: Console, *, elapsed: bool = False) -> Progress:
+    """The progress bar of a long run (description, bar, done/total, time left or, with
+    ``elapsed``, time taken), on ``console`` (stderr), gone when finished.
+
+    It shows only on an interactive terminal: where stderr is a file or a pipe (a log,
+    CI) it writes nothing at all (Rich would leave an empty line per bar there). A task
+    without a total (a phase of unknown length) shows a moving bar and no count."""
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
         Progress,
         TextColumn,
+        TimeElapsedColumn,
         TimeRemainingColumn,
     )
+    from rich.text import Text
 
-    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                    TimeRemainingColumn(), console=console, transient=True)
+    class Count(MofNCompleteColumn):
+        def render(self, task) -> Text:
+            return Text("") if task.total is None else super().render(task)
+
+    return Progress(TextColumn("{task.description}"), BarColumn(), Count(),
+                    TimeElapsedColumn() if elapsed else TimeRemainingColumn(),
+                    console=console, transient=True, disable=not console.is_interactive)

@@ -67,6 +67,25 @@ def lost_packages(events: list[dict], run: Simulation) -> list[int]:
     return bad
 
 
+def window_counts(run: Simulation) -> tuple[int, int]:
+    """(offered, delivered) of the report: the packages spawned in the measured window
+    ``[warm-up, horizon)`` and the hand-overs completed in ``[warm-up, horizon]``."""
+    H = run.horizon
+    st = run.stream
+    offered = int(((st.t >= WARMUP_SHARE * H) & (st.t < H)).sum())
+    return offered, int(_delivered_in_window(run).sum())
+
+
+def _delivered_in_window(run: Simulation) -> np.ndarray:
+    return (run.delivered >= WARMUP_SHARE * run.horizon) & (run.delivered <= run.horizon)
+
+
+def flights_flown(run: Simulation) -> list:
+    """The flights of the report: those that left by the horizon (a run may also hold
+    flights planned to leave after it)."""
+    return [f for f in run.flights if f.plan.depart <= run.horizon]
+
+
 def report(run: Simulation, separation: SeparationReport | None = None) -> dict:
     """The ``report.json`` numbers of ``run`` (:data:`FIELDS` first, then
     ``settings`` and a few more counts); runs the separation checker unless given its
@@ -81,14 +100,12 @@ def report(run: Simulation, separation: SeparationReport | None = None) -> dict:
     w0 = WARMUP_SHARE * H
     hours = (H - w0) / 3600.0
     st = run.stream
-    spawned = (st.t >= w0) & (st.t < H)
-    done = (run.delivered >= w0) & (run.delivered <= H)
-    offered = int(spawned.sum())
-    delivered = int(done.sum())
+    done = _delivered_in_window(run)
+    offered, delivered = window_counts(run)
     times = (run.delivered - st.t)[done]
     waited = np.where(np.isnan(run.pickup) | (run.pickup > H), H, run.pickup) - st.t
     waited = waited[st.t < H]
-    flights = [f for f in run.flights if f.plan.depart <= H]
+    flights = flights_flown(run)
     loiter_s = 2 * math.pi * s.drone.turn_radius / s.drone.cruise_speed
     circles = sum(sum(1 for j in range(f.plan.loiters)
                       if f.plan.landing_request + j * loiter_s <= H) for f in flights)

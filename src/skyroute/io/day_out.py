@@ -37,24 +37,17 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from skyroute.io.plot import save_figure
+    from skyroute.io.plot import place_labels, save_figure
     from skyroute.io.world_out import draw_world, finish_axes
 
     fig, ax = plt.subplots(figsize=(10, 6))
-    draw_world(ax, site.world)
+    draw_world(ax, site.world, label="no-fly zone")
     f = result.flight.flight
     if f.moves:
         pts = np.vstack([f.frm[:1], f.to])
         ax.plot(pts[:, 0], pts[:, 1], "-", color="tab:blue", lw=0.8, label="flight")
-    placed: list[tuple[float, float]] = []
-    for s in site.shops:  # shops close together get their labels stacked, not piled up
-        ax.plot(*s.lonlat, "s", color="tab:purple", ms=7)
-        near = sum(1 for q in placed if abs(q[0] - s.lonlat[0]) < 0.0012 and
-                   abs(q[1] - s.lonlat[1]) < 0.0003)
-        placed.append(s.lonlat)
-        ax.annotate(s.name, s.lonlat, fontsize=7, textcoords="offset points",
-                    xytext=(5, (6, -12, 18, -24, 30)[near % 5]))
-    ax.plot([], [], "s", color="tab:purple", label="shop")
+    shops = np.array([s.lonlat for s in site.shops], dtype=float).reshape(-1, 2)
+    ax.plot(shops[:, 0], shops[:, 1], "s", color="tab:purple", ms=7, zorder=5, label="shop")
     served = {p.lonlat for p in result.delivered}
     missed = {site.locate(o.deliver_to) for o in result.orders
               if o.order_no not in {p.order.order_no for p in result.delivered}
@@ -63,15 +56,18 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
                                (missed, "tab:red", "customer not served")):
         if pts:
             a = np.array(sorted(pts))
-            ax.plot(a[:, 0], a[:, 1], "o", color=colour, ms=7, label=label)
-    ax.plot(*site.home, "*", color="black", ms=13, label="home")
+            ax.plot(a[:, 0], a[:, 1], "o", color=colour, ms=7, zorder=5, label=label)
+    ax.plot(*site.home, "*", color="black", ms=13, zorder=6, label="home")
     pct = result.money_pct
-    ax.set_title(f"{result.date:%d %b %Y}: {len(result.delivered)}/{len(result.orders)} "
-                 f"orders, {'no orders' if pct is None else f'{pct:.1f}% of the money'}, "
+    ax.set_title(f"Delivery day {result.date:%d %b %Y}: {len(result.delivered)}/"
+                 f"{len(result.orders)} orders, "
+                 f"{'no orders' if pct is None else f'{pct:.1f}% of the money'}, "
                  f"{f.moves} moves", fontsize=10)
     finish_axes(ax, site.world)
-    ax.ticklabel_format(useOffset=False)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    # shop names last, on the final axes, each where it covers no other name or marker
+    # (shops a few metres apart had their names piled on one another's squares)
+    place_labels(ax, shops, [s.name for s in site.shops], fontsize=7,
+                 avoid=[*served, *missed, site.home])
     return save_figure(fig, path)
 
 

@@ -466,7 +466,8 @@ def plot_map(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
     import matplotlib.pyplot as plt
     from matplotlib.collections import LineCollection
 
-    from skyroute.io.plot import save_figure
+    from skyroute.fleet.report import flights_flown
+    from skyroute.io.plot import legend_outside, place_labels, save_figure
 
     s = sim.scenario
     fig, ax = plt.subplots(figsize=(9, 8))
@@ -490,22 +491,23 @@ def plot_map(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
                     label=f"{kind.replace('takeoff', 'take-off')} runway" if k == 0 else None)
     gates = np.array([gate_position(a, g) for a in s.airports for g in (0, 1)])
     ax.plot(gates[:, 1], gates[:, 0], "s", color="tab:red", ms=3, zorder=4, label="gates")
-    for a in s.airports:
-        ax.annotate(a.id, (a.east, a.north), textcoords="offset points", xytext=(8, 8),
-                    fontsize=11, fontweight="bold", zorder=5,
-                    bbox={"boxstyle": "round,pad=0.2", "fc": "white", "alpha": 0.8})
     ax.autoscale_view()
     ax.set_aspect("equal")
     ax.set_xlabel("east (m)")
     ax.set_ylabel("north (m)")
+    # the flights the report counts (a run also holds flights planned past its end)
     ax.set_title(f"{s.name}: {sim.scheduler} dispatch, {sim.airspace} airspace, "
-                 f"{sim.hours:g} h, seed {sim.seed}, {len(sim.flights)} flights",
+                 f"{sim.hours:g} h, seed {sim.seed}, {len(flights_flown(sim))} flights",
                  fontsize=10)
     if n > 10:
         sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(0, n - 1))
         fig.colorbar(sm, ax=ax, label="drone", orientation="horizontal", shrink=0.6,
                      pad=0.08, aspect=40)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    legend_outside(ax)
+    # airport names last, each where it covers no other name (30 airports piled up)
+    place_labels(ax, [(a.east, a.north) for a in s.airports], [a.id for a in s.airports],
+                 avoid=gates[:, ::-1], fontsize=11 if len(s.airports) <= 12 else 8,
+                 fontweight="bold")
     return save_figure(fig, path, dpi=dpi)
 
 
@@ -518,6 +520,7 @@ def plot_timeline(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from skyroute.fleet.report import window_counts
     from skyroute.io.plot import save_figure
 
     H = sim.horizon
@@ -553,7 +556,7 @@ def plot_timeline(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
     else:  # too many airports to name: circles per time bin
         bins = np.linspace(0.0, H / scale, 61)
         low.hist(denied[:, 0] / scale, bins=bins, color="tab:red", alpha=0.8)
-        low.set_ylabel(f"per {bins[1]:.3g} {unit}")
+        low.set_ylabel(f"per {_duration(H / 60)}")
     low.set_title(f"loiter circles (landing refused): {len(denied)}", fontsize=9)
     low.set_xlabel(f"time ({unit})")
     for ax in (top, low):
@@ -563,7 +566,20 @@ def plot_timeline(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
         ax.set_xlim(0, H / scale)
     top.legend(loc="upper left", fontsize=8)
     s = sim.scenario
+    # the report's numbers first (the measured window, as the command's table prints
+    # them), then the whole run that the curves show
+    offered, done = window_counts(sim)
     top.set_title(f"{s.name}: {sim.scheduler} dispatch, {sim.airspace} airspace, "
-                  f"seed {sim.seed}: {int(delivered[-1])} of {int(spawned[-1])} packages "
-                  "delivered", fontsize=10)
+                  f"{sim.hours:g} h, seed {sim.seed}\n{done} of {offered} packages delivered "
+                  f"after the {_duration(WARMUP_SHARE * H)} warm-up; {int(delivered[-1])} of "
+                  f"{int(spawned[-1])} in the whole run", fontsize=10)
     return save_figure(fig, path, dpi=dpi)
+
+
+def _duration(seconds: float) -> str:
+    """``4 min``, ``1.5 h``, ``30 s``: a span in the unit that reads best."""
+    if seconds >= 2 * 3600:
+        return f"{seconds / 3600:.3g} h"
+    if seconds >= 120:
+        return f"{seconds / 60:.3g} min"
+    return f"{seconds:.3g} s"

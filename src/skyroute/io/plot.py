@@ -1,4 +1,6 @@
-"""PNG pictures of maps and paths (matplotlib, imported only when a plot is asked for)."""
+"""PNG pictures of maps and paths (matplotlib, imported only when a plot is asked for),
+and the conventions every map picture shares: start and goal drawn on top and never cut
+by the frame, the legend outside the map, labels that keep out of each other's way."""
 
 from __future__ import annotations
 
@@ -11,12 +13,18 @@ from skyroute.files import write_atomic
 from skyroute.result import PlanResult
 from skyroute.world.grid import Grid
 
+DPI = 150
+MAX_DPI = 400  # a 512x512 map: about 2,300 pixels a side
+CELL_PIXELS = 4  # a grid picture gives each cell at least this many pixels, up to MAX_DPI
+DOTS_UP_TO = 60  # a path's points are marked when it has at most this many
+
 
 def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
-                   goal: tuple[int, int], path: str | Path, *, dpi: int = 150) -> Path:
+                   goal: tuple[int, int], path: str | Path, *, dpi: int | None = None) -> Path:
     """Draw the grid (blocked cells dark), the path, start (green) and goal (red).
 
-    Axes are cell coordinates (x to the right, y down, as MovingAI counts them).
+    Axes are cell coordinates (x to the right, y down, as MovingAI counts them). ``dpi``
+    defaults to :func:`grid_dpi`: large maps get the pixels their cells need.
     """
     import matplotlib
 
@@ -25,26 +33,151 @@ def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
 
     h, w = grid.blocked.shape
     size = 7.0
-    fig, ax = plt.subplots(figsize=(size * min(1.6, max(0.6, w / h)), size))
+    area = (size * min(1.6, max(0.6, w / h)), size)  # the map's, inches
+    dpi = grid_dpi(grid.blocked.shape, area) if dpi is None else dpi
+    fig, ax = plt.subplots(figsize=area)
     ax.imshow(grid.blocked, cmap="Greys", vmin=0, vmax=1.4, interpolation="nearest",
               extent=(-0.5, w - 0.5, h - 0.5, -0.5))
+    ax.plot([], [], "s", color=plt.get_cmap("Greys")(1 / 1.4), ms=7, label="blocked")
     if result.found:
-        p = np.asarray(result.path)
-        ax.plot(p[:, 0], p[:, 1], "-", color="tab:blue", lw=1.6, label="path")
-        if len(p) <= 60:
-            ax.plot(p[:, 0], p[:, 1], ".", color="tab:blue", ms=4)
-    ax.plot(*start, "o", color="tab:green", ms=8, label="start")
-    ax.plot(*goal, "*", color="tab:red", ms=12, label="goal")
+        # A line no wider than a cell (in points), so a corridor of a maze stays visible.
+        cell_pt = 72 * min(area[0] * 0.8 / w, area[1] * 0.8 / h)
+        draw_path(ax, result.path, lw=float(np.clip(cell_pt, 0.6, 1.6)))
+    mark_ends(ax, start, goal, start_text=_cell(start), goal_text=_cell(goal))
     cost = f"cost {result.cost:.3f}" if result.found else result.status.value
-    ax.set_title(f"{grid.name}: {result.algorithm}, {cost}, {result.expanded} expanded",
+    ax.set_title(f"{grid.name}: {result.algorithm}, {cost}, {result.expanded:,} expanded",
                  fontsize=10)
     ax.set_xlabel("x (column)")
     ax.set_ylabel("y (row)")
-    ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    legend_outside(ax)
     return save_figure(fig, path, dpi=dpi)
 
 
-def save_figure(fig, path: str | Path, *, dpi: int = 150) -> Path:
+def grid_dpi(shape: tuple[int, int], figsize: tuple[float, float]) -> int:
+    """The resolution that gives each cell of a map of ``shape`` (rows, columns) drawn
+    on a figure of ``figsize`` inches about :data:`CELL_PIXELS` pixels: :data:`DPI` for
+    small maps (a 32x32 map stays a small file), up to :data:`MAX_DPI` for large ones."""
+    h, w = shape
+    cell_in = min(figsize[0] * 0.8 / w, figsize[1] * 0.8 / h)  # the axes take ~80%
+    return int(np.clip(np.ceil(CELL_PIXELS / cell_in), DPI, MAX_DPI))
+
+
+def _cell(c) -> str:
+    return f"({int(c[0])}, {int(c[1])})"
+
+
+def draw_path(ax, points, *, lw: float = 1.6, label: str = "path") -> None:
+    """A path as a line above the map, its points marked when there are few of them
+    (a densely sampled trajectory would be drawn as a thick string of beads)."""
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    dots = len(p) <= DOTS_UP_TO
+    ax.plot(p[:, 0], p[:, 1], "-o" if dots else "-", color="tab:blue", lw=lw, ms=3,
+            label=label, zorder=4)
+
+
+def mark_ends(ax, start, goal, *, start_text: str = "", goal_text: str = "") -> None:
+    """Start (green dot) and goal (red star) above everything else and not clipped by
+    the frame (a start in a map's corner was half cut off); each legend entry names its
+    point."""
+    for xy, marker, colour, ms, name, text in ((start, "o", "tab:green", 9, "start",
+                                                start_text),
+                                               (goal, "*", "tab:red", 14, "goal", goal_text)):
+        ax.plot(*np.asarray(xy, dtype=float)[:2], marker, color=colour, ms=ms,
+                markeredgecolor="white", markeredgewidth=0.8, clip_on=False, zorder=6,
+                label=f"{name} {text}".strip())
+
+
+def legend_outside(ax, **kw):
+    """The legend beside the axes (right, top aligned), so it never covers the map; the
+    figure is widened by the legend's width, so the map keeps its size. Returns it."""
+    fig = ax.figure
+    legend = ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8,
+                       borderaxespad=0, **kw)
+    width = legend.get_window_extent(fig.canvas.get_renderer()).width / fig.dpi
+    w, h = fig.get_size_inches()
+    fig.set_size_inches(w + width + 0.1, h)
+    return legend
+
+
+def place_labels(ax, points, texts, *, avoid=(), fontsize: float = 8,
+                 marker_pt: float = 4.0, **style) -> list:
+    """Annotate ``points`` (data coordinates) with ``texts`` where each label overlaps
+    least the labels already placed, the other points and the markers at ``avoid``, on
+    a white box so a line under it stays readable.
+
+    Eight places right beside the point are tried first (right, above, below, left);
+    one that would sit nearer another of ``points`` than its own reads as that point's
+    label, so it counts as half covered. When none is clear, a label may go a little further
+    out with a thin leader line to its point. Call it last, once the axes' limits,
+    aspect and legend are set (it lays the figure out to measure the labels). Returns
+    the annotations."""
+    from matplotlib.text import Text
+
+    fig = ax.figure
+    fig.tight_layout()
+    ax.apply_aspect()
+    renderer = fig.canvas.get_renderer()
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    others = np.asarray(avoid, dtype=float).reshape(-1, 2)
+    r = marker_pt * fig.dpi / 72.0  # a marker's half width in pixels
+    centre = ax.transData.transform(np.vstack([pts, others]))
+    taken = [(x - r, y - r, x + r, y + r) for x, y in centre]
+    box = {"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.75}
+    style = {"fontsize": fontsize, "bbox": box, "zorder": 7, **style}
+    out = []
+    for k, ((x, y), text) in enumerate(zip(pts, texts, strict=True)):
+        best = None
+        for rank, (dx, dy, lead) in enumerate(_PLACES):
+            extra = {"arrowprops": {"arrowstyle": "-", "lw": 0.6, "color": "0.3",
+                                    "shrinkA": 0, "shrinkB": 2}} if lead else {}
+            ann = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points",
+                              ha="left" if dx > 0 else "right" if dx < 0 else "center",
+                              va="bottom" if dy > 0 else "top" if dy < 0 else "center",
+                              **style, **extra)
+            ann.update_positions(renderer)
+            e = Text.get_window_extent(ann, renderer)  # the words, not the leader line
+            bb = (e.x0, e.y0, e.x1, e.y1)
+            cost = sum(_overlap(bb, t) for i, t in enumerate(taken) if i != k)
+            if not lead and _nearer_other(bb, centre[:len(pts)], k, 3 * r):
+                cost += 0.5 * (bb[2] - bb[0]) * (bb[3] - bb[1])
+            cost += rank * 1e-6  # ties go to the nearer, more usual place
+            if best is None or cost < best[0]:
+                if best is not None:
+                    best[1].remove()
+                best = (cost, ann, bb)
+            else:
+                ann.remove()
+            if cost < 1e-3:
+                break
+        taken.append(best[2])
+        out.append(best[1])
+    return out
+
+
+_NEAR, _FAR = 5, 16  # points from the marker to its label (_FAR: with a leader line)
+_PLACES = tuple((dx * d, dy * d, d == _FAR) for d in (_NEAR, _FAR)
+                for dx, dy in ((1, 1), (1, -1), (0, 1.4), (0, -1.4), (-1, 1), (-1, -1),
+                               (1.4, 0), (-1.4, 0)))
+
+
+def _nearer_other(bb, centre: np.ndarray, k: int, within: float) -> bool:
+    """Whether another point lies within ``within`` pixels of box ``bb`` and nearer to
+    it than point ``k``: a reader would take the label for that point's."""
+    dx = np.maximum(np.maximum(bb[0] - centre[:, 0], centre[:, 0] - bb[2]), 0)
+    dy = np.maximum(np.maximum(bb[1] - centre[:, 1], centre[:, 1] - bb[3]), 0)
+    d = np.hypot(dx, dy)
+    own = d[k]
+    d[k] = np.inf
+    return bool((d < within).any() and d.min() < own + 1.0)
+
+
+def _overlap(a, b) -> float:
+    w = min(a[2], b[2]) - max(a[0], b[0])
+    h = min(a[3], b[3]) - max(a[1], b[1])
+    return w * h if w > 0 and h > 0 else 0.0
+
+
+def save_figure(fig, path: str | Path, *, dpi: int = DPI) -> Path:
     """Render a matplotlib figure to PNG (cropped to everything drawn, legends beside the
     axes included), close it, and write the file whole."""
     import matplotlib.pyplot as plt

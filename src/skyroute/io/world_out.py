@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.geo import heading_of, lonlat_to_enu
-from skyroute.io.plot import save_figure
+from skyroute.io.plot import draw_path, legend_outside, mark_ends, save_figure
 from skyroute.result import PlanResult
 from skyroute.world.world import World
 
@@ -57,7 +57,8 @@ def world_path_geojson(world: World, result: PlanResult) -> dict:
 def plot_world_path(world: World, result: PlanResult, start, goal, path: str | Path, *,
                     edges: np.ndarray | None = None, dpi: int = 150) -> Path:
     """Draw obstacles (grey), the boundary (dashed), roadmap edges (thin, plane
-    segments), the path; ``result.path``, ``start`` and ``goal`` in the world's frame."""
+    segments), the path; ``result.path``, ``start`` and ``goal`` in the world's frame
+    (the legend names start and goal as they were given)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -72,19 +73,30 @@ def plot_world_path(world: World, result: PlanResult, start, goal, path: str | P
                                          label=f"{result.algorithm} graph "
                                                f"({len(edges):,} edges)"))
     if result.found:
-        p = world.to_plane(result.path, "path")
-        ax.plot(p[:, 0], p[:, 1], "-o", color="tab:blue", lw=1.8, ms=3, label="path")
-    ax.plot(*world.to_plane(start, "start")[0], "o", color="tab:green", ms=9, label="start")
-    ax.plot(*world.to_plane(goal, "goal")[0], "*", color="tab:red", ms=13, label="goal")
+        draw_path(ax, world.to_plane(result.path, "path"), lw=1.8)
+    mark_ends(ax, world.to_plane(start, "start")[0], world.to_plane(goal, "goal")[0],
+              start_text=_point(world, start), goal_text=_point(world, goal))
     unit = "deg" if world.plane == "degrees" else "m"
     cost = f"{result.cost:.6g} {unit}" if result.found else result.status.value
     ax.set_title(f"{world.name}: {result.algorithm}, {cost}", fontsize=10)
-    finish_axes(ax, world, legend_below=edges is not None and len(edges) > 0)
+    finish_axes(ax, world)
     return save_figure(fig, path, dpi=dpi)
 
 
-def draw_world(ax, world: World) -> None:
-    """Obstacles filled grey (holes white) and the boundary dashed.
+_POINT_NAMES = {"lonlat": ("lon", "lat", ""), "degrees": ("lon", "lat", ""),
+                "ned": ("north", "east", " m"), "enu": ("east", "north", " m")}
+
+
+def _point(world: World, p) -> str:
+    """A point as it was typed, in the world's frame: ``(north 120 m, east -180 m)``."""
+    a, b, unit = _POINT_NAMES[world.frame]
+    x, y = np.asarray(p, dtype=float).reshape(-1)[:2]
+    return f"({a} {x:.7g}{unit}, {b} {y:.7g}{unit})"
+
+
+def draw_world(ax, world: World, *, label: str = "obstacles") -> None:
+    """Obstacles filled grey (holes white; ``label`` in the legend) and the boundary
+    dashed.
 
     The obstacles go in two collections, not one patch each: a city of thousands of
     boxes then draws (and places the legend) in a fraction of a second."""
@@ -96,24 +108,23 @@ def draw_world(ax, world: World) -> None:
         for part in getattr(poly, "geoms", [poly]):
             shells.append(np.asarray(part.exterior.coords))
             holes.extend(np.asarray(hole.coords) for hole in part.interiors)
-    for rings, colour in ((shells, "0.45"), (holes, "white")):
+    for rings, colour, name in ((shells, "0.45", label), (holes, "white", None)):
         if rings:
-            ax.add_collection(PolyCollection(rings, facecolors=colour, linewidths=0))
+            ax.add_collection(PolyCollection(rings, facecolors=colour, linewidths=0,
+                                             label=name))
     ax.autoscale_view()
     if world.boundary is not None:
         x, y = shapely.Polygon(world.boundary).exterior.xy
         ax.plot(x, y, "--", color="tab:orange", lw=1.2, label="boundary")
 
 
-def finish_axes(ax, world: World, *, legend_below: bool = False) -> None:
-    """Axis names, true proportions (degrees squeezed by cos latitude), a legend (below
-    the axes when lines cover the whole map and no place inside is free)."""
-    ax.set_xlabel("longitude" if world.plane == "degrees" else "east (m)")
-    ax.set_ylabel("latitude" if world.plane == "degrees" else "north (m)")
+def finish_axes(ax, world: World) -> None:
+    """Axis names with units, true proportions (degrees squeezed by cos latitude), plain
+    tick numbers (no "+5.594e1" offset on latitudes), the legend beside the map."""
+    degrees = world.plane == "degrees"
+    ax.set_xlabel("longitude (°)" if degrees else "east (m)")
+    ax.set_ylabel("latitude (°)" if degrees else "north (m)")
     ax.set_aspect("equal" if world.plane == "metres" else
                   1 / np.cos(np.radians(np.mean(ax.get_ylim()))))
-    if legend_below:
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=4, fontsize=8,
-                  frameon=False)
-    else:
-        ax.legend(loc="best", fontsize=8, framealpha=0.9)
+    ax.ticklabel_format(useOffset=False, style="plain")
+    legend_outside(ax)

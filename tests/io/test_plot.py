@@ -1,0 +1,168 @@
+"""Map pictures as a user reads them, checked on matplotlib's objects and the PNG's
+header, not on pixels: the legend beside the map, start and goal on top and named, a
+title with the command's own numbers, units on the axes, true proportions, enough
+pixels for a large grid and no more for a small one, labels that keep apart."""
+
+from __future__ import annotations
+
+import struct
+
+import matplotlib
+import numpy as np
+import pytest
+
+matplotlib.use("Agg")  # before pyplot: no window on a desktop either
+import matplotlib.pyplot as plt
+from matplotlib.text import Text
+
+import skyroute
+from skyroute.io import plot as plot_mod
+from skyroute.io import world_out
+from skyroute.io.plot import draw_path, grid_dpi, place_labels, plot_grid_path
+from skyroute.result import PlanResult, Status
+from skyroute.world.grid import Grid
+from skyroute.world.load import load_world
+from tests.conftest import ROOT
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The figures saved while the test runs (still drawn to their files)."""
+    saved = []
+    real = plot_mod.save_figure
+
+    def keep(fig, path, **kw):
+        saved.append(fig)
+        return real(fig, path, **kw)
+
+    monkeypatch.setattr(plot_mod, "save_figure", keep)
+    monkeypatch.setattr(world_out, "save_figure", keep)
+    return saved
+
+
+def png_size(path) -> tuple[int, int]:
+    """(width, height) from the PNG's IHDR chunk."""
+    return struct.unpack(">II", path.read_bytes()[16:24])
+
+
+def drawn(fig):
+    """The renderer of ``fig`` drawn again (a closed figure has lost its Agg canvas)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return canvas.get_renderer()
+
+
+def boxes(fig, *artists):
+    r = drawn(fig)
+    return [a.get_window_extent(r) for a in artists]
+
+
+def test_grid_picture_legend_beside_the_map_and_ends_named(figures, tmp_path):
+    blocked = np.zeros((8, 8), dtype=bool)
+    blocked[3, 1:7] = True
+    grid = Grid(blocked, name="bar")
+    result = skyroute.plan(grid, (0, 0), (7, 7))
+    plot_grid_path(grid, result, (0, 0), (7, 7), tmp_path / "p.png")
+    (fig,) = figures
+    ax = fig.axes[0]
+    legend = ax.get_legend()
+    axes_box, legend_box = boxes(fig, ax, legend)
+    assert legend_box.x0 >= axes_box.x1  # beside the map: it covers no path or goal
+    texts = [t.get_text() for t in legend.get_texts()]
+    assert texts == ["blocked", "path", "start (0, 0)", "goal (7, 7)"]
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    for end in ("start (0, 0)", "goal (7, 7)"):  # a corner start was half cut off
+        assert not lines[end].get_clip_on()
+        assert lines[end].get_zorder() > lines["path"].get_zorder()
+    assert ax.get_title() == f"bar: astar, cost {result.cost:.3f}, {result.expanded:,} expanded"
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("x (column)", "y (row)")
+    assert ax.get_aspect() == 1.0
+
+
+def test_grid_picture_pixels_follow_the_map_size(tmp_path):
+    """A 512x512 map gets about 4 pixels a cell (it was a 1,000-pixel thumbnail, 2 a
+    cell, the maze's corridors lost under the path); a 32x32 map stays small."""
+    rng = np.random.default_rng(0)
+    for side, name in ((512, "big.png"), (32, "small.png")):
+        blocked = rng.random((side, side)) < 0.1
+        blocked[0, 0] = blocked[-1, -1] = False
+        grid = Grid(blocked, name=name)
+        result = PlanResult(Status.FOUND, np.array([[0.0, 0.0], [side - 1, side - 1]]),
+                            1.0, algorithm="astar")
+        plot_grid_path(grid, result, (0, 0), (side - 1, side - 1), tmp_path / name)
+    w, h = png_size(tmp_path / "big.png")
+    assert min(w, h) >= 4 * 512
+    w, h = png_size(tmp_path / "small.png")
+    assert max(w, h) <= 1300 and (tmp_path / "small.png").stat().st_size < 100_000
+    assert grid_dpi((32, 32), (7, 7)) == 150 and grid_dpi((4096, 4096), (7, 7)) == 400
+
+
+@pytest.mark.parametrize(("n", "marker"), [(60, "o"), (61, "None")])
+def test_a_dense_trajectory_is_a_line_not_beads(n, marker):
+    fig, ax = plt.subplots()
+    draw_path(ax, np.c_[np.arange(n), np.zeros(n)])
+    assert ax.get_lines()[0].get_marker() == marker
+    plt.close(fig)
+
+
+def test_world_picture_in_degrees_reads_plain_latitudes(figures, tmp_path):
+    """``fly --vehicle step`` draws on the lon/lat plane: its latitudes were ticked as
+    offsets from "+5.594e1"."""
+    world = load_world(ROOT / "examples" / "city.csv", altitude=10).in_frame("degrees")
+    a, b = (-3.1890, 55.9456), (-3.1850, 55.9432)
+    result = skyroute.plan(world, a, b)
+    world_out.plot_world_path(world, result, a, b, tmp_path / "w.png")
+    (fig,) = figures
+    ax = fig.axes[0]
+    drawn(fig)
+    assert ax.yaxis.get_major_formatter().get_offset() == ""
+    assert ax.xaxis.get_major_formatter().get_offset() == ""
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("longitude (°)", "latitude (°)")
+    assert ax.get_aspect() == pytest.approx(1 / np.cos(np.radians(55.944)), rel=1e-3)
+    texts = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "start (lon -3.189, lat 55.9456)" in texts and "obstacles" in texts
+    axes_box, legend_box = boxes(fig, ax, ax.get_legend())
+    assert legend_box.x0 >= axes_box.x1
+    assert ax.get_title() == f"city.csv: visibility, {result.cost:.6g} deg"
+
+
+def test_world_picture_names_ned_points_by_their_axes(figures, tmp_path):
+    world = load_world(ROOT / "examples" / "city.csv", altitude=10, frame="ned")
+    start, goal = (0.0, 0.0), (120.0, -180.0)
+    result = PlanResult(Status.FOUND, np.array([start, goal]), 216.3, algorithm="lattice")
+    world_out.plot_world_path(world, result, start, goal, tmp_path / "w.png")
+    ax = figures[0].axes[0]
+    texts = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "goal (north 120 m, east -180 m)" in texts
+    # drawn in the plane: east to the right, north up
+    goal_line = next(ln for ln in ax.get_lines() if ln.get_label().startswith("goal"))
+    assert goal_line.get_xydata().tolist() == [[-180.0, 120.0]]
+    assert ax.get_aspect() == 1.0 and ax.get_xlabel() == "east (m)"
+
+
+def test_labels_of_close_points_keep_apart():
+    """Five shops a few metres apart (the ILP data's): no name covers another, and none
+    sits nearer another shop than its own."""
+    pts = np.array([(-3.191065, 55.945626), (-3.191257, 55.945626), (-3.186103, 55.944656),
+                    (-3.185236, 55.944709), (-3.185332, 55.944656), (-3.185300, 55.944680)])
+    names = ["Rudis", "Greggs", "The Nile Valley", "The Picnic Basket", "Bing Tea", "Soup"]
+    fig, ax = plt.subplots(figsize=(10, 6))
+    ax.set_xlim(-3.1929, -3.1839)
+    ax.set_ylim(55.9424, 55.9464)
+    ax.plot(pts[:, 0], pts[:, 1], "s")
+    anns = place_labels(ax, pts, names, fontsize=7)
+    r = drawn(fig)
+    bb = [Text.get_window_extent(a, r) for a in anns]  # the words, not a leader line
+    for i in range(len(bb)):
+        for j in range(i):
+            assert not bb[i].overlaps(bb[j]), (names[i], names[j])
+    centre = ax.transData.transform(pts)
+    for k, (a, b) in enumerate(zip(anns, bb, strict=True)):
+        if a.arrow_patch is not None:  # a leader line says whose label it is
+            continue
+        d = [np.hypot(max(b.x0 - x, 0, x - b.x1), max(b.y0 - y, 0, y - b.y1))
+             for x, y in centre]
+        assert int(np.argmin(d)) == k or d[k] == min(d), names[k]
+    plt.close(fig)
