@@ -13,7 +13,15 @@ from tests.conftest import ROOT
 EXAMPLE = str(ROOT / "examples" / "lunch")
 
 
+def _files_row(out: str) -> list[str]:
+    """The cells of the table's "files" row, one file a line."""
+    rows = [line.split("│") for line in out.splitlines() if line.count("│") == 3]
+    start = next(k for k, r in enumerate(rows) if r[1].strip() == "files")
+    return [r[2].strip() for r in rows[start:]]
+
+
 def test_one_day_writes_its_files_and_table(monkeypatch, capsys, tmp_path, fly_once):
+    monkeypatch.setenv("COLUMNS", "400")  # whole paths in the table, not folded
     db = f"sqlite:///{tmp_path / 'd.db'}"
     code, out, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data", EXAMPLE,
                          "--db", db, "--out", str(tmp_path / "out"))
@@ -22,6 +30,16 @@ def test_one_day_writes_its_files_and_table(monkeypatch, capsys, tmp_path, fly_o
     files = sorted(p.name for p in (tmp_path / "out").iterdir())
     assert files == ["drone-03-01-2024.geojson", "drone-03-01-2024.png",
                      "report-03-01-2024.json"]
+    # the table named only the GeoJSON
+    assert _files_row(out) == [str(tmp_path / "out" / f) for f in (
+        "drone-03-01-2024.geojson", "report-03-01-2024.json", "drone-03-01-2024.png")]
+    code, out, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data", EXAMPLE,
+                         "--db", db, "--out", str(tmp_path / "bare"), "--no-plot")
+    assert code == 0, err
+    assert _files_row(out) == [str(tmp_path / "bare" / f) for f in (
+        "drone-03-01-2024.geojson", "report-03-01-2024.json")]
+    assert sorted(p.name for p in (tmp_path / "bare").iterdir()) == [
+        "drone-03-01-2024.geojson", "report-03-01-2024.json"]
     assert (tmp_path / "out" / "drone-03-01-2024.png").read_bytes()[:4] == b"\x89PNG"
     report = json.loads((tmp_path / "out" / "report-03-01-2024.json").read_text())
     assert report["orders_placed"] == 36 and 0 < report["moves"] <= 1500

@@ -99,10 +99,10 @@ def deliver_command(
             progress.remove_task(task)
             days = progress.add_task("days", total=len(by_date))
             t0 = time.perf_counter()
+            written: list[Path] = []  # every file, as written: the one-day table lists them
 
             def finished(r: DayResult) -> None:
-                if out is not None:
-                    write_outputs(site, r, out, plot=draw)
+                written.extend(write_outputs(site, r, out, plot=draw))
                 progress.advance(days)
 
             results = run_days(engine, src, by_date, executor=ex, method=method,
@@ -110,12 +110,12 @@ def deliver_command(
             wall = time.perf_counter() - t0
         workers = ex.workers
     if day is not None:
-        _one_day(results[0], out, as_json)
+        _one_day(results[0], written, as_json)
     else:
         _summary(results, wall, jobs, workers, ex.kind, as_json)
 
 
-def _one_day(r: DayResult, out: Path, as_json: bool) -> None:
+def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
     rep = r.report()
     if as_json:
         typer.echo(json.dumps(rep))
@@ -128,7 +128,7 @@ def _one_day(r: DayResult, out: Path, as_json: bool) -> None:
              + ("" if pct is None else f" ({pct:.2f}%)")),
             ("moves", f"{rep['moves']} (battery left {rep['moves_left']})"),
             ("time", f"{rep['seconds']:.2f} s"),
-            ("files", str(out / f"drone-{r.date:%d-%m-%Y}.geojson"))]
+            ("files", "\n".join(str(f) for f in files))]
     for k, v in rows:
         t.add_row(k, str(v))
     Console().print(t)
