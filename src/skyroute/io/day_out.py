@@ -31,7 +31,9 @@ def geojson(result: DayResult, home) -> str:
 
 
 def plot_day(site, result: DayResult, path: Path) -> Path:
-    """Zones, area, the flight, shops, customers served (green) or not (red), home."""
+    """Zones, area, the flight, shops, customer places (:func:`customer_places`: served,
+    partly served or not served, each kind in the legend only when the day has one,
+    with its count), home."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -48,15 +50,12 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
         ax.plot(pts[:, 0], pts[:, 1], "-", color="tab:blue", lw=0.8, label="flight")
     shops = np.array([s.lonlat for s in site.shops], dtype=float).reshape(-1, 2)
     ax.plot(shops[:, 0], shops[:, 1], "s", color="tab:purple", ms=7, zorder=5, label="shop")
-    served = {p.lonlat for p in result.delivered}
-    missed = {site.locate(o.deliver_to) for o in result.orders
-              if o.order_no not in {p.order.order_no for p in result.delivered}
-              and o not in {q for q, _ in result.invalid}} - served
-    for pts, colour, label in ((served, "tab:green", "customer served"),
-                               (missed, "tab:red", "customer not served")):
-        if pts:
-            a = np.array(sorted(pts))
-            ax.plot(a[:, 0], a[:, 1], "o", color=colour, ms=7, zorder=5, label=label)
+    places = customer_places(site, result)
+    for kind, counts in places.items():
+        if counts:
+            a = np.array(list(counts), dtype=float)
+            ax.plot(a[:, 0], a[:, 1], linestyle="none", zorder=5, label=_place_label(kind, counts),
+                    **_PLACE_STYLE[kind])
     ax.plot(*site.home, "*", color="black", ms=13, zorder=6, label="home")
     pct = result.money_pct
     ax.set_title(f"Delivery day {result.date:%d %b %Y}: {len(result.delivered)}/"
@@ -67,8 +66,56 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
     # shop names last, on the final axes, each where it covers no other name or marker
     # (shops a few metres apart had their names piled on one another's squares)
     place_labels(ax, shops, [s.name for s in site.shops], fontsize=7,
-                 avoid=[*served, *missed, site.home])
+                 avoid=[p for counts in places.values() for p in counts] + [site.home])
     return save_figure(fig, path)
+
+
+SERVED, PARTLY, NOT_SERVED = "served", "partly served", "not served"
+
+# a partly served place must not pass for a served one: another shape, half green, half red
+_PLACE_STYLE = {
+    SERVED: {"marker": "o", "color": "tab:green", "ms": 7},
+    PARTLY: {"marker": "D", "color": "tab:green", "markerfacecoloralt": "tab:red",
+             "fillstyle": "left", "markeredgecolor": "black", "markeredgewidth": 0.6,
+             "ms": 7},
+    NOT_SERVED: {"marker": "o", "color": "tab:red", "ms": 7},
+}
+
+
+def customer_places(site, result: DayResult) -> dict[str, dict[tuple[float, float],
+                                                                tuple[int, int]]]:
+    """The day's customer places (lon, lat) by how they were served, each with
+    (orders delivered there, valid orders placed for it): ``"served"`` (every one
+    delivered), ``"partly served"`` (some) and ``"not served"`` (none), in that order,
+    places sorted. Invalid orders are left out: never flown, the report lists them.
+
+    A place with 3 orders of which 2 were flown is partly served: the picture drew it
+    as served, since it only asked whether anything was delivered there."""
+    invalid = {o.order_no for o, _ in result.invalid}
+    delivered = {p.order.order_no for p in result.delivered}
+    counts: dict[tuple[float, float], tuple[int, int]] = {}
+    for o in result.orders:
+        if o.order_no in invalid:
+            continue
+        place = tuple(site.locate(o.deliver_to))
+        done, placed = counts.get(place, (0, 0))
+        counts[place] = (done + (o.order_no in delivered), placed + 1)
+    out: dict = {SERVED: {}, PARTLY: {}, NOT_SERVED: {}}
+    for place, (done, placed) in sorted(counts.items()):
+        kind = SERVED if done == placed else NOT_SERVED if done == 0 else PARTLY
+        out[kind][place] = (done, placed)
+    return out
+
+
+def _place_label(kind: str, counts: dict) -> str:
+    """``customer served (5 places)``; a partly served kind also counts its orders."""
+    n = len(counts)
+    text = f"customer {kind} ({n} place{'' if n == 1 else 's'}"
+    if kind == PARTLY:
+        done = sum(d for d, _ in counts.values())
+        placed = sum(p for _, p in counts.values())
+        text += f", {done} of {placed} orders"
+    return text + ")"
 
 
 def output_paths(out: Path, date: dt.date, *, plot: bool = True) -> list[Path]:
