@@ -166,3 +166,93 @@ def test_labels_of_close_points_keep_apart():
              for x, y in centre]
         assert int(np.argmin(d)) == k or d[k] == min(d), names[k]
     plt.close(fig)
+
+
+def title_fits(fig, ax) -> list[str]:
+    """The title's lines, once checked to lie within the figure's width."""
+    title = ax.title
+    box = Text.get_window_extent(title, drawn(fig))
+    assert box.x0 >= 0 and box.x1 <= fig.bbox.width, title.get_text()
+    return title.get_text().split("\n")
+
+
+def test_pruned_grid_path_says_so_in_the_title(figures, tmp_path):
+    grid = skyroute.load_map("den312d")
+    result = skyroute.plan(grid, (50, 76), (60, 13), algorithm="theta", prune="los")
+    plot_grid_path(grid, result, (50, 76), (60, 13), tmp_path / "p.png", prune="los")
+    fig = figures[0]
+    lines = title_fits(fig, fig.axes[0])
+    assert lines == [f"den312d.map: theta, cost {result.cost:.3f}, {result.expanded:,} "
+                     "expanded", f"pruned (los): {len(result.path)} waypoints"]
+
+
+def test_a_long_title_on_a_narrow_map_takes_two_lines_within_the_figure(figures, tmp_path):
+    blocked = np.zeros((60, 8), dtype=bool)  # tall and narrow: the narrowest figure
+    grid = Grid(blocked, name="a_rather_long_name_for_a_narrow_map.map")
+    result = skyroute.plan(grid, (0, 0), (7, 59), prune="collinear")
+    plot_grid_path(grid, result, (0, 0), (7, 59), tmp_path / "p.png", prune="collinear")
+    fig = figures[0]
+    lines = title_fits(fig, fig.axes[0])
+    assert len(lines) == 2 and lines[1].endswith(f"pruned (collinear): {len(result.path)} "
+                                                 "waypoints")
+    assert ", ".join(lines).startswith("a_rather_long_name_for_a_narrow_map.map: astar, cost")
+
+
+def test_grid_legend_says_the_blocked_cells_are_grown_by_the_safety_margin(figures, tmp_path):
+    grid = skyroute.load_map("den312d", safety=1.5)
+    result = skyroute.plan(grid, (61, 77), (20, 3))
+    plot_grid_path(grid, result, (61, 77), (20, 3), tmp_path / "p.png", safety=1.5)
+    texts = [t.get_text() for t in figures[0].axes[0].get_legend().get_texts()]
+    assert texts[0] == "blocked, grown by 1.5 m"
+    assert figures[0].axes[0].get_title().count("\n") == 0  # not pruned: one line
+
+
+@pytest.mark.parametrize(("altitude", "safety", "frame", "label"), [
+    (10, 2, "ned", "obstacles at 10 m, grown by 2 m"),
+    (10.5, 0, "lonlat", "obstacles at 10.5 m"),
+    (None, 0, "enu", "obstacles at all altitudes"),
+    (None, 2e-05, "degrees", "obstacles at all altitudes, grown by 2e-05 deg"),
+])
+def test_obstacles_label_names_altitude_and_margin(altitude, safety, frame, label):
+    assert world_out.obstacles_label(altitude, safety, frame) == label
+
+
+def _legend(fig) -> list[str]:
+    return [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+
+
+CITY = str(ROOT / "examples" / "city.csv")
+
+
+def test_plan_world_plot_names_altitude_and_safety(monkeypatch, capsys, figures, tmp_path):
+    from tests.cli.test_cli import run
+
+    code, _, err = run(monkeypatch, capsys, "plan-world", CITY, "--frame", "ned", "--start",
+                       "0,0", "--goal", "120,-180", "--altitude", "10", "--safety", "2",
+                       "--algorithm", "astar", "--resolution", "2", "--plot",
+                       str(tmp_path / "w.png"))
+    assert code == 0, err
+    (fig,) = figures
+    assert _legend(fig)[0] == "obstacles at 10 m, grown by 2 m"
+    assert title_fits(fig, fig.axes[0]) == [fig.axes[0].get_title()]
+
+
+def test_fly_step_plot_gives_the_margin_in_metres(monkeypatch, capsys, figures, tmp_path):
+    """The step drone flies on the lon/lat plane, but --safety grew the city in metres."""
+    from tests.cli.test_cli import run
+
+    code, _, err = run(monkeypatch, capsys, "fly", CITY, "--vehicle", "step",
+                       "--start=-3.1890,55.9456", "--goal=-3.1850,55.9432", "--safety", "2",
+                       "--plot", str(tmp_path / "s.png"))
+    assert code == 0, err
+    assert _legend(figures[0])[0] == "obstacles at all altitudes, grown by 2 m"
+
+
+def test_plan_prune_plot_from_the_command_line(monkeypatch, capsys, figures, tmp_path):
+    from tests.cli.test_cli import run
+
+    code, _, err = run(monkeypatch, capsys, "plan", "den312d", "--start", "50,76", "--goal",
+                       "60,13", "--algorithm", "theta", "--prune", "los", "--plot",
+                       str(tmp_path / "p.png"))
+    assert code == 0, err
+    assert figures[0].axes[0].get_title().endswith("\npruned (los): 5 waypoints")

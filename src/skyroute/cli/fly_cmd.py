@@ -188,7 +188,7 @@ def fly_command(
     if out is not None and doc["reached"]:
         write_atomic(out, _render(out, rows, doc["columns"], world.to_lonlat(xy)))
     if plot is not None and doc["reached"]:
-        from skyroute.io.world_out import plot_world_path
+        from skyroute.io.world_out import obstacles_label, plot_world_path
 
         # The title shows the length the table and --json report (a Dubins path's
         # exact arcs); only a vehicle without one is measured along the drawn polyline,
@@ -198,7 +198,9 @@ def fly_command(
             plane = world.to_plane(xy)
             length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
         shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)
-        plot_world_path(world, shown, a, xy[-1], plot)
+        # --safety is in the units of the frame loaded (metres after 'step' moved to degrees)
+        plot_world_path(world, shown, a, xy[-1], plot,
+                        obstacles=obstacles_label(altitude, safety, frame))
     if as_json:
         typer.echo(json.dumps({k: v for k, v in doc.items() if k != "columns"}))
     else:

@@ -81,7 +81,7 @@ def plan_command(
         if plot:
             from skyroute.io.plot import plot_grid_path
 
-            plot_grid_path(grid, result, s, t, plot)
+            plot_grid_path(grid, result, s, t, plot, prune=opts.prune, safety=safety)
     if as_json:
         typer.echo(json.dumps(result.to_dict()))
     else:

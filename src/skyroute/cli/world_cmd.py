@@ -16,6 +16,7 @@ from skyroute.cli.tables import result_table
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
+    obstacles_label,
     path_north_east,
     plot_world_path,
     waypoints,
@@ -73,7 +74,8 @@ def plan_world_command(
             write_atomic(geojson, dumps(world_path_geojson(world, result)))
         if plot:
             plot_world_path(world, result, a, b, plot,
-                            edges=roadmap_edges(world, algorithm, samples=samples, seed=seed))
+                            edges=roadmap_edges(world, algorithm, samples=samples, seed=seed),
+                            obstacles=obstacles_label(altitude, safety, world.frame))
     if as_json:
         typer.echo(json.dumps(world_result_doc(world, result)))
     else:

@@ -20,11 +20,15 @@ DOTS_UP_TO = 60  # a path's points are marked when it has at most this many
 
 
 def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
-                   goal: tuple[int, int], path: str | Path, *, dpi: int | None = None) -> Path:
+                   goal: tuple[int, int], path: str | Path, *, dpi: int | None = None,
+                   prune: str = "none", safety: float = 0.0) -> Path:
     """Draw the grid (blocked cells dark), the path, start (green) and goal (red).
 
     Axes are cell coordinates (x to the right, y down, as MovingAI counts them). ``dpi``
-    defaults to :func:`grid_dpi`: large maps get the pixels their cells need.
+    defaults to :func:`grid_dpi`: large maps get the pixels their cells need. ``prune``
+    and ``safety`` are what the grid and the path were made with: the title says how a
+    path was pruned ("pruned (los): 5 waypoints"), the legend that the blocked cells
+    include the safety margin ("blocked, grown by 1.5 m").
     """
     import matplotlib
 
@@ -38,19 +42,43 @@ def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
     fig, ax = plt.subplots(figsize=area)
     ax.imshow(grid.blocked, cmap="Greys", vmin=0, vmax=1.4, interpolation="nearest",
               extent=(-0.5, w - 0.5, h - 0.5, -0.5))
-    ax.plot([], [], "s", color=plt.get_cmap("Greys")(1 / 1.4), ms=7, label="blocked")
+    ax.plot([], [], "s", color=plt.get_cmap("Greys")(1 / 1.4), ms=7,
+            label="blocked" + (f", grown by {safety:g} m" if safety > 0 else ""))
     if result.found:
         # A line no wider than a cell (in points), so a corridor of a maze stays visible.
         cell_pt = 72 * min(area[0] * 0.8 / w, area[1] * 0.8 / h)
         draw_path(ax, result.path, lw=float(np.clip(cell_pt, 0.6, 1.6)))
     mark_ends(ax, start, goal, start_text=_cell(start), goal_text=_cell(goal))
     cost = f"cost {result.cost:.3f}" if result.found else result.status.value
-    ax.set_title(f"{grid.name}: {result.algorithm}, {cost}, {result.expanded:,} expanded",
-                 fontsize=10)
+    parts = [f"{grid.name}: {result.algorithm}", cost, f"{result.expanded:,} expanded"]
+    if prune != "none" and result.found:
+        parts.append(f"pruned ({prune}): {len(result.path)} waypoints")
+    set_title(ax, parts)
     ax.set_xlabel("x (column)")
     ax.set_ylabel("y (row)")
     legend_outside(ax)
     return save_figure(fig, path, dpi=dpi)
+
+
+def set_title(ax, parts, *, fontsize: float = 10):
+    """The title ``parts`` joined by ", ": on one line when it fits the axes' width,
+    otherwise the parts that fit on the first line and the rest on a second, so a long
+    title (a pruned path's, on a narrow map) stays over the map. Returns the title."""
+    from matplotlib.font_manager import FontProperties
+
+    fig = ax.figure
+    renderer = fig.canvas.get_renderer()
+    font = FontProperties(size=fontsize)
+    room = ax.get_position().width * fig.bbox.width  # pixels
+
+    def width(text: str) -> float:
+        return renderer.get_text_width_height_descent(text, font, ismath=False)[0]
+
+    first = 1
+    while first < len(parts) and width(", ".join(parts[:first + 1])) <= room:
+        first += 1
+    lines = [", ".join(parts[:first])] + ([", ".join(parts[first:])] if parts[first:] else [])
+    return ax.set_title("\n".join(lines), fontsize=fontsize)
 
 
 def grid_dpi(shape: tuple[int, int], figsize: tuple[float, float]) -> int:

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.geo import heading_of, lonlat_to_enu
-from skyroute.io.plot import draw_path, legend_outside, mark_ends, save_figure
+from skyroute.io.plot import draw_path, legend_outside, mark_ends, save_figure, set_title
 from skyroute.result import PlanResult
 from skyroute.world.world import World
 
@@ -55,17 +55,20 @@ def world_path_geojson(world: World, result: PlanResult) -> dict:
 
 
 def plot_world_path(world: World, result: PlanResult, start, goal, path: str | Path, *,
-                    edges: np.ndarray | None = None, dpi: int = 150) -> Path:
+                    edges: np.ndarray | None = None, dpi: int = 150,
+                    obstacles: str = "obstacles") -> Path:
     """Draw obstacles (grey), the boundary (dashed), roadmap edges (thin, plane
     segments), the path; ``result.path``, ``start`` and ``goal`` in the world's frame
-    (the legend names start and goal as they were given)."""
+    (the legend names start and goal as they were given). ``obstacles`` is the grey
+    shapes' legend entry: :func:`obstacles_label` says at which altitude and grown by
+    what margin the world was loaded, which the world itself does not record."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(8, 8))
-    draw_world(ax, world)
+    draw_world(ax, world, label=obstacles)
     if edges is not None and len(edges):
         from matplotlib.collections import LineCollection
 
@@ -78,9 +81,20 @@ def plot_world_path(world: World, result: PlanResult, start, goal, path: str | P
               start_text=_point(world, start), goal_text=_point(world, goal))
     unit = "deg" if world.plane == "degrees" else "m"
     cost = f"{result.cost:.6g} {unit}" if result.found else result.status.value
-    ax.set_title(f"{world.name}: {result.algorithm}, {cost}", fontsize=10)
+    set_title(ax, [f"{world.name}: {result.algorithm}", cost])
     finish_axes(ax, world)
     return save_figure(fig, path, dpi=dpi)
+
+
+def obstacles_label(altitude: float | None, safety: float, frame: str) -> str:
+    """What the grey shapes of a world loaded by :func:`skyroute.load_world` with
+    ``altitude``, ``safety`` and ``frame`` are: the obstacles that count at that altitude
+    (all of them for None), already grown by the margin (metres; degrees in the degrees
+    frame), e.g. ``obstacles at 10 m, grown by 2 m``."""
+    at = "all altitudes" if altitude is None else f"{altitude:g} m"
+    unit = "deg" if frame == "degrees" else "m"
+    grown = f", grown by {safety:g} {unit}" if safety > 0 else ""
+    return f"obstacles at {at}{grown}"
 
 
 _POINT_NAMES = {"lonlat": ("lon", "lat", ""), "degrees": ("lon", "lat", ""),
