@@ -28,9 +28,11 @@ const player = new Player({
   },
   onEnd: () => {
     if (day) {
+      const partly = customerPlaces(day.orders).filter(isPartly).length;
       say(status, `The flight of ${day.date} is over: ${day.report.orders_delivered} of ` +
         `${day.report.orders_placed} orders delivered, ${fmt(day.report.money_pct, 1)} % of the money ` +
-        `in ${day.moves} moves.`, "ok");
+        `in ${day.moves} moves` + (partly ? `; ${partly} customer place${partly > 1 ? "s" : ""} ` +
+        "partly served (ringed)." : "."), "ok");
     }
   },
 });
@@ -224,12 +226,18 @@ function drawMap(ctx, v) {
       ctx.stroke();
     }
   }
-  // customers of the day: blue, green once their order is delivered
+  // customers of the day, one dot a place (several orders may share one): blue, green
+  // once its delivered orders are all delivered, grey when none of its orders is served;
+  // a grey ring marks a place where some orders are served and some are not
   const k = Math.floor(t);
-  for (const o of day.orders) {
-    if (!o.lonlat) continue;
-    const at = o.status === "delivered" ? day.doneAt.get(o.order_no) : undefined;
-    dot(ctx, P(o.lonlat), 4.5, at !== undefined && at <= k ? "#1b7a3d" : o.status === "delivered" ? "#0072b2" : "#8a8f99");
+  for (const place of customerPlaces(day.orders)) {
+    const served = place.orders.filter(o => o.status === "delivered");
+    const done = served.every(o => (day.doneAt.get(o.order_no) ?? Infinity) <= k);
+    const at = P(place.lonlat);
+    const partly = isPartly(place);
+    dot(ctx, at, 4.5, !served.length ? "#8a8f99" : done ? "#1b7a3d" : "#0072b2",
+        partly ? "#8a8f99" : "#fff");
+    if (partly) dot(ctx, at, 7, "rgba(0,0,0,0)", "#5b6475");
   }
   if (site) {
     for (const s of site.shops) {
@@ -285,3 +293,24 @@ function drawMap(ctx, v) {
 }
 
 start();
+
+/** The day's orders grouped by their customer's place: [{lonlat, orders}], in order of
+ * first appearance (orders without a place left out). */
+function customerPlaces(orders) {
+  const places = new Map();
+  for (const o of orders) {
+    if (!o.lonlat) continue;
+    const key = o.lonlat.join(",");
+    if (!places.has(key)) places.set(key, { lonlat: o.lonlat, orders: [] });
+    places.get(key).orders.push(o);
+  }
+  return [...places.values()];
+}
+
+/** Some of a place's valid orders delivered and some not (invalid orders never count,
+ * as on the day's PNG). */
+function isPartly(place) {
+  const valid = place.orders.filter((o) => o.status !== "invalid");
+  const served = valid.filter((o) => o.status === "delivered").length;
+  return served > 0 && served < valid.length;
+}
