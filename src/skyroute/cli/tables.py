@@ -1,5 +1,5 @@
 """Rich output shared by commands: the PlanResult table, a console wide enough for tables,
-the progress bar of long runs."""
+the progress bar of long runs and where progress shows."""
 
 from __future__ import annotations
 
@@ -47,6 +47,13 @@ def wide_console() -> Console:
     return out if out.is_terminal else Console(width=160)
 
 
+def shows_progress(console: Console) -> bool:
+    """Whether progress (a bar, a status line) shows on ``console``: only on an
+    interactive terminal, never on a file or a pipe (a log, CI), where it would garble
+    what is read there."""
+    return console.is_interactive
+
+
 def progress_bar(console: Console, *, elapsed: bool = False) -> Progress:
     """The progress bar of a long run (description, bar, done/total, time left or, with
     ``elapsed``, time taken), on ``console`` (stderr), gone when finished.
@@ -70,4 +77,4 @@ def progress_bar(console: Console, *, elapsed: bool = False) -> Progress:
 
     return Progress(TextColumn("{task.description}"), BarColumn(), Count(),
                     TimeElapsedColumn() if elapsed else TimeRemainingColumn(),
-                    console=console, transient=True, disable=not console.is_interactive)
+                    console=console, transient=True, disable=not shows_progress(console))
