@@ -8,11 +8,15 @@ No timing asserts: the work waits on the status's ``settled`` event, never on a 
 from __future__ import annotations
 
 import io
+import json
 
 import pytest
 from rich.console import Console
 
+from skyroute.cli import plan_cmd
+from skyroute.cli import status as status_mod
 from skyroute.cli.status import COMPILING, delayed_status
+from tests.cli.test_cli import QUERY, run
 
 ERASED = "\x1b[2K"  # the line erased
 CURSOR_BACK = "\x1b[?25h"  # the cursor shown again
@@ -97,3 +101,37 @@ def test_says_kernels_compile_only_when_numba_compiles():
         add_one(2)  # compiled now: no event, the note stays for this phase
         status.update("writing")
         assert status.text == "writing…"  # a new phase, nothing compiled in it
+
+
+def test_plan_json_stdout_stays_pure_json_while_the_status_shows(monkeypatch, capsys):
+    # stderr made an interactive terminal as Rich reads the environment; the plan waits
+    # until the status is up, so it shows while stdout gets the JSON
+    monkeypatch.setenv("TTY_COMPATIBLE", "1")
+    monkeypatch.setenv("TTY_INTERACTIVE", "1")
+    monkeypatch.setattr(status_mod, "DELAY", 0.0)
+    made = []
+
+    def recording(*args, **kwargs):
+        made.append(delayed_status(*args, **kwargs))
+        return made[-1]
+
+    real_load = plan_cmd.load_map
+
+    def held_load(*args, **kwargs):
+        assert made[-1].settled.wait(10)
+        return real_load(*args, **kwargs)
+
+    monkeypatch.setattr(plan_cmd, "delayed_status", recording)
+    monkeypatch.setattr(plan_cmd, "load_map", held_load)
+    code, out, err = run(monkeypatch, capsys, "plan", *QUERY, "--json")
+    assert code == 0, err
+    assert json.loads(out)["status"] == "found"  # the whole of stdout is the JSON
+    assert made[-1].shown and "planning…" in err and cleared(err, "…")
+
+
+def test_plan_json_off_a_terminal_writes_nothing_else(monkeypatch, capsys,
+                                                      no_forced_terminal):
+    monkeypatch.setattr(status_mod, "DELAY", 0.0)
+    code, out, err = run(monkeypatch, capsys, "plan", *QUERY, "--json")
+    assert code == 0, err
+    assert json.loads(out)["status"] == "found" and err == ""

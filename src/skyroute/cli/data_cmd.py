@@ -10,6 +10,7 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
+from skyroute.cli.status import delayed_status
 from skyroute.errors import OptionError
 
 data_app = typer.Typer(help="Delivery data sets: synthesise one, serve one over HTTP.",
@@ -27,14 +28,15 @@ def data_synth(
         min=0, help="Seed: the same seed writes the same files.")] = 1,
 ) -> None:
     """Write a synthetic data set in the ILP layout (website/, database/) in another town."""
-    from skyroute.delivery.synth import synth
-
     try:
         first = dt.date.fromisoformat(start)
     except ValueError:
         raise OptionError(f"--start {start!r}: expected a date YYYY-MM-DD") from None
-    summary = synth(folder, days=days, orders_per_day=orders_per_day, seed=seed, start=first,
-                    customers=customers)
+    with delayed_status(f"writing a data set to {folder}"):  # imports included: seconds
+        from skyroute.delivery.synth import synth
+
+        summary = synth(folder, days=days, orders_per_day=orders_per_day, seed=seed,
+                        start=first, customers=customers)
     Console().print(json.dumps(summary))
 
 

@@ -15,6 +15,7 @@ from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli import world_args as wa
+from skyroute.cli.status import delayed_status
 from skyroute.errors import OptionError, check_choice
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
@@ -163,28 +164,29 @@ def fly_command(
     _check_typed_heading(h1, goal, "goal", vehicle)
     h0 = _one_heading(h0, start_heading, "start")
     h1 = _one_heading(h1, goal_heading, "goal")
-    world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
-                       frame=frame)
-    world.check_point(a, "start")  # one error, in the user's frame, for every vehicle
-    if targets is None:
-        world.check_point(b, "goal")
-    if vehicle == "step":
-        world, a, b = world.in_frame("degrees"), world.to_lonlat(a)[0], world.to_lonlat(b)[0]
-        doc, rows, xy = _fly_step(world, a, b, planner)
-    elif vehicle == "dubins" and targets is not None:
-        doc, rows, xy = _fly_tour(world, a, h0, _read_targets(targets, world), radius, step,
-                                  max_expansions)
-    elif vehicle == "dubins" and planner == "hybrid":
-        doc, rows, xy = _fly_hybrid(world, a, b, h0, h1, radius, step, reverse,
-                                    max_expansions, approach)
-    elif vehicle == "dubins":
-        doc, rows, xy = _fly_dubins(world, a, b, radius, h0 or 0.0, h1, step)
-    elif vehicle == "lattice":
-        doc, rows, xy = _fly_lattice(world, a, b, headings, speed, math.radians(turn_rate),
-                                     h0 or 0.0, resolution)
-    else:
-        doc, rows, xy = _fly_field(world, a, b, step, escape, sensor_range, sensor_rays,
-                                   field_mode, math.radians(max_turn))
+    with delayed_status("planning"):  # a first Dubins flight compiles for 10-20 s
+        world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
+                           frame=frame)
+        world.check_point(a, "start")  # one error, in the user's frame, for every vehicle
+        if targets is None:
+            world.check_point(b, "goal")
+        if vehicle == "step":
+            world, a, b = world.in_frame("degrees"), world.to_lonlat(a)[0], world.to_lonlat(b)[0]
+            doc, rows, xy = _fly_step(world, a, b, planner)
+        elif vehicle == "dubins" and targets is not None:
+            doc, rows, xy = _fly_tour(world, a, h0, _read_targets(targets, world), radius, step,
+                                      max_expansions)
+        elif vehicle == "dubins" and planner == "hybrid":
+            doc, rows, xy = _fly_hybrid(world, a, b, h0, h1, radius, step, reverse,
+                                        max_expansions, approach)
+        elif vehicle == "dubins":
+            doc, rows, xy = _fly_dubins(world, a, b, radius, h0 or 0.0, h1, step)
+        elif vehicle == "lattice":
+            doc, rows, xy = _fly_lattice(world, a, b, headings, speed, math.radians(turn_rate),
+                                         h0 or 0.0, resolution)
+        else:
+            doc, rows, xy = _fly_field(world, a, b, step, escape, sensor_range, sensor_rays,
+                                       field_mode, math.radians(max_turn))
     if out is not None and doc["reached"]:
         write_atomic(out, _render(out, rows, doc["columns"], world.to_lonlat(xy)))
     if plot is not None and doc["reached"]:

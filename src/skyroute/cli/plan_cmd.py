@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from skyroute.cli.parse import parse_cell
+from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import result_table
 from skyroute.errors import OptionError
 from skyroute.files import check_writable, write_atomic
@@ -66,15 +67,17 @@ def plan_command(
         raise OptionError("--index answers exact octile queries: leave --algorithm, "
                           "--connectivity, --corner-cutting, --heuristic, --weight, --prune "
                           "and --max-expansions at their defaults", param="index")
-    grid = load_map(map_file, resolution=resolution, safety=safety)
-    if index is not None:
-        from skyroute.search.prepared import load_index
+    with delayed_status("planning"):  # a first run compiles its kernels for seconds
+        grid = load_map(map_file, resolution=resolution, safety=safety)
+        if index is not None:
+            from skyroute.search.prepared import load_index
 
-        result = load_index(index, grid).plan(s, t)
-    else:
-        result = plan(grid, s, t, algorithm=opts.algorithm, connectivity=opts.connectivity,
-                      corner_cutting=opts.corner_cutting, heuristic=opts.heuristic,
-                      weight=opts.weight, prune=opts.prune, max_expansions=max_expansions)
+            result = load_index(index, grid).plan(s, t)
+        else:
+            result = plan(grid, s, t, algorithm=opts.algorithm,
+                          connectivity=opts.connectivity, corner_cutting=opts.corner_cutting,
+                          heuristic=opts.heuristic, weight=opts.weight, prune=opts.prune,
+                          max_expansions=max_expansions)
     if result.found:
         if geojson:
             write_atomic(geojson, dumps(grid_path_geojson(grid, result)))
@@ -119,8 +122,7 @@ def prepare_command(
     if grid.blocked.all():
         Console(stderr=True).print(f"note: every cell of {grid.name} is blocked (--safety "
                                    f"{safety:g}): the index will refuse every query")
-    with Console(stderr=True).status(f"Preparing {grid.name} (the first run also compiles "
-                                     "the kernels: a minute or two)"):
+    with delayed_status(f"preparing {grid.name}"):  # a first run compiles for a minute
         index = prepare(grid, method=method)
     written = index.save(out)
     Console().print(f"{grid.name}: {index.describe()}, built in {index.build_seconds:.3f} s, "

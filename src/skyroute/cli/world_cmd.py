@@ -12,6 +12,7 @@ from rich.console import Console
 from rich.markup import escape  # help is Rich markup: '[north, ...]' would read as a tag
 
 from skyroute.cli import world_args as wa
+from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import result_table
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
@@ -62,10 +63,11 @@ def plan_world_command(
     frame = wa.frame_of(frame)
     a = wa.parse_pair(start, "--start", wa.point_names(frame))
     b = wa.parse_pair(goal, "--goal", wa.point_names(frame))
-    world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
-                       frame=frame)
-    result = plan(world, a, b, algorithm=algorithm, resolution=resolution, samples=samples,
-                  seed=seed)
+    with delayed_status("planning"):  # a roadmap or raster, and a first run's compiles
+        world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
+                           frame=frame)
+        result = plan(world, a, b, algorithm=algorithm, resolution=resolution,
+                      samples=samples, seed=seed)
     alt = 0.0 if altitude is None else altitude
     if result.found:
         if waypoints_out:
@@ -112,5 +114,6 @@ def synth_city_command(
     """Write a synthetic city (random box buildings in street blocks) as colliders.csv."""
     from skyroute.world.synth import synth_city
 
-    write_atomic(out, synth_city(np.random.default_rng(seed), blocks=blocks))  # checks blocks
+    with delayed_status(f"writing {out}"):  # 100 x 100 blocks: 35,000 buildings
+        write_atomic(out, synth_city(np.random.default_rng(seed), blocks=blocks))  # checks blocks
     typer.echo(f"wrote {out}: {blocks}x{blocks} blocks, home (0, 0) on a street crossing")
