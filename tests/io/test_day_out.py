@@ -18,7 +18,6 @@ from skyroute.delivery.orders import price, read_csv_orders
 from skyroute.delivery.site import load_site
 from skyroute.delivery.source import DirSource
 from skyroute.io import day_out
-from skyroute.io import plot as plot_mod
 from skyroute.motion.step_drone import Flight
 from tests.conftest import ROOT
 
@@ -79,20 +78,6 @@ def test_a_day_with_one_order_left_is_not_all_green(site, orders):
     assert sorted(places["partly served"]) == sorted(list(orders)[:2])
     assert not places["not served"]
     assert len(places["served"]) == len(orders) - 2
-
-
-@pytest.fixture
-def figures(monkeypatch):
-    """The figures saved while the test runs (still drawn to their files)."""
-    saved = []
-    real = plot_mod.save_figure
-
-    def keep(fig, path, **kw):
-        saved.append(fig)
-        return real(fig, path, **kw)
-
-    monkeypatch.setattr(plot_mod, "save_figure", keep)
-    return saved
 
 
 def _customers(ax) -> dict:

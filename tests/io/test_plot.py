@@ -16,28 +16,12 @@ import matplotlib.pyplot as plt
 from matplotlib.text import Text
 
 import skyroute
-from skyroute.io import plot as plot_mod
 from skyroute.io import world_out
 from skyroute.io.plot import draw_path, grid_dpi, place_labels, plot_grid_path
 from skyroute.result import PlanResult, Status
 from skyroute.world.grid import Grid
 from skyroute.world.load import load_world
 from tests.conftest import ROOT
-
-
-@pytest.fixture
-def figures(monkeypatch):
-    """The figures saved while the test runs (still drawn to their files)."""
-    saved = []
-    real = plot_mod.save_figure
-
-    def keep(fig, path, **kw):
-        saved.append(fig)
-        return real(fig, path, **kw)
-
-    monkeypatch.setattr(plot_mod, "save_figure", keep)
-    monkeypatch.setattr(world_out, "save_figure", keep)
-    return saved
 
 
 def png_size(path) -> tuple[int, int]:
