@@ -58,6 +58,9 @@ def test_range_prints_a_monthly_table(monkeypatch, capsys, tmp_path, fly_once):
     assert code == 0, err
     assert "2 days" in out and "2024-01" in out and "mean %" in out
     assert not list(tmp_path.glob("*.png"))  # no pictures for a range unless asked
+    # where the files went (a range said nothing of them): a GeoJSON and a report a day
+    assert len(list(tmp_path.glob("*-0?-01-2024.*"))) == 4
+    assert f"wrote 4 files to {tmp_path}" in " ".join(out.split())
 
 
 def test_db_init_and_import(monkeypatch, capsys, tmp_path):

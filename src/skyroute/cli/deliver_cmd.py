@@ -112,7 +112,7 @@ def deliver_command(
     if day is not None:
         _one_day(results[0], written, as_json)
     else:
-        _summary(results, wall, jobs, workers, ex.kind, as_json)
+        _summary(results, wall, jobs, workers, ex.kind, as_json, written)
 
 
 def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
@@ -137,11 +137,12 @@ def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
 
 
 def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kind: str,
-             as_json: bool) -> None:
+             as_json: bool, files: list[Path]) -> None:
     from skyroute.jobs.deliver import summarise
 
     s = summarise(results)
-    s.update(wall_seconds=wall, jobs=jobs, executor=kind, workers=workers)
+    s.update(wall_seconds=wall, jobs=jobs, executor=kind, workers=workers,
+             files=len(files), folders=sorted({str(f.parent) for f in files}))
     if as_json:
         typer.echo(json.dumps(s))
         return
@@ -155,3 +156,6 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
     for m, v in s["months"].items():
         t.add_row(m, str(v["days"]), f"{v['mean_pct']:.2f}", f"{v['min_pct']:.2f}")
     Console().print(t)
+    if files:
+        Console().print(f"wrote {len(files):,} files to {', '.join(s['folders'])}",
+                        markup=False)
