@@ -14,7 +14,7 @@ from tests.jobs.conftest import EXAMPLE
 
 RANGE = ["--from", "2024-01-01", "--to", "2024-01-02"]  # (2024-01-03: see test_deliver_jobs)
 TIMING = ("wall_seconds", "seconds_per_day_mean", "seconds_per_day_max", "jobs",
-          "executor", "workers")
+          "executor", "workers", "folders")  # and where the files went: each its own --out
 
 
 def test_deliver_range_on_dask_is_the_local_range(monkeypatch, capsys, tmp_path):
@@ -28,6 +28,7 @@ def test_deliver_range_on_dask_is_the_local_range(monkeypatch, capsys, tmp_path)
         out[name] = json.loads(text), store.connect(db)
     (a, ea), (b, eb) = out["local"], out["dask"]
     assert (b["executor"], b["workers"], a["executor"]) == ("dask", 2, "local")
+    assert (a["folders"], b["folders"]) == ([str(tmp_path / "local")], [str(tmp_path / "dask")])
     assert {k: v for k, v in a.items() if k not in TIMING} == \
         {k: v for k, v in b.items() if k not in TIMING}
     for d in (dt.date(2024, 1, 1), dt.date(2024, 1, 2)):
