@@ -133,6 +133,8 @@ SEED3 = _seed3()
     ("/jobs/deliver", {"from": 1704240000, "to": DAY}, "from", "YYYY-MM-DD"),
     ("/jobs/deliver", {"date": DAY, "method": "magic"}, "method", "'milp'"),
     ("/jobs/deliver", {"date": DAY, "jobs": 4}, "jobs", "Extra inputs"),
+    # the field's Python name is no key of the API (the schema already refused it)
+    ("/jobs/deliver", {"from_": "2024-01-01", "to": DAY}, "from_", "Extra inputs"),
     ("/jobs/fleet", {}, "body", "exactly one of preset and scenario"),
     ("/jobs/fleet", {"preset": "seed-2x2"}, "preset", "'seed-3x3'"),
     ("/jobs/fleet", {"preset": "seed-3x3", "hours": 0}, "hours", "greater than 0"),

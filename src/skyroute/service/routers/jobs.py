@@ -45,7 +45,8 @@ class DeliverJob(BaseModel):
     ``date``, or both ``from`` and ``to`` (null counts as not given; the schema states
     it as ``oneOf``)."""
 
-    model_config = ConfigDict(extra="forbid", populate_by_name=True,
+    # by its alias alone: "from_" is no field of the API (the schema forbids it too)
+    model_config = ConfigDict(extra="forbid",
                               json_schema_extra=exactly_one("date", ("from", "to")))
 
     date: IsoDate | None = Field(None, description="One day. Give date, or both from "
