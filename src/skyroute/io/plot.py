@@ -46,7 +46,7 @@ def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
             label="blocked" + (f", grown by {safety:g} m" if safety > 0 else ""))
     if result.found:
         # A line no wider than a cell (in points), so a corridor of a maze stays visible.
-        cell_pt = 72 * min(area[0] * 0.8 / w, area[1] * 0.8 / h)
+        cell_pt = 72 * _cell_inches(grid.blocked.shape, area)
         draw_path(ax, result.path, lw=float(np.clip(cell_pt, 0.6, 1.6)))
     mark_ends(ax, start, goal, start_text=_cell(start), goal_text=_cell(goal))
     cost = f"cost {result.cost:.3f}" if result.found else result.status.value
@@ -85,9 +85,14 @@ def grid_dpi(shape: tuple[int, int], figsize: tuple[float, float]) -> int:
     """The resolution that gives each cell of a map of ``shape`` (rows, columns) drawn
     on a figure of ``figsize`` inches about :data:`CELL_PIXELS` pixels: :data:`DPI` for
     small maps (a 32x32 map stays a small file), up to :data:`MAX_DPI` for large ones."""
+    return int(np.clip(np.ceil(CELL_PIXELS / _cell_inches(shape, figsize)), DPI, MAX_DPI))
+
+
+def _cell_inches(shape: tuple[int, int], figsize: tuple[float, float]) -> float:
+    """A cell's side in inches when a map of ``shape`` fills the axes (about 80%) of a
+    figure of ``figsize``."""
     h, w = shape
-    cell_in = min(figsize[0] * 0.8 / w, figsize[1] * 0.8 / h)  # the axes take ~80%
-    return int(np.clip(np.ceil(CELL_PIXELS / cell_in), DPI, MAX_DPI))
+    return min(figsize[0] * 0.8 / w, figsize[1] * 0.8 / h)
 
 
 def _cell(c) -> str:

@@ -12,7 +12,7 @@ import numpy as np
 from skyroute.geo import heading_of, lonlat_to_enu
 from skyroute.io.plot import draw_path, legend_outside, mark_ends, save_figure, set_title
 from skyroute.result import PlanResult
-from skyroute.world.world import World
+from skyroute.world.world import AXES, World
 
 
 def path_lonlat(world: World, path: np.ndarray) -> np.ndarray:
@@ -97,13 +97,11 @@ def obstacles_label(altitude: float | None, safety: float, frame: str) -> str:
     return f"obstacles at {at}{grown}"
 
 
-_POINT_NAMES = {"lonlat": ("lon", "lat", ""), "degrees": ("lon", "lat", ""),
-                "ned": ("north", "east", " m"), "enu": ("east", "north", " m")}
-
-
 def _point(world: World, p) -> str:
-    """A point as it was typed, in the world's frame: ``(north 120 m, east -180 m)``."""
-    a, b, unit = _POINT_NAMES[world.frame]
+    """A point as it was typed, in the world's frame and named by its axes
+    (:data:`~skyroute.world.world.AXES`): ``(north 120 m, east -180 m)``."""
+    a, b = AXES[world.frame]
+    unit = "" if world.frame in ("lonlat", "degrees") else " m"
     x, y = np.asarray(p, dtype=float).reshape(-1)[:2]
     return f"({a} {x:.7g}{unit}, {b} {y:.7g}{unit})"
 
