@@ -337,16 +337,6 @@ def test_path_free_is_exact_at_a_corner():
 
 # -- smaller contracts --------------------------------------------------------------------
 
-def test_docstring_examples():
-    import doctest
-
-    from skyroute.motion import hybrid, pieces
-
-    for module in (hybrid, pieces):
-        result = doctest.testmod(module)
-        assert result.attempted > 0 and result.failed == 0
-
-
 def test_same_start_and_goal():
     world = make_world([(40, 40, 60, 60)])
     res = plan(world, (10, 10, 1.0), (10, 10, 1.0), R)
