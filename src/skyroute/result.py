@@ -94,6 +94,15 @@ class PlanResult:
         d["path_lonlat"] = None
         return r
 
+    def __repr__(self) -> str:
+        """A summary: the status, cost, path size and the statistics (``path`` holds
+        the points)."""
+        cost = f", cost {self.cost:.6g}" if self.status is Status.FOUND else ""
+        checks = f", {self.los_checks} line-of-sight checks" if self.los_checks else ""
+        return (f"<PlanResult {self.status.value}{cost}, {len(self.path)} points, "
+                f"{self.algorithm or 'planner'}: {self.expanded} expanded, "
+                f"frontier {self.max_frontier}{checks}, {self.seconds * 1e3:.3g} ms>")
+
     @property
     def found(self) -> bool:
         """True when a path was found."""

@@ -227,3 +227,17 @@ def test_a_floating_point_image_is_refused(tmp_path):
     Image.fromarray(np.zeros((2, 2), np.float32)).save(tmp_path / "f.tiff")
     with pytest.raises(InputFormatError, match="floating-point image"):
         load_map(tmp_path / "f.tiff")
+
+
+def test_reprs_summarise_grid_result_and_index():
+    """A notebook shows a line, not the arrays: sizes, counts and statistics."""
+    grid = load_map("den312d")
+    assert repr(grid) == ("<Grid 'den312d.map': 65x81 cells, "
+                          f"{int(grid.blocked.sum())} blocked, resolution 1, origin (0.0, 0.0)>")
+    r = skyroute.plan(grid, (50, 76), (60, 13))
+    text = repr(r)
+    assert text.startswith("<PlanResult found, cost 112.556, 109 points, astar: ")
+    assert f"{r.expanded} expanded" in text and "array" not in text
+    stopped = repr(skyroute.plan(grid, (50, 76), (60, 13), max_expansions=5))
+    assert stopped.startswith("<PlanResult budget_exhausted, 0 points") and "cost" not in stopped
+    assert repr(skyroute.prepare(grid)).startswith("<PreparedGrid 'den312d.map': subgoal index")

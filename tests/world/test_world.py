@@ -142,3 +142,9 @@ def test_fcnd_prm_and_grid_paths_are_free():
             assert w.segment_free(a, b)
     with pytest.raises(QueryError, match="lies inside obstacle 'box at line"):
         skyroute.plan(w, (-310.2, -439.2)[::-1], goal)
+
+
+def test_repr_summarises_the_world():
+    world = skyroute.World([shapely.box(0, 0, 1, 1)] * 3, 0.0, 10.0, (),
+                           boundary=shapely.box(-5, -5, 5, 5), name="three")
+    assert repr(world) == "<World 'three': 3 obstacles, a boundary, frame 'enu'>"

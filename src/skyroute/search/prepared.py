@@ -125,6 +125,9 @@ class PreparedGrid:
         return (f"subgoal index ({self.accelerator}), {self.subgoals} subgoals, "
                 f"{self.edges} edges")
 
+    def __repr__(self) -> str:
+        return f"<PreparedGrid {self.grid.name!r}: {self.describe()}>"
+
     @property
     def nbytes(self) -> int:
         """Bytes of the index arrays, the padded grid and the query workspace."""

@@ -69,6 +69,12 @@ class Grid:
         too (a writable copy could change under the search caches keyed by the grid)."""
         return Grid, (self.blocked, self.resolution, self.origin, self.name)
 
+    def __repr__(self) -> str:
+        """A summary, not the array (a 512x512 map printed in a notebook is noise)."""
+        return (f"<Grid {self.name!r}: {self.width}x{self.height} cells, "
+                f"{int(np.count_nonzero(self.blocked))} blocked, "
+                f"resolution {self.resolution:g}, origin {self.origin}>")
+
     @property
     def cell_size(self) -> float:
         """Deprecated name of :attr:`resolution`."""

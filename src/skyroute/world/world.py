@@ -82,6 +82,14 @@ class World:
         object.__setattr__(self, "ceilings", ceilings)
         object.__setattr__(self, "names", names)
 
+    def __repr__(self) -> str:
+        """A summary, not thousands of polygons."""
+        home = "" if self.home is None else \
+            f", home ({self.home.lon:.6f}, {self.home.lat:.6f})"
+        boundary = "" if self.boundary is None else ", a boundary"
+        return (f"<World {self.name!r}: {len(self.obstacles)} obstacles{boundary}, "
+                f"frame {self.frame!r}{home}>")
+
     # -- frames ----------------------------------------------------------------------
 
     @property
