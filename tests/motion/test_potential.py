@@ -65,3 +65,10 @@ def test_arc_mode_escapes_the_c_shape_more_smoothly_than_steps():
     assert arc.smoothness < step.smoothness
     with pytest.raises(OptionError):
         run_field(world, start, goal, mode="glide")
+
+
+def test_repr_summarises_the_run():
+    world, start, goal = course("easy")
+    run = run_field(world, start, goal, escape=False)
+    assert repr(run) == (f"<FieldRun found, {run.moves} moves, length {run.distance:.6g}, "
+                         "0 escape moves>")

@@ -203,3 +203,9 @@ def test_compiled_move_test_is_never_more_permissive_than_shapely(world):
         ref = world.segments_clear(np.broadcast_to(p, nxt.shape), nxt)
         assert not np.any(clear & ~ref)
         assert np.array_equal(clear, ref)
+
+
+def test_flight_repr_counts_moves_and_hovers():
+    p = np.array([-3.19, 55.94])
+    flight = Flight(p[None], np.array([HOVER]), p[None].copy()).hover()
+    assert repr(flight) == "<Flight found, 2 moves (2 hovers), 0 expanded, 0 ms>"

@@ -61,3 +61,11 @@ def test_turns_cost_time_on_a_real_map():
     r = plan_turns(grid, (50, 76), (60, 13), turn_rate=math.pi / 4)
     assert r.time < travel_time(a.path, turn_rate=math.pi / 4)
     assert r.distance >= a.cost - 1e-9  # the fastest route is never shorter than the shortest
+
+
+def test_repr_summarises_the_route():
+    r = plan_turns(skyroute.load_map("den312d"), (50, 76), (60, 13), turn_rate=math.pi / 4)
+    text = repr(r)
+    assert text.startswith(f"<LatticeResult found, {r.time:.6g} s over {r.distance:.6g}, "
+                           f"{len(r.cells)} cells, {r.expanded} expanded")
+    assert "array" not in text

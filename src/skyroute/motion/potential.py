@@ -47,6 +47,11 @@ class FieldRun:
     distance: float = 0.0  # length flown, plane units (along the arcs in arc mode)
     smoothness: float = 0.0  # mean absolute heading change per move, radians
 
+    def __repr__(self) -> str:
+        """A summary, not the poses."""
+        return (f"<FieldRun {self.status.value}, {self.moves} moves, length "
+                f"{self.distance:.6g}, {self.escaped} escape moves>")
+
     @property
     def reached(self) -> bool:
         """True when the goal was reached."""

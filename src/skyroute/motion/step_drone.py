@@ -57,6 +57,12 @@ class Flight:
     seconds: float = 0.0
     extra: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        """A summary, not the moves."""
+        hovers = int(np.count_nonzero(self.angle == HOVER)) if len(self.angle) else 0
+        return (f"<Flight {self.status.value}, {self.moves} moves ({hovers} hovers), "
+                f"{self.expanded} expanded, {self.seconds * 1e3:.3g} ms>")
+
     @property
     def moves(self) -> int:
         """Number of moves, hovers included."""

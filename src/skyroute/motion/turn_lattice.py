@@ -48,6 +48,13 @@ class LatticeResult:
     seconds: float
     path: np.ndarray | None = None  # planned on a World: the cells' centres in its frame
 
+    def __repr__(self) -> str:
+        """A summary, not the cells."""
+        route = (f", {self.time:.6g} s over {self.distance:.6g}"
+                 if self.status is Status.FOUND else "")
+        return (f"<LatticeResult {self.status.value}{route}, {len(self.cells)} cells, "
+                f"{self.expanded} expanded, {self.seconds * 1e3:.3g} ms>")
+
     @property
     def found(self) -> bool:
         """True when a route was found."""
