@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 import pytest
+import shapely
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -280,6 +281,9 @@ def test_save_load_round_trip_and_refusals(tmp_path):
         skyroute.load_index(junk, grid)
     with pytest.raises(skyroute.OptionError, match="grid must be a skyroute Grid, got str"):
         skyroute.load_index(path, "den312d")
+    world = skyroute.World([], 0.0, 10.0, (), boundary=shapely.box(0, 0, 9, 9))
+    with pytest.raises(skyroute.OptionError, match="got World; a World needs no prepare"):
+        skyroute.prepare(world)
     with np.load(path) as z:
         data = dict(z)
     data["version"] = np.int64(FORMAT_VERSION + 1)

@@ -247,7 +247,11 @@ def per_query_seconds(index: PreparedGrid, pairs: np.ndarray, rounds: int = 3) -
 
 def _require_grid(grid) -> None:
     if not isinstance(grid, Grid):
-        raise OptionError(f"grid must be a skyroute Grid, got {type(grid).__name__}",
+        from skyroute.world.world import World  # only on this error: shapely is heavy
+
+        hint = ("; a World needs no prepare: skyroute.plan builds its roadmap on the "
+                "first query and reuses it") if isinstance(grid, World) else ""
+        raise OptionError(f"grid must be a skyroute Grid, got {type(grid).__name__}{hint}",
                           param="grid")
 
 
