@@ -122,3 +122,15 @@ def test_commands_registered_on_the_app_are_unwrapped_too(monkeypatch):
     result = CliRunner().invoke(host, ["direct", "--help"])
     assert "A second paragraph, wrapped in the source at an arbitrary column." in {
         line.strip() for line in result.output.splitlines()}
+
+
+def test_version_is_the_installed_one():
+    """pyproject takes its version from skyroute.__version__: the two cannot drift."""
+    from importlib.metadata import version
+
+    import skyroute
+
+    result = CliRunner().invoke(app, ["--version"])
+    assert result.exit_code == 0
+    assert result.output == f"skyroute {skyroute.__version__}\n"
+    assert version("skyroute") == skyroute.__version__

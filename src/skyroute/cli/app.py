@@ -105,8 +105,18 @@ app = typer.Typer(help="skyroute: plan where drones and small robots fly or driv
                   pretty_exceptions_enable=False)
 
 
+def _print_version(value: bool) -> None:
+    if value:
+        from skyroute import __version__
+
+        print(f"skyroute {__version__}")
+        raise typer.Exit()
+
+
 @app.callback()
-def _group() -> None:
+def _group(version: bool = typer.Option(False, "--version", callback=_print_version,
+                                        is_eager=True, help="Print the version and exit.")
+           ) -> None:
     # With no command registered Typer would not build a group; a callback makes it one
     # (the loaders' commands are added by the group class).
     pass
