@@ -241,3 +241,29 @@ def test_fleet_md_python_example():
     by any test, and showed no output to compare with)."""
     result = doctest.testfile(str(ROOT / "docs" / "fleet.md"), module_relative=False)
     assert result.attempted >= 6 and result.failed == 0
+
+
+def test_relative_links_resolve():
+    """Every relative link of the README, the changelog and docs/ names a file that exists
+    and, with ``#anchor``, a heading of it (GitHub's anchors: lower case, punctuation
+    dropped, spaces as hyphens)."""
+    import re
+
+    def anchors(path):
+        return {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-")
+                for h in re.findall(r"^#+ (.*)$", path.read_text(), re.M)}
+
+    pages = [ROOT / "README.md", ROOT / "CHANGELOG.md", *sorted((ROOT / "docs").glob("*.md"))]
+    links = [(page, link) for page in pages
+             for link in re.findall(r"\]\(([^)\s]+)\)", re.sub(r"^```.*?^```", "",
+                                                            page.read_text(),
+                                                            flags=re.M | re.S))
+             if not re.match(r"[a-z]+:", link)]
+    assert len(links) >= 15  # the pattern still finds them
+    bad = []
+    for page, link in links:
+        path, _, anchor = link.partition("#")
+        target = (page.parent / path) if path else page
+        if not target.exists() or (anchor and anchor not in anchors(target)):
+            bad.append((page.name, link))
+    assert bad == []
