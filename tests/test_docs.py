@@ -87,7 +87,7 @@ def test_readme_cli_examples_run_in_order(monkeypatch, capsys, tmp_path, fly_onc
     # The README's 'data synth' command writes what the repository ships in examples/lunch
     # (the set the README's set-up command flies), file for file.
     synth = next(c for c in commands if c.startswith("skyroute data synth "))
-    assert json.loads(printed[synth].replace("\n", ""))["orders"] == 108
+    assert json.loads(printed[synth])["orders"] == 108
     assert same_tree(ROOT / "examples" / "lunch", tmp_path / shlex.split(synth)[3])
 
 
@@ -154,3 +154,124 @@ def test_cli_md_names_every_option(name, cmd):
             assert any(names(f, sections[key]) for f in flags), (name, flags)
             for old in p.secondary_opts + flags[1:]:
                 assert names(old, text), (name, old)
+
+
+FLAG = r"(?<![\w-])--?[a-zA-Z][\w-]*"
+
+
+def cli_md_options(text: str, names: list[str]) -> list[tuple[str, str]]:
+    """(command, option) for every option docs/cli.md writes in a synopsis of a command:
+    a code block's lines from a ``skyroute COMMAND`` line to the next, an inline
+    ```skyroute COMMAND ...``` span, and the first column of a table in the command's own
+    ``## skyroute COMMAND`` section. Prose may name other commands' options; these may not."""
+    import re
+
+    def command(chunk):
+        words = chunk.split()
+        found = [n for n in names if words[:1] == ["skyroute"]
+                 and words[1:1 + len(n.split())] == n.split()]
+        return max(found, key=len, default=None)
+
+    blocks = re.findall(r"^```[^\n]*\n(.*?)^```", text, re.M | re.S)
+    prose = re.sub(r"^```[^\n]*\n.*?^```", "", text, flags=re.M | re.S)
+    chunks = [c for b in blocks for c in re.split(r"\n(?=skyroute )", b)]
+    chunks += prose.split("`")[1::2]  # inline code spans
+    pairs = [(command(c), f) for c in chunks for f in re.findall(FLAG, c)]
+    for key, body in re.findall(r"^## skyroute ([a-z -]+)\n(.*?)(?=^## |\Z)", prose,
+                                re.M | re.S):
+        if key in names:
+            pairs += [(key, f) for cell in re.findall(r"^\| ([^|\n]*)\|", body, re.M)
+                      for f in re.findall(FLAG, cell)]
+    return [(c, f) for c, f in pairs if c is not None]
+
+
+def test_cli_md_options_are_the_commands_options():
+    """Every option docs/cli.md gives a command in its synopses and option tables is one
+    of that command's (or an old name it keeps): an option renamed or dropped in the
+    code but not in the page fails here; one renamed in the page only fails
+    test_cli_md_names_every_option."""
+    commands = dict(_cli_commands())
+    pairs = cli_md_options((ROOT / "docs" / "cli.md").read_text(), list(commands))
+    assert len({c for c, _ in pairs}) >= 20 and len(pairs) >= 200  # the parser found them
+    known = {name: {o for p in cmd.params for o in p.opts + p.secondary_opts} | {"--help"}
+             for name, cmd in commands.items()}
+    assert [(c, f) for c, f in pairs if f not in known[c]] == []
+
+
+def doc_command_lines() -> list[tuple[str, str]]:
+    """(file, command line) for each ``skyroute`` command in a code block of README.md
+    and docs/*.md, after any environment settings or ``time`` in front, up to a ``>``
+    redirection; synopses (with ``[optional]`` parts) are left out."""
+    import re
+
+    out = []
+    for path in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        for block in re.findall(r"^```[^\n]*\n(.*?)^```", path.read_text(), re.M | re.S):
+            for line in block.replace("\\\n", " ").splitlines():
+                for part in re.split(r";|&&", line.split(" #")[0]):
+                    m = re.search(r"(?:^|[\s/])(skyroute [^>]*)", part)
+                    if m and "[" not in m.group(1):
+                        out.append((path.name, m.group(1).strip()))
+    return out
+
+
+def test_doc_command_lines_parse():
+    """Every ``skyroute`` command line the README and docs/ show, benchmarks' long runs
+    included, names a command and options that exist, with the right arity (parsed by the
+    CLI's own parser, not run)."""
+    import shlex
+
+    import typer.main
+    from typer.exceptions import TyperException  # click's errors (typer carries its own)
+
+    from skyroute.cli.app import app
+
+    root = typer.main.get_command(app)
+    lines = doc_command_lines()
+    assert len(lines) >= 60
+    bad = []
+    for name, line in lines:
+        args, cmd = shlex.split(line)[1:], root
+        while hasattr(cmd, "list_commands") and args and args[0] in cmd.list_commands(None):
+            cmd = cmd.get_command(None, args.pop(0))
+        if hasattr(cmd, "list_commands"):
+            bad.append((name, line, f"no such command: {args[:1]}"))
+            continue
+        try:
+            cmd.make_context("skyroute", args)
+        except TyperException as exc:  # an unknown option, a missing value or argument
+            bad.append((name, line, exc.format_message()))
+    assert bad == []
+
+
+def test_fleet_md_python_example():
+    """docs/fleet.md's Python example runs and prints what the page says (it was not run
+    by any test, and showed no output to compare with)."""
+    result = doctest.testfile(str(ROOT / "docs" / "fleet.md"), module_relative=False)
+    assert result.attempted >= 6 and result.failed == 0
+
+
+def test_relative_links_resolve():
+    """Every relative link of the README, the changelog and docs/ names a file that exists
+    and, with ``#anchor``, a heading of it (GitHub's anchors: lower case, punctuation
+    dropped, spaces as hyphens)."""
+    import re
+
+    def anchors(path):
+        return {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-")
+                for h in re.findall(r"^#+ (.*)$", path.read_text(), re.M)}
+
+    pages = [ROOT / "README.md", ROOT / "CHANGELOG.md", *sorted((ROOT / "docs").glob("*.md"))]
+    links = [(page, link) for page in pages
+             for link in re.findall(r"\]\(([^)\s]+)\)", re.sub(r"^```.*?^```", "",
+                                                            page.read_text(),
+                                                            flags=re.M | re.S))
+             if not re.match(r"[a-z]+:", link)]
+    assert len(links) >= 15  # the pattern still finds them
+    bad = []
+    for page, link in links:
+        path, _, anchor = link.partition("#")
+        target = (page.parent / path) if path else page
+        if not target.exists() or (anchor and anchor not in anchors(target)):
+            bad.append((page.name, link))
+    assert bad == []

@@ -61,3 +61,14 @@ def test_synth_refuses_a_negative_seed(monkeypatch, capsys, tmp_path):
     with pytest.raises(OptionError, match="seed=-1"):
         synth(tmp_path / "y", seed=-1)
     assert not (tmp_path / "x").exists() and not (tmp_path / "y").exists()
+
+
+def test_synth_prints_its_summary_as_plain_json(monkeypatch, capsys, tmp_path):
+    """stdout is one line of JSON, the folder as given: it went through Rich, which ate
+    '[bold]' as markup and broke a long line inside a string (invalid JSON)."""
+    out = tmp_path / ("a folder whose name is long enough to pass 80 columns " * 2) / "x[bold]y"
+    code, stdout, err = run(monkeypatch, capsys, "data", "synth", str(out), "--days", "1",
+                            "--orders-per-day", "1")
+    assert code == 0, err
+    assert stdout.count("\n") == 1 and json.loads(stdout)["folder"] == str(out)
+    assert (out / "database" / "orders.csv").exists()

@@ -37,7 +37,7 @@ def data_synth(
 
         summary = synth(folder, days=days, orders_per_day=orders_per_day, seed=seed,
                         start=first, customers=customers)
-    Console().print(json.dumps(summary))
+    typer.echo(json.dumps(summary))  # not through Rich: no markup, no wrapping
 
 
 @data_app.command("serve")
