@@ -13,11 +13,19 @@ import pytest
 
 matplotlib.use("Agg")  # before pyplot: no window on a desktop either
 import matplotlib.pyplot as plt
+from matplotlib.collections import LineCollection
 from matplotlib.text import Text
 
 import skyroute
 from skyroute.io import world_out
-from skyroute.io.plot import draw_path, grid_dpi, place_labels, plot_grid_path
+from skyroute.io.plot import (
+    PALETTE_COLOURS,
+    draw_path,
+    grid_dpi,
+    place_labels,
+    plot_grid_path,
+    save_figure,
+)
 from skyroute.result import PlanResult, Status
 from skyroute.world.grid import Grid
 from skyroute.world.load import load_world
@@ -81,6 +89,34 @@ def test_grid_picture_pixels_follow_the_map_size(tmp_path):
     w, h = png_size(tmp_path / "small.png")
     assert max(w, h) <= 1300 and (tmp_path / "small.png").stat().st_size < 100_000
     assert grid_dpi((32, 32), (7, 7)) == 150 and grid_dpi((4096, 4096), (7, 7)) == 400
+
+
+def test_a_graph_picture_is_a_palette_png_true_to_its_colours(figures, tmp_path):
+    """A visibility graph's 2,500 thin translucent edges (already one LineCollection at
+    150 dpi) blended into thousands of colours: 1.7 MB of RGBA. Written with one byte a
+    pixel from a 256-colour palette, every colour within a few levels."""
+    import io
+
+    from PIL import Image
+
+    rng = np.random.default_rng(0)
+    fig, ax = plt.subplots(figsize=(6, 6))
+    ax.add_collection(LineCollection(rng.random((2500, 2, 2)), colors="tab:cyan",
+                                     linewidths=0.3, alpha=0.5))
+    draw_path(ax, [(0.1, 0.1), (0.9, 0.8)])
+    buf = io.BytesIO()
+    fig.tight_layout()
+    fig.savefig(buf, format="png", dpi=150, bbox_inches="tight")  # as drawn, RGBA
+    save_figure(fig, tmp_path / "g.png")
+    data = (tmp_path / "g.png").read_bytes()
+    assert data[25] == 3  # IHDR colour type 3: a palette image (6, RGBA, before)
+    with Image.open(tmp_path / "g.png") as img, Image.open(buf) as rgba:
+        assert img.mode == "P" and len(img.getcolors(256)) <= PALETTE_COLOURS
+        ours = np.asarray(img.convert("RGB"), dtype=int)
+        exact = np.asarray(rgba.convert("RGB"), dtype=int)
+    assert ours.shape == exact.shape
+    error = np.abs(ours - exact).max(axis=2)
+    assert error.mean() < 3 and np.percentile(error, 99) <= 16
 
 
 @pytest.mark.parametrize(("n", "marker"), [(60, "o"), (61, "None")])
