@@ -12,7 +12,7 @@ from tests.conftest import ROOT
 MODULES = ["skyroute.world.grid", "skyroute.world.load", "skyroute.planner",
            "skyroute.fleet.vehicle", "skyroute.fleet.trajectory",
            "skyroute.fleet.separation", "skyroute.fleet.flightplan",
-           "skyroute.io.fleet_out", "skyroute.fleet.limits"]
+           "skyroute.io.fleet_out", "skyroute.fleet.limits", "skyroute.io.plot"]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -25,6 +25,7 @@ from skyroute.io.plot import (
     place_labels,
     plot_grid_path,
     save_figure,
+    title_lines,
 )
 from skyroute.result import PlanResult, Status
 from skyroute.world.grid import Grid
@@ -203,8 +204,9 @@ def test_pruned_grid_path_says_so_in_the_title(figures, tmp_path):
     plot_grid_path(grid, result, (50, 76), (60, 13), tmp_path / "p.png", prune="los")
     fig = figures[0]
     lines = title_fits(fig, fig.axes[0])
-    assert lines == [f"den312d.map: theta, cost {result.cost:.3f}, {result.expanded:,} "
-                     "expanded", f"pruned (los): {len(result.path)} waypoints"]
+    # balanced: it read "...cost 110.179, 1,587 expanded" over "pruned (los): 5 waypoints"
+    assert lines == [f"den312d.map: theta, cost {result.cost:.3f}",
+                     f"{result.expanded:,} expanded, pruned (los): {len(result.path)} waypoints"]
 
 
 def test_a_long_title_on_a_narrow_map_takes_two_lines_within_the_figure(figures, tmp_path):
@@ -214,9 +216,35 @@ def test_a_long_title_on_a_narrow_map_takes_two_lines_within_the_figure(figures,
     plot_grid_path(grid, result, (0, 0), (7, 59), tmp_path / "p.png", prune="collinear")
     fig = figures[0]
     lines = title_fits(fig, fig.axes[0])
-    assert len(lines) == 2 and lines[1].endswith(f"pruned (collinear): {len(result.path)} "
-                                                 "waypoints")
-    assert ", ".join(lines).startswith("a_rather_long_name_for_a_narrow_map.map: astar, cost")
+    # no two lines fit over the map: three even ones, not the name over all the rest
+    assert lines == ["a_rather_long_name_for_a_narrow_map.map: astar",
+                     f"cost {result.cost:.3f}, {result.expanded:,} expanded",
+                     f"pruned (collinear): {len(result.path)} waypoints"]
+
+
+@pytest.mark.parametrize(("room", "lines"), [
+    (80, ["den312d.map: theta, cost 110.179, 1,587 expanded, pruned (los): 5 waypoints"]),
+    # the cut nearest the middle, not as much as fits on the first line
+    (50, ["den312d.map: theta, cost 110.179", "1,587 expanded, pruned (los): 5 waypoints"]),
+    (41, ["den312d.map: theta, cost 110.179", "1,587 expanded, pruned (los): 5 waypoints"]),
+    (40, ["den312d.map: theta", "cost 110.179, 1,587 expanded", "pruned (los): 5 waypoints"]),
+    (28, ["den312d.map: theta", "cost 110.179, 1,587 expanded", "pruned (los): 5 waypoints"]),
+    # narrower than any part: the fewest lines as narrow as whole parts allow
+    (10, ["den312d.map: theta", "cost 110.179", "1,587 expanded", "pruned (los): 5 waypoints"]),
+])
+def test_title_lines_are_balanced(room, lines):
+    parts = ["den312d.map: theta", "cost 110.179", "1,587 expanded", "pruned (los): 5 waypoints"]
+    assert title_lines(parts, room) == lines
+
+
+def test_title_lines_keep_the_timeline_sentence_whole():
+    parts = ["seed-9x9: seed dispatch", "layers airspace", "1 h", "seed 0",
+             "63 of 109 packages delivered after the 6 min warm-up; 66 of 124 in the whole run"]
+    assert title_lines(parts, 100) == [", ".join(parts[:4]), parts[4]]
+    assert title_lines(["Delivery day 03 Jan 2022: 4/4 orders", "100.0% of the money",
+                        "220 moves"], 40) == ["Delivery day 03 Jan 2022: 4/4 orders",
+                                              "100.0% of the money, 220 moves"]
+    assert title_lines(["a", "b"], 1, width=lambda t: 0) == ["a, b"]
 
 
 def test_grid_legend_says_the_blocked_cells_are_grown_by_the_safety_margin(figures, tmp_path):
@@ -276,4 +304,4 @@ def test_plan_prune_plot_from_the_command_line(monkeypatch, capsys, figures, tmp
                        "60,13", "--algorithm", "theta", "--prune", "los", "--plot",
                        str(tmp_path / "p.png"))
     assert code == 0, err
-    assert figures[0].axes[0].get_title().endswith("\npruned (los): 5 waypoints")
+    assert figures[0].axes[0].get_title().endswith("expanded, pruned (los): 5 waypoints")

@@ -5,6 +5,9 @@ by the frame, the legend outside the map, labels that keep out of each other's w
 from __future__ import annotations
 
 import io
+import math
+from collections.abc import Callable, Sequence
+from itertools import combinations, pairwise
 from pathlib import Path
 
 import numpy as np
@@ -62,10 +65,11 @@ def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
     return save_figure(fig, path, dpi=dpi)
 
 
-def set_title(ax, parts, *, fontsize: float = 10):
-    """The title ``parts`` joined by ", ": on one line when it fits the axes' width,
-    otherwise the parts that fit on the first line and the rest on a second, so a long
-    title (a pruned path's, on a narrow map) stays over the map. Returns the title."""
+def set_title(ax, parts: Sequence[str], *, fontsize: float = 10):
+    """The title of every picture: ``parts`` joined by ", " on as few lines as fit the
+    axes' width, broken where the lines come out most even (:func:`title_lines`), so a
+    long title (a pruned path's, on a narrow map) stays over the map. Returns the
+    title."""
     from matplotlib.font_manager import FontProperties
 
     fig = ax.figure
@@ -76,11 +80,33 @@ def set_title(ax, parts, *, fontsize: float = 10):
     def width(text: str) -> float:
         return renderer.get_text_width_height_descent(text, font, ismath=False)[0]
 
-    first = 1
-    while first < len(parts) and width(", ".join(parts[:first + 1])) <= room:
-        first += 1
-    lines = [", ".join(parts[:first])] + ([", ".join(parts[first:])] if parts[first:] else [])
-    return ax.set_title("\n".join(lines), fontsize=fontsize)
+    return ax.set_title("\n".join(title_lines(parts, room, width)), fontsize=fontsize)
+
+
+def title_lines(parts: Sequence[str], room: float,
+                width: Callable[[str], float] = len) -> list[str]:
+    """``parts`` joined by ", " into the fewest lines no wider than ``room`` (as
+    ``width`` measures a line; characters by default), cut where the longest line is
+    shortest (and then the shortest longest): "a_long_map.map: theta, cost 110.179" over
+    "1,587 expanded, pruned (los): 5 waypoints", not the first three parts over the
+    last. A part is never cut; when no number of lines fits, the fewest lines that are
+    as narrow as whole parts allow.
+
+    >>> title_lines(["map: astar", "cost 12.5", "40 expanded", "pruned: 3 waypoints"], 32)
+    ['map: astar, cost 12.5', '40 expanded, pruned: 3 waypoints']
+    """
+    parts = list(parts)
+    best, best_width = [", ".join(parts)], math.inf
+    for n in range(1, len(parts) + 1):
+        splits = ([", ".join(parts[a:b]) for a, b in pairwise((0, *cuts, len(parts)))]
+                  for cuts in combinations(range(1, len(parts)), n - 1))
+        lines = min(splits, key=lambda ls: (max(map(width, ls)), -min(map(width, ls))))
+        widest = max(map(width, lines))
+        if widest <= room:
+            return lines
+        if widest < best_width:
+            best, best_width = lines, widest
+    return best
 
 
 def grid_dpi(shape: tuple[int, int], figsize: tuple[float, float]) -> int:
