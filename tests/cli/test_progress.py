@@ -9,7 +9,7 @@ import json
 
 from rich.console import Console
 
-from skyroute.cli.tables import progress_bar
+from skyroute.cli.tables import print_table, progress_bar
 from tests.cli.test_cli import run
 
 
@@ -59,7 +59,8 @@ def test_sweep_table_wraps_numbers_instead_of_cutting_them():
                      ("loiters", 5, 4), ("capacity_bound_per_hour", 48.3, 4.2)):
         row[m], row[m + "_ci95"] = v, ci
     screen = io.StringIO()
-    Console(file=screen, width=100).print(_sweep_table(preset("seed-3x3"), 2.0, [0, 1], [row]))
+    print_table(Console(file=screen, width=100),
+                _sweep_table(preset("seed-3x3"), 2.0, [0, 1], [row]))
     text = screen.getvalue()
     assert "…" not in text
     for cell in ("optimal", "shared", "48.8", "±3.6", "1693", "±681", "3502", "±1373"):

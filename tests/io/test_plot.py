@@ -13,11 +13,20 @@ import pytest
 
 matplotlib.use("Agg")  # before pyplot: no window on a desktop either
 import matplotlib.pyplot as plt
+from matplotlib.collections import LineCollection
 from matplotlib.text import Text
 
 import skyroute
 from skyroute.io import world_out
-from skyroute.io.plot import draw_path, grid_dpi, place_labels, plot_grid_path
+from skyroute.io.plot import (
+    PALETTE_COLOURS,
+    draw_path,
+    grid_dpi,
+    place_labels,
+    plot_grid_path,
+    save_figure,
+    title_lines,
+)
 from skyroute.result import PlanResult, Status
 from skyroute.world.grid import Grid
 from skyroute.world.load import load_world
@@ -81,6 +90,35 @@ def test_grid_picture_pixels_follow_the_map_size(tmp_path):
     w, h = png_size(tmp_path / "small.png")
     assert max(w, h) <= 1300 and (tmp_path / "small.png").stat().st_size < 100_000
     assert grid_dpi((32, 32), (7, 7)) == 150 and grid_dpi((4096, 4096), (7, 7)) == 400
+
+
+def test_a_graph_picture_is_a_palette_png_true_to_its_colours(figures, tmp_path):
+    """A visibility graph's 2,500 thin translucent edges (already one LineCollection at
+    150 dpi) blended into thousands of colours: 1.7 MB of RGBA. Written with one byte a
+    pixel from a 256-colour palette, every colour within a few levels."""
+    import io
+
+    from PIL import Image
+
+    rng = np.random.default_rng(0)
+    fig, ax = plt.subplots(figsize=(6, 6))
+    ax.add_collection(LineCollection(rng.random((2500, 2, 2)), colors="tab:cyan",
+                                     linewidths=0.3, alpha=0.5))
+    draw_path(ax, [(0.1, 0.1), (0.9, 0.8)])
+    buf = io.BytesIO()
+    fig.tight_layout()
+    fig.savefig(buf, format="png", dpi=150, bbox_inches="tight")  # as drawn, RGBA
+    save_figure(fig, tmp_path / "g.png")
+    data = (tmp_path / "g.png").read_bytes()
+    assert data[25] == 3  # IHDR colour type 3: a palette image (6, RGBA, before)
+    with Image.open(tmp_path / "g.png") as img, Image.open(buf) as rgba:
+        assert img.mode == "P" and len(img.getcolors(256)) <= PALETTE_COLOURS
+        ours = np.asarray(img.convert("RGB"), dtype=int)
+        exact = np.asarray(rgba.convert("RGB"), dtype=int)
+    assert ours.shape == exact.shape
+    error = np.abs(ours - exact).max(axis=2)
+    assert error.mean() < 3 and np.percentile(error, 99) <= 16
+    assert (ours[0, 0] == 255).all()  # the common colours exact: the ground stays white
 
 
 @pytest.mark.parametrize(("n", "marker"), [(60, "o"), (61, "None")])
@@ -166,8 +204,9 @@ def test_pruned_grid_path_says_so_in_the_title(figures, tmp_path):
     plot_grid_path(grid, result, (50, 76), (60, 13), tmp_path / "p.png", prune="los")
     fig = figures[0]
     lines = title_fits(fig, fig.axes[0])
-    assert lines == [f"den312d.map: theta, cost {result.cost:.3f}, {result.expanded:,} "
-                     "expanded", f"pruned (los): {len(result.path)} waypoints"]
+    # balanced: it read "...cost 110.179, 1,587 expanded" over "pruned (los): 5 waypoints"
+    assert lines == [f"den312d.map: theta, cost {result.cost:.3f}",
+                     f"{result.expanded:,} expanded, pruned (los): {len(result.path)} waypoints"]
 
 
 def test_a_long_title_on_a_narrow_map_takes_two_lines_within_the_figure(figures, tmp_path):
@@ -177,9 +216,35 @@ def test_a_long_title_on_a_narrow_map_takes_two_lines_within_the_figure(figures,
     plot_grid_path(grid, result, (0, 0), (7, 59), tmp_path / "p.png", prune="collinear")
     fig = figures[0]
     lines = title_fits(fig, fig.axes[0])
-    assert len(lines) == 2 and lines[1].endswith(f"pruned (collinear): {len(result.path)} "
-                                                 "waypoints")
-    assert ", ".join(lines).startswith("a_rather_long_name_for_a_narrow_map.map: astar, cost")
+    # no two lines fit over the map: three even ones, not the name over all the rest
+    assert lines == ["a_rather_long_name_for_a_narrow_map.map: astar",
+                     f"cost {result.cost:.3f}, {result.expanded:,} expanded",
+                     f"pruned (collinear): {len(result.path)} waypoints"]
+
+
+@pytest.mark.parametrize(("room", "lines"), [
+    (80, ["den312d.map: theta, cost 110.179, 1,587 expanded, pruned (los): 5 waypoints"]),
+    # the cut nearest the middle, not as much as fits on the first line
+    (50, ["den312d.map: theta, cost 110.179", "1,587 expanded, pruned (los): 5 waypoints"]),
+    (41, ["den312d.map: theta, cost 110.179", "1,587 expanded, pruned (los): 5 waypoints"]),
+    (40, ["den312d.map: theta", "cost 110.179, 1,587 expanded", "pruned (los): 5 waypoints"]),
+    (28, ["den312d.map: theta", "cost 110.179, 1,587 expanded", "pruned (los): 5 waypoints"]),
+    # narrower than any part: the fewest lines as narrow as whole parts allow
+    (10, ["den312d.map: theta", "cost 110.179", "1,587 expanded", "pruned (los): 5 waypoints"]),
+])
+def test_title_lines_are_balanced(room, lines):
+    parts = ["den312d.map: theta", "cost 110.179", "1,587 expanded", "pruned (los): 5 waypoints"]
+    assert title_lines(parts, room) == lines
+
+
+def test_title_lines_keep_the_timeline_sentence_whole():
+    parts = ["seed-9x9: seed dispatch", "layers airspace", "1 h", "seed 0",
+             "63 of 109 packages delivered after the 6 min warm-up; 66 of 124 in the whole run"]
+    assert title_lines(parts, 100) == [", ".join(parts[:4]), parts[4]]
+    assert title_lines(["Delivery day 03 Jan 2022: 4/4 orders", "100.0% of the money",
+                        "220 moves"], 40) == ["Delivery day 03 Jan 2022: 4/4 orders",
+                                              "100.0% of the money, 220 moves"]
+    assert title_lines(["a", "b"], 1, width=lambda t: 0) == ["a, b"]
 
 
 def test_grid_legend_says_the_blocked_cells_are_grown_by_the_safety_margin(figures, tmp_path):
@@ -239,4 +304,4 @@ def test_plan_prune_plot_from_the_command_line(monkeypatch, capsys, figures, tmp
                        "60,13", "--algorithm", "theta", "--prune", "los", "--plot",
                        str(tmp_path / "p.png"))
     assert code == 0, err
-    assert figures[0].axes[0].get_title().endswith("\npruned (los): 5 waypoints")
+    assert figures[0].axes[0].get_title().endswith("expanded, pruned (los): 5 waypoints")

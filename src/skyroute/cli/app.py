@@ -127,19 +127,20 @@ def maps_command() -> None:
     from rich.console import Console
     from rich.table import Table
 
+    from skyroute.cli.tables import print_table
     from skyroute.world.load import bundled_maps
     from skyroute.world.movingai import read_map
 
     table = Table(title="bundled maps (Sturtevant 2012, MovingAI; see CITATION.md)")
     for col in ("name", "size", "free", "scenario lines", "file"):
-        table.add_column(col)
+        table.add_column(col, overflow="fold" if col == "file" else "ellipsis")
     for name, path in bundled_maps().items():
         grid = read_map(path)
         scen = path.with_name(path.name + ".scen")
         lines = len(scen.read_text().splitlines()) - 1 if scen.exists() else 0
         table.add_row(name, f"{grid.width}x{grid.height}", f"{grid.free_fraction:.0%}",
                       str(lines), str(path))
-    Console().print(table)
+    print_table(Console(), table)
 
 
 def main() -> None:

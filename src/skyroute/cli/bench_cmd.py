@@ -23,7 +23,7 @@ from skyroute.bench.grid import (
 from skyroute.bench.peers import skip_reason
 from skyroute.bench.random_maps import parse_random
 from skyroute.cli.parse import parse_list
-from skyroute.cli.tables import progress_bar
+from skyroute.cli.tables import print_table, progress_bar
 from skyroute.errors import OptionError
 from skyroute.files import check_writable, write_atomic
 from skyroute.world.load import bundled_maps
@@ -86,7 +86,10 @@ def bench_grid(
         if rep.get("prepared", {}).get("build_peak_error"):
             console.print(f"[yellow]{rep['map']}: {rep['prepared']['build_peak_error']}"
                           "[/yellow]")
-        out.print(_table(rep))
+        # the speed-ups and the cost ratios stay longest on a narrow terminal
+        print_table(out, _table(rep), optional=(
+            *(f"x faster than {row['runner']}" for row in rep["rows"] if row["peer"]),
+            "cost/opt max", "cost/opt mean", "M exp/s"))
     if json_out:
         doc = {"settings": {"maps": str(folder), "per_map": per_map, "random": randoms,
                             "prepared": prepared,

@@ -13,7 +13,7 @@ from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli.bench_cmd import bench_app
-from skyroute.cli.tables import progress_bar, wide_console
+from skyroute.cli.tables import print_table, progress_bar, wide_console
 from skyroute.errors import OptionError
 from skyroute.files import check_writable, write_atomic
 
@@ -72,7 +72,7 @@ def bench_jobs_command(
                   f"{r['mean_pct']:.2f}" if r["mean_pct"] is not None else "-",
                   f"{r['min_pct']:.2f}" if r["min_pct"] is not None else "-")
     out = wide_console()
-    out.print(t)
+    print_table(out, t)
     sims = simulated(rows, durations, counts) if durations and counts else []
     if sims:
         s = Table(title=f"simulated from the local:1 task times (sum {sum(durations):.1f} s, "
@@ -84,7 +84,7 @@ def bench_jobs_command(
             s.add_row(str(r["workers"]), f"{r['local_seconds']:.1f}", f"{r['speedup']:.2f}x",
                       f"{r['dask_seconds']:.1f}" if dask else "-",
                       f"{r['dask_speedup']:.2f}x" if dask else "-")
-        out.print(s)
+        print_table(out, s)
     if json_out:
         write_atomic(json_out, json.dumps(
             {"machine": {"python": platform.python_version(), "cpus": _cpus()},

@@ -13,7 +13,7 @@ from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli.bench_cmd import bench_app
-from skyroute.cli.tables import wide_console
+from skyroute.cli.tables import print_table, wide_console
 from skyroute.errors import OptionError, check_choice
 from skyroute.files import check_writable, write_atomic
 
@@ -92,6 +92,9 @@ def bench_service(
                   f"{r['per_core_requests_per_second']:,.0f}"
                   if "per_core_requests_per_second" in r else "-",
                   ms(r, "client_cpu_ms_per_request"))
-    wide_console().print(t)
+    # the client's view and the CPU costs give way first on a narrow terminal
+    print_table(wide_console(), t, optional=("client p50 ms", "client p99 ms",
+                                             "server CPU ms/req", "req/s per server core",
+                                             "client CPU ms/req"))
     if json_out:
         write_atomic(json_out, json.dumps(rows, indent=1))

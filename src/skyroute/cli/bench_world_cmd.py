@@ -27,7 +27,7 @@ from skyroute.bench.world import (
 )
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_list
-from skyroute.cli.tables import progress_bar
+from skyroute.cli.tables import print_table, progress_bar
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 from skyroute.files import check_writable, write_atomic
 from skyroute.motion.step_drone import MERGE
@@ -141,7 +141,7 @@ def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, 
                       "-" if row.get("simplified_ratio") is None else
                       f"{row['simplified_ratio']:.4f}",
                       {True: "yes", False: "no", None: "-"}[row.get("valid")])
-        out.print(t)
+        print_table(out, t)
     city_timing = None
     if city is not None and city_queries_n > 0:
         c = city_timing = city_queries(cases[-1][0], city_queries_n,
@@ -210,7 +210,7 @@ def bench_motion(
         return
     out = Console()
     d = dubins_speed()
-    out.print(_dubins_table(d))
+    print_table(out, _dubins_table(d))
     if dubins:
         if json_out:
             write_atomic(json_out, json.dumps({"dubins": d}, indent=1))
@@ -285,7 +285,7 @@ def _bench_curvature(worlds, seed, secs, city, tours, json_out) -> None:
             ratio = f"{s['median_ratio']:.3f}" if s["median_ratio"] is not None else "-"
             table.add_row(name, f"{s['found']}/{s['queries']}", f"{s['valid']}/{s['found']}",
                           ratio, f"{s['median_ms']:.1f}", f"{s['p95_ms']:.1f}")
-    out.print(table)
+    print_table(out, table)
     for name, s in summ.items():
         if "compared" in s:
             worst = f"{s['worst_ratio']:.4f}" if s["worst_ratio"] is not None else "-"

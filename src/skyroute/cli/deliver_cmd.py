@@ -13,7 +13,7 @@ from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
-from skyroute.cli.tables import progress_bar
+from skyroute.cli.tables import print_table, progress_bar
 from skyroute.delivery.day import METHODS, DayResult
 from skyroute.delivery.store import DEFAULT_DB
 from skyroute.errors import OptionError, SkyrouteError, check_choice
@@ -121,6 +121,8 @@ def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
         typer.echo(json.dumps(rep))
         return
     t = Table(title=f"delivery day {r.date}", show_header=False)
+    t.add_column()
+    t.add_column(overflow="fold")  # a long file path folds; numbers stay whole
     pct = rep["money_pct"]
     rows = [("orders placed", rep["orders_placed"]), ("delivered", rep["orders_delivered"]),
             ("invalid", rep["orders_invalid"]),
@@ -131,7 +133,7 @@ def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
             ("files", "\n".join(str(f) for f in files))]
     for k, v in rows:
         t.add_row(k, str(v))
-    Console().print(t)
+    print_table(Console(), t)
     for o, reason in r.invalid:
         Console(stderr=True).print(f"invalid order {o.order_no}: {reason}", markup=False)
 
@@ -155,7 +157,7 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
         t.add_column(col, justify="right")
     for m, v in s["months"].items():
         t.add_row(m, str(v["days"]), f"{v['mean_pct']:.2f}", f"{v['min_pct']:.2f}")
-    Console().print(t)
+    print_table(Console(), t)
     if files:
         Console().print(f"wrote {len(files):,} files to {', '.join(s['folders'])}",
                         markup=False)

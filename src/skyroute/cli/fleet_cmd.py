@@ -12,7 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
-from skyroute.cli.tables import progress_bar, wide_console
+from skyroute.cli.tables import print_table, progress_bar, wide_console
 from skyroute.errors import OptionError, check_choice
 from skyroute.fleet.limits import (
     MAX_DRONES,
@@ -181,7 +181,7 @@ def simulate_command(
     if as_json:
         typer.echo(json.dumps(rep))
     else:
-        Console().print(_report_table(rep, files))
+        print_table(Console(), _report_table(rep, files))
     if rep["conflicts"] or rep["lost"]:
         Console(stderr=True).print(f"skyroute: {rep['conflicts']} loss(es) of separation, "
                                    f"{rep['lost']} lost package(s)", markup=False)
@@ -198,7 +198,7 @@ def _report_table(rep: dict, files: list[Path]) -> Table:
                     f"airports, {st['hours']:g} h, {st['scheduler']} + {st['airspace']}, "
                     f"seed {st['seed']}", show_header=False)
     t.add_column(style="bold")
-    t.add_column()
+    t.add_column(overflow="fold")  # a long file path folds; numbers stay whole
     rows = [
         ("offered", f"{rep['offered']} ({rep['offered_per_hour']:.1f}/h after the "
                     f"{st['warmup_s'] / 60:g} min warm-up)"),
@@ -344,21 +344,25 @@ def sweep_command(
         typer.echo(json.dumps({"scenario": s.name, "hours": hours, "seeds": seed_list,
                                "rows": clean}, allow_nan=False))
     else:
-        wide_console().print(_sweep_table(s, hours, seed_list, rows))
+        print_table(wide_console(), _sweep_table(s, hours, seed_list, rows),
+                    optional=_SWEEP_OPTIONAL)
     if any(r["conflicts"] or r["lost"] for r in rows):
         raise typer.Exit(1)
+
+
+# Units under the names, so a header is no wider than its numbers; the last ones give way
+# first on a narrow terminal (print_table's optional columns).
+_SWEEP_COLUMNS = ("scheduler", "airspace", "offered\n/h", "delivered\n/h", "served\n%",
+                  "p95\ns", "max wait\ns", "loiters", "capacity\n/h", "conflicts", "lost")
+_SWEEP_OPTIONAL = ("max wait\ns", "capacity\n/h", "loiters")
 
 
 def _sweep_table(s: Scenario, hours: float, seeds: list[int], rows: list[dict]) -> Table:
     t = Table(title=f"fleet sweep {s.name}: {s.drones} drones, {len(s.airports)} airports, "
                     f"{hours:g} h x {len(seeds)} seeds (mean ±95% CI)")
-    for col in ("scheduler", "airspace", "offered/h", "delivered/h", "served %", "p95 s",
-                "max wait s", "loiters", "capacity/h", "conflicts", "lost"):
-        # On a narrow terminal a cell wraps before its "±" instead of losing its digits
-        # to "…"; the names keep their width.
-        name = col in ("scheduler", "airspace")
-        t.add_column(col, justify="right", no_wrap=name, min_width=7 if name else None,
-                     overflow="ellipsis" if name else "fold")
+    for col in _SWEEP_COLUMNS:
+        # a cell wraps before its "±" on a narrow terminal (print_table keeps words whole)
+        t.add_column(col, justify="right")
 
     def pm(r, m, spec, scale=1.0):
         v, ci = r[m], r[m + "_ci95"]

@@ -10,7 +10,7 @@ import typer
 
 from skyroute.cli.parse import parse_cell
 from skyroute.cli.status import delayed_status
-from skyroute.cli.tables import result_table
+from skyroute.cli.tables import print_table, result_table
 from skyroute.errors import OptionError
 from skyroute.files import check_writable, write_atomic
 from skyroute.io.geojson import dumps, grid_path_geojson
@@ -91,7 +91,8 @@ def plan_command(
         from rich.console import Console
 
         files = (("plot", plot), ("geojson", geojson)) if result.found else ()
-        Console().print(result_table(f"{grid.name}: {result.algorithm}", result, files=files))
+        print_table(Console(), result_table(f"{grid.name}: {result.algorithm}", result,
+                                            files=files))
     if not result.found:
         raise typer.Exit(EXIT_NOT_FOUND)
 

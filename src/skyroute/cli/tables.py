@@ -1,8 +1,11 @@
 """Rich output shared by commands: the PlanResult table, a console wide enough for tables,
-the progress bar of long runs and where progress shows."""
+how every table is laid out to fit a terminal, the progress bar of long runs and where
+progress shows."""
 
 from __future__ import annotations
 
+import re
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from skyroute.result import PlanResult
@@ -20,7 +23,7 @@ def result_table(title: str, result: PlanResult, *, unit: str = "",
 
     table = Table(title=title, show_header=False)
     table.add_column(style="bold")
-    table.add_column()
+    table.add_column(overflow="fold")  # a long file path folds; numbers stay whole
     table.add_row("status", result.status.value)
     if result.found:
         table.add_row("cost", f"{result.cost:.6f}" + (f" {unit}" if unit else ""))
@@ -45,6 +48,82 @@ def wide_console() -> Console:
 
     out = Console()
     return out if out.is_terminal else Console(width=160)
+
+
+# A word that starts like a number ("12.5", "±3.2", "(0.00%)", "256x256", "1,900"): it is
+# never split across lines. Paths and names may fold where their column allows it.
+_NUMBER = re.compile(r"[(±+-]?\.?\d")
+
+
+def print_table(console: Console, table: Table, *, optional: Sequence[str] = ()) -> None:
+    """Print ``table`` on ``console`` laid out by :func:`fit_table`."""
+    console.print(fit_table(console, table, optional=optional))
+
+
+def fit_table(console: Console, table: Table, *, optional: Sequence[str] = ()) -> Table:
+    """``table`` (changed in place) laid out to fit ``console`` with no number split across
+    lines, the one rule of every table the CLI prints.
+
+    Rich narrows the widest columns first and then all of them evenly, cutting through
+    words, so at 80 columns a sweep read "35." over "2". Here each column is at least its
+    longest number or header word (and its longest word unless its overflow is "fold", as
+    for file paths), and the width left over goes to the columns that need least more to
+    show on one line. When that is still too wide the table drops its vertical
+    lines, and then the ``optional`` columns (named by header, the last first) with a
+    caption that names them. A table that fits is printed as built."""
+    from rich import box
+
+    cols, extra = _measure(console, table)
+    if sum(hi for _, hi in cols) + extra <= console.width:
+        return table
+    if sum(lo for lo, _ in cols) + extra > console.width:
+        table.box, table.show_edge, table.pad_edge = box.SIMPLE_HEAD, False, False
+        table.collapse_padding = True
+        cols, extra = _measure(console, table)
+    dropped = []
+    for header in reversed(optional):
+        if sum(lo for lo, _ in cols) + extra <= console.width:
+            break
+        table.columns = [c for c in table.columns if c.header != header]
+        for i, c in enumerate(table.columns):
+            c._index = i  # Rich pads the first and last column by this index
+        dropped.append(" ".join(str(header).split()))
+        cols, extra = _measure(console, table)
+    if dropped:
+        note = f"not shown at {console.width} columns: {', '.join(reversed(dropped))}"
+        table.caption = f"{table.caption}\n{note}" if table.caption else note
+    spare = console.width - extra - sum(lo for lo, _ in cols)
+    if spare < 0:
+        return table  # narrower than any layout with whole words: Rich's own
+    # the columns that need least get all they need first, so that at most one column
+    # has some cells wrapped and others not
+    for c, (lo, hi) in sorted(zip(table.columns, cols, strict=True),
+                              key=lambda col: col[1][1] - col[1][0]):
+        give = min(hi - lo, spare)
+        c.width, spare = lo + give, spare - give
+    return table
+
+
+def _measure(console: Console, table: Table) -> tuple[list[tuple[int, int]], int]:
+    """Each column's (least, natural) width of its text, and the width of the rest (lines
+    and padding)."""
+    from rich.measure import Measurement
+
+    opts = console.options.update_width(100_000)
+    cols = []
+    for c in table.columns:
+        body = list(c.cells)
+        head = [Measurement.get(console, opts, c.header)] if table.show_header else []
+        sizes = head + [Measurement.get(console, opts, x) for x in body]
+        words = [w for x in body if isinstance(x, str) for w in x.split()]
+        least = max([m.minimum for m in head]
+                    + [len(w) for w in words if c.overflow != "fold" or _NUMBER.match(w)]
+                    + [m.minimum for x, m in zip(body, sizes[len(head):], strict=True)
+                       if not isinstance(x, str)]
+                    + [c.min_width or 0, 1])
+        cols.append((least, max([m.maximum for m in sizes] + [least])))
+    extra = Measurement.get(console, opts, table).maximum
+    return cols, extra - sum(hi for _, hi in cols)
 
 
 def shows_progress(console: Console) -> bool:

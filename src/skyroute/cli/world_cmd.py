@@ -13,7 +13,7 @@ from rich.markup import escape  # help is Rich markup: '[north, ...]' would read
 
 from skyroute.cli import world_args as wa
 from skyroute.cli.status import delayed_status
-from skyroute.cli.tables import result_table
+from skyroute.cli.tables import print_table, result_table
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
@@ -83,9 +83,9 @@ def plan_world_command(
     else:
         files = (("waypoints file", waypoints_out), ("geojson", geojson), ("plot", plot)) \
             if result.found else ()
-        Console().print(result_table(f"{world.name}: {result.algorithm}", result,
-                                     unit="deg" if world.plane == "degrees" else "m",
-                                     files=files))
+        print_table(Console(), result_table(f"{world.name}: {result.algorithm}", result,
+                                            unit="deg" if world.plane == "degrees" else "m",
+                                            files=files))
     if not result.found:
         raise typer.Exit(EXIT_NOT_FOUND)
 

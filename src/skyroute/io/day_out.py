@@ -39,7 +39,7 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from skyroute.io.plot import place_labels, save_figure
+    from skyroute.io.plot import place_labels, save_figure, set_title
     from skyroute.io.world_out import draw_world, finish_axes
 
     fig, ax = plt.subplots(figsize=(10, 6))
@@ -58,10 +58,10 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
                     **_PLACE_STYLE[kind])
     ax.plot(*site.home, "*", color="black", ms=13, zorder=6, label="home")
     pct = result.money_pct
-    ax.set_title(f"Delivery day {result.date:%d %b %Y}: {len(result.delivered)}/"
-                 f"{len(result.orders)} orders, "
-                 f"{'no orders' if pct is None else f'{pct:.1f}% of the money'}, "
-                 f"{f.moves} moves", fontsize=10)
+    set_title(ax, [f"Delivery day {result.date:%d %b %Y}: {len(result.delivered)}/"
+                   f"{len(result.orders)} orders",
+                   "no orders" if pct is None else f"{pct:.1f}% of the money",
+                   f"{f.moves} moves"])
     finish_axes(ax, site.world)
     # shop names last, on the final axes, each where it covers no other name or marker
     # (shops a few metres apart had their names piled on one another's squares)

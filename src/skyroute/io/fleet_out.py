@@ -467,7 +467,7 @@ def plot_map(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
     from matplotlib.collections import LineCollection
 
     from skyroute.fleet.report import flights_flown
-    from skyroute.io.plot import legend_outside, place_labels, save_figure
+    from skyroute.io.plot import legend_outside, place_labels, save_figure, set_title
 
     s = sim.scenario
     fig, ax = plt.subplots(figsize=(9, 8))
@@ -496,9 +496,7 @@ def plot_map(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
     ax.set_xlabel("east (m)")
     ax.set_ylabel("north (m)")
     # the flights the report counts (a run also holds flights planned past its end)
-    ax.set_title(f"{s.name}: {sim.scheduler} dispatch, {sim.airspace} airspace, "
-                 f"{sim.hours:g} h, seed {sim.seed}, {len(flights_flown(sim))} flights",
-                 fontsize=10)
+    set_title(ax, [*_settings(sim), f"{len(flights_flown(sim))} flights"])
     if n > 10:
         sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(0, n - 1))
         fig.colorbar(sm, ax=ax, label="drone", orientation="horizontal", shrink=0.6,
@@ -521,7 +519,7 @@ def plot_timeline(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
     import matplotlib.pyplot as plt
 
     from skyroute.fleet.report import window_counts
-    from skyroute.io.plot import save_figure
+    from skyroute.io.plot import save_figure, set_title
 
     H = sim.horizon
     st = sim.stream
@@ -557,7 +555,7 @@ def plot_timeline(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
         bins = np.linspace(0.0, H / scale, 61)
         low.hist(denied[:, 0] / scale, bins=bins, color="tab:red", alpha=0.8)
         low.set_ylabel(f"per {_duration(H / 60)}")
-    low.set_title(f"loiter circles (landing refused): {len(denied)}", fontsize=9)
+    set_title(low, [f"loiter circles (landing refused): {len(denied)}"], fontsize=9)
     low.set_xlabel(f"time ({unit})")
     for ax in (top, low):
         ax.axvspan(0, WARMUP_SHARE * H / scale, color="0.88", zorder=0,
@@ -565,15 +563,20 @@ def plot_timeline(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
         ax.grid(alpha=0.3)
         ax.set_xlim(0, H / scale)
     top.legend(loc="upper left", fontsize=8)
-    s = sim.scenario
     # the report's numbers first (the measured window, as the command's table prints
     # them), then the whole run that the curves show
     offered, done = window_counts(sim)
-    top.set_title(f"{s.name}: {sim.scheduler} dispatch, {sim.airspace} airspace, "
-                  f"{sim.hours:g} h, seed {sim.seed}\n{done} of {offered} packages delivered "
-                  f"after the {_duration(WARMUP_SHARE * H)} warm-up; {int(delivered[-1])} of "
-                  f"{int(spawned[-1])} in the whole run", fontsize=10)
+    set_title(top, [*_settings(sim), f"{done} of {offered} packages delivered after the "
+                                     f"{_duration(WARMUP_SHARE * H)} warm-up; "
+                                     f"{int(delivered[-1])} of {int(spawned[-1])} in the whole "
+                                     "run"])
     return save_figure(fig, path, dpi=dpi)
+
+
+def _settings(sim: Simulation) -> list[str]:
+    """The title parts that say which run a picture shows."""
+    return [f"{sim.scenario.name}: {sim.scheduler} dispatch", f"{sim.airspace} airspace",
+            f"{sim.hours:g} h", f"seed {sim.seed}"]
 
 
 def _duration(seconds: float) -> str:

@@ -5,6 +5,9 @@ by the frame, the legend outside the map, labels that keep out of each other's w
 from __future__ import annotations
 
 import io
+import math
+from collections.abc import Callable, Sequence
+from itertools import combinations, pairwise
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +20,8 @@ DPI = 150
 MAX_DPI = 400  # a 512x512 map: about 2,300 pixels a side
 CELL_PIXELS = 4  # a grid picture gives each cell at least this many pixels, up to MAX_DPI
 DOTS_UP_TO = 60  # a path's points are marked when it has at most this many
+PALETTE_COLOURS = 256  # every picture is written as an 8-bit palette PNG
+SNAP = 8  # a common colour replaces the palette entry within this many levels of it
 
 
 def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
@@ -60,10 +65,11 @@ def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
     return save_figure(fig, path, dpi=dpi)
 
 
-def set_title(ax, parts, *, fontsize: float = 10):
-    """The title ``parts`` joined by ", ": on one line when it fits the axes' width,
-    otherwise the parts that fit on the first line and the rest on a second, so a long
-    title (a pruned path's, on a narrow map) stays over the map. Returns the title."""
+def set_title(ax, parts: Sequence[str], *, fontsize: float = 10):
+    """The title of every picture: ``parts`` joined by ", " on as few lines as fit the
+    axes' width, broken where the lines come out most even (:func:`title_lines`), so a
+    long title (a pruned path's, on a narrow map) stays over the map. Returns the
+    title."""
     from matplotlib.font_manager import FontProperties
 
     fig = ax.figure
@@ -74,11 +80,33 @@ def set_title(ax, parts, *, fontsize: float = 10):
     def width(text: str) -> float:
         return renderer.get_text_width_height_descent(text, font, ismath=False)[0]
 
-    first = 1
-    while first < len(parts) and width(", ".join(parts[:first + 1])) <= room:
-        first += 1
-    lines = [", ".join(parts[:first])] + ([", ".join(parts[first:])] if parts[first:] else [])
-    return ax.set_title("\n".join(lines), fontsize=fontsize)
+    return ax.set_title("\n".join(title_lines(parts, room, width)), fontsize=fontsize)
+
+
+def title_lines(parts: Sequence[str], room: float,
+                width: Callable[[str], float] = len) -> list[str]:
+    """``parts`` joined by ", " into the fewest lines no wider than ``room`` (as
+    ``width`` measures a line; characters by default), cut where the longest line is
+    shortest (and then the shortest longest): "a_long_map.map: theta, cost 110.179" over
+    "1,587 expanded, pruned (los): 5 waypoints", not the first three parts over the
+    last. A part is never cut; when no number of lines fits, the fewest lines that are
+    as narrow as whole parts allow.
+
+    >>> title_lines(["map: astar", "cost 12.5", "40 expanded", "pruned: 3 waypoints"], 32)
+    ['map: astar, cost 12.5', '40 expanded, pruned: 3 waypoints']
+    """
+    parts = list(parts)
+    best, best_width = [", ".join(parts)], math.inf
+    for n in range(1, len(parts) + 1):
+        splits = ([", ".join(parts[a:b]) for a, b in pairwise((0, *cuts, len(parts)))]
+                  for cuts in combinations(range(1, len(parts)), n - 1))
+        lines = min(splits, key=lambda ls: (max(map(width, ls)), -min(map(width, ls))))
+        widest = max(map(width, lines))
+        if widest <= room:
+            return lines
+        if widest < best_width:
+            best, best_width = lines, widest
+    return best
 
 
 def grid_dpi(shape: tuple[int, int], figsize: tuple[float, float]) -> int:
@@ -212,7 +240,8 @@ def _overlap(a, b) -> float:
 
 def save_figure(fig, path: str | Path, *, dpi: int = DPI) -> Path:
     """Render a matplotlib figure to PNG (cropped to everything drawn, legends beside the
-    axes included), close it, and write the file whole."""
+    axes included), close it, and write the file whole, as a palette image
+    (:func:`palette_png`)."""
     import matplotlib.pyplot as plt
 
     buf = io.BytesIO()
@@ -221,4 +250,43 @@ def save_figure(fig, path: str | Path, *, dpi: int = DPI) -> Path:
     # (fleet map.png, the day's map) was clipped at the image's right edge.
     fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
     plt.close(fig)
-    return write_atomic(path, buf.getvalue())
+    return write_atomic(path, palette_png(buf.getvalue()))
+
+
+def palette_png(png: bytes) -> bytes:
+    """An opaque PNG as an 8-bit palette PNG of at most :data:`PALETTE_COLOURS` colours.
+
+    Thin anti-aliased lines over a map (a visibility graph's 2,500 edges, a fleet's
+    tracks) blend into thousands of colours, a few pixels each, which zlib packs badly
+    in 4 bytes a pixel: 1.7 MB for a 6x6-block city. Matplotlib already draws the edges
+    as one collection at 150 dpi; it is the pixels, not the artists, that cost. One byte
+    a pixel from an adaptive palette (Pillow's fast octree, no dithering) makes such a
+    picture 3-5 times smaller, within a few levels of every colour; the most common
+    colours (the white ground, the greys, the markers' colours) stay exact."""
+    from PIL import Image
+
+    with Image.open(io.BytesIO(png)) as img:
+        rgb = img.convert("RGB")
+    small = rgb.quantize(PALETTE_COLOURS, method=Image.Quantize.FASTOCTREE,
+                         dither=Image.Dither.NONE)
+    small.putpalette(_exact_palette(small.getpalette()[:3 * PALETTE_COLOURS],
+                                    rgb.getcolors(rgb.width * rgb.height)))
+    out = io.BytesIO()
+    small.save(out, format="png")
+    return out.getvalue()
+
+
+def _exact_palette(palette: list[int], colours: list[tuple[int, tuple]]) -> list[int]:
+    """``palette`` (flat RGB) with each of the most common ``colours`` ((count, rgb), as
+    Pillow counts them) put in place of the entry nearest it, where that entry is its
+    octree average (within :data:`SNAP` levels): the octree's mean of white and its
+    anti-aliased neighbours was (254, 254, 254), a grey frame round every picture."""
+    pal = np.array(palette, dtype=float).reshape(-1, 3)
+    taken = np.zeros(len(pal), dtype=bool)
+    for _, rgb in sorted(colours, key=lambda c: -c[0])[:PALETTE_COLOURS // 4]:
+        d = np.abs(pal - rgb).max(axis=1)
+        d[taken] = np.inf
+        k = int(d.argmin())
+        if d[k] <= SNAP:
+            pal[k], taken[k] = rgb, True
+    return pal.astype(int).ravel().tolist()
