@@ -35,6 +35,16 @@ def test_plan_json_and_files(monkeypatch, capsys, tmp_path):
     assert feature["properties"]["cost"] == doc["cost"]
 
 
+@pytest.mark.parametrize("name", ["a[/]b.png", "x[bold]y.png"])
+def test_names_print_as_given_not_as_markup(monkeypatch, capsys, tmp_path, name):
+    """A file name is data: Rich markup read '[/]' as a closing tag (a MarkupError
+    traceback after the picture was written) and dropped '[bold]' from the name shown."""
+    png = tmp_path / name
+    code, out, err = run(monkeypatch, capsys, "plan", *QUERY, "--plot", str(png))
+    assert code == 0, err
+    assert png.exists() and name in out and not err
+
+
 def test_plan_table_and_prune(monkeypatch, capsys):
     import skyroute
 
@@ -117,6 +127,7 @@ def test_bench_grid_runs_and_reports_missing_peers(monkeypatch, capsys, tmp_path
                          "--peers", "pathfinding,networkx", "--json", str(out_json))
     assert code == 0, err
     assert "peer pathfinding is not installed" in err
+    assert "pip install 'skyroute[bench]'" in " ".join(err.split())  # markup took [bench]
     doc = json.loads(out_json.read_text())
     rows = {r["runner"]: r for r in doc["maps"][0]["rows"]}
     for a in ("astar", "jps", "dijkstra"):

@@ -124,10 +124,9 @@ def _group(version: bool = typer.Option(False, "--version", callback=_print_vers
 
 def maps_command() -> None:
     """List the MovingAI maps bundled with skyroute (usable by name as MAP)."""
-    from rich.console import Console
     from rich.table import Table
 
-    from skyroute.cli.tables import print_table
+    from skyroute.cli.tables import plain_console, print_table
     from skyroute.world.load import bundled_maps
     from skyroute.world.movingai import read_map
 
@@ -140,7 +139,7 @@ def maps_command() -> None:
         lines = len(scen.read_text().splitlines()) - 1 if scen.exists() else 0
         table.add_row(name, f"{grid.width}x{grid.height}", f"{grid.free_fraction:.0%}",
                       str(lines), str(path))
-    print_table(Console(), table)
+    print_table(plain_console(), table)
 
 
 def main() -> None:

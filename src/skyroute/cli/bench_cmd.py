@@ -23,7 +23,7 @@ from skyroute.bench.grid import (
 from skyroute.bench.peers import skip_reason
 from skyroute.bench.random_maps import parse_random
 from skyroute.cli.parse import parse_list
-from skyroute.cli.tables import print_table, progress_bar
+from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.errors import OptionError
 from skyroute.files import check_writable, write_atomic
 from skyroute.world.load import bundled_maps
@@ -73,19 +73,19 @@ def bench_grid(
         check_writable(json_out)
     only_random = randoms and maps is None and not map_names
     pairs = [] if only_random else find_pairs(folder, map_names or ())
-    console = Console(stderr=True)
+    console = plain_console(stderr=True)
     for p in missing:
-        console.print(f"[yellow]peer {p} is not installed; skipped "
-                      "(pip install 'skyroute[bench]')[/yellow]")
+        console.print(f"peer {p} is not installed; skipped "
+                      "(pip install 'skyroute[bench]')", style="yellow")
     cases = [load_case(m, s, per_map=per_map) for m, s in pairs]
     cases += [random_case(spec, per_map=per_map, seed=seed) for spec in randoms]
     _note_skipped_peers(console, cases, have, ours=bool(algs) or prepared)
     reports = _run(console, cases, algorithms=algs, peers=have, seed=seed, prepared=prepared)
-    out = Console()
+    out = plain_console()
     for rep in reports:
         if rep.get("prepared", {}).get("build_peak_error"):
-            console.print(f"[yellow]{rep['map']}: {rep['prepared']['build_peak_error']}"
-                          "[/yellow]")
+            console.print(f"{rep['map']}: {rep['prepared']['build_peak_error']}",
+                          style="yellow")
         # the speed-ups and the cost ratios stay longest on a narrow terminal
         print_table(out, _table(rep), optional=(
             *(f"x faster than {row['runner']}" for row in rep["rows"] if row["peer"]),
@@ -122,7 +122,7 @@ def _note_skipped_peers(console: Console, cases: list[Case], peers: list[str], *
                               f"({'; '.join(f'{p}: {w}' for p, w in skipped.items())}); give "
                               "--algorithms or --prepared")
         for p, why in skipped.items():
-            console.print(f"[yellow]peer {p} skipped on {case.label}: {why}[/yellow]")
+            console.print(f"peer {p} skipped on {case.label}: {why}", style="yellow")
 
 
 def _run(console: Console, cases: list[Case], **options) -> list[dict]:

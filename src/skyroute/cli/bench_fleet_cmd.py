@@ -8,12 +8,11 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from skyroute.bench.fleet import CASES, bench_case
 from skyroute.cli.bench_cmd import bench_app
-from skyroute.cli.tables import print_table, progress_bar, wide_console
+from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError, check_choice
 from skyroute.files import check_writable, write_atomic
 
@@ -38,7 +37,7 @@ def bench_fleet(
             raise OptionError(f"--case {k} is not valid; choose 1 to {len(CASES)}")
     if json_out:  # a bad path fails now, not after the runs
         check_writable(json_out)
-    err = Console(stderr=True)
+    err = plain_console(stderr=True)
     rows = []
     with progress_bar(err, elapsed=True) as progress:
         for k in chosen:

@@ -9,11 +9,10 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli.bench_cmd import bench_app
-from skyroute.cli.tables import print_table, progress_bar, wide_console
+from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError
 from skyroute.files import check_writable, write_atomic
 
@@ -53,7 +52,7 @@ def bench_jobs_command(
     if json_out:  # a bad path fails now, not after the runs
         check_writable(json_out)
     n_days = (d1 - d0).days + 1
-    with progress_bar(Console(stderr=True)) as progress:
+    with progress_bar(plain_console(stderr=True)) as progress:
         task = progress.add_task("days", total=n_days * len(plan))
         got = bench_jobs(data, d0, d1, plan, method=method,
                          on_day=lambda: progress.advance(task))

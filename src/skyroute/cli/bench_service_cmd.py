@@ -9,11 +9,10 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli.bench_cmd import bench_app
-from skyroute.cli.tables import print_table, wide_console
+from skyroute.cli.tables import plain_console, print_table, wide_console
 from skyroute.errors import OptionError, check_choice
 from skyroute.files import check_writable, write_atomic
 
@@ -61,7 +60,7 @@ def bench_service(
     if json_out:  # a bad path fails now, not after the runs
         check_writable(json_out)
     rows = []
-    err = Console(stderr=True)
+    err = plain_console(stderr=True)
     for x in loads:
         err.print(f"{x}: {requests:,} requests, {clients} {client} clients in {client_processes} "
                   f"process(es), {workers} server process(es) ...")

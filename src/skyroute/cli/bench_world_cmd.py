@@ -12,7 +12,6 @@ from typing import Annotated
 
 import numpy as np
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from skyroute.bench.world import (
@@ -27,7 +26,7 @@ from skyroute.bench.world import (
 )
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_list
-from skyroute.cli.tables import print_table, progress_bar
+from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 from skyroute.files import check_writable, write_atomic
 from skyroute.motion.step_drone import MERGE
@@ -115,11 +114,11 @@ def _world_cases(worlds, seed, city, altitude, safety) -> list[tuple]:
 
 def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, seconds,
                  chosen, json_out) -> None:
-    console = Console(stderr=True)
+    console = plain_console(stderr=True)
     cases = _world_cases(worlds, seed, city, altitude, safety)
     if not ompl_available():
-        console.print("[yellow]OMPL is not installed; skyroute only "
-                      "(pip install 'skyroute[bench]')[/yellow]")
+        console.print("OMPL is not installed; skyroute only "
+                      "(pip install 'skyroute[bench]')", style="yellow")
     reports = []
     with progress_bar(console) as progress:
         task = progress.add_task("worlds", total=len(cases))
@@ -127,7 +126,7 @@ def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, 
             reports.append(bench_query(world, s, g, seconds=seconds, planners=chosen,
                                        rrt_budgets=(0.1, 0.3, 1.0, 3.0), other=other))
             progress.advance(task)
-    out = Console()
+    out = plain_console()
     for rep in reports:
         t = Table(title=f"{rep['world']}: optimum {rep['optimum']:.3f}; RRT* within 1% "
                         f"after {rep['rrtstar_budget_within_1pct'] or 'more than 3'} s")
@@ -208,7 +207,7 @@ def bench_motion(
     if curvature:
         _bench_curvature(worlds, seed, secs, city, tours, json_out)
         return
-    out = Console()
+    out = plain_console()
     d = dubins_speed()
     print_table(out, _dubins_table(d))
     if dubins:
@@ -216,7 +215,7 @@ def bench_motion(
             write_atomic(json_out, json.dumps({"dubins": d}, indent=1))
         _exit_past_ompl()
         return
-    with progress_bar(Console(stderr=True)) as progress:
+    with progress_bar(plain_console(stderr=True)) as progress:
         task = progress.add_task("pairs", total=14 * 13)
         r = step_drone_pairs(*ilp, max_expansions=max_expansions, merge=merge,
                              on_pair=lambda: progress.advance(task))
@@ -272,8 +271,8 @@ def _bench_curvature(worlds, seed, secs, city, tours, json_out) -> None:
     from skyroute.bench.curvature import curvature_queries, run_queries, summary, tour_benchmark
 
     queries = curvature_queries(worlds, seed, city=city)  # a bad --city fails here, first
-    out = Console()
-    with progress_bar(Console(stderr=True)) as progress:
+    out = plain_console()
+    with progress_bar(plain_console(stderr=True)) as progress:
         task = progress.add_task("planner runs", total=None)
         rows = run_queries(queries, secs, on_step=lambda r: progress.advance(task))
     summ = summary(rows)

@@ -8,9 +8,9 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 
 from skyroute.cli.status import delayed_status
+from skyroute.cli.tables import plain_console
 from skyroute.errors import OptionError
 
 data_app = typer.Typer(help="Delivery data sets: synthesise one, serve one over HTTP.",
@@ -51,7 +51,7 @@ def data_serve(
     from skyroute.delivery.serve import make_server
 
     server = make_server(folder, port, host)
-    Console(stderr=True).print(f"serving {folder / 'website'} at http://{host}:"
+    plain_console(stderr=True).print(f"serving {folder / 'website'} at http://{host}:"
                                f"{server.server_address[1]} (Ctrl-C to stop)")
     try:
         server.serve_forever()

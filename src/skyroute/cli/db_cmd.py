@@ -6,8 +6,8 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 
+from skyroute.cli.tables import plain_console
 from skyroute.delivery.store import DEFAULT_DB
 
 db_app = typer.Typer(help="The SQL store of orders, deliveries and flight paths.",
@@ -22,7 +22,7 @@ def db_init(db: Annotated[str, typer.Option(help="SQLAlchemy URL of the store.")
     from skyroute.delivery.store import init
 
     rev = init(open_store(db))
-    Console().print(f"{db}: schema at revision {rev}")
+    plain_console().print(f"{db}: schema at revision {rev}")
 
 
 @db_app.command("import")
@@ -38,5 +38,5 @@ def db_import(
 
     orders = read_csv_orders(data)
     added, had = import_orders(open_store(db), orders)
-    Console().print(f"{db}: {added:,} orders added, {len(orders) - added:,} already there "
+    plain_console().print(f"{db}: {added:,} orders added, {len(orders) - added:,} already there "
                     f"({had + added:,} stored)")

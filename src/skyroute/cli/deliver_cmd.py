@@ -9,11 +9,10 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
-from skyroute.cli.tables import print_table, progress_bar
+from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.delivery.day import METHODS, DayResult
 from skyroute.delivery.store import DEFAULT_DB
 from skyroute.errors import OptionError, SkyrouteError, check_choice
@@ -82,7 +81,7 @@ def deliver_command(
     engine = open_store(db)
     # the executor before any work: a wrong --dask address fails at once
     with open_from_flags(executor, dask, jobs, (d1 - d0).days + 1) as ex:
-        err = Console(stderr=True)
+        err = plain_console(stderr=True)
         if data is not None:
             added, _ = import_orders(engine, read_csv_orders(data))
             if added:
@@ -133,9 +132,9 @@ def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
             ("files", "\n".join(str(f) for f in files))]
     for k, v in rows:
         t.add_row(k, str(v))
-    print_table(Console(), t)
+    print_table(plain_console(), t)
     for o, reason in r.invalid:
-        Console(stderr=True).print(f"invalid order {o.order_no}: {reason}", markup=False)
+        plain_console(stderr=True).print(f"invalid order {o.order_no}: {reason}")
 
 
 def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kind: str,
@@ -157,7 +156,6 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
         t.add_column(col, justify="right")
     for m, v in s["months"].items():
         t.add_row(m, str(v["days"]), f"{v['mean_pct']:.2f}", f"{v['min_pct']:.2f}")
-    print_table(Console(), t)
+    print_table(plain_console(), t)
     if files:
-        Console().print(f"wrote {len(files):,} files to {', '.join(s['folders'])}",
-                        markup=False)
+        plain_console().print(f"wrote {len(files):,} files to {', '.join(s['folders'])}")

@@ -8,11 +8,10 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
-from skyroute.cli.tables import print_table, progress_bar, wide_console
+from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError, check_choice
 from skyroute.fleet.limits import (
     MAX_DRONES,
@@ -161,7 +160,7 @@ def simulate_command(
         from skyroute.io.fleet_out import check_run_outputs
 
         check_run_outputs(out, plot=plot)
-    err = Console(stderr=True)
+    err = plain_console(stderr=True)
     files: list[Path] = []
     with progress_bar(err) as progress:
         task = progress.add_task("simulated seconds", total=round(hours * 3600))
@@ -181,10 +180,10 @@ def simulate_command(
     if as_json:
         typer.echo(json.dumps(rep))
     else:
-        print_table(Console(), _report_table(rep, files))
+        print_table(plain_console(), _report_table(rep, files))
     if rep["conflicts"] or rep["lost"]:
-        Console(stderr=True).print(f"skyroute: {rep['conflicts']} loss(es) of separation, "
-                                   f"{rep['lost']} lost package(s)", markup=False)
+        plain_console(stderr=True).print(f"skyroute: {rep['conflicts']} loss(es) of "
+                                         f"separation, {rep['lost']} lost package(s)")
         raise typer.Exit(1)
 
 
@@ -331,7 +330,7 @@ def sweep_command(
     for r in rate_list:  # each run's packages (rate x hours) within the limit
         check_work(s, hours=hours, rate=r, rate_flag="--rates")
     runs = len(scheds) * len(spaces) * len(rate_list) * len(seed_list)
-    err = Console(stderr=True)
+    err = plain_console(stderr=True)
     with progress_bar(err) as progress:
         task = progress.add_task("runs", total=runs)
         with open_from_flags(executor, dask, jobs, runs) as ex:

@@ -11,12 +11,11 @@ from typing import Annotated
 
 import numpy as np
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from skyroute.cli import world_args as wa
 from skyroute.cli.status import delayed_status
-from skyroute.cli.tables import print_table
+from skyroute.cli.tables import plain_console, print_table
 from skyroute.errors import OptionError, check_choice
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
@@ -212,7 +211,7 @@ def fly_command(
             if k != "reached":
                 table.add_row(k, f"{v:.6g}" if isinstance(v, float) else str(v))
         table.add_row("reached", str(doc["reached"]))
-        print_table(Console(), table)
+        print_table(plain_console(), table)
     if not doc["reached"]:
         raise typer.Exit(EXIT_NOT_REACHED)
 

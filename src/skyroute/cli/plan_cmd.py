@@ -88,10 +88,10 @@ def plan_command(
     if as_json:
         typer.echo(json.dumps(result.to_dict()))
     else:
-        from rich.console import Console
+        from skyroute.cli.tables import plain_console
 
         files = (("plot", plot), ("geojson", geojson)) if result.found else ()
-        print_table(Console(), result_table(f"{grid.name}: {result.algorithm}", result,
+        print_table(plain_console(), result_table(f"{grid.name}: {result.algorithm}", result,
                                             files=files))
     if not result.found:
         raise typer.Exit(EXIT_NOT_FOUND)
@@ -111,8 +111,7 @@ def prepare_command(
         help="Metres per cell for .csv walls (as for plan).")] = 1.0,
 ) -> None:
     """Build a map's index once for fast exact queries ('skyroute plan MAP --index ...')."""
-    from rich.console import Console
-
+    from skyroute.cli.tables import plain_console
     from skyroute.search.prepared import prepare
 
     if Path(map_file).is_file() and out.resolve() == Path(map_file).resolve():
@@ -121,10 +120,10 @@ def prepare_command(
     check_writable(out)  # before the build, which can take a while
     grid = load_map(map_file, resolution=resolution, safety=safety)
     if grid.blocked.all():
-        Console(stderr=True).print(f"note: every cell of {grid.name} is blocked (--safety "
+        plain_console(stderr=True).print(f"note: every cell of {grid.name} is blocked (--safety "
                                    f"{safety:g}): the index will refuse every query")
     with delayed_status(f"preparing {grid.name}"):  # a first run compiles for a minute
         index = prepare(grid, method=method)
     written = index.save(out)
-    Console().print(f"{grid.name}: {index.describe()}, built in {index.build_seconds:.3f} s, "
+    plain_console().print(f"{grid.name}: {index.describe()}, built in {index.build_seconds:.3f} s, "
                     f"{written.stat().st_size / 1e6:.2f} MB -> {written}")

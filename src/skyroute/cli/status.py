@@ -77,7 +77,9 @@ class DelayedStatus:
     def _retext(self) -> None:
         with self._lock:
             if self._spinner is not None:
-                self._spinner.update(text=self.text)
+                from rich.text import Text  # loaded already: the spinner shows
+
+                self._spinner.update(text=Text(self.text))  # as given: no markup
 
     def _on_compile(self) -> None:
         if not self._compiled:
@@ -100,19 +102,19 @@ class DelayedStatus:
             if self._done.wait(self._delay):
                 return
             self._watch_compiles()  # numba may have been loaded by the work meanwhile
-            from rich.console import Console
             from rich.live import Live
             from rich.spinner import Spinner
+            from rich.text import Text
 
-            from skyroute.cli.tables import shows_progress
+            from skyroute.cli.tables import plain_console, shows_progress
 
-            console = self._console or Console(stderr=True)
+            console = self._console or plain_console(stderr=True)
             if not shows_progress(console):
                 return
             with self._lock:
                 if self._done.is_set():
                     return
-                self._spinner = Spinner("dots", text=self.text, style="status.spinner")
+                self._spinner = Spinner("dots", text=Text(self.text), style="status.spinner")
                 # stdout stays the command's own (pure JSON with --json); stray stderr
                 # lines (warnings) print above the status
                 live = Live(self._spinner, console=console, refresh_per_second=12.5,

@@ -41,13 +41,21 @@ def result_table(title: str, result: PlanResult, *, unit: str = "",
     return table
 
 
+def plain_console(*, stderr: bool = False, width: int | None = None) -> Console:
+    """A Rich console that prints text as given, markup off: what the CLI prints holds
+    file, map and scenario names, where markup took `[bold]` as a style (dropped from
+    the name) and `[/]` as a closing tag (a MarkupError traceback), and "pip install
+    'skyroute[bench]'" lost its extra. Colour goes by ``style=`` instead."""
+    from rich.console import Console
+
+    return Console(stderr=stderr, width=width, markup=False)
+
+
 def wide_console() -> Console:
     """Stdout for wide tables: at least 160 columns when it is a file or a pipe (where
     Rich would otherwise wrap every cell at 80)."""
-    from rich.console import Console
-
-    out = Console()
-    return out if out.is_terminal else Console(width=160)
+    out = plain_console()
+    return out if out.is_terminal else plain_console(width=160)
 
 
 # A word that starts like a number ("12.5", "±3.2", "(0.00%)", "256x256", "1,900"): it is
@@ -154,6 +162,6 @@ def progress_bar(console: Console, *, elapsed: bool = False) -> Progress:
         def render(self, task) -> Text:
             return Text("") if task.total is None else super().render(task)
 
-    return Progress(TextColumn("{task.description}"), BarColumn(), Count(),
+    return Progress(TextColumn("{task.description}", markup=False), BarColumn(), Count(),
                     TimeElapsedColumn() if elapsed else TimeRemainingColumn(),
                     console=console, transient=True, disable=not shows_progress(console))

@@ -8,12 +8,11 @@ from typing import Annotated
 
 import numpy as np
 import typer
-from rich.console import Console
 from rich.markup import escape  # help is Rich markup: '[north, ...]' would read as a tag
 
 from skyroute.cli import world_args as wa
 from skyroute.cli.status import delayed_status
-from skyroute.cli.tables import print_table, result_table
+from skyroute.cli.tables import plain_console, print_table, result_table
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
@@ -83,7 +82,7 @@ def plan_world_command(
     else:
         files = (("waypoints file", waypoints_out), ("geojson", geojson), ("plot", plot)) \
             if result.found else ()
-        print_table(Console(), result_table(f"{world.name}: {result.algorithm}", result,
+        print_table(plain_console(), result_table(f"{world.name}: {result.algorithm}", result,
                                             unit="deg" if world.plane == "degrees" else "m",
                                             files=files))
     if not result.found:
