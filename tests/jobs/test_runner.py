@@ -172,3 +172,96 @@ def test_reading_a_dead_servers_job_fails_it(tmp_path):
     job = runner.get(engine, dead)
     assert (job["state"], job["error"]) == ("failed", runner.ORPHANED)
     assert runner.get(engine, live)["state"] == "queued"
+
+
+def stall(engine) -> None:
+    """As if this process had been silent for two DEAD_AFTERs: its heartbeat set back,
+    then another server fails its jobs as orphans."""
+    import datetime as dt
+
+    from skyroute.delivery.store import tables
+    from skyroute.jobs import store
+
+    servers = tables(engine, ("servers",))["servers"]
+    with engine.begin() as c:
+        then = store.db_now(c) - dt.timedelta(seconds=2 * runner.DEAD_AFTER)
+        c.execute(servers.update().where(servers.c.id == runner.owner())
+                  .values(heartbeat=then))
+    store.fail_orphans(engine, runner.ORPHANED, dead_after=runner.DEAD_AFTER)
+
+
+def settle(timeout: float = 60) -> None:
+    """Wait until this process has no job queued or running."""
+    end = time.monotonic() + timeout
+    while runner.pending() and time.monotonic() < end:
+        time.sleep(0.01)
+    assert runner.pending() == 0
+
+
+@pytest.mark.parametrize("late", ["result", "progress"])
+def test_jobs_failed_while_this_process_stalled_stay_failed(tmp_path, monkeypatch, caplog,
+                                                            late):
+    """A stall fails this process's running and queued jobs as orphans. When it wakes,
+    the running job's result (or its next progress) is discarded and the queued job is
+    not run: both stay failed as the client was told."""
+    import threading
+
+    release, ran = threading.Event(), []
+
+    def hold(engine, job_id, params, *, executor, progress):
+        ran.append(job_id)
+        progress(0.5)
+        release.wait(60)
+        if late == "progress":
+            progress(1.0)
+            ran.append("went on")
+        return {"late": True}
+
+    monkeypatch.setattr(runner, "heartbeat", lambda: None)  # the stall: no beats
+    monkeypatch.setitem(runner.KINDS, "hold", runner.Kind(dict, hold))
+    engine = lunch_store(f"sqlite:///{tmp_path / 'stall.db'}", ())
+    first = runner.submit(engine, "hold", {}, executor=None)
+    second = runner.submit(engine, "hold", {}, executor=None)
+    try:
+        end = time.monotonic() + 60
+        while runner.get(engine, first)["state"] != "running" and time.monotonic() < end:
+            time.sleep(0.01)
+        stall(engine)
+        assert [runner.get(engine, i)["state"] for i in (first, second)] == ["failed"] * 2
+    finally:
+        release.set()
+    with caplog.at_level("WARNING", logger="skyroute.jobs"):
+        settle()
+    assert ran == [first]  # the second job never ran; the first stopped at its progress
+    for job_id in (first, second):
+        job = runner.get(engine, job_id)
+        assert (job["state"], job["error"], job["result"]) == \
+            ("failed", runner.ORPHANED, None), job
+    said = caplog.text
+    what = "its result is discarded" if late == "result" else "it is stopped"
+    assert f"job {first} is already failed ({runner.ORPHANED}); {what}" in said, said
+    assert f"job {second} is already failed ({runner.ORPHANED}); it is not run" in said
+
+
+@pytest.mark.parametrize("when", ["before the run is stored", "after the run is stored"])
+def test_a_fleet_job_failed_while_it_ran_leaves_no_run(tmp_path, monkeypatch, when):
+    """A fleet job failed as an orphan while its worker simulated (or just after the
+    worker stored the run) ends failed, with no run left in fleet_runs."""
+    from skyroute.jobs import fleet, store
+
+    engine = lunch_store(f"sqlite:///{tmp_path / 'fleet.db'}", ())
+    monkeypatch.setattr(runner, "heartbeat", lambda: None)
+    if when == "before the run is stored":
+        real = fleet.report
+        monkeypatch.setattr(fleet, "report", lambda sim: (stall(engine), real(sim))[1])
+    else:
+        real = store.save_fleet_run
+        monkeypatch.setattr(store, "save_fleet_run",
+                            lambda *a, **kw: (real(*a, **kw), stall(engine))[0])
+    with open_executor("local", workers=1) as ex:  # the task runs in this process
+        job_id = runner.submit(engine, "fleet", {"preset": "seed-3x3", "hours": 0.1},
+                               executor=ex)
+        settle(300)
+    job = runner.get(engine, job_id)
+    assert (job["state"], job["error"], job["result"]) == ("failed", runner.ORPHANED, None)
+    assert store.list_fleet_runs(engine, job_id=job_id) == []

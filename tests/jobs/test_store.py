@@ -5,6 +5,7 @@ with their files, on SQLite and PostgreSQL alike."""
 from __future__ import annotations
 
 import datetime as dt
+import uuid
 from pathlib import Path
 
 import pytest
@@ -208,3 +209,109 @@ def test_the_database_clock_is_utc_without_a_zone(engine):
         now = store.db_now(c)
     here = dt.datetime.now(dt.UTC).replace(tzinfo=None)
     assert now.tzinfo is None and abs(now - here) < dt.timedelta(hours=1)  # not local time
+
+
+FILES = {"events_jsonl": "", "tracks_csv": b"", "packages_csv": "", "fleet_geojson": ""}
+
+
+def save_run(engine, job_id: str, run_id: str | None = None) -> str:
+    return store.save_fleet_run(engine, scenario="s", params={}, report={}, job_id=job_id,
+                                run_id=run_id, **FILES)
+
+
+def test_a_job_failed_as_an_orphan_stays_failed(engine):
+    """A stalled server's job is failed as an orphan (its stored run with it); when the
+    server wakes, its result, its error and its progress are refused, and so is the
+    fleet run its worker would store."""
+    stale(engine, "stalled", 120)
+    job_id = store.create_job(engine, "fleet", {}, owner="stalled")
+    assert store.set_progress(engine, job_id, 0.5)
+    save_run(engine, job_id)  # the worker stored it, then the server stalled
+    assert job_id in store.fail_orphans(engine, "orphaned", dead_after=60)
+    assert store.list_fleet_runs(engine, job_id=job_id) == []
+
+    assert store.finish_job(engine, job_id, {"fleet_run": "r"}) is False
+    assert store.fail_job(engine, job_id, "a late error") is False
+    assert store.set_progress(engine, job_id, 0.9) is False
+    with pytest.raises(store.JobEndedError, match=f"job {job_id} has failed; its fleet "
+                                                  "run is not stored"):
+        save_run(engine, job_id, late := str(uuid.uuid4()))
+    job = store.get_job(engine, job_id)
+    assert (job["state"], job["error"], job["result"], job["progress"]) == \
+        ("failed", "orphaned", None, 0.5)
+    assert store.list_fleet_runs(engine, job_id=job_id) == []
+    assert store.get_fleet_run(engine, late) is None
+
+
+def test_ended_jobs_are_never_written_again(engine):
+    done = store.create_job(engine, "fleet", {})
+    assert store.finish_job(engine, done, {"fleet_run": "r1"})  # queued -> done
+    run = save_run(engine, done)
+    assert save_run(engine, done, run) == run  # a task run twice replaces its run
+    assert store.fail_job(engine, done, "too late") is False
+    assert store.finish_job(engine, done, {"fleet_run": "r2"}) is False
+    job = store.get_job(engine, done)
+    assert (job["state"], job["error"], job["result"]) == ("done", None, {"fleet_run": "r1"})
+    assert [r["id"] for r in store.list_fleet_runs(engine, job_id=done)] == [run]
+
+    failed = store.create_job(engine, "fleet", {})
+    assert store.set_progress(engine, failed, 0.2)
+    save_run(engine, failed)
+    assert store.fail_job(engine, failed, "first")  # running -> failed, its run gone
+    assert store.fail_job(engine, failed, "second") is False
+    assert store.finish_job(engine, failed, {}) is False
+    job = store.get_job(engine, failed)
+    assert (job["state"], job["error"], job["result"]) == ("failed", "first", None)
+    assert store.list_fleet_runs(engine, job_id=failed) == []
+    for write in (lambda: store.finish_job(engine, "no-such-job", {}),
+                  lambda: store.fail_job(engine, "no-such-job", "x"),
+                  lambda: store.set_progress(engine, "no-such-job", 0.1)):
+        assert write() is False
+    with pytest.raises(SkyrouteError, match="job_id='no-such-job': no such job"):
+        save_run(engine, "no-such-job")
+
+
+def blocked_by(engine, pid: int) -> int:
+    """How many PostgreSQL sessions wait for the session ``pid`` (read in a transaction
+    of its own: pg_stat_activity is a snapshot taken once per transaction)."""
+    with engine.connect() as c:
+        return c.execute(sa.text("select count(*) from pg_stat_activity "
+                                 "where :pid = any(pg_blocking_pids(pid))"),
+                         {"pid": pid}).scalar_one()
+
+
+def test_a_run_saved_while_its_job_fails_waits_for_the_failure(pg_url):
+    """PostgreSQL: a worker saving its run while another server's transaction is failing
+    the job waits for that transaction and then refuses the run (a plain read would
+    see the job still running and store a run of a failed job)."""
+    import threading
+    import time
+
+    e = dstore.connect(pg_url)
+    dstore.init(e)
+    job_id = store.create_job(e, "fleet", {})
+    store.set_progress(e, job_id, 0.5)
+    jobs = dstore.tables(e, ("jobs",))["jobs"]
+    outcome = []
+
+    def worker():
+        try:
+            outcome.append(save_run(e, job_id))
+        except store.JobEndedError as exc:
+            outcome.append(exc)
+
+    with e.connect() as other:
+        tx = other.begin()  # the failing server's transaction, not yet committed
+        other.execute(jobs.update().where(jobs.c.id == job_id).values(state="failed"))
+        pid = other.execute(sa.text("select pg_backend_pid()")).scalar_one()
+        saving = threading.Thread(target=worker)
+        saving.start()
+        end = time.monotonic() + 30
+        while not blocked_by(e, pid) and time.monotonic() < end:  # the worker waits
+            time.sleep(0.01)
+        assert blocked_by(e, pid) == 1
+        tx.commit()
+    saving.join(30)
+    assert len(outcome) == 1 and isinstance(outcome[0], store.JobEndedError), outcome
+    assert store.list_fleet_runs(e, job_id=job_id) == []
+    e.dispose()

@@ -6,6 +6,9 @@ back (:func:`simulate_report`); the caller turns the reports into means with 95%
 confidence intervals (:func:`sweep_rows`). A fleet run's worker (:func:`fly_fleet`) also
 stores the run in ``fleet_runs`` itself, in one transaction under an id the caller chose,
 so a run re-run after its worker died replaces itself; it sends back the id and report.
+The run of a job failed meanwhile (an orphan of a stalled server) is not stored: the
+worker's save raises :class:`~skyroute.jobs.store.JobEndedError`, and a run saved just
+before the failure is deleted by it.
 ``skyroute fleet sweep`` and the runner's ``sweep`` job call the same :func:`sweep`.
 """
 

@@ -37,8 +37,11 @@ before its workers start, and by :func:`get` on another owner's unfinished job) 
 ``failed`` with :data:`ORPHANED` the unfinished jobs whose owner has been silent for
 :data:`DEAD_AFTER` seconds, or that have no owner (jobs stored before owners were), and
 leaves the live servers' jobs alone. A process stalled
-for longer than that (or cut off from the store) has its jobs marked failed; one it
-finishes after all is then recorded ``done`` over the failure.
+for longer than that (or cut off from the store) has its jobs marked failed, and they
+stay failed: a job failed while queued is not run, one failed while running is stopped
+at its next progress write, and a result or error that comes after all is discarded
+(logged as a warning on ``skyroute.jobs``), as is the fleet run a late fleet job's
+worker would store (:func:`skyroute.jobs.store.save_fleet_run`).
 """
 
 from __future__ import annotations
@@ -215,23 +218,40 @@ def _beat_forever() -> None:
 
 
 def _run(engine, job_id: str, kind: str, params: dict, executor) -> None:
-    store.set_progress(engine, job_id, 0.0)
+    if not store.set_progress(engine, job_id, 0.0):
+        _ended(engine, job_id, "it is not run")
+        return
     last = time.monotonic()
 
     def progress(share: float) -> None:
         nonlocal last
         now = time.monotonic()
         if share >= 1.0 or now - last >= PROGRESS_EVERY:
-            store.set_progress(engine, job_id, min(1.0, max(0.0, share)))
+            if not store.set_progress(engine, job_id, min(1.0, max(0.0, share))):
+                raise store.JobEndedError(f"job {job_id} ended while it ran")
             last = now
 
     try:
         result = KINDS[kind].run(engine, job_id, params, executor=executor,
                                  progress=progress)
+    except store.JobEndedError:  # from progress, or from a worker storing a fleet run
+        _ended(engine, job_id, "it is stopped")
+        return
     except Exception as exc:
         expected = isinstance(exc, SkyrouteError)
         log.log(logging.INFO if expected else logging.ERROR, "job %s (%s) failed", job_id,
                 kind, exc_info=True)
-        store.fail_job(engine, job_id, error_line(exc))
+        if not store.fail_job(engine, job_id, error_line(exc)):
+            _ended(engine, job_id, "its error is discarded")
         return
-    store.finish_job(engine, job_id, result)
+    if not store.finish_job(engine, job_id, result):
+        _ended(engine, job_id, "its result is discarded")
+
+
+def _ended(engine, job_id: str, what: str) -> None:
+    """Log that this process's job was found ended (failed as an orphan while this
+    process was stalled or cut off from the store) and what becomes of it."""
+    job = store.get_job(engine, job_id)
+    state = "gone" if job is None else job["state"]
+    log.warning("job %s is already %s (%s); %s", job_id, state,
+                (job or {}).get("error") or "no error", what)

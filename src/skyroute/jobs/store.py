@@ -6,6 +6,11 @@ the servers; ``skyroute db init`` upgrades to the newest).
   ``state`` is ``queued``, ``running``, ``done`` or ``failed``; ``progress`` 0..1;
   ``params`` and ``result`` JSON; ``error`` one line. Times are UTC. ``owner`` is the id
   of the server process that runs the job (None for jobs stored before revision 0003).
+  A job only moves queued -> running -> done or failed (queued -> failed too): each
+  write checks, in its own statement, that the job is still queued or running, and a
+  job done or failed is never written again (:func:`finish_job` and :func:`fail_job`
+  say whether they wrote). An owner never changes, so the state alone tells whether
+  a result is still wanted.
 - ``servers(id, started, heartbeat)``: the server processes that own jobs, each beating
   (:func:`beat`) while it has jobs to run; times from the database's clock, so servers
   on hosts whose clocks differ agree on who is silent. :func:`fail_orphans` fails the
@@ -14,7 +19,9 @@ the servers; ``skyroute db init`` upgrades to the newest).
   packages_csv, fleet_geojson, created)``: a fleet run's ``report.json``,
   ``events.jsonl``, ``tracks.csv`` (bytes), ``packages.csv`` and ``fleet.geojson`` as
   :mod:`skyroute.io.fleet_out` writes them (a big run's tracks are big: 1 s rows of 1000
-  drones for an hour are about 150 MB; use a coarser ``track_step``).
+  drones for an hour are about 150 MB; use a coarser ``track_step``). No run names a
+  failed job: failing a job deletes its runs in the same transaction, and
+  :func:`save_fleet_run` refuses (:class:`JobEndedError`) a run of a job already failed.
 
 Every function takes the engine first and runs one short transaction. Lookups of an
 unknown id return None.
@@ -31,14 +38,20 @@ import sqlalchemy as sa
 
 from skyroute.caches import register
 from skyroute.delivery.store import connect, tables
-from skyroute.errors import OptionError
+from skyroute.errors import OptionError, SkyrouteError
 
 STATES = ("queued", "running", "done", "failed")
+LIVE = ("queued", "running")  # the states a job may still leave
 TABLES = ("jobs", "fleet_runs", "servers")
 
 
 _ENGINES: dict[str, sa.Engine] = {}
 register(_ENGINES.clear)
+
+
+class JobEndedError(SkyrouteError):
+    """A write for a job that has already ended (failed, say as an orphan of a stalled
+    server): nothing was written."""
 
 
 def worker_url(engine: sa.Engine) -> str:
@@ -98,35 +111,50 @@ def create_job(engine: sa.Engine, kind: str, params: dict, *,
     return job_id
 
 
-def set_progress(engine: sa.Engine, job_id: str, progress: float) -> None:
-    """Mark the job ``running`` at ``progress`` (0..1). A job already done or failed is
-    left as it is."""
+def set_progress(engine: sa.Engine, job_id: str, progress: float) -> bool:
+    """Mark the job ``running`` at ``progress`` (0..1); False (and nothing written) when
+    it is no longer queued or running."""
     p = float(progress)
     if not 0.0 <= p <= 1.0:
         raise OptionError(f"progress={progress!r} must be within 0..1", param="progress")
-    jobs = _t(engine)["jobs"]
-    with engine.begin() as c:
-        c.execute(jobs.update().where(jobs.c.id == job_id,
-                                      jobs.c.state.in_(("queued", "running")))
-                  .values(state="running", progress=p, updated=_now()))
+    return _move(engine, job_id, state="running", progress=p)
 
 
-def finish_job(engine: sa.Engine, job_id: str, result: dict | None) -> None:
-    """Mark the job ``done`` (progress 1) with its JSON ``result``."""
-    jobs = _t(engine)["jobs"]
-    with engine.begin() as c:
-        c.execute(jobs.update().where(jobs.c.id == job_id)
-                  .values(state="done", progress=1.0, result=json_safe(result),
-                          error=None, updated=_now()))
+def finish_job(engine: sa.Engine, job_id: str, result: dict | None) -> bool:
+    """Mark the job ``done`` (progress 1) with its JSON ``result``; False (and nothing
+    written) when it is no longer queued or running: a late result, say of a server
+    that stalled until its job was failed as an orphan, leaves that job failed."""
+    return _move(engine, job_id, state="done", progress=1.0, result=json_safe(result),
+                 error=None)
 
 
-def fail_job(engine: sa.Engine, job_id: str, error: str) -> None:
-    """Mark the job ``failed`` with ``error`` (made one line; no traceback belongs here)."""
-    jobs = _t(engine)["jobs"]
+def fail_job(engine: sa.Engine, job_id: str, error: str) -> bool:
+    """Mark the job ``failed`` with ``error`` (made one line; no traceback belongs here)
+    and delete its fleet runs; False (and nothing written) when it is no longer queued
+    or running."""
     line = " ".join(str(error).split()) or "failed"
+    return _move(engine, job_id, state="failed", error=line)
+
+
+def _move(engine: sa.Engine, job_id: str, **values) -> bool:
+    """Write ``values`` to the job if it is still queued or running, in one statement
+    (the check and the write cannot be parted by another server's write); a job moved
+    to ``failed`` loses its fleet runs in the same transaction. Whether it was written."""
+    t = _t(engine)
+    jobs = t["jobs"]
     with engine.begin() as c:
-        c.execute(jobs.update().where(jobs.c.id == job_id)
-                  .values(state="failed", error=line, updated=_now()))
+        moved = c.execute(jobs.update().where(jobs.c.id == job_id, jobs.c.state.in_(LIVE))
+                          .values(**values, updated=_now())).rowcount == 1
+        if moved and values["state"] == "failed":
+            _drop_runs(c, t, [job_id])
+    return moved
+
+
+def _drop_runs(c: sa.Connection, t: dict[str, sa.Table], job_ids: list[str]) -> None:
+    """Delete the fleet runs of ``job_ids``, jobs just marked failed: no run names a
+    failed job (a run saved before its job failed goes with the failure)."""
+    if job_ids:
+        c.execute(t["fleet_runs"].delete().where(t["fleet_runs"].c.job_id.in_(job_ids)))
 
 
 def db_now(conn: sa.Connection) -> dt.datetime:
@@ -153,8 +181,9 @@ def beat(engine: sa.Engine, server: str) -> None:
 
 def fail_orphans(engine: sa.Engine, error: str, *, dead_after: float) -> list[str]:
     """Mark ``failed`` with ``error`` every ``queued`` or ``running`` job whose owner
-    has not beaten for ``dead_after`` seconds (or that has no owner), and forget those
-    servers; the jobs' ids. The live servers' jobs are left as they are."""
+    has not beaten for ``dead_after`` seconds (or that has no owner), delete their fleet
+    runs and forget those servers; the ids of the jobs it failed. The live servers' jobs
+    are left as they are."""
     if not dead_after > 0:
         raise OptionError(f"dead_after={dead_after!r} must be a number of seconds > 0",
                           param="dead_after")
@@ -163,12 +192,14 @@ def fail_orphans(engine: sa.Engine, error: str, *, dead_after: float) -> list[st
     with engine.begin() as c:
         cutoff = db_now(c) - dt.timedelta(seconds=dead_after)
         alive = sa.select(servers.c.id).where(servers.c.heartbeat >= cutoff)
-        orphaned = sa.and_(jobs.c.state.in_(("queued", "running")),
+        orphaned = sa.and_(jobs.c.state.in_(LIVE),
                            sa.or_(jobs.c.owner.is_(None), jobs.c.owner.not_in(alive)))
-        ids = [r[0] for r in c.execute(sa.select(jobs.c.id).where(orphaned))]
-        if ids:
-            c.execute(jobs.update().where(jobs.c.id.in_(ids), orphaned)
-                      .values(state="failed", error=error, updated=_now()))
+        # RETURNING: the jobs this statement failed, not those a select saw before it
+        # (a job finished in between is left done, and not reported)
+        ids = list(c.scalars(jobs.update().where(orphaned)
+                             .values(state="failed", error=error, updated=_now())
+                             .returning(jobs.c.id)))
+        _drop_runs(c, t, ids)
         c.execute(servers.delete().where(servers.c.heartbeat < cutoff))
     return ids
 
@@ -192,10 +223,24 @@ def save_fleet_run(engine: sa.Engine, *, scenario: str, params: dict, report: di
                    fleet_geojson: str, job_id: str | None = None,
                    run_id: str | None = None) -> str:
     """Store a fleet run in one transaction; its id. Saving again under the same
-    ``run_id`` replaces the run (a task re-run after its worker died stores it once)."""
+    ``run_id`` replaces the run (a task re-run after its worker died stores it once).
+    The run of a job already failed is refused (:class:`JobEndedError`), an unknown
+    ``job_id`` too (a SkyrouteError naming it)."""
     run_id = run_id or str(uuid.uuid4())
-    runs = _t(engine)["fleet_runs"]
+    t = _t(engine)
+    runs, jobs = t["fleet_runs"], t["jobs"]
     with engine.begin() as c:
+        if job_id is not None:
+            # a write, not a read: it takes the job's row lock (PostgreSQL) or the write
+            # lock (SQLite) before the run is written, so a failure of the job comes
+            # either before (seen here) or after (and deletes this run)
+            state = c.execute(jobs.update().where(jobs.c.id == job_id)
+                              .values(state=jobs.c.state).returning(jobs.c.state)
+                              ).scalar_one_or_none()
+            if state is None:
+                raise SkyrouteError(f"job_id={job_id!r}: no such job", param="job_id")
+            if state == "failed":
+                raise JobEndedError(f"job {job_id} has failed; its fleet run is not stored")
         c.execute(runs.delete().where(runs.c.id == run_id))
         c.execute(runs.insert().values(
             id=run_id, job_id=job_id, scenario=scenario, params=json_safe(params),
