@@ -184,7 +184,9 @@ def plan_turns_world(world: World, start, goal, *, resolution: float | None = No
     on a World do, so every move is exactly free): ``start`` and ``goal`` in the world's
     frame, ``start_heading`` and the result's ``headings`` in its heading convention,
     ``path`` the route in its frame; ``speed`` in plane units per second, ``distance``
-    in plane units."""
+    in plane units. The route runs between the centres of the free cells nearest
+    ``start`` and ``goal`` (reachable from them in a straight line), not the exact
+    points: a leg joining them would take a turn the lattice does not price."""
     s = world.check_point(start, "start")
     t = world.check_point(goal, "goal")
     grid = world_raster(world, s, t, resolution)
