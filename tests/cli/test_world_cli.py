@@ -91,6 +91,7 @@ def test_a_city_too_large_for_its_planner_is_one_line_naming_it(monkeypatch, cap
     city = tmp_path / "c.csv"
     code, _, _ = run(monkeypatch, capsys, "synth-city", str(city), "--blocks", "3")
     assert code == 0
+    monkeypatch.setenv("SKYROUTE_CACHE", str(tmp_path))  # not a graph an earlier test kept
     monkeypatch.setattr(visibility, "MAX_CORNERS", 20)  # the city has about 70
     monkeypatch.setattr(corner_distance, "MAX_CORNERS", 20)
     png = tmp_path / "p.png"
