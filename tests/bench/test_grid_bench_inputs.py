@@ -174,6 +174,36 @@ def test_bad_options_name_the_real_flag(monkeypatch, capsys, no_timing, args, wo
     assert_one_line(code, out, err, words)
 
 
+@pytest.mark.parametrize("args, words", [
+    (["--per-map", "10001"], "--per-map 10,001 is over the limit of 10,000 queries a map (0 "
+                             "runs every scenario line)"),
+    (["--random", "16:0.2", "--per-map", "1000000000"], "--per-map 1,000,000,000 is over the "
+                                                        "limit of 10,000"),
+    (["--random", "512:0.2", "--random", "4096:0.2", "--per-map", "33"],
+     "--per-map 33 far queries on a 4096x4096 random map would each search its 16,777,216 "
+     "cells for the optimum; at most 32 on a map that size"),
+])
+def test_too_many_queries_are_refused_before_any_map_is_made(monkeypatch, capsys, no_timing,
+                                                             args, words):
+    def made(*_args, **_kwargs):
+        raise AssertionError("a map or its queries were made before --per-map was checked")
+
+    for name in ("random_grid", "far_queries", "read_map"):
+        monkeypatch.setattr(grid_mod, name, made)
+    code, out, err = run(monkeypatch, capsys, "bench", "grid", "--peers", "", *args)
+    assert_one_line(code, out, err, words)
+
+
+def test_random_case_checks_its_queries_before_making_the_map(monkeypatch):
+    def made(*_args, **_kwargs):
+        raise AssertionError("the map was made")
+
+    monkeypatch.setattr(grid_mod, "random_grid", made)
+    with pytest.raises(OptionError, match=r"^per_map=2,049 far queries on a 512x512 random map"):
+        grid_mod.random_case("512:0.2", per_map=2049, seed=0)
+    assert grid_mod.MAX_RANDOM_CELL_QUERIES // (512 * 512) == 2048
+
+
 def test_networkx_is_skipped_with_a_note_on_a_large_map(monkeypatch, capsys, tmp_path):
     small = dataclasses.replace(peers.PEERS["networkx"], max_cells=100)
     monkeypatch.setitem(peers.PEERS, "networkx", small)

@@ -136,3 +136,13 @@ def test_ilp_places_broken_file(tmp_path, doc, words):
     with pytest.raises(InputFormatError, match=words) as err:
         ilp_places(path)
     assert str(err.value).startswith(f"{path}: ")
+
+
+def test_bench_world_city_too_large_for_the_visibility_graph(monkeypatch, capsys, no_work,
+                                                             tmp_path):
+    from skyroute.roadmap import visibility
+
+    monkeypatch.setattr(visibility, "MAX_CORNERS", 7)
+    c = city(tmp_path, "0,0,100,5,5,100", "50,50,20,5,5,20")  # 8 corners at 10 m
+    err = one_line(*run(monkeypatch, capsys, "bench", "world", "--worlds", "0", "--city", c))
+    assert "c.csv: 8 obstacle corners, over the limit of 7 for the visibility graph" in err

@@ -217,6 +217,10 @@ def test_scenario_names_the_bad_option(monkeypatch, capsys, args, words):
     (["--rates", "1e5", "--hours", "4"], "--rates 100000 with --hours 4 would spawn about "
                                          "4e+05 packages"),
     (["--hours", "1e9"], "--hours 1e+09 is over the limit of 168"),
+    # every seed and rate within its limit, their product not
+    (["--seeds", "0-999", "--rates", "10,20,30"], "2 scheduler(s) x 2 airspace(s) x 3 rate(s) "
+     "x 1,000 seed(s) is 12,000 runs, over the limit of 10,000 in one sweep; give fewer "
+     "--seeds, --rates, --scheduler or --airspace"),
 ])
 def test_sweep_refuses_huge_values_before_running(monkeypatch, capsys, args, words):
     monkeypatch.setattr("skyroute.jobs.fleet.sweep", _no_run)
@@ -241,8 +245,40 @@ def test_bench_fleet_checks_its_json_path_before_running(monkeypatch, capsys, tm
     assert len(err.strip().splitlines()) == 1
 
 
-def test_a_flight_too_long_to_sample_is_one_line(monkeypatch, capsys, tmp_path):
-    path = _scenario_file(tmp_path, lambda d: d["drone"].update(turn_radius=1e12))
-    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", path, "--hours", "0.1")
+@pytest.mark.parametrize("edit, field", [
+    (lambda d: d["drone"].update(turn_radius=1e12), "drone.turn_radius"),
+    (lambda d: d["drone"].update(cruise_speed=0.001, landing_speed=0.0005),
+     "drone.cruise_speed"),
+    (lambda d: d["airspace"].update(layer_step=1e9), "airspace.layer_step"),
+])
+def test_a_flight_too_long_to_sample_names_the_file_and_field(monkeypatch, capsys, tmp_path,
+                                                              edit, field):
+    monkeypatch.setattr("skyroute.fleet.simulate.run", _no_run)  # refused when read
+    monkeypatch.setattr("skyroute.jobs.fleet.sweep", _no_run)
+    path = _scenario_file(tmp_path, edit)
+    for command in ("simulate", "sweep"):
+        code, out, err = run(monkeypatch, capsys, "fleet", command, path, "--hours", "0.1")
+        assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+        assert err.startswith(f"skyroute: error: {path}: {field}: a flight "), err
+        assert "h with its loiters, over the limit of 12 h" in err
+
+
+def test_more_drones_flying_too_high_names_the_file(monkeypatch, capsys, tmp_path):
+    # one drone cruises at base_altitude; the 1,000th would climb 1e10 m to its layer
+    path = _scenario_file(tmp_path, lambda d: (d.update(drones=1), d["airspace"].update(
+        layer_step=1e7, shared_levels=1)))
+    monkeypatch.setattr("skyroute.fleet.simulate.run", _no_run)
+    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", path, "--drones", "1000")
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
-    assert "would be airborne up to 4.54e+08 h with its loiters, over the limit of 12 h" in err
+    assert err.startswith(f"skyroute: error: {path}: airspace.layer_step: a flight "), err
+
+
+def test_a_package_csv_past_the_limit_is_one_line(monkeypatch, capsys, tmp_path):
+    # every row after the horizon: the old code read them all, dropped them and ran empty
+    (tmp_path / "p.csv").write_text("t,from_airport,from_gate,to_airport,to_gate\n"
+                                    + "1e9,A,0,B,1\n" * 100_001)
+    path = _scenario_file(tmp_path, lambda d: d["packages"].update(csv="p.csv"))
+    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", path, "--hours", "0.1")
+    assert code == 2 and out == ""
+    assert err == (f"skyroute: error: {tmp_path / 'p.csv'}:100002: more than 100,000 "
+                   "packages, the limit of one run; split the file\n")

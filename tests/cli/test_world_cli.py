@@ -81,3 +81,43 @@ def test_synth_city_refuses_a_city_too_large_or_empty(monkeypatch, capsys, tmp_p
     code, text, err = run(monkeypatch, capsys, "synth-city", str(out), "--blocks", blocks)
     assert code == 2 and text == "" and words in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_a_city_too_large_for_its_planner_is_one_line_naming_it(monkeypatch, capsys,
+                                                                tmp_path):
+    from skyroute.motion import corner_distance
+    from skyroute.roadmap import visibility
+
+    city = tmp_path / "c.csv"
+    code, _, _ = run(monkeypatch, capsys, "synth-city", str(city), "--blocks", "3")
+    assert code == 0
+    monkeypatch.setenv("SKYROUTE_CACHE", str(tmp_path))  # not a graph an earlier test kept
+    monkeypatch.setattr(visibility, "MAX_CORNERS", 20)  # the city has about 70
+    monkeypatch.setattr(corner_distance, "MAX_CORNERS", 20)
+    png = tmp_path / "p.png"
+    for args, words in (
+            (["plan-world"], "over the limit of 20 for the visibility graph (built over every "
+                             "pair of them); plan with prm or on a grid (theta, astar)"),
+            (["fly", "--vehicle", "dubins"], "over the limit of 20 for Hybrid A*'s corner "
+                                             "distances"),
+            (["fly", "--vehicle", "dubins", "--planner", "waypoints"], "visibility graph")):
+        code, out, err = run(monkeypatch, capsys, *args, str(city), "--frame", "ned",
+                             "--start", "0,0", "--goal", "60,60", "--plot", str(png))
+        assert code == 2 and out == "" and err.count("\n") == 1, err
+        assert err.startswith("skyroute: error: c.csv: ") and words in err, err
+        assert " obstacle corners, " in err and not png.exists()
+    # the same city on a grid is planned
+    code, _, err = run(monkeypatch, capsys, "plan-world", str(city), "--frame", "ned",
+                       "--start", "0,0", "--goal", "60,60", "--algorithm", "theta")
+    assert code == 0, err
+
+
+def test_a_colliders_file_of_too_many_boxes_is_one_line(monkeypatch, capsys, tmp_path):
+    city = tmp_path / "c.csv"
+    city.write_text("lat0 37.792480, lon0 -122.397450\nposX,posY,posZ,halfSizeX,halfSizeY,"
+                    "halfSizeZ\n" + "1,1,1,1,1,1\n" * 50_001)
+    code, out, err = run(monkeypatch, capsys, "plan-world", str(city), "--frame", "ned",
+                         "--start", "0,0", "--goal", "60,60", "--algorithm", "prm")
+    assert code == 2 and out == ""
+    assert err == (f"skyroute: error: {city}: 50,001 boxes, over the limit of 50,000 in a "
+                   "colliders file\n")

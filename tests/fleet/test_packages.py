@@ -137,3 +137,13 @@ def test_csv_that_cannot_be_read(tmp_path, nine):
     p.write_bytes(b"\xff\xfe\x00t,from")
     with pytest.raises(InputFormatError, match=f"{p}: not text"):
         packages.read_csv(p, nine)
+
+
+def test_a_csv_past_the_package_limit_names_the_line(tmp_path, nine):
+    p = write(tmp_path, HEADER + "0,A,0,B,1\n" * 100_000)
+    assert len(packages.read_csv(p, nine)) == 100_000
+    p = write(tmp_path, HEADER + "\n" + "0,A,0,B,1\n" * 100_001, "big.csv")
+    with pytest.raises(InputFormatError) as err:
+        packages.read_csv(p, nine)
+    assert str(err.value) == (f"{p}:100003: more than 100,000 packages, the limit of one "
+                              "run; split the file")

@@ -418,13 +418,15 @@ def test_reservations_accept_what_is_far_apart_in_space_or_time():
 
 
 @pytest.mark.parametrize("edit, words", [
-    (lambda d: d["drone"].update(turn_radius=1e12), "A -> B at 50 m would be airborne up to "
-                                                    "4.54e+08 h"),
-    (lambda d: d["airspace"].update(layer_step=1e9), "C -> A at 2e+09 m would be airborne"),
+    (lambda d: d["drone"].update(turn_radius=1e12), "drone.turn_radius: a flight A -> B at "
+                                                    "50 m would be airborne up to 4.54e+08 h"),
+    (lambda d: d["airspace"].update(layer_step=1e9), "airspace.layer_step: a flight C -> A at "
+                                                     "2e+09 m would be airborne"),
     (lambda d: d["drone"].update(cruise_speed=0.001, landing_speed=0.0005),
-     "would be airborne up to 6.09e+03 h"),
+     "drone.cruise_speed: a flight A -> B at 50 m would be airborne up to 6.09e+03 h"),
 ])
 def test_a_flight_airborne_too_long_is_refused_before_it_is_sampled(edit, words):
+    # a Scenario made in Python is not checked as a file is: the run checks each flight
     from skyroute.fleet.scenario import Scenario
     from skyroute.fleet.simulate import SimulationError
 
@@ -432,4 +434,22 @@ def test_a_flight_airborne_too_long_is_refused_before_it_is_sampled(edit, words)
     edit(data)
     with pytest.raises(SimulationError, match="over the limit of 12 h") as info:
         run(Scenario.model_validate(data), hours=0.2, seed=0)
-    assert words in str(info.value)
+    assert str(info.value).startswith("scenario: " + words)
+
+
+def test_a_scenario_read_with_a_flight_too_long_names_the_file_and_field(tmp_path):
+    import yaml
+
+    from skyroute.errors import InputFormatError
+    from skyroute.fleet.scenario import load_scenario, parse_scenario
+
+    data = preset("seed-3x3").model_dump()
+    data["drone"]["turn_radius"] = 1e12
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(InputFormatError) as info:
+        load_scenario(path)
+    assert str(info.value).startswith(f"{path}: drone.turn_radius: a flight ")
+    assert str(info.value).endswith("over the limit of 12 h (drone.turn_radius is 1e+12)")
+    with pytest.raises(InputFormatError, match=r"^scenario: drone\.turn_radius: a flight "):
+        parse_scenario(data)

@@ -94,6 +94,8 @@ def test_fleet_and_sweep_params_are_completed():
      "rate_per_hour=100000 with hours=8 would spawn about 8e+05 packages (limit 100,000)"),
     ({"preset": "seed-3x3", "hours": 8, "track_step": 1e-6},
      "track_step=1e-06 with hours=8 and 3 drones would write up to 8.6e+10 track rows"),
+    ({"scenario": {**preset("seed-3x3").model_dump(), "drone": {"turn_radius": 1e12}}},
+     "scenario: drone.turn_radius: a flight "),
 ])
 def test_bad_fleet_params_name_the_field(params, words):
     from skyroute.errors import OptionError
@@ -107,6 +109,9 @@ def test_bad_fleet_params_name_the_field(params, words):
     ({"seeds": list(range(1001))}, "seeds: 1,001 seeds is over the limit of 1,000"),
     ({"rates": [1e5], "hours": 4}, "rate_per_hour=100000 with hours=4 would spawn about 4e+05"),
     ({"hours": 1e9}, "hours=1e+09 is over the limit"),
+    ({"seeds": list(range(1000)), "rates": [10, 20, 30]}, "2 scheduler(s) x 2 airspace(s) x "
+     "3 rate(s) x 1,000 seed(s) is 12,000 runs, over the limit of 10,000 in one sweep; give "
+     "fewer rates or seeds"),
 ])
 def test_bad_sweep_params_past_the_limits(params, words):
     from skyroute.errors import OptionError
@@ -114,3 +119,15 @@ def test_bad_sweep_params_past_the_limits(params, words):
     with pytest.raises(OptionError) as err:
         check_sweep_params({"preset": "seed-3x3", **params})
     assert words in str(err.value)
+
+
+def test_a_sweep_past_the_run_limit_is_refused_before_its_tasks():
+    from skyroute.errors import OptionError
+
+    class NoRuns:
+        def map(self, *_args, **_kwargs):
+            pytest.fail("the sweep's runs were sent to the executor")
+
+    with pytest.raises(OptionError, match="is 12,000 runs, over the limit of 10,000"):
+        sweep(preset("seed-3x3"), rates=(10, 20, 30), seeds=range(1000), hours=1,
+              executor=NoRuns())

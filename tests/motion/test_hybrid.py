@@ -403,3 +403,25 @@ def test_reverse_parks_beside_where_it_started():
     check_path(world, forward, start, goal, R)
     check_path(world, res, start, goal, R, reverse=True)
     assert res.length < forward.length
+
+
+def test_a_world_past_the_corner_limit_is_refused_before_the_table(monkeypatch):
+    from skyroute.motion import corner_distance
+
+    def fail(*_args):
+        pytest.fail("the corner table was built")
+
+    monkeypatch.setattr(corner_distance, "MAX_CORNERS", 10)
+    monkeypatch.setattr(World, "segments_free", fail)
+    world = make_world([(10, 10, 20, 20), (40, 40, 50, 50), (70, 10, 80, 20)], boundary=None)
+    with pytest.raises(OptionError) as err:
+        corner_distance.corner_graph(world)
+    assert str(err.value).endswith(": 12 obstacle corners, over the limit of 10 for Hybrid "
+                                   "A*'s corner distances (built over every pair of them); "
+                                   "plan with the waypoints planner or another vehicle "
+                                   "(lattice, field), or plan at an altitude that keeps "
+                                   "fewer obstacles")
+    monkeypatch.setattr(World, "merged", fail)  # four apart: refused before the union
+    four = make_world([(10 * k, 60, 10 * k + 5, 65) for k in range(4)], boundary=None)
+    with pytest.raises(OptionError, match=": at least 12 obstacle corners, over the limit"):
+        corner_distance.corner_graph(four)

@@ -263,3 +263,69 @@ def test_city_cut_against_the_brute_force_and_a_no_path_pair():
     assert not shapely.contains_xy(holes, *street).any()
     r = VisibilityGraph(world, cache=False).plan(street, yard)
     assert r.status is Status.NO_PATH and r.expanded == 0
+
+
+# -- the size limit: refused before the pairs of corners are tested -----------------------
+
+def row_of_boxes(n, gap=10.0):
+    """``n`` 2 m boxes in a row (``gap`` apart: apart; 2: touching), named like a file."""
+    polys = [shapely.box(gap * k, 0, gap * k + 2, 2) for k in range(n)]
+    return World(np.array(polys, dtype=object), np.full(n, -np.inf), np.full(n, np.inf),
+                 (), None, "enu", None, "city.csv")
+
+
+def test_a_world_past_the_corner_limit_is_refused_before_its_pairs(monkeypatch):
+    from skyroute.errors import OptionError
+    from skyroute.roadmap import visibility
+
+    def fail(*_args):
+        pytest.fail("the pairs of corners were tested")
+
+    monkeypatch.setattr(visibility, "MAX_CORNERS", 40)
+    monkeypatch.setattr(visibility.sk, "corner_pairs", fail)
+    tail = (" obstacle corners, over the limit of 40 for the visibility graph (built over "
+            "every pair of them); plan with prm or on a grid (theta, astar), or plan at an "
+            "altitude that keeps fewer obstacles")
+    # 12 boxes apart: 48 corners, counted after the union (12 groups: at least 36)
+    with pytest.raises(OptionError) as err:
+        VisibilityGraph(row_of_boxes(12), cache=False)
+    assert str(err.value) == "city.csv: 48" + tail and err.value.param == "algorithm"
+    with pytest.raises(OptionError, match=r"^city\.csv: 48 obstacle corners"):
+        visibility.check_size(row_of_boxes(12))
+    # 14 apart are at least 42: refused without the union of the obstacles
+    monkeypatch.setattr(World, "merged", fail)
+    with pytest.raises(OptionError) as err:
+        VisibilityGraph(row_of_boxes(14), cache=False)
+    assert str(err.value) == "city.csv: at least 42" + tail
+    # 30 touching boxes are one obstacle of 4 corners: built and planned on
+    monkeypatch.undo()
+    touching = row_of_boxes(30, gap=2.0)
+    assert visibility.fewest_corners(touching) == 3
+    assert skyroute.plan(touching, (-1.0, -1.0), (61.0, 3.0)).found
+
+
+def test_the_corner_bound_is_a_lower_bound():
+    from skyroute.roadmap.visibility import fewest_corners
+    from skyroute.world.colliders import read_colliders
+    from skyroute.world.geometry import convex_corners
+    from skyroute.world.synth import synth_city
+
+    for seed in range(3):
+        text = synth_city(np.random.default_rng(seed), blocks=4)
+        for safety in (0.0, 8.0):  # grown boxes touch and merge
+            world = read_colliders("c.csv", text=text, safety=safety)
+            assert 0 < fewest_corners(world) <= len(convex_corners(world.merged())[0])
+
+
+@pytest.mark.shared_data
+def test_the_fcnd_city_is_far_inside_the_limits():
+    from skyroute.roadmap import visibility
+    from skyroute.world import colliders
+    from skyroute.world.geometry import convex_corners
+
+    world = skyroute.load_world(CITY, frame="enu")
+    assert len(world.obstacles) == 3845 and colliders.MAX_BOXES > 10 * 3845
+    corners = len(convex_corners(world.merged())[0])
+    assert visibility.fewest_corners(world) <= corners == 3347
+    assert 2 * corners < visibility.MAX_CORNERS
+    visibility.check_size(world)  # no error

@@ -53,3 +53,40 @@ def test_the_json_path_is_checked_before_the_load(monkeypatch, capsys, tmp_path)
                        "--json", str(tmp_path / "file" / "rows.json"))
     assert code == 2 and "rows.json: cannot write: " in err and "file is not a folder" in err
     assert len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--requests", "100001"], "--requests 100,001 is over the limit of 100,000 measured "
+                               "requests a load"),
+    (["--clients", "501"], "--clients 501 is over the limit of 500 concurrent clients"),
+    (["--workers", "65"], "--workers 65 is over the limit of 64 server processes"),
+    (["--client-processes", "1000000"], "--client-processes 1,000,000 is over the limit of "
+                                        "64 client processes"),
+    (["--client-processes", "0"], "--client-processes 0 must be at least 1"),
+])
+def test_a_load_past_its_limits_is_refused_before_the_server_starts(monkeypatch, capsys,
+                                                                    args, words):
+    def no_load(*_args, **_kwargs):
+        raise AssertionError("the service was loaded")
+
+    monkeypatch.setattr("skyroute.bench.service.bench_plan", no_load)
+    monkeypatch.setattr("skyroute.bench.service.Server", no_load)
+    code, out, err = run(monkeypatch, capsys, "bench", "service", *args)
+    assert code == 2 and out == "" and err == f"skyroute: error: {words}\n"
+
+
+def test_the_library_load_names_its_parameters(monkeypatch):
+    from skyroute.bench import service
+    from skyroute.errors import OptionError
+
+    def no_server(*_args, **_kwargs):
+        raise AssertionError("the server was started")
+
+    monkeypatch.setattr(service, "Server", no_server)
+    monkeypatch.setattr(service, "plan_queries", no_server)  # 10**9 bodies filled memory
+    with pytest.raises(OptionError, match=r"^requests=1,000,000,000 is over the limit of "
+                                          r"100,000 ") as err:
+        service.bench_plan(map_name="den312d", requests=10**9)
+    assert err.value.param == "requests"
+    with pytest.raises(OptionError, match=r"^workers=100 is over the limit of 64 server"):
+        service.bench_flightpath(db="sqlite://", workers=100)

@@ -292,3 +292,17 @@ def test_default_resolution_spans_the_points():
     far = w.to_plane([FAR_WEST])[0]
     inside = w.to_plane([CITY_LONLAT[0]])[0]
     assert default_resolution(w, [far, inside]) == (x1 - far[0]) / 1000
+
+
+def test_a_world_too_large_for_the_visibility_graph_is_422(client, monkeypatch, tmp_path):
+    from skyroute.roadmap import visibility
+
+    monkeypatch.setenv("SKYROUTE_CACHE", str(tmp_path))  # not a graph an earlier test kept
+    monkeypatch.setattr(visibility, "MAX_CORNERS", 20)
+    body = {**CITY_BODY, "world_text": CITY.read_text()}
+    assert_problem(client.post("/plan", json=body, headers=AUTH), 422, "algorithm",
+                   "obstacle corners, over the limit of 20 for the visibility graph")
+    many = "lat0 55.944494, lon0 -3.186874\nposX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n"
+    body = {**body, "world_text": many + "1,1,1,1,1,1\n" * 50_001, "algorithm": "prm"}
+    assert_problem(client.post("/plan", json=body, headers=AUTH), 422, "world_text",
+                   "50,001 boxes, over the limit of 50,000 in a colliders file")

@@ -1,5 +1,5 @@
 """colliders.csv home lines: a malformed number is an InputFormatError on line 1, and a
-byte-order mark (Excel writes one) is read past."""
+byte-order mark (Excel writes one) is read past; a file too large is refused unread."""
 
 import pytest
 
@@ -40,3 +40,34 @@ def test_byte_order_mark_is_read_past(tmp_path):
     assert list(b.obstacles) == list(a.obstacles)
     text = read_colliders("upload.csv", text="\ufeff" + plain.read_text(), frame="enu")
     assert list(text.obstacles) == list(a.obstacles)
+
+
+# -- size limits: refused before the file is read or its rows parsed ----------------------
+
+def test_a_file_past_the_byte_limit_is_refused_before_it_is_read(tmp_path):
+    from skyroute.world import colliders
+
+    path = tmp_path / "huge.csv"
+    with path.open("wb") as fh:  # sparse: no 10 MB written
+        fh.truncate(colliders.MAX_BYTES + 1)
+    with pytest.raises(InputFormatError) as err:
+        skyroute.load_world(path)
+    assert str(err.value) == (f"{path}: 10,000,001 bytes, over the limit of 10,000,000 for "
+                              "a colliders file (at most 50,000 boxes)")
+
+
+def test_a_file_of_too_many_boxes_is_refused_before_its_rows_are_parsed(tmp_path):
+    from skyroute.world import colliders
+
+    text = f"{HOME}\n{HEADER}\n" + "1,1,1,1,1,1\n" * (colliders.MAX_BOXES + 1)
+    path = tmp_path / "city.csv"
+    path.write_text(text)
+    words = "50,001 boxes, over the limit of 50,000 in a colliders file"
+    with pytest.raises(InputFormatError) as err:
+        read_colliders(path)
+    assert str(err.value) == f"{path}: {words}"
+    with pytest.raises(InputFormatError, match=f"^upload.csv: {words}$"):  # an upload too
+        read_colliders("upload.csv", text=text)
+    # at the limit it is read (blank lines are not boxes)
+    path.write_text(f"{HOME}\n{HEADER}\n\n" + "1,1,1,1,1,1\n" * colliders.MAX_BOXES)
+    assert len(read_colliders(path).obstacles) == colliders.MAX_BOXES

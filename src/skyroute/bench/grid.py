@@ -32,6 +32,13 @@ from skyroute.world.movingai import Scenario, query_line, read_map, read_scen
 
 # Algorithms whose cost must equal the scenario's octile optimum.
 OPTIMAL = ("dijkstra", "astar", "jps")
+# Queries a map: the largest MovingAI scenario file here has 12,121 lines (per_map=0
+# runs them all); the documented runs sample 20-40.
+MAX_PER_MAP = 10_000
+# A random map's optima are one scipy Dijkstra over its cells per query (0.06 s on
+# 512x512, 0.35 s on 1024x1024): queries x cells is limited to minutes of them; the
+# default 20 queries on the largest map (4096x4096) are 335 million.
+MAX_RANDOM_CELL_QUERIES = 1 << 29
 
 
 def find_pairs(folder: str | Path, names: Sequence[str] = ()) -> list[tuple[Path, Path]]:
@@ -157,19 +164,34 @@ def load_case(map_path: Path, scen_path: Path, *, per_map: int) -> Case:
 def random_case(spec: str, *, per_map: int, seed: int) -> Case:
     """A synthetic ``SIDE:SHARE`` map (numpy seed ``seed``) with ``per_map`` far queries
     whose optima come from scipy; all of them are run."""
-    check_random_per_map(per_map)
     side, share = parse_random(spec)
+    check_random_per_map(per_map, side)
     grid = random_grid(side, share, seed)
     return Case(grid.name, grid, far_queries(grid, per_map, seed), 0)
 
 
-def check_random_per_map(per_map: int) -> None:
+def check_per_map(per_map: int) -> None:
+    """An OptionError past :data:`MAX_PER_MAP` queries a map (0, every line, is fine)."""
+    if per_map > MAX_PER_MAP:
+        raise OptionError(f"per_map={per_map:,} is over the limit of {MAX_PER_MAP:,} queries "
+                          "a map (0 runs every scenario line)", param="per_map")
+
+
+def check_random_per_map(per_map: int, side: int | None = None) -> None:
     """A random map's queries are made, not sampled from a file: ``per_map=0`` (every
-    scenario line) cannot apply to it, so it is refused rather than guessed."""
+    scenario line) cannot apply to it, so it is refused rather than guessed; nor may
+    ``per_map`` x the cells of a ``side`` x ``side`` map pass
+    :data:`MAX_RANDOM_CELL_QUERIES` (each query's optimum searches the whole map)."""
     if per_map <= 0:
         raise OptionError(f"per_map={per_map} (every scenario line) has no meaning for random "
                           "maps, which have no scenario file; give a count >= 1",
                           param="per_map")
+    check_per_map(per_map)
+    if side is not None and per_map * side * side > MAX_RANDOM_CELL_QUERIES:
+        most = MAX_RANDOM_CELL_QUERIES // (side * side)
+        raise OptionError(f"per_map={per_map:,} far queries on a {side}x{side} random map "
+                          f"would each search its {side * side:,} cells for the optimum; "
+                          f"at most {most:,} on a map that size", param="per_map")
 
 
 def check_scenario(grid: Grid, scen: Scenario, map_name: str) -> None:

@@ -15,6 +15,11 @@ Server-side time is the app's own ``Server-Timing: app;dur=`` (from the request 
 the app to its response headers; for ``/plan`` also ``wait`` for the search slot and
 ``plan``, the search and its JSON). Client latency adds the network stack, uvicorn's
 parsing and the client's own queueing on a shared machine.
+
+A load's size is limited (:func:`check_load`) before the server starts: every request
+is drawn and every answer recorded in memory, each client holds a connection (a file
+descriptor on both sides) and each process is a Python interpreter. The documented runs
+send 2,000-5,000 requests from 50 clients.
 """
 
 from __future__ import annotations
@@ -30,11 +35,33 @@ from pathlib import Path
 
 import numpy as np
 
-from skyroute.errors import SkyrouteError
+from skyroute.errors import OptionError, SkyrouteError
 
 TOKEN = "bench-service-token"
 CLIENTS = ("httpx", "raw")
+MAX_REQUESTS = 100_000  # 20 times the largest documented load; minutes at 1,000/s
+MAX_CLIENTS = 500  # connections: both ends stay well inside a default 1,024 open files
+MAX_PROCESSES = 64  # server workers, and client processes
 _TIMING = re.compile(r"(\w+);dur=([0-9.]+)")
+
+
+def check_load(*, clients: int, requests: int, workers: int = 1,
+               client_processes: int = 1, flags: bool = False) -> None:
+    """An OptionError naming the parameter (``flags``: the CLI's option, whose
+    ``--workers`` is not the ``--jobs`` other commands call workers) when a load is below
+    1 or past its limit (:data:`MAX_CLIENTS`, :data:`MAX_REQUESTS`,
+    :data:`MAX_PROCESSES`)."""
+    for name, value, limit, what in (
+            ("clients", clients, MAX_CLIENTS, "concurrent clients"),
+            ("requests", requests, MAX_REQUESTS, "measured requests a load"),
+            ("workers", workers, MAX_PROCESSES, "server processes"),
+            ("client_processes", client_processes, MAX_PROCESSES, "client processes")):
+        given = f"--{name.replace('_', '-')} {value:,}" if flags else f"{name}={value:,}"
+        if value < 1:
+            raise OptionError(f"{given} must be at least 1", param=None if flags else name)
+        if value > limit:
+            raise OptionError(f"{given} is over the limit of {limit:,} {what}",
+                              param=None if flags else name)
 
 
 def free_port() -> int:
@@ -278,6 +305,8 @@ def bench_plan(*, map_name: str = "Paris_1_512", clients: int = 50, requests: in
     client latency percentiles in ms, requests/s, errors)."""
     import tempfile
 
+    check_load(clients=clients, requests=requests, workers=workers,
+               client_processes=client_processes)
     queries = plan_queries(map_name, warmup + requests, seed=seed, algorithm=algorithm)
     auth = {"Authorization": f"Bearer {TOKEN}"}
     with tempfile.TemporaryDirectory() as tmp, \
@@ -301,6 +330,8 @@ def bench_flightpath(*, db: str, date: str | None = None, clients: int = 50,
     ``date``): the summary, as :func:`bench_plan`'s."""
     import httpx
 
+    check_load(clients=clients, requests=requests, workers=workers,
+               client_processes=client_processes)
     with Server(db=db, workers=workers) as srv:
         days = httpx.get(srv.url + "/days", timeout=30).json()
         if date is None:

@@ -46,7 +46,9 @@ def check_altitude(altitude: float) -> None:
 def load_city(path, *, altitude: float, safety: float) -> World:
     """A colliders city in the enu frame with the obstacles that count at ``altitude``.
     An altitude no building reaches is an OptionError naming the file and the tallest
-    top: the empty world left would have no extent to plan in."""
+    top: the empty world left would have no extent to plan in; so is a city too large
+    for the visibility graph the benchmark builds on it (before any timing)."""
+    from skyroute.roadmap.visibility import check_size
     from skyroute.world.load import load_world
 
     check_altitude(altitude)
@@ -55,6 +57,7 @@ def load_city(path, *, altitude: float, safety: float) -> World:
     if len(world.obstacles) == 0:
         raise OptionError(f"altitude={altitude:g}: {no_building_at(city, altitude, safety)}",
                           param="altitude")
+    check_size(world)
     return world
 
 

@@ -14,6 +14,7 @@ from rich.table import Table
 from skyroute.bench.grid import (
     Case,
     bench_case,
+    check_per_map,
     check_random_per_map,
     check_runners,
     find_pairs,
@@ -63,6 +64,7 @@ def bench_grid(
 
     Every map and scenario is read and checked before any timing.
     """
+    check_per_map(per_map)
     folder = maps or next(iter(bundled_maps().values())).parent
     algs, have, missing = check_runners(parse_list(algorithms), parse_list(peers))
     if not (algs or have or prepared):
@@ -106,8 +108,8 @@ def _random_specs(specs: list[str] | tuple, per_map: int) -> list[str]:
     seen: dict[tuple, str] = {}
     for spec in specs:
         seen.setdefault(parse_random(spec), spec)
-    if seen:
-        check_random_per_map(per_map)
+    for side, _share in seen:
+        check_random_per_map(per_map, side)
     return list(seen.values())
 
 

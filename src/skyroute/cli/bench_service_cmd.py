@@ -46,7 +46,7 @@ def bench_service(
 ) -> None:
     """Load the service on 127.0.0.1 (uvicorn in a process of its own) and report
     server-side (Server-Timing) and client latency percentiles, requests/s and errors."""
-    from skyroute.bench.service import CLIENTS, bench_flightpath, bench_plan
+    from skyroute.bench.service import CLIENTS, bench_flightpath, bench_plan, check_load
 
     loads = load or (["plan", "flightpath"] if db else ["plan"])
     for x in loads:
@@ -54,9 +54,8 @@ def bench_service(
     check_choice("client", client, CLIENTS)
     if "flightpath" in loads and db is None:
         raise OptionError("--load flightpath needs --db URL (a store with a flown day)")
-    if min(clients, requests, workers, client_processes) < 1:
-        raise OptionError("--clients, --requests, --workers and --client-processes must be "
-                          "at least 1")
+    check_load(clients=clients, requests=requests, workers=workers,
+               client_processes=client_processes, flags=True)
     if json_out:  # a bad path fails now, not after the runs
         check_writable(json_out)
     rows = []

@@ -20,6 +20,7 @@ from skyroute.fleet.limits import (
     MAX_RATE,
     MAX_SEEDS,
     MAX_TRACK_ROWS,
+    check_sweep,
     expected_packages,
     track_rows,
 )
@@ -94,7 +95,10 @@ def resolve_scenario(path: Path | None, preset_name: str | None, airports: int |
             raise OptionError("--airports needs --drones")
         s = generate(airports, drones, area_km=area_km, seed=seed)
     if drones is not None and drones != s.drones:
+        from skyroute.fleet.airborne import check_flights
+
         s = s.model_copy(update={"drones": drones})
+        check_flights(s, path if path is not None else s.name)  # more drones: higher layers
     return s
 
 
@@ -323,13 +327,15 @@ def sweep_command(
     rate_list = _rates(rates)
     seed_list = parse_seeds(seeds)
     _number("hours", hours, low=0, strict=True, high=MAX_HOURS)
+    runs = check_sweep(schedulers=len(scheds), airspaces=len(spaces), rates=len(rate_list),
+                       seeds=len(seed_list), fewer="--seeds, --rates, --scheduler or "
+                       "--airspace")
     executor_kind(executor, dask, jobs)
     s = resolve_scenario(scenario, preset_name, airports, drones, area_km, 0)
     if scenario is not None and s.packages.csv is not None:
         raise OptionError("sweep runs Poisson streams; this scenario names a package CSV")
     for r in rate_list:  # each run's packages (rate x hours) within the limit
         check_work(s, hours=hours, rate=r, rate_flag="--rates")
-    runs = len(scheds) * len(spaces) * len(rate_list) * len(seed_list)
     err = plain_console(stderr=True)
     with progress_bar(err) as progress:
         task = progress.add_task("runs", total=runs)

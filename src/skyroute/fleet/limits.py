@@ -7,7 +7,8 @@ and 100 airports for 1 h at 4000 packages/h (4,000 packages) and 100 drones and 
 airports for 24 h at 600/h (14,400 packages; 8.6 million rows of tracks.csv at 1 s);
 the presets and sweeps run 3-18 drones for 4 h at up to 360/h. Where the cost is a
 product, the product is checked (:func:`check_run`): the packages a run spawns (rate x
-hours) and the rows of its tracks (drones x seconds / track step).
+hours) and the rows of its tracks (drones x seconds / track step); and, for a sweep, its
+runs (:func:`check_sweep`: schedulers x airspaces x rates x seeds).
 
 >>> expected_packages(600, 24)
 14400.0
@@ -28,6 +29,7 @@ MAX_HOURS = 24.0 * 7  # simulated hours: a week
 MAX_PACKAGES = 1e5  # packages a run is expected to spawn (rate x hours): 7x the largest
 MAX_TRACK_ROWS = 2e7  # tracks.csv rows (drones x seconds / step): 0.85 GB, 3 GB of memory
 MAX_SEEDS = 1000  # seeds in one sweep (the documented sweeps use 30)
+MAX_SWEEP_RUNS = 10_000  # runs in one sweep (the documented ones: 2x2x2 settings x 30 seeds)
 MAX_FLIGHT_HOURS = 12.0  # airborne time of one flight, its loiters included
 
 
@@ -68,3 +70,16 @@ def check_run(*, drones: int, hours: float, rate_per_hour: float | None,
                               f"{drones} drones would write up to {rows:.2g} track rows "
                               f"(limit {MAX_TRACK_ROWS:,.0f}); raise track_step",
                               param=("track_step", "hours"))
+
+
+def check_sweep(*, schedulers: int, airspaces: int, rates: int, seeds: int,
+                fewer: str = "rates or seeds") -> int:
+    """The runs of a sweep of that many schedulers, airspaces, rates and seeds; an
+    OptionError past :data:`MAX_SWEEP_RUNS` (``fewer``: what to give fewer of)."""
+    runs = schedulers * airspaces * rates * seeds
+    if runs > MAX_SWEEP_RUNS:
+        raise OptionError(f"{schedulers} scheduler(s) x {airspaces} airspace(s) x {rates:,} "
+                          f"rate(s) x {seeds:,} seed(s) is {runs:,} runs, over the limit of "
+                          f"{MAX_SWEEP_RUNS:,} in one sweep; give fewer {fewer}",
+                          param=("rates", "seeds"))
+    return runs

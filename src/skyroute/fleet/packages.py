@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError
+from skyroute.fleet.limits import MAX_PACKAGES
 from skyroute.fleet.scenario import Scenario
 
 CSV_HEADER = ("t", "from_airport", "from_gate", "to_airport", "to_gate")
@@ -87,8 +88,9 @@ def poisson(scenario: Scenario, *, hours: float, seed: int = 0,
 
 def read_csv(path: str | Path, scenario: Scenario) -> Stream:
     """Packages from a CSV with header ``t,from_airport,from_gate,to_airport,to_gate``
-    (airport ids of the scenario, gates 0 or 1, ``t`` seconds >= 0); an error names the
-    file, the line and the field."""
+    (airport ids of the scenario, gates 0 or 1, ``t`` seconds >= 0), at most
+    :data:`~skyroute.fleet.limits.MAX_PACKAGES` of them (the limit of a Poisson run, met
+    as the file is read); an error names the file, the line and the field."""
     p = Path(path)
     ids = {a.id: k for k, a in enumerate(scenario.airports)}
     rows = []
@@ -101,6 +103,9 @@ def read_csv(path: str | Path, scenario: Scenario) -> Stream:
             for line, rec in enumerate(reader, start=2):
                 if not rec or all(not x.strip() for x in rec):
                     continue
+                if len(rows) >= MAX_PACKAGES:
+                    raise InputFormatError(p, f"more than {MAX_PACKAGES:,.0f} packages, the "
+                                           "limit of one run; split the file", line=line)
                 rows.append(_row(p, line, rec, ids))
     except OSError as exc:
         raise InputFormatError(p, f"cannot read: {exc}") from None

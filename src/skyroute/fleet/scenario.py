@@ -254,16 +254,21 @@ def load_scenario(path: str | Path) -> Scenario:
 
 
 def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
-    """A Scenario from plain data; the first error as one line naming the field."""
+    """A Scenario from plain data; the first error as one line naming the field (also a
+    flight that would stay airborne past the limit: :mod:`skyroute.fleet.airborne`)."""
+    from skyroute.fleet.airborne import check_flights
+
     if not isinstance(data, dict):
         raise InputFormatError(where, "expected a mapping of scenario fields")
     try:
-        return Scenario.model_validate(data)
+        s = Scenario.model_validate(data)
     except ValidationError as exc:
         err = exc.errors()[0]
         field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err["loc"])
         msg = err["msg"].removeprefix("Value error, ")
         raise InputFormatError(where, f"{field.lstrip('.') or 'scenario'}: {msg}") from None
+    check_flights(s, where)
+    return s
 
 
 def generate(airports: int, drones: int, *, area_km: float = 8.0, seed: int = 0,

@@ -37,6 +37,7 @@ import numpy as np
 
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 from skyroute.fleet import dispatch, packages
+from skyroute.fleet.airborne import MAX_LOITERS, too_long
 from skyroute.fleet.airspace import (
     MODES,
     Reservations,
@@ -45,7 +46,6 @@ from skyroute.fleet.airspace import (
     samples,
 )
 from skyroute.fleet.flightplan import FlightPlan, plan_flight
-from skyroute.fleet.limits import MAX_FLIGHT_HOURS
 from skyroute.fleet.packages import Stream
 from skyroute.fleet.scenario import Scenario, runway_ends
 from skyroute.fleet.timetable import Timetable
@@ -53,7 +53,6 @@ from skyroute.fleet.trajectory import Pieces
 from skyroute.geo import heading_to_plane
 from skyroute.motion import dubins
 
-MAX_LOITERS = 12
 WARMUP_SHARE = 0.1
 SAMPLE_DT = 1.0
 _LOCAL = 4  # optimal dispatch: packages considered per airport beyond the oldest
@@ -337,16 +336,13 @@ class _Engine:
             plan = plan_flight(self.s, 0, self.ids[o], self.ids[b], depart=0.0, altitude=alt,
                                origin_gate=og, destination_gate=bg)
             d = self.s.drone
-            # before the flight is sampled each second: a turn_radius or a layer_step of
-            # 1e9 m asked for gigabytes of samples
-            air = float(plan.pieces.t1.max() - plan.pieces.t0.min()) \
-                + MAX_LOITERS * 2 * math.pi * d.turn_radius / d.cruise_speed
-            if air > MAX_FLIGHT_HOURS * 3600:
-                raise SimulationError(
-                    f"a flight {self.ids[o]} -> {self.ids[b]} at {alt:g} m would be airborne "
-                    f"up to {air / 3600:.3g} h with its loiters, over the limit of "
-                    f"{MAX_FLIGHT_HOURS:g} h; check the scenario's drone speeds, turn_radius "
-                    "and airspace levels")
+            # before the flight is sampled each second (fleet.airborne): a scenario read
+            # from a file was checked on its farthest airports, this is every flight
+            sp = self.s.airspace
+            error = too_long(self.s, o, b, round((alt - sp.base_altitude) / sp.layer_step),
+                             plan)
+            if error:
+                raise SimulationError(f"scenario: {error}")
             a_o, a_b = self.s.airports[o], self.s.airports[b]
             thr, _ = runway_ends(a_o, a_o.takeoff)
             # on the take-off runway from the airport's position to lift-off

@@ -24,7 +24,7 @@ import sqlalchemy as sa
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.fleet.airspace import MODES
 from skyroute.fleet.dispatch import SCHEDULERS
-from skyroute.fleet.limits import MAX_SEEDS, check_run
+from skyroute.fleet.limits import MAX_SEEDS, check_run, check_sweep
 from skyroute.fleet.report import report
 from skyroute.fleet.scenario import Scenario, parse_scenario, preset
 from skyroute.fleet.simulate import run
@@ -113,6 +113,8 @@ def sweep(scenario: Scenario, *, schedulers=SCHEDULERS, airspaces=MODES,
         raise OptionError("a sweep runs Poisson streams; this scenario names a package CSV",
                           param="scenario")
     seeds = list(seeds)
+    check_sweep(schedulers=len(schedulers), airspaces=len(airspaces), rates=len(rates),
+                seeds=len(seeds))
     configs, specs = sweep_specs(scenario, schedulers=schedulers, airspaces=airspaces,
                                  rates=rates, seeds=seeds, hours=hours)
     return sweep_rows(configs, len(seeds), executor.map(simulate_report, specs,
@@ -240,6 +242,8 @@ def check_sweep_params(params: dict) -> dict:
         _number({"seeds": x}, "seeds", None, low=0, strict=False, integer=True)
         for x in seeds))
     out["hours"] = _number(params, "hours", 1.0, low=0, strict=True)
+    check_sweep(schedulers=len(out["schedulers"]), airspaces=len(out["airspaces"]),
+                rates=len(rates or [None]), seeds=len(out["seeds"]))
     for rate in rates or [s.packages.rate_per_hour]:
         check_run(drones=s.drones, hours=out["hours"], rate_per_hour=rate)
     return out

@@ -10,6 +10,11 @@ is then at least max(|q - t|, min over corners c that q sees of |q - c| + D(c)) 
 target (:func:`skyroute.motion.move_search.distance`), and exactly that without a
 boundary or with a convex one (a non-convex boundary's corners are not in the table,
 which can only raise the value above the true one; keep boundaries convex).
+
+The table is dense, N x N, and its build holds a few arrays of N x N / 2 pairs: a world
+of more than :data:`MAX_CORNERS` is refused before it starts (5,300 corners,
+``skyroute synth-city --blocks 24``, peaked at 1.9 GB; 8,363 ran out of 4 GB). Its free
+test is shapely's, about a minute per 1,000 corners squared (3,675 corners: 187 s).
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from skyroute.motion.move_search import _sight
 from skyroute.motion.zone_kernels import zone_arrays
 from skyroute.world.world import World
 
+MAX_CORNERS = 5_000  # the FCND city has 3,347
 _TABLES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -53,12 +59,21 @@ def corner_graph(world: World) -> CornerGraph:
 
 
 def _build(world: World) -> CornerGraph:
+    from skyroute.roadmap.visibility import fewest_corners, refuse_corners
     from skyroute.world.geometry import convex_corners
 
+    def refuse(n: int, at_least: bool = False) -> None:
+        refuse_corners(world, n, limit=MAX_CORNERS, table="Hybrid A*'s corner distances",
+                       instead="plan with the waypoints planner or another vehicle (lattice, "
+                       "field)",
+                       at_least=at_least)
+
+    refuse(fewest_corners(world), at_least=True)
     merged = world.merged()
     edges = np.ascontiguousarray(zone_arrays(merged)[0], dtype=float)
     corners, prev, nxt = convex_corners(merged)
     n = len(corners)
+    refuse(n)
     adj = np.full((n, n), np.inf)
     if n > 1:
         i, j = np.triu_indices(n, 1)

@@ -5,6 +5,11 @@ Line 1 is ``lat0 <deg>, lon0 <deg>``; line 2 the header
 east and height above ground, and half extents along north, east and up (metres). Each
 box grows by ``safety`` on every side and at its top; it counts at an altitude below
 its top + safety.
+
+A file is refused before it is read past :data:`MAX_BYTES`, and after its lines are
+split, before any is parsed, past :data:`MAX_BOXES` boxes: the FCND city has 3,845 boxes
+(132 kB) and ``skyroute synth-city --blocks 100`` 34,921 (1.7 MB), which PRM and the
+grid planners take in seconds; 140,000 boxes took them about a minute (docs/cli.md).
 """
 
 from __future__ import annotations
@@ -21,6 +26,8 @@ from skyroute.world.points import MAX_METRES
 from skyroute.world.world import World
 
 HEADER = "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ"
+MAX_BOXES = 50_000  # 13 times the FCND city's
+MAX_BYTES = 10_000_000  # 200 bytes a box line (FCND's are 35); a file is read whole
 _HOME = re.compile(r"^\s*lat0\s+(-?[\d.]+)\s*,\s*lon0\s+(-?[\d.]+)\s*$")
 
 
@@ -31,10 +38,16 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
     already in hand (an upload); ``path`` then only names it in errors."""
     path = Path(path)
     try:  # utf-8-sig: Excel starts a saved CSV with a byte-order mark
-        text = path.read_text(encoding="utf-8-sig") if text is None else text
+        if text is None:
+            _check_bytes(path, path.stat().st_size)
+            text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         raise InputFormatError(path, f"cannot read: {exc}") from None
     lines = text.removeprefix("\ufeff").splitlines()
+    boxes = sum(1 for line in lines[2:] if line.strip())
+    if boxes > MAX_BOXES:
+        raise InputFormatError(path, f"{boxes:,} boxes, over the limit of {MAX_BOXES:,} in a "
+                               "colliders file")
     lat0, lon0 = _home(path, lines[0] if lines else None)
     if not (-90 <= lat0 <= 90 and -180 <= lon0 <= 180):
         raise InputFormatError(path, f"home lat0 {lat0}, lon0 {lon0} is not a place", line=1)
@@ -67,6 +80,13 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
     names = tuple(f"box at line {n}" for n in range(3, 3 + len(rows)))
     return World(boxes, up - hu - s, up + hu + s, names, None, frame,
                  Home(lon0, lat0, 0.0), name=path.name)
+
+
+def _check_bytes(path: Path, size: int) -> None:
+    """Refuse a file of ``size`` bytes past :data:`MAX_BYTES` before it is read."""
+    if size > MAX_BYTES:
+        raise InputFormatError(path, f"{size:,} bytes, over the limit of {MAX_BYTES:,} for "
+                               f"a colliders file (at most {MAX_BOXES:,} boxes)")
 
 
 def _home(path: Path, line: str | None) -> tuple[float, float]:
