@@ -441,6 +441,7 @@ def test_a_scenario_read_with_a_flight_too_long_names_the_file_and_field(tmp_pat
     import yaml
 
     from skyroute.errors import InputFormatError
+    from skyroute.fleet.airborne import check_flights
     from skyroute.fleet.scenario import load_scenario, parse_scenario
 
     data = preset("seed-3x3").model_dump()
@@ -448,8 +449,8 @@ def test_a_scenario_read_with_a_flight_too_long_names_the_file_and_field(tmp_pat
     path = tmp_path / "s.yaml"
     path.write_text(yaml.safe_dump(data))
     with pytest.raises(InputFormatError) as info:
-        load_scenario(path)
+        check_flights(load_scenario(path), path)
     assert str(info.value).startswith(f"{path}: drone.turn_radius: a flight ")
     assert str(info.value).endswith("over the limit of 12 h (drone.turn_radius is 1e+12)")
     with pytest.raises(InputFormatError, match=r"^scenario: drone\.turn_radius: a flight "):
-        parse_scenario(data)
+        check_flights(parse_scenario(data))

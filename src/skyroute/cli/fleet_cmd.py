@@ -95,10 +95,10 @@ def resolve_scenario(path: Path | None, preset_name: str | None, airports: int |
             raise OptionError("--airports needs --drones")
         s = generate(airports, drones, area_km=area_km, seed=seed)
     if drones is not None and drones != s.drones:
-        from skyroute.fleet.airborne import check_flights
+        s = s.model_copy(update={"drones": drones})  # more drones: higher layers
+    from skyroute.fleet.airborne import check_flights
 
-        s = s.model_copy(update={"drones": drones})
-        check_flights(s, path if path is not None else s.name)  # more drones: higher layers
+    check_flights(s, path if path is not None else s.name)
     return s
 
 

@@ -2,7 +2,7 @@
 with its worst loiters, before the flight is sampled each second (a turn_radius or a
 layer_step of 1e9 m asked for gigabytes of samples).
 
-A scenario is checked when it is read (:func:`check_flights`, on the farthest airports
+A scenario is checked before a run (:func:`check_flights`, on the farthest airports
 at the highest level either airspace may give a drone), so the error names the file;
 the simulation checks each flight it plans as well. Either error names the field to
 blame: the one whose default shortens the flight most.

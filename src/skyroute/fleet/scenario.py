@@ -254,10 +254,10 @@ def load_scenario(path: str | Path) -> Scenario:
 
 
 def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
-    """A Scenario from plain data; the first error as one line naming the field (also a
-    flight that would stay airborne past the limit: :mod:`skyroute.fleet.airborne`)."""
-    from skyroute.fleet.airborne import check_flights
-
+    """A Scenario from plain data; the first error as one line naming the field. How
+    long its flights stay airborne is checked by those that plan them
+    (:func:`skyroute.fleet.airborne.check_flights`, which plans with this module's
+    types: it sits above it)."""
     if not isinstance(data, dict):
         raise InputFormatError(where, "expected a mapping of scenario fields")
     try:
@@ -267,7 +267,6 @@ def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
         field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err["loc"])
         msg = err["msg"].removeprefix("Value error, ")
         raise InputFormatError(where, f"{field.lstrip('.') or 'scenario'}: {msg}") from None
-    check_flights(s, where)
     return s
 
 

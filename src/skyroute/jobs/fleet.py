@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import sqlalchemy as sa
 
 from skyroute.errors import InputFormatError, OptionError, check_choice
+from skyroute.fleet.airborne import check_flights
 from skyroute.fleet.airspace import MODES
 from skyroute.fleet.dispatch import SCHEDULERS
 from skyroute.fleet.limits import MAX_SEEDS, check_run, check_sweep
@@ -177,6 +178,7 @@ def _scenario(params: dict) -> tuple[Scenario, dict]:
     else:
         try:
             s = parse_scenario(params["scenario"], "scenario")
+            check_flights(s, "scenario")
         except InputFormatError as exc:  # "scenario: airports[1].north: ..."
             raise OptionError(str(exc), param="scenario") from None
         kept = {"scenario": s.model_dump()}

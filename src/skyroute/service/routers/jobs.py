@@ -159,6 +159,7 @@ def post_deliver(body: DeliverJob, res: ResourcesDep):
              responses=responses(401, 403, 413, 422, 429, 503),
              summary="Run a fleet simulation as a job")
 def post_fleet(body: FleetJob, res: ResourcesDep):
+    from skyroute.fleet.airborne import check_flights
     from skyroute.fleet.scenario import Scenario, parse_scenario, preset
 
     if body.scenario is not None:
@@ -176,6 +177,7 @@ def post_fleet(body: FleetJob, res: ResourcesDep):
                           f"limit of {MAX_AIRPORTS}", field="scenario.airports")
         try:
             scenario: Scenario = parse_scenario(body.scenario, "scenario")
+            check_flights(scenario, "scenario")
         except SkyrouteError as exc:
             text = str(exc).removeprefix("scenario: ")
             raise Problem(422, f"scenario.{text}", field="scenario." + text.split(":")[0]
