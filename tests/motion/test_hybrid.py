@@ -425,3 +425,38 @@ def test_a_world_past_the_corner_limit_is_refused_before_the_table(monkeypatch):
     four = make_world([(10 * k, 60, 10 * k + 5, 65) for k in range(4)], boundary=None)
     with pytest.raises(OptionError, match=": at least 12 obstacle corners, over the limit"):
         corner_distance.corner_graph(four)
+
+
+def test_corner_table_is_shapely_on_the_merged_obstacles():
+    """The corner table (now the world's visibility graph) holds exactly the bitangent
+    corner pairs that shapely finds free of the merged obstacles, with their lengths (two
+    boxes sharing an edge are one block: no path squeezes between them)."""
+    from skyroute.motion import corner_distance
+    from skyroute.world.geometry import convex_corners
+
+    # two boxes meeting along y = 20 for x in 20..30: a step of 6 convex corners, and the
+    # bitangent (10, 20) -> (40, 20) runs through their shared edge, inside the block
+    world = make_world([(10, 10, 30, 20), (20, 20, 40, 30), (50, 40, 60, 70),
+                        (20, 50, 35, 60), shapely.Polygon([(70, 10), (90, 15), (80, 30)])])
+    g = corner_distance.corner_graph(world)
+    corners, prev, nxt = convex_corners(world.merged())
+    assert len(corners) == len(g.corners) == 17  # 6 + 4 + 4 + 3
+    order = [int(np.flatnonzero((corners == c).all(axis=1))[0]) for c in g.corners]
+    corners, prev, nxt = corners[order], prev[order], nxt[order]
+    union = shapely.union_all(world.obstacles)
+
+    def tangent(k, d):  # the line along d through corner k leaves both ring edges one side
+        a, b = prev[k] - corners[k], nxt[k] - corners[k]
+        return (d[0] * a[1] - d[1] * a[0]) * (d[0] * b[1] - d[1] * b[0]) >= 0
+
+    step = [int(np.flatnonzero((g.corners == c).all(axis=1))[0]) for c in ((10, 20), (40, 20))]
+    assert g.adjacency[step[0], step[1]] == np.inf
+    for i in range(17):
+        for j in range(17):
+            if i == j:
+                continue
+            d = corners[j] - corners[i]
+            seg = shapely.LineString([corners[i], corners[j]])
+            free = tangent(i, d) and tangent(j, -d) and \
+                not seg.relate_pattern(union, "T********")
+            assert g.adjacency[i, j] == (pytest.approx(seg.length) if free else np.inf), (i, j)

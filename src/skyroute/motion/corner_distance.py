@@ -11,10 +11,13 @@ target (:func:`skyroute.motion.move_search.distance`), and exactly that without 
 boundary or with a convex one (a non-convex boundary's corners are not in the table,
 which can only raise the value above the true one; keep boundaries convex).
 
-The table is dense, N x N, and its build holds a few arrays of N x N / 2 pairs: a world
-of more than :data:`MAX_CORNERS` is refused before it starts (5,300 corners,
-``skyroute synth-city --blocks 24``, peaked at 1.9 GB; 8,363 ran out of 4 GB). Its free
-test is shapely's, about a minute per 1,000 corners squared (3,675 corners: 187 s).
+The table is dense, N x N: a world of more than :data:`MAX_CORNERS` is refused before
+it starts (5,300 corners, ``skyroute synth-city --blocks 24``, peaked at 1.9 GB when the
+table tested its own pairs). Its free segments are the world's visibility graph
+(:func:`skyroute.roadmap.world_plan.visibility_graph`: the compiled sight test, kept
+with the world and on disk, shared with ``plan-world``): the FCND city at 5 m altitude
+and 5 m safety, 1,128 corners, took 68 s through shapely's test pair by pair and takes
+0.4 s so (docs/benchmarks.md section 6).
 """
 
 from __future__ import annotations
@@ -60,6 +63,7 @@ def corner_graph(world: World) -> CornerGraph:
 
 def _build(world: World) -> CornerGraph:
     from skyroute.roadmap.visibility import fewest_corners, refuse_corners
+    from skyroute.roadmap.world_plan import visibility_graph
     from skyroute.world.geometry import convex_corners
 
     def refuse(n: int, at_least: bool = False) -> None:
@@ -70,29 +74,17 @@ def _build(world: World) -> CornerGraph:
 
     refuse(fewest_corners(world), at_least=True)
     merged = world.merged()
-    edges = np.ascontiguousarray(zone_arrays(merged)[0], dtype=float)
-    corners, prev, nxt = convex_corners(merged)
-    n = len(corners)
-    refuse(n)
+    refuse(len(convex_corners(merged)[0]))
+    # The visibility graph's nodes are these convex corners (those outside a boundary
+    # dropped: no path inside a convex boundary bends there) and its edges the free
+    # bitangent segments between them, both ways: exactly this table's entries.
+    graph = visibility_graph(world)
+    n = len(graph.corners)
     adj = np.full((n, n), np.inf)
-    if n > 1:
-        i, j = np.triu_indices(n, 1)
-        d = corners[j] - corners[i]
-
-        def tangent(at, other_dir):
-            a, b = prev[at] - corners[at], nxt[at] - corners[at]
-            s1 = other_dir[:, 0] * a[:, 1] - other_dir[:, 1] * a[:, 0]
-            s2 = other_dir[:, 0] * b[:, 1] - other_dir[:, 1] * b[:, 0]
-            return s1 * s2 >= 0
-
-        keep = tangent(i, d) & tangent(j, -d)
-        i, j = i[keep], j[keep]
-        ok = world.segments_free(corners[i], corners[j])
-        i, j = i[ok], j[ok]
-        w = np.hypot(*(corners[j] - corners[i]).T)
-        adj[i, j] = w
-        adj[j, i] = w
-    return CornerGraph(np.ascontiguousarray(corners, dtype=float), adj, edges)
+    i, j, w = graph.edge_arrays()
+    adj[i, j] = w
+    edges = np.ascontiguousarray(zone_arrays(merged)[0], dtype=float)
+    return CornerGraph(np.ascontiguousarray(graph.corners, dtype=float), adj, edges)
 
 
 @njit(cache=True)

@@ -81,11 +81,16 @@ class VisibilityGraph:
         """Free bitangent edges between corners."""
         return len(self._indices) // 2
 
+    def edge_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every free edge in both directions: corner ids ``i``, ``j`` and lengths."""
+        rows = np.repeat(np.arange(len(self.corners)), np.diff(self._indptr))
+        return rows, self._indices, self._weights
+
     def edge_segments(self) -> np.ndarray:
         """(E, 2, 2) plane segments of the graph's edges (for plots)."""
-        rows = np.repeat(np.arange(len(self.corners)), np.diff(self._indptr))
-        keep = rows < self._indices
-        return np.stack([self.corners[rows[keep]], self.corners[self._indices[keep]]], axis=1)
+        rows, cols, _ = self.edge_arrays()
+        keep = rows < cols
+        return np.stack([self.corners[rows[keep]], self.corners[cols[keep]]], axis=1)
 
     def free(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Exact (shapely's) verdict for each segment a[k] -> b[k]: it meets no obstacle
