@@ -246,3 +246,22 @@ def test_a_flight_too_long_to_sample_is_one_line(monkeypatch, capsys, tmp_path):
     code, out, err = run(monkeypatch, capsys, "fleet", "simulate", path, "--hours", "0.1")
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
     assert "would be airborne up to 4.54e+08 h with its loiters, over the limit of 12 h" in err
+
+
+def _short_strip(d: dict) -> None:
+    d["airports"][2]["takeoff"]["length"] = 320.0  # holds the roll to 50 m, not to 90 m
+    d["drones"] = 5
+
+
+@pytest.mark.parametrize("command", [["simulate", "--out", "OUT"], ["sweep", "--seeds", "0"]])
+def test_a_level_whose_roll_overruns_a_runway_is_one_line_before_any_work(
+        monkeypatch, capsys, tmp_path, command):
+    path = _scenario_file(tmp_path, _short_strip)
+    out_dir = tmp_path / "run"
+    args = [str(out_dir) if a == "OUT" else a for a in command]
+    code, out, err = run(monkeypatch, capsys, "fleet", args[0], path, *args[1:],
+                         "--hours", "0.1", "--airspace", "layers")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert ("airport C's take-off runway (320 m) is shorter than the take-off roll to climb "
+            "to 90 m (326 m), drone 4's level in layers" in err)
+    assert not out_dir.exists()

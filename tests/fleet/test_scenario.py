@@ -253,3 +253,44 @@ def test_generate_names_the_one_bad_argument(kwargs, param, words):
     with pytest.raises(OptionError) as info:
         sc.generate(**kwargs)
     assert info.value.param == param and words in str(info.value)
+
+
+# ------------------------------------------------------------------ runways and ground rolls
+
+def _roll(h: float) -> float:
+    return takeoff_phases(h, 20.0, 40.0, 50.0)[0]
+
+
+@pytest.mark.parametrize("edit, words", [
+    # 150 m strips: the take-off roll to the lowest level (294 m) and the roll-out (192 m)
+    # ran off their ends, silently
+    (lambda d: d["airports"][1]["takeoff"].update(length=150.0),
+     f"airports[1].takeoff.length: 150 m is shorter than the take-off roll ({_roll(50):.0f}"
+     " m to climb to the lowest level, 50 m)"),
+    (lambda d: d["airports"][2]["landing"].update(length=150.0),
+     "airports[2].landing.length: 150 m is shorter than the roll-out (drone.rollout, "
+     "192 m)"),
+    # too shallow a climb leaves no roll: it failed mid-run naming a --climb-angle-deg
+    # flag that does not exist, and no file
+    (lambda d: d["drone"].update(climb_angle_deg=5.0),
+     "drone.climb_angle_deg: 5 degrees is too shallow: the climb to 50 m alone is longer "
+     "than the seed's take-off distance"),
+])
+def test_runways_must_hold_the_ground_rolls(tmp_path, edit, words):
+    import yaml
+
+    data = sc.preset("seed-3x3").model_dump()
+    edit(data)
+    p = tmp_path / "bad.yaml"
+    p.write_text(yaml.safe_dump(data, sort_keys=False))
+    with pytest.raises(InputFormatError) as info:
+        sc.load_scenario(p)
+    assert str(info.value) == f"{p}: {words}"
+
+
+def test_runways_just_long_enough_are_allowed():
+    data = sc.preset("seed-3x3").model_dump()
+    data["airports"][0]["takeoff"]["length"] = math.ceil(_roll(50.0) * 1000) / 1000
+    data["airports"][0]["landing"]["length"] = 192.0
+    s = sc.parse_scenario(data)
+    assert s.airports[0].landing.length == 192.0

@@ -420,7 +420,6 @@ def test_reservations_accept_what_is_far_apart_in_space_or_time():
 @pytest.mark.parametrize("edit, words", [
     (lambda d: d["drone"].update(turn_radius=1e12), "A -> B at 50 m would be airborne up to "
                                                     "4.54e+08 h"),
-    (lambda d: d["airspace"].update(layer_step=1e9), "C -> A at 2e+09 m would be airborne"),
     (lambda d: d["drone"].update(cruise_speed=0.001, landing_speed=0.0005),
      "would be airborne up to 6.09e+03 h"),
 ])
@@ -433,3 +432,27 @@ def test_a_flight_airborne_too_long_is_refused_before_it_is_sampled(edit, words)
     with pytest.raises(SimulationError, match="over the limit of 12 h") as info:
         run(Scenario.model_validate(data), hours=0.2, seed=0)
     assert words in str(info.value)
+
+
+def test_a_top_level_whose_roll_overruns_a_runway_is_refused_before_the_run():
+    from skyroute.errors import OptionError
+    from skyroute.fleet.scenario import Scenario
+
+    data = preset("seed-3x3").model_dump()
+    data["airports"][2]["takeoff"]["length"] = 320.0  # holds the roll to 50 m (294 m)
+    data["drones"] = 5  # layers: the top drone cruises at 90 m, a 326 m roll
+    s = Scenario.model_validate(data)
+    with pytest.raises(OptionError) as err:
+        run(s, hours=0.2, seed=0, airspace="layers")
+    assert str(err.value) == ("airport C's take-off runway (320 m) is shorter than the "
+                              "take-off roll to climb to 90 m (326 m), drone 4's level in "
+                              "layers; fly shared, fewer drones or a longer runway")
+    sim = run(s, hours=0.2, seed=0, airspace="shared")  # its top level is 80 m: 319 m
+    assert sim.flights
+    # a layer_step of 1e9 m (it reached the 12 h airborne limit, see above) is refused
+    # by its roll now, before any flight is planned
+    data = preset("seed-3x3").model_dump()
+    data["airspace"]["layer_step"] = 1e9
+    with pytest.raises(OptionError, match=r"to climb to 2e\+09 m \(679845521 m\), drone "
+                                          "2's level in layers"):
+        run(Scenario.model_validate(data), hours=0.2, seed=0)

@@ -143,7 +143,7 @@ def simulate_command(
     Exits 1 when the independent checker finds a loss of separation or a package is lost.
     """
     from skyroute.fleet.report import report
-    from skyroute.fleet.simulate import run
+    from skyroute.fleet.simulate import check_levels, run
 
     check_choice("scheduler", scheduler, SCHEDULERS)
     if airspace is not None:
@@ -156,6 +156,7 @@ def simulate_command(
     s = _with_separation(resolve_scenario(scenario, preset_name, airports, drones, area_km,
                                           seed), sep_horizontal, sep_vertical)
     check_work(s, hours=hours, rate=rate, track_step=track_step if out is not None else None)
+    check_levels(s, airspace)  # every level's take-off roll on every runway, before the bar
     if out is not None:  # a bad --out fails before the run, not after it with some files
         from skyroute.io.fleet_out import check_run_outputs
 
@@ -316,6 +317,7 @@ def sweep_command(
 ) -> None:
     """Run every scheduler x airspace x rate on every seed (the same package streams for
     each setting); one table of means with 95% confidence intervals."""
+    from skyroute.fleet.simulate import check_levels
     from skyroute.jobs.fleet import sweep
 
     scheds = _choices(scheduler, "--scheduler", SCHEDULERS)
@@ -327,6 +329,8 @@ def sweep_command(
     s = resolve_scenario(scenario, preset_name, airports, drones, area_km, 0)
     if scenario is not None and s.packages.csv is not None:
         raise OptionError("sweep runs Poisson streams; this scenario names a package CSV")
+    for mode in spaces:  # every level's take-off roll on every runway
+        check_levels(s, mode)
     for r in rate_list:  # each run's packages (rate x hours) within the limit
         check_work(s, hours=hours, rate=r, rate_flag="--rates")
     runs = len(scheds) * len(spaces) * len(rate_list) * len(seed_list)

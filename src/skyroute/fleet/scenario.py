@@ -37,6 +37,7 @@ from skyroute.fleet.limits import (
     MAX_DRONES,
     MAX_RATE,
 )
+from skyroute.fleet.vehicle import takeoff_phases
 
 MAX_GATE_DISTANCE = 500.0  # metres from an airport's position to a gate it places
 
@@ -213,8 +214,32 @@ class Scenario(_Strict):
                     for rw in (a.landing, a.takeoff):
                         ends = runway_ends(a, rw)
                         if poly.intersects(shapely.LineString([(p[1], p[0]) for p in ends])):
-                            raise ValueError(f"no_fly_zones[{k}] ({z.name!r}) covers a "
+                            raise ValueError(f"no_fly_zones[{k}]: zone {z.name!r} covers a "
                                              f"runway of airport {a.id}")
+        return self
+
+    @model_validator(mode="after")
+    def _ground_rolls(self) -> Scenario:
+        # a 150 m strip was accepted and drones rolled 294 m off its end on take-off and
+        # 192 m on landing; the roll grows with the level, so later levels are checked
+        # when a run knows its top one (skyroute.fleet.simulate)
+        d = self.drone
+        h = self.airspace.base_altitude
+        roll = takeoff_roll(d, h)
+        if roll is None:
+            raise ValueError(f"drone.climb_angle_deg: {d.climb_angle_deg:g} degrees is too "
+                             f"shallow: the climb to {h:g} m alone is longer than the seed's "
+                             "take-off distance")
+        k = short_takeoff_runway(self.airports, roll)
+        if k is not None:
+            raise ValueError(f"airports[{k}].takeoff.length: "
+                             f"{self.airports[k].takeoff.length:g} m is shorter than the "
+                             f"take-off roll ({roll:.0f} m to climb to the lowest level, "
+                             f"{h:g} m)")
+        for k, a in enumerate(self.airports):
+            if a.landing.length < d.rollout:
+                raise ValueError(f"airports[{k}].landing.length: {a.landing.length:g} m is "
+                                 f"shorter than the roll-out (drone.rollout, {d.rollout:g} m)")
         return self
 
     def airport(self, airport_id: str) -> Airport:
@@ -224,6 +249,25 @@ class Scenario(_Strict):
                 return a
         raise OptionError(f"no airport {airport_id!r}; airports: "
                           + ", ".join(a.id for a in self.airports))
+
+
+def takeoff_roll(drone: Drone, altitude: float) -> float | None:
+    """Metres of runway the take-off roll before a climb to ``altitude`` takes (the seed's
+    take-off distance less the climb; it grows with the altitude), or None when the
+    climb alone is longer than that distance (too shallow a ``climb_angle_deg``)."""
+    try:
+        return takeoff_phases(altitude, drone.climb_angle_deg, drone.landing_speed,
+                              drone.cruise_speed)[0]
+    except OptionError:  # no roll left: the climb alone is longer
+        return None
+
+
+def short_takeoff_runway(airports, roll: float) -> int | None:
+    """Index of the first airport whose take-off runway is shorter than ``roll``."""
+    for k, a in enumerate(airports):
+        if a.takeoff.length < roll:
+            return k
+    return None
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -263,7 +307,8 @@ def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
         err = exc.errors()[0]
         field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err["loc"])
         msg = err["msg"].removeprefix("Value error, ")
-        raise InputFormatError(where, f"{field.lstrip('.') or 'scenario'}: {msg}") from None
+        # a check of several fields (at the model level) names its own field first
+        raise InputFormatError(where, f"{field.lstrip('.')}: {msg}" if field else msg) from None
 
 
 def generate(airports: int, drones: int, *, area_km: float = 8.0, seed: int = 0,
