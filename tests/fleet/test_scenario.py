@@ -137,6 +137,9 @@ def _other_beside_first(d: dict) -> None:
      "no_fly_zones[0].points[1][1]: 1e+06 m from home is over the limit of 100,000 m"),
     (lambda d: d.update(airports=d["airports"] * 34),
      "airports: 102 airports is over the limit of 100"),
+    # a list of every level was made for each flight: a MemoryError traceback
+    (lambda d: d["airspace"].update(shared_levels=10**9),
+     "airspace.shared_levels: 1e+09 levels is over the limit of 1,000"),
 ])
 def test_bad_scenario_files_give_one_line_naming_the_field(tmp_path, edit, words):
     import yaml

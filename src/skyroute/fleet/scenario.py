@@ -35,6 +35,7 @@ from skyroute.fleet.limits import (
     MAX_AREA_KM,
     MAX_DISTANCE,
     MAX_DRONES,
+    MAX_LEVELS,
     MAX_RATE,
 )
 from skyroute.fleet.vehicle import takeoff_phases
@@ -151,7 +152,8 @@ class Airspace(_Strict):
     sep_vertical: float = Field(default=10.0, gt=0)
     base_altitude: float = Field(default=50.0, ge=50.0, description="lowest cruise level")
     layer_step: float = Field(default=10.0, gt=0)
-    shared_levels: int = Field(default=4, ge=1, description="levels by direction")
+    shared_levels: Annotated[int, _at_most(MAX_LEVELS, "levels")] = Field(
+        default=4, ge=1, description="levels by direction")
 
 
 class NoFlyZone(_Strict):
