@@ -74,6 +74,15 @@ def test_toml_scenarios_load(tmp_path):
      "airports[0].landing.heading_deg: Input should be a finite number"),
     (lambda y: y.replace("north: 273.9", "north: .nan", 1),
      "airports[0].north: Input should be a finite number"),
+    # YAML reads yes, on and true as booleans, and pydantic took them for 1: one drone,
+    # a cruise at 1 m/s, a corner at (1, 0)
+    (lambda y: y.replace("drones: 3", "drones: yes"),
+     "drones: True is a boolean, not valid here"),
+    (lambda y: y.replace("handover_seconds: 15.0", "handover_seconds: on"),
+     "handover_seconds: True is a boolean, not valid here"),
+    (lambda y: y.replace("no_fly_zones: []", "no_fly_zones: [{points: [[true, 0], "
+                                             "[0, 100], [100, 100]]}]"),
+     "no_fly_zones[0].points: True is a boolean, not valid here"),
 ])
 def test_bad_scenarios_name_the_field_and_the_file(tmp_path, edit, words):
     p = tmp_path / "bad.yaml"

@@ -66,6 +66,29 @@ class _Strict(BaseModel):
     # checks and failed later with a message naming neither the file nor the field
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
+    @field_validator("*", mode="before")
+    @classmethod
+    def _no_booleans(cls, v):
+        # no field is a boolean, and YAML reads yes, on and true as True, which pydantic
+        # took for 1 (`drones: yes` was one drone, `cruise_speed: on` 1 m/s)
+        found = _first_bool(v)
+        if found is not None:
+            raise ValueError(f"{found} is a boolean, not valid here (YAML reads yes, no, on, "
+                             "off, true and false as booleans)")
+        return v
+
+
+def _first_bool(v) -> bool | None:
+    """The first boolean in ``v`` or in its (nested) lists, or None."""
+    if isinstance(v, bool):
+        return v
+    if isinstance(v, list | tuple):
+        for x in v:
+            found = _first_bool(x)
+            if found is not None:
+                return found
+    return None
+
 
 class Runway(_Strict):
     """A straight runway through its airport's position."""
