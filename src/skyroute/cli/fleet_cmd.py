@@ -212,9 +212,11 @@ def _report_table(rep: dict, files: list[Path]) -> Table:
         ("loiter circles", f"{rep['loiters']} ({rep['loiter_s']:.0f} s)"),
         ("flights", f"{rep['flights']} ({rep['reposition_flights']} empty repositioning)"),
         ("conflicts", str(rep["conflicts"])),
-        ("closest pair", f"{_fmt(rep['min_horizontal_m'], '.1f', ' m')} horizontally; "
+        # each least distance is taken while the other is under its minimum
+        ("closest pair", f"{_fmt(rep['min_horizontal_m'], '.1f', ' m')} horizontally within "
+                         f"{st['sep_vertical']:g} m vertically; "
                          f"{_fmt(rep['min_vertical_m'], '.1f', ' m')} vertically within "
-                         f"{st['sep_horizontal']:g} m"),
+                         f"{st['sep_horizontal']:g} m horizontally"),
         ("lost packages", str(rep["lost"])),
         ("wall time", f"{rep['wall_seconds']:.2f} s "
                       f"({_fmt(rep['sim_seconds_per_wall_second'], ',.0f')} simulated s/s)"),
