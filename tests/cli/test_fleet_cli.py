@@ -35,7 +35,12 @@ def test_simulate_table_and_separation_override(monkeypatch, capsys):
                          "--drones", "2", "--area-km", "3", "--hours", "0.5",
                          "--sep-horizontal", "80", "--rate", "30")
     assert code == 0, err
-    assert "conflicts" in out and "within 80 m" in out and "2 drones, 3 airports" in out
+    assert "conflicts" in out and "2 drones, 3 airports" in out
+    # each least distance says the other minimum it was taken within: "98.3 m
+    # horizontally; 20.0 m vertically within 50 m" read as if the closest pair were 98 m
+    # apart yet another came within 50 m
+    assert "horizontally within 10 m vertically" in out, out
+    assert "vertically within 80 m horizontally" in out, out
 
 
 @pytest.mark.parametrize("args, words", [
@@ -249,7 +254,6 @@ def test_bench_fleet_checks_its_json_path_before_running(monkeypatch, capsys, tm
     (lambda d: d["drone"].update(turn_radius=1e12), "drone.turn_radius"),
     (lambda d: d["drone"].update(cruise_speed=0.001, landing_speed=0.0005),
      "drone.cruise_speed"),
-    (lambda d: d["airspace"].update(layer_step=1e9), "airspace.layer_step"),
 ])
 def test_a_flight_too_long_to_sample_names_the_file_and_field(monkeypatch, capsys, tmp_path,
                                                               edit, field):
@@ -263,14 +267,17 @@ def test_a_flight_too_long_to_sample_names_the_file_and_field(monkeypatch, capsy
         assert "h with its loiters, over the limit of 12 h" in err
 
 
-def test_more_drones_flying_too_high_names_the_file(monkeypatch, capsys, tmp_path):
-    # one drone cruises at base_altitude; the 1,000th would climb 1e10 m to its layer
+def test_more_drones_flying_too_high_is_one_line(monkeypatch, capsys, tmp_path):
+    # one drone cruises at base_altitude; the 1,000th would climb 1e10 m to its layer, a
+    # take-off roll no runway holds (the 12 h airborne check skips levels not flown)
     path = _scenario_file(tmp_path, lambda d: (d.update(drones=1), d["airspace"].update(
         layer_step=1e7, shared_levels=1)))
-    monkeypatch.setattr("skyroute.fleet.simulate.run", _no_run)
-    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", path, "--drones", "1000")
+    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", path, "--drones", "1000",
+                         "--hours", "0.1")
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
-    assert err.startswith(f"skyroute: error: {path}: airspace.layer_step: a flight "), err
+    assert "shorter than the take-off roll to climb to 9.99e+09 m" in err
+    assert err.rstrip().endswith("drone 999's level in layers; fly shared, fewer drones or a "
+                                 "longer runway")
 
 
 def test_a_package_csv_past_the_limit_is_one_line(monkeypatch, capsys, tmp_path):
@@ -282,3 +289,22 @@ def test_a_package_csv_past_the_limit_is_one_line(monkeypatch, capsys, tmp_path)
     assert code == 2 and out == ""
     assert err == (f"skyroute: error: {tmp_path / 'p.csv'}:100002: more than 100,000 "
                    "packages, the limit of one run; split the file\n")
+
+
+def _short_strip(d: dict) -> None:
+    d["airports"][2]["takeoff"]["length"] = 320.0  # holds the roll to 50 m, not to 90 m
+    d["drones"] = 5
+
+
+@pytest.mark.parametrize("command", [["simulate", "--out", "OUT"], ["sweep", "--seeds", "0"]])
+def test_a_level_whose_roll_overruns_a_runway_is_one_line_before_any_work(
+        monkeypatch, capsys, tmp_path, command):
+    path = _scenario_file(tmp_path, _short_strip)
+    out_dir = tmp_path / "run"
+    args = [str(out_dir) if a == "OUT" else a for a in command]
+    code, out, err = run(monkeypatch, capsys, "fleet", args[0], path, *args[1:],
+                         "--hours", "0.1", "--airspace", "layers")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert ("airport C's take-off runway (320 m) is shorter than the take-off roll to climb "
+            "to 90 m (326 m), drone 4's level in layers" in err)
+    assert not out_dir.exists()

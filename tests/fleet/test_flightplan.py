@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from skyroute.errors import OptionError
+from skyroute.errors import OptionError, QueryError
 from skyroute.fleet.flightplan import (
     PHASES,
     gate_position,
@@ -344,3 +344,17 @@ def test_ground_position_hand_worked(straight):
               [0, -300 + roll], [0, 4700], [0, 4700 + 144], [0, 5000], [0, 4985]]
     assert np.allclose(g[:10], expect, atol=1e-9)
     assert np.isnan(g[10:]).all()
+
+
+def test_a_take_off_roll_longer_than_the_runway_is_refused():
+    # the roll grows with the level (the seed's regression less a fixed-angle climb):
+    # 294 m to 50 m, 326 m to 90 m; a 320 m runway takes the first, not the second
+    s = two_airports()
+    data = s.model_dump()
+    data["airports"][0]["takeoff"]["length"] = 320.0
+    s = Scenario.model_validate(data)
+    assert plan_flight(s, 1, "A", "B", depart=0.0, altitude=50.0).phase("climb")
+    with pytest.raises(QueryError) as err:
+        plan_flight(s, 1, "A", "B", depart=0.0, altitude=90.0)
+    assert str(err.value) == ("airport A's take-off runway (320 m) is shorter than the "
+                              "take-off roll to climb to 90 m (326 m)")

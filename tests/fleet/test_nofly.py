@@ -76,3 +76,49 @@ def test_a_fleet_run_keeps_out_of_a_zone_and_apart():
     assert rep["conflicts"] == 0 and rep["lost"] == 0 and rep["delivered"] > 0
     poly = shapely.Polygon([(e, n) for n, e in ZONE])
     assert _inside(sim.pieces(), poly) == 0
+
+
+@pytest.fixture(scope="module")
+def zoned_run():
+    s = _two_airports([[-300, -500], [-300, 500], [300, 500], [300, -500]])
+    return run(s, hours=0.3, seed=1)
+
+
+def test_the_run_files_show_the_zones(zoned_run):
+    # an operator saw the drones bend round nothing: no file showed the zones
+    from skyroute.geo import Home, lonlat_to_ned
+    from skyroute.io.fleet_out import fleet_geojson, fleet_geojson_from_tracks, tracks_csv
+
+    s = zoned_run.scenario
+    home = Home(lon=s.home_lon, lat=s.home_lat)
+    for fc in (fleet_geojson(zoned_run),
+               fleet_geojson_from_tracks(s, tracks_csv(zoned_run, 5.0))):
+        zones = [f for f in fc["features"] if f["properties"]["kind"] == "no_fly_zone"]
+        assert [f["properties"]["name"] for f in zones] == ["wall"]
+        geom = zones[0]["geometry"]
+        assert geom["type"] == "Polygon" and len(geom["coordinates"]) == 1
+        ring = np.array(geom["coordinates"][0])
+        assert ring[0].tolist() == ring[-1].tolist() and len(ring) == 5  # closed
+        ne = lonlat_to_ned(ring[:, 0], ring[:, 1], np.zeros(len(ring)), home)[:, :2]
+        poly = shapely.Polygon(ne[:, ::-1])  # (east, north)
+        assert poly.exterior.is_ccw  # RFC 7946: the exterior ring anticlockwise
+        want = shapely.Polygon([(e, n) for n, e in s.no_fly_zones[0].points])
+        assert poly.normalize().equals_exact(want.normalize(), 0.01)
+
+
+def test_the_map_draws_the_zones(zoned_run, tmp_path, monkeypatch):
+    import skyroute.io.plot as plot
+    from skyroute.io.fleet_out import plot_map
+
+    figures = []
+    save = plot.save_figure
+    monkeypatch.setattr(plot, "save_figure",
+                        lambda fig, path, **kw: figures.append(fig) or save(fig, path, **kw))
+    plot_map(zoned_run, tmp_path / "map.png")
+    ax = figures[0].axes[0]
+    zones = [p for p in ax.patches if p.get_gid() == "no_fly_zone wall"]
+    assert len(zones) == 1
+    corners = {tuple(np.round(v, 6)) for v in zones[0].get_xy()}
+    assert corners == {(float(e), float(n)) for n, e in zoned_run.scenario.no_fly_zones[0]
+                       .points}
+    assert "no-fly zone" in [t.get_text() for t in ax.get_legend().get_texts()]

@@ -74,6 +74,15 @@ def test_toml_scenarios_load(tmp_path):
      "airports[0].landing.heading_deg: Input should be a finite number"),
     (lambda y: y.replace("north: 273.9", "north: .nan", 1),
      "airports[0].north: Input should be a finite number"),
+    # YAML reads yes, on and true as booleans, and pydantic took them for 1: one drone,
+    # a cruise at 1 m/s, a corner at (1, 0)
+    (lambda y: y.replace("drones: 3", "drones: yes"),
+     "drones: True is a boolean, not valid here"),
+    (lambda y: y.replace("handover_seconds: 15.0", "handover_seconds: on"),
+     "handover_seconds: True is a boolean, not valid here"),
+    (lambda y: y.replace("no_fly_zones: []", "no_fly_zones: [{points: [[true, 0], "
+                                             "[0, 100], [100, 100]]}]"),
+     "no_fly_zones[0].points: True is a boolean, not valid here"),
 ])
 def test_bad_scenarios_name_the_field_and_the_file(tmp_path, edit, words):
     p = tmp_path / "bad.yaml"
@@ -137,6 +146,9 @@ def _other_beside_first(d: dict) -> None:
      "no_fly_zones[0].points[1][1]: 1e+06 m from home is over the limit of 100,000 m"),
     (lambda d: d.update(airports=d["airports"] * 34),
      "airports: 102 airports is over the limit of 100"),
+    # a list of every level was made for each flight: a MemoryError traceback
+    (lambda d: d["airspace"].update(shared_levels=10**9),
+     "airspace.shared_levels: 1e+09 levels is over the limit of 1,000"),
 ])
 def test_bad_scenario_files_give_one_line_naming_the_field(tmp_path, edit, words):
     import yaml
@@ -253,3 +265,44 @@ def test_generate_names_the_one_bad_argument(kwargs, param, words):
     with pytest.raises(OptionError) as info:
         sc.generate(**kwargs)
     assert info.value.param == param and words in str(info.value)
+
+
+# ------------------------------------------------------------------ runways and ground rolls
+
+def _roll(h: float) -> float:
+    return takeoff_phases(h, 20.0, 40.0, 50.0)[0]
+
+
+@pytest.mark.parametrize("edit, words", [
+    # 150 m strips: the take-off roll to the lowest level (294 m) and the roll-out (192 m)
+    # ran off their ends, silently
+    (lambda d: d["airports"][1]["takeoff"].update(length=150.0),
+     f"airports[1].takeoff.length: 150 m is shorter than the take-off roll ({_roll(50):.0f}"
+     " m to climb to the lowest level, 50 m)"),
+    (lambda d: d["airports"][2]["landing"].update(length=150.0),
+     "airports[2].landing.length: 150 m is shorter than the roll-out (drone.rollout, "
+     "192 m)"),
+    # too shallow a climb leaves no roll: it failed mid-run naming a --climb-angle-deg
+    # flag that does not exist, and no file
+    (lambda d: d["drone"].update(climb_angle_deg=5.0),
+     "drone.climb_angle_deg: 5 degrees is too shallow: the climb to 50 m alone is longer "
+     "than the seed's take-off distance"),
+])
+def test_runways_must_hold_the_ground_rolls(tmp_path, edit, words):
+    import yaml
+
+    data = sc.preset("seed-3x3").model_dump()
+    edit(data)
+    p = tmp_path / "bad.yaml"
+    p.write_text(yaml.safe_dump(data, sort_keys=False))
+    with pytest.raises(InputFormatError) as info:
+        sc.load_scenario(p)
+    assert str(info.value) == f"{p}: {words}"
+
+
+def test_runways_just_long_enough_are_allowed():
+    data = sc.preset("seed-3x3").model_dump()
+    data["airports"][0]["takeoff"]["length"] = math.ceil(_roll(50.0) * 1000) / 1000
+    data["airports"][0]["landing"]["length"] = 192.0
+    s = sc.parse_scenario(data)
+    assert s.airports[0].landing.length == 192.0

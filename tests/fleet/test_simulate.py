@@ -420,8 +420,6 @@ def test_reservations_accept_what_is_far_apart_in_space_or_time():
 @pytest.mark.parametrize("edit, words", [
     (lambda d: d["drone"].update(turn_radius=1e12), "drone.turn_radius: a flight A -> B at "
                                                     "50 m would be airborne up to 4.54e+08 h"),
-    (lambda d: d["airspace"].update(layer_step=1e9), "airspace.layer_step: a flight C -> A at "
-                                                     "2e+09 m would be airborne"),
     (lambda d: d["drone"].update(cruise_speed=0.001, landing_speed=0.0005),
      "drone.cruise_speed: a flight A -> B at 50 m would be airborne up to 6.09e+03 h"),
 ])
@@ -454,3 +452,42 @@ def test_a_scenario_read_with_a_flight_too_long_names_the_file_and_field(tmp_pat
     assert str(info.value).endswith("over the limit of 12 h (drone.turn_radius is 1e+12)")
     with pytest.raises(InputFormatError, match=r"^scenario: drone\.turn_radius: a flight "):
         check_flights(parse_scenario(data))
+
+
+def test_a_top_level_whose_roll_overruns_a_runway_is_refused_before_the_run():
+    from skyroute.errors import OptionError
+    from skyroute.fleet.scenario import Scenario
+
+    data = preset("seed-3x3").model_dump()
+    data["airports"][2]["takeoff"]["length"] = 320.0  # holds the roll to 50 m (294 m)
+    data["drones"] = 5  # layers: the top drone cruises at 90 m, a 326 m roll
+    s = Scenario.model_validate(data)
+    with pytest.raises(OptionError) as err:
+        run(s, hours=0.2, seed=0, airspace="layers")
+    assert str(err.value) == ("airport C's take-off runway (320 m) is shorter than the "
+                              "take-off roll to climb to 90 m (326 m), drone 4's level in "
+                              "layers; fly shared, fewer drones or a longer runway")
+    sim = run(s, hours=0.2, seed=0, airspace="shared")  # its top level is 80 m: 319 m
+    assert sim.flights
+    # a layer_step of 1e9 m (it reached the 12 h airborne limit, see above) is refused
+    # by its roll now, before any flight is planned
+    data = preset("seed-3x3").model_dump()
+    data["airspace"]["layer_step"] = 1e9
+    with pytest.raises(OptionError, match=r"to climb to 2e\+09 m \(679845521 m\), drone "
+                                          "2's level in layers"):
+        run(Scenario.model_validate(data), hours=0.2, seed=0)
+
+
+def test_the_airborne_check_skips_levels_no_runway_holds():
+    """100 drones on seed-9x9 fly shared (layers would put drone 99 at 1040 m, a roll
+    longer than the runways, which check_levels refuses for layers only): the scenario's
+    12 h check must not refuse it by planning a flight at that layer."""
+    from skyroute.errors import OptionError
+    from skyroute.fleet.airborne import check_flights
+    from skyroute.fleet.simulate import check_levels
+
+    s = preset("seed-9x9").model_copy(update={"drones": 100})
+    check_flights(s, "seed-9x9")
+    check_levels(s, "shared")
+    with pytest.raises(OptionError, match="drone 99's level in layers"):
+        check_levels(s, "layers")

@@ -147,7 +147,7 @@ def simulate_command(
     Exits 1 when the independent checker finds a loss of separation or a package is lost.
     """
     from skyroute.fleet.report import report
-    from skyroute.fleet.simulate import run
+    from skyroute.fleet.simulate import check_levels, run
 
     check_choice("scheduler", scheduler, SCHEDULERS)
     if airspace is not None:
@@ -160,6 +160,7 @@ def simulate_command(
     s = _with_separation(resolve_scenario(scenario, preset_name, airports, drones, area_km,
                                           seed), sep_horizontal, sep_vertical)
     check_work(s, hours=hours, rate=rate, track_step=track_step if out is not None else None)
+    check_levels(s, airspace)  # every level's take-off roll on every runway, before the bar
     if out is not None:  # a bad --out fails before the run, not after it with some files
         from skyroute.io.fleet_out import check_run_outputs
 
@@ -215,9 +216,11 @@ def _report_table(rep: dict, files: list[Path]) -> Table:
         ("loiter circles", f"{rep['loiters']} ({rep['loiter_s']:.0f} s)"),
         ("flights", f"{rep['flights']} ({rep['reposition_flights']} empty repositioning)"),
         ("conflicts", str(rep["conflicts"])),
-        ("closest pair", f"{_fmt(rep['min_horizontal_m'], '.1f', ' m')} horizontally; "
+        # each least distance is taken while the other is under its minimum
+        ("closest pair", f"{_fmt(rep['min_horizontal_m'], '.1f', ' m')} horizontally within "
+                         f"{st['sep_vertical']:g} m vertically; "
                          f"{_fmt(rep['min_vertical_m'], '.1f', ' m')} vertically within "
-                         f"{st['sep_horizontal']:g} m"),
+                         f"{st['sep_horizontal']:g} m horizontally"),
         ("lost packages", str(rep["lost"])),
         ("wall time", f"{rep['wall_seconds']:.2f} s "
                       f"({_fmt(rep['sim_seconds_per_wall_second'], ',.0f')} simulated s/s)"),
@@ -320,6 +323,7 @@ def sweep_command(
 ) -> None:
     """Run every scheduler x airspace x rate on every seed (the same package streams for
     each setting); one table of means with 95% confidence intervals."""
+    from skyroute.fleet.simulate import check_levels
     from skyroute.jobs.fleet import sweep
 
     scheds = _choices(scheduler, "--scheduler", SCHEDULERS)
@@ -334,6 +338,8 @@ def sweep_command(
     s = resolve_scenario(scenario, preset_name, airports, drones, area_km, 0)
     if scenario is not None and s.packages.csv is not None:
         raise OptionError("sweep runs Poisson streams; this scenario names a package CSV")
+    for mode in spaces:  # every level's take-off roll on every runway
+        check_levels(s, mode)
     for r in rate_list:  # each run's packages (rate x hours) within the limit
         check_work(s, hours=hours, rate=r, rate_flag="--rates")
     err = plain_console(stderr=True)

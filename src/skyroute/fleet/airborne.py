@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from skyroute.errors import InputFormatError, SkyrouteError
-from skyroute.fleet.flightplan import plan_flight
+from skyroute.fleet.flightplan import plan_flight, takeoff_overrun
 from skyroute.fleet.limits import MAX_FLIGHT_HOURS
 from skyroute.fleet.scenario import Airspace, Drone, Scenario
 
@@ -54,14 +54,31 @@ def too_long(scenario: Scenario, origin: int, destination: int, level: int,
 def check_flights(scenario: Scenario, where: object = "scenario") -> None:
     """An InputFormatError naming ``where`` (the file) and the field when a flight
     between the farthest airports, either way, at the highest level either airspace may
-    use (a drone's layer, or a shared level), would be airborne past the limit."""
+    use (a drone's layer, or a shared level) that its runway holds, would be airborne past
+    the limit."""
     pos = np.array([[a.north, a.east] for a in scenario.airports])
     far = np.hypot(*(pos[:, None] - pos[None]).transpose(2, 0, 1))
     o, b = (int(k) for k in np.unravel_index(np.argmax(far), far.shape))
     for x, y in ((o, b), (b, o)):
-        error = too_long(scenario, x, y, _top(scenario))
+        error = too_long(scenario, x, y, _held(scenario, x, _top(scenario)))
         if error:
             raise InputFormatError(where, error)
+
+
+def _held(scenario: Scenario, origin: int, top: int) -> int:
+    """The highest level up to ``top`` whose take-off roll airport ``origin``'s runway
+    holds (the roll grows with the level). Higher levels are refused before a run, for
+    the airspace it flies (:func:`skyroute.fleet.simulate.check_levels`): a scenario
+    that flies ``shared`` is not refused for a layer it never uses."""
+    a, sp = scenario.airports[origin], scenario.airspace
+    lo, hi = 0, top
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if takeoff_overrun(scenario, a, sp.base_altitude + mid * sp.layer_step) is None:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
 
 
 def _airborne(scenario: Scenario, origin: int, destination: int, level: int,

@@ -74,7 +74,7 @@ import numpy as np
 
 from skyroute.errors import OptionError, QueryError, check_choice
 from skyroute.fleet import nofly
-from skyroute.fleet.scenario import Airport, Drone, Scenario, runway_ends
+from skyroute.fleet.scenario import Airport, Drone, Scenario, runway_ends, takeoff_roll
 from skyroute.fleet.trajectory import ARC, LINE, Pieces, Trajectory, arc_piece
 from skyroute.fleet.vehicle import (
     MIN_CRUISE_ALTITUDE,
@@ -284,6 +284,9 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
     u_up = np.array([math.cos(psi_up), math.sin(psi_up)])
     roll, roll_s, climb, climb_s = takeoff_phases(h, d.climb_angle_deg, d.landing_speed,
                                                   d.cruise_speed)
+    overrun = takeoff_overrun(scenario, a, h)
+    if overrun is not None:
+        raise QueryError(overrun, param="altitude")
     lift_off = thr + roll * u_up
     t_lift = add("takeoff", roll_s)
 
@@ -367,6 +370,21 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
         taxi_out_route=route_out, taxi_in_route=route_in,
         takeoff_roll=rolls[0], rollout_roll=rolls[1], aircraft=d,
         gate_widths=(a.gate_width, b.gate_width))
+
+
+def takeoff_overrun(scenario: Scenario, airport: Airport, altitude: float) -> str | None:
+    """Why ``airport``'s take-off runway cannot hold the roll before a climb to
+    ``altitude`` (the roll grows with the altitude: the seed's take-off distance less a
+    climb at a fixed angle), or None when it can."""
+    roll = takeoff_roll(scenario.drone, altitude)
+    if roll is None:
+        return (f"drone.climb_angle_deg {scenario.drone.climb_angle_deg:g} is too shallow: "
+                f"the climb to {altitude:g} m alone is longer than the seed's take-off "
+                "distance")
+    if roll > airport.takeoff.length:
+        return (f"airport {airport.id}'s take-off runway ({airport.takeoff.length:g} m) is "
+                f"shorter than the take-off roll to climb to {altitude:g} m ({roll:.0f} m)")
+    return None
 
 
 def ground_position(plan: FlightPlan, t) -> np.ndarray:

@@ -31,6 +31,7 @@ MAX_TRACK_ROWS = 2e7  # tracks.csv rows (drones x seconds / step): 0.85 GB, 3 GB
 MAX_SEEDS = 1000  # seeds in one sweep (the documented sweeps use 30)
 MAX_SWEEP_RUNS = 10_000  # runs in one sweep (the documented ones: 2x2x2 settings x 30 seeds)
 MAX_FLIGHT_HOURS = 12.0  # airborne time of one flight, its loiters included
+MAX_LEVELS = MAX_DRONES  # shared cruise levels: as many as the largest fleet has layers
 
 
 def expected_packages(rate_per_hour: float, hours: float) -> float:

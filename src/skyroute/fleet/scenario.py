@@ -35,8 +35,10 @@ from skyroute.fleet.limits import (
     MAX_AREA_KM,
     MAX_DISTANCE,
     MAX_DRONES,
+    MAX_LEVELS,
     MAX_RATE,
 )
+from skyroute.fleet.vehicle import takeoff_phases
 
 MAX_GATE_DISTANCE = 500.0  # metres from an airport's position to a gate it places
 
@@ -63,6 +65,29 @@ class _Strict(BaseModel):
     # no NaN or infinity anywhere: a NaN position or an infinite speed passed the range
     # checks and failed later with a message naming neither the file nor the field
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _no_booleans(cls, v):
+        # no field is a boolean, and YAML reads yes, on and true as True, which pydantic
+        # took for 1 (`drones: yes` was one drone, `cruise_speed: on` 1 m/s)
+        found = _first_bool(v)
+        if found is not None:
+            raise ValueError(f"{found} is a boolean, not valid here (YAML reads yes, no, on, "
+                             "off, true and false as booleans)")
+        return v
+
+
+def _first_bool(v) -> bool | None:
+    """The first boolean in ``v`` or in its (nested) lists, or None."""
+    if isinstance(v, bool):
+        return v
+    if isinstance(v, list | tuple):
+        for x in v:
+            found = _first_bool(x)
+            if found is not None:
+                return found
+    return None
 
 
 class Runway(_Strict):
@@ -150,7 +175,8 @@ class Airspace(_Strict):
     sep_vertical: float = Field(default=10.0, gt=0)
     base_altitude: float = Field(default=50.0, ge=50.0, description="lowest cruise level")
     layer_step: float = Field(default=10.0, gt=0)
-    shared_levels: int = Field(default=4, ge=1, description="levels by direction")
+    shared_levels: Annotated[int, _at_most(MAX_LEVELS, "levels")] = Field(
+        default=4, ge=1, description="levels by direction")
 
 
 class NoFlyZone(_Strict):
@@ -213,8 +239,32 @@ class Scenario(_Strict):
                     for rw in (a.landing, a.takeoff):
                         ends = runway_ends(a, rw)
                         if poly.intersects(shapely.LineString([(p[1], p[0]) for p in ends])):
-                            raise ValueError(f"no_fly_zones[{k}] ({z.name!r}) covers a "
+                            raise ValueError(f"no_fly_zones[{k}]: zone {z.name!r} covers a "
                                              f"runway of airport {a.id}")
+        return self
+
+    @model_validator(mode="after")
+    def _ground_rolls(self) -> Scenario:
+        # a 150 m strip was accepted and drones rolled 294 m off its end on take-off and
+        # 192 m on landing; the roll grows with the level, so later levels are checked
+        # when a run knows its top one (skyroute.fleet.simulate)
+        d = self.drone
+        h = self.airspace.base_altitude
+        roll = takeoff_roll(d, h)
+        if roll is None:
+            raise ValueError(f"drone.climb_angle_deg: {d.climb_angle_deg:g} degrees is too "
+                             f"shallow: the climb to {h:g} m alone is longer than the seed's "
+                             "take-off distance")
+        k = short_takeoff_runway(self.airports, roll)
+        if k is not None:
+            raise ValueError(f"airports[{k}].takeoff.length: "
+                             f"{self.airports[k].takeoff.length:g} m is shorter than the "
+                             f"take-off roll ({roll:.0f} m to climb to the lowest level, "
+                             f"{h:g} m)")
+        for k, a in enumerate(self.airports):
+            if a.landing.length < d.rollout:
+                raise ValueError(f"airports[{k}].landing.length: {a.landing.length:g} m is "
+                                 f"shorter than the roll-out (drone.rollout, {d.rollout:g} m)")
         return self
 
     def airport(self, airport_id: str) -> Airport:
@@ -224,6 +274,25 @@ class Scenario(_Strict):
                 return a
         raise OptionError(f"no airport {airport_id!r}; airports: "
                           + ", ".join(a.id for a in self.airports))
+
+
+def takeoff_roll(drone: Drone, altitude: float) -> float | None:
+    """Metres of runway the take-off roll before a climb to ``altitude`` takes (the seed's
+    take-off distance less the climb; it grows with the altitude), or None when the
+    climb alone is longer than that distance (too shallow a ``climb_angle_deg``)."""
+    try:
+        return takeoff_phases(altitude, drone.climb_angle_deg, drone.landing_speed,
+                              drone.cruise_speed)[0]
+    except OptionError:  # no roll left: the climb alone is longer
+        return None
+
+
+def short_takeoff_runway(airports, roll: float) -> int | None:
+    """Index of the first airport whose take-off runway is shorter than ``roll``."""
+    for k, a in enumerate(airports):
+        if a.takeoff.length < roll:
+            return k
+    return None
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -266,7 +335,8 @@ def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
         err = exc.errors()[0]
         field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err["loc"])
         msg = err["msg"].removeprefix("Value error, ")
-        raise InputFormatError(where, f"{field.lstrip('.') or 'scenario'}: {msg}") from None
+        # a check of several fields (at the model level) names its own field first
+        raise InputFormatError(where, f"{field.lstrip('.')}: {msg}" if field else msg) from None
     return s
 
 

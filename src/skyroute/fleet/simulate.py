@@ -45,7 +45,7 @@ from skyroute.fleet.airspace import (
     level_choices,
     samples,
 )
-from skyroute.fleet.flightplan import FlightPlan, plan_flight
+from skyroute.fleet.flightplan import FlightPlan, plan_flight, takeoff_overrun
 from skyroute.fleet.packages import Stream
 from skyroute.fleet.scenario import Scenario, runway_ends
 from skyroute.fleet.timetable import Timetable
@@ -137,11 +137,35 @@ def simulate(scenario: Scenario, stream: Stream, *, hours: float, seed: int = 0,
     h = float(hours)
     if not (math.isfinite(h) and h > 0):
         raise OptionError(f"hours={hours!r} must be a number > 0", param="hours")
+    check_levels(scenario, mode)
     run = Simulation(scenario, stream, h, int(seed), scheduler, mode)
     wall = time.perf_counter()
     _Engine(run, progress).go()
     run.wall_seconds = time.perf_counter() - wall
     return run
+
+
+def check_levels(scenario: Scenario, airspace: str | None = None) -> None:
+    """Refuse, before a run, a cruise level of ``airspace`` (default the scenario's mode)
+    whose take-off roll some airport's take-off runway cannot hold (the scenario itself
+    checks only the lowest level): an :class:`OptionError` naming the airport, the level
+    and what to change. A flight planned at such a level would roll off the runway."""
+    mode = scenario.airspace.mode if airspace is None else airspace
+    check_choice("airspace", mode, MODES)
+    sp = scenario.airspace
+    if mode == "layers":
+        levels = [(layer_altitude(sp, d), f"drone {d}'s level in layers")
+                  for d in range(scenario.drones)]
+        advice = "fly shared, fewer drones or a longer runway"
+    else:
+        levels = [(sp.base_altitude + k * sp.layer_step, f"one of the {sp.shared_levels} "
+                   "shared levels") for k in range(sp.shared_levels)]
+        advice = "fewer shared_levels, a smaller layer_step or a longer runway"
+    shortest = min(scenario.airports, key=lambda a: (a.takeoff.length, a.id))
+    for alt, which in reversed(levels):  # the top level first: the longest roll
+        why = takeoff_overrun(scenario, shortest, alt)
+        if why is not None:
+            raise OptionError(f"{why}, {which}; {advice}", param="airspace")
 
 
 class _Engine:

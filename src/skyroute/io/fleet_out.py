@@ -338,7 +338,8 @@ def airborne_samples(plan: FlightPlan, step: float, horizon: float):
 def fleet_geojson(sim: Simulation, step: float = 2.0) -> dict:
     """A FeatureCollection in lon/lat (WGS84, from the scenario's home): airports
     (``kind`` ``airport``), gates (``gate``), runways (``landing``, ``takeoff``: threshold
-    to far end) and one LineString per flight airborne in the run (``kind``
+    to far end), no-fly zones (``no_fly_zone``: a Polygon with the zone's ``name``) and
+    one LineString per flight airborne in the run (``kind``
     ``reposition`` or ``delivery``; lift-off to touchdown or the horizon, sampled every
     ``step`` seconds and at every piece's ends). Track points carry a third coordinate,
     the flight's altitude in metres above the airports."""
@@ -375,7 +376,8 @@ def fleet_geojson(sim: Simulation, step: float = 2.0) -> dict:
 
 def fleet_geojson_from_tracks(scenario, tracks_csv_text: str | bytes) -> dict:
     """What a store keeps of a run (its scenario and ``tracks.csv``) as a FeatureCollection
-    in lon/lat: the airports, gates and runways of :func:`fleet_geojson`, and one
+    in lon/lat: the airports, gates, runways and no-fly zones of :func:`fleet_geojson`,
+    and one
     LineString (``kind`` ``track``; lon, lat, altitude) per stretch a drone is airborne in
     the tracks, with its ``drone``, ``t0_s`` and ``t1_s``. Coarser than the run's own
     file: the tracks' step, without package or flight plan."""
@@ -422,7 +424,8 @@ def fleet_geojson_from_tracks(scenario, tracks_csv_text: str | bytes) -> dict:
 
 
 def _ground(s) -> list[tuple[dict, np.ndarray]]:
-    """(properties, (north, east) points) of the airports, gates and runways."""
+    """(properties, (north, east) points) of the airports, gates, runways and no-fly
+    zones."""
     ground: list[tuple[dict, np.ndarray]] = []
     for a in s.airports:
         ground.append(({"kind": "airport", "id": a.id}, np.array([[a.north, a.east]])))
@@ -434,6 +437,12 @@ def _ground(s) -> list[tuple[dict, np.ndarray]]:
         for kind, rwy in (("landing", a.landing), ("takeoff", a.takeoff)):
             ground.append(({"kind": kind, "airport": a.id, "heading_deg": rwy.heading_deg,
                             "length_m": rwy.length}, np.array(runway_ends(a, rwy))))
+    for z in s.no_fly_zones:  # closed rings, anticlockwise seen from above (RFC 7946)
+        ring = np.array([*z.points, z.points[0]], dtype=float)
+        n, e = ring[:, 0], ring[:, 1]
+        if np.sum(e[:-1] * n[1:] - e[1:] * n[:-1]) < 0:  # clockwise in (east, north)
+            ring = ring[::-1]
+        ground.append(({"kind": "no_fly_zone", "name": z.name}, ring))
     return ground
 
 
@@ -444,8 +453,12 @@ def _ground_features(ground, lonlat: np.ndarray) -> list[dict]:
     for props, pts in ground:
         ll = lonlat[i:i + len(pts)].tolist()
         i += len(pts)
-        geom = ({"type": "Point", "coordinates": ll[0]} if len(pts) == 1
-                else {"type": "LineString", "coordinates": ll})
+        if props["kind"] == "no_fly_zone":
+            geom = {"type": "Polygon", "coordinates": [ll]}
+        elif len(pts) == 1:
+            geom = {"type": "Point", "coordinates": ll[0]}
+        else:
+            geom = {"type": "LineString", "coordinates": ll}
         features.append({"type": "Feature", "geometry": geom, "properties": props})
     return features
 
@@ -457,14 +470,16 @@ def _alts(ground, flights) -> np.ndarray:
 
 # -- pictures -----------------------------------------------------------------------
 def plot_map(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
-    """``map.png``: runways (landing dark, take-off light), gates, airports, and the
-    airborne tracks coloured by drone (a legend up to 10 drones, else a colour bar);
-    metres north and east of the home, true proportions."""
+    """``map.png``: runways (landing dark, take-off light), gates, airports, no-fly zones
+    (hatched, named), and the airborne tracks coloured by drone (a legend up to 10
+    drones, else a colour bar); metres north and east of the home, true proportions."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import shapely
     from matplotlib.collections import LineCollection
+    from matplotlib.patches import Polygon
 
     from skyroute.fleet.report import flights_flown
     from skyroute.io.plot import legend_outside, place_labels, save_figure, set_title
@@ -491,6 +506,14 @@ def plot_map(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
                     label=f"{kind.replace('takeoff', 'take-off')} runway" if k == 0 else None)
     gates = np.array([gate_position(a, g) for a in s.airports for g in (0, 1)])
     ax.plot(gates[:, 1], gates[:, 0], "s", color="tab:red", ms=3, zorder=4, label="gates")
+    for k, z in enumerate(s.no_fly_zones):  # under the tracks, which go round them
+        ax.add_patch(Polygon([(e, n) for n, e in z.points], closed=True, zorder=1,
+                             facecolor=(0.7, 0.15, 0.12, 0.15), edgecolor=(0.7, 0.15, 0.12),
+                             hatch="//", lw=1.0, gid=f"no_fly_zone {z.name}",
+                             label="no-fly zone" if k == 0 else None))
+        c = shapely.Polygon([(e, n) for n, e in z.points]).representative_point()
+        ax.text(c.x, c.y, z.name, ha="center", va="center", fontsize=8, style="italic",
+                color=(0.55, 0.1, 0.08), zorder=1)
     ax.autoscale_view()
     ax.set_aspect("equal")
     ax.set_xlabel("east (m)")

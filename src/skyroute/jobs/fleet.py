@@ -28,7 +28,7 @@ from skyroute.fleet.dispatch import SCHEDULERS
 from skyroute.fleet.limits import MAX_SEEDS, check_run, check_sweep
 from skyroute.fleet.report import report
 from skyroute.fleet.scenario import Scenario, parse_scenario, preset
-from skyroute.fleet.simulate import run
+from skyroute.fleet.simulate import check_levels, run
 from skyroute.io.fleet_out import events_jsonl, fleet_geojson, packages_csv, tracks_csv
 from skyroute.io.geojson import dumps
 from skyroute.jobs import store
@@ -211,6 +211,7 @@ def check_fleet_params(params: dict) -> dict:
     check_choice("scheduler", out["scheduler"], SCHEDULERS)
     out["airspace"] = params.get("airspace", s.airspace.mode)
     check_choice("airspace", out["airspace"], MODES)
+    check_levels(s, out["airspace"])
     out["rate_per_hour"] = _number(params, "rate_per_hour", None, low=0, strict=False)
     out["track_step"] = _number(params, "track_step", 1.0, low=0, strict=True)
     rate = out["rate_per_hour"]
@@ -228,6 +229,8 @@ def check_sweep_params(params: dict) -> dict:
     s, out = _scenario(params)
     out["schedulers"] = _list(params, "schedulers", SCHEDULERS, SCHEDULERS)
     out["airspaces"] = _list(params, "airspaces", MODES, MODES)
+    for mode in out["airspaces"]:
+        check_levels(s, mode)
     rates = params.get("rates")
     if rates is not None:
         if not isinstance(rates, list | tuple) or not rates:

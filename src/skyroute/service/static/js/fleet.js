@@ -115,7 +115,7 @@ async function load(id) {
   }
   const events = parseEvents(eventsText);
   const proj = localProjection(scenario.home_lon, scenario.home_lat);
-  const ground = { airports: [], gates: [], runways: [] };
+  const ground = { airports: [], gates: [], runways: [], zones: [] };
   for (const f of geo.features || []) {
     const p = f.properties || {};
     const g = f.geometry;
@@ -124,6 +124,8 @@ async function load(id) {
     else if (p.kind === "gate") ground.gates.push({ airport: p.airport, gate: p.gate, at: proj.fwd(g.coordinates) });
     else if (p.kind === "landing" || p.kind === "takeoff") {
       ground.runways.push({ kind: p.kind, airport: p.airport, line: g.coordinates.map((c) => proj.fwd(c)) });
+    } else if (p.kind === "no_fly_zone" && g.type === "Polygon") {
+      ground.zones.push({ name: p.name, ring: g.coordinates[0].map((c) => proj.fwd(c)) });
     }
   }
   const rep = detail.report || entry.report || {};
@@ -134,7 +136,8 @@ async function load(id) {
   const lastEvent = events.length ? events[events.length - 1].t : 0;
   const horizon = (params.hours ?? rep.simulated_hours) * 3600 ||
     Math.max(tracks.n ? tracks.t[tracks.n - 1] : 0, lastEvent);
-  const pts = [...ground.airports.map((a) => a.at), ...ground.gates.map((g) => g.at), ...ground.runways.flatMap((r) => r.line)];
+  const pts = [...ground.airports.map((a) => a.at), ...ground.gates.map((g) => g.at), ...ground.runways.flatMap((r) => r.line),
+    ...ground.zones.flatMap((z) => z.ring)];
   let b = bbox(pts);
   for (let i = 0; i < tracks.n; i++) b = bbox([[tracks.east[i], tracks.north[i]]], b);
   run = {
@@ -182,6 +185,17 @@ function tables() {
 function drawMap(ctx, v) {
   if (!run) return;
   const g = run.ground;
+  for (const z of g.zones) { // under everything: the tracks go round them
+    v.path(z.ring, true);
+    ctx.fillStyle = "rgba(179, 38, 30, 0.12)";
+    ctx.fill();
+    ctx.strokeStyle = "#b3261e";
+    ctx.lineWidth = 1.5;
+    ctx.stroke();
+    const c = z.ring.slice(0, -1).reduce((s, q) => [s[0] + q[0], s[1] + q[1]], [0, 0]);
+    const n = Math.max(z.ring.length - 1, 1);
+    label(ctx, z.name, v.px([c[0] / n, c[1] / n]), { align: "center", font: "italic 11px system-ui, sans-serif", color: "#8c1d18" });
+  }
   ctx.lineCap = "butt";
   for (const kind of ["takeoff", "landing"]) {
     for (const r of g.runways.filter((x) => x.kind === kind)) {
