@@ -403,3 +403,29 @@ def test_reverse_parks_beside_where_it_started():
     check_path(world, forward, start, goal, R)
     check_path(world, res, start, goal, R, reverse=True)
     assert res.length < forward.length
+
+
+def _tower() -> World:
+    return World([shapely.box(1, 1, 3, 3)], [0], [50], ("tower",))
+
+
+def test_hybrid_takes_0d_arrays_and_numpy_bools():
+    # array(0.5) was refused as a radius, np.True_ as reverse
+    a = plan(_tower(), (np.array(0.0), np.array(2.0), 0), (5, 2, 0), np.array(0.5),
+             step=np.array(0.3), reverse=np.bool_(False))
+    b = plan(_tower(), (0, 2, 0), (5, 2, 0), 0.5, step=0.3)
+    assert a.found and a.length == b.length
+
+
+@pytest.mark.parametrize("kw", [{"smooth": "no"}, {"approach": True},
+                                {"seed": 1.5}, {"max_expansions": "5"}])
+def test_hybrid_names_a_bad_option(kw):
+    # smooth="no" and approach=True were taken
+    (name, _), = kw.items()
+    with pytest.raises(OptionError, match=f"{name}="):
+        plan(_tower(), (0, 2, 0), (5, 2, 0), 0.5, **kw)
+
+
+def test_runway_goal_names_a_bad_heading():
+    with pytest.raises(OptionError, match="runway_heading="):
+        runway_goal((0, 0), "x", 1.0)
