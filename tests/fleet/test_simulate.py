@@ -433,3 +433,15 @@ def test_a_flight_airborne_too_long_is_refused_before_it_is_sampled(edit, words)
     with pytest.raises(SimulationError, match="over the limit of 12 h") as info:
         run(Scenario.model_validate(data), hours=0.2, seed=0)
     assert words in str(info.value)
+
+
+def test_run_names_a_bad_scenario_hours_or_seed():
+    # an AttributeError for a dict, numpy's errors for the seed
+    from skyroute.errors import OptionError
+
+    with pytest.raises(OptionError, match="scenario must be a Scenario"):
+        run({"airports": []}, hours=0.1)
+    for kw in ({"hours": "1"}, {"hours": True}, {"seed": "1"}, {"seed": -1}):
+        (name, _), = kw.items()
+        with pytest.raises(OptionError, match=f"{name}="):
+            run(preset("seed-3x3"), **{"hours": 0.1, **kw})
