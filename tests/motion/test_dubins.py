@@ -345,3 +345,7 @@ def test_tour_names_a_bad_option(kw):
     name = next(k for k in kw if k != "radius") if len(kw) > 1 else "radius"
     with pytest.raises(OptionError, match=f"{name}="):
         D.tour((0, 0, 0), [(10, 0)], **kw)
+
+
+def test_a_dubins_path_says_found_as_every_result_does():
+    assert D.shortest_path((0, 0, 0), (10, 0, 0), 1.0).found is True

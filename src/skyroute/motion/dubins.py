@@ -139,6 +139,11 @@ class DubinsPath:
         """Always found: without obstacles a Dubins path joins any two poses."""
         return Status.FOUND
 
+    @property
+    def found(self) -> bool:
+        """Always True (see :attr:`status`), as every result's ``found``."""
+        return True
+
     def pose_at(self, s: float) -> np.ndarray:
         """(x, y, heading) after travelling ``s`` along the path (0 <= s <= length)."""
         return self.sample_at(np.array([real("s", s)]))[0]
