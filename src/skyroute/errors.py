@@ -7,6 +7,7 @@ so the CLI can print it as one line.
 from __future__ import annotations
 
 import math
+import numbers
 import warnings
 from collections.abc import Hashable
 
@@ -69,12 +70,76 @@ def renamed(new: str, value: object, old: str, old_value: object) -> object:
     return old_value
 
 
-def real(name: str, value: object) -> float:
-    """``value`` as a finite float when it is a real number (not a bool, a string or an
-    array), else an :class:`OptionError` naming ``name``."""
-    import numbers
+def real(name: str, value: object, *, low: float | None = None, strict: bool = False,
+         high: float | None = None, need: str | None = None) -> float:
+    """``value`` as a finite float when it is a real number (a Python or numpy number, or
+    a 0-d numeric array; not a bool, a string or a longer array) within ``low`` (``>``
+    when ``strict``, else ``>=``) and ``high``, else an :class:`OptionError` naming
+    ``name`` (``need``: what the message says it must be, when not the default)."""
+    x = _scalar(value)
+    if _is_bool(x) or not isinstance(x, numbers.Real) \
+            or not math.isfinite(x):
+        raise OptionError(f"{name}={value!r} must be {need or 'a finite number'}",
+                          param=name)
+    x = float(x)
+    if (low is not None and (x <= low if strict else x < low)) or \
+            (high is not None and x > high):
+        need = need or f"a number {_range(low, strict, high)}"
+        raise OptionError(f"{name}={value!r} must be {need}", param=name)
+    return x
 
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) \
-            or not math.isfinite(value):
-        raise OptionError(f"{name}={value!r} must be a finite number", param=name)
-    return float(value)
+
+def whole(name: str, value: object, *, low: int | None = None,
+          high: int | None = None, need: str | None = None) -> int:
+    """``value`` as an int when it is an integer (a Python or numpy integer, or a 0-d
+    integer array; not a bool, a float or a string) within [``low``, ``high``], else an
+    :class:`OptionError` naming ``name`` (``need`` as for :func:`real`)."""
+    x = _scalar(value)
+    if _is_bool(x) or not isinstance(x, numbers.Integral) or \
+            (low is not None and x < low) or (high is not None and x > high):
+        need = need or f"an integer {_range(low, False, high)}".rstrip()
+        raise OptionError(f"{name}={value!r} must be {need}", param=name)
+    return int(x)
+
+
+def flag(name: str, value: object) -> bool:
+    """``value`` as a bool when it is True or False (numpy's too), else an OptionError."""
+    if not _is_bool(value):
+        raise OptionError(f"{name}={value!r} must be True or False", param=name)
+    return bool(value)
+
+
+NO_BUDGET = 2**63 - 1  # max_expansions=None: no budget (an int64 for the kernels)
+
+
+def budget(value: object, name: str = "max_expansions") -> int:
+    """An expansion budget: None is none (:data:`NO_BUDGET`), else an integer >= 0 (one
+    above an int64 is no budget either)."""
+    if value is None:
+        return NO_BUDGET
+    return min(whole(name, value, low=0), NO_BUDGET)
+
+
+def _scalar(value: object) -> object:
+    """A 0-d numpy array's element (``np.array(2.0)`` reads as 2.0); anything else as is.
+    (numpy is not imported here: ``skyroute --version`` reads this module.)"""
+    if type(value).__name__ == "ndarray" and getattr(value, "ndim", None) == 0 \
+            and value.dtype.kind in "biuf":
+        return value[()]
+    return value
+
+
+def _is_bool(value: object) -> bool:
+    """True for Python's and numpy's booleans (numbers.Integral holds Python's only)."""
+    return isinstance(value, bool) or type(value).__name__ in ("bool_", "bool")
+
+
+def _range(low, strict: bool, high) -> str:
+    """'>= 1', '> 0', 'from 2 to 10,000,000', '<= 5' (integers with thousands commas)."""
+    lo, hi = (None if v is None else f"{v:,}" if isinstance(v, int) else f"{v:g}"
+              for v in (low, high))
+    if lo is not None and hi is not None:
+        return f"from {lo} to {hi}" if not strict else f"> {lo} and <= {hi}"
+    if lo is not None:
+        return f"{'>' if strict else '>='} {lo}"
+    return "" if hi is None else f"<= {hi}"

@@ -15,10 +15,10 @@ if TYPE_CHECKING:
 
 def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
          connectivity: int | None = None, corner_cutting: bool = False,
-         heuristic: str | None = None, weight: float = 1.0, prune: str | None = None,
+         heuristic: str | None = None, weight: float | None = None, prune: str | None = None,
          max_expansions: int | None = None, resolution: float | None = None,
-         samples: int = 1000, neighbours: int = 10, prm_star: bool = False,
-         seed: int = 0) -> PlanResult:
+         samples: int | None = None, neighbours: int | None = None,
+         prm_star: bool | None = None, seed: int | None = None) -> PlanResult:
     """Plan a path on a Grid from cell ``start`` to cell ``goal``, both (x, y) = (column,
     row), or on a World between two points given in the world's frame.
 
@@ -43,12 +43,19 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
         free side suffices; squeezing between two diagonal blocked cells is never legal.
     heuristic : {"octile", "euclidean", "manhattan", "zero"}, optional
         Default octile (8-connected), Manhattan (4-connected), Euclidean (any-angle).
-    weight : float
-        >= 1; weighted A* returns a cost at most ``weight`` x the optimum.
+    weight : float, optional
+        >= 1 (default 1); weighted A* returns a cost at most ``weight`` x the optimum.
     prune : {"none", "collinear", "los"}, optional
         Drop straight-on points, or also shortcut by line of sight. Never illegal or longer.
     max_expansions : int, optional
         Stop with status ``budget_exhausted`` after this many expansions.
+    resolution : float, optional
+        A World planned by a grid algorithm: the cell size in plane units.
+    samples, neighbours, prm_star, seed : optional
+        A World planned by "prm": 1000 samples, 10 neighbours (or k-PRM*'s), seed 0.
+
+    An option that the chosen planner does not read (``seed`` on a Grid, ``heuristic``
+    with "visibility", ``resolution`` with "prm", ...) is an OptionError, not ignored.
 
     Returns
     -------
@@ -58,9 +65,11 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
     Raises
     ------
     QueryError
-        start or goal outside the grid or on a blocked cell.
+        start or goal outside the grid or on a blocked cell (or outside the World or
+        inside an obstacle), or not two numbers (two integers on a Grid).
     OptionError
-        an unknown or out-of-range option (the message lists the valid ones).
+        an unknown, out-of-range or inapplicable option (the message lists the valid
+        ones).
 
     Examples
     --------
@@ -81,15 +90,23 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
             raise OptionError(f"grid must be a skyroute Grid or World, got "
                               f"{type(grid).__name__}")
         extra = {k: v for k, v in (("connectivity", connectivity), ("heuristic", heuristic),
-                                   ("prune", prune)) if v is not None}
-        if corner_cutting:
-            extra["corner_cutting"] = True
-        if weight != 1.0:
+                                   ("prune", prune), ("resolution", resolution))
+                 if v is not None}
+        if corner_cutting is not False:
+            extra["corner_cutting"] = corner_cutting
+        if weight is not None:
             extra["weight"] = weight
+        roadmap = {k: v for k, v in (("samples", samples), ("neighbours", neighbours),
+                                     ("prm_star", prm_star), ("seed", seed)) if v is not None}
         return plan_world(grid, start, goal, algorithm=algorithm or "visibility",
-                          resolution=resolution, samples=samples, neighbours=neighbours,
-                          prm_star=prm_star, seed=seed, max_expansions=max_expansions,
-                          **extra)
+                          max_expansions=max_expansions, **roadmap, **extra)
+    if (resolution, samples, neighbours, prm_star, seed) != (None,) * 5:
+        name, value = next((n, v) for n, v in (
+            ("resolution", resolution), ("samples", samples), ("neighbours", neighbours),
+            ("prm_star", prm_star), ("seed", seed)) if v is not None)
+        raise OptionError(f"{name}={value!r} applies to planning on a World "
+                              f"(a grid is searched as it is)", param=name)
+    weight = 1.0 if weight is None else weight
     try:  # the cached option set straight away: on a 32x32 map a query takes 9 us
         opts = _grid_options(algorithm or "astar", connectivity, corner_cutting, heuristic,
                              weight, prune, max_expansions)

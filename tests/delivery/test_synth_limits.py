@@ -72,3 +72,18 @@ def test_synth_prints_its_summary_as_plain_json(monkeypatch, capsys, tmp_path):
     assert code == 0, err
     assert stdout.count("\n") == 1 and json.loads(stdout)["folder"] == str(out)
     assert (out / "database" / "orders.csv").exists()
+
+
+def test_synth_takes_numpy_integers_and_names_bad_ones(tmp_path):
+    # days=np.int64(1) was a TypeError inside timedelta; "1" and 1.5 TypeErrors
+    import numpy as np
+
+    summary = synth(tmp_path / "a", days=np.int64(1), orders_per_day=np.int64(2),
+                    seed=np.int64(3))
+    assert summary["days"] == 1
+    for kw in ({"days": "1"}, {"days": 1.5}, {"days": True}, {"orders_per_day": -1},
+               {"customers": 0}, {"seed": 1.5}):
+        (name, _), = kw.items()
+        with pytest.raises(OptionError, match=f"{name}="):
+            synth(tmp_path / "b", **kw)
+    assert not (tmp_path / "b").exists()

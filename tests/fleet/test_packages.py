@@ -147,3 +147,24 @@ def test_a_csv_past_the_package_limit_names_the_line(tmp_path, nine):
         packages.read_csv(p, nine)
     assert str(err.value) == (f"{p}:100003: more than 100,000 packages, the limit of one "
                               "run; split the file")
+
+
+@pytest.mark.parametrize("kw", [{"seed": "3"}, {"seed": 3.5}, {"seed": -1},
+                                {"seed": True}, {"hours": True}, {"hours": "2"},
+                                {"rate_per_hour": "60"}, {"hours": 1e300},
+                                {"rate_per_hour": 1e300}])
+def test_poisson_names_a_bad_option(nine, kw):
+    # seeds were numpy's TypeError or ValueError, huge values "lam value too large";
+    # True and "2" hours were taken
+    kw = {"hours": 1.0, **kw}
+    with pytest.raises(OptionError) as err:
+        packages.poisson(nine, **kw)
+    bad = next(k for k in kw if k != "hours") if len(kw) > 1 else "hours"
+    assert bad in str(err.value)
+
+
+def test_poisson_takes_numpy_numbers(nine):
+    a = packages.poisson(nine, hours=np.float32(1.0), seed=np.int64(3),
+                         rate_per_hour=np.array(60.0))
+    b = packages.poisson(nine, hours=1.0, seed=3, rate_per_hour=60.0)
+    assert np.array_equal(a.t, b.t)

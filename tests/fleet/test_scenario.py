@@ -306,3 +306,25 @@ def test_runways_just_long_enough_are_allowed():
     data["airports"][0]["landing"]["length"] = 192.0
     s = sc.parse_scenario(data)
     assert s.airports[0].landing.length == 192.0
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    ({"airports": "3", "drones": 3}, "airports"), ({"airports": 3, "drones": "3"}, "drones"),
+    ({"airports": 3, "drones": 3.5}, "drones"), ({"airports": 3, "drones": True}, "drones"),
+    ({"airports": 3, "drones": 3, "area_km": "4"}, "area_km"),
+    ({"airports": 3, "drones": 3, "seed": "1"}, "seed"),
+    ({"airports": 3, "drones": 3, "seed": -1}, "seed"),
+    ({"airports": 3, "drones": 3, "rate_per_hour": "60"}, "rate_per_hour")])
+def test_generate_names_a_bad_type(kwargs, name):
+    # TypeErrors, a pydantic ValidationError for 3.5 drones, numpy's for the seed; True
+    # drones made a scenario named "3xTrue"
+    with pytest.raises(OptionError, match=f"{name}=") as err:
+        sc.generate(**kwargs)
+    assert err.value.param == name
+
+
+def test_generate_takes_numpy_numbers():
+    import numpy as np
+
+    a = sc.generate(np.int64(3), np.int64(3), area_km=np.float32(4.0), seed=np.int64(2))
+    assert a == sc.generate(3, 3, area_km=4.0, seed=2)

@@ -491,3 +491,15 @@ def test_the_airborne_check_skips_levels_no_runway_holds():
     check_levels(s, "shared")
     with pytest.raises(OptionError, match="drone 99's level in layers"):
         check_levels(s, "layers")
+
+
+def test_run_names_a_bad_scenario_hours_or_seed():
+    # an AttributeError for a dict, numpy's errors for the seed
+    from skyroute.errors import OptionError
+
+    with pytest.raises(OptionError, match="scenario must be a Scenario"):
+        run({"airports": []}, hours=0.1)
+    for kw in ({"hours": "1"}, {"hours": True}, {"seed": "1"}, {"seed": -1}):
+        (name, _), = kw.items()
+        with pytest.raises(OptionError, match=f"{name}="):
+            run(preset("seed-3x3"), **{"hours": 0.1, **kw})

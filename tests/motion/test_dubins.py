@@ -273,3 +273,79 @@ def test_batch_takes_strided_and_non_contiguous_poses():
     np.testing.assert_array_equal(D.lengths(both[:, :3], both[:, 3:], 1.2),
                                   D.lengths(s, g, 1.2))
     np.testing.assert_array_equal(D.lengths(s[::2], g[::2], 1.2), D.lengths(s, g, 1.2)[::2])
+
+
+@pytest.mark.parametrize("radius", ["1", [1.0], None, True])
+def test_a_bad_radius_is_an_option_error(radius):
+    # "1" and None were numpy TypeErrors, True was a radius of 1
+    for call in (lambda: D.shortest_path((0, 0, 0), (10, 0, 0), radius),
+                 lambda: D.lengths([[0, 0, 0]], [[10, 0, 0]], radius),
+                 lambda: D.through([(0, 0), (10, 0)], radius),
+                 lambda: D.loiter((0, 0), radius)):
+        with pytest.raises(OptionError, match="radius="):
+            call()
+
+
+@pytest.mark.parametrize("pose", [(0, 0), (0, 0, 0, 0), "000", None, (math.nan, 0, 0)])
+def test_a_bad_pose_is_a_query_error(pose):
+    # a numpy reshape ValueError before (an OptionError for NaN)
+    from skyroute import QueryError
+
+    with pytest.raises(QueryError, match="start"):
+        D.shortest_path(pose, (10, 0, 0), 1.0)
+    with pytest.raises(QueryError, match="starts"):
+        D.lengths([pose], [(10, 0, 0)], 1.0)
+
+
+def test_lengths_refuse_nan_poses():
+    # NaN came back as a length
+    from skyroute import QueryError
+
+    with pytest.raises(QueryError, match="goals must be finite"):
+        D.lengths([[0, 0, 0]], [[math.nan, 0, 0]], 1.0)
+
+
+@pytest.mark.parametrize("kw", [{"step": 0}, {"step": -1.0}, {"step": math.nan},
+                                {"turns": -1.0}, {"turns": math.inf}, {"turns": "2"},
+                                {"start_angle": math.nan}, {"step": 1e-12}])
+def test_loiter_names_a_bad_option(kw):
+    # step=0 was a ZeroDivisionError, -1 one pose, turns=inf "Maximum allowed size"
+    (name, _), = kw.items()
+    with pytest.raises(OptionError, match=f"{name}="):
+        D.loiter((0, 0), 5.0, **kw)
+
+
+@pytest.mark.parametrize("headings", [0, -3, "36", True, 2.5])
+def test_through_names_a_bad_headings(headings):
+    # 0 was "argmin of an empty sequence", True and 2.5 were taken
+    with pytest.raises(OptionError, match="headings="):
+        D.through([(0, 0), (10, 0)], 1.0, headings=headings)
+
+
+def test_dubins_takes_numpy_numbers():
+    p = D.shortest_path(np.float32([0, 0, 0]), (10, 0, 0), np.array(2.0))
+    assert p.length == D.shortest_path((0, 0, 0), (10, 0, 0), 2.0).length
+    assert len(D.through([(0, 0), (10, 0)], np.float32(1.0), headings=np.int64(8))) == 1
+    assert p.sample(np.float32(1.0)).shape == p.sample(1.0).shape
+
+
+@pytest.mark.parametrize("radius", [np.int64(2), np.float32(2.0), np.array(2.0)])
+def test_tour_takes_numpy_radius_and_headings(radius):
+    # refused as "radius=np.float32(2.0) must be > 0"
+    r = D.tour((0, 0, 0), [(10, 0), (10, 10)], radius, headings=np.int64(8))
+    assert r.found and r.length == D.tour((0, 0, 0), [(10, 0), (10, 10)], 2.0,
+                                          headings=8).length
+
+
+@pytest.mark.parametrize("kw", [{"radius": True}, {"headings": True},
+                                {"exact_limit": "8"}, {"exact_limit": -1},
+                                {"exact_limit": 2.5}])
+def test_tour_names_a_bad_option(kw):
+    kw = {"radius": 2.0, **kw}
+    name = next(k for k in kw if k != "radius") if len(kw) > 1 else "radius"
+    with pytest.raises(OptionError, match=f"{name}="):
+        D.tour((0, 0, 0), [(10, 0)], **kw)
+
+
+def test_a_dubins_path_says_found_as_every_result_does():
+    assert D.shortest_path((0, 0, 0), (10, 0, 0), 1.0).found is True

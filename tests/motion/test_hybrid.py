@@ -460,3 +460,29 @@ def test_corner_table_is_shapely_on_the_merged_obstacles():
             free = tangent(i, d) and tangent(j, -d) and \
                 not seg.relate_pattern(union, "T********")
             assert g.adjacency[i, j] == (pytest.approx(seg.length) if free else np.inf), (i, j)
+
+
+def _tower() -> World:
+    return World([shapely.box(1, 1, 3, 3)], [0], [50], ("tower",))
+
+
+def test_hybrid_takes_0d_arrays_and_numpy_bools():
+    # array(0.5) was refused as a radius, np.True_ as reverse
+    a = plan(_tower(), (np.array(0.0), np.array(2.0), 0), (5, 2, 0), np.array(0.5),
+             step=np.array(0.3), reverse=np.bool_(False))
+    b = plan(_tower(), (0, 2, 0), (5, 2, 0), 0.5, step=0.3)
+    assert a.found and a.length == b.length
+
+
+@pytest.mark.parametrize("kw", [{"smooth": "no"}, {"approach": True},
+                                {"seed": 1.5}, {"max_expansions": "5"}])
+def test_hybrid_names_a_bad_option(kw):
+    # smooth="no" and approach=True were taken
+    (name, _), = kw.items()
+    with pytest.raises(OptionError, match=f"{name}="):
+        plan(_tower(), (0, 2, 0), (5, 2, 0), 0.5, **kw)
+
+
+def test_runway_goal_names_a_bad_heading():
+    with pytest.raises(OptionError, match="runway_heading="):
+        runway_goal((0, 0), "x", 1.0)

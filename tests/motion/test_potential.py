@@ -72,3 +72,34 @@ def test_repr_summarises_the_run():
     run = run_field(world, start, goal, escape=False)
     assert repr(run) == (f"<FieldRun found, {run.moves} moves, length {run.distance:.6g}, "
                          "0 escape moves>")
+
+
+@pytest.mark.parametrize("kw", [{"step": "1"}, {"attract": math.nan}, {"repulse": math.inf},
+                                {"attract": -1.0}, {"sensor_range": "6"},
+                                {"tolerance": "0.5"}, {"max_turn": "1"},
+                                {"sensor_rays": 12.5}, {"max_moves": -1},
+                                {"max_moves": 12.5}, {"window": 0}, {"window": 2.5},
+                                {"escape": "no"}, {"heading": "x"}])
+def test_run_field_names_a_bad_option(kw):
+    # TypeErrors, a GEOSException for attract=nan, an IndexError for window=-1; a
+    # negative attraction and escape="no" were taken
+    world, s, t = course("easy")
+    (name, _), = kw.items()
+    with pytest.raises(OptionError, match=f"{name}="):
+        run_field(world, s, t, **kw)
+
+
+def test_run_field_takes_numpy_numbers():
+    world, s, t = course("easy")
+    a = run_field(world, s, t, step=np.float32(0.5), sensor_rays=np.int64(36),
+                  max_moves=np.int64(2000), window=np.array(40))
+    b = run_field(world, s, t, step=0.5)
+    assert a.status == b.status and a.moves == b.moves
+
+
+def test_a_field_run_says_found_as_every_result_does():
+    # FieldRun had only .reached, the step drone's Flight neither
+    world, s, t = course("easy")
+    r = run_field(world, s, t)
+    assert r.found is r.reached is True
+    assert run_field(world, s, t, max_moves=3).found is False

@@ -209,3 +209,45 @@ def test_flight_repr_counts_moves_and_hovers():
     p = np.array([-3.19, 55.94])
     flight = Flight(p[None], np.array([HOVER]), p[None].copy()).hover()
     assert repr(flight) == "<Flight found, 2 moves (2 hovers), 0 expanded, 0 ms>"
+
+
+def _degrees_square() -> skyroute.World:
+    """One zone in a small confinement box, in the degrees frame (no shared data)."""
+    return skyroute.World([shapely.box(-3.1885, 55.9440, -3.1875, 55.9445)], [0], [50],
+                          ("zone",), shapely.box(-3.192, 55.942, -3.184, 55.946), "degrees")
+
+
+@pytest.mark.parametrize("kw", [{"step": 0}, {"step": "x"}, {"step": math.nan},
+                                {"step": -STEP}, {"max_expansions": "5"},
+                                {"max_expansions": None}, {"max_expansions": 5.5},
+                                {"max_expansions": -1}, {"merge": "x"}])
+def test_plan_moves_names_a_bad_option(kw):
+    # step=0 was a ZeroDivisionError, "5" a numba TypingError, NaN and -STEP "no_path"
+    (name, _), = kw.items()
+    with pytest.raises(skyroute.OptionError, match=f"{name}="):
+        plan_moves(_degrees_square(), (-3.1890, 55.9442), (-3.1870, 55.9442), **kw)
+
+
+@pytest.mark.parametrize("kw", [{"step": 0}, {"step": "x"}, {"max_moves": "5"},
+                                {"max_moves": -1}])
+def test_follow_names_a_bad_option(kw):
+    (name, _), = kw.items()
+    with pytest.raises(skyroute.OptionError, match=f"{name}="):
+        follow(_degrees_square(), [(-3.1890, 55.9442), (-3.1870, 55.9442)], **kw)
+
+
+@pytest.mark.parametrize("path", [[], [(1, 2, 3)], [(-3.1890, 55.9442), (math.nan, 55.9)],
+                                  "ab"])
+def test_follow_refuses_a_path_that_is_not_lon_lat_points(path):
+    # [] was an IndexError, (N, 3) a reshape error, NaN a silent "no_path"
+    with pytest.raises(skyroute.QueryError, match="path"):
+        follow(_degrees_square(), path)
+
+
+def test_step_drone_takes_numpy_numbers():
+    w = _degrees_square()
+    s, t = (-3.1890, 55.9442), (-3.1870, 55.9442)
+    a = plan_moves(w, np.array(s), t, step=np.float64(STEP), max_expansions=np.int64(10**5))
+    b = plan_moves(w, s, t)
+    assert a.found and a.moves == b.moves
+    assert follow(w, np.array([s, t]), max_moves=np.int64(100)).found

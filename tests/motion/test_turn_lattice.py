@@ -69,3 +69,30 @@ def test_repr_summarises_the_route():
     assert text.startswith(f"<LatticeResult found, {r.time:.6g} s over {r.distance:.6g}, "
                            f"{len(r.cells)} cells, {r.expanded} expanded")
     assert "array" not in text
+
+
+def test_lattice_options_are_checked():
+    # "2" was a TypeError, inf a speed, -1 and "5" budgets, NaN a heading
+    import pytest
+
+    from skyroute.motion.turn_lattice import plan_turns_world
+
+    grid = skyroute.load_map("den312d")
+    for kw in ({"speed": "2"}, {"speed": math.inf}, {"turn_rate": None},
+               {"max_expansions": -1}, {"max_expansions": "5"},
+               {"start_heading": math.nan}, {"start_heading": "x"}):
+        (name, _), = kw.items()
+        with pytest.raises(skyroute.OptionError, match=f"{name}="):
+            plan_turns(grid, (50, 76), (60, 13), **kw)
+    with pytest.raises(skyroute.OptionError, match="speed="):
+        travel_time([(0, 0), (1, 0)], speed=0)
+    with pytest.raises(skyroute.QueryError):
+        travel_time([(0, 0, 0), (1, 0, 0)])
+    import shapely
+
+    tower = skyroute.World([shapely.box(1, 1, 3, 3)], [0], [50], ("tower",))
+    with pytest.raises(skyroute.OptionError, match="speed="):
+        plan_turns_world(tower, (0, 2), (4, 2), speed="1")
+    r = plan_turns(grid, (50, 76), (60, 13), speed=np.float32(2), start_heading=np.array(1.0),
+                   max_expansions=np.int64(10**6))
+    assert r.found

@@ -54,3 +54,43 @@ def test_max_expansions_is_refused_and_expanded_counts_settled_nodes():
     assert 0 < near.expanded < far.expanded <= 302
     with pytest.raises(skyroute.OptionError, match="seed"):
         PRM(world, samples=300, seed=-1)
+
+
+def _square() -> skyroute.World:
+    import shapely
+
+    return skyroute.World([shapely.box(1, 1, 3, 3)], [0], [50], ("tower",))
+
+
+@pytest.mark.parametrize("option", [{"samples": "50"}, {"samples": 50.5},
+                                    {"samples": float("nan")}, {"samples": [50]},
+                                    {"neighbours": 5.5}, {"neighbours": True},
+                                    {"neighbours": "5"}, {"prm_star": "yes"},
+                                    {"seed": [1]}, {"samples": 10**12}])
+def test_bad_prm_options_name_themselves(option):
+    # a TypeError from a comparison or the roadmap cache before; 5.5 neighbours and
+    # prm_star="yes" were taken
+    (name, _), = option.items()
+    with pytest.raises(skyroute.OptionError, match=f"{name}=") as err:
+        skyroute.plan(_square(), (0, 2), (4, 2), algorithm="prm", **option)
+    assert err.value.param == name
+
+
+def test_prm_takes_numpy_integers():
+    r = skyroute.plan(_square(), (0, 2), (4, 2), algorithm="prm", samples=np.int64(60),
+                      neighbours=np.int64(6), seed=np.int64(2))
+    same = skyroute.plan(_square(), (0, 2), (4, 2), algorithm="prm", samples=60,
+                         neighbours=6, seed=2)
+    assert r.found and r.cost == same.cost
+
+
+@pytest.mark.parametrize("algorithm, option", [
+    ("visibility", {"heuristic": "octile"}), ("visibility", {"weight": 2.0}),
+    ("visibility", {"seed": 3}), ("visibility", {"resolution": 0.5}),
+    ("prm", {"resolution": 0.5}), ("prm", {"connectivity": 4}),
+    ("astar", {"samples": 50}), ("theta", {"seed": 1})])
+def test_options_the_world_planner_does_not_read_are_refused(algorithm, option):
+    # they were ignored: plan(world, ..., heuristic="octile") ran the visibility graph
+    (name, _), = option.items()
+    with pytest.raises(skyroute.OptionError, match=f"{name}=.*algorithm='{algorithm}'"):
+        skyroute.plan(_square(), (0, 2), (4, 2), algorithm=algorithm, **option)

@@ -129,3 +129,11 @@ def test_repeated_queries_reuse_the_graph():
     assert again.los_checks == first.los_checks == fresh.los_checks
     assert first.los_checks <= 1 + 2 * len(graph.corners)
     assert first.extra["edges"] == graph.edge_count > 0
+
+
+@pytest.mark.parametrize("budget", [-1, "5", 5.0, True])
+def test_visibility_refuses_a_bad_budget(budget):
+    # -1 ended "budget_exhausted" and "5" was taken as 5
+    world = World([shapely.box(1, 1, 3, 3)], [0], [50], ("tower",))
+    with pytest.raises(skyroute.OptionError, match="max_expansions="):
+        skyroute.plan(world, (0, 2), (4, 2), max_expansions=budget)

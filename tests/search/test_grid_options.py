@@ -126,3 +126,26 @@ def test_an_option_conflict_names_the_option(options, param):
     with pytest.raises(skyroute.OptionError) as info:
         grid_options(**options)
     assert info.value.param == param
+
+
+@pytest.mark.parametrize("weight", [np.float32(1.5), np.int64(2), np.array(1.5)])
+def test_numpy_weights_are_numbers(weight):
+    # np.float32, np.int64 and 0-d arrays were refused as "must be a number >= 1"
+    grid = skyroute.load_map("den312d")
+    r = skyroute.plan(grid, (50, 76), (60, 13), weight=weight)
+    assert r.found and r.cost <= float(weight) * 112.55634919 + 1e-9
+
+
+def test_a_bool_weight_is_refused():
+    with pytest.raises(skyroute.OptionError, match="weight=True"):
+        skyroute.plan(skyroute.load_map("den312d"), (50, 76), (60, 13), weight=True)
+
+
+@pytest.mark.parametrize("option", [{"seed": 3}, {"resolution": 2.0}, {"samples": 50},
+                                    {"neighbours": 4}, {"prm_star": True}])
+def test_world_options_on_a_grid_are_refused(option):
+    # they were ignored without a word: a grid is searched as it is
+    (name, _), = option.items()
+    with pytest.raises(skyroute.OptionError, match=f"{name}=") as err:
+        skyroute.plan(skyroute.load_map("den312d"), (50, 76), (60, 13), **option)
+    assert err.value.param == name

@@ -241,3 +241,21 @@ def test_reprs_summarise_grid_result_and_index():
     stopped = repr(skyroute.plan(grid, (50, 76), (60, 13), max_expansions=5))
     assert stopped.startswith("<PlanResult budget_exhausted, 0 points") and "cost" not in stopped
     assert repr(skyroute.prepare(grid)).startswith("<PreparedGrid 'den312d.map': subgoal index")
+
+
+@pytest.mark.parametrize("cells", [[[1, 2, 3], [4, 5, 6]], [1, 2, 3], "ab"])
+def test_grid_conversions_refuse_what_is_not_n_by_2(cells):
+    # [[1, 2, 3], [4, 5, 6]] came back as three points
+    grid = Grid(np.zeros((8, 8), bool))
+    for convert in (grid.to_world, grid.to_cell):
+        with pytest.raises(skyroute.QueryError):
+            convert(cells)
+
+
+@pytest.mark.parametrize("cell", [(1, 2, 3), "ab", (1.5, 2), None])
+def test_grid_cell_tests_refuse_what_is_not_two_integers(cell):
+    grid = Grid(np.zeros((8, 8), bool))
+    for test in (grid.is_free, grid.in_bounds):
+        with pytest.raises(skyroute.QueryError, match="two integers"):
+            test(cell)
+    assert grid.is_free((np.int64(1), np.int64(2))) and not grid.in_bounds((8, 0))

@@ -148,3 +148,55 @@ def test_repr_summarises_the_world():
     world = skyroute.World([shapely.box(0, 0, 1, 1)] * 3, 0.0, 10.0, (),
                            boundary=shapely.box(-5, -5, 5, 5), name="three")
     assert repr(world) == "<World 'three': 3 obstacles, a boundary, frame 'enu'>"
+
+
+def _tower() -> skyroute.World:
+    return skyroute.World([shapely.box(1, 1, 3, 3)], [0], [50], ("tower",))
+
+
+@pytest.mark.parametrize("algorithm", ["astar", "theta", "jps"])
+def test_grid_planners_pass_round_an_obstacle_that_spans_an_unbounded_world(algorithm):
+    # the raster ended at the obstacle's own bounds: "no_path" where the visibility graph
+    # found 4.83 (the README's example world)
+    exact = skyroute.plan(_tower(), (0, 2), (4, 2))
+    r = skyroute.plan(_tower(), (0, 2), (4, 2), algorithm=algorithm, resolution=0.1)
+    assert r.found and exact.cost - 1e-9 <= r.cost <= exact.cost * 1.1
+
+
+@pytest.mark.parametrize("kw", [{"resolution": "1"}, {"resolution": [1]},
+                                {"safety": "1"}, {"safety": [1]}, {"altitude": "x"},
+                                {"bounds": (0, 0, 1)}])
+def test_rasterize_names_a_bad_option(kw):
+    # a numpy TypeError or ValueError before
+    kw = {"resolution": 0.5, **kw}
+    name = next(k for k in kw if k != "resolution") if len(kw) > 1 else "resolution"
+    with pytest.raises(OptionError, match=f"{name}="):
+        _tower().rasterize(**kw)
+
+
+def test_rasterize_takes_numpy_numbers():
+    a = _tower().rasterize(np.array(0.5), safety=np.float32(0.25))
+    b = _tower().rasterize(0.5, safety=0.25)
+    assert np.array_equal(a.blocked, b.blocked)
+
+
+@pytest.mark.parametrize("kw", [{"altitude": float("nan")}, {"altitude": "10"},
+                                {"altitude": [10]}, {"safety": "1"}, {"safety": True}])
+def test_load_world_names_a_bad_altitude_or_safety(kw):
+    # altitude=nan kept no building (an empty city), [10] was taken, "1" a TypeError
+    (name, _), = kw.items()
+    with pytest.raises(OptionError, match=f"{name}="):
+        skyroute.load_world("examples/city.csv", **kw)
+
+
+@pytest.mark.parametrize("query", ["is_free", "inside", "blocking", "clearance"])
+def test_point_queries_refuse_three_columns(query):
+    # an (N, 3) array was read as 3N/2 points: two rows of three gave three answers
+    with pytest.raises(QueryError, match=r"got shape \(2, 3\)"):
+        getattr(_tower(), query)([[0, 2, 0], [4, 2, 0]])
+    assert len(getattr(_tower(), query)([])) == 0
+
+
+def test_segment_queries_refuse_unequal_ends():
+    with pytest.raises(QueryError, match="as many points"):
+        _tower().segments_free([[0, 0]], [[1, 1], [2, 2]])

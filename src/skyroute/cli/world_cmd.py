@@ -23,7 +23,7 @@ from skyroute.io.world_out import (
     world_path_geojson,
 )
 from skyroute.planner import plan
-from skyroute.roadmap.world_plan import WORLD_ALGORITHMS, roadmap_edges
+from skyroute.roadmap.world_plan import WORLD_ALGORITHMS, options_for, roadmap_edges
 from skyroute.world.load import load_world
 
 EXIT_NOT_FOUND = 1
@@ -65,8 +65,10 @@ def plan_world_command(
     with delayed_status("planning"):  # a roadmap or raster, and a first run's compiles
         world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
                            frame=frame)
-        result = plan(world, a, b, algorithm=algorithm, resolution=resolution,
-                      samples=samples, seed=seed)
+        # the options have defaults whatever the algorithm: pass the ones it reads
+        result = plan(world, a, b, algorithm=algorithm,
+                      **options_for(algorithm, resolution=resolution, samples=samples,
+                                    seed=seed))
     alt = 0.0 if altitude is None else altitude
     if result.found:
         if waypoints_out:

@@ -16,7 +16,7 @@ import numpy as np
 import shapely
 from shapely import affinity
 
-from skyroute.errors import OptionError
+from skyroute.errors import OptionError, whole
 from skyroute.files import write_atomic
 from skyroute.motion.step_drone import STEP
 
@@ -179,11 +179,10 @@ def _details(words: str, p: tuple[float, float]) -> str:
 def synth(out: Path, *, days: int = 7, orders_per_day: int = 12, seed: int = 1,
           start: dt.date = dt.date(2024, 1, 1), customers: int = 7) -> dict:
     """Write the data set to ``out``; return a summary of what was written."""
-    if days < 1 or orders_per_day < 0 or customers < 1:
-        raise OptionError(f"days={days} and customers={customers} must be at least 1, "
-                          f"orders_per_day={orders_per_day} >= 0", param="days")
-    if seed < 0:
-        raise OptionError(f"seed={seed} must be >= 0", param="seed")
+    # integers, numpy's too (a numpy days= broke timedelta), each named alone
+    days, customers = whole("days", days, low=1), whole("customers", customers, low=1)
+    orders_per_day = whole("orders_per_day", orders_per_day, low=0)
+    seed = whole("seed", seed, low=0)
     try:
         start + dt.timedelta(days=days - 1)
     except OverflowError:

@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from skyroute.errors import InputFormatError, OptionError
-from skyroute.fleet.limits import MAX_PACKAGES
+from skyroute.errors import InputFormatError, OptionError, real, whole
+from skyroute.fleet.limits import MAX_PACKAGES, expected_packages
 from skyroute.fleet.scenario import Scenario
 
 CSV_HEADER = ("t", "from_airport", "from_gate", "to_airport", "to_gate")
@@ -55,10 +55,8 @@ def _stream(t, origin, og, dest, dg) -> Stream:
 
 
 def _hours(hours) -> float:
-    h = float(hours)
-    if not (math.isfinite(h) and h > 0):
-        raise OptionError(f"hours={hours!r} must be a number > 0", param="hours")
-    return h
+    """Simulated hours: a finite number > 0."""
+    return real("hours", hours, low=0.0, strict=True)
 
 
 def poisson(scenario: Scenario, *, hours: float, seed: int = 0,
@@ -66,11 +64,14 @@ def poisson(scenario: Scenario, *, hours: float, seed: int = 0,
     """A Poisson stream over ``[0, hours * 3600)`` at ``rate_per_hour`` (default the
     scenario's), origin and destination airports and gates uniform, airports distinct."""
     h = _hours(hours)
-    rate = scenario.packages.rate_per_hour if rate_per_hour is None else float(rate_per_hour)
-    if not (math.isfinite(rate) and rate >= 0):
-        raise OptionError(f"rate_per_hour={rate_per_hour!r} must be a number >= 0",
-                          param="rate_per_hour")
-    rng = np.random.default_rng(seed)
+    rate = scenario.packages.rate_per_hour if rate_per_hour is None else \
+        real("rate_per_hour", rate_per_hour, low=0.0)
+    n = expected_packages(rate, h)
+    if n > MAX_PACKAGES:  # numpy's "lam value too large" before, or all memory
+        raise OptionError(f"rate_per_hour={rate:g} with hours={h:g} would spawn about "
+                          f"{n:.2g} packages (limit {MAX_PACKAGES:,g}); lower one of them",
+                          param=("rate_per_hour", "hours"))
+    rng = np.random.default_rng(whole("seed", seed, low=0))
     horizon = h * 3600.0
     if rate == 0:
         n = 0

@@ -29,7 +29,7 @@ from pydantic import (
     model_validator,
 )
 
-from skyroute.errors import InputFormatError, OptionError
+from skyroute.errors import InputFormatError, OptionError, real, whole
 from skyroute.fleet.limits import (
     MAX_AIRPORTS,
     MAX_AREA_KM,
@@ -346,18 +346,17 @@ def generate(airports: int, drones: int, *, area_km: float = 8.0, seed: int = 0,
     runways apart), runway headings seeded, ``drones`` drones; each within the limits of
     :mod:`skyroute.fleet.limits`."""
     # each argument named alone: a bad drone count was reported as airports=
-    if not 2 <= airports <= MAX_AIRPORTS:
-        raise OptionError(f"airports={airports} must be 2 to {MAX_AIRPORTS}",
-                          param="airports")
-    if not 1 <= drones <= MAX_DRONES:
-        raise OptionError(f"drones={drones} must be 1 to {MAX_DRONES:,}", param="drones")
-    if not (math.isfinite(area_km) and 0 < area_km <= MAX_AREA_KM):
+    airports = whole("airports", airports, low=2, high=MAX_AIRPORTS,
+                     need=f"2 to {MAX_AIRPORTS}")
+    drones = whole("drones", drones, low=1, high=MAX_DRONES, need=f"1 to {MAX_DRONES:,}")
+    area_km = real("area_km", area_km, need=f"a number > 0 and <= {MAX_AREA_KM:,g}")
+    if not 0 < area_km <= MAX_AREA_KM:
         raise OptionError(f"area_km={area_km:g} must be a number > 0 and <= {MAX_AREA_KM:,g}",
                           param="area_km")
-    if rate_per_hour is not None and not (math.isfinite(rate_per_hour)
-                                          and 0 <= rate_per_hour <= MAX_RATE):
-        raise OptionError(f"rate_per_hour={rate_per_hour:g} must be a number >= 0 and <= "
-                          f"{MAX_RATE:,g}", param="rate_per_hour")
+    seed = whole("seed", seed, low=0)
+    if rate_per_hour is not None:
+        rate_per_hour = real("rate_per_hour", rate_per_hour, low=0.0, high=MAX_RATE,
+                             need=f"a number >= 0 and <= {MAX_RATE:,g}")
     rng = np.random.default_rng(seed)
     size = area_km * 1000.0
     spacing = 900.0

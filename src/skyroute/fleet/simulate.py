@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skyroute.errors import OptionError, SkyrouteError, check_choice
+from skyroute.errors import OptionError, SkyrouteError, check_choice, real, whole
 from skyroute.fleet import dispatch, packages
 from skyroute.fleet.airborne import MAX_LOITERS, too_long
 from skyroute.fleet.airspace import (
@@ -114,6 +114,7 @@ def run(scenario: Scenario, *, hours: float, seed: int = 0, scheduler: str = "se
     """Simulate ``scenario`` for ``hours`` on its own packages
     (:func:`skyroute.fleet.packages.for_scenario`: its CSV, read from ``base``, or the
     Poisson stream of ``seed`` at ``rate_per_hour``, default the scenario's)."""
+    _check_scenario(scenario)
     stream = packages.for_scenario(scenario, hours=hours, seed=seed, base=base,
                                    rate_per_hour=rate_per_hour)
     sim = simulate(scenario, stream, hours=hours, seed=seed, scheduler=scheduler,
@@ -131,14 +132,13 @@ def simulate(scenario: Scenario, stream: Stream, *, hours: float, seed: int = 0,
     the stream carries the randomness) with the ``scheduler`` (``seed`` or ``optimal``)
     and ``airspace`` (``layers`` or ``shared``; default the scenario's).
     ``progress(t)`` is called now and then with the simulated time reached."""
+    _check_scenario(scenario)
     check_choice("scheduler", scheduler, dispatch.SCHEDULERS)
     mode = scenario.airspace.mode if airspace is None else airspace
     check_choice("airspace", mode, MODES)
-    h = float(hours)
-    if not (math.isfinite(h) and h > 0):
-        raise OptionError(f"hours={hours!r} must be a number > 0", param="hours")
+    h = real("hours", hours, low=0.0, strict=True)
     check_levels(scenario, mode)
-    run = Simulation(scenario, stream, h, int(seed), scheduler, mode)
+    run = Simulation(scenario, stream, h, whole("seed", seed, low=0), scheduler, mode)
     wall = time.perf_counter()
     _Engine(run, progress).go()
     run.wall_seconds = time.perf_counter() - wall
@@ -166,6 +166,13 @@ def check_levels(scenario: Scenario, airspace: str | None = None) -> None:
         why = takeoff_overrun(scenario, shortest, alt)
         if why is not None:
             raise OptionError(f"{why}, {which}; {advice}", param="airspace")
+
+
+def _check_scenario(scenario) -> None:
+    if not isinstance(scenario, Scenario):
+        raise OptionError(f"scenario must be a Scenario (from load_scenario, "
+                          f"parse_scenario, preset or generate), not "
+                          f"{type(scenario).__name__}", param="scenario")
 
 
 class _Engine:

@@ -22,12 +22,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from skyroute.errors import OptionError
+from skyroute.errors import OptionError, QueryError, flag, real, whole
 from skyroute.motion import dubins_kernel
 from skyroute.motion.dubins_batch import lengths_kernel
 from skyroute.motion.dubins_kernel import WORDS
 from skyroute.motion.tour import TourResult, tour  # noqa: F401  (skyroute.motion.dubins.tour)
 from skyroute.result import Status
+from skyroute.world.points import as_points
 
 TWO_PI = 2 * math.pi
 
@@ -40,9 +41,18 @@ def _mod2pi(a):
     return np.where((TWO_PI - m < 1e-12) | ((a < 0) & (a > -1e-12)), 0.0, m)
 
 
-def _check_radius(radius) -> None:
-    if not (np.all(np.isfinite(radius)) and np.all(np.asarray(radius) > 0)):
-        raise OptionError(f"radius={radius!r} must be a positive number")
+def _check_radius(radius) -> float:
+    """``radius`` as a float > 0, else an OptionError naming it."""
+    try:
+        return real("radius", radius, low=0.0, strict=True)
+    except OptionError:
+        raise OptionError(f"radius={radius!r} must be a positive number",
+                          param="radius") from None
+
+
+def _poses(poses, what: str) -> np.ndarray:
+    """(x, y, heading) numbers or an (N, 3) array of them, finite, as float (N, 3)."""
+    return np.ascontiguousarray(as_points(poses, what, dims=3))
 
 
 def _words(starts: np.ndarray, goals: np.ndarray, radius: float) -> np.ndarray:
@@ -97,13 +107,16 @@ def _words(starts: np.ndarray, goals: np.ndarray, radius: float) -> np.ndarray:
 
 
 def lengths(starts, goals, radius: float) -> np.ndarray:
-    """Shortest Dubins lengths for (N, 3) arrays of start and goal poses (compiled)."""
-    _check_radius(radius)
-    s = np.ascontiguousarray(starts, dtype=np.float64).reshape(-1, 3)
-    g = np.ascontiguousarray(goals, dtype=np.float64).reshape(-1, 3)
+    """Shortest Dubins lengths for (N, 3) arrays of start and goal poses (compiled).
+
+    Raises QueryError for poses that are not (N, 3) finite numbers or not as many,
+    OptionError for a radius that is not a number > 0."""
+    r = _check_radius(radius)
+    s = _poses(starts, "starts") if np.size(starts) else np.empty((0, 3))
+    g = _poses(goals, "goals") if np.size(goals) else np.empty((0, 3))
     if s.shape != g.shape:
-        raise OptionError(f"starts {s.shape} and goals {g.shape} must have the same shape")
-    return lengths_kernel(s, g, float(radius))
+        raise QueryError(f"starts {s.shape} and goals {g.shape} must have the same shape")
+    return lengths_kernel(s, g, r)
 
 
 @dataclass(frozen=True)
@@ -126,13 +139,25 @@ class DubinsPath:
         """Always found: without obstacles a Dubins path joins any two poses."""
         return Status.FOUND
 
+    @property
+    def found(self) -> bool:
+        """Always True (see :attr:`status`), as every result's ``found``."""
+        return True
+
     def pose_at(self, s: float) -> np.ndarray:
         """(x, y, heading) after travelling ``s`` along the path (0 <= s <= length)."""
-        return self.sample_at(np.array([s]))[0]
+        return self.sample_at(np.array([real("s", s)]))[0]
 
     def sample_at(self, s: np.ndarray) -> np.ndarray:
-        """(K, 3) poses at arc lengths ``s`` (clipped to [0, length])."""
-        s = np.clip(np.asarray(s, dtype=float), 0.0, self.length)
+        """(K, 3) poses at arc lengths ``s`` (clipped to [0, length]; a 1-D array)."""
+        try:
+            s = np.asarray(s, dtype=float)
+        except (TypeError, ValueError):
+            raise QueryError(f"s={s!r} must be arc lengths (numbers)") from None
+        if s.ndim != 1 or not np.isfinite(s).all():
+            raise QueryError(f"s must be a 1-D array of finite arc lengths, got shape "
+                             f"{s.shape}")
+        s = np.clip(s, 0.0, self.length)
         out = np.empty((len(s), 3))
         x, y, th = self.start
         r = self.radius
@@ -149,8 +174,7 @@ class DubinsPath:
     def sample(self, step: float) -> np.ndarray:
         """Poses every ``step`` metres; the first sample is exactly the start and the last
         exactly the goal."""
-        if not (math.isfinite(step) and step > 0):
-            raise OptionError(f"step={step!r} must be a positive number")
+        step = real("step", step, low=0.0, strict=True)
         n = math.floor(self.length / step + 1e-12)
         s = np.arange(n + 1) * step
         if s[-1] < self.length - 1e-12 or (len(s) == 1 and self.start != self.goal):
@@ -173,15 +197,21 @@ def _advance(pose: np.ndarray, kind: str, s: np.ndarray, r: float) -> np.ndarray
 
 
 def shortest_path(start, goal, radius: float) -> DubinsPath:
-    """The shortest Dubins path from pose ``start`` to pose ``goal`` with turning ``radius``."""
-    _check_radius(radius)
-    s = tuple(float(v) for v in np.asarray(start, dtype=float).reshape(3))
-    g = tuple(float(v) for v in np.asarray(goal, dtype=float).reshape(3))
-    if not all(map(math.isfinite, s + g)):
-        raise OptionError(f"poses must be finite, got {start!r} and {goal!r}")
-    seg, total = dubins_kernel.words(*s, *g, float(radius))  # compiled: one query
+    """The shortest Dubins path from pose ``start`` to pose ``goal`` (x, y, heading) with
+    turning ``radius`` > 0. Raises QueryError for a pose that is not three finite
+    numbers, OptionError for a bad radius."""
+    r = _check_radius(radius)
+    s, g = (_one_pose(p, what) for p, what in ((start, "start"), (goal, "goal")))
+    seg, total = dubins_kernel.words(*s, *g, r)  # compiled: one query
     k = int(np.argmin(total))
-    return DubinsPath(s, g, float(radius), WORDS[k], tuple(float(v) for v in seg[k]))
+    return DubinsPath(s, g, r, WORDS[k], tuple(float(v) for v in seg[k]))
+
+
+def _one_pose(pose, what: str) -> tuple[float, float, float]:
+    p = _poses(pose, what)
+    if len(p) != 1:
+        raise QueryError(f"{what} must be one pose (x, y, heading), got {len(p)}")
+    return tuple(float(v) for v in p[0])
 
 
 def through(points, radius: float, *, start_heading: float | None = None,
@@ -190,9 +220,12 @@ def through(points, radius: float, *, start_heading: float | None = None,
     ``headings`` candidates so the total is shortest (dynamic programming over the
     candidates, each stage one vectorised :func:`lengths` call)."""
     _check_radius(radius)
-    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    headings = whole("headings", headings, low=1)
+    pts = as_points(points, "points")
     if len(pts) < 2:
-        raise OptionError("through() needs at least two points")
+        raise QueryError("points: through() needs at least two points")
+    start_heading, end_heading = (None if h is None else real(name, h) for name, h in (
+        ("start_heading", start_heading), ("end_heading", end_heading)))
     cand = np.arange(headings) * TWO_PI / headings
     options = [np.array([h]) if h is not None else cand
                for h in ([start_heading] + [None] * (len(pts) - 2) + [end_heading])]
@@ -219,10 +252,10 @@ def runway_approach(start, threshold, runway_heading: float, radius: float, *,
                     final: float | None = None) -> list[DubinsPath]:
     """Fly from pose ``start`` onto a straight final approach of length ``final``
     (default 3 r) that crosses the runway ``threshold`` (x, y) on ``runway_heading``."""
-    final = 3 * radius if final is None else float(final)
-    if final < 0:
-        raise OptionError(f"final={final!r} must be >= 0")
-    tx, ty = np.asarray(threshold, dtype=float).reshape(2)
+    radius = _check_radius(radius)
+    runway_heading = real("runway_heading", runway_heading)
+    final = 3 * radius if final is None else real("final", final, low=0.0)
+    tx, ty = _one_point(threshold, "threshold")
     gate = (tx - final * math.cos(runway_heading), ty - final * math.sin(runway_heading),
             runway_heading)
     legs = [shortest_path(start, gate, radius)]
@@ -233,9 +266,17 @@ def runway_approach(start, threshold, runway_heading: float, radius: float, *,
 
 def loiter(center, radius: float, *, start_angle: float = 0.0, turns: float = 1.0,
            step: float = 1.0, clockwise: bool = False) -> np.ndarray:
-    """(K, 3) poses around a holding circle, ``turns`` times, every ``step`` metres."""
-    _check_radius(radius)
-    cx, cy = np.asarray(center, dtype=float).reshape(2)
+    """(K, 3) poses around a holding circle, ``turns`` (> 0) times, every ``step`` (> 0)
+    metres."""
+    radius = _check_radius(radius)
+    start_angle = real("start_angle", start_angle)
+    turns = real("turns", turns, low=0.0, strict=True)
+    step = real("step", step, low=0.0, strict=True)
+    clockwise = flag("clockwise", clockwise)
+    if TWO_PI * radius * turns / step > MAX_SAMPLES:
+        raise OptionError(f"turns={turns:g} of radius={radius:g} every step={step:g} makes "
+                          f"more than {MAX_SAMPLES:,} poses", param="step")
+    cx, cy = _one_point(center, "center")
     total = TWO_PI * radius * turns
     s = np.append(np.arange(0.0, total, step), total)
     ang = start_angle + (-1 if clockwise else 1) * s / radius
@@ -243,3 +284,13 @@ def loiter(center, radius: float, *, start_angle: float = 0.0, turns: float = 1.
     return np.c_[cx + radius * np.cos(ang), cy + radius * np.sin(ang), _mod2pi(heading)]
 
 
+
+
+MAX_SAMPLES = 10**7  # poses one loiter returns (240 MB)
+
+
+def _one_point(point, what: str) -> tuple[float, float]:
+    p = as_points(point, what)
+    if len(p) != 1:
+        raise QueryError(f"{what} must be one point (x, y), got {len(p)}")
+    return float(p[0, 0]), float(p[0, 1])

@@ -66,7 +66,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skyroute.errors import OptionError, QueryError
+from skyroute.errors import OptionError, QueryError, budget, flag, real, whole
 from skyroute.motion import hybrid_search
 from skyroute.motion.arc_kernels import chain_free, edge_index
 from skyroute.motion.corner_distance import corner_graph
@@ -119,8 +119,7 @@ class HybridResult:
         in the world's frame (points as the world reads them, headings in [0, 2 pi) in
         its convention); the first row is exactly the start as given and the last
         exactly the goal (its heading too, when one was given). Empty unless found."""
-        if not (isinstance(step, numbers.Real) and math.isfinite(step) and step > 0):
-            raise OptionError(f"step={step!r} must be a positive number")
+        step = real("step", step, low=0.0, strict=True)
         if not self.found:
             return np.empty((0, 3))
         poses = sample(list(self.segments), float(step), self.start, self.goal)
@@ -141,11 +140,8 @@ def runway_goal(threshold, runway_heading: float, approach_length: float) -> tup
     that final piece, which ends on the runway ``threshold`` (x, y) flying
     ``runway_heading`` (the gate of :func:`skyroute.motion.dubins.runway_approach`)."""
     tx, ty = _xy(threshold, "threshold")
-    h = float(runway_heading)
-    a = float(approach_length)
-    if not (math.isfinite(h) and math.isfinite(a) and a >= 0):
-        raise OptionError(f"runway_heading={runway_heading!r} and approach_length="
-                          f"{approach_length!r} must be finite, approach_length >= 0")
+    h = real("runway_heading", runway_heading)
+    a = real("approach_length", approach_length, low=0.0)
     gate = (tx - a * math.cos(h), ty - a * math.sin(h), h)
     return gate, Piece("S", gate, a, math.inf)
 
@@ -203,7 +199,9 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     OptionError
         an out-of-range option.
     """
-    r, H, step, budget = _options(radius, heading_bins, step, reverse, max_expansions, seed)
+    r, H, step, limit = _options(radius, heading_bins, step, reverse, max_expansions, seed,
+                                 smooth)
+    reverse, smooth, seed = bool(reverse), bool(smooth), int(seed)
     sxy, sth = _in_plane(world, *_pose(start, "start"))
     gxy, gth = _in_plane(world, *_pose(goal, "goal"))
     given = tuple(tuple(float(v) for v in p) for p in (start, goal))
@@ -212,9 +210,7 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     if approach is not None:
         if gth is None:
             raise QueryError("goal needs a runway heading (x, y, heading) with approach=")
-        if not (isinstance(approach, numbers.Real) and math.isfinite(approach) and
-                approach >= 0):
-            raise OptionError(f"approach={approach!r} must be a number >= 0")
+        approach = real("approach", approach, low=0.0)
         threshold = gxy
         world.check_plane_point(threshold, "goal")
         gate, final = runway_goal(threshold, gth, approach)
@@ -237,7 +233,7 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     # first ends at once when the goal is boxed in (facing a wall, or only reachable from
     # outside the boundary), which the forward search would learn only after exhausting
     # the whole world; when it finishes it is the answer.
-    first = min(budget, _REVERSE_BUDGET)
+    first = min(limit, _REVERSE_BUDGET)
     if reverse:
         back = lattice.search(gxy, gth, sxy, sth, first)
     else:
@@ -245,7 +241,7 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     if back.code == NO_PATH or (back.code == FOUND and back.expanded < first):
         res, expanded = back.reversed(reverse), back.expanded
     else:
-        res = lattice.search(sxy, sth, gxy, gth, budget - back.expanded)
+        res = lattice.search(sxy, sth, gxy, gth, limit - back.expanded)
         expanded = back.expanded + res.expanded
     status = STATUS_OF_CODE[res.code]
     start_pose = (float(sxy[0]), float(sxy[1]), math.nan if sth is None else float(sth))
@@ -408,44 +404,38 @@ def _region(world: World, s, g, margin: float) -> tuple[float, float, float, flo
         max(s[0], g[0]) + margin, max(s[1], g[1]) + margin)
 
 
-def _options(radius, heading_bins, step, reverse, max_expansions, seed):
-    if isinstance(radius, bool) or not isinstance(radius, numbers.Real) or \
-            not (math.isfinite(radius) and radius > 0):
-        raise OptionError(f"radius={radius!r} must be > 0 and finite")
-    r = float(radius)
-    if isinstance(heading_bins, bool) or not isinstance(heading_bins, numbers.Integral) or \
-            heading_bins < 4:
-        raise OptionError(f"heading_bins={heading_bins!r} must be an integer >= 4")
-    H = int(heading_bins)
+def _options(radius, heading_bins, step, reverse, max_expansions, seed, smooth):
+    """The options checked (numpy numbers and 0-d arrays read as numbers), each error
+    naming its parameter."""
+    try:
+        r = real("radius", radius, low=0.0, strict=True)
+    except OptionError:
+        raise OptionError(f"radius={radius!r} must be > 0 and finite", param="radius") \
+            from None
+    H = whole("heading_bins", heading_bins, low=4)
     if step is None:
         arc = r * 2 * math.pi / H
         step = arc * max(1, round(H / 18))
-    elif isinstance(step, bool) or not isinstance(step, numbers.Real) or \
-            not (math.isfinite(step) and 0 < step <= math.pi * r):
-        raise OptionError(f"step={step!r} must be in (0, pi * radius] = (0, {math.pi * r:g}]")
-    if not isinstance(reverse, bool):
-        raise OptionError(f"reverse={reverse!r} must be True or False")
-    if max_expansions is None:
-        budget = np.iinfo(np.int64).max
-    elif isinstance(max_expansions, bool) or not isinstance(max_expansions,
-                                                             numbers.Integral) \
-            or max_expansions < 0:
-        raise OptionError(f"max_expansions={max_expansions!r} must be an integer >= 0")
     else:
-        budget = int(max_expansions)
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
-        raise OptionError(f"seed={seed!r} must be an integer")
-    return r, H, float(step), budget
+        try:
+            step = real("step", step, low=0.0, strict=True, high=math.pi * r)
+        except OptionError:
+            raise OptionError(f"step={step!r} must be in (0, pi * radius] = "
+                              f"(0, {math.pi * r:g}]", param="step") from None
+    flag("reverse", reverse)
+    flag("smooth", smooth)
+    whole("seed", seed)
+    return r, H, float(step), budget(max_expansions)
 
 
 def _pose(p, what: str) -> tuple[np.ndarray, float | None]:
     """(x, y) array and heading (None when absent) of a start or goal."""
     try:
-        vals = list(p)
+        vals = [v[()] if isinstance(v, np.ndarray) and v.ndim == 0 else v for v in p]
     except TypeError:
         raise QueryError(f"{what}={p!r} must be (x, y) or (x, y, heading)") from None
     if len(vals) not in (2, 3) or not all(
-            isinstance(v, numbers.Real) and not isinstance(v, bool) for v in vals):
+            isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_) for v in vals):
         raise QueryError(f"{what}={p!r} must be (x, y) or (x, y, heading) numbers")
     if not all(math.isfinite(float(v)) for v in vals):
         raise QueryError(f"{what}={p!r} must be finite numbers")

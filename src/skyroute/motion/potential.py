@@ -26,7 +26,7 @@ import numpy as np
 import shapely
 
 from skyroute.caches import register
-from skyroute.errors import OptionError, check_choice
+from skyroute.errors import check_choice, flag, real, whole
 from skyroute.result import Status
 from skyroute.world.world import World
 
@@ -56,6 +56,11 @@ class FieldRun:
     def reached(self) -> bool:
         """True when the goal was reached."""
         return self.status is Status.FOUND
+
+    @property
+    def found(self) -> bool:
+        """:attr:`reached`, under the name every other result uses."""
+        return self.reached
 
     @property
     def moves(self) -> int:
@@ -156,14 +161,19 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
     convention; default towards the goal). Points come in and the run's path goes out in
     the world's frame; distances (``step``, ``sensor_range``) are plane units."""
     check_choice("mode", mode, MODES)
-    for name, value, ok, rule in (
-            ("step", step, step > 0, "> 0"), ("sensor_range", sensor_range,
-                                               sensor_range > 0, "> 0"),
-            ("sensor_rays", sensor_rays, sensor_rays >= 4, ">= 4"),
-            ("tolerance", tolerance, tolerance > 0, "> 0"),
-            ("max_turn", max_turn, 0 < max_turn <= math.pi, "in (0, pi] radians")):
-        if not ok:
-            raise OptionError(f"{name}={value!r} must be {rule}", param=name)
+    step, sensor_range, tolerance = (real(name, value, low=0.0, strict=True, need="> 0")
+                                     for name, value in (("step", step),
+                                                         ("sensor_range", sensor_range),
+                                                         ("tolerance", tolerance)))
+    attract, repulse = (real(name, value, low=0.0, need=">= 0") for name, value in
+                        (("attract", attract), ("repulse", repulse)))
+    max_turn = real("max_turn", max_turn, low=0.0, strict=True, high=math.pi,
+                    need="in (0, pi] radians")
+    sensor_rays = whole("sensor_rays", sensor_rays, low=4, need=">= 4")
+    max_moves = whole("max_moves", max_moves, low=0)
+    window = whole("window", window, low=1)
+    escape = flag("escape", escape)
+    heading = None if heading is None else real("heading", heading)
     p = world.check_point(start, "start")
     t = world.check_point(goal, "goal")
     theta = math.atan2(*(t - p)[::-1]) if heading is None else \

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from skyroute.caches import register
-from skyroute.errors import OptionError, renamed
+from skyroute.errors import OptionError, QueryError, real, renamed, whole
 from skyroute.motion import move_search
 from skyroute.motion.zone_kernels import zone_arrays
 from skyroute.result import FOUND, STATUS_OF_CODE, Status
@@ -62,6 +62,11 @@ class Flight:
         hovers = int(np.count_nonzero(self.angle == HOVER)) if len(self.angle) else 0
         return (f"<Flight {self.status.value}, {self.moves} moves ({hovers} hovers), "
                 f"{self.expanded} expanded, {self.seconds * 1e3:.3g} ms>")
+
+    @property
+    def found(self) -> bool:
+        """True when the flight ends where it was asked to (as every result's ``found``)."""
+        return self.status is Status.FOUND
 
     @property
     def moves(self) -> int:
@@ -99,7 +104,11 @@ def _check_world(world: World) -> None:
 
 def legal(world: World, p, step: float = STEP) -> np.ndarray:
     """(36,) bool: which of the 36 headings are legal moves from ``p``."""
-    p = np.asarray(p, dtype=float).reshape(2)
+    step = real("step", step, low=0.0, strict=True)
+    p = world.to_plane(p, "p")
+    if len(p) != 1:
+        raise QueryError(f"p must be one point (lon, lat), got {len(p)}")
+    p = p[0]
     rad = np.radians(ANGLES)
     to = p + step * np.c_[np.cos(rad), np.sin(rad)]
     return world.segments_clear(np.broadcast_to(p, to.shape), to)
@@ -180,11 +189,15 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     goal = renamed("goal", goal, "target", target)
     if goal is None:
         raise OptionError("plan_moves needs a goal", param="goal")
+    step = real("step", step, low=0.0, strict=True)
+    max_expansions = whole("max_expansions", max_expansions, low=0)
+    merge = real("merge", merge, low=0.0, strict=True)
     t0 = time.perf_counter()
     s = world.check_point(start, "start")
-    t = world.to_plane(goal, "goal")[0]
-    if not merge > 0:
-        raise OptionError(f"merge={merge!r} must be a positive number", param="merge")
+    t = world.to_plane(goal, "goal")
+    if len(t) != 1:
+        raise QueryError(f"goal must be one point (lon, lat), got {len(t)}")
+    t = t[0]
     rad = np.radians(ANGLES)
     deltas = step * np.c_[np.cos(rad), np.sin(rad)]
     bound = _bound(world, t)
@@ -216,8 +229,12 @@ def follow(world: World, path, *, step: float = STEP, max_moves: int = 1500) -> 
     heading to the current waypoint rounded to 10 degrees, or the nearest legal one to
     it; a waypoint counts as reached when the drone is closer than ``step``."""
     _check_world(world)
+    step = real("step", step, low=0.0, strict=True)
+    max_moves = whole("max_moves", max_moves, low=0)
     t0 = time.perf_counter()
-    pts = np.asarray(path, dtype=float).reshape(-1, 2)
+    pts = world.to_plane(path, "path") if np.size(path) else np.empty((0, 2))
+    if len(pts) == 0:
+        raise QueryError("path must hold at least one (lon, lat) point")
     p = pts[0].copy()
     frm, ang, to = [], [], []
     target = 1

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from skyroute.errors import OptionError, QueryError
+from skyroute.errors import QueryError, real, whole
 from skyroute.motion import hybrid
 from skyroute.motion.dubins_kernel import TURNS, shortest_length, words
 from skyroute.motion.pieces import chain, sample
@@ -114,11 +114,10 @@ def tour(start_pose, targets, radius: float, *, world: World | None = None,
     to the chosen arrival heading; a leg it cannot fly makes the tour's status.
     """
     t0 = time.perf_counter()
-    if not (isinstance(radius, (int, float)) and math.isfinite(radius) and radius > 0):
-        raise OptionError(f"radius={radius!r} must be > 0", param="radius")
-    if not (isinstance(headings, int) and 1 <= headings <= 72):
-        raise OptionError(f"headings={headings!r} must be an integer in 1..72",
-                          param="headings")
+    radius = real("radius", radius, low=0.0, strict=True)  # numpy numbers too
+    headings = whole("headings", headings, low=1, high=72)
+    exact_limit = whole("exact_limit", exact_limit, low=0)
+    seed = whole("seed", seed)  # as hybrid.plan reads it (also when no leg needs it)
     start = as_points(start_pose, "start_pose", dims=3)[0]
     pts = as_points(targets, "targets")
     if len(pts) == 0:

@@ -18,13 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from skyroute.errors import OptionError, check_choice
+from skyroute.errors import budget, check_choice, real
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH, STATUS_OF_CODE, Status
 from skyroute.roadmap.raster import entry_cell, world_raster
 from skyroute.search import heap
 from skyroute.search.los import line_of_sight
 from skyroute.search.space import space_of
 from skyroute.world.grid import Grid, check_cell
+from skyroute.world.points import plane_points
 from skyroute.world.world import World
 
 _DIRS = {
@@ -144,9 +145,9 @@ def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
     (radians, from the x axis towards +y) snaps to the nearest lattice heading, or any.
     """
     check_choice("headings", headings, (8, 16))
-    for name, value in (("speed", speed), ("turn_rate", turn_rate)):
-        if not value > 0:
-            raise OptionError(f"{name}={value!r} must be positive", param=name)
+    speed, turn_rate = _rates(speed, turn_rate)
+    start_heading = None if start_heading is None else real("start_heading", start_heading)
+    budget_ = budget(max_expansions)
     s = check_cell(grid, start, "start")
     t = check_cell(grid, goal, "goal")
     space = space_of(grid)
@@ -154,11 +155,10 @@ def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
     sh = -1
     if start_heading is not None:
         sh = int(np.argmin(np.abs((ang - start_heading + np.pi) % (2 * np.pi) - np.pi)))
-    budget = np.iinfo(np.int64).max if max_expansions is None else int(max_expansions)
     t0 = time.perf_counter()
     code, end, g, parent, expanded = _lattice_kernel(
         space.blocked, space.Wp, space.index(s), sh, space.index(t), headings, dirs, offs,
-        lens, turn, float(speed), float(turn_rate), budget)
+        lens, turn, speed, turn_rate, budget_)
     seconds = time.perf_counter() - t0
     if code != FOUND:
         return LatticeResult(STATUS_OF_CODE[code], np.empty((0, 2)), np.empty(0), math.inf,
@@ -187,11 +187,13 @@ def plan_turns_world(world: World, start, goal, *, resolution: float | None = No
     in plane units. The route runs between the centres of the free cells nearest
     ``start`` and ``goal`` (reachable from them in a straight line), not the exact
     points: a leg joining them would take a turn the lattice does not price."""
+    speed, _ = _rates(speed, turn_rate)  # named as given, before it is rescaled
     s = world.check_point(start, "start")
     t = world.check_point(goal, "goal")
     grid = world_raster(world, s, t, resolution)
     cs, ct = entry_cell(world, grid, s, "start"), entry_cell(world, grid, t, "goal")
-    h0 = None if start_heading is None else float(world.heading_to_plane(start_heading))
+    h0 = None if start_heading is None else \
+        float(world.heading_to_plane(real("start_heading", start_heading)))
     res = plan_turns(grid, cs, ct, headings=headings, speed=speed / grid.resolution,
                      turn_rate=turn_rate, start_heading=h0, max_expansions=max_expansions)
     if not res.found:
@@ -205,7 +207,9 @@ def travel_time(cells, *, speed: float = 1.0, turn_rate: float = math.pi / 2,
                 start_heading: float | None = None) -> float:
     """Time to drive a cell path: its length / speed plus every heading change / turn rate
     (the first move's turn counted from ``start_heading`` when given)."""
-    c = np.asarray(cells, dtype=float).reshape(-1, 2)
+    speed, turn_rate = _rates(speed, turn_rate)
+    start_heading = None if start_heading is None else real("start_heading", start_heading)
+    c = plane_points(cells, "cells")
     if len(c) < 2:
         return 0.0
     d = np.diff(c, axis=0)
@@ -215,3 +219,9 @@ def travel_time(cells, *, speed: float = 1.0, turn_rate: float = math.pi / 2,
     if start_heading is not None:
         turns += abs((ang[0] - start_heading + np.pi) % (2 * np.pi) - np.pi)
     return float(np.hypot(*d.T).sum() / speed + turns / turn_rate)
+
+
+def _rates(speed, turn_rate) -> tuple[float, float]:
+    """``speed`` and ``turn_rate`` as finite floats > 0, else an OptionError naming one."""
+    return (real("speed", speed, low=0.0, strict=True, need="positive"),
+            real("turn_rate", turn_rate, low=0.0, strict=True, need="positive"))

@@ -22,7 +22,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from skyroute.errors import OptionError
+from skyroute.errors import OptionError, flag, whole
 from skyroute.result import PlanResult, Status
 from skyroute.roadmap.simplify import shortcut, smooth
 from skyroute.world.world import World
@@ -33,12 +33,8 @@ class PRM:
 
     def __init__(self, world: World, *, samples: int = 1000, neighbours: int = 10,
                  prm_star: bool = False, seed: int = 0) -> None:
-        if samples < 2 or neighbours < 1:
-            raise OptionError(f"samples={samples} must be >= 2 and neighbours={neighbours} >= 1",
-                              param="samples" if samples < 2 else "neighbours")
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-            raise OptionError(f"seed={seed!r} must be an integer >= 0", param="seed")
-        self.seed = int(seed)
+        samples, neighbours, prm_star, seed = prm_options(samples, neighbours, prm_star, seed)
+        self.seed = seed
         rng = np.random.default_rng(self.seed)
         t0 = time.perf_counter()
         self.world = world.merged()
@@ -127,6 +123,17 @@ class PRM:
     def edge_segments(self) -> np.ndarray:
         """(E, 2, 2) plane segments of the roadmap's edges (for plots)."""
         return self.points[self.edges]
+
+
+MAX_SAMPLES = 10**7  # 160 MB of points and far more of edges: past it, a MemoryError
+
+
+def prm_options(samples, neighbours, prm_star, seed) -> tuple[int, int, bool, int]:
+    """The options checked and as plain Python values (numpy integers are integers), or
+    an OptionError naming the first bad one."""
+    return (whole("samples", samples, low=2, high=MAX_SAMPLES),
+            whole("neighbours", neighbours, low=1), flag("prm_star", prm_star),
+            whole("seed", seed, low=0))
 
 
 def _free_samples(world: World, box: tuple, samples: int, rng) -> np.ndarray:

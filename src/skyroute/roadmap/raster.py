@@ -17,7 +17,7 @@ import weakref
 import numpy as np
 
 from skyroute.caches import register
-from skyroute.errors import OptionError, QueryError
+from skyroute.errors import OptionError, QueryError, real
 from skyroute.result import PlanResult, Status
 from skyroute.roadmap.simplify import shortcut
 from skyroute.search.grid_plan import plan_grid
@@ -35,15 +35,28 @@ def default_resolution(world: World, points=()) -> float:
     return max(xmax - xmin, ymax - ymin) / 1000.0
 
 
+def raster_box(world: World, s, t, r: float) -> tuple[float, float, float, float]:
+    """The plane box a raster of cell size ``r`` covers: the world's boundary, or, in an
+    unbounded world, its obstacles and plane points ``s`` and ``t`` with 4 cells round
+    them all (without them, obstacles that span the extent had no way round)."""
+    box = world.extent_with([s, t], margin=4 * r)
+    if world.boundary is None:
+        box = (box[0] - 4 * r, box[1] - 4 * r, box[2] + 4 * r, box[3] + 4 * r)
+    return box
+
+
 def world_raster(world: World, s: np.ndarray, t: np.ndarray,
                  resolution: float | None) -> Grid:
     """The world's plane rasterised with a half-diagonal clearance, holding plane points
     ``s`` and ``t`` (built once per world, resolution and extent)."""
-    r = default_resolution(world, [s, t]) if resolution is None else float(resolution)
-    if not (math.isfinite(r) and r > 0):
-        raise OptionError(f"resolution={resolution!r} must be a positive number",
-                          param="resolution")
-    box = world.extent_with([s, t], margin=4 * r)
+    if resolution is None:
+        r = default_resolution(world, [s, t])
+    else:
+        r = real("resolution", resolution)
+        if r <= 0:
+            raise OptionError(f"resolution={resolution!r} must be a positive number",
+                              param="resolution")
+    box = raster_box(world, s, t, r)
     per_world = _RASTERS.setdefault(world, {})
     key = (r, box)
     if key not in per_world:

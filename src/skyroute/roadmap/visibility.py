@@ -30,7 +30,7 @@ import shapely
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
-from skyroute.errors import OptionError
+from skyroute.errors import OptionError, budget
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.roadmap import sight_kernels as sk
 from skyroute.roadmap.corner_search import corner_astar
@@ -40,7 +40,6 @@ from skyroute.world.world import World
 
 MAX_CORNERS = 10_000  # about 12 million pairs tested: 1 GB and 8 s (see above)
 SAVE_AFTER = 0.1  # seconds: with cache=None, keep graphs that took longer to build
-NO_BUDGET = np.iinfo(np.int64).max
 
 
 class VisibilityGraph:
@@ -106,6 +105,7 @@ class VisibilityGraph:
     def plan(self, start, goal, *, max_expansions: int | None = None) -> PlanResult:
         """Exact shortest path from plane point ``start`` to ``goal`` (the plane is the
         world's; :func:`skyroute.plan` converts from and to the world's frame)."""
+        limit = budget(max_expansions)  # checked first: also when no search runs
         w = self.world
         s = w.check_plane_point(start, "start")
         t = w.check_plane_point(goal, "goal")
@@ -124,10 +124,9 @@ class VisibilityGraph:
                               time.perf_counter() - t0, "visibility", extra)
         goal_len = np.full(n, np.inf)
         goal_len[to_t] = len_t
-        budget = NO_BUDGET if max_expansions is None else int(max_expansions)
         code, nodes, cost, expanded, frontier = corner_astar(
             self.corners, self._indptr, self._indices, self._weights, from_s, len_s,
-            goal_len, s[0], s[1], t[0], t[1], budget)
+            goal_len, s[0], s[1], t[0], t[1], limit)
         coords = np.vstack([self.corners, s, t])[nodes] if len(nodes) else np.empty((0, 2))
         return PlanResult(STATUS_OF_CODE[code], coords, float(cost), int(expanded),
                           int(frontier), tests, time.perf_counter() - t0, "visibility", extra)

@@ -11,9 +11,9 @@ import weakref
 import numpy as np
 
 from skyroute.caches import register
-from skyroute.errors import check_choice
+from skyroute.errors import OptionError, check_choice
 from skyroute.result import PlanResult
-from skyroute.roadmap.prm import PRM
+from skyroute.roadmap.prm import PRM, prm_options
 from skyroute.roadmap.raster import plan_on_raster
 from skyroute.roadmap.visibility import VisibilityGraph
 from skyroute.search.grid_plan import GRID_ALGORITHMS, grid_options
@@ -40,28 +40,48 @@ def visibility_graph(world: World, *, cache: bool | None = None) -> VisibilityGr
 def prm_roadmap(world: World, *, samples: int = 1000, neighbours: int = 10,
                 prm_star: bool = False, seed: int = 0) -> PRM:
     """The world's PRM for these options (built on first use, kept with the world)."""
+    samples, neighbours, prm_star, seed = prm_options(samples, neighbours, prm_star, seed)
     return _roadmap(world, ("prm", samples, neighbours, prm_star, seed),
                     lambda: PRM(world, samples=samples, neighbours=neighbours,
                                 prm_star=prm_star, seed=seed))
 
 
+PRM_OPTIONS = ("samples", "neighbours", "prm_star", "seed")
+GRID_OPTIONS = ("resolution", "connectivity", "corner_cutting", "heuristic", "weight", "prune")
+
+
+def options_for(algorithm: str, **given) -> dict:
+    """The options of ``given`` that ``algorithm`` reads (for callers such as the CLI
+    and the service, which fill every option with a default whatever the algorithm)."""
+    reads = () if algorithm == "visibility" else PRM_OPTIONS if algorithm == "prm" \
+        else GRID_OPTIONS
+    return {k: v for k, v in given.items() if k in reads or k not in (*PRM_OPTIONS,
+                                                                      *GRID_OPTIONS)}
+
+
 def plan_world(world: World, start, goal, *, algorithm: str = "visibility",
-               resolution: float | None = None, samples: int = 1000, neighbours: int = 10,
-               prm_star: bool = False, seed: int = 0, max_expansions: int | None = None,
-               **grid_kwargs) -> PlanResult:
+               max_expansions: int | None = None, **options) -> PlanResult:
     """See :func:`skyroute.plan`: ``start`` and ``goal`` in the world's frame, the path
-    in it too (and in lon/lat as ``path_lonlat`` where the world has a home)."""
+    in it too (and in lon/lat as ``path_lonlat`` where the world has a home).
+    ``options``: PRM's (:data:`PRM_OPTIONS`) or the grid algorithms'
+    (:data:`GRID_OPTIONS`); one the algorithm does not read is an OptionError."""
     check_choice("algorithm", algorithm, WORLD_ALGORITHMS)
+    for name, value in options.items():
+        if name not in options_for(algorithm, **{name: value}):
+            reads = "PRM" if name in PRM_OPTIONS else "the grid algorithms" \
+                if name in GRID_OPTIONS else "no planner"
+            raise OptionError(f"{name}={value!r} does not apply to algorithm={algorithm!r} "
+                              f"(it is read by {reads})", param=name)
     s = world.check_point(start, "start")  # errors speak the caller's frame
     t = world.check_point(goal, "goal")
     if algorithm == "visibility":
         res = visibility_graph(world).plan(s, t, max_expansions=max_expansions)
     elif algorithm == "prm":
-        rm = prm_roadmap(world, samples=samples, neighbours=neighbours, prm_star=prm_star,
-                         seed=seed)
+        rm = prm_roadmap(world, **options)
         res = rm.plan(s, t, max_expansions=max_expansions)
     else:
-        opts = grid_options(algorithm, max_expansions=max_expansions, **grid_kwargs)
+        resolution = options.pop("resolution", None)
+        opts = grid_options(algorithm, max_expansions=max_expansions, **options)
         res = plan_on_raster(world, s, t, opts, resolution)
     return in_frame(world, res, start, goal)
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass
 from functools import lru_cache
@@ -10,7 +9,7 @@ from functools import lru_cache
 import numpy as np
 
 from skyroute.caches import register
-from skyroute.errors import OptionError, check_choice
+from skyroute.errors import OptionError, budget, check_choice, real
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search.astar import astar_kernel
 from skyroute.search.bfs import bfs_kernel
@@ -26,7 +25,6 @@ from skyroute.world.grid import Grid
 
 GRID_ALGORITHMS = ("bfs", "dijkstra", "astar", "jps", "theta", "lazy_theta")
 ANY_ANGLE = ("theta", "lazy_theta")
-NO_BUDGET = np.iinfo(np.int64).max
 
 
 @dataclass(frozen=True)
@@ -78,22 +76,17 @@ def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, pr
         raise OptionError(f"algorithm={algorithm!r} takes no heuristic option "
                           f"(it uses {_default_h(algorithm, connectivity)!r})",
                           param="heuristic")
-    if not (isinstance(weight, int | float) and math.isfinite(weight) and weight >= 1.0):
-        raise OptionError(f"weight={weight!r} must be a number >= 1", param="weight")
+    try:  # numpy scalars and 0-d arrays too; not a bool
+        weight = real("weight", weight, low=1.0)
+    except OptionError:
+        raise OptionError(f"weight={weight!r} must be a number >= 1", param="weight") from None
     if weight != 1.0 and algorithm in ("bfs", "dijkstra", "jps"):
         raise OptionError(f"algorithm={algorithm!r} takes no weight; use 'astar'",
                           param="weight")
     prune = "none" if prune is None else prune
     check_choice("prune", prune, PRUNE_MODES)
-    if max_expansions is None:
-        max_expansions = NO_BUDGET
-    elif isinstance(max_expansions, bool) or not isinstance(max_expansions, int | np.integer) \
-            or max_expansions < 0:
-        raise OptionError(f"max_expansions={max_expansions!r} must be an integer >= 0",
-                          param="max_expansions")
     return canonical(GridOptions(algorithm, int(connectivity), bool(corner_cutting),
-                                 heuristic, float(weight), prune,
-                                 min(int(max_expansions), NO_BUDGET)))  # >= 2**63: none
+                                 heuristic, weight, prune, budget(max_expansions)))
 
 
 _CANONICAL: dict[GridOptions, GridOptions] = {}  # one object per distinct option set

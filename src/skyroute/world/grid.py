@@ -18,6 +18,7 @@ from functools import cached_property
 import numpy as np
 
 from skyroute.errors import OptionError, QueryError, real, renamed
+from skyroute.world.points import plane_points
 
 
 @dataclass(frozen=True, eq=False, init=False)
@@ -93,22 +94,24 @@ class Grid:
         return int(self.blocked.shape[0])
 
     def in_bounds(self, cell: tuple[int, int]) -> bool:
-        """True when cell (x, y) lies on the grid."""
-        x, y = cell
+        """True when cell (x, y) lies on the grid; QueryError unless two integers."""
+        x, y = cell_xy(cell, "cell")
         return 0 <= x < self.width and 0 <= y < self.height
 
     def is_free(self, cell: tuple[int, int]) -> bool:
-        """True when cell (x, y) is on the grid and not blocked."""
-        return self.in_bounds(cell) and not self.blocked[cell[1], cell[0]]
+        """True when cell (x, y) is on the grid and not blocked; QueryError unless two
+        integers."""
+        x, y = cell_xy(cell, "cell")
+        return 0 <= x < self.width and 0 <= y < self.height and not self.blocked[y, x]
 
     def to_world(self, cells: np.ndarray) -> np.ndarray:
         """Centres in metres of an (N, 2) array of (x, y) cells (float cells allowed)."""
-        c = np.asarray(cells, dtype=float).reshape(-1, 2)
+        c = plane_points(cells, "cells")
         return (c + 0.5) * self.resolution + np.asarray(self.origin)
 
     def to_cell(self, points: np.ndarray) -> np.ndarray:
         """The (x, y) cells containing an (N, 2) array of world points (may be off-grid)."""
-        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        p = plane_points(points)
         return np.floor((p - np.asarray(self.origin)) / self.resolution).astype(np.int64)
 
     def inflate(self, safety: float | None = None, *, clearance: float | None = None) -> Grid:
@@ -138,19 +141,25 @@ class Grid:
         return float(1.0 - self.blocked.mean())
 
 
-def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
-    """(x, y) as ints, on the grid and free; else QueryError naming ``what``. A mapping
-    or a set is refused (unpacking it gives its keys or members, in no (x, y) order), and
-    bytes (b"\\x01\\x02" unpacks to two ints)."""
+def cell_xy(cell: object, what: str) -> tuple[int, int]:
+    """(x, y) as ints, else QueryError naming ``what``. A mapping or a set is refused
+    (unpacking it gives its keys or members, in no (x, y) order), and bytes
+    (b"\\x01\\x02" unpacks to two ints)."""
     if isinstance(cell, Mapping | Set | bytes | bytearray):
         raise QueryError(f"{what} {cell!r} must be two integers (x, y), not a "
                          f"{type(cell).__name__}")
     try:
         x, y = cell  # type: ignore[misc]
-        x, y = operator.index(x), operator.index(y)
+        return operator.index(x), operator.index(y)
     except (TypeError, ValueError):
         raise QueryError(f"{what} {cell!r} must be two integers (x, y)") from None
-    if not grid.in_bounds((x, y)):
+
+
+def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
+    """(x, y) as ints (:func:`cell_xy`), on the grid and free; else QueryError naming
+    ``what``."""
+    x, y = cell_xy(cell, what)
+    if not (0 <= x < grid.width and 0 <= y < grid.height):
         raise QueryError(f"{what} ({x}, {y}) lies outside the {grid.width}x{grid.height} grid "
                          f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})")
     if grid.blocked[y, x]:

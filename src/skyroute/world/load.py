@@ -6,8 +6,6 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from skyroute.errors import InputFormatError, OptionError, check_choice, real, renamed
 from skyroute.files import as_path
 from skyroute.world.grid import Grid
@@ -119,8 +117,10 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
 
     check_choice("frame", frame, (*FRAMES, *FRAME_ALIASES))
     frame = FRAME_ALIASES.get(frame, frame)
-    if not (np.isfinite(safety) and safety >= 0):
+    if real("safety", safety) < 0:
         raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
+    safety = float(safety)
+    altitude = None if altitude is None else real("altitude", altitude)
     most = 180.0 if frame == "degrees" else MAX_METRES
     if safety > most:
         raise OptionError(f"safety={safety!r} must be at most {most:g} "

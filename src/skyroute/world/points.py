@@ -39,6 +39,29 @@ def as_points(points, what: str, *, dims: int = 2) -> np.ndarray:
     return p
 
 
+def plane_points(points, what: str = "points") -> np.ndarray:
+    """``points`` ((2,) or (N, 2) numbers, or none) as a float (N, 2) array for a
+    vectorised query, else a QueryError naming ``what`` (an (N, 3) array was read as
+    3N/2 points). Not checked for finiteness: a query of NaN is simply not free.
+
+    >>> plane_points([[1, 2, 3], [4, 5, 6]], "points")
+    Traceback (most recent call last):
+      ...
+    skyroute.errors.QueryError: points must be (a, b) numbers or an (N, 2) array, got shape (2, 3)
+    """
+    try:
+        p = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise QueryError(f"{what} must be numbers, got {points!r}") from None
+    if p.ndim == 2 and p.shape[1] == 2:
+        return p
+    if p.shape == (2,):
+        return p[None, :]
+    if p.size == 0:
+        return p.reshape(0, 2)
+    raise QueryError(f"{what} must be (a, b) numbers or an (N, 2) array, got shape {p.shape}")
+
+
 def check_places(p: np.ndarray, what: str) -> np.ndarray:
     """``p`` when every row is a (lon, lat) on Earth, else a QueryError naming ``what``."""
     bad = (np.abs(p[:, 0]) > 180) | (np.abs(p[:, 1]) > 90)

@@ -22,7 +22,7 @@ import numpy as np
 import shapely
 from shapely import STRtree
 
-from skyroute.errors import OptionError, QueryError, check_choice, renamed
+from skyroute.errors import OptionError, QueryError, check_choice, real, renamed
 from skyroute.geo import (
     FRAME_ALIASES,
     FRAMES,
@@ -33,7 +33,7 @@ from skyroute.geo import (
     lonlat_to_enu,
 )
 from skyroute.world.grid import Grid, raster_shape
-from skyroute.world.points import as_points, check_metres, check_places
+from skyroute.world.points import as_points, check_metres, check_places, plane_points
 
 AXES = {"lonlat": ("lon", "lat"), "degrees": ("lon", "lat"), "ned": ("north", "east"),
         "enu": ("x", "y")}
@@ -118,7 +118,7 @@ class World:
 
     def from_plane(self, points) -> np.ndarray:
         """(N, 2) plane points -> points in the world's frame."""
-        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        p = plane_points(points)
         if self.frame == "ned":
             return p[:, ::-1].copy()
         if self.frame == "lonlat":
@@ -134,7 +134,7 @@ class World:
         return self._through_home(lonlat, lonlat_to_enu)
 
     def _through_home(self, points, convert) -> np.ndarray:
-        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        p = plane_points(points)
         if self.frame == "degrees" or len(p) == 0:
             return p.copy()
         if self.home is None:
@@ -181,6 +181,7 @@ class World:
         """The obstacles that count at ``altitude`` (floor <= altitude < ceiling); None: all."""
         if altitude is None:
             return self
+        altitude = real("altitude", altitude)  # a NaN kept no obstacle: an empty world
         keep = (self.floors <= altitude) & (self.ceilings > altitude)
         return World(self.obstacles[keep], self.floors[keep], self.ceilings[keep],
                      tuple(np.asarray(self.names, dtype=object)[keep]), self.boundary,
@@ -233,7 +234,7 @@ class World:
 
     def inside(self, points) -> np.ndarray:
         """True where a point lies strictly inside the boundary (always, without one)."""
-        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        p = plane_points(points)
         if self.boundary is None:
             return np.ones(len(p), bool)
         pts = shapely.points(p)
@@ -241,7 +242,7 @@ class World:
 
     def blocking(self, points) -> np.ndarray:
         """Index of an obstacle whose interior holds each point, or -1."""
-        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        p = plane_points(points)
         out = np.full(len(p), -1, np.int64)
         if len(self.obstacles) == 0:
             return out
@@ -257,8 +258,7 @@ class World:
     def segments_free(self, a, b) -> np.ndarray:
         """True for each segment a[i] -> b[i] that meets no obstacle interior and lies
         strictly inside the boundary. a, b: (N, 2)."""
-        a = np.asarray(a, dtype=float).reshape(-1, 2)
-        b = np.asarray(b, dtype=float).reshape(-1, 2)
+        a, b = _segment_ends(a, b)
         n = len(a)
         ok = np.ones(n, bool)
         if n == 0:
@@ -283,8 +283,7 @@ class World:
     def segments_clear(self, a, b) -> np.ndarray:
         """Stricter than :meth:`segments_free`: the segment may not even touch an obstacle
         (closed polygons), and lies strictly inside the boundary. The ILP rules' test."""
-        a = np.asarray(a, dtype=float).reshape(-1, 2)
-        b = np.asarray(b, dtype=float).reshape(-1, 2)
+        a, b = _segment_ends(a, b)
         lines = shapely.linestrings(np.stack([a, b], axis=1))
         ok = np.ones(len(a), bool)
         if len(self.obstacles):
@@ -311,7 +310,7 @@ class World:
 
     def clearance(self, points) -> np.ndarray:
         """Distance from each point to the nearest obstacle (0 inside one); inf if none."""
-        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        p = plane_points(points)
         if len(self.obstacles) == 0:
             return np.full(len(p), np.inf)
         pts = shapely.points(p)
@@ -325,7 +324,7 @@ class World:
         there is no boundary: planners must be able to reach points beyond the obstacles."""
         if self.boundary is not None:
             return self.bounds
-        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        p = plane_points(points)
         x0, y0, x1, y1 = self.bounds if len(self.obstacles) else (*p.min(0), *p.max(0))
         lo = np.minimum([x0, y0], p.min(0) - margin)
         hi = np.maximum([x1, y1], p.max(0) + margin)
@@ -397,14 +396,23 @@ class World:
         obstacle's edge. Obstacles are buffered with 32-gon circles enlarged by
         1/cos(pi/32), so the test never under-blocks. ``bounds`` (xmin, ymin, xmax, ymax)
         overrides the world's extent. ``clearance`` is the old name of ``safety``."""
-        if not (np.isfinite(resolution) and resolution > 0):
-            raise OptionError(f"resolution={resolution!r} must be a positive number")
+        if real("resolution", resolution) <= 0:
+            raise OptionError(f"resolution={resolution!r} must be a positive number",
+                              param="resolution")
+        resolution = float(resolution)
         safety = renamed("safety", safety, "clearance", clearance)
-        safety = 0.0 if safety is None else safety
-        if not (np.isfinite(safety) and safety >= 0):
+        safety = 0.0 if safety is None else real("safety", safety)
+        if safety < 0:
             raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
         w = self.at(altitude)
-        xmin, ymin, xmax, ymax = self.bounds if bounds is None else bounds
+        if bounds is None:
+            xmin, ymin, xmax, ymax = self.bounds
+        else:
+            b = np.asarray(bounds, dtype=object).ravel()
+            if len(b) != 4:
+                raise OptionError(f"bounds={bounds!r} must be (xmin, ymin, xmax, ymax)",
+                                  param="bounds")
+            xmin, ymin, xmax, ymax = (real("bounds", v) for v in b)
         width, height = raster_shape(xmax - xmin, ymax - ymin, resolution)
         xs = xmin + (np.arange(width) + 0.5) * resolution
         ys = ymin + (np.arange(height) + 0.5) * resolution
@@ -427,3 +435,11 @@ class World:
             gx, gy = np.meshgrid(xs, ys)
             blocked |= ~shapely.contains_xy(inner, gx, gy)
         return Grid(blocked, resolution, (xmin, ymin), name=self.name)
+
+
+def _segment_ends(a, b) -> tuple[np.ndarray, np.ndarray]:
+    """Two (N, 2) arrays of segment ends, or a QueryError naming ``a`` or ``b``."""
+    a, b = plane_points(a, "a"), plane_points(b, "b")
+    if len(a) != len(b):
+        raise QueryError(f"a and b must hold as many points: {len(a)} and {len(b)}")
+    return a, b

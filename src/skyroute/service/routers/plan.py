@@ -191,18 +191,22 @@ def _plan_checked(body: PlanRequest, res: Resources) -> dict:
 
             out["geojson"] = grid_path_geojson(grid, r)
     else:
+        from skyroute.roadmap.world_plan import options_for
+
         world = _world(body)
         _check_world_limits(body, world, res)
         algorithm = body.algorithm or "visibility"
         if algorithm == "prm":
             budget = None  # scipy's Dijkstra has no budget; samples bound the work
-        r = plan(world, tuple(body.start), tuple(body.goal),
-                 algorithm=algorithm, connectivity=body.connectivity,
-                 corner_cutting=body.corner_cutting, heuristic=body.heuristic,
-                 weight=body.weight, prune=body.prune,
+        # the body has a default for every option: pass the ones the algorithm reads
+        r = plan(world, tuple(body.start), tuple(body.goal), algorithm=algorithm,
                  max_expansions=None if algorithm == "prm" else budget,
-                 resolution=body.resolution, samples=body.samples,
-                 neighbours=body.neighbours, prm_star=body.prm_star, seed=body.seed)
+                 **options_for(algorithm, connectivity=body.connectivity,
+                               corner_cutting=body.corner_cutting, heuristic=body.heuristic,
+                               weight=body.weight, prune=body.prune,
+                               resolution=body.resolution, samples=body.samples,
+                               neighbours=body.neighbours, prm_star=body.prm_star,
+                               seed=body.seed))
         out = r.to_dict()
         out["frame"] = world.frame
         if r.found:
@@ -270,12 +274,11 @@ def _check_world_limits(body: PlanRequest, world, res: Resources) -> None:
 
 
 def _raster_cells(body: PlanRequest, world) -> tuple[int, float]:
-    """The cells and resolution of the raster a grid algorithm will build: the world's
-    extent grown to hold start and goal with a margin of 4 cells, as
-    :func:`skyroute.roadmap.raster.world_raster` builds it."""
-    from skyroute.roadmap.raster import default_resolution
+    """The cells and resolution of the raster a grid algorithm will build
+    (:func:`skyroute.roadmap.raster.raster_box`, as ``world_raster`` builds it)."""
+    from skyroute.roadmap.raster import default_resolution, raster_box
 
     s, t = world.check_point(body.start, "start"), world.check_point(body.goal, "goal")
     r = default_resolution(world, [s, t]) if body.resolution is None else body.resolution
-    x0, y0, x1, y1 = world.extent_with([s, t], margin=4 * r)
+    x0, y0, x1, y1 = raster_box(world, s, t, r)
     return max(1, math.ceil((x1 - x0) / r)) * max(1, math.ceil((y1 - y0) / r)), r
