@@ -179,12 +179,14 @@ def _inside(mx, my, edges, lo, hi, eps):
 
 @njit(cache=True)
 def segment_code(px, py, qx, qy, edges, owner, first, start, items, x0, y0, cell, nx, ny,
-                 eps, stamp, ts, spans, touched):
+                 eps, stamp, ts, spans, touched, verts):
     """FREE, BLOCKED or UNSURE for segment pq, whose ends lie in no obstacle's interior
     (corners, checked points: a segment wholly inside one would pass). Scratch (see
     :func:`scratch`): ``stamp`` (E + 1,) int64, its last entry counting calls; ``ts``
     (MAX_CONTACTS,) and ``spans`` (MAX_CONTACTS, 2) float; ``touched`` (MAX_CONTACTS,)
-    int64."""
+    int64; ``verts`` (MAX_CONTACTS, 2) float: the edge vertices on pq, since two distinct
+    ones closer than eps can give the same parameter along pq and hide the sliver
+    between them (boxes overlapping by 4e-17 of a metre: their union's interior)."""
     if px == qx and py == qy:
         return UNSURE
     tick = stamp[-1] + 1
@@ -192,6 +194,7 @@ def segment_code(px, py, qx, qy, edges, owner, first, start, items, x0, y0, cell
     nt = 0
     ns = 0
     nk = 0
+    nv = 0
     unsure = False
     xlo, xhi = min(px, qx), max(px, qx)
     ylo, yhi = min(py, qy), max(py, qy)
@@ -235,6 +238,21 @@ def segment_code(px, py, qx, qy, edges, owner, first, start, items, x0, y0, cell
                     unsure = True
                     continue
                 before = nt
+                for v in range(2):  # the edge's ends on pq's line
+                    if (o1 if v == 0 else o2) != 0:
+                        continue
+                    vx, vy = (ax, ay) if v == 0 else (bx, by)
+                    near = False
+                    for j in range(nv):
+                        d2 = (verts[j, 0] - vx) ** 2 + (verts[j, 1] - vy) ** 2
+                        near = near or 0.0 < d2 <= eps * eps
+                    unsure = unsure or near
+                    if nv < verts.shape[0]:
+                        verts[nv, 0] = vx
+                        verts[nv, 1] = vy
+                        nv += 1
+                    else:
+                        unsure = True
                 if o1 == 0 and o2 == 0:  # along the edge's line
                     ta = _param(px, py, qx, qy, ax, ay)
                     tb = _param(px, py, qx, qy, bx, by)
@@ -308,9 +326,10 @@ def segment_code(px, py, qx, qy, edges, owner, first, start, items, x0, y0, cell
 
 
 def scratch(index: EdgeIndex) -> tuple:
-    """Fresh scratch arrays for :func:`segment_code` (stamp, ts, spans, touched)."""
+    """Fresh scratch arrays for :func:`segment_code` (stamp, ts, spans, touched, verts)."""
     return (np.zeros(len(index.edges) + 1, np.int64), np.empty(MAX_CONTACTS),
-            np.empty((MAX_CONTACTS, 2)), np.empty(MAX_CONTACTS, np.int64))
+            np.empty((MAX_CONTACTS, 2)), np.empty(MAX_CONTACTS, np.int64),
+            np.empty((MAX_CONTACTS, 2)))
 
 
 @njit(cache=True)
@@ -372,11 +391,11 @@ def tangent_ids(px, py, corners, prev, nxt):
 
 @njit(cache=True)
 def segment_codes(a, b, edges, owner, first, start, items, x0, y0, cell, nx, ny, eps,
-                  stamp, ts, spans, touched):
+                  stamp, ts, spans, touched, verts):
     """:func:`segment_code` for each segment a[k] -> b[k] ((K, 2) arrays)."""
     out = np.empty(a.shape[0], np.int64)
     for k in range(a.shape[0]):
         out[k] = segment_code(a[k, 0], a[k, 1], b[k, 0], b[k, 1], edges, owner, first,
                               start, items, x0, y0, cell, nx, ny, eps, stamp, ts, spans,
-                              touched)
+                              touched, verts)
     return out
