@@ -335,9 +335,34 @@ def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
         err = exc.errors()[0]
         field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err["loc"])
         msg = err["msg"].removeprefix("Value error, ")
+        if err["type"] == "extra_forbidden":  # a typo: say what the section takes
+            msg = _unknown_key(err["loc"])
         # a check of several fields (at the model level) names its own field first
         raise InputFormatError(where, f"{field.lstrip('.')}: {msg}" if field else msg) from None
     return s
+
+
+def _unknown_key(loc: tuple) -> str:
+    """"unknown key; valid: ..." for the key at ``loc`` (a validation error's path),
+    with the closest valid key first when one is close ("cruise_sped")."""
+    import difflib
+    import typing
+
+    model: type[BaseModel] = Scenario
+    for part in loc[:-1]:
+        if isinstance(part, int):
+            continue
+        kinds = [model.model_fields[part].annotation]
+        while kinds:  # list[Airport], Optional[Packages], Annotated[...]: the model in it
+            kind = kinds.pop()
+            if isinstance(kind, type) and issubclass(kind, BaseModel):
+                model = kind
+                break
+            kinds.extend(typing.get_args(kind))
+    valid = list(model.model_fields)
+    close = difflib.get_close_matches(str(loc[-1]), valid, n=1)
+    hint = f"did you mean {close[0]}? " if close else ""
+    return f"unknown key; {hint}valid: {', '.join(valid)}"
 
 
 def generate(airports: int, drones: int, *, area_km: float = 8.0, seed: int = 0,
