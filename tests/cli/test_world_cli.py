@@ -54,6 +54,14 @@ def test_local_frame_and_degrees_frame(monkeypatch, capsys):
     (["--start=abc", "--goal=-3.1913,55.9455"], "--start 'abc' must be two numbers LON,LAT"),
     (["--start=-3.186874,55.944494", "--goal=-3.1913,55.9455", "--algorithm", "rrt"],
      "--algorithm 'rrt' is not valid"),
+    # options the algorithm does not read were ignored, as skyroute.plan now refuses them
+    (["--start=-3.186874,55.944494", "--goal=-3.1913,55.9455", "--samples", "50"],
+     "--algorithm visibility does not use --samples (--samples and --seed: prm; "
+     "--resolution: the grid algorithms)"),
+    (["--start=-3.186874,55.944494", "--goal=-3.1913,55.9455", "--algorithm", "astar",
+      "--seed", "3", "--samples", "9"], "--algorithm astar does not use --samples or --seed"),
+    (["--start=-3.186874,55.944494", "--goal=-3.1913,55.9455", "--algorithm", "prm",
+      "--resolution", "0.001"], "--algorithm prm does not use --resolution"),
 ])
 def test_bad_queries_are_one_line_exit_2(monkeypatch, capsys, tmp_path, args, words):
     png = tmp_path / "p.png"

@@ -13,6 +13,7 @@ from rich.markup import escape  # help is Rich markup: '[north, ...]' would read
 from skyroute.cli import world_args as wa
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console, print_table, result_table
+from skyroute.errors import OptionError
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
@@ -42,8 +43,8 @@ def plan_world_command(
     resolution: Annotated[float | None, typer.Option(
         help="Grid algorithms: cell size in world units (default: 1000 cells across).")] =
         None,
-    samples: Annotated[int, typer.Option(help="PRM samples.")] = 1000,
-    seed: Annotated[int, typer.Option(help="PRM random seed.")] = 0,
+    samples: Annotated[int | None, typer.Option(help="PRM samples (default 1000).")] = None,
+    seed: Annotated[int | None, typer.Option(help="PRM random seed (default 0).")] = None,
     waypoints_out: Annotated[Path | None, typer.Option(
         "--waypoints", help=escape("Write [[north, east, altitude, heading], ...] JSON here."))] =
         None,
@@ -60,15 +61,20 @@ def plan_world_command(
     found.
     """
     frame = wa.frame_of(frame)
+    given = {k: v for k, v in (("resolution", resolution), ("samples", samples),
+                               ("seed", seed)) if v is not None}
+    stray = [k for k in given if algorithm in WORLD_ALGORITHMS
+             and k not in options_for(algorithm, **given)]
+    if stray:  # as skyroute.plan refuses them: an option that would change nothing
+        raise OptionError(f"--algorithm {algorithm} does not use "
+                          + " or ".join(f"--{k}" for k in stray)
+                          + " (--samples and --seed: prm; --resolution: the grid algorithms)")
     a = wa.parse_pair(start, "--start", wa.point_names(frame))
     b = wa.parse_pair(goal, "--goal", wa.point_names(frame))
     with delayed_status("planning"):  # a roadmap or raster, and a first run's compiles
         world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
                            frame=frame)
-        # the options have defaults whatever the algorithm: pass the ones it reads
-        result = plan(world, a, b, algorithm=algorithm,
-                      **options_for(algorithm, resolution=resolution, samples=samples,
-                                    seed=seed))
+        result = plan(world, a, b, algorithm=algorithm, **given)
     alt = 0.0 if altitude is None else altitude
     if result.found:
         if waypoints_out:
@@ -77,7 +83,9 @@ def plan_world_command(
             write_atomic(geojson, dumps(world_path_geojson(world, result)))
         if plot:
             plot_world_path(world, result, a, b, plot,
-                            edges=roadmap_edges(world, algorithm, samples=samples, seed=seed),
+                            edges=roadmap_edges(world, algorithm,
+                                                **{k: given[k] for k in ("samples", "seed")
+                                                   if k in given}),
                             obstacles=obstacles_label(altitude, safety, world.frame))
     if as_json:
         typer.echo(json.dumps(world_result_doc(world, result)))
