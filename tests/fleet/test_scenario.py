@@ -158,6 +158,12 @@ def _other_beside_first(d: dict) -> None:
      "airspace.shared_levels: 1e+09 levels is over the limit of 1,000"),
 ])
 def test_bad_scenario_files_give_one_line_naming_the_field(tmp_path, edit, words):
+    p, msg = _refused(tmp_path, edit)
+    assert msg.startswith(f"{p}: ") and words in msg and "\n" not in msg
+
+
+def _refused(tmp_path, edit) -> tuple:
+    """(file, error) of seed-3x3 edited by ``edit``, written and read back."""
     import yaml
 
     data = sc.preset("seed-3x3").model_dump()
@@ -166,8 +172,7 @@ def test_bad_scenario_files_give_one_line_naming_the_field(tmp_path, edit, words
     p.write_text(yaml.safe_dump(data, sort_keys=False))
     with pytest.raises(InputFormatError) as info:
         sc.load_scenario(p)
-    msg = str(info.value)
-    assert msg.startswith(f"{p}: ") and words in msg and "\n" not in msg
+    return p, str(info.value)
 
 
 @pytest.mark.parametrize("edit, words", [
@@ -296,15 +301,8 @@ def _roll(h: float) -> float:
      "than the seed's take-off distance"),
 ])
 def test_runways_must_hold_the_ground_rolls(tmp_path, edit, words):
-    import yaml
-
-    data = sc.preset("seed-3x3").model_dump()
-    edit(data)
-    p = tmp_path / "bad.yaml"
-    p.write_text(yaml.safe_dump(data, sort_keys=False))
-    with pytest.raises(InputFormatError) as info:
-        sc.load_scenario(p)
-    assert str(info.value) == f"{p}: {words}"
+    p, msg = _refused(tmp_path, edit)
+    assert msg == f"{p}: {words}"
 
 
 def test_runways_just_long_enough_are_allowed():

@@ -14,6 +14,14 @@ from skyroute.errors import QueryError
 MAX_METRES = 1e7
 
 
+def _floats(points, what: str) -> np.ndarray:
+    """``points`` as a float array, or a QueryError naming ``what``."""
+    try:
+        return np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise QueryError(f"{what} must be numbers, got {points!r}") from None
+
+
 def as_points(points, what: str, *, dims: int = 2) -> np.ndarray:
     """``points`` ((dims,) or (N, dims) numbers) as a float (N, dims) array.
 
@@ -24,10 +32,7 @@ def as_points(points, what: str, *, dims: int = 2) -> np.ndarray:
       ...
     skyroute.errors.QueryError: goal must be (a, b) numbers or an (N, 2) array, got shape (1, 3)
     """
-    try:
-        p = np.asarray(points, dtype=float)
-    except (TypeError, ValueError):
-        raise QueryError(f"{what} must be numbers, got {points!r}") from None
+    p = _floats(points, what)
     if p.ndim == 1:
         p = p[None, :]
     if p.ndim != 2 or p.shape[1] != dims:
@@ -49,10 +54,7 @@ def plane_points(points, what: str = "points") -> np.ndarray:
       ...
     skyroute.errors.QueryError: points must be (a, b) numbers or an (N, 2) array, got shape (2, 3)
     """
-    try:
-        p = np.asarray(points, dtype=float)
-    except (TypeError, ValueError):
-        raise QueryError(f"{what} must be numbers, got {points!r}") from None
+    p = _floats(points, what)
     if p.ndim == 2 and p.shape[1] == 2:
         return p
     if p.shape == (2,):
