@@ -100,7 +100,8 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
                                      ("prm_star", prm_star), ("seed", seed)) if v is not None}
         return plan_world(grid, start, goal, algorithm=algorithm or "visibility",
                           max_expansions=max_expansions, **roadmap, **extra)
-    if (resolution, samples, neighbours, prm_star, seed) != (None,) * 5:
+    if resolution is not None or samples is not None or neighbours is not None or \
+            prm_star is not None or seed is not None:  # chained: the grid path is hot
         name, value = next((n, v) for n, v in (
             ("resolution", resolution), ("samples", samples), ("neighbours", neighbours),
             ("prm_star", prm_star), ("seed", seed)) if v is not None)
