@@ -199,3 +199,22 @@ def test_bad_out_leaves_earlier_runs_stored(monkeypatch, capsys, tmp_path, fly_o
                        "--db", f"sqlite:///{db}", "--out", str(tmp_path / "bad"))
     assert code == 2 and "report-01-01-2024.json: cannot write: it is a folder" in err
     assert _stored_rows(db) == rows
+
+
+def test_an_order_number_too_long_for_the_store_is_one_line(monkeypatch, capsys, tmp_path):
+    # orders.order_no holds 8 characters: PostgreSQL raised a DataError traceback,
+    # SQLite stored the order (and flew it) as given
+    import shutil
+
+    data = tmp_path / "data"
+    shutil.copytree(EXAMPLE, data)
+    with (data / "database" / "orders.csv").open("a") as f:
+        f.write("123456789,2024-01-01,s2400001,brook.boat.brick\n")
+    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", _no_flying)
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", str(data),
+                       "--db", f"sqlite:///{tmp_path / 'o.db'}", "--out", str(tmp_path / "o"))
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "order '123456789': order_no '123456789' is 9 characters, orders.order_no " \
+           "holds at most 8" in err
+    assert not any(_stored_rows(tmp_path / "o.db").values())
+    assert not (tmp_path / "o").exists()

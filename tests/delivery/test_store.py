@@ -4,6 +4,7 @@ written whole (a killed run leaves the previous day) and rerunning replaces it."
 from __future__ import annotations
 
 import datetime as dt
+import re
 import subprocess
 import sys
 import textwrap
@@ -124,3 +125,48 @@ def test_a_store_at_an_unknown_revision_is_one_line(tmp_path):
         conn.execute(sa.text("update alembic_version set version_num = '9999'"))
     with pytest.raises(SkyrouteError, match=r"schema is unknown.*'9999'.*newer version"):
         store.init(e)
+
+
+@pytest.mark.parametrize("field, value, words", [
+    ("order_no", "123456789", "order '123456789': order_no '123456789' is 9 characters"),
+    ("customer", "s24000011", "order '0000000a': customer 's24000011' is 9 characters"),
+    ("deliver_to", "a." * 40 + "b", "order '0000000a': deliver_to 'a.a."),
+])
+def test_an_order_wider_than_its_column_is_refused_on_any_store(engine, field, value,
+                                                                 words):
+    # PostgreSQL refused it with a DataError traceback; SQLite stored it, so the two
+    # stores held different orders
+    good = {"order_no": "0000000a", "date": DAY, "customer": "s2400001",
+            "deliver_to": "a.b.c", "items": ("x",)}
+    orders = [Order(**{**good, "order_no": "0000000b"}), Order(**{**good, field: value})]
+    with pytest.raises(SkyrouteError, match=re.escape(words) + ".*holds at most"):
+        store.import_orders(engine, orders)
+    with engine.connect() as c:
+        assert c.execute(sa.text("select count(*) from orders")).scalar_one() == 0
+
+
+def test_an_item_wider_than_its_column_is_refused(engine):
+    orders = [Order("0000000a", DAY, "s2400001", "a.b.c", ("x", "y" * 101))]
+    with pytest.raises(SkyrouteError, match=r"order '0000000a': item 'y+' is 101 characters, "
+                                            r"order_details\.item holds at most 100"):
+        store.import_orders(engine, orders)
+
+
+@pytest.mark.parametrize("field", ["money_delivered", "money_placed"])
+def test_money_over_sql_integer_is_one_line_and_no_rows(engine, field):
+    # an INTEGER column is 32 bits on PostgreSQL (a DataError traceback after the day
+    # was flown), 64 on SQLite (an OverflowError traceback past 2**63)
+    store.write_day(engine, DAY, run_row(5), [], moves(5))
+    with pytest.raises(SkyrouteError, match=rf"2024-01-01: runs\.{field} 3000000000 is "
+                                            r"outside the store's INTEGER range"):
+        store.write_day(engine, DAY, {**run_row(3), field: 3_000_000_000}, [], moves(3))
+    rows = store.day_rows(engine, DAY)["flightpath"]
+    assert len(rows) == 5  # the day as it was
+
+
+def test_a_delivery_cost_over_sql_integer_names_the_order(engine):
+    big = {"order_no": "0000000a", "delivered_to": "a.b.c", "cost_in_pence": 2**63 + 50}
+    with pytest.raises(SkyrouteError, match=r"2024-01-01: order '0000000a': deliveries\."
+                                            r"cost_in_pence 9223372036854775858 is outside"):
+        store.write_day(engine, DAY, run_row(1), [big], moves(1))
+    assert store.day_rows(engine, DAY) == {"deliveries": [], "flightpath": []}

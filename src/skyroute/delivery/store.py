@@ -30,6 +30,7 @@ from skyroute.caches import register
 from skyroute.errors import SkyrouteError
 
 DEFAULT_DB = "sqlite:///skyroute.db"
+SQL_INT = (-2**31, 2**31 - 1)  # an INTEGER column: 32 bits on PostgreSQL, 64 on SQLite
 TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
 _REFLECTED: dict[tuple[str, tuple[str, ...]], dict[str, sa.Table]] = {}
 register(_REFLECTED.clear)
@@ -108,22 +109,45 @@ def init(engine: sa.Engine) -> str:
         return MigrationContext.configure(conn).get_current_revision()
 
 
+def check_fits(table: sa.Table, row: dict, where: str) -> None:
+    """A SkyrouteError naming ``where``, the column and the value unless every value of
+    ``row`` fits ``table``'s column on any store: text within its length, a whole number
+    within :data:`SQL_INT` for an INTEGER. PostgreSQL refused such a value with a
+    traceback, SQLite stored it (so the two stores differed) or overflowed past 2**63."""
+    for name, value in row.items():
+        typ = table.c[name].type
+        if isinstance(value, str) and getattr(typ, "length", None) \
+                and len(value) > typ.length:
+            raise SkyrouteError(f"{where}{name} {value!r} is {len(value)} characters, "
+                                f"{table.name}.{name} holds at most {typ.length}")
+        if isinstance(value, int) and isinstance(typ, sa.Integer) \
+                and not isinstance(typ, sa.BigInteger) \
+                and not SQL_INT[0] <= value <= SQL_INT[1]:
+            raise SkyrouteError(f"{where}{table.name}.{name} {value} is outside the store's "
+                                f"INTEGER range ({SQL_INT[0]:,} to {SQL_INT[1]:,})")
+
+
 def import_orders(engine: sa.Engine, all_orders: Iterable) -> tuple[int, int]:
     """Insert the orders (and their items) not already stored; (added, already there).
-    One transaction: an error leaves the store as it was."""
+    One transaction: an error leaves the store as it was; a value wider than its column
+    is an error naming the order (:func:`check_fits`), checked before anything is
+    written."""
     t = tables(engine)
     orders, order_details = t["orders"], t["order_details"]
     with engine.begin() as conn:
         have = set(conn.scalars(sa.select(orders.c.order_no)))
         new = [o for o in all_orders if o.order_no not in have]
-        if new:
-            conn.execute(orders.insert(), [
-                {"order_no": o.order_no, "delivery_date": o.date, "customer": o.customer,
-                 "deliver_to": o.deliver_to} for o in new])
-            rows = [{"order_no": o.order_no, "line": k, "item": item}
-                    for o in new for k, item in enumerate(o.items)]
-            if rows:
-                conn.execute(order_details.insert(), rows)
+        heads = [{"order_no": o.order_no, "delivery_date": o.date, "customer": o.customer,
+                  "deliver_to": o.deliver_to} for o in new]
+        rows = [{"order_no": o.order_no, "line": k, "item": item}
+                for o in new for k, item in enumerate(o.items)]
+        for table, batch in ((orders, heads), (order_details, rows)):
+            for row in batch:
+                check_fits(table, row, f"order {row['order_no']!r}: ")
+        if heads:
+            conn.execute(orders.insert(), heads)
+        if rows:
+            conn.execute(order_details.insert(), rows)
     return len(new), len(have)
 
 
@@ -160,16 +184,21 @@ def order_dates(engine: sa.Engine) -> list[dt.date]:
 
 def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[dict],
               moves: Iterable[dict]) -> None:
-    """Replace one day's results in one transaction (``moves`` may be a generator)."""
+    """Replace one day's results in one transaction (``moves`` may be a generator). The
+    run and delivery rows are checked to fit their columns first (:func:`check_fits`:
+    money beyond a 32-bit INTEGER), so a failure leaves the day as it was."""
     t_ = tables(engine)
     flightpath, deliveries, runs = t_["flightpath"], t_["deliveries"], t_["runs"]
+    head = {**run, "delivery_date": date,
+            "settings": json.dumps(run.get("settings", {}), sort_keys=True)}
+    rows = [{**d, "delivery_date": date} for d in delivered]
+    check_fits(runs, head, f"{date}: ")
+    for row in rows:
+        check_fits(deliveries, row, f"{date}: order {row.get('order_no')!r}: ")
     with engine.begin() as conn:
         for t in (flightpath, deliveries, runs):
             conn.execute(t.delete().where(t.c.delivery_date == date))
-        conn.execute(runs.insert(), [{**run, "delivery_date": date,
-                                      "settings": json.dumps(run.get("settings", {}),
-                                                             sort_keys=True)}])
-        rows = [{**d, "delivery_date": date} for d in delivered]
+        conn.execute(runs.insert(), [head])
         if rows:
             conn.execute(deliveries.insert(), rows)
         batch = []
