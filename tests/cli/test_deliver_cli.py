@@ -218,3 +218,31 @@ def test_an_order_number_too_long_for_the_store_is_one_line(monkeypatch, capsys,
            "holds at most 8" in err
     assert not any(_stored_rows(tmp_path / "o.db").values())
     assert not (tmp_path / "o").exists()
+
+
+def test_each_invalid_order_is_one_line_on_a_narrow_stderr(monkeypatch, capsys, tmp_path):
+    # Rich wrapped the line at 80 columns (a pipe, a log), splitting the file in a reason
+    import shutil
+
+    data = tmp_path / ("a-long-folder-name-" * 4)
+    shutil.copytree(EXAMPLE, data)
+    (data / "website" / "words" / "heron" / "tulip" / "wren" / "details.json").unlink()
+    monkeypatch.setenv("COLUMNS", "60")
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", str(data),
+                       "--db", f"sqlite:///{tmp_path / 'o.db'}", "--out", str(tmp_path / "o"),
+                       "--no-plot")
+    assert code == 0, err
+    lines = [x for x in err.splitlines() if "invalid order" in x]
+    assert len(lines) == 3 and all(x.endswith("details.json: no such file") for x in lines)
+
+
+
+def test_db_lines_do_not_wrap(monkeypatch, capsys, tmp_path):
+    # a long URL was split over two lines at 80 columns (a pipe, a log)
+    monkeypatch.setenv("COLUMNS", "40")
+    db = f"sqlite:///{tmp_path / ('long-store-name-' * 4)}.db"
+    code, out, err = run(monkeypatch, capsys, "db", "init", "--db", db)
+    assert code == 0 and out.strip() == f"{db}: schema at revision 0003", err
+    code, out, err = run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", db)
+    assert code == 0 and len(out.strip().splitlines()) == 1, err
+    assert out.startswith(f"{db}: 108 orders added")

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from skyroute.cli.tables import plain_console
-from skyroute.delivery.store import DEFAULT_DB
+from skyroute.delivery.store import DEFAULT_DB, safe_url
 
 db_app = typer.Typer(help="The SQL store of orders, deliveries and flight paths.",
                      no_args_is_help=True)
@@ -22,7 +22,7 @@ def db_init(db: Annotated[str, typer.Option(help="SQLAlchemy URL of the store.")
     from skyroute.delivery.store import init
 
     rev = init(open_store(db))
-    plain_console().print(f"{db}: schema at revision {rev}")
+    plain_console().print(f"{safe_url(db)}: schema at revision {rev}", soft_wrap=True)
 
 
 @db_app.command("import")
@@ -38,5 +38,5 @@ def db_import(
 
     orders = read_csv_orders(data)
     added, had = import_orders(open_store(db), orders)
-    plain_console().print(f"{db}: {added:,} orders added, {len(orders) - added:,} already there "
-                    f"({had + added:,} stored)")
+    plain_console().print(f"{safe_url(db)}: {added:,} orders added, {len(orders) - added:,} "
+                          f"already there ({had + added:,} stored)", soft_wrap=True)

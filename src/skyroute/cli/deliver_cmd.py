@@ -85,7 +85,8 @@ def deliver_command(
         if data is not None:
             added, _ = import_orders(engine, read_csv_orders(data))
             if added:
-                err.print(f"imported {added:,} orders from {data / 'database'}")
+                err.print(f"imported {added:,} orders from {data / 'database'}",
+                          soft_wrap=True)
         elif not order_dates(engine):
             raise SkyrouteError(f"{db}: no orders stored; load them with 'skyroute db "
                                 "import DIR' or give --data DIR")
@@ -134,7 +135,9 @@ def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
         t.add_row(k, str(v))
     print_table(plain_console(), t)
     for o, reason in r.invalid:
-        plain_console(stderr=True).print(f"invalid order {o.order_no}: {reason}")
+        # one line however long (Rich wrapped at 80 columns in a pipe or a log)
+        plain_console(stderr=True).print(f"invalid order {o.order_no}: {reason}",
+                                         soft_wrap=True)
 
 
 def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kind: str,

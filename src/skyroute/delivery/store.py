@@ -78,8 +78,12 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
     return engine
 
 
-def _safe(url: str) -> str:
+def safe_url(url: str) -> str:
+    """``url`` with its password as ``***``: for messages and logs."""
     return sa.engine.make_url(url).render_as_string(hide_password=True)
+
+
+_safe = safe_url
 
 
 def init(engine: sa.Engine) -> str:
