@@ -103,6 +103,10 @@ def test_killed_run_leaves_no_partial_day(engine, tmp_path):
 def test_bad_urls_are_one_line_errors(tmp_path):
     with pytest.raises(SkyrouteError, match="not a database URL"):
         store.connect("nonsense")
+    for url in ("sqlite://u:sekret@/tmp/x.db", "nonsense://u:sekret@h"):  # not echoed
+        with pytest.raises(SkyrouteError, match=r"u:\*\*\*@") as err:
+            store.connect(url)
+        assert "sekret" not in str(err.value)
     with pytest.raises(SkyrouteError, match="cannot connect"):
         store.connect("postgresql+psycopg://nobody@127.0.0.1:1/none")
     e = store.connect(f"sqlite:///{tmp_path / 'empty.db'}")

@@ -14,7 +14,7 @@ from rich.table import Table
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
 from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.delivery.day import METHODS, DayResult
-from skyroute.delivery.store import DEFAULT_DB
+from skyroute.delivery.store import DEFAULT_DB, safe_url
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 
 
@@ -88,7 +88,7 @@ def deliver_command(
                 err.print(f"imported {added:,} orders from {data / 'database'}",
                           soft_wrap=True)
         elif not order_dates(engine):
-            raise SkyrouteError(f"{db}: no orders stored; load them with 'skyroute db "
+            raise SkyrouteError(f"{safe_url(db)}: no orders stored; load them with 'skyroute db "
                                 "import DIR' or give --data DIR")
         by_date = days_between(engine, d0, d1)
         all_orders = [o for v in by_date.values() for o in v]

@@ -67,8 +67,9 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
         with engine.connect():
             pass
     except sa.exc.ArgumentError:
-        raise SkyrouteError(f"url={url!r}: not a database URL (e.g. sqlite:///skyroute.db or "
-                            "postgresql+psycopg://user@127.0.0.1:5432/test)", param="url") from None
+        raise SkyrouteError(f"url={_safe(url)!r}: not a database URL (e.g. "
+                            "sqlite:///skyroute.db or postgresql+psycopg://user@127.0.0.1:5432/"
+                            "test)", param="url") from None
     except (sa.exc.OperationalError, sa.exc.InterfaceError) as exc:
         raise SkyrouteError(f"url={_safe(url)}: cannot connect: "
                             f"{str(exc.orig).strip().splitlines()[0]}", param="url") from None
@@ -79,8 +80,14 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
 
 
 def safe_url(url: str) -> str:
-    """``url`` with its password as ``***``: for messages and logs."""
-    return sa.engine.make_url(url).render_as_string(hide_password=True)
+    """``url`` with its password as ``***``: for messages and logs (also a string
+    SQLAlchemy cannot parse, whose ``user:password@`` is masked as text)."""
+    try:
+        return sa.engine.make_url(url).render_as_string(hide_password=True)
+    except sa.exc.ArgumentError:
+        import re
+
+        return re.sub(r"(://[^:/@]*:)[^@/]*@", r"\1***@", str(url))
 
 
 _safe = safe_url
