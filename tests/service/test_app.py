@@ -163,3 +163,20 @@ def test_writes_need_the_token(client, headers, status, path, body):
 def test_reads_need_no_token(client):
     for path in ("/health", "/maps", "/maps/den312d", "/days", "/orders?date=2024-01-01"):
         assert client.get(path).status_code == 200, path
+
+
+@pytest.mark.parametrize("path", ["/health", "/maps", "/maps/den312d", "/days",
+                                  "/orders?date=2024-01-01", "/openapi.json", "/"])
+def test_head_answers_as_get_without_a_body(client, path):
+    """HEAD on a readable resource is its GET's status and headers (RFC 9110), not the
+    404 the viewer's static mount gave for every API path."""
+    get, head = client.get(path), client.head(path)
+    assert get.status_code == 200
+    assert head.status_code == 200 and head.content == b""
+    assert head.headers["content-type"] == get.headers["content-type"]
+
+
+def test_head_on_an_unknown_resource_is_its_get_status(client):
+    r = client.head("/maps/atlantis")
+    assert r.status_code == 404 and r.content == b""
+    assert r.headers["content-type"] == PROBLEM
