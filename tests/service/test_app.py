@@ -220,3 +220,17 @@ def test_documented_errors_include_415_and_503(client):
     for path in ("/days", "/days/{date}", "/days/{date}/flightpath.geojson", "/orders",
                  "/site.geojson", "/jobs/{job_id}", "/fleet/runs"):
         assert "503" in spec["paths"][path]["get"]["responses"], path
+
+
+@pytest.mark.parametrize("path, body, field", [
+    ("/plan", {"map": "den312d", "start": [50, 76]}, "goal"),  # pydantic's check
+    ("/plan", {"map_text": "garbage", "start": [0, 0], "goal": [1, 1]}, "map_text"),
+    ("/jobs/fleet", {"scenario": {"name": "x"}}, "scenario.airports"),
+    ("/jobs/fleet", {"preset": "seed-3x3", "rate": 100000, "hours": 24}, "rate"),
+])
+def test_an_errors_message_is_the_detail_without_its_field(client, path, body, field):
+    """``errors[].message`` reads the same whoever found the fault (the model or a
+    router): the detail is ``field: message``, the message does not repeat the field."""
+    doc = assert_problem(client.post(path, json=body, headers=AUTH), 422, field)
+    message = doc["errors"][0]["message"]
+    assert doc["detail"] == f"{field}: {message}" and not message.startswith(field)

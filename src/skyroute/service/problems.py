@@ -62,7 +62,9 @@ def problem_response(status: int, detail: str, *, field: str | None = None,
            "status": status, "detail": detail}
     if field is not None:
         doc["field"] = field
-        doc["errors"] = errors or [{"field": field, "message": detail}]
+        # as a validation error reads: the message without the "field: " the detail has
+        doc["errors"] = errors or [{"field": field,
+                                    "message": detail.removeprefix(f"{field}: ")}]
     return JSONResponse(doc, status_code=status, media_type=MEDIA_TYPE, headers=headers)
 
 
