@@ -163,3 +163,74 @@ def test_writes_need_the_token(client, headers, status, path, body):
 def test_reads_need_no_token(client):
     for path in ("/health", "/maps", "/maps/den312d", "/days", "/orders?date=2024-01-01"):
         assert client.get(path).status_code == 200, path
+
+
+@pytest.mark.parametrize("path", ["/health", "/maps", "/maps/den312d", "/days",
+                                  "/orders?date=2024-01-01", "/openapi.json", "/"])
+def test_head_answers_as_get_without_a_body(client, path):
+    """HEAD on a readable resource is its GET's status and headers (RFC 9110), not the
+    404 the viewer's static mount gave for every API path."""
+    get, head = client.get(path), client.head(path)
+    assert get.status_code == 200
+    assert head.status_code == 200 and head.content == b""
+    assert head.headers["content-type"] == get.headers["content-type"]
+
+
+def test_head_on_an_unknown_resource_is_its_get_status(client):
+    r = client.head("/maps/atlantis")
+    assert r.status_code == 404 and r.content == b""
+    assert r.headers["content-type"] == PROBLEM
+
+
+@pytest.mark.parametrize("path, body", [
+    ("/plan", '{"map": "den312d", "start": [50, 76], "goal": [60, 13]}'),
+    ("/jobs/deliver", '{"date": "2024-01-03"}'),
+    ("/jobs/fleet", '{"preset": "seed-3x3"}'),
+])
+@pytest.mark.parametrize("ctype, words", [
+    ("text/plain", "Content-Type text/plain is not JSON"),
+    ("application/x-www-form-urlencoded",  # what `curl -d` sends
+     "Content-Type application/x-www-form-urlencoded is not JSON"),
+    ("application/xml; charset=utf-8", "Content-Type application/xml is not JSON"),
+    (None, "no Content-Type"),
+])
+def test_a_body_that_is_not_declared_json_is_415(client, path, body, ctype, words):
+    """A JSON body sent as another media type (or none) is never read: a 415 naming the
+    media type, not a 422 saying the body is not an object."""
+    headers = {**AUTH, **({"Content-Type": ctype} if ctype else {})}
+    doc = assert_problem(client.post(path, content=body, headers=headers), 415, words=words)
+    assert "application/json" in doc["detail"] and "field" not in doc
+
+
+@pytest.mark.parametrize("ctype", ["application/json", "application/json; charset=utf-8",
+                                   "application/merge-patch+json"])
+def test_json_media_types_are_read(client, ctype):
+    body = b'{"map": "den312d", "start": [50, 76], "goal": [60, 13], "geojson": false}'
+    r = client.post("/plan", content=body, headers={**AUTH, "Content-Type": ctype})
+    assert r.status_code == 200, r.text
+
+
+def test_documented_errors_include_415_and_503(client):
+    """Every body takes a 415; every operation that opens the store may answer 503."""
+    spec = client.get("/openapi.json").json()
+    for path, ops in spec["paths"].items():
+        for method, op in ops.items():
+            if "requestBody" in op:
+                assert "415" in op["responses"], (method, path)
+    for path in ("/days", "/days/{date}", "/days/{date}/flightpath.geojson", "/orders",
+                 "/site.geojson", "/jobs/{job_id}", "/fleet/runs"):
+        assert "503" in spec["paths"][path]["get"]["responses"], path
+
+
+@pytest.mark.parametrize("path, body, field", [
+    ("/plan", {"map": "den312d", "start": [50, 76]}, "goal"),  # pydantic's check
+    ("/plan", {"map_text": "garbage", "start": [0, 0], "goal": [1, 1]}, "map_text"),
+    ("/jobs/fleet", {"scenario": {"name": "x"}}, "scenario.airports"),
+    ("/jobs/fleet", {"preset": "seed-3x3", "rate": 100000, "hours": 24}, "rate"),
+])
+def test_an_errors_message_is_the_detail_without_its_field(client, path, body, field):
+    """``errors[].message`` reads the same whoever found the fault (the model or a
+    router): the detail is ``field: message``, the message does not repeat the field."""
+    doc = assert_problem(client.post(path, json=body, headers=AUTH), 422, field)
+    message = doc["errors"][0]["message"]
+    assert doc["detail"] == f"{field}: {message}" and not message.startswith(field)

@@ -26,3 +26,14 @@ def test_packages_csv_of_no_run_or_no_file_is_404(site_client, fake):  # noqa: F
     fake.runs["c"] = {"id": "c", "scenario": "seed-3x3"}
     assert_problem(site_client.get("/fleet/runs/c/packages.csv"), 404,
                    words="has no packages.csv")
+
+
+def test_a_runs_files_name_packages_csv_where_it_is_stored(site_client, fake):  # noqa: F811
+    """A client finds a run's files in its ``files``: packages.csv among them when the
+    run has it (it was left out, though served), not when it would be a 404."""
+    fake.runs["a"] = {"id": "a", "scenario": "seed-3x3", "packages_csv": CSV}
+    fake.runs["c"] = {"id": "c", "scenario": "seed-3x3"}
+    files = site_client.get("/fleet/runs/a").json()["files"]
+    assert files["packages.csv"] == "/fleet/runs/a/packages.csv"
+    assert site_client.get(files["packages.csv"]).text == CSV
+    assert "packages.csv" not in site_client.get("/fleet/runs/c").json()["files"]

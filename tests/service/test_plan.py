@@ -306,3 +306,38 @@ def test_a_world_too_large_for_the_visibility_graph_is_422(client, monkeypatch, 
     body = {**body, "world_text": many + "1,1,1,1,1,1\n" * 50_001, "algorithm": "prm"}
     assert_problem(client.post("/plan", json=body, headers=AUTH), 422, "world_text",
                    "50,001 boxes, over the limit of 50,000 in a colliders file")
+
+
+@pytest.mark.parametrize("options, field, words", [
+    ({"resolution": 2}, "resolution", "applies to planning on a World"),
+    ({"samples": 50}, "samples", "applies to planning on a World"),
+    ({"seed": 3}, "seed", "applies to planning on a World"),
+    ({"prm_star": True}, "prm_star", "applies to planning on a World"),
+    ({"frame": "enu"}, "frame", "applies to a world (world_text)"),
+    ({"altitude": 10}, "altitude", "applies to a world (world_text)"),
+    ({"boundary": [0, 0, 10, 10]}, "boundary", "applies to a world (world_text)"),
+])
+def test_a_world_option_on_a_map_is_422(client, options, field, words):
+    """As skyroute.plan refuses them on a Grid: an option the search would not read is an
+    error naming it, not silently dropped."""
+    assert_problem(client.post("/plan", json={**DEN, **options}, headers=AUTH), 422, field,
+                   words)
+
+
+@pytest.mark.parametrize("options, field", [
+    ({"samples": 300}, "samples"),  # visibility, the default on a world
+    ({"algorithm": "astar", "seed": 3}, "seed"),
+    ({"algorithm": "prm", "resolution": 2}, "resolution"),
+    ({"algorithm": "prm", "heuristic": "octile"}, "heuristic"),
+    ({"weight": 1.5}, "weight"),
+])
+def test_an_option_the_world_algorithm_does_not_read_is_422(client, options, field):
+    body = {**CITY_BODY, "world_text": CITY.read_text(), **options}
+    assert_problem(client.post("/plan", json=body, headers=AUTH), 422, field,
+                   "does not apply to algorithm=")
+
+
+def test_null_options_count_as_not_given(client):
+    body = {**DEN, "resolution": None, "altitude": None, "boundary": None,
+            "geojson": False}
+    assert client.post("/plan", json=body, headers=AUTH).status_code == 200

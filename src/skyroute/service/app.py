@@ -17,7 +17,7 @@ from fastapi_offline import FastAPIOffline
 
 import skyroute
 from skyroute.service import problems
-from skyroute.service.middleware import BodyLimit, ServerTiming
+from skyroute.service.middleware import BodyLimit, HeadAsGet, ServerTiming
 from skyroute.service.resources import Resources
 from skyroute.service.routers import (
     days,
@@ -62,6 +62,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         app.include_router(module.router)
     app.add_middleware(ServerTiming)  # inside the body limit: the body is in hand
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
+    app.add_middleware(HeadAsGet)
     app.mount("/", StaticFiles(directory=STATIC, html=True), name="static")
     return app
 
@@ -75,9 +76,9 @@ def _post_only(paths: tuple[str, ...]) -> APIRouter:
         raise problems.Problem(405, f"{request.method} is not allowed on "
                                f"{request.url.path}; use POST", headers={"Allow": "POST"})
 
-    for path in paths:
-        router.add_api_route(path, not_allowed, methods=["GET", "HEAD", "PUT", "PATCH",
-                                                         "DELETE", "OPTIONS"])
+    for path in paths:  # (HEAD arrives as GET: HeadAsGet)
+        router.add_api_route(path, not_allowed, methods=["GET", "PUT", "PATCH", "DELETE",
+                                                         "OPTIONS"])
     return router
 
 

@@ -1,6 +1,7 @@
-"""Two plain ASGI middlewares: the request body limit (413 past it, before any handler
-reads a byte too many) and the server-side timing header every response carries
-(``Server-Timing: app;dur=MS``, which the load benchmark reads).
+"""Three plain ASGI middlewares: the request body limit (413 past it, before any handler
+reads a byte too many), the server-side timing header every response carries
+(``Server-Timing: app;dur=MS``, which the load benchmark reads), and HEAD answered as
+GET without its body.
 
 The body limit runs first and hands the app the whole body, so ``app;dur`` is the time
 from the complete request to the response headers: the server's work on the request,
@@ -101,3 +102,24 @@ class ServerTiming:
             await send(message)
 
         await self.app(scope, receive, timed_send)
+
+
+class HeadAsGet:
+    """Answer ``HEAD`` as ``GET`` with the body left out (RFC 9110: the same status and
+    headers). FastAPI's routes take GET alone, so without this the viewer's static mount
+    answered HEAD on every API path with a 404."""
+
+    def __init__(self, app) -> None:
+        self.app = app
+
+    async def __call__(self, scope, receive, send) -> None:
+        if scope["type"] != "http" or scope["method"] != "HEAD":
+            await self.app(scope, receive, send)
+            return
+
+        async def no_body(message) -> None:
+            if message["type"] == "http.response.body":
+                message = {**message, "body": b""}
+            await send(message)
+
+        await self.app({**scope, "method": "GET"}, receive, no_body)

@@ -62,7 +62,9 @@ def problem_response(status: int, detail: str, *, field: str | None = None,
            "status": status, "detail": detail}
     if field is not None:
         doc["field"] = field
-        doc["errors"] = errors or [{"field": field, "message": detail}]
+        # as a validation error reads: the message without the "field: " the detail has
+        doc["errors"] = errors or [{"field": field,
+                                    "message": detail.removeprefix(f"{field}: ")}]
     return JSONResponse(doc, status_code=status, media_type=MEDIA_TYPE, headers=headers)
 
 
@@ -102,6 +104,19 @@ def _message(err: dict) -> str:
 NOT_JSON = "the request body cannot be read as JSON text (UTF-8)"
 
 
+def _not_json_media(request: Request) -> str | None:
+    """Why FastAPI left the body unread (its rule: ``application/json`` or
+    ``application/*+json``), or None for a JSON media type."""
+    ctype = request.headers.get("content-type")
+    if not ctype:
+        return "the request has a body but no Content-Type"
+    media = ctype.split(";")[0].strip().lower()
+    main, _, sub = media.partition("/")
+    if main == "application" and (sub == "json" or sub.endswith("+json")):
+        return None
+    return f"Content-Type {media} is not JSON"
+
+
 async def _validation(request: Request, exc: RequestValidationError) -> JSONResponse:
     bad = next((e for e in exc.errors() if e.get("type") == "json_invalid"), None)
     if bad is not None:  # its loc is a byte offset, not a field: a 400, as for non-UTF-8
@@ -109,6 +124,11 @@ async def _validation(request: Request, exc: RequestValidationError) -> JSONResp
         reason = (bad.get("ctx") or {}).get("error", "")
         at = f" at byte {where[0]}" if where and isinstance(where[0], int) else ""
         return problem_response(400, f"{NOT_JSON}: {reason or 'invalid JSON'}{at}")
+    if any(tuple(e.get("loc", ())) == ("body",) and e.get("type") != "missing"
+           for e in exc.errors()):  # a body that was there but never read as JSON
+        why = _not_json_media(request)
+        if why is not None:
+            return problem_response(415, f"{why}; send the body as application/json")
     errors = [{"field": field_name(tuple(e.get("loc", ()))), "message": _message(e)}
               for e in exc.errors()]
     first = errors[0] if errors else {"field": "body", "message": "invalid input"}
@@ -163,7 +183,8 @@ def responses(*codes: int) -> dict:
 def document(app: FastAPI) -> None:
     """Make ``app``'s OpenAPI say what the handlers do: every error response is
     ``application/problem+json`` with :class:`ProblemDoc` (FastAPI documents its 422 as
-    JSON of its own shape), an operation with inputs documents 422, and a write 413."""
+    JSON of its own shape), an operation with inputs documents 422, one with a body 400
+    and 415, and a write 413."""
     from fastapi.openapi.utils import get_openapi
 
     def openapi() -> dict:
@@ -186,6 +207,7 @@ def document(app: FastAPI) -> None:
                     codes.setdefault("422", {})
                 if op.get("requestBody"):
                     codes.setdefault("400", {})  # a body that is not UTF-8 text
+                    codes.setdefault("415", {})  # a body not sent as JSON
                 if method in ("post", "put", "patch"):
                     codes.setdefault("413", {})
                 for code, resp in codes.items():

@@ -87,7 +87,8 @@ class Day(BaseModel):
     orders: list[DayOrder] = Field(description="Every order of the day.")
 
 
-@router.get("/days", response_model=list[DaySummary], summary="Stored delivery days")
+@router.get("/days", response_model=list[DaySummary], responses=responses(503),
+            summary="Stored delivery days")
 def list_days(eng: EngineDep) -> list[dict]:
     from skyroute.delivery.reads import stored_days
 
@@ -104,7 +105,7 @@ def _report(eng, date: dt.date) -> dict:
     return rep
 
 
-@router.get("/days/{date}", response_model=Day, responses=responses(404, 422),
+@router.get("/days/{date}", response_model=Day, responses=responses(404, 422, 503),
             summary="A stored day: report, deliveries, orders")
 def get_day(date: DayDate, eng: EngineDep,
             res: ResourcesDep) -> dict:
@@ -140,7 +141,7 @@ def get_day(date: DayDate, eng: EngineDep,
                              "description": "The flight as one LineString in lon/lat "
                              "(the file `deliver` writes), with each move's ILP angle and "
                              "order number in its properties."},
-                       **responses(404, 422)},
+                       **responses(404, 422, 503)},
             summary="A stored day's flight as GeoJSON")
 async def get_flightpath(date: DayDate, request: Request, res: ResourcesDep) -> Response:
     # The file is made once per stored version of the day and served from memory; the

@@ -37,7 +37,9 @@ class Run(BaseModel):
     offset: int
     limit: int
     events_total: int
-    files: dict[str, str]
+    files: dict[str, str] = Field(description="Each of the run's files by name: "
+                                  "events.jsonl, tracks.csv, fleet.geojson, and "
+                                  "packages.csv where the run has it.")
 
 
 def _store():
@@ -117,11 +119,13 @@ def get_run(run_id: RunId, res: ResourcesDep,
     lines = _text(run, "events", "events_jsonl").splitlines()
     page = [json.loads(x) for x in lines[offset:offset + limit]]
     base = f"/fleet/runs/{run_id}"
+    names = ["events.jsonl", "tracks.csv", "fleet.geojson"]
+    if _text(run, "packages_csv", "packages"):  # a run stored without it: a 404 there
+        names.append("packages.csv")
     return {"id": str(run["id"]), "report": _as_dict(run.get("report")),
             "scenario": _scenario(run), "params": _as_dict(run.get("params")),
             "events": page, "offset": offset, "limit": limit, "events_total": len(lines),
-            "files": {k: f"{base}/{k}" for k in ("events.jsonl", "tracks.csv",
-                                                 "fleet.geojson")}}
+            "files": {k: f"{base}/{k}" for k in names}}
 
 
 def _file(content: str, media_type: str, name: str) -> Response:

@@ -23,7 +23,7 @@ class OrderOut(BaseModel):
     items: list[str]
 
 
-@router.get("/orders", response_model=list[OrderOut], responses=responses(422),
+@router.get("/orders", response_model=list[OrderOut], responses=responses(422, 503),
             summary="The stored orders of a day")
 def list_orders(date: Annotated[IsoDate, Query(description="The day, YYYY-MM-DD.")],
                 eng: EngineDep) -> list[dict]:

@@ -182,31 +182,20 @@ def _plan_checked(body: PlanRequest, res: Resources) -> dict:
         grid = _grid(body, res)
         start, goal = _cell(body.start, "start"), _cell(body.goal, "goal")
         r = plan(grid, start, goal, algorithm=body.algorithm or "astar",
-                 connectivity=body.connectivity, corner_cutting=body.corner_cutting,
-                 heuristic=body.heuristic, weight=body.weight, prune=body.prune,
-                 max_expansions=budget)
+                 max_expansions=budget, **_options(body))
         out = r.to_dict()
         if body.geojson:
             from skyroute.io.geojson import grid_path_geojson
 
             out["geojson"] = grid_path_geojson(grid, r)
     else:
-        from skyroute.roadmap.world_plan import options_for
-
         world = _world(body)
         _check_world_limits(body, world, res)
         algorithm = body.algorithm or "visibility"
         if algorithm == "prm":
             budget = None  # scipy's Dijkstra has no budget; samples bound the work
-        # the body has a default for every option: pass the ones the algorithm reads
         r = plan(world, tuple(body.start), tuple(body.goal), algorithm=algorithm,
-                 max_expansions=None if algorithm == "prm" else budget,
-                 **options_for(algorithm, connectivity=body.connectivity,
-                               corner_cutting=body.corner_cutting, heuristic=body.heuristic,
-                               weight=body.weight, prune=body.prune,
-                               resolution=body.resolution, samples=body.samples,
-                               neighbours=body.neighbours, prm_star=body.prm_star,
-                               seed=body.seed))
+                 max_expansions=None if algorithm == "prm" else budget, **_options(body))
         out = r.to_dict()
         out["frame"] = world.frame
         if r.found:
@@ -223,7 +212,26 @@ def _plan_checked(body: PlanRequest, res: Resources) -> dict:
     return out
 
 
+OPTIONS = ("connectivity", "corner_cutting", "heuristic", "weight", "prune", "resolution",
+           "samples", "neighbours", "prm_star", "seed")
+WORLD_ONLY = ("frame", "altitude", "boundary")  # how a world_text is read
+
+
+def _options(body: PlanRequest) -> dict:
+    """The planner options the request gave (null counts as not given), for
+    :func:`skyroute.plan` to read or refuse as it does in Python: ``seed`` on a map or
+    ``samples`` with "visibility" is a 422 naming it, not dropped."""
+    given = body.model_fields_set
+    return {k: getattr(body, k) for k in OPTIONS
+            if k in given and getattr(body, k) is not None}
+
+
 def _grid(body: PlanRequest, res: Resources):
+    stray = next((k for k in WORLD_ONLY if k in body.model_fields_set
+                  and getattr(body, k) is not None), None)
+    if stray is not None:
+        raise Problem(422, f"{stray}={getattr(body, stray)!r} applies to a world "
+                      "(world_text); a map is searched as it is", field=stray)
     if body.map is not None:
         grid = res.grid(body.map)
         if grid is None:
