@@ -174,3 +174,87 @@ def test_a_delivery_cost_over_sql_integer_names_the_order(engine):
                                             r"cost_in_pence 9223372036854775858 is outside"):
         store.write_day(engine, DAY, run_row(1), [big], moves(1))
     assert store.day_rows(engine, DAY) == {"deliveries": [], "flightpath": []}
+
+
+def _import_meanwhile(engine, other, orders) -> list:
+    """Arrange that ``other`` imports ``orders`` just before ``engine`` inserts its own
+    (after it has read which are stored): two ``skyroute db import`` or ``deliver
+    --data`` runs at once. What the other import did (returned or raised) is listed."""
+    seen: list = []
+
+    def meanwhile(conn, cursor, statement, *args):
+        if statement.lstrip().upper().startswith("INSERT INTO ORDERS") and not seen:
+            try:
+                seen.append(store.import_orders(other, orders))
+            except SkyrouteError as exc:
+                seen.append(exc)
+
+    sa.event.listen(engine, "before_cursor_execute", meanwhile)
+    return seen
+
+
+TWO = [Order("0000000a", DAY, "s2400001", "a.b.c", ("x",)),
+       Order("0000000b", DAY, "s2400002", "a.b.d", ("z",))]
+
+
+def test_two_imports_at_once_wait_for_each_other(engine):
+    # the second read "not stored" too and its insert was an IntegrityError traceback;
+    # on SQLite the first now holds the write lock from its read, so the other waits
+    # (here past its 0.2 s busy timeout: a one-line error, nothing written)
+    other = store.connect(f"{engine.url}?timeout=0.2")
+    seen = _import_meanwhile(engine, other, TWO)
+    assert store.import_orders(engine, TWO) == (2, 0)
+    assert len(seen) == 1 and isinstance(seen[0], SkyrouteError)
+    assert re.search(r"store\.db\?timeout=0\.2: the store is busy: another process kept it "
+                     r"locked", str(seen[0]))
+    assert store.import_orders(other, TWO) == (0, 2)
+
+
+def test_an_import_that_lost_the_race_adds_the_rest(engine, monkeypatch):
+    # PostgreSQL does not serialise the two: the later insert collides, is read again
+    monkeypatch.setattr(store, "writing", lambda e: e.begin(), raising=False)
+    seen = _import_meanwhile(engine, store.connect(str(engine.url)), TWO[:1])
+    assert store.import_orders(engine, TWO) == (1, 1)
+    assert seen == [(1, 0)]
+    assert store.orders_between(engine, DAY, DAY)[DAY] == TWO
+
+
+def test_a_new_store_made_by_two_processes_at_once(tmp_path):
+    # the second saw no schema and made it again: "not a usable store: table orders
+    # already exists"; making it now holds the write lock, so the second finds it made
+    url = f"sqlite:///{tmp_path / 'new.db'}"
+    script = textwrap.dedent(f"""
+        from skyroute.delivery import store
+        print(store.init(store.connect({url!r})))
+    """)
+    procs = [subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True,
+                              cwd=str(Path(__file__).parents[2])) for _ in range(3)]
+    outs = [p.communicate(timeout=60)[0] for p in procs]
+    done = [(p.returncode, out) for p, out in zip(procs, outs, strict=True)]
+    assert done == [(0, "0003\n")] * 3
+
+
+def test_a_store_locked_too_long_is_one_line(tmp_path):
+    import sqlite3
+
+    path = tmp_path / "busy.db"
+    store.init(store.connect(f"sqlite:///{path}"))
+    holder = sqlite3.connect(path, isolation_level=None)
+    holder.execute("BEGIN IMMEDIATE")  # another process writing, for longer than we wait
+    try:
+        e = store.connect(f"sqlite:///{path}?timeout=0.1")
+        with pytest.raises(SkyrouteError, match=r"busy\.db\?timeout=0\.1: the store is busy"):
+            store.write_day(e, DAY, run_row(1), [], moves(1))
+        with pytest.raises(SkyrouteError, match="the store is busy"):
+            store.init(e)
+    finally:
+        holder.rollback()
+        holder.close()
+    assert store.day_rows(e, DAY) == {"deliveries": [], "flightpath": []}
+
+
+def test_sqlite_waits_longer_than_pythons_five_seconds(tmp_path):
+    e = store.connect(f"sqlite:///{tmp_path / 'x.db'}")
+    with e.connect() as c:
+        assert c.exec_driver_sql("pragma busy_timeout").scalar() == store.BUSY_SECONDS * 1000

@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import datetime as dt
 import json
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import sqlalchemy as sa
@@ -30,6 +31,10 @@ from skyroute.caches import register
 from skyroute.errors import SkyrouteError
 
 DEFAULT_DB = "sqlite:///skyroute.db"
+# How long a SQLite store waits for another process's write to finish before it is an
+# error (Python's sqlite3 waits 5 s): a cron job's import or a day being stored by another
+# 'skyroute deliver'. A URL's own '?timeout=SECONDS' wins.
+BUSY_SECONDS = 30.0
 SQL_INT = (-2**31, 2**31 - 1)  # an INTEGER column: 32 bits on PostgreSQL, 64 on SQLite
 TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
 _REFLECTED: dict[tuple[str, tuple[str, ...]], dict[str, sa.Table]] = {}
@@ -60,10 +65,11 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
     """An engine for ``url``; a bad URL or an unreachable server is one clear error."""
     try:
         parsed = sa.engine.make_url(url)
-        if parsed.drivername.startswith("sqlite") and parsed.database not in (None, "",
-                                                                               ":memory:"):
+        sqlite = parsed.drivername.startswith("sqlite")
+        if sqlite and parsed.database not in (None, "", ":memory:"):
             Path(parsed.database).parent.mkdir(parents=True, exist_ok=True)
-        engine = sa.create_engine(url)
+        busy = {"timeout": BUSY_SECONDS} if sqlite and "timeout" not in parsed.query else {}
+        engine = sa.create_engine(url, connect_args=busy)
         with engine.connect():
             pass
     except sa.exc.ArgumentError:
@@ -93,6 +99,28 @@ def safe_url(url: str) -> str:
 _safe = safe_url
 
 
+@contextmanager
+def writing(engine: sa.Engine) -> Iterator[sa.Connection]:
+    """``engine.begin()`` for a transaction that reads, then writes what it read was
+    missing. On SQLite it takes the write lock first (``BEGIN IMMEDIATE``): two processes
+    importing the same orders, or making the schema of a new store, at once both read
+    "not there" and the second's insert was an IntegrityError traceback ("table orders
+    already exists" for the schema); now the second waits and reads the first's rows. A
+    lock held by another process past the busy timeout is a SkyrouteError, not a
+    "database is locked" traceback."""
+    try:
+        with engine.begin() as conn:
+            if conn.dialect.name == "sqlite":
+                conn.exec_driver_sql("BEGIN IMMEDIATE")
+            yield conn
+    except sa.exc.OperationalError as exc:
+        if "locked" not in str(exc.orig):
+            raise
+        raise SkyrouteError(f"{_safe(str(engine.url))}: the store is busy: another process "
+                            "kept it locked for too long (its busy timeout); try again when "
+                            "it is done") from None
+
+
 def init(engine: sa.Engine) -> str:
     """Create or upgrade the schema to the newest migration; return its revision."""
     from alembic import command
@@ -104,7 +132,7 @@ def init(engine: sa.Engine) -> str:
     cfg.set_main_option("script_location", str(Path(__file__).parent / "migrations"))
     url = _safe(str(engine.url))
     try:
-        with engine.begin() as conn:
+        with writing(engine) as conn:
             cfg.attributes["connection"] = conn
             command.upgrade(cfg, "head")
     except sa.exc.DatabaseError as exc:  # e.g. a file that is not SQLite's
@@ -145,7 +173,18 @@ def import_orders(engine: sa.Engine, all_orders: Iterable) -> tuple[int, int]:
     written."""
     t = tables(engine)
     orders, order_details = t["orders"], t["order_details"]
-    with engine.begin() as conn:
+    all_orders = list(all_orders)
+    try:
+        return _import(engine, orders, order_details, all_orders)
+    except sa.exc.IntegrityError:
+        # another process added some of these orders after this one read what was there
+        # (PostgreSQL; SQLite serialises the two in writing()): read again, add the rest
+        return _import(engine, orders, order_details, all_orders)
+
+
+def _import(engine: sa.Engine, orders: sa.Table, order_details: sa.Table,
+            all_orders: list) -> tuple[int, int]:
+    with writing(engine) as conn:
         have = set(conn.scalars(sa.select(orders.c.order_no)))
         new = [o for o in all_orders if o.order_no not in have]
         heads = [{"order_no": o.order_no, "delivery_date": o.date, "customer": o.customer,
@@ -206,7 +245,7 @@ def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[d
     check_fits(runs, head, f"{date}: ")
     for row in rows:
         check_fits(deliveries, row, f"{date}: order {row.get('order_no')!r}: ")
-    with engine.begin() as conn:
+    with writing(engine) as conn:
         for t in (flightpath, deliveries, runs):
             conn.execute(t.delete().where(t.c.delivery_date == date))
         conn.execute(runs.insert(), [head])
