@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 from typing import Annotated
 
@@ -99,6 +100,9 @@ def serve_command(
                    f"{TOKEN_ENV} or --token-file to choose one):\n    {settings.token}")
     else:
         typer.echo(f"write token from {where}", err=True)
+    # SIGTERM is how a server is stopped (systemd, docker): uvicorn shuts down gracefully
+    # and then re-raises it, which run_cli's handler would report as "terminated", 143
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if workers == 1:
         uvicorn.run(create_app(settings), host=host, port=port, log_level=log_level)
     else:
