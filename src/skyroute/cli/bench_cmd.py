@@ -151,7 +151,8 @@ def _table(rep: dict) -> Table:
                f"{prep['index']}" if prep else None)
     t = Table(title=f"{rep['map']} ({rep['size'][0]}x{rep['size'][1]}): "
                     f"{rep['queries']} of {rep['scen_lines']} scenario lines", caption=caption)
-    for col in ("runner", "median ms", "M exp/s", "matched", "cost/opt mean", "cost/opt max"):
+    for col in ("runner", "median ms", "M exp/s", "matched", "invalid", "cost/opt mean",
+                "cost/opt max"):
         t.add_column(col, justify="left" if col == "runner" else "right")
     for p in peers:
         t.add_column(f"x faster than {p}", justify="right")
@@ -159,7 +160,8 @@ def _table(rep: dict) -> Table:
         eps = row["expansions_per_s"]
         cells = [row["runner"] + (" (peer)" if row["peer"] else ""),
                  _fmt(row["median_ms"], ".3f"), _fmt(eps and eps / 1e6, ".2f"),
-                 f"{row['matched']}/{rep['queries']}", _fmt(row["mean_cost_ratio"], ".4f"),
+                 f"{row['matched']}/{rep['queries']}", str(row["invalid"]),
+                 _fmt(row["mean_cost_ratio"], ".4f"),
                  _fmt(row["max_cost_ratio"], ".4f")]
         cells += [_fmt(row["speedup_vs"].get(p), ".2f") if not row["peer"] else ""
                   for p in peers]
