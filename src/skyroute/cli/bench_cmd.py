@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import platform
 from pathlib import Path
 from typing import Annotated
 
@@ -21,7 +20,8 @@ from skyroute.bench.grid import (
     load_case,
     random_case,
 )
-from skyroute.bench.peers import skip_reason
+from skyroute.bench.machine import machine
+from skyroute.bench.peers import PEERS, skip_reason
 from skyroute.bench.random_maps import parse_random
 from skyroute.cli.parse import parse_list
 from skyroute.cli.tables import plain_console, print_table, progress_bar
@@ -97,8 +97,7 @@ def bench_grid(
                             "prepared": prepared,
                             "algorithms": algs, "peers": have, "missing_peers": missing,
                             "seed": seed},
-               "machine": {"python": platform.python_version(),
-                           "processor": platform.processor() or platform.machine()},
+               "machine": machine([PEERS[p].module for p in have]),
                "maps": reports}
         write_atomic(json_out, json.dumps(doc, indent=1))
 
