@@ -225,3 +225,37 @@ def test_networkx_limit_is_2048_squared():
     why = peers.skip_reason("networkx", Grid(np.zeros((2048, 2049), dtype=bool)))
     assert "over its limit of 4,194,304 cells" in why
     assert peers.skip_reason("pyastar2d", Grid(np.zeros((4096, 4096), dtype=bool))) is None
+
+
+def test_json_report_records_what_a_rerun_needs(monkeypatch, capsys, tmp_path):
+    """The seed, the versions (skyroute, numpy, numba, the peers) and the CPU: two
+    reports are only comparable with them (it held Python's version and "x86_64")."""
+    write_pair(tmp_path)
+    out_json = tmp_path / "report.json"
+    code, _, err = run(monkeypatch, capsys, "bench", "grid", "--maps", str(tmp_path),
+                       "--algorithms", "astar", "--peers", "networkx", "--seed", "7",
+                       "--json", str(out_json))
+    assert code == 0, err
+    doc = json.loads(out_json.read_text())
+    m = doc["machine"]
+    import skyroute
+    assert doc["settings"]["seed"] == 7 and m["skyroute"] == skyroute.__version__
+    assert m["packages"]["numpy"] == np.__version__ and m["packages"]["numba"]
+    assert "networkx" in m["packages"] and m["cpu"] and m["cores"] >= 1 and m["date"]
+
+
+def test_dubins_json_records_its_seed_and_machine(monkeypatch, capsys, tmp_path):
+    from skyroute.bench import motion
+
+    fake = {"radius": 1.7, "seed": 0, "repeats": 7, "ompl_calls": 5000,
+            "threading_layer": "omp", "rows": []}
+    monkeypatch.setattr(motion, "dubins_speed", lambda: fake)
+    # the command leaves with os._exit once OMPL is imported (its leak report at exit)
+    monkeypatch.setattr("skyroute.cli.bench_world_cmd._exit_past_ompl", lambda: None)
+    out_json = tmp_path / "dubins.json"
+    code, _, err = run(monkeypatch, capsys, "bench", "motion", "--dubins",
+                       "--json", str(out_json))
+    assert code == 0, err
+    doc = json.loads(out_json.read_text())
+    assert doc["dubins"] == fake and doc["machine"]["packages"]["numba"]
+    assert "ompl" in doc["machine"]["packages"]

@@ -187,3 +187,20 @@ def test_ompl_simplification_is_timed(monkeypatch):
     assert run["seconds"] > 0 and run["simplify_seconds"] > 0
     assert run["seconds"] + run["simplify_seconds"] == clock.now
     assert bench_world.ompl_rows(run)[1]["seconds"] == clock.now
+
+
+def test_tours_report_how_much_longer_nearest_first_is(monkeypatch):
+    """greedy_longer_* is nearest-first's length over the exact tour's, minus 1: a greedy
+    tour of 150 against an exact 100 is 50 % longer (it read 33 %, the exact tour's
+    saving, as 1 - 100/150)."""
+    import skyroute.motion.tour as tour_mod
+
+    def fake_tour(start, pts, radius, *, headings, exact_limit=None):
+        length = 100.0 if exact_limit is None else 110.0
+        return types.SimpleNamespace(length=length, greedy_bound=150.0, seconds=0.0)
+
+    monkeypatch.setattr(tour_mod, "tour", fake_tour)
+    t = bench_curvature.tour_benchmark(2, 0)
+    assert t["greedy_longer_mean"] == pytest.approx(0.5)
+    assert t["greedy_longer_min"] == t["greedy_longer_max"] == pytest.approx(0.5)
+    assert t["local_gap_mean"] == pytest.approx(0.1)

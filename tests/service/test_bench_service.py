@@ -27,7 +27,9 @@ def test_flightpath_load_from_the_cli(monkeypatch, capsys, tmp_path, lunch):
                           "--db", lunch[0], "--requests", "30", "--clients", "3",
                           "--client", "raw", "--json", str(out))
     assert code == 0, err
-    (row,) = json.loads(out.read_text())
+    doc = json.loads(out.read_text())
+    (row,) = doc["rows"]
+    assert doc["settings"]["requests"] == 30 and doc["machine"]["skyroute"]
     assert row["load"] == "GET /days/2024-01-03/flightpath.geojson"
     assert row["errors"] == 0 and row["requests"] == 30 and "req/s" in text
 
@@ -63,6 +65,12 @@ def test_the_json_path_is_checked_before_the_load(monkeypatch, capsys, tmp_path)
     (["--client-processes", "1000000"], "--client-processes 1,000,000 is over the limit of "
                                         "64 client processes"),
     (["--client-processes", "0"], "--client-processes 0 must be at least 1"),
+    # a bad planner was a whole load of 422s and exit 0; a bad map was found after the
+    # loads before it had run
+    (["--algorithm", "astr"], "--algorithm 'astr' is not valid; choose one of 'bfs', "
+                              "'dijkstra', 'astar', 'jps', 'theta', 'lazy_theta'"),
+    (["--map", "nope"], "--map 'nope' is not a bundled map; choose one of 'Berlin_1_256', "
+                        "'Paris_1_512', 'den312d'"),
 ])
 def test_a_load_past_its_limits_is_refused_before_the_server_starts(monkeypatch, capsys,
                                                                     args, words):

@@ -6,8 +6,12 @@ Times are wall clock around one call: ``skyroute.plan`` for ours (validation inc
 ``PreparedGrid.plan`` for the ``prepared`` runner (its index is built once per map, timed
 apart as ``build_seconds``, its size the arrays' ``nbytes``, the build's peak resident
 memory from a fresh process as ``build_peak_bytes``), the peer's own query call
-for a peer (its one-off set-up is not timed). What the bench does with an answer (the
-peer path's octile cost, reading a result's fields) happens after the clock stops.
+for a peer (its one-off set-up is not timed). What the bench does with an answer
+(checking and re-measuring its path, reading a result's fields) happens after the clock
+stops. A line is matched when the answer is a legal path for the query and its length,
+re-measured from the path (:mod:`skyroute.bench.path_check`), equals the optimum; an
+answer that is no legal path, or whose reported cost is not its path's length, is
+counted as ``invalid``.
 """
 
 from __future__ import annotations
@@ -21,11 +25,12 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.bench.build_memory import build_peak_bytes
-from skyroute.bench.peers import PEERS, available, octile_cost, skip_reason
+from skyroute.bench.path_check import Checker, legal_length, path_length
+from skyroute.bench.peers import PEERS, available, skip_reason
 from skyroute.bench.random_maps import far_queries, parse_random, random_grid
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.planner import plan
-from skyroute.search.grid_plan import GRID_ALGORITHMS
+from skyroute.search.grid_plan import ANY_ANGLE, GRID_ALGORITHMS
 from skyroute.search.prepared import prepare
 from skyroute.world.grid import Grid
 from skyroute.world.movingai import Scenario, query_line, read_map, read_scen
@@ -76,6 +81,7 @@ class RunnerStats:
     ratios: list = field(default_factory=list)
     matched: int = 0
     failed: int = 0
+    invalid: int = 0
     expanded: int = 0
     search_seconds: float = 0.0
 
@@ -89,28 +95,39 @@ class RunnerStats:
                                  if self.search_seconds > 0 and not self.peer else None),
             "matched": self.matched,
             "failed": self.failed,
+            "invalid": self.invalid,
             "mean_cost_ratio": float(np.mean(self.ratios)) if self.ratios else None,
             "max_cost_ratio": float(np.max(self.ratios)) if self.ratios else None,
         }
 
 
-# A runner is (query, score): query(s, t) is the timed call, score(answer) turns its
-# answer into (cost or None, expanded, search seconds) after the clock has stopped.
+# A runner is (query, score): query(s, t) is the timed call, score(answer, s, t) turns
+# its answer into (path length or None for no path, legal, expanded, search seconds)
+# after the clock has stopped.
 Runner = tuple[Callable, Callable]
 
 
-def _score_result(r) -> tuple:
-    return r.cost if r.found else None, r.expanded, r.seconds
+def _result_scorer(check: Checker, *, any_angle: bool = False) -> Callable:
+    """Score a PlanResult by its path, re-measured; legal only when the path answers
+    the query and its reported cost is that path's length."""
+    def score(r, s, t):
+        if not r.found:
+            return None, False, r.expanded, r.seconds
+        length = check(r.path, s, t, any_angle)
+        legal = length is not None and abs(r.cost - length) <= 1e-9 * max(1.0, length)
+        return path_length(r.path), legal, r.expanded, r.seconds
+
+    return score
 
 
-def _ours(grid: Grid, algorithm: str) -> Runner:
+def _ours(grid: Grid, algorithm: str, check: Checker) -> Runner:
     def run(s, t):
         return plan(grid, s, t, algorithm=algorithm)
 
-    return run, _score_result
+    return run, _result_scorer(check, any_angle=algorithm in ANY_ANGLE)
 
 
-def _prepared(grid: Grid, info: dict) -> Runner:
+def _prepared(grid: Grid, info: dict, check: Checker) -> Runner:
     index = prepare(grid)  # first build: loads the compiled kernels from numba's cache
     index = prepare(grid)
     try:
@@ -123,15 +140,17 @@ def _prepared(grid: Grid, info: dict) -> Runner:
                 accelerator=index.accelerator, index=index.describe(),
                 candidates_us={k: v * 1e6 for k, v in index.candidates.items()})
 
-    return index.plan, _score_result
+    return index.plan, _result_scorer(check)
 
 
-def _peer(grid: Grid, name: str) -> Runner:
+def _peer(grid: Grid, name: str, check: Checker) -> Runner:
     peer = PEERS[name]
 
-    def score(answer):
+    def score(answer, s, t):
         cells = peer.cells(answer)
-        return (None if cells is None else octile_cost(cells)), 0, 0.0
+        if cells is None:
+            return None, False, 0, 0.0
+        return path_length(cells), check(cells, s, t) is not None, 0, 0.0
 
     return peer.prepare(grid), score
 
@@ -255,15 +274,18 @@ def bench_queries(grid: Grid, scen: Scenario, label: str, *, per_map: int,
     rng = np.random.default_rng(seed)
     n = len(scen) if per_map <= 0 else min(per_map, len(scen))
     idx = np.sort(rng.choice(len(scen), size=n, replace=False))
-    runners = [(RunnerStats(a, False), *_ours(grid, a)) for a in algorithms]
+    check = legal_length(grid)
+    runners = [(RunnerStats(a, False), *_ours(grid, a, check)) for a in algorithms]
     info: dict = {}
     if prepared:
-        runners.append((RunnerStats("prepared", False), *_prepared(grid, info)))
+        runners.append((RunnerStats("prepared", False), *_prepared(grid, info, check)))
     skipped = {p: why for p in peers if (why := skip_reason(p, grid))}
-    runners += [(RunnerStats(p, True), *_peer(grid, p)) for p in peers if p not in skipped]
+    runners += [(RunnerStats(p, True), *_peer(grid, p, check)) for p in peers
+                if p not in skipped]
     first = idx[0]
     for _, run, score in runners:  # warm-up: compile, caches
-        score(run(tuple(scen.starts[first].tolist()), tuple(scen.goals[first].tolist())))
+        s, t = tuple(scen.starts[first].tolist()), tuple(scen.goals[first].tolist())
+        score(run(s, t), s, t)
     for q, i in enumerate(idx):
         s, t = tuple(scen.starts[i].tolist()), tuple(scen.goals[i].tolist())
         opt = float(scen.optimal[i])
@@ -272,14 +294,15 @@ def bench_queries(grid: Grid, scen: Scenario, label: str, *, per_map: int,
             t0 = time.perf_counter()
             answer = run(s, t)
             stats.times.append(time.perf_counter() - t0)
-            cost, expanded, search_s = score(answer)
+            cost, legal, expanded, search_s = score(answer, s, t)
             stats.expanded += expanded
             stats.search_seconds += search_s
             if cost is None:
                 stats.failed += 1
                 continue
             stats.ratios.append(cost / opt if opt > 0 else (1.0 if cost == 0 else np.inf))
-            stats.matched += bool(scen.matches(int(i), cost))
+            stats.invalid += not legal
+            stats.matched += legal and bool(scen.matches(int(i), cost))
         if on_query:
             on_query()
     rows = [r[0].row() for r in runners]

@@ -36,7 +36,8 @@ def dubins_speed(*, sizes=(100_000, 1_000_000), threads=(1, 2), repeats: int = 7
     if space is not None:  # made before any clock starts: OMPL's times hold distance() only
         m_max = min(n_max, ompl_calls)
         a, b = _ompl_states(space, s[:m_max]), _ompl_states(space, g[:m_max])
-    out = {"radius": radius, "threading_layer": None, "rows": []}
+    out = {"radius": radius, "seed": seed, "repeats": repeats, "ompl_calls": ompl_calls,
+           "threading_layer": None, "rows": []}
     before = numba.get_num_threads()
     try:
         for n in sizes:

@@ -135,9 +135,3 @@ def skip_reason(name: str, grid: Grid) -> str | None:
     return (f"{grid.width}x{grid.height} is over its limit of {peer.max_cells:,} cells "
             f"(its graph would need about {need:.0f} GB)")
 
-
-def octile_cost(cells: np.ndarray) -> float:
-    """Length of a chain of cells with orthogonal steps 1 and diagonal steps sqrt 2."""
-    d = np.abs(np.diff(np.asarray(cells, dtype=float), axis=0))
-    return float(np.sum(np.maximum(d[:, 0], d[:, 1]) + (math.sqrt(2) - 1) *
-                        np.minimum(d[:, 0], d[:, 1])))

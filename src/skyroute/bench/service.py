@@ -280,17 +280,28 @@ def _summary(records: list[dict], wall: float) -> dict:
     return out
 
 
-def plan_queries(map_name: str, n: int, *, seed: int = 0,
-                 algorithm: str = "astar") -> list[dict]:
-    """``n`` POST /plan bodies: scenario lines of ``map_name`` drawn uniformly (seeded)."""
+def check_plan_load(map_name: str, algorithm: str) -> Path:
+    """The bundled map ``map_name``'s path when it is one and ``algorithm`` is a grid
+    algorithm, else an OptionError naming the option: before any server starts, not a
+    load of answers that are all 422."""
+    from skyroute.errors import check_choice
+    from skyroute.search.grid_plan import GRID_ALGORITHMS
     from skyroute.world.load import bundled_maps
-    from skyroute.world.movingai import read_scen
 
     maps = bundled_maps()
     if map_name not in maps:
-        raise SkyrouteError(f"map={map_name!r} is not a bundled map; choose one of "
-                            + ", ".join(repr(m) for m in maps), param="map")
-    scen = read_scen(str(maps[map_name]) + ".scen")
+        raise OptionError(f"map={map_name!r} is not a bundled map; choose one of "
+                          + ", ".join(repr(m) for m in maps), param="map")
+    check_choice("algorithm", algorithm, GRID_ALGORITHMS)
+    return maps[map_name]
+
+
+def plan_queries(map_name: str, n: int, *, seed: int = 0,
+                 algorithm: str = "astar") -> list[dict]:
+    """``n`` POST /plan bodies: scenario lines of ``map_name`` drawn uniformly (seeded)."""
+    from skyroute.world.movingai import read_scen
+
+    scen = read_scen(str(check_plan_load(map_name, algorithm)) + ".scen")
     rows = np.random.default_rng(seed).integers(0, len(scen), n)
     return [{"map": map_name, "start": scen.starts[i].tolist(),
              "goal": scen.goals[i].tolist(), "algorithm": algorithm, "geojson": False}

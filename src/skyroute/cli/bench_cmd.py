@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import platform
 from pathlib import Path
 from typing import Annotated
 
@@ -21,7 +20,8 @@ from skyroute.bench.grid import (
     load_case,
     random_case,
 )
-from skyroute.bench.peers import skip_reason
+from skyroute.bench.machine import machine
+from skyroute.bench.peers import PEERS, skip_reason
 from skyroute.bench.random_maps import parse_random
 from skyroute.cli.parse import parse_list
 from skyroute.cli.tables import plain_console, print_table, progress_bar
@@ -97,8 +97,7 @@ def bench_grid(
                             "prepared": prepared,
                             "algorithms": algs, "peers": have, "missing_peers": missing,
                             "seed": seed},
-               "machine": {"python": platform.python_version(),
-                           "processor": platform.processor() or platform.machine()},
+               "machine": machine([PEERS[p].module for p in have]),
                "maps": reports}
         write_atomic(json_out, json.dumps(doc, indent=1))
 
@@ -151,7 +150,8 @@ def _table(rep: dict) -> Table:
                f"{prep['index']}" if prep else None)
     t = Table(title=f"{rep['map']} ({rep['size'][0]}x{rep['size'][1]}): "
                     f"{rep['queries']} of {rep['scen_lines']} scenario lines", caption=caption)
-    for col in ("runner", "median ms", "M exp/s", "matched", "cost/opt mean", "cost/opt max"):
+    for col in ("runner", "median ms", "M exp/s", "matched", "invalid", "cost/opt mean",
+                "cost/opt max"):
         t.add_column(col, justify="left" if col == "runner" else "right")
     for p in peers:
         t.add_column(f"x faster than {p}", justify="right")
@@ -159,7 +159,8 @@ def _table(rep: dict) -> Table:
         eps = row["expansions_per_s"]
         cells = [row["runner"] + (" (peer)" if row["peer"] else ""),
                  _fmt(row["median_ms"], ".3f"), _fmt(eps and eps / 1e6, ".2f"),
-                 f"{row['matched']}/{rep['queries']}", _fmt(row["mean_cost_ratio"], ".4f"),
+                 f"{row['matched']}/{rep['queries']}", str(row["invalid"]),
+                 _fmt(row["mean_cost_ratio"], ".4f"),
                  _fmt(row["max_cost_ratio"], ".4f")]
         cells += [_fmt(row["speedup_vs"].get(p), ".2f") if not row["peer"] else ""
                   for p in peers]

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import platform
 from pathlib import Path
 from typing import Annotated
 
@@ -11,6 +10,7 @@ import typer
 from rich.table import Table
 
 from skyroute.bench.fleet import CASES, bench_case
+from skyroute.bench.machine import machine
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError, check_choice
@@ -61,7 +61,4 @@ def bench_fleet(
     # the speed is the point; the traffic columns give way first on a narrow terminal
     print_table(wide_console(), t, optional=("conflicts", "lost", "delivered/h", "offered/h"))
     if json_out:
-        write_atomic(json_out, json.dumps({"machine": {"python": platform.python_version(),
-                                                       "processor": platform.processor()
-                                                       or platform.machine()},
-                                           "rows": rows}, indent=1))
+        write_atomic(json_out, json.dumps({"machine": machine(), "rows": rows}, indent=1))

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import datetime as dt
 import json
-import platform
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich.table import Table
 
+from skyroute.bench.machine import machine
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError
@@ -86,11 +86,8 @@ def bench_jobs_command(
         print_table(out, s)
     if json_out:
         write_atomic(json_out, json.dumps(
-            {"machine": {"python": platform.python_version(), "cpus": _cpus()},
+            {"settings": {"data": str(data), "from": str(d0), "to": str(d1),
+                          "method": method, "runs": runs, "simulate": counts},
+             "machine": machine(("dask", "distributed")),
              "rows": rows, "simulated": sims, "durations": durations}, indent=1))
 
-
-def _cpus() -> int:
-    import os
-
-    return os.cpu_count() or 1

@@ -46,7 +46,14 @@ def bench_service(
 ) -> None:
     """Load the service on 127.0.0.1 (uvicorn in a process of its own) and report
     server-side (Server-Timing) and client latency percentiles, requests/s and errors."""
-    from skyroute.bench.service import CLIENTS, bench_flightpath, bench_plan, check_load
+    from skyroute.bench.machine import machine
+    from skyroute.bench.service import (
+        CLIENTS,
+        bench_flightpath,
+        bench_plan,
+        check_load,
+        check_plan_load,
+    )
 
     loads = load or (["plan", "flightpath"] if db else ["plan"])
     for x in loads:
@@ -56,6 +63,8 @@ def bench_service(
         raise OptionError("--load flightpath needs --db URL (a store with a flown day)")
     check_load(clients=clients, requests=requests, workers=workers,
                client_processes=client_processes, flags=True)
+    if "plan" in loads:
+        check_plan_load(map_name, algorithm)
     if json_out:  # a bad path fails now, not after the runs
         check_writable(json_out)
     rows = []
@@ -95,4 +104,9 @@ def bench_service(
                                              "server CPU ms/req", "req/s per server core",
                                              "client CPU ms/req"))
     if json_out:
-        write_atomic(json_out, json.dumps(rows, indent=1))
+        write_atomic(json_out, json.dumps(
+            {"settings": {"seed": seed, "requests": requests, "clients": clients,
+                          "workers": workers, "client_processes": client_processes,
+                          "client": client},
+             "machine": machine(("fastapi", "uvicorn", "httpx", "sqlalchemy")), "rows": rows},
+            indent=1))

@@ -14,6 +14,7 @@ import numpy as np
 import typer
 from rich.table import Table
 
+from skyroute.bench.machine import machine
 from skyroute.bench.world import (
     OMPL_PLANNERS,
     bench_query,
@@ -156,7 +157,11 @@ def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, 
                   + ("-" if c["no_path_median_ms"] is None else
                      f"{c['no_path_median_ms']:.2f} ms, max {c['no_path_max_ms']:.2f} ms"))
     if json_out:
-        write_atomic(json_out, json.dumps({"seconds": seconds, "seed": seed, "worlds": reports,
+        settings = {"worlds": worlds, "seed": seed, "seconds": seconds, "planners": chosen,
+                    "city": city and str(city), "altitude": altitude, "safety": safety,
+                    "city_queries": city_queries_n, "no_path": no_path}
+        write_atomic(json_out, json.dumps({**settings, "settings": settings,
+                                           "machine": machine(("ompl",)), "worlds": reports,
                                            "city_queries": city_timing},
                                           indent=1, default=float))
 
@@ -212,7 +217,8 @@ def bench_motion(
     print_table(out, _dubins_table(d))
     if dubins:
         if json_out:
-            write_atomic(json_out, json.dumps({"dubins": d}, indent=1))
+            write_atomic(json_out, json.dumps({"machine": machine(("ompl",)), "dubins": d},
+                                              indent=1))
         _exit_past_ompl()
         return
     with progress_bar(plain_console(stderr=True)) as progress:
@@ -227,7 +233,9 @@ def bench_motion(
               f"(ratio {r['ratio']:.4f}); plan_moves per leg median {r['median_ms']:.1f} ms, "
               f"p90 {r['p90_ms']:.1f} ms, max {r['max_ms']:.1f} ms")
     if json_out:
-        write_atomic(json_out, json.dumps({"dubins": d, "step_drone": r}, indent=1))
+        write_atomic(json_out, json.dumps(
+            {"settings": {"data": str(data), "max_expansions": max_expansions, "merge": merge},
+             "machine": machine(("ompl",)), "dubins": d, "step_drone": r}, indent=1))
     _exit_past_ompl()
 
 
@@ -301,5 +309,8 @@ def _bench_curvature(worlds, seed, secs, city, tours, json_out) -> None:
                   f"{t['local_exact']}); exact {t['exact_ms_median']:.0f} ms, local "
                   f"{t['local_ms_median']:.0f} ms median")
     if json_out:
-        write_atomic(json_out, json.dumps({"rows": rows, "summary": summ, "tours": t},
+        settings = {"worlds": worlds, "seed": seed, "budgets": list(secs),
+                    "city": city and str(city), "tours": tours}
+        write_atomic(json_out, json.dumps({"settings": settings, "machine": machine(("ompl",)),
+                                           "rows": rows, "summary": summ, "tours": t},
                                           indent=1, default=str))
