@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from skyroute.blas_probe import defer
 from skyroute.lazy import exports
+from skyroute.version import __version__ as __version__  # re-exported
 
 defer()  # numba's first kernel load need not import scipy.linalg
 
@@ -26,8 +27,6 @@ if TYPE_CHECKING:  # the real imports, for readers and type checkers
     from skyroute.world.grid import Grid
     from skyroute.world.load import bundled_maps, load_map, load_world
     from skyroute.world.world import World
-
-__version__ = "0.1.0"
 
 _HOME = {
     "Grid": "skyroute.world.grid",

@@ -9,7 +9,7 @@ import platform
 from collections.abc import Sequence
 from importlib import metadata
 
-import skyroute
+from skyroute.version import __version__
 
 # What every bench's numbers depend on; each command adds its peers.
 BASE = ("numpy", "numba", "scipy", "shapely")
@@ -25,7 +25,7 @@ def machine(packages: Sequence[str] = ()) -> dict:
             versions[name] = metadata.version(name)
         except metadata.PackageNotFoundError:
             versions[name] = None
-    return {"skyroute": skyroute.__version__,
+    return {"skyroute": __version__,
             "python": platform.python_version(),
             "packages": versions,
             "cpu": cpu_model(),
