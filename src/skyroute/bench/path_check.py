@@ -16,6 +16,7 @@ from itertools import pairwise
 import numpy as np
 
 from skyroute.search.los import line_of_sight
+from skyroute.search.space import space_of
 from skyroute.world.grid import Grid
 
 # (path, start, goal, any_angle) -> its length when legal, else None
@@ -30,11 +31,11 @@ def path_length(path) -> float:
 
 def legal_length(grid: Grid) -> Checker:
     """A checker for ``grid``: the length of a path that answers (start, goal) legally,
-    None otherwise. The padded grid for the line-of-sight test is made once, here."""
+    None otherwise. The line-of-sight test reads the grid's cached search space (the
+    padded flat array the planners use)."""
     h, w = grid.blocked.shape
-    padded = np.ones((h + 2, w + 2), dtype=np.uint8)
-    padded[1:-1, 1:-1] = grid.blocked
-    flat, wp = padded.ravel(), w + 2
+    space = space_of(grid)
+    flat, wp = space.blocked, space.Wp
 
     def check(path, start, goal, any_angle: bool = False) -> float | None:
         p = np.asarray(path, dtype=float)
