@@ -76,10 +76,7 @@ def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, pr
         raise OptionError(f"algorithm={algorithm!r} takes no heuristic option "
                           f"(it uses {_default_h(algorithm, connectivity)!r})",
                           param="heuristic")
-    try:  # numpy scalars and 0-d arrays too; not a bool
-        weight = real("weight", weight, low=1.0)
-    except OptionError:
-        raise OptionError(f"weight={weight!r} must be a number >= 1", param="weight") from None
+    weight = real("weight", weight, low=1.0, need="a number >= 1")  # numpy's too; no bool
     if weight != 1.0 and algorithm in ("bfs", "dijkstra", "jps"):
         raise OptionError(f"algorithm={algorithm!r} takes no weight; use 'astar'",
                           param="weight")
