@@ -259,3 +259,16 @@ def test_dubins_json_records_its_seed_and_machine(monkeypatch, capsys, tmp_path)
     doc = json.loads(out_json.read_text())
     assert doc["dubins"] == fake and doc["machine"]["packages"]["numba"]
     assert "ompl" in doc["machine"]["packages"]
+
+
+def test_cpu_model_names_family_and_model():
+    """A VM's model name can be the bare vendor's, shared by two generations: the
+    family and model numbers tell them apart (Zen 4 and Zen 5 are both "AMD EPYC")."""
+    from skyroute.bench.machine import cpu_model
+
+    two = ("processor\t: 0\nvendor_id\t: AuthenticAMD\ncpu family\t: 26\nmodel\t\t: 2\n"
+           "model name\t: AMD EPYC\n\nprocessor\t: 1\ncpu family\t: 25\nmodel\t\t: 17\n"
+           "model name\t: other\n")
+    assert cpu_model(two) == "AMD EPYC (family 26, model 2)"
+    assert cpu_model("Processor\t: ARMv8 rev 1\nHardware\t: BCM2835\n") == "ARMv8 rev 1"
+    assert cpu_model("") != ""  # platform's answer

@@ -34,15 +34,29 @@ def machine(packages: Sequence[str] = ()) -> dict:
             "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")}
 
 
-def cpu_model() -> str:
-    """The CPU's model name from /proc/cpuinfo (Linux); elsewhere what ``platform``
-    knows ("x86_64" at least)."""
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as f:
-            for line in f:
-                key, _, value = line.partition(":")
-                if key.strip() in ("model name", "Hardware", "Processor") and value.strip():
-                    return value.strip()
-    except OSError:
-        pass
-    return platform.processor() or platform.machine()
+def cpu_model(cpuinfo: str | None = None) -> str:
+    """The CPU's model name from /proc/cpuinfo (Linux; ``cpuinfo``: that file's text),
+    with its family and model numbers where given: a VM's name is often only the vendor's
+    ("AMD EPYC"), which two CPU generations share. Elsewhere what ``platform`` knows
+    ("x86_64" at least)."""
+    if cpuinfo is None:
+        try:
+            with open("/proc/cpuinfo", encoding="utf-8") as f:
+                cpuinfo = f.read()
+        except OSError:
+            cpuinfo = ""
+    fields: dict[str, str] = {}
+    for line in cpuinfo.splitlines():
+        key, _, value = line.partition(":")
+        key, value = key.strip(), value.strip()
+        if not key and fields:
+            break  # the first processor's block is enough
+        if value:
+            fields.setdefault(key, value)
+    name = next((v for k, v in fields.items() if k in ("model name", "Hardware", "Processor")),
+                None)
+    if name is None:
+        return platform.processor() or platform.machine()
+    if "cpu family" in fields and "model" in fields:
+        return f"{name} (family {fields['cpu family']}, model {fields['model']})"
+    return name
