@@ -308,3 +308,19 @@ def test_a_level_whose_roll_overruns_a_runway_is_one_line_before_any_work(
     assert ("airport C's take-off runway (320 m) is shorter than the take-off roll to climb "
             "to 90 m (326 m), drone 4's level in layers" in err)
     assert not out_dir.exists()
+
+
+def test_an_airport_no_cruise_can_reach_is_one_line_before_any_work(monkeypatch, capsys,
+                                                                     tmp_path):
+    # a ring of no-fly zones round C failed mid-run, when C was first flown, with the
+    # planner's raw status and no file
+    from tests.fleet.test_nofly import RING_ERROR, ringed
+
+    monkeypatch.setattr("skyroute.fleet.simulate.run", _no_run)
+    monkeypatch.setattr("skyroute.jobs.fleet.sweep", _no_run)
+    path = tmp_path / "ring.yaml"
+    path.write_text(yaml.safe_dump(ringed(), sort_keys=False))
+    for command in ("simulate", "sweep"):
+        code, out, err = run(monkeypatch, capsys, "fleet", command, str(path), "--hours", "0.1")
+        assert code == 2 and out == "", err
+        assert err == f"skyroute: error: {path}: {RING_ERROR}\n"

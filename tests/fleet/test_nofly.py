@@ -122,3 +122,76 @@ def test_the_map_draws_the_zones(zoned_run, tmp_path, monkeypatch):
     assert corners == {(float(e), float(n)) for n, e in zoned_run.scenario.no_fly_zones[0]
                        .points}
     assert "no-fly zone" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+# two C-shaped zones round airport C that touch only at two corners, (1500, 0) and
+# (4500, 0): no gap between them, though their union is two polygons and has no hole
+RING = [{"name": "west", "points": [[1400, -1600], [1400, 0], [1500, 0], [1500, -1500],
+                                    [4500, -1500], [4500, 0], [4600, 0], [4600, -1600]]},
+        {"name": "east", "points": [[1500, 0], [1500, 1600], [4500, 1600], [4500, 0],
+                                    [4400, 0], [4400, 1500], [1600, 1500], [1600, 0]]}]
+RING_ERROR = ("no_fly_zones: no cruise can join airports C and A: zones 'west', 'east' "
+              "close a ring round C (zones that touch leave no gap)")
+
+
+def ringed(zones=RING) -> dict:
+    """Airports A and B 8 km apart (the farthest pair, which the airborne check flies)
+    and C, 3 km north of their midpoint, inside ``zones``."""
+    def port(name, north, east, landing):
+        return {"id": name, "north": north, "east": east,
+                "landing": {"heading_deg": landing}, "takeoff": {"heading_deg": 90}}
+
+    return {"name": "ring", "airports": [port("A", 0, -4000, 90), port("B", 0, 4000, 90),
+                                         port("C", 3000, 0, 0)],
+            "no_fly_zones": zones}
+
+
+def test_airports_a_ring_of_zones_cuts_off_are_refused_before_a_run(monkeypatch):
+    # a run failed when C was first flown, mid-run, with the planner's raw status
+    # ("B -> C at 50 m: no cruise around the no-fly zones ...: no_path")
+    from skyroute.fleet import simulate
+    from skyroute.fleet.airborne import check_flights
+
+    s = parse_scenario(ringed())
+    with pytest.raises(InputFormatError) as err:
+        check_flights(s, "ring.yaml")
+    assert str(err.value) == f"ring.yaml: {RING_ERROR}"
+
+    def no_flight(*_args, **_kwargs):
+        raise AssertionError("a flight was planned before the zones were checked")
+
+    monkeypatch.setattr(simulate, "plan_flight", no_flight)
+    with pytest.raises(InputFormatError) as err:
+        run(s, hours=0.5, seed=0)
+    assert str(err.value) == f"scenario: {RING_ERROR}"
+
+
+def test_a_gap_in_the_ring_lets_the_cruise_through():
+    from skyroute.fleet.airborne import check_flights
+    from skyroute.fleet.nofly import cut_off
+
+    # the east zone's lower arm stops 100 m short: a gap wider than a turning circle
+    east = [[1500, 100], [1500, 1600], [4500, 1600], [4500, 0], [4400, 0], [4400, 1500],
+            [1600, 1500], [1600, 100]]
+    s = parse_scenario(ringed([RING[0], {"name": "east", "points": east}]))
+    assert cut_off(s) is None
+    check_flights(s, "ring.yaml")  # no error
+    # zones in a ring round no airport, or round every one, part none of them
+    for move in (lambda n, e: (n, e + 2e4), lambda n, e: (3000 + 4 * (n - 3000), 4 * e)):
+        moved = [{**z, "points": [move(n, e) for n, e in z["points"]]} for z in RING]
+        assert cut_off(parse_scenario(ringed(moved))) is None
+
+
+def test_a_cruise_the_planner_cannot_find_names_the_flight_not_a_status():
+    from skyroute.fleet.nofly import cruise
+    from skyroute.motion.dubins import shortest_path
+
+    s = parse_scenario(ringed())
+    start, goal = (0.0, 0.0, 0.0), (0.0, 3000.0, 0.0)  # (east, north, heading): into C
+    with pytest.raises(QueryError) as err:
+        cruise(s, start, goal, 250.0, shortest_path(start, goal, 250.0),
+               what="flight A -> C at 50 m")
+    assert str(err.value) == ("flight A -> C at 50 m: no cruise with a 250 m turning radius "
+                              "gets round the no-fly zones from the climb-out (0 N, 0 E) to "
+                              "the approach gate (3000 N, 0 E)")
+    assert err.value.param == "no_fly_zones"

@@ -131,3 +131,15 @@ def test_a_sweep_past_the_run_limit_is_refused_before_its_tasks():
     with pytest.raises(OptionError, match="is 12,000 runs, over the limit of 10,000"):
         sweep(preset("seed-3x3"), rates=(10, 20, 30), seeds=range(1000), hours=1,
               executor=NoRuns())
+
+
+def test_fleet_and_sweep_jobs_refuse_an_airport_no_cruise_can_reach():
+    # the job failed mid-run, when C was first flown, with the planner's raw status
+    from skyroute.errors import OptionError
+    from tests.fleet.test_nofly import RING_ERROR, ringed
+
+    for check in (check_fleet_params, check_sweep_params):
+        with pytest.raises(OptionError) as err:
+            check({"scenario": ringed()})
+        assert str(err.value) == f"scenario: {RING_ERROR}"
+        assert err.value.param == "scenario"

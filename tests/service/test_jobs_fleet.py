@@ -15,6 +15,7 @@ import uuid
 
 import pytest
 
+from tests.fleet.test_nofly import ringed
 from tests.service.conftest import AUTH, DAY, EXAMPLE, make_client
 from tests.service.test_app import assert_problem
 
@@ -122,6 +123,7 @@ def _seed3() -> dict:
 
 
 SEED3 = _seed3()
+RINGED = ringed()
 
 
 @pytest.mark.parametrize("path, body, field, words", [
@@ -165,6 +167,9 @@ SEED3 = _seed3()
      "less than or equal"),
     ("/jobs/fleet", {"scenario": {"packages": "x"}}, "scenario.packages",
      "expected a mapping"),
+    # a ring of no-fly zones round an airport: refused now, not when it is first flown
+    ("/jobs/fleet", {"scenario": RINGED}, "scenario.no_fly_zones",
+     "no cruise can join airports C and A: zones 'west', 'east' close a ring round C"),
     ("/jobs/fleet", {"scenario": {"packages": [1]}}, "scenario.packages",
      "expected a mapping"),
 ])

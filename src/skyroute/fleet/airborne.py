@@ -5,7 +5,9 @@ layer_step of 1e9 m asked for gigabytes of samples).
 A scenario is checked before a run (:func:`check_flights`, on the farthest airports
 at the highest level either airspace may give a drone), so the error names the file;
 the simulation checks each flight it plans as well. Either error names the field to
-blame: the one whose default shortens the flight most.
+blame: the one whose default shortens the flight most. :func:`check_flights` first
+refuses airports that no-fly zones cut off (:func:`skyroute.fleet.nofly.check_joined`):
+every place that is about to fly a scenario calls it.
 """
 
 from __future__ import annotations
@@ -14,7 +16,8 @@ import math
 
 import numpy as np
 
-from skyroute.errors import InputFormatError, SkyrouteError
+from skyroute.errors import InputFormatError, QueryError, SkyrouteError
+from skyroute.fleet.nofly import check_joined
 from skyroute.fleet.flightplan import plan_flight, takeoff_overrun
 from skyroute.fleet.limits import MAX_FLIGHT_HOURS
 from skyroute.fleet.scenario import Airspace, Drone, Scenario
@@ -52,15 +55,22 @@ def too_long(scenario: Scenario, origin: int, destination: int, level: int,
 
 
 def check_flights(scenario: Scenario, where: object = "scenario") -> None:
-    """An InputFormatError naming ``where`` (the file) and the field when a flight
-    between the farthest airports, either way, at the highest level either airspace may
-    use (a drone's layer, or a shared level) that its runway holds, would be airborne past
-    the limit."""
+    """An InputFormatError naming ``where`` (the file) and the field when no-fly zones cut
+    some airports off from the others (:func:`~skyroute.fleet.nofly.check_joined`), when
+    the flight between the farthest airports cannot be planned round the zones, or when
+    that flight, either way, at the highest level either airspace may use (a drone's
+    layer, or a shared level) that its runway holds, would be airborne past the limit."""
+    check_joined(scenario, where)
     pos = np.array([[a.north, a.east] for a in scenario.airports])
     far = np.hypot(*(pos[:, None] - pos[None]).transpose(2, 0, 1))
     o, b = (int(k) for k in np.unravel_index(np.argmax(far), far.shape))
     for x, y in ((o, b), (b, o)):
-        error = too_long(scenario, x, y, _held(scenario, x, _top(scenario)))
+        try:
+            error = too_long(scenario, x, y, _held(scenario, x, _top(scenario)))
+        except QueryError as exc:  # a climb-out, final, loiter or cruise the zones block
+            if exc.param != "no_fly_zones":
+                raise
+            raise InputFormatError(where, f"no_fly_zones: {exc}") from None
         if error:
             raise InputFormatError(where, error)
 

@@ -309,7 +309,7 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
     plane_goal = (gate[1], gate[0], float(heading_to_plane(psi_down, "ned")))
     path = shortest_path(plane_start, plane_goal, r)
     route = nofly.cruise(scenario, plane_start, plane_goal, r, path,  # around no-fly zones
-                         what=f"{origin} -> {destination} at {h:g} m")
+                         what=f"flight {origin} -> {destination} at {h:g} m")
     psi = psi_up  # compass heading (radians) along the way
     clock = tr.t
     for letter, length in route:

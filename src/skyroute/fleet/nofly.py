@@ -5,7 +5,9 @@ climb-out pose to the approach gate is the shortest Dubins path when it stays cl
 every zone, else a Hybrid A* path (:func:`skyroute.motion.hybrid.plan`, same turning
 radius, exact arcs and straights) around them. The straight parts a flight cannot bend
 (the climb along the take-off runway, the final approach, a loiter circle) are checked
-and an error names the airport and the zone when one crosses a zone.
+and an error names the airport and the zone when one crosses a zone. Airports that zones
+close a ring round, so that no cruise can join them to the others, are refused before a
+run (:func:`check_joined`), not when that pair is first flown.
 
 Plane convention (as :mod:`skyroute.motion`): x east, y north, headings anticlockwise
 from +x.
@@ -18,7 +20,7 @@ import functools
 import numpy as np
 import shapely
 
-from skyroute.errors import QueryError
+from skyroute.errors import InputFormatError, QueryError
 from skyroute.motion import hybrid
 from skyroute.motion.dubins import DubinsPath
 from skyroute.motion.pieces import KINDS, chain
@@ -79,10 +81,62 @@ def cruise(scenario, start, goal, radius: float, path: DubinsPath, *,
     if hybrid.path_free(world, pieces):
         return words
     res = hybrid.plan(world, start, goal, radius)
-    if not res.found:
-        raise QueryError(f"{what}: no cruise around the no-fly zones from the climb-out "
-                         f"({start[1]:.0f} N, {start[0]:.0f} E) to the approach gate "
-                         f"({goal[1]:.0f} N, {goal[0]:.0f} E): {res.status.value}",
-                         param="no_fly_zones")
+    if not res.found:  # joined in the plane (check_joined), yet too narrow to turn in
+        raise QueryError(f"{what}: no cruise with a {radius:g} m turning radius gets round "
+                         f"the no-fly zones from the climb-out ({start[1]:.0f} N, "
+                         f"{start[0]:.0f} E) to the approach gate ({goal[1]:.0f} N, "
+                         f"{goal[0]:.0f} E)", param="no_fly_zones")
     return [(p.kind, p.length) for p in res.segments]
 
+
+
+def cut_off(scenario) -> tuple[list[str], list[str], list[str]] | None:
+    """None when no ring of no-fly zones parts the airports, else (the airports inside
+    the first such ring, those outside it, the ring's zones as the message names them).
+
+    A cheap necessary condition for every cruise, in place of one Hybrid A* search per
+    pair of airports: both ends in one connected part of the plane outside the zones.
+    The zones are grown by the clearance the planner keeps from every edge (1e-9 of
+    their extent, :func:`skyroute.motion.hybrid.path_free`), so zones that touch, or
+    leave a gap no path fits through, close a ring as one zone would. The plane outside
+    the grown zones is joined unless their union has a hole holding some airports and
+    not others. (An airport's runway is clear of every zone and its climb-out and final
+    approach are checked by :func:`check_line`, so the airport stands for both ends of
+    its cruises.) A gap too narrow to turn in is not caught here: the planner finds no
+    cruise through it when the pair is first flown.
+    """
+    zones = scenario.no_fly_zones
+    if not zones:
+        return None
+    polys = [shapely.Polygon([(e, n) for n, e in z.points]) for z in zones]
+    x0, y0, x1, y1 = shapely.total_bounds(polys)
+    grown = shapely.buffer(polys, 1e-9 * max(1.0, x1 - x0, y1 - y0))
+    ports = shapely.points([(a.east, a.north) for a in scenario.airports])
+    ids = [a.id for a in scenario.airports]
+    names = [z.name for z in zones]
+    for part in shapely.get_parts(shapely.union_all(grown)):
+        for ring in part.interiors:
+            inside = shapely.contains(shapely.Polygon(ring), ports)
+            if inside.any() and not inside.all():
+                ring_zones = [repr(n) if names.count(n) == 1 else f"no_fly_zones[{k}]"
+                              for k, (n, g) in enumerate(zip(names, grown, strict=True))
+                              if g.intersects(part)]
+                return ([i for i, x in zip(ids, inside, strict=True) if x],
+                        [i for i, x in zip(ids, inside, strict=True) if not x], ring_zones)
+    return None
+
+
+def check_joined(scenario, where: object = "scenario") -> None:
+    """An InputFormatError naming ``where`` (the file), two airports and the zones when
+    no-fly zones close a ring round some airports and not others (:func:`cut_off`): no
+    cruise could join them, and a run would fail when that pair is first flown."""
+    found = cut_off(scenario)
+    if found is None:
+        return
+    inside, outside, ring = found
+    zones = f"zones {', '.join(ring)} close" if len(ring) > 1 else f"zone {ring[0]} closes"
+    more = len(inside) - 1
+    others = f" and {more} other airport{'s' if more > 1 else ''}" if more else ""
+    raise InputFormatError(where, f"no_fly_zones: no cruise can join airports {inside[0]} "
+                           f"and {outside[0]}: {zones} a ring round {inside[0]}{others} "
+                           "(zones that touch leave no gap)")

@@ -46,6 +46,7 @@ from skyroute.fleet.airspace import (
     samples,
 )
 from skyroute.fleet.flightplan import FlightPlan, plan_flight, takeoff_overrun
+from skyroute.fleet.nofly import check_joined
 from skyroute.fleet.packages import Stream
 from skyroute.fleet.scenario import Scenario, runway_ends
 from skyroute.fleet.timetable import Timetable
@@ -138,6 +139,7 @@ def simulate(scenario: Scenario, stream: Stream, *, hours: float, seed: int = 0,
     check_choice("airspace", mode, MODES)
     h = real("hours", hours, low=0.0, strict=True)
     check_levels(scenario, mode)
+    check_joined(scenario)  # airports no cruise joins: refused now, not mid-run
     run = Simulation(scenario, stream, h, whole("seed", seed, low=0), scheduler, mode)
     wall = time.perf_counter()
     _Engine(run, progress).go()
