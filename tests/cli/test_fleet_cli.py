@@ -324,3 +324,26 @@ def test_an_airport_no_cruise_can_reach_is_one_line_before_any_work(monkeypatch,
         code, out, err = run(monkeypatch, capsys, "fleet", command, str(path), "--hours", "0.1")
         assert code == 2 and out == "", err
         assert err == f"skyroute: error: {path}: {RING_ERROR}\n"
+
+
+def test_nothing_offered_has_no_served_share(monkeypatch, capsys):
+    # a run offered no package reported "served 100.0%" (served_share 1.0)
+    base = ["--preset", "seed-3x3", "--hours", "0.2"]
+    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", *base, "--rate", "0",
+                         "--json")
+    assert code == 0, err
+    rep = json.loads(out)
+    assert rep["offered"] == 0 and rep["served_share"] is None
+    code, out, err = run(monkeypatch, capsys, "fleet", "simulate", *base, "--rate", "0")
+    assert code == 0 and "0 (0.0/h, served -)" in out, err
+    sweep = ["fleet", "sweep", *base, "--scheduler", "seed", "--airspace", "layers",
+             "--rates", "0", "--seeds", "0-1"]
+    code, out, err = run(monkeypatch, capsys, *sweep, "--json")
+    assert code == 0, err
+    (row,) = json.loads(out)["rows"]
+    assert row["served_share"] is None and row["served_share_ci95"] is None
+    code, out, err = run(monkeypatch, capsys, *sweep)
+    assert code == 0, err
+    (line,) = [x for x in out.splitlines() if " layers " in x]
+    cells = [c.strip() for c in line.strip(" \u2502").split("\u2502")]
+    assert cells[2:5] == ["0", "0.0 \u00b10.0", "-"], out  # offered, delivered/h, served %

@@ -207,7 +207,7 @@ def _report_table(rep: dict, files: list[Path]) -> Table:
         ("offered", f"{rep['offered']} ({rep['offered_per_hour']:.1f}/h after the "
                     f"{st['warmup_s'] / 60:g} min warm-up)"),
         ("delivered", f"{rep['delivered']} ({rep['delivered_per_hour']:.1f}/h, served "
-                      f"{rep['served_share']:.1%})"),
+                      f"{_fmt(rep['served_share'], '.1%')})"),
         ("capacity bound", _fmt(rep["capacity_bound_per_hour"], ".1f", "/h")
          + f" (mean cycle {_fmt(rep['mean_cycle_s'], '.0f', ' s')})"),
         ("delivery time p50 / p95", f"{_fmt(rep['p50_delivery_s'], '.0f', ' s')} / "

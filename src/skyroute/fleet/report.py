@@ -4,7 +4,8 @@ Rates count only the measured window ``[warm-up, horizon]``: the first
 :data:`~skyroute.fleet.simulate.WARMUP_SHARE` of the horizon (drones spreading out from
 their start gates) is excluded. ``offered`` are the packages spawned in the window,
 ``delivered`` the hand-overs completed in it (whenever the package spawned), so
-``served_share`` compares two rates over one window. Delivery times (spawn to hand-over)
+``served_share`` compares two rates over one window (None when nothing was offered: a
+share of nothing is undefined, not 100%). Delivery times (spawn to hand-over)
 are those of the packages delivered in the window.
 
 ``lost`` is counted from the event log alone, not from the simulation's own arrays: a
@@ -114,7 +115,7 @@ def report(run: Simulation, separation: SeparationReport | None = None) -> dict:
         "offered": offered,
         "delivered": delivered,
         "delivered_per_hour": delivered / hours,
-        "served_share": delivered / offered if offered else 1.0,
+        "served_share": delivered / offered if offered else None,
         "p50_delivery_s": float(np.percentile(times, 50)) if len(times) else None,
         "p95_delivery_s": float(np.percentile(times, 95)) if len(times) else None,
         "max_wait_s": float(waited.max()) if len(waited) else 0.0,
