@@ -305,8 +305,10 @@ def test_a_level_whose_roll_overruns_a_runway_is_one_line_before_any_work(
     code, out, err = run(monkeypatch, capsys, "fleet", args[0], path, *args[1:],
                          "--hours", "0.1", "--airspace", "layers")
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
-    assert ("airport C's take-off runway (320 m) is shorter than the take-off roll to climb "
-            "to 90 m (326 m), drone 4's level in layers" in err)
+    # the file is named, as for every other scenario error
+    assert err.startswith(f"skyroute: error: {path}: airport C's take-off runway (320 m) is "
+                          "shorter than the take-off roll to climb to 90 m (326 m), drone "
+                          "4's level in layers"), err
     assert not out_dir.exists()
 
 

@@ -143,3 +143,19 @@ def test_fleet_and_sweep_jobs_refuse_an_airport_no_cruise_can_reach():
             check({"scenario": ringed()})
         assert str(err.value) == f"scenario: {RING_ERROR}"
         assert err.value.param == "scenario"
+
+
+def test_a_level_whose_roll_overruns_a_runway_names_the_jobs_scenario():
+    # the message named the airport and level but not the scenario, unlike the others
+    from skyroute.errors import OptionError
+
+    data = preset("seed-3x3").model_dump()
+    data["airports"][2]["takeoff"]["length"] = 320.0  # holds the roll to 50 m, not to 90 m
+    data["drones"] = 5
+    for check, extra in ((check_fleet_params, {"airspace": "layers"}),
+                         (check_sweep_params, {"airspaces": ["layers"]})):
+        with pytest.raises(OptionError) as err:
+            check({"scenario": data, **extra})
+        assert str(err.value).startswith("scenario: airport C's take-off runway (320 m) is "
+                                         "shorter than the take-off roll to climb to 90 m")
+        assert err.value.param == "airspace"

@@ -98,8 +98,13 @@ def resolve_scenario(path: Path | None, preset_name: str | None, airports: int |
         s = s.model_copy(update={"drones": drones})  # more drones: higher layers
     from skyroute.fleet.airborne import check_flights
 
-    check_flights(s, path if path is not None else s.name)
+    check_flights(s, scenario_name(path, s))
     return s
+
+
+def scenario_name(path: Path | None, s: Scenario) -> Path | str:
+    """What an error about the scenario names: its file, else its name (a preset's)."""
+    return path if path is not None else s.name
 
 
 def _with_separation(s: Scenario, sep_h: float | None, sep_v: float | None) -> Scenario:
@@ -160,7 +165,8 @@ def simulate_command(
     s = _with_separation(resolve_scenario(scenario, preset_name, airports, drones, area_km,
                                           seed), sep_horizontal, sep_vertical)
     check_work(s, hours=hours, rate=rate, track_step=track_step if out is not None else None)
-    check_levels(s, airspace)  # every level's take-off roll on every runway, before the bar
+    # every level's take-off roll on every runway, before the bar
+    check_levels(s, airspace, where=scenario_name(scenario, s))
     if out is not None:  # a bad --out fails before the run, not after it with some files
         from skyroute.io.fleet_out import check_run_outputs
 
@@ -339,7 +345,7 @@ def sweep_command(
     if scenario is not None and s.packages.csv is not None:
         raise OptionError("sweep runs Poisson streams; this scenario names a package CSV")
     for mode in spaces:  # every level's take-off roll on every runway
-        check_levels(s, mode)
+        check_levels(s, mode, where=scenario_name(scenario, s))
     for r in rate_list:  # each run's packages (rate x hours) within the limit
         check_work(s, hours=hours, rate=r, rate_flag="--rates")
     err = plain_console(stderr=True)

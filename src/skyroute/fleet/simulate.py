@@ -147,11 +147,13 @@ def simulate(scenario: Scenario, stream: Stream, *, hours: float, seed: int = 0,
     return run
 
 
-def check_levels(scenario: Scenario, airspace: str | None = None) -> None:
+def check_levels(scenario: Scenario, airspace: str | None = None, *,
+                 where: object = None) -> None:
     """Refuse, before a run, a cruise level of ``airspace`` (default the scenario's mode)
     whose take-off roll some airport's take-off runway cannot hold (the scenario itself
     checks only the lowest level): an :class:`OptionError` naming the airport, the level
-    and what to change. A flight planned at such a level would roll off the runway."""
+    and what to change, after ``where`` (the scenario's file, or ``"scenario"``) when
+    given. A flight planned at such a level would roll off the runway."""
     mode = scenario.airspace.mode if airspace is None else airspace
     check_choice("airspace", mode, MODES)
     sp = scenario.airspace
@@ -167,7 +169,8 @@ def check_levels(scenario: Scenario, airspace: str | None = None) -> None:
     for alt, which in reversed(levels):  # the top level first: the longest roll
         why = takeoff_overrun(scenario, shortest, alt)
         if why is not None:
-            raise OptionError(f"{why}, {which}; {advice}", param="airspace")
+            raise OptionError(("" if where is None else f"{where}: ")
+                              + f"{why}, {which}; {advice}", param="airspace")
 
 
 def _check_scenario(scenario) -> None:

@@ -188,6 +188,12 @@ def _scenario(params: dict) -> tuple[Scenario, dict]:
     return s, kept
 
 
+def _where(kept: dict) -> str:
+    """What an error about the job's scenario names (as :func:`_scenario`'s do):
+    ``scenario`` for one given by its fields, else the preset's name."""
+    return "scenario" if "scenario" in kept else kept["preset"]
+
+
 def _list(params: dict, key: str, default: tuple, valid: tuple) -> list:
     v = params.get(key, list(default))
     if not isinstance(v, list | tuple) or not v:
@@ -211,7 +217,7 @@ def check_fleet_params(params: dict) -> dict:
     check_choice("scheduler", out["scheduler"], SCHEDULERS)
     out["airspace"] = params.get("airspace", s.airspace.mode)
     check_choice("airspace", out["airspace"], MODES)
-    check_levels(s, out["airspace"])
+    check_levels(s, out["airspace"], where=_where(out))
     out["rate_per_hour"] = _number(params, "rate_per_hour", None, low=0, strict=False)
     out["track_step"] = _number(params, "track_step", 1.0, low=0, strict=True)
     rate = out["rate_per_hour"]
@@ -230,7 +236,7 @@ def check_sweep_params(params: dict) -> dict:
     out["schedulers"] = _list(params, "schedulers", SCHEDULERS, SCHEDULERS)
     out["airspaces"] = _list(params, "airspaces", MODES, MODES)
     for mode in out["airspaces"]:
-        check_levels(s, mode)
+        check_levels(s, mode, where=_where(out))
     rates = params.get("rates")
     if rates is not None:
         if not isinstance(rates, list | tuple) or not rates:
