@@ -20,6 +20,7 @@ from tests.jobs.conftest import lunch_store
 SWEEP = {"schedulers": ["seed", "optimal"], "airspaces": ["shared"], "seeds": [0, 1],
          "hours": 0.5}
 TIMING = ("wall_seconds", "sim_seconds_per_wall_second")
+BUSY = {**preset("seed-3x3").model_dump(), "packages": {"rate_per_hour": 1e4}}
 
 
 def same(a, b) -> bool:
@@ -96,6 +97,9 @@ def test_fleet_and_sweep_params_are_completed():
      "track_step=1e-06 with hours=8 and 3 drones would write up to 8.6e+10 track rows"),
     ({"scenario": {**preset("seed-3x3").model_dump(), "drone": {"turn_radius": 1e12}}},
      "scenario: drone.turn_radius: a flight "),
+    # no rate given: the scenario's, so hours is to blame (rate_per_hour= was named)
+    ({"scenario": BUSY, "hours": 24},
+     "hours=24 at the scenario's 10000 packages/h would spawn about 2.4e+05 packages"),
 ])
 def test_bad_fleet_params_name_the_field(params, words):
     from skyroute.errors import OptionError
@@ -107,7 +111,10 @@ def test_bad_fleet_params_name_the_field(params, words):
 
 @pytest.mark.parametrize("params, words", [
     ({"seeds": list(range(1001))}, "seeds: 1,001 seeds is over the limit of 1,000"),
-    ({"rates": [1e5], "hours": 4}, "rate_per_hour=100000 with hours=4 would spawn about 4e+05"),
+    ({"rates": [1e5], "hours": 4}, "rates=100000 with hours=4 would spawn about 4e+05"),
+    # no rate given: the scenario's, so hours is to blame (rate_per_hour= was named)
+    ({"preset": None, "scenario": BUSY, "hours": 24},
+     "hours=24 at the scenario's 10000 packages/h would spawn about 2.4e+05 packages"),
     ({"hours": 1e9}, "hours=1e+09 is over the limit"),
     ({"seeds": list(range(1000)), "rates": [10, 20, 30]}, "2 scheduler(s) x 2 airspace(s) x "
      "3 rate(s) x 1,000 seed(s) is 12,000 runs, over the limit of 10,000 in one sweep; give "

@@ -26,7 +26,8 @@ class Terminated(BaseException):
 
 # Library parameters whose CLI flag is not simply --name-with-dashes.
 FLAG_OF = {"url": "--db", "names": "--map", "waypoints_out": "--waypoints",
-           "mode": "--field-mode", "address": "--dask", "workers": "--jobs"}
+           "mode": "--field-mode", "address": "--dask", "workers": "--jobs",
+           "rate_per_hour": "--rate"}
 
 
 def in_flags(exc: SkyrouteError) -> str:

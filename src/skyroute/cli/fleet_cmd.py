@@ -12,18 +12,8 @@ from rich.table import Table
 
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
-from skyroute.errors import OptionError, check_choice
-from skyroute.fleet.limits import (
-    MAX_DRONES,
-    MAX_HOURS,
-    MAX_PACKAGES,
-    MAX_RATE,
-    MAX_SEEDS,
-    MAX_TRACK_ROWS,
-    check_sweep,
-    expected_packages,
-    track_rows,
-)
+from skyroute.errors import OptionError, check_choice, real
+from skyroute.fleet.limits import MAX_DRONES, MAX_RATE, MAX_SEEDS, check_run, check_sweep
 from skyroute.fleet.scenario import PRESETS, Scenario, generate, load_scenario, preset, to_yaml
 
 fleet_app = typer.Typer(help="Fixed-wing drones carry packages between airports: simulate, "
@@ -43,37 +33,6 @@ AreaKm = Annotated[float, typer.Option(help="Side of the square the airports are
 Hours = Annotated[float, typer.Option(help="Simulated hours.")]
 Seed = Annotated[int, typer.Option(min=0, help="Seed of the package stream (and of a generated "
                                         "scenario's layout).")]
-
-
-def _number(name: str, value: float | None, *, low: float, strict: bool,
-            high: float | None = None) -> None:
-    ok = value is not None and math.isfinite(value) and (value > low if strict else value >= low)
-    if value is not None and not ok:
-        raise OptionError(f"--{name} {value!r} must be a number {'>' if strict else '>='} "
-                          f"{low:g}")
-    if value is not None and high is not None and value > high:
-        raise OptionError(f"--{name} {value:g} is over the limit of {high:,g}")
-
-
-def check_work(s: Scenario, *, hours: float, rate: float | None,
-               track_step: float | None = None, rate_flag: str = "--rate") -> None:
-    """Refuse, before any work, a run whose packages (rate x hours) or tracks.csv rows
-    (drones x seconds / ``track_step``; None: no tracks written) are past the limits of
-    :mod:`skyroute.fleet.limits`, naming the options (or the scenario's rate)."""
-    if rate is not None or s.packages.csv is None:
-        r = s.packages.rate_per_hour if rate is None else rate
-        n = expected_packages(r, hours)
-        if n > MAX_PACKAGES:
-            what = (f"{rate_flag} {r:g} with --hours {hours:g}" if rate is not None else
-                    f"--hours {hours:g} at the scenario's {r:g} packages/h")
-            raise OptionError(f"{what} would spawn about {n:.2g} packages (limit "
-                              f"{MAX_PACKAGES:,g}); lower --hours or {rate_flag}")
-    if track_step is not None:
-        rows = track_rows(s.drones, hours, track_step)
-        if rows > MAX_TRACK_ROWS:
-            raise OptionError(f"--track-step {track_step:g} with --hours {hours:g} and "
-                              f"{s.drones} drones would write up to {rows:.2g} track rows "
-                              f"(limit {MAX_TRACK_ROWS:,.0f}); raise --track-step")
 
 
 def resolve_scenario(path: Path | None, preset_name: str | None, airports: int | None,
@@ -108,9 +67,8 @@ def scenario_name(path: Path | None, s: Scenario) -> Path | str:
 
 
 def _with_separation(s: Scenario, sep_h: float | None, sep_v: float | None) -> Scenario:
-    _number("sep-horizontal", sep_h, low=0, strict=True)
-    _number("sep-vertical", sep_v, low=0, strict=True)
-    change = {k: v for k, v in (("sep_horizontal", sep_h), ("sep_vertical", sep_v))
+    change = {k: real(k, v, low=0.0, strict=True)
+              for k, v in (("sep_horizontal", sep_h), ("sep_vertical", sep_v))
               if v is not None}
     if not change:
         return s
@@ -157,14 +115,19 @@ def simulate_command(
     check_choice("scheduler", scheduler, SCHEDULERS)
     if airspace is not None:
         check_choice("airspace", airspace, AIRSPACES)
-    _number("hours", hours, low=0, strict=True, high=MAX_HOURS)
-    _number("rate", rate, low=0, strict=False, high=MAX_RATE)
-    _number("track-step", track_step, low=0, strict=True)
+    hours = real("hours", hours, low=0.0, strict=True)
+    rate = None if rate is None else real("rate_per_hour", rate, low=0.0)
+    track_step = real("track_step", track_step, low=0.0, strict=True)
     if plot and out is None:
         raise OptionError("--plot needs --out DIR (the folder for map.png and timeline.png)")
     s = _with_separation(resolve_scenario(scenario, preset_name, airports, drones, area_km,
                                           seed), sep_horizontal, sep_vertical)
-    check_work(s, hours=hours, rate=rate, track_step=track_step if out is not None else None)
+    # the packages (rate x hours; a package CSV's rows are counted as it is read) and
+    # the tracks.csv rows, within the limits, before any work
+    check_run(drones=s.drones, hours=hours, rate_given=rate is not None,
+              rate_per_hour=rate if rate is not None or s.packages.csv is not None
+              else s.packages.rate_per_hour,
+              track_step=track_step if out is not None else None)
     # every level's take-off roll on every runway, before the bar
     check_levels(s, airspace, where=scenario_name(scenario, s))
     if out is not None:  # a bad --out fails before the run, not after it with some files
@@ -247,7 +210,6 @@ def scenario_command(
         help="Packages offered per hour (default 20 per airport).")] = None,
 ) -> None:
     """Print a valid scenario as YAML, every field with its default, ready to edit."""
-    _number("rate", rate, low=0, strict=False, high=MAX_RATE)
     typer.echo(to_yaml(generate(airports, drones, area_km=area_km, seed=seed,
                                 rate_per_hour=rate)), nl=False)
 
@@ -336,7 +298,7 @@ def sweep_command(
     spaces = _choices(airspace, "--airspace", AIRSPACES)
     rate_list = _rates(rates)
     seed_list = parse_seeds(seeds)
-    _number("hours", hours, low=0, strict=True, high=MAX_HOURS)
+    hours = real("hours", hours, low=0.0, strict=True)
     runs = check_sweep(schedulers=len(scheds), airspaces=len(spaces), rates=len(rate_list),
                        seeds=len(seed_list), fewer="--seeds, --rates, --scheduler or "
                        "--airspace")
@@ -347,7 +309,8 @@ def sweep_command(
     for mode in spaces:  # every level's take-off roll on every runway
         check_levels(s, mode, where=scenario_name(scenario, s))
     for r in rate_list:  # each run's packages (rate x hours) within the limit
-        check_work(s, hours=hours, rate=r, rate_flag="--rates")
+        check_run(drones=s.drones, hours=hours, rate_given=r is not None, rate_name="rates",
+                  rate_per_hour=s.packages.rate_per_hour if r is None else r)
     err = plain_console(stderr=True)
     with progress_bar(err) as progress:
         task = progress.add_task("runs", total=runs)

@@ -46,30 +46,38 @@ def track_rows(drones: int, hours: float, track_step: float) -> float:
 
 
 def check_run(*, drones: int, hours: float, rate_per_hour: float | None,
-              track_step: float | None = None) -> None:
+              track_step: float | None = None, rate_given: bool = True,
+              rate_name: str = "rate_per_hour") -> None:
     """Raise an :class:`~skyroute.errors.OptionError` naming the parameters when a run of
     ``drones`` for ``hours`` at ``rate_per_hour`` (None: a package CSV, whose rows are
     read, not drawn) writing tracks every ``track_step`` seconds (None: no tracks) is
     past a limit of this module (the drones are a scenario's, within :data:`MAX_DRONES`).
-    The values are assumed finite and positive."""
+    The values are assumed finite and positive. ``rate_given`` False: the rate is the
+    scenario's, so the messages blame ``hours``; ``rate_name``: the parameter the rate
+    was given as (a sweep's ``rates``)."""
     if hours > MAX_HOURS:
         raise OptionError(f"hours={hours:g} is over the limit of {MAX_HOURS:,g} simulated "
                           "hours", param="hours")
     if rate_per_hour is not None:
-        if rate_per_hour > MAX_RATE:
-            raise OptionError(f"rate_per_hour={rate_per_hour:g} is over the limit of "
-                              f"{MAX_RATE:,g} packages per hour", param="rate_per_hour")
-        n = expected_packages(rate_per_hour, hours)
+        r = rate_per_hour
+        if rate_given and r > MAX_RATE:
+            raise OptionError(f"{rate_name}={r:g} is over the limit of {MAX_RATE:,g} "
+                              "packages per hour", param=rate_name)
+        n = expected_packages(r, hours)
+        if n > MAX_PACKAGES and rate_given:
+            raise OptionError(f"{rate_name}={r:g} with hours={hours:g} would spawn about "
+                              f"{n:.2g} packages (limit {MAX_PACKAGES:,g}); lower one of "
+                              "them", param=(rate_name, "hours"))
         if n > MAX_PACKAGES:
-            raise OptionError(f"rate_per_hour={rate_per_hour:g} with hours={hours:g} would "
+            raise OptionError(f"hours={hours:g} at the scenario's {r:g} packages/h would "
                               f"spawn about {n:.2g} packages (limit {MAX_PACKAGES:,g}); lower "
-                              "one of them", param=("rate_per_hour", "hours"))
+                              "it or the scenario's packages.rate_per_hour", param="hours")
     if track_step is not None:
         rows = track_rows(drones, hours, track_step)
         if rows > MAX_TRACK_ROWS:
             raise OptionError(f"track_step={track_step:g} with hours={hours:g} and "
                               f"{drones} drones would write up to {rows:.2g} track rows "
-                              f"(limit {MAX_TRACK_ROWS:,.0f}); raise track_step",
+                              f"(limit {MAX_TRACK_ROWS:,.0f}); raise the step",
                               param=("track_step", "hours"))
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import sqlalchemy as sa
 
-from skyroute.errors import InputFormatError, OptionError, check_choice
+from skyroute.errors import InputFormatError, OptionError, check_choice, real, whole
 from skyroute.fleet.airborne import check_flights
 from skyroute.fleet.airspace import MODES
 from skyroute.fleet.dispatch import SCHEDULERS
@@ -153,18 +153,9 @@ def fly_fleet(task: FleetTask) -> dict:
 
 # -- the runner's "fleet" and "sweep" jobs -------------------------------------------------
 
-def _number(params: dict, key: str, default, *, low: float, strict: bool,
-            integer: bool = False):
-    v = params.get(key, default)
-    if v is None and default is None:
-        return None
-    ok = isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) \
-        and (v > low if strict else v >= low) and (not integer or float(v).is_integer())
-    if not ok:
-        kind = "an integer" if integer else "a number"
-        raise OptionError(f"{key}={v!r} must be {kind} {'>' if strict else '>='} {low:g}",
-                          param=key)
-    return int(v) if integer else float(v)
+def _rate(key: str, value) -> float:
+    """A rate in packages per hour (the bound is :func:`check_run`'s)."""
+    return real(key, value, low=0.0, need="a number >= 0")
 
 
 def _scenario(params: dict) -> tuple[Scenario, dict]:
@@ -211,18 +202,21 @@ def check_fleet_params(params: dict) -> dict:
     _known(params, {"preset", "scenario", "hours", "seed", "scheduler", "airspace",
                     "rate_per_hour", "track_step"}, "fleet")
     s, out = _scenario(params)
-    out["hours"] = _number(params, "hours", 1.0, low=0, strict=True)
-    out["seed"] = _number(params, "seed", 0, low=0, strict=False, integer=True)
+    out["hours"] = real("hours", params.get("hours", 1.0), low=0.0, strict=True)
+    out["seed"] = whole("seed", params.get("seed", 0), low=0)
     out["scheduler"] = params.get("scheduler", "seed")
     check_choice("scheduler", out["scheduler"], SCHEDULERS)
     out["airspace"] = params.get("airspace", s.airspace.mode)
     check_choice("airspace", out["airspace"], MODES)
     check_levels(s, out["airspace"], where=_where(out))
-    out["rate_per_hour"] = _number(params, "rate_per_hour", None, low=0, strict=False)
-    out["track_step"] = _number(params, "track_step", 1.0, low=0, strict=True)
+    rate = params.get("rate_per_hour")
+    out["rate_per_hour"] = None if rate is None else _rate("rate_per_hour", rate)
+    out["track_step"] = real("track_step", params.get("track_step", 1.0), low=0.0,
+                             strict=True)
     rate = out["rate_per_hour"]
     check_run(drones=s.drones, hours=out["hours"], track_step=out["track_step"],
-              rate_per_hour=s.packages.rate_per_hour if rate is None else rate)
+              rate_per_hour=s.packages.rate_per_hour if rate is None else rate,
+              rate_given=rate is not None)
     return out
 
 
@@ -241,7 +235,7 @@ def check_sweep_params(params: dict) -> dict:
     if rates is not None:
         if not isinstance(rates, list | tuple) or not rates:
             raise OptionError(f"rates={rates!r} must be a non-empty list", param="rates")
-        rates = [_number({"rates": r}, "rates", None, low=0, strict=False) for r in rates]
+        rates = [_rate("rates", r) for r in rates]
     out["rates"] = rates
     seeds = params.get("seeds", list(range(10)))
     if not isinstance(seeds, list | tuple) or not seeds:
@@ -249,14 +243,13 @@ def check_sweep_params(params: dict) -> dict:
     if len(seeds) > MAX_SEEDS:
         raise OptionError(f"seeds: {len(seeds):,} seeds is over the limit of {MAX_SEEDS:,}",
                           param="seeds")
-    out["seeds"] = list(dict.fromkeys(
-        _number({"seeds": x}, "seeds", None, low=0, strict=False, integer=True)
-        for x in seeds))
-    out["hours"] = _number(params, "hours", 1.0, low=0, strict=True)
+    out["seeds"] = list(dict.fromkeys(whole("seeds", x, low=0) for x in seeds))
+    out["hours"] = real("hours", params.get("hours", 1.0), low=0.0, strict=True)
     check_sweep(schedulers=len(out["schedulers"]), airspaces=len(out["airspaces"]),
                 rates=len(rates or [None]), seeds=len(out["seeds"]))
     for rate in rates or [s.packages.rate_per_hour]:
-        check_run(drones=s.drones, hours=out["hours"], rate_per_hour=rate)
+        check_run(drones=s.drones, hours=out["hours"], rate_per_hour=rate,
+                  rate_given=rates is not None, rate_name="rates")
     return out
 
 
