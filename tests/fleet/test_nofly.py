@@ -195,3 +195,15 @@ def test_a_cruise_the_planner_cannot_find_names_the_flight_not_a_status():
                               "gets round the no-fly zones from the climb-out (0 N, 0 E) to "
                               "the approach gate (3000 N, 0 E)")
     assert err.value.param == "no_fly_zones"
+
+
+def test_a_flight_the_zones_block_names_the_scenario_file_when_read():
+    # the airborne check plans the farthest pair: a final approach through a zone was a
+    # QueryError naming no file
+    from skyroute.fleet.airborne import check_flights
+
+    s = _two_airports([[-100, 2200], [-100, 2500], [100, 2500], [100, 2200]])
+    with pytest.raises(InputFormatError) as err:
+        check_flights(s, "two.yaml")
+    assert str(err.value) == ("two.yaml: no_fly_zones: airport E's final approach from 80 m "
+                              "crosses no-fly zone 'wall'")

@@ -17,9 +17,9 @@ import math
 import numpy as np
 
 from skyroute.errors import InputFormatError, QueryError, SkyrouteError
-from skyroute.fleet.nofly import check_joined
 from skyroute.fleet.flightplan import plan_flight, takeoff_overrun
 from skyroute.fleet.limits import MAX_FLIGHT_HOURS
+from skyroute.fleet.nofly import check_joined
 from skyroute.fleet.scenario import Airspace, Drone, Scenario
 
 MAX_LOITERS = 12  # full circles a flight may wait before its landing is granted
