@@ -89,7 +89,6 @@ def cruise(scenario, start, goal, radius: float, path: DubinsPath, *,
     return [(p.kind, p.length) for p in res.segments]
 
 
-
 def cut_off(scenario) -> tuple[list[str], list[str], list[str]] | None:
     """None when no ring of no-fly zones parts the airports, else (the airports inside
     the first such ring, those outside it, the ring's zones as the message names them).
