@@ -97,6 +97,7 @@ def read_geojson_world(path: str | Path, *, boundary: str | Path | shapely.Polyg
     so polygons stay polygons; a point at the corner keeps at least that distance).
     ``text``: the document itself, already fetched; ``path`` then only names it (a URL).
     """
+    source = str(path)
     if text is None:
         path = Path(path)
     zones, names, found = [], [], None
@@ -127,7 +128,8 @@ def read_geojson_world(path: str | Path, *, boundary: str | Path | shapely.Polyg
             pnames.append(name)
     n = len(polys)
     return World(np.array(polys, dtype=object), np.full(n, -np.inf), np.full(n, np.inf),
-                 tuple(pnames), found, frame, home, name=str(path).rstrip("/").rsplit("/")[-1])
+                 tuple(pnames), found, frame, home, name=source.rstrip("/").rsplit("/")[-1],
+                 source=source)
 
 
 def _to_metres(shape: shapely.Geometry, home: Home) -> shapely.Geometry:

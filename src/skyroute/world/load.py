@@ -152,4 +152,4 @@ def _with_boundary(world: World, lonlat_box) -> World:
 
     return World(world.obstacles, world.floors, world.ceilings, world.names,
                  shapely.transform(lonlat_box, world.plane_from_lonlat), world.frame,
-                 world.home, world.name)
+                 world.home, world.name, world.source)

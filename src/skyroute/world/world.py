@@ -46,7 +46,10 @@ class World:
     Obstacles and boundary are given in the plane (shapely x, y: east, north metres, or
     lon, lat in the "degrees" frame). ``frame`` says how callers give and get points:
     "enu" (the default: the plane itself), "ned" ("local" is an alias), "lonlat" (needs
-    ``home``) or "degrees".
+    ``home``) or "degrees". ``name`` titles tables and pictures (a file's base name);
+    ``source`` is the file as the caller named it (None for a world built in code), which
+    errors about the whole world name. Neither takes part in equality (a World is equal
+    only to itself) nor in the caches' keys.
     """
 
     obstacles: np.ndarray  # object array of shapely Polygons
@@ -57,6 +60,7 @@ class World:
     frame: str = "enu"
     home: Home | None = None
     name: str = field(default="world", compare=False)
+    source: str | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         obs = np.asarray(self.obstacles, dtype=object).ravel()
@@ -89,6 +93,11 @@ class World:
         boundary = "" if self.boundary is None else ", a boundary"
         return (f"<World {self.name!r}: {len(self.obstacles)} obstacles{boundary}, "
                 f"frame {self.frame!r}{home}>")
+
+    @property
+    def where(self) -> str:
+        """What an error about the whole world names: its file as given, else its name."""
+        return self.name if self.source is None else self.source
 
     # -- frames ----------------------------------------------------------------------
 
@@ -173,7 +182,7 @@ class World:
             obstacles = shapely.transform(self.obstacles, to_new)
             boundary = None if boundary is None else shapely.transform(boundary, to_new)
         return World(obstacles, self.floors, self.ceilings, self.names, boundary, frame,
-                     self.home, self.name)
+                     self.home, self.name, self.source)
 
     # -- views -----------------------------------------------------------------------
 
@@ -185,7 +194,7 @@ class World:
         keep = (self.floors <= altitude) & (self.ceilings > altitude)
         return World(self.obstacles[keep], self.floors[keep], self.ceilings[keep],
                      tuple(np.asarray(self.names, dtype=object)[keep]), self.boundary,
-                     self.frame, self.home, self.name)
+                     self.frame, self.home, self.name, self.source)
 
     @cached_property
     def tree(self) -> STRtree:
@@ -210,7 +219,7 @@ class World:
             first = self.names[members[0]] if len(members) else f"block {i}"
             names.append(first if len(members) <= 1 else f"{first} and {len(members) - 1} more")
         return World(parts, np.full(n, -np.inf), np.full(n, np.inf), tuple(names),
-                     self.boundary, self.frame, self.home, self.name)
+                     self.boundary, self.frame, self.home, self.name, self.source)
 
     @cached_property
     def _prepared_boundary(self):
