@@ -100,8 +100,8 @@ def test_a_feature_written_lat_lon_is_named_not_silently_far_away(tmp_path, fram
     path = write(tmp_path / "z.geojson", ZONE, swapped(ZONE), AREA)
     text = refused(path, "feature 1 ('swapped') lies ", frame=frame)
     assert text.endswith(" km from the rest of the world (a world reaches at most 1,000 km "
-                         "from its centre): are its coordinates (lat, lon)? GeoJSON is "
-                         "[lon, lat]")
+                         "from its centre): are its coordinates (lat, lon)? GeoJSON and "
+                         "boundary boxes are (lon, lat)")
     refused(write(tmp_path / "z.geojson", ZONE, swapped(AREA)), "feature 1 ('swapped') lies ")
 
 
@@ -141,3 +141,23 @@ def test_plan_world_with_a_swapped_feature_is_one_line_and_writes_nothing(monkey
                           "--goal=-3.186,55.949", "--geojson", str(out))
     assert code == 2 and text == "" and err.count("\n") == 1 and not out.exists()
     assert err.startswith(f"skyroute: error: {path}: feature 1 ('swapped') lies ")
+
+
+def test_a_boundary_box_written_lat_lon_is_refused_for_zones_and_cities(monkeypatch, capsys,
+                                                                        tmp_path):
+    # a colliders city took it, projected 7,800 km away, and then told the user to swap
+    # their (right) start: "(55.9445, -3.1869) is inside: points are (lon, lat)"
+    box = "55.93,-3.2,55.96,-3.18"
+    zones = write(tmp_path / "z.geojson", ZONE)
+    refused(zones, f"boundary='{box}' lies ", boundary=box)
+    city = tmp_path / "c.csv"
+    city.write_text("lat0 55.944494, lon0 -3.186874\n"
+                    "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n10,10,5,1,1,5\n")
+    code, out, err = run(monkeypatch, capsys, "plan-world", str(city), f"--boundary={box}",
+                         "--start=-3.1869,55.9445", "--goal=-3.1868,55.9446")
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert err.startswith(f"skyroute: error: --boundary '{box}' reaches 7,843 km from the "
+                          "city's home (lon -3.18687, lat 55.9445), more than 1,000 km: are "
+                          "its coordinates (lat, lon)?")
+    w = skyroute.load_world(city, boundary="-3.2,55.93,-3.18,55.96")  # the right way round
+    assert skyroute.plan(w, (-3.1869, 55.9445), (-3.1868, 55.9446)).found

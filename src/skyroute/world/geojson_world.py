@@ -29,6 +29,7 @@ from skyroute.world.world import World
 
 MAX_BYTES = 10_000_000  # as a colliders file's; the ILP zones are 11 kB; read whole
 MAX_REACH = 1_000_000  # metres from home: a world up to 2,000 km across
+SWAPPED = "are its coordinates (lat, lon)? GeoJSON and boundary boxes are (lon, lat)"
 
 
 def _features(path: Path | str, text: str | None = None) -> list[dict]:
@@ -150,7 +151,8 @@ def read_geojson_world(path: str | Path, *, boundary: str | Path | shapely.Polyg
             labels.append(label)
     if boundary is not None:
         found = boundary if isinstance(boundary, shapely.Polygon) else parse_boundary(boundary)
-        found_label = "the boundary"
+        found_label = "the boundary" if isinstance(boundary, shapely.Polygon) else \
+            f"boundary={str(boundary)!r}"
     if not zones and found is None:
         raise InputFormatError(path, "no zones and no boundary")
     shapes = zones + ([found] if found is not None else [])
@@ -204,8 +206,7 @@ def _check_reach(path: Path | str, shapes: list, labels: list[str], home: Home) 
         raise InputFormatError(path, f"the world reaches {reach / 1000:,.0f} km from its "
                                f"centre; {limit}")
     raise InputFormatError(path, f"{labels[far]} lies {km:,.0f} km from the rest of the world "
-                           f"({limit}): are its coordinates (lat, lon)? GeoJSON is "
-                           "[lon, lat]")
+                           f"({limit}): {SWAPPED}")
 
 
 def _to_metres(shape: shapely.Geometry, home: Home) -> shapely.Geometry:
