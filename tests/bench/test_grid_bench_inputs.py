@@ -31,7 +31,7 @@ def scen_text(*lines, size=(4, 3), name="tiny.map"):
 def write_pair(folder, stem="tiny", scen=None, map_text=TINY_MAP):
     (folder / f"{stem}.map").write_text(map_text)
     path = folder / f"{stem}.map.scen"
-    path.write_text(scen or scen_text((0, 0, 3, 0, 4.82842712)))
+    path.write_text(scen or scen_text((0, 0, 3, 0, 4.82842712), name=f"{stem}.map"))
     return path
 
 
@@ -65,12 +65,26 @@ def test_scen_line_on_a_blocked_cell_names_file_and_line(monkeypatch, capsys, tm
 def test_wrong_size_scen_fails_before_the_good_map_is_timed(monkeypatch, capsys, tmp_path,
                                                             no_timing):
     write_pair(tmp_path, "a")
-    bad = write_pair(tmp_path, "b", scen=scen_text((0, 0, 1, 0, 1.0), size=(5, 3)))
+    bad = write_pair(tmp_path, "b", scen=scen_text((0, 0, 1, 0, 1.0), size=(5, 3),
+                                                   name="b.map"))
     out_json = tmp_path / "r.json"
     code, out, err = run(monkeypatch, capsys, "bench", "grid", "--maps", str(tmp_path),
                          "--peers", "", "--json", str(out_json))
     assert_one_line(code, out, err, f"{bad}:2: scenario is for a 5x3 map, b.map is 4x3")
     assert not out_json.exists()
+
+
+@pytest.mark.parametrize("named", ["other.map", "maps/dao/other.map"])
+def test_scen_for_another_map_of_the_same_size_is_refused(monkeypatch, capsys, tmp_path,
+                                                          no_timing, named):
+    # the same size and free cells: only the scenario's map column tells the maps apart
+    bad = write_pair(tmp_path, scen=scen_text((0, 0, 3, 0, 4.82842712), name=named))
+    code, out, err = run(monkeypatch, capsys, "bench", "grid", "--maps", str(tmp_path),
+                         "--peers", "")
+    assert_one_line(code, out, err, f"{bad}:2: scenario is for other.map (its map column), "
+                    "not tiny.map")
+    write_pair(tmp_path, scen=scen_text((0, 0, 3, 0, 4.82842712), name="maps\\tiny.map"))
+    assert load_case(tmp_path / "tiny.map", bad, per_map=0).queries == 1  # a folder is ignored
 
 
 def test_check_scenario_start_outside_the_map(tmp_path):

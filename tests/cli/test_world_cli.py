@@ -96,8 +96,9 @@ def test_a_city_too_large_for_its_planner_is_one_line_naming_it(monkeypatch, cap
     from skyroute.motion import corner_distance
     from skyroute.roadmap import visibility
 
-    city = tmp_path / "c.csv"
-    code, _, _ = run(monkeypatch, capsys, "synth-city", str(city), "--blocks", "3")
+    monkeypatch.chdir(tmp_path)
+    city = "sub/c.csv"  # named as given, not by its base name only
+    code, _, _ = run(monkeypatch, capsys, "synth-city", city, "--blocks", "3")
     assert code == 0
     monkeypatch.setenv("SKYROUTE_CACHE", str(tmp_path))  # not a graph an earlier test kept
     monkeypatch.setattr(visibility, "MAX_CORNERS", 20)  # the city has about 70
@@ -109,13 +110,13 @@ def test_a_city_too_large_for_its_planner_is_one_line_naming_it(monkeypatch, cap
             (["fly", "--vehicle", "dubins"], "over the limit of 20 for Hybrid A*'s corner "
                                              "distances"),
             (["fly", "--vehicle", "dubins", "--planner", "waypoints"], "visibility graph")):
-        code, out, err = run(monkeypatch, capsys, *args, str(city), "--frame", "ned",
+        code, out, err = run(monkeypatch, capsys, *args, city, "--frame", "ned",
                              "--start", "0,0", "--goal", "60,60", "--plot", str(png))
         assert code == 2 and out == "" and err.count("\n") == 1, err
-        assert err.startswith("skyroute: error: c.csv: ") and words in err, err
+        assert err.startswith("skyroute: error: sub/c.csv: ") and words in err, err
         assert " obstacle corners, " in err and not png.exists()
     # the same city on a grid is planned
-    code, _, err = run(monkeypatch, capsys, "plan-world", str(city), "--frame", "ned",
+    code, _, err = run(monkeypatch, capsys, "plan-world", city, "--frame", "ned",
                        "--start", "0,0", "--goal", "60,60", "--algorithm", "theta")
     assert code == 0, err
 

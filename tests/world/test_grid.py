@@ -110,6 +110,15 @@ def test_segment_file_and_errors(tmp_path):
     assert tuple(g.origin) == (-0.75, -0.75)
 
 
+@pytest.mark.parametrize("header", ["x1,y1,x2,y2\r\n", ""])
+def test_segment_file_with_a_byte_order_mark_reads_as_without(tmp_path, header):
+    rows = "0,0,2,0\r\n2,0,2,2\r\n"
+    plain, bom = tmp_path / "walls.csv", tmp_path / "excel.csv"
+    plain.write_text(header + rows)
+    bom.write_bytes(b"\xef\xbb\xbf" + (header + rows).encode())  # Excel's "CSV UTF-8"
+    np.testing.assert_array_equal(load_map(bom).blocked, load_map(plain).blocked)
+
+
 def test_png_dark_pixels_are_blocked(tmp_path):
     img = np.full((3, 4), 255, np.uint8)
     img[1, 2] = 0
@@ -131,6 +140,26 @@ def test_npy_and_unknown_suffix(tmp_path):
     (tmp_path / "bad.png").write_text("not an image")
     with pytest.raises(InputFormatError, match=r"bad\.png: cannot read as an image"):
         load_map(tmp_path / "bad.png")
+
+
+@pytest.mark.parametrize("content, words", [
+    (b"junk", "not a .npy file"),
+    (None, "not a .npy file"),  # an .npz archive named .npy
+    (np.array([[0.0, np.nan], [0.0, 0.0]]), "NaN at cell (1, 0) (x, y)"),
+])
+def test_npy_that_is_no_array_or_holds_nan_is_one_line(tmp_path, content, words):
+    p = tmp_path / "m.npy"
+    if content is None:
+        with p.open("wb") as fh:
+            np.savez(fh, a=np.zeros((2, 2)))
+    elif isinstance(content, bytes):
+        p.write_bytes(content)
+    else:
+        np.save(p, content)
+    with pytest.raises(InputFormatError) as err:
+        load_map(p)
+    assert str(err.value).startswith(f"{p}: ") and words in str(err.value)
+    assert "allow_pickle" not in str(err.value)
 
 
 def test_missing_file_lists_bundled_maps(tmp_path):

@@ -25,13 +25,17 @@ def test_terrain_characters_and_cell_order(tmp_path):
     assert not g.is_free((3, 2))  # water is blocked
 
 
-@pytest.mark.parametrize("variant", ["crlf", "no-final-newline", "crlf-no-final"])
+@pytest.mark.parametrize("variant", ["crlf", "no-final-newline", "crlf-no-final", "bom",
+                                     "bom-crlf", "blank-end", "spaces-end"])
 def test_line_endings(tmp_path, variant):
     text = SMALL
     if "crlf" in variant:
         text = text.replace("\n", "\r\n")
     if "final" in variant:
         text = text.rstrip("\r\n")
+    if variant.startswith("bom"):  # Notepad's "UTF-8 with BOM"
+        text = "\ufeff" + text
+    text += {"blank-end": "\n\n", "spaces-end": "  \n\t\n"}.get(variant, "")
     g = read_map(write(tmp_path, text))
     np.testing.assert_array_equal(g.blocked, read_map(write(tmp_path, SMALL, "b.map")).blocked)
 
@@ -54,6 +58,13 @@ def test_malformed_maps_name_the_line(tmp_path, text, line, words):
     assert err.value.line == line
     assert str(err.value).startswith(f"{p}:{line}: ")
     assert words in str(err.value)
+
+
+def test_a_byte_order_mark_is_read_past_in_a_scen_too(tmp_path):
+    plain = read_scen(write(tmp_path, SCEN, "m.map.scen"))
+    bom = read_scen(write(tmp_path, "\ufeff" + SCEN.replace("\n", "\r\n"), "b.map.scen"))
+    np.testing.assert_array_equal(bom.starts, plain.starts)
+    assert bom.map_name == "m.map"
 
 
 def test_binary_file_is_a_format_error(tmp_path):

@@ -200,3 +200,22 @@ def test_point_queries_refuse_three_columns(query):
 def test_segment_queries_refuse_unequal_ends():
     with pytest.raises(QueryError, match="as many points"):
         _tower().segments_free([[0, 0]], [[1, 1], [2, 2]])
+
+
+def test_a_loaded_world_keeps_the_path_it_was_given_through_views_and_pickling(tmp_path,
+                                                                               monkeypatch):
+    import pickle
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "sub").mkdir()
+    write(tmp_path / "sub" / "c.csv", COLLIDERS)
+    w = skyroute.load_world("sub/c.csv", boundary="-122.4,37.79,-122.39,37.80")
+    assert (w.name, w.source, w.where) == ("c.csv", "sub/c.csv", "sub/c.csv")
+    for view in (w.at(10.0), w.merged(), w.in_frame("ned"), w.in_frame("degrees"),
+                 pickle.loads(pickle.dumps(w))):
+        assert (view.name, view.source) == ("c.csv", "sub/c.csv")
+    again = skyroute.load_world(tmp_path / "sub" / "c.csv")
+    assert again.source == str(tmp_path / "sub" / "c.csv")
+    assert w == w and w != again  # a World is equal only to itself, as before
+    built = skyroute.World(w.obstacles, w.floors, w.ceilings, w.names, name="mine")
+    assert built.source is None and built.where == "mine"

@@ -81,7 +81,7 @@ def run_skyroute(world: World, start, goal, radius: float) -> dict:
     from skyroute.motion.hybrid import path_free, plan
 
     fresh = World(world.obstacles, world.floors, world.ceilings, world.names,
-                  world.boundary, world.frame, world.home, world.name)
+                  world.boundary, world.frame, world.home, world.name, world.source)
     t0 = time.perf_counter()
     r = plan(fresh, start, goal, radius)
     cold = time.perf_counter() - t0
@@ -186,7 +186,7 @@ def city_world(path, *, altitude: float = 10.0, safety: float = 2.0) -> World:
     x0, y0, x1, y1 = city.bounds
     box = shapely.box(x0 - 20, y0 - 20, x1 + 20, y1 + 20)
     return World(city.obstacles, city.floors, city.ceilings, city.names, box, "enu",
-                 city.home, f"{city.name} (boundary 20 m out)")
+                 city.home, f"{city.name} (boundary 20 m out)", city.source)
 
 
 def curvature_queries(worlds: int = 10, seed: int = 0, *, city=None,

@@ -83,7 +83,7 @@ def free_pair(world: World, rng: np.random.Generator, min_dist: float) -> tuple:
         if world.is_free(p).all() and math.dist(*p) >= min_dist and \
                 plan(world, p[0], p[1]).found:
             return p[0], p[1]
-    raise SkyrouteError(f"{world.name}: no two free points {min_dist:g} apart with a path "
+    raise SkyrouteError(f"{world.where}: no two free points {min_dist:g} apart with a path "
                         "between them in 1000 draws")
 
 
@@ -161,7 +161,7 @@ def run_ours(world: World, start, goal, other: tuple | None = None) -> list[dict
     from skyroute.roadmap.world_plan import visibility_graph
 
     fresh = World(world.obstacles, world.floors, world.ceilings, world.names,
-                  world.boundary, world.frame, world.home, world.name)
+                  world.boundary, world.frame, world.home, world.name, world.source)
     rows = []
     t0 = time.perf_counter()
     visibility_graph(fresh, cache=False)  # built here, not read from the disk cache
@@ -224,7 +224,7 @@ def random_free_pair(world: World, rng: np.random.Generator, min_dist: float) ->
         p = rng.uniform([xmin, ymin], [xmax, ymax], size=(2, 2))
         if math.dist(*p) >= min_dist and world.is_free(p).all():
             return p[0], p[1]
-    raise SkyrouteError(f"{world.name}: no two free points {min_dist:g} apart in 100,000 "
+    raise SkyrouteError(f"{world.where}: no two free points {min_dist:g} apart in 100,000 "
                         "draws")
 
 

@@ -275,8 +275,8 @@ def _read_targets(path: Path, world) -> np.ndarray:
     list of [A, B]; errors name the file and line."""
     from skyroute.errors import InputFormatError
 
-    try:
-        text = path.read_text()
+    try:  # utf-8-sig: Excel's "CSV UTF-8" starts with a byte-order mark
+        text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         raise InputFormatError(path, f"cannot read: {exc}") from None
     if path.suffix.lower() == ".json":

@@ -63,7 +63,7 @@ class VisibilityGraph:
             polygons, arrays = stored
         self.world = World(polygons, np.full(len(polygons), -np.inf),
                            np.full(len(polygons), np.inf), tuple(arrays["names"].tolist()),
-                           world.boundary, world.frame, world.home, world.name)
+                           world.boundary, world.frame, world.home, world.name, world.source)
         self.corners, self._prev, self._next = arrays["corners"], arrays["prev"], \
             arrays["next"]
         self._indptr, self._indices, self._weights = arrays["indptr"], arrays["indices"], \
@@ -185,7 +185,7 @@ def refuse_corners(world: World, corners: int, *, limit: int, table: str, instea
     ``instead`` says what to do, ``param`` the parameter that chose ``table``."""
     if corners > limit:
         many = f"at least {corners:,}" if at_least else f"{corners:,}"
-        raise OptionError(f"{world.name}: {many} obstacle corners, over the limit of "
+        raise OptionError(f"{world.where}: {many} obstacle corners, over the limit of "
                           f"{limit:,} for {table} (built over every pair of them); "
                           f"{instead}, or plan at an altitude that keeps fewer obstacles",
                           param=param)

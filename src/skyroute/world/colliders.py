@@ -36,7 +36,7 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
     """Read a colliders file into a World in ``frame`` ("lonlat", "ned" or "enu"; the
     plane is east/north metres around home at (lon0, lat0)). ``text``: the file's content,
     already in hand (an upload); ``path`` then only names it in errors."""
-    path = Path(path)
+    source, path = str(path), Path(path)
     try:  # utf-8-sig: Excel starts a saved CSV with a byte-order mark
         if text is None:
             _check_bytes(path, path.stat().st_size)
@@ -79,7 +79,7 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
     boxes = shapely.box(east - he - s, north - hn - s, east + he + s, north + hn + s)
     names = tuple(f"box at line {n}" for n in range(3, 3 + len(rows)))
     return World(boxes, up - hu - s, up + hu + s, names, None, frame,
-                 Home(lon0, lat0, 0.0), name=path.name)
+                 Home(lon0, lat0, 0.0), name=path.name, source=source)
 
 
 def _check_bytes(path: Path, size: int) -> None:

@@ -6,6 +6,12 @@ feature whose properties carry ``"boundary": true`` or whose name mentions
 ``MINLON,MINLAT,MAXLON,MAXLAT``. Frames: "degrees" keeps (lon, lat) as a flat plane
 (the ILP rules); "lonlat" (the default), "ned" and "enu" project to east/north metres
 around a home at the centre of the boundary (or of the zones), see :mod:`skyroute.geo`.
+
+A file is refused before it is read past :data:`MAX_BYTES` (as a colliders file is), and
+a world whose lon/lat box (zones and boundary) reaches more than :data:`MAX_REACH` metres
+from that home is refused naming the feature farthest from the others: one feature
+written (lat, lon) by mistake lies thousands of kilometres away, where it would silently
+guard nothing (and the tangent plane at home is off by 0.1 % at 500 km, 0.4 % at 1,000).
 """
 
 from __future__ import annotations
@@ -21,10 +27,17 @@ from skyroute.geo import FRAME_ALIASES, FRAMES, Home, lonlat_to_enu
 from skyroute.world.points import check_places
 from skyroute.world.world import World
 
+MAX_BYTES = 10_000_000  # as a colliders file's; the ILP zones are 11 kB; read whole
+MAX_REACH = 1_000_000  # metres from home: a world up to 2,000 km across
+SWAPPED = "are its coordinates (lat, lon)? GeoJSON and boundary boxes are (lon, lat)"
+
 
 def _features(path: Path | str, text: str | None = None) -> list[dict]:
-    try:
-        doc = json.loads(Path(path).read_text() if text is None else text)
+    try:  # utf-8-sig: a byte-order mark (Windows editors) is read past
+        if text is None:
+            _check_bytes(path, Path(path).stat().st_size)
+            text = Path(path).read_text(encoding="utf-8-sig")
+        doc = json.loads(text.removeprefix("\ufeff"))
     except (OSError, UnicodeDecodeError) as exc:
         raise InputFormatError(path, f"cannot read: {exc}") from None
     except json.JSONDecodeError as exc:
@@ -35,18 +48,31 @@ def _features(path: Path | str, text: str | None = None) -> list[dict]:
     return doc["features"]
 
 
+def _check_bytes(path: Path | str, size: int) -> None:
+    """Refuse a file of ``size`` bytes past :data:`MAX_BYTES` before it is read."""
+    if size > MAX_BYTES:
+        raise InputFormatError(path, f"{size:,} bytes, over the limit of {MAX_BYTES:,} for "
+                               "a GeoJSON file")
+
+
 def _polygon(path: Path, i: int, feature: dict) -> tuple[shapely.Geometry, str]:
-    props = feature.get("properties") or {}
-    name = str(props.get("name", f"feature {i}"))
-    geom = feature.get("geometry") or {}
-    kind = geom.get("type")
+    if not isinstance(feature, dict):
+        raise InputFormatError(path, f"feature {i} is {type(feature).__name__} "
+                               f"{json.dumps(feature)[:40]}, not a GeoJSON Feature object")
+    name = str(_properties(feature).get("name", f"feature {i}"))
+    geom = feature.get("geometry")
+    kind = geom.get("type") if isinstance(geom, dict) else None
     if kind not in ("Polygon", "MultiPolygon"):
-        raise InputFormatError(path, f"feature {i} ({name!r}) is a {kind}; only Polygon and "
+        what = "has no geometry" if geom is None else f"is a {kind}" if kind else \
+            "has a geometry with no type"
+        raise InputFormatError(path, f"feature {i} ({name!r}) {what}; only Polygon and "
                                "MultiPolygon features are zones")
     try:
         shape = shapely.from_geojson(json.dumps(geom))
     except shapely.errors.GEOSException as exc:
         raise InputFormatError(path, f"feature {i} ({name!r}): bad coordinates: {exc}") from None
+    if shape.is_empty:
+        raise InputFormatError(path, f"feature {i} ({name!r}) has no coordinates")
     if not shape.is_valid:
         raise InputFormatError(path, f"feature {i} ({name!r}) is not a valid polygon: "
                                f"{shapely.is_valid_reason(shape)}")
@@ -57,8 +83,14 @@ def _polygon(path: Path, i: int, feature: dict) -> tuple[shapely.Geometry, str]:
     return shape, name
 
 
+def _properties(feature: dict) -> dict:
+    """A feature's properties; none (null, or not an object) read as {}."""
+    props = feature.get("properties")
+    return props if isinstance(props, dict) else {}
+
+
 def _is_boundary(feature: dict) -> bool:
-    props = feature.get("properties") or {}
+    props = _properties(feature)
     return props.get("boundary") is True or "confinement" in str(props.get("name", "")).lower()
 
 
@@ -97,23 +129,36 @@ def read_geojson_world(path: str | Path, *, boundary: str | Path | shapely.Polyg
     so polygons stay polygons; a point at the corner keeps at least that distance).
     ``text``: the document itself, already fetched; ``path`` then only names it (a URL).
     """
+    source = str(path)
     if text is None:
         path = Path(path)
-    zones, names, found = [], [], None
+    zones, names, labels, found, found_label = [], [], [], None, None
     for i, feature in enumerate(_features(path, text)):
         shape, name = _polygon(path, i, feature)
+        label = f"feature {i} ({name!r})"
         if _is_boundary(feature):
-            found = shape
+            if found is not None:
+                raise InputFormatError(path, f"two boundaries: {found_label} and {label} (a "
+                                       "feature with \"boundary\": true or \"confinement\" "
+                                       "in its name); keep one")
+            if shape.geom_type != "Polygon":
+                raise InputFormatError(path, f"{label} is the boundary, so it must be one "
+                                       f"Polygon, not a {shape.geom_type}")
+            found, found_label = shape, label
         else:
             zones.append(shape)
             names.append(name)
+            labels.append(label)
     if boundary is not None:
         found = boundary if isinstance(boundary, shapely.Polygon) else parse_boundary(boundary)
+        found_label = "the boundary" if isinstance(boundary, shapely.Polygon) else \
+            f"boundary={str(boundary)!r}"
     if not zones and found is None:
         raise InputFormatError(path, "no zones and no boundary")
-    allb = shapely.total_bounds(np.array(zones + ([found] if found is not None else []),
-                                         dtype=object))
+    shapes = zones + ([found] if found is not None else [])
+    allb = shapely.total_bounds(np.array(shapes, dtype=object))
     home = Home((allb[0] + allb[2]) / 2, (allb[1] + allb[3]) / 2, 0.0)
+    _check_reach(path, shapes, labels + ([found_label] if found is not None else []), home)
     check_choice("frame", frame, (*FRAMES, *FRAME_ALIASES))
     if frame != "degrees":
         zones = [_to_metres(z, home) for z in zones]
@@ -127,7 +172,41 @@ def read_geojson_world(path: str | Path, *, boundary: str | Path | shapely.Polyg
             pnames.append(name)
     n = len(polys)
     return World(np.array(polys, dtype=object), np.full(n, -np.inf), np.full(n, np.inf),
-                 tuple(pnames), found, frame, home, name=str(path).rstrip("/").rsplit("/")[-1])
+                 tuple(pnames), found, frame, home, name=source.rstrip("/").rsplit("/")[-1],
+                 source=source)
+
+
+def _check_reach(path: Path | str, shapes: list, labels: list[str], home: Home) -> None:
+    """Refuse a world whose lon/lat box (zones and boundary) reaches more than
+    :data:`MAX_REACH` metres (straight through the Earth) from its centre ``home``, saying
+    what is likely wrong: a shape across the antimeridian, or one far from the others,
+    (lat, lon) written for (lon, lat)."""
+    shapes = np.array(shapes, dtype=object)
+    box = shapely.bounds(shapes)  # (n, 4): lon0, lat0, lon1, lat1
+    lon0, lat0 = box[:, :2].min(axis=0)
+    lon1, lat1 = box[:, 2:].max(axis=0)
+    corners = lonlat_to_enu(np.array([lon0, lon1, lon0, lon1]),
+                            np.array([lat0, lat0, lat1, lat1]), 0.0, home)
+    reach = np.linalg.norm(corners, axis=1).max()
+    if reach <= MAX_REACH:
+        return
+    limit = f"a world reaches at most {MAX_REACH / 1000:,.0f} km from its centre"
+    if lon1 - lon0 > 180:
+        wide = np.flatnonzero(box[:, 2] - box[:, 0] > 180)
+        who = f"{labels[wide[0]]} spans" if len(wide) else "the zones span"
+        raise InputFormatError(path, f"{who} lon {lon0:g} to {lon1:g}, across the "
+                               f"antimeridian; {limit}")
+    centres = shapely.get_coordinates(shapely.centroid(shapes))
+    mid = Home(*np.median(centres, axis=0), 0.0)
+    far = int(np.argmax(np.linalg.norm(lonlat_to_enu(*centres.T, 0.0, mid), axis=1)))
+    rest = np.delete(centres, far, axis=0)
+    km = 0.0 if len(rest) == 0 else np.linalg.norm(
+        lonlat_to_enu(*centres[far], 0.0, Home(*np.median(rest, axis=0), 0.0))) / 1000
+    if km * 1000 <= MAX_REACH:
+        raise InputFormatError(path, f"the world reaches {reach / 1000:,.0f} km from its "
+                               f"centre; {limit}")
+    raise InputFormatError(path, f"{labels[far]} lies {km:,.0f} km from the rest of the world "
+                           f"({limit}): {SWAPPED}")
 
 
 def _to_metres(shape: shapely.Geometry, home: Home) -> shapely.Geometry:

@@ -9,6 +9,8 @@ import numpy as np
 from skyroute.errors import InputFormatError
 from skyroute.world.grid import Grid
 
+NPY_MAGIC = b"\x93NUMPY"
+
 
 def from_array(array: np.ndarray, *, resolution: float = 1.0,
                origin: tuple[float, float] = (0.0, 0.0), name: str = "array") -> Grid:
@@ -52,10 +54,18 @@ def _sixteen_bit(path: Path, pixels: np.ndarray) -> np.ndarray:
 
 
 def read_npy(path: str | Path, *, resolution: float = 1.0) -> Grid:
-    """A Grid from a ``.npy`` file holding a 2-D array (non-zero = blocked)."""
+    """A Grid from a ``.npy`` file holding a 2-D array (non-zero = blocked; NaN, which
+    says neither, is refused naming its cell)."""
     path = Path(path)
     try:
-        arr = np.load(path, allow_pickle=False)
+        with path.open("rb") as fh:
+            if fh.read(6) != NPY_MAGIC:  # np.load would try it as a pickle or a .npz
+                raise InputFormatError(path, "not a .npy file (numpy.save writes one; it "
+                                       "starts with \\x93NUMPY)")
+            fh.seek(0)
+            arr = np.load(fh, allow_pickle=False)
+    except InputFormatError:
+        raise
     except (OSError, ValueError) as exc:
         raise InputFormatError(path, f"cannot read as a .npy array: {exc}") from None
     if arr.ndim != 2 or 0 in arr.shape:
@@ -63,4 +73,8 @@ def read_npy(path: str | Path, *, resolution: float = 1.0) -> Grid:
     if arr.dtype.kind not in "biuf":
         raise InputFormatError(path, f"expected an array of numbers or booleans, got dtype "
                                f"{arr.dtype}")
+    if arr.dtype.kind == "f" and np.isnan(arr).any():
+        row, col = np.argwhere(np.isnan(arr))[0]
+        raise InputFormatError(path, f"NaN at cell ({col}, {row}) (x, y); use 0 for free and "
+                               "non-zero for blocked")
     return from_array(arr, resolution=resolution, name=path.name)

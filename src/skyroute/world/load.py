@@ -134,7 +134,8 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
                               "'lonlat', 'ned' or 'enu'", param="frame")
         world = read_colliders(p, safety=safety, frame=frame, text=text)
         if boundary is not None:
-            world = _with_boundary(world, parse_boundary(boundary))
+            world = _with_boundary(world, _near_home(boundary, parse_boundary(boundary),
+                                                     world.home))
     elif p.suffix.lower() in (".geojson", ".json"):
         world = read_geojson_world(p, boundary=boundary, safety=safety, frame=frame,
                                    text=text)
@@ -142,6 +143,24 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
         raise InputFormatError(p, f"unknown world type {p.suffix!r}; valid: .csv (colliders), "
                                ".geojson")
     return world.at(altitude)
+
+
+def _near_home(given, lonlat_box, home):
+    """``lonlat_box`` when it lies within the GeoJSON worlds' reach of a city's home, else
+    an OptionError: beyond it a (lat, lon) box is projected into a distorted far-off area
+    that no start or goal near home lies in."""
+    import numpy as np
+
+    from skyroute.geo import lonlat_to_enu
+    from skyroute.world.geojson_world import MAX_REACH, SWAPPED
+
+    xy = np.asarray(lonlat_box.exterior.coords)
+    km = np.linalg.norm(lonlat_to_enu(xy[:, 0], xy[:, 1], 0.0, home), axis=1).max() / 1000
+    if km * 1000 > MAX_REACH:
+        raise OptionError(f"boundary={str(given)!r} reaches {km:,.0f} km from the city's home "
+                          f"(lon {home.lon:g}, lat {home.lat:g}), more than "
+                          f"{MAX_REACH / 1000:,.0f} km: {SWAPPED}", param="boundary")
+    return lonlat_box
 
 
 def _with_boundary(world: World, lonlat_box) -> World:
@@ -152,4 +171,4 @@ def _with_boundary(world: World, lonlat_box) -> World:
 
     return World(world.obstacles, world.floors, world.ceilings, world.names,
                  shapely.transform(lonlat_box, world.plane_from_lonlat), world.frame,
-                 world.home, world.name)
+                 world.home, world.name, world.source)

@@ -4,7 +4,8 @@ Format: https://movingai.com/benchmarks/formats.html (Sturtevant 2012). Terrain:
 ``.``, ``G`` and ``S`` are passable; ``@``, ``O``, ``T`` and ``W`` are blocked. Water
 (``W``) is "traversable, but not passable from terrain", and no cost is given for it; a
 ground robot starting on terrain can never enter it, so it is blocked here. LF and CRLF
-line endings are accepted, with or without a final newline.
+line endings are accepted, with or without a final newline, and so are a UTF-8
+byte-order mark (Windows editors write one) and blank lines (spaces only) at the end.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ def _lines(path: Path, raw: bytes | None = None) -> list[str]:
             raw = path.read_bytes()
         except OSError as exc:
             raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
+    raw = raw.removeprefix(b"\xef\xbb\xbf")  # a UTF-8 byte-order mark
     if not raw.strip():
         raise InputFormatError(path, "the file is empty", line=1)
     try:
@@ -70,7 +72,7 @@ def read_map(path: str | Path, *, text: str | bytes | None = None) -> Grid:
         got = lines[3].strip() if len(lines) > 3 else "end of file"
         raise InputFormatError(path, f"expected 'map', got {got!r}", line=4)
     rows = lines[4:]
-    while rows and rows[-1] == "":
+    while rows and not rows[-1].strip():
         rows.pop()
     if len(rows) != height:
         raise InputFormatError(

@@ -22,7 +22,7 @@ def read_segments(path: str | Path) -> np.ndarray:
     """Read ``x1,y1,x2,y2`` rows (an optional header row of names is skipped) as (N, 4)."""
     path = Path(path)
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark (Excel) read past
     except (OSError, UnicodeDecodeError) as exc:
         raise InputFormatError(path, f"cannot read: {exc}") from None
     rows = []

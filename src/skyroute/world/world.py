@@ -46,7 +46,10 @@ class World:
     Obstacles and boundary are given in the plane (shapely x, y: east, north metres, or
     lon, lat in the "degrees" frame). ``frame`` says how callers give and get points:
     "enu" (the default: the plane itself), "ned" ("local" is an alias), "lonlat" (needs
-    ``home``) or "degrees".
+    ``home``) or "degrees". ``name`` titles tables and pictures (a file's base name);
+    ``source`` is the file as the caller named it (None for a world built in code), which
+    errors about the whole world name. Neither takes part in equality (a World is equal
+    only to itself) nor in the caches' keys.
     """
 
     obstacles: np.ndarray  # object array of shapely Polygons
@@ -57,6 +60,7 @@ class World:
     frame: str = "enu"
     home: Home | None = None
     name: str = field(default="world", compare=False)
+    source: str | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         obs = np.asarray(self.obstacles, dtype=object).ravel()
@@ -89,6 +93,11 @@ class World:
         boundary = "" if self.boundary is None else ", a boundary"
         return (f"<World {self.name!r}: {len(self.obstacles)} obstacles{boundary}, "
                 f"frame {self.frame!r}{home}>")
+
+    @property
+    def where(self) -> str:
+        """What an error about the whole world names: its file as given, else its name."""
+        return self.name if self.source is None else self.source
 
     # -- frames ----------------------------------------------------------------------
 
@@ -173,7 +182,7 @@ class World:
             obstacles = shapely.transform(self.obstacles, to_new)
             boundary = None if boundary is None else shapely.transform(boundary, to_new)
         return World(obstacles, self.floors, self.ceilings, self.names, boundary, frame,
-                     self.home, self.name)
+                     self.home, self.name, self.source)
 
     # -- views -----------------------------------------------------------------------
 
@@ -185,7 +194,7 @@ class World:
         keep = (self.floors <= altitude) & (self.ceilings > altitude)
         return World(self.obstacles[keep], self.floors[keep], self.ceilings[keep],
                      tuple(np.asarray(self.names, dtype=object)[keep]), self.boundary,
-                     self.frame, self.home, self.name)
+                     self.frame, self.home, self.name, self.source)
 
     @cached_property
     def tree(self) -> STRtree:
@@ -210,7 +219,7 @@ class World:
             first = self.names[members[0]] if len(members) else f"block {i}"
             names.append(first if len(members) <= 1 else f"{first} and {len(members) - 1} more")
         return World(parts, np.full(n, -np.inf), np.full(n, np.inf), tuple(names),
-                     self.boundary, self.frame, self.home, self.name)
+                     self.boundary, self.frame, self.home, self.name, self.source)
 
     @cached_property
     def _prepared_boundary(self):
@@ -332,24 +341,37 @@ class World:
 
     def check_point(self, point, what: str) -> np.ndarray:
         """One point in the world's frame -> its (2,) plane point when it is free, else a
-        QueryError naming ``what`` that speaks in the world's frame."""
+        QueryError naming ``what`` that speaks in the world's frame and shows the point as
+        given (not as it comes back from the plane: far from home a lon/lat does not)."""
         p = self.to_plane(point, what)
         if len(p) != 1:
             raise QueryError(f"{what} must be one point (a, b), got {len(p)} points")
-        return self.check_plane_point(p[0], what)
+        return self.check_plane_point(p[0], what, given=as_points(point, what)[0])
 
-    def check_plane_point(self, p: np.ndarray, what: str) -> np.ndarray:
-        """A (2,) plane point when it is free, else a QueryError in the world's frame."""
+    def check_plane_point(self, p: np.ndarray, what: str, *, given=None) -> np.ndarray:
+        """A (2,) plane point when it is free, else a QueryError in the world's frame
+        (``given``: the point as the caller wrote it, shown instead of ``p`` converted)."""
         p = np.asarray(p, dtype=float).reshape(2)
+        shown = self._fmt(p) if given is None else self._fmt_frame(given)
         if not self.inside([p])[0]:
-            raise QueryError(f"{what} {self._fmt(p)} lies outside the map "
-                             f"({self._extent_text()})")
+            raise QueryError(f"{what} {shown} lies outside the map "
+                             f"({self._extent_text()}){self._swapped_hint(given)}")
         j = int(self.blocking([p])[0])
         if j >= 0:
             near = self.nearest_free(p, j)
-            raise QueryError(f"{what} {self._fmt(p)} lies inside obstacle "
+            raise QueryError(f"{what} {shown} lies inside obstacle "
                              f"{self.names[j]!r}; nearest free point {self._fmt(near)}")
         return p
+
+    def _swapped_hint(self, given) -> str:
+        """'; ... (lon, lat)' when a lon/lat point outside the map would lie inside it
+        with its two numbers swapped, else ''."""
+        if given is None or self.frame not in ("lonlat", "degrees"):
+            return ""
+        q = np.asarray(given, dtype=float)[::-1]
+        if abs(q[0]) > 180 or abs(q[1]) > 90 or not self.inside(self.to_plane(q))[0]:
+            return ""
+        return f"; {self._fmt_frame(q)} is inside: points are (lon, lat)"
 
     def nearest_free(self, p: np.ndarray, j: int) -> np.ndarray:
         """A free point just outside obstacle j, nearest to p."""
@@ -366,7 +388,11 @@ class World:
 
     def _fmt(self, p) -> str:
         """A plane point as the caller wrote it: 7 decimals of a degree (about 1 cm) or cm."""
-        a, b = self.from_plane([p])[0]
+        return self._fmt_frame(self.from_plane([p])[0])
+
+    def _fmt_frame(self, q) -> str:
+        """A point in the world's frame, as :meth:`_fmt` shows it."""
+        a, b = q
         fmt = "{:.7f}" if self.frame in ("lonlat", "degrees") else "{:.2f}"
         return f"({fmt.format(a)}, {fmt.format(b)})"
 
