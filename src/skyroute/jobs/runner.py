@@ -36,7 +36,11 @@ there (:func:`heartbeat`); :func:`fail_orphans` (also called by ``skyroute serve
 before its workers start, and by :func:`get` on another owner's unfinished job) marks
 ``failed`` with :data:`ORPHANED` the unfinished jobs whose owner has been silent for
 :data:`DEAD_AFTER` seconds, or that have no owner (jobs stored before owners were), and
-leaves the live servers' jobs alone. A process stalled
+leaves the live servers' jobs alone. An owner that shares this process's view of
+process ids (the same boot, the same PID namespace: a server restarted on the same
+machine or in the same container) and has ended is seen so at once (:func:`gone`: its
+process id free, or another process's), so a restarted server fails its predecessor's
+jobs at start, not a minute later; owners elsewhere keep the heartbeat rule. A process stalled
 for longer than that (or cut off from the store) has its jobs marked failed, and they
 stay failed: a job failed while queued is not run, one failed while running is stopped
 at its next progress write, and a result or error that comes after all is discarded
@@ -46,6 +50,7 @@ worker would store (:func:`skyroute.jobs.store.save_fleet_run`).
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import math
 import os
@@ -55,6 +60,7 @@ import threading
 import time
 import uuid
 from collections.abc import Callable
+from pathlib import Path
 from typing import NamedTuple
 
 import sqlalchemy as sa
@@ -88,17 +94,79 @@ _beater: threading.Thread | None = None
 _pending = 0
 _stores: dict[str, list] = {}  # URL -> [engine, this process's unfinished jobs there]
 _owner: tuple[int, str] | None = None  # (pid, id)
+_space_id: str | None = None  # _space(): "" where there is none
 _reaped: dict[str, float] = {}  # URL -> when get() last failed orphans there (monotonic)
 
 
 def owner() -> str:
-    """This process's owner id, ``HOST:PID:RANDOM`` (made once per process; the random
-    part tells apart processes that reuse a host name and process id)."""
+    """This process's owner id, ``HOST:PID:RANDOM``, then ``:SPACE:START`` where the
+    process can be seen (:func:`_space`, :func:`_started`); made once per process. The
+    random part tells apart processes that reuse a host name and process id; ``SPACE``
+    and ``START`` let another process that sees the same process ids tell at once that
+    this one has ended (:func:`gone`)."""
     global _owner
-    if _owner is None or _owner[0] != os.getpid():
-        _owner = (os.getpid(), f"{socket.gethostname()[:60]}:{os.getpid()}:"
-                               f"{uuid.uuid4().hex[:12]}")
+    pid = os.getpid()
+    if _owner is None or _owner[0] != pid:
+        me = f"{socket.gethostname()[:40]}:{pid}:{uuid.uuid4().hex[:12]}"
+        space, start = _space(), _started(pid)
+        if space is not None and start is not None:
+            me += f":{space}:{start[1]}"
+        _owner = (pid, me)
     return _owner[1]
+
+
+def gone(owner_id: str | None) -> bool:
+    """True when ``owner_id`` names a process that has certainly ended: one that shares
+    this process's view of process ids (the same boot of the same kernel, the same PID
+    namespace, so not another container with the same host name) and whose process id is
+    free now, held by a zombie, or held by a process started at another time (the id
+    reused). False when that cannot be told (another machine or container, an owner id
+    without ``SPACE:START``, no ``/proc``): the heartbeat rule decides those."""
+    if not isinstance(owner_id, str):  # a job stored before owners were
+        return False
+    parts = owner_id.rsplit(":", 4)
+    if len(parts) != 5 or not parts[1].isdigit() or not parts[4].isdigit():
+        return False
+    pid = int(parts[1])
+    if pid <= 0 or owner_id == owner() or parts[3] != _space():
+        return False
+    try:
+        os.kill(pid, 0)  # signal 0: only asks whether the process exists
+    except ProcessLookupError:
+        return True
+    except OSError:  # another user's process (EPERM): it exists
+        pass
+    now = _started(pid)
+    return now is not None and (now[0] in "ZX" or now[1] != parts[4])
+
+
+def _space() -> str | None:
+    """A short hash of this boot of the kernel and this process's PID namespace: the
+    processes that share it see the same process ids. None where ``/proc`` does not say
+    (not Linux), or names another namespace's processes (its ``self`` is not this
+    process)."""
+    global _space_id
+    if _space_id is None:
+        try:
+            boot = Path("/proc/sys/kernel/random/boot_id").read_text().strip()
+            ns = os.readlink("/proc/self/ns/pid")
+            ours = Path("/proc/self/stat").read_text().split(" ", 1)[0] == str(os.getpid())
+        except OSError:
+            ours = False
+        _space_id = (hashlib.sha256(f"{boot}|{ns}".encode()).hexdigest()[:12] if ours
+                     else "")
+    return _space_id or None
+
+
+def _started(pid: int) -> tuple[str, str] | None:
+    """(state, start time in clock ticks after boot) of process ``pid`` from
+    ``/proc/PID/stat``; None where it cannot be read."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    fields = stat[stat.rfind(")") + 2:].split()  # after "pid (command) "
+    return (fields[0], fields[19]) if len(fields) > 19 else None
 
 
 def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
@@ -130,7 +198,8 @@ def fail_orphans(engine: sa.Engine) -> list[str]:
     servers that stopped: owners silent for :data:`DEAD_AFTER` seconds, or none; their
     ids. A job runs only in the process that took it, so none of these will ever end.
     ``skyroute serve`` calls it at start; :func:`heartbeat` while jobs run."""
-    return store.fail_orphans(engine, ORPHANED, dead_after=DEAD_AFTER)
+    ended = [o for o in store.live_owners(engine) if gone(o)]
+    return store.fail_orphans(engine, ORPHANED, dead_after=DEAD_AFTER, gone=ended)
 
 
 def heartbeat() -> None:
@@ -164,7 +233,7 @@ def get(engine: sa.Engine, job_id: str) -> dict | None:
         due = now - _reaped.get(url, -math.inf) >= HEARTBEAT_EVERY
         if due:
             _reaped[url] = now
-    if due and job_id in fail_orphans(engine):
+    if (due or gone(job["owner"])) and job_id in fail_orphans(engine):
         job = store.get_job(engine, job_id)
     return job
 
