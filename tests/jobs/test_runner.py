@@ -100,6 +100,39 @@ def test_bad_params_are_refused_before_queueing(tmp_path, kind, params, words):
         assert c.exec_driver_sql("select count(*) from jobs").scalar_one() == 0
 
 
+def test_a_delivery_job_runs_while_a_long_fleet_job_holds_its_lane(tmp_path, monkeypatch):
+    """Deliveries and fleet jobs run in two lanes: a day submitted behind a long fleet
+    run is flown and done while that run goes on; a second fleet run waits for the first
+    (one at a time in a lane)."""
+    import threading
+
+    release = threading.Event()
+
+    def hold(engine, job_id, params, *, executor, progress):  # a long fleet run
+        progress(0.5)
+        release.wait(120)
+        return {"held": True}
+
+    monkeypatch.setitem(runner.KINDS, "fleet",
+                        runner.KINDS["fleet"]._replace(check=dict, run=hold))
+    engine = lunch_store(f"sqlite:///{tmp_path / 'lanes.db'}", ("2024-01-03",))
+    with open_executor("local", workers=1) as ex:
+        long = runner.submit(engine, "fleet", {}, executor=ex)
+        after = runner.submit(engine, "fleet", {}, executor=ex)
+        try:
+            day = runner.submit(engine, "deliver", {"date": "2024-01-03",
+                                                    "data": str(EXAMPLE)}, executor=ex)
+            job = runner.wait(engine, day, timeout=90)
+            assert job["state"] == "done" and job["result"]["days"] == 1, job
+            assert runner.get(engine, long)["state"] == "running"
+            assert runner.get(engine, after)["state"] == "queued"
+        finally:
+            release.set()
+        for job_id in (long, after):
+            assert runner.wait(engine, job_id, timeout=60)["result"] == {"held": True}
+    settle()
+
+
 def test_two_servers_on_one_store_fail_only_the_orphans_of_dead_ones(tmp_path, monkeypatch):
     """This process's job and a live server's job survive another server's start and
     this process's heartbeat; a silent server's job and one without an owner do not."""

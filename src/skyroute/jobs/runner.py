@@ -19,9 +19,15 @@ Kinds (:data:`KINDS`) and their parameters:
   ``seeds``, ``hours`` (:func:`skyroute.jobs.fleet.check_sweep_params`). Result:
   ``{"rows": [...]}``.
 
-Jobs run one at a time in the order submitted, in one background thread per process
-(each job already spreads its tasks over every worker of the executor); a job waiting
-for the one before it stays ``queued``. While a job runs it is ``running`` with its
+Jobs run in two lanes per process, each a background thread running its jobs one at a
+time in the order submitted: deliveries in one, fleet runs and sweeps in the other
+(:data:`KINDS`' ``lane``). Each job spreads its tasks over the executor's workers, and
+the two lanes share them (a local ``map`` keeps at most twice its workers' tasks in the
+pool), so a delivery job does not wait behind a long fleet run or sweep, nor a fleet
+run behind a long range of days; a job waiting for one of its lane before it stays
+``queued``. Fleet runs and sweeps share a lane because both fly the compiled Dubins
+kernels, whose threading layer may not take two threads at once when a job's tasks run
+in this process (one worker). While a job runs it is ``running`` with its
 progress, the share of its tasks done (a fleet run is one task: 0, then 1). It ends
 ``done`` with its result, or ``failed`` with a one-line error: a SkyrouteError's message,
 else the exception's type and message; the traceback goes to the ``skyroute.jobs``
@@ -75,21 +81,21 @@ PROGRESS_EVERY = 0.2  # seconds between progress writes (the last one always goe
 class Kind(NamedTuple):
     check: Callable[[dict], dict]
     run: Callable[..., dict]
+    lane: str | None = None  # the jobs it takes turns with (None: those of its kind)
 
 
 KINDS = {
     "deliver": Kind(deliver.check_params, deliver.deliver_job),
-    "fleet": Kind(fleet.check_fleet_params, fleet.fleet_job),
-    "sweep": Kind(fleet.check_sweep_params, fleet.sweep_job),
+    "fleet": Kind(fleet.check_fleet_params, fleet.fleet_job, "fleet"),
+    "sweep": Kind(fleet.check_sweep_params, fleet.sweep_job, "fleet"),
 }
 
 ORPHANED = "the server stopped while this job ran; submit it again"
 HEARTBEAT_EVERY = 10.0  # seconds between a process's heartbeats while it has jobs
 DEAD_AFTER = 60.0  # seconds without a heartbeat after which an owner is dead
 
-_queue: queue.Queue = queue.Queue()
 _lock = threading.Lock()
-_thread: threading.Thread | None = None
+_lanes: dict[str, tuple[queue.Queue, threading.Thread]] = {}  # lane -> its jobs, thread
 _beater: threading.Thread | None = None
 _pending = 0
 _stores: dict[str, list] = {}  # URL -> [engine, this process's unfinished jobs there]
@@ -173,7 +179,7 @@ def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
     """Check ``params``, record the job (``queued``) and queue it to run on
     ``executor`` (an open :func:`~skyroute.jobs.executor.open_executor`, which the
     caller keeps open and closes); the job's id."""
-    global _thread, _beater, _pending
+    global _beater, _pending
     check_choice("kind", kind, tuple(KINDS))
     params = KINDS[kind].check(params)
     me = owner()
@@ -182,10 +188,14 @@ def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
     with _lock:
         _pending += 1
         _stores.setdefault(str(engine.url), [engine, 0])[1] += 1
-        _queue.put((engine, job_id, kind, params, executor))
-        if _thread is None or not _thread.is_alive():
-            _thread = threading.Thread(target=_work, name="skyroute-jobs", daemon=True)
-            _thread.start()
+        lane = KINDS[kind].lane or kind
+        jobs, thread = _lanes.get(lane) or (queue.Queue(), None)
+        jobs.put((engine, job_id, kind, params, executor))
+        if thread is None or not thread.is_alive():
+            thread = threading.Thread(target=_work, args=(jobs,), daemon=True,
+                                      name=f"skyroute-jobs-{lane}")
+            _lanes[lane] = (jobs, thread)
+            thread.start()
         if _beater is None or not _beater.is_alive():
             _beater = threading.Thread(target=_beat_forever, name="skyroute-jobs-beat",
                                        daemon=True)
@@ -263,10 +273,10 @@ def error_line(exc: BaseException) -> str:
     return " ".join(text.split()) or type(exc).__name__
 
 
-def _work() -> None:
+def _work(jobs: queue.Queue) -> None:
     global _pending
     while True:
-        engine, job_id, kind, params, executor = _queue.get()
+        engine, job_id, kind, params, executor = jobs.get()
         try:
             _run(engine, job_id, kind, params, executor)
         except Exception:  # the store itself failed: keep serving the queue
