@@ -24,6 +24,28 @@ def test_local_results_in_item_order_and_each_reported_once(workers):
     assert sorted(seen) == list(enumerate(out))
 
 
+def test_maps_from_two_threads_take_turns_on_the_local_workers():
+    """A short map started while a long one runs (the runner's two lanes) waits for a few
+    of the long one's tasks, not for all of them: it ends long before the long one."""
+    import threading
+
+    ends = {}
+    with open_executor("local", workers=2) as ex:
+        ex.map(time.sleep, [0.0, 0.0])  # the pool's processes started
+
+        def long():
+            ex.map(time.sleep, [0.3] * 12)  # 6 rounds of 2 workers: about 1.8 s
+            ends["long"] = time.monotonic()
+
+        thread = threading.Thread(target=long)
+        thread.start()
+        time.sleep(0.2)
+        ex.map(time.sleep, [0.01, 0.01])
+        ends["short"] = time.monotonic()
+        thread.join()
+    assert ends["short"] < ends["long"] - 0.6, ends
+
+
 def test_dask_gives_what_local_gives(dask_executor):
     seen = []
     out = dask_executor.map(math.sqrt, ITEMS, on_result=lambda i, r: seen.append((i, r)))

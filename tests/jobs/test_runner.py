@@ -100,6 +100,39 @@ def test_bad_params_are_refused_before_queueing(tmp_path, kind, params, words):
         assert c.exec_driver_sql("select count(*) from jobs").scalar_one() == 0
 
 
+def test_a_delivery_job_runs_while_a_long_fleet_job_holds_its_lane(tmp_path, monkeypatch):
+    """Deliveries and fleet jobs run in two lanes: a day submitted behind a long fleet
+    run is flown and done while that run goes on; a second fleet run waits for the first
+    (one at a time in a lane)."""
+    import threading
+
+    release = threading.Event()
+
+    def hold(engine, job_id, params, *, executor, progress):  # a long fleet run
+        progress(0.5)
+        release.wait(120)
+        return {"held": True}
+
+    monkeypatch.setitem(runner.KINDS, "fleet",
+                        runner.KINDS["fleet"]._replace(check=dict, run=hold))
+    engine = lunch_store(f"sqlite:///{tmp_path / 'lanes.db'}", ("2024-01-03",))
+    with open_executor("local", workers=1) as ex:
+        long = runner.submit(engine, "fleet", {}, executor=ex)
+        after = runner.submit(engine, "fleet", {}, executor=ex)
+        try:
+            day = runner.submit(engine, "deliver", {"date": "2024-01-03",
+                                                    "data": str(EXAMPLE)}, executor=ex)
+            job = runner.wait(engine, day, timeout=90)
+            assert job["state"] == "done" and job["result"]["days"] == 1, job
+            assert runner.get(engine, long)["state"] == "running"
+            assert runner.get(engine, after)["state"] == "queued"
+        finally:
+            release.set()
+        for job_id in (long, after):
+            assert runner.wait(engine, job_id, timeout=60)["result"] == {"held": True}
+    settle()
+
+
 def test_two_servers_on_one_store_fail_only_the_orphans_of_dead_ones(tmp_path, monkeypatch):
     """This process's job and a live server's job survive another server's start and
     this process's heartbeat; a silent server's job and one without an owner do not."""
@@ -172,6 +205,117 @@ def test_reading_a_dead_servers_job_fails_it(tmp_path):
     job = runner.get(engine, dead)
     assert (job["state"], job["error"]) == ("failed", runner.ORPHANED)
     assert runner.get(engine, live)["state"] == "queued"
+
+
+CHILD = """
+import sys
+from skyroute.jobs import runner, store
+engine = store.engine_for(sys.argv[1])
+me = runner.owner()
+store.beat(engine, me)
+job = store.create_job(engine, "fleet", {}, owner=me)
+store.set_progress(engine, job, 0.3)
+print(job, me, flush=True)
+sys.stdin.read()  # runs until the test closes its stdin
+"""
+
+
+@pytest.mark.parametrize("db", ["sqlite", "postgresql"])
+def test_a_stopped_servers_jobs_fail_at_once_on_its_machine(tmp_path, request, db):
+    """A server process on this machine that has ended, a moment after its heartbeat,
+    has its running job failed at the next look (a restarted server's start, or a read),
+    not 60 s later; while it runs its job is left alone."""
+    import os
+    import subprocess
+    import sys
+
+    from skyroute.jobs import store
+
+    url = (f"sqlite:///{tmp_path / 'gone.db'}" if db == "sqlite"
+           else request.getfixturevalue("pg_url"))
+    engine = lunch_store(url, ())
+    child = subprocess.Popen([sys.executable, "-c", CHILD, url], stdin=subprocess.PIPE,
+                             stdout=subprocess.PIPE, text=True,
+                             env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    try:
+        job_id, its_owner = child.stdout.readline().split()
+        assert runner.fail_orphans(engine) == []
+        assert runner.get(engine, job_id)["state"] == "running"
+    finally:
+        child.stdin.close()
+    assert child.wait(60) == 0
+    assert runner.fail_orphans(engine) == [job_id]  # as `skyroute serve` at its start
+    job = runner.get(engine, job_id)
+    assert (job["state"], job["error"]) == ("failed", runner.ORPHANED)
+    assert its_owner not in store.live_owners(engine)
+
+
+def test_reading_a_job_of_an_ended_process_fails_it_at_once(tmp_path):
+    """``runner.get`` (GET /jobs/{id}) fails the job of a process seen to have ended
+    even right after another read looked for orphans."""
+    import os
+    import subprocess
+    import sys
+
+    url = f"sqlite:///{tmp_path / 'read.db'}"
+    engine = lunch_store(url, ())
+    child = subprocess.Popen([sys.executable, "-c", CHILD, url], stdin=subprocess.PIPE,
+                             stdout=subprocess.PIPE, text=True,
+                             env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    try:
+        job_id, _ = child.stdout.readline().split()
+        assert runner.get(engine, job_id)["state"] == "running"  # looked: none for 10 s
+    finally:
+        child.stdin.close()
+    assert child.wait(60) == 0
+    job = runner.get(engine, job_id)
+    assert (job["state"], job["error"]) == ("failed", runner.ORPHANED)
+
+
+def test_reading_a_job_without_an_owner_between_looks_for_orphans(tmp_path):
+    """A job stored before owners were (owner None) read right after a look for orphans
+    is shown as it is (and failed at the next look), not an error."""
+    from skyroute.jobs import store
+
+    engine = lunch_store(f"sqlite:///{tmp_path / 'none.db'}", ())
+    first = store.create_job(engine, "fleet", {})
+    assert runner.get(engine, first)["state"] == "failed"  # a look for orphans
+    second = store.create_job(engine, "fleet", {})
+    assert runner.get(engine, second)["state"] == "queued"  # within HEARTBEAT_EVERY
+    assert second in runner.fail_orphans(engine)
+
+
+def test_only_an_owner_this_process_can_see_is_known_gone():
+    """Its process id free, a zombie's, or another process's (started at another time):
+    gone. On another machine or in another container, or an owner id without the
+    process's start: not known, left to the heartbeat."""
+    import os
+    import subprocess
+    import sys
+
+    me = runner.owner()
+    host, pid, rand, space, start = me.rsplit(":", 4)
+    assert int(pid) == os.getpid() and space == runner._space() and start.isdigit()
+    ended = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)
+    free = int(ended.stdout)  # a process id that was just given back
+    parent = os.getppid()
+    its_start = runner._started(parent)[1]
+    assert runner.gone(f"{host}:{free}:{rand}:{space}:{start}")
+    assert runner.gone(f"{host}:{parent}:{rand}:{space}:{int(its_start) + 1}")  # reused
+    assert not runner.gone(f"{host}:{parent}:{rand}:{space}:{its_start}")  # alive
+    assert not runner.gone(f"{host}:{free}:{rand}:{'0' * 12}:{start}")  # elsewhere
+    assert not runner.gone(f"{host}:{free}:{rand}")  # an owner id of an older server
+    assert not runner.gone(me) and not runner.gone("other-server:1:a")
+    zombie = subprocess.Popen([sys.executable, "-c", "pass"])
+    end = time.monotonic() + 60
+    while runner._started(zombie.pid)[0] != "Z" and time.monotonic() < end:
+        time.sleep(0.01)
+    try:
+        assert runner.gone(f"{host}:{zombie.pid}:{rand}:{space}:"
+                           f"{runner._started(zombie.pid)[1]}")
+    finally:
+        zombie.wait()
 
 
 def stall(engine) -> None:

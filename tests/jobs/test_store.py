@@ -204,6 +204,30 @@ def test_orphans_are_the_jobs_of_silent_or_unknown_owners(engine):
         store.fail_orphans(engine, "orphaned", dead_after=0)
 
 
+def test_owners_known_to_have_ended_are_orphans_at_once(engine):
+    """An owner the caller knows has ended (``gone``) loses its unfinished jobs and its
+    server row though it beat a moment ago; a live owner's jobs and row stay."""
+    store.beat(engine, "ended")
+    store.beat(engine, "live")
+    ended = store.create_job(engine, "fleet", {}, owner="ended")
+    store.set_progress(engine, ended, 0.5)
+    ended_done = store.create_job(engine, "fleet", {}, owner="ended")
+    store.finish_job(engine, ended_done, {})
+    live = store.create_job(engine, "fleet", {}, owner="live")
+    assert {"ended", "live"} <= set(store.live_owners(engine))
+    assert None not in store.live_owners(engine)
+
+    failed = store.fail_orphans(engine, "orphaned", dead_after=60, gone=["ended"])
+    assert ended in failed and live not in failed and ended_done not in failed
+    assert (store.get_job(engine, ended)["state"], store.get_job(engine, live)["state"],
+            store.get_job(engine, ended_done)["state"]) == ("failed", "queued", "done")
+    servers = dstore.tables(engine, ("servers",))["servers"]
+    with engine.connect() as c:
+        left = set(c.scalars(sa.select(servers.c.id)))
+    assert "live" in left and "ended" not in left
+    assert "ended" not in store.live_owners(engine)
+
+
 def test_the_database_clock_is_utc_without_a_zone(engine):
     with engine.connect() as c:
         now = store.db_now(c)

@@ -184,6 +184,45 @@ def test_bad_input_is_422_naming_the_field(client, body, field, words):
     assert_problem(client.post("/plan", json=body, headers=AUTH), 422, field, words)
 
 
+@pytest.mark.parametrize("body, field, words", [
+    ({**DEN, "start": ["50", "76"]}, "start[0]", "valid number"),
+    ({**DEN, "goal": [60, True]}, "goal[1]", "valid number"),
+    ({**DEN, "weight": "2"}, "weight", "valid number"),
+    ({**DEN, "weight": True}, "weight", "valid number"),
+    ({**DEN, "safety": "1"}, "safety", "valid number"),
+    ({**DEN, "max_expansions": "100"}, "max_expansions", "valid integer"),
+    ({**DEN, "max_expansions": 100.0}, "max_expansions", "valid integer"),
+    ({**DEN, "max_expansions": True}, "max_expansions", "valid integer"),
+    ({**DEN, "corner_cutting": "yes"}, "corner_cutting", "valid boolean"),
+    ({**DEN, "corner_cutting": 1}, "corner_cutting", "valid boolean"),
+    ({**DEN, "geojson": 0}, "geojson", "valid boolean"),
+    ({**CITY_BODY, "altitude": "10"}, "altitude", "valid number"),
+    ({**CITY_BODY, "boundary": ["-3.2", 55.9, -3.1, 56.0]}, "boundary[0]", "valid number"),
+    ({**CITY_BODY, "algorithm": "prm", "samples": 100.0}, "samples", "valid integer"),
+    ({**CITY_BODY, "algorithm": "prm", "seed": "3"}, "seed", "valid integer"),
+    ({**CITY_BODY, "algorithm": "prm", "prm_star": "false"}, "prm_star", "valid boolean"),
+])
+def test_a_value_of_another_type_is_422_as_skyroute_plan_refuses_it(client, body, field,
+                                                                     words):
+    """A numeric string, a boolean as a number, a number as a boolean, 100.0 as a count:
+    skyroute.plan refuses each (an OptionError naming it), so the service does too,
+    rather than planning with what it guessed."""
+    if "world_format" in body:
+        body = {**body, "world_text": CITY.read_text()}
+    assert_problem(client.post("/plan", json=body, headers=AUTH), 422, field, words)
+
+
+def test_integers_for_numbers_and_whole_floats_for_cells_are_accepted(client):
+    """JSON has one number type: 2 is a weight of 2.0, and 50.0 names cell 50 (as a
+    JavaScript client may send it)."""
+    want = client.post("/plan", json={**DEN, "weight": 2.0, "safety": 0.0},
+                       headers=AUTH).json()
+    got = client.post("/plan", json={**DEN, "start": [50.0, 76.0], "weight": 2,
+                                     "safety": 0}, headers=AUTH)
+    assert got.status_code == 200, got.text
+    assert (got.json()["cost"], got.json()["path"]) == (want["cost"], want["path"])
+
+
 def test_a_body_that_is_not_text_is_400(client):
     r = client.post("/plan", content=b'{"map": "\xff\xfe"}', headers={
         **AUTH, "Content-Type": "application/json"})

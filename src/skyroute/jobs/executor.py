@@ -14,7 +14,10 @@ items must pickle: ``fn`` a module-level function, the items plain data.
 - ``local``: ``workers`` processes started with the ``spawn`` method (a forked child of
   a process whose compiled kernels have started OpenMP threads dies), created on the
   first ``map`` and reused until ``close``; one worker runs the tasks in the calling
-  process, as a plain loop.
+  process, as a plain loop. A ``map`` keeps at most twice ``workers`` of its tasks in
+  the pool and hands it the next as one ends, so ``map`` calls from several threads
+  (the runner's lanes) share the workers in turn: a short one started while a long one
+  runs waits for a few of its tasks, not all of them.
 - ``dask``: a ``distributed.Client`` on an existing scheduler (``address`` such as
   ``tcp://10.0.0.5:8786``) or on an in-process ``LocalCluster`` of ``workers`` worker
   processes, one thread each. Dask re-runs the tasks of a worker that dies on another
@@ -25,9 +28,11 @@ items must pickle: ``fn`` a module-level function, the items plain data.
 from __future__ import annotations
 
 import gc
+import itertools
 import logging
 import multiprocessing
 import os
+import threading
 from collections.abc import Callable, Iterable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Any
@@ -83,6 +88,7 @@ class LocalExecutor(_Executor):
     def __init__(self, workers: int) -> None:
         self.workers = workers
         self._pool: ProcessPoolExecutor | None = None
+        self._lock = threading.Lock()  # map may be called from several threads
 
     def __repr__(self) -> str:
         return f"LocalExecutor(workers={self.workers})"
@@ -96,31 +102,44 @@ class LocalExecutor(_Executor):
                 if on_result:
                     on_result(i, out[-1])
             return out
-        if self._pool is None:
-            self._pool = ProcessPoolExecutor(
-                self.workers, mp_context=multiprocessing.get_context("spawn"))
-        futures = {self._pool.submit(fn, item): i for i, item in enumerate(items)}
-        return _gather(futures, on_result)
+        with self._lock:
+            if self._pool is None:
+                self._pool = ProcessPoolExecutor(
+                    self.workers, mp_context=multiprocessing.get_context("spawn"))
+            pool = self._pool
+        return _gather(lambda item: pool.submit(fn, item), items, 2 * self.workers,
+                       on_result)
 
     def close(self) -> None:
-        if self._pool is not None:
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = None
+        with self._lock:
+            if self._pool is not None:
+                self._pool.shutdown(wait=False, cancel_futures=True)
+                self._pool = None
 
 
-def _gather(futures: dict, on_result) -> list:
-    """Results of ``futures`` (future -> index) in index order; ``on_result`` as each
-    finishes. On an error or Ctrl-C the futures not yet started are cancelled."""
-    out: list = [None] * len(futures)
-    pending = set(futures)
+def _gather(submit: Callable, items: list, window: int, on_result) -> list:
+    """Results of ``submit(item)`` (a future) for every item, in item order, at most
+    ``window`` of them submitted and not yet ended at a time; ``on_result`` as each
+    ends. On an error or Ctrl-C the futures not yet started are cancelled (and the
+    items not yet submitted never are)."""
+    out: list = [None] * len(items)
+    todo = iter(enumerate(items))
+    pending: dict = {}  # future -> index
+
+    def top_up() -> None:
+        for i, item in itertools.islice(todo, window - len(pending)):
+            pending[submit(item)] = i
+
     try:
+        top_up()
         while pending:
-            done, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for f in sorted(done, key=futures.get):
-                i = futures[f]
+            done, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for f in sorted(done, key=pending.get):
+                i = pending.pop(f)
                 out[i] = f.result()
                 if on_result:
                     on_result(i, out[i])
+            top_up()
     except BaseException:
         for f in pending:
             f.cancel()

@@ -19,9 +19,15 @@ Kinds (:data:`KINDS`) and their parameters:
   ``seeds``, ``hours`` (:func:`skyroute.jobs.fleet.check_sweep_params`). Result:
   ``{"rows": [...]}``.
 
-Jobs run one at a time in the order submitted, in one background thread per process
-(each job already spreads its tasks over every worker of the executor); a job waiting
-for the one before it stays ``queued``. While a job runs it is ``running`` with its
+Jobs run in two lanes per process, each a background thread running its jobs one at a
+time in the order submitted: deliveries in one, fleet runs and sweeps in the other
+(:data:`KINDS`' ``lane``). Each job spreads its tasks over the executor's workers, and
+the two lanes share them (a local ``map`` keeps at most twice its workers' tasks in the
+pool), so a delivery job does not wait behind a long fleet run or sweep, nor a fleet
+run behind a long range of days; a job waiting for one of its lane before it stays
+``queued``. Fleet runs and sweeps share a lane because both fly the compiled Dubins
+kernels, whose threading layer may not take two threads at once when a job's tasks run
+in this process (one worker). While a job runs it is ``running`` with its
 progress, the share of its tasks done (a fleet run is one task: 0, then 1). It ends
 ``done`` with its result, or ``failed`` with a one-line error: a SkyrouteError's message,
 else the exception's type and message; the traceback goes to the ``skyroute.jobs``
@@ -36,7 +42,11 @@ there (:func:`heartbeat`); :func:`fail_orphans` (also called by ``skyroute serve
 before its workers start, and by :func:`get` on another owner's unfinished job) marks
 ``failed`` with :data:`ORPHANED` the unfinished jobs whose owner has been silent for
 :data:`DEAD_AFTER` seconds, or that have no owner (jobs stored before owners were), and
-leaves the live servers' jobs alone. A process stalled
+leaves the live servers' jobs alone. An owner that shares this process's view of
+process ids (the same boot, the same PID namespace: a server restarted on the same
+machine or in the same container) and has ended is seen so at once (:func:`gone`: its
+process id free, or another process's), so a restarted server fails its predecessor's
+jobs at start, not a minute later; owners elsewhere keep the heartbeat rule. A process stalled
 for longer than that (or cut off from the store) has its jobs marked failed, and they
 stay failed: a job failed while queued is not run, one failed while running is stopped
 at its next progress write, and a result or error that comes after all is discarded
@@ -46,6 +56,7 @@ worker would store (:func:`skyroute.jobs.store.save_fleet_run`).
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import math
 import os
@@ -55,6 +66,7 @@ import threading
 import time
 import uuid
 from collections.abc import Callable
+from pathlib import Path
 from typing import NamedTuple
 
 import sqlalchemy as sa
@@ -69,43 +81,105 @@ PROGRESS_EVERY = 0.2  # seconds between progress writes (the last one always goe
 class Kind(NamedTuple):
     check: Callable[[dict], dict]
     run: Callable[..., dict]
+    lane: str | None = None  # the jobs it takes turns with (None: those of its kind)
 
 
 KINDS = {
     "deliver": Kind(deliver.check_params, deliver.deliver_job),
-    "fleet": Kind(fleet.check_fleet_params, fleet.fleet_job),
-    "sweep": Kind(fleet.check_sweep_params, fleet.sweep_job),
+    "fleet": Kind(fleet.check_fleet_params, fleet.fleet_job, "fleet"),
+    "sweep": Kind(fleet.check_sweep_params, fleet.sweep_job, "fleet"),
 }
 
 ORPHANED = "the server stopped while this job ran; submit it again"
 HEARTBEAT_EVERY = 10.0  # seconds between a process's heartbeats while it has jobs
 DEAD_AFTER = 60.0  # seconds without a heartbeat after which an owner is dead
 
-_queue: queue.Queue = queue.Queue()
 _lock = threading.Lock()
-_thread: threading.Thread | None = None
+_lanes: dict[str, tuple[queue.Queue, threading.Thread]] = {}  # lane -> its jobs, thread
 _beater: threading.Thread | None = None
 _pending = 0
 _stores: dict[str, list] = {}  # URL -> [engine, this process's unfinished jobs there]
 _owner: tuple[int, str] | None = None  # (pid, id)
+_space_id: str | None = None  # _space(): "" where there is none
 _reaped: dict[str, float] = {}  # URL -> when get() last failed orphans there (monotonic)
 
 
 def owner() -> str:
-    """This process's owner id, ``HOST:PID:RANDOM`` (made once per process; the random
-    part tells apart processes that reuse a host name and process id)."""
+    """This process's owner id, ``HOST:PID:RANDOM``, then ``:SPACE:START`` where the
+    process can be seen (:func:`_space`, :func:`_started`); made once per process. The
+    random part tells apart processes that reuse a host name and process id; ``SPACE``
+    and ``START`` let another process that sees the same process ids tell at once that
+    this one has ended (:func:`gone`)."""
     global _owner
-    if _owner is None or _owner[0] != os.getpid():
-        _owner = (os.getpid(), f"{socket.gethostname()[:60]}:{os.getpid()}:"
-                               f"{uuid.uuid4().hex[:12]}")
+    pid = os.getpid()
+    if _owner is None or _owner[0] != pid:
+        me = f"{socket.gethostname()[:40]}:{pid}:{uuid.uuid4().hex[:12]}"
+        space, start = _space(), _started(pid)
+        if space is not None and start is not None:
+            me += f":{space}:{start[1]}"
+        _owner = (pid, me)
     return _owner[1]
+
+
+def gone(owner_id: str | None) -> bool:
+    """True when ``owner_id`` names a process that has certainly ended: one that shares
+    this process's view of process ids (the same boot of the same kernel, the same PID
+    namespace, so not another container with the same host name) and whose process id is
+    free now, held by a zombie, or held by a process started at another time (the id
+    reused). False when that cannot be told (another machine or container, an owner id
+    without ``SPACE:START``, no ``/proc``): the heartbeat rule decides those."""
+    if not isinstance(owner_id, str):  # a job stored before owners were
+        return False
+    parts = owner_id.rsplit(":", 4)
+    if len(parts) != 5 or not parts[1].isdigit() or not parts[4].isdigit():
+        return False
+    pid = int(parts[1])
+    if pid <= 0 or owner_id == owner() or parts[3] != _space():
+        return False
+    try:
+        os.kill(pid, 0)  # signal 0: only asks whether the process exists
+    except ProcessLookupError:
+        return True
+    except OSError:  # another user's process (EPERM): it exists
+        pass
+    now = _started(pid)
+    return now is not None and (now[0] in "ZX" or now[1] != parts[4])
+
+
+def _space() -> str | None:
+    """A short hash of this boot of the kernel and this process's PID namespace: the
+    processes that share it see the same process ids. None where ``/proc`` does not say
+    (not Linux), or names another namespace's processes (its ``self`` is not this
+    process)."""
+    global _space_id
+    if _space_id is None:
+        try:
+            boot = Path("/proc/sys/kernel/random/boot_id").read_text().strip()
+            ns = os.readlink("/proc/self/ns/pid")
+            ours = Path("/proc/self/stat").read_text().split(" ", 1)[0] == str(os.getpid())
+        except OSError:
+            ours = False
+        _space_id = (hashlib.sha256(f"{boot}|{ns}".encode()).hexdigest()[:12] if ours
+                     else "")
+    return _space_id or None
+
+
+def _started(pid: int) -> tuple[str, str] | None:
+    """(state, start time in clock ticks after boot) of process ``pid`` from
+    ``/proc/PID/stat``; None where it cannot be read."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    fields = stat[stat.rfind(")") + 2:].split()  # after "pid (command) "
+    return (fields[0], fields[19]) if len(fields) > 19 else None
 
 
 def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
     """Check ``params``, record the job (``queued``) and queue it to run on
     ``executor`` (an open :func:`~skyroute.jobs.executor.open_executor`, which the
     caller keeps open and closes); the job's id."""
-    global _thread, _beater, _pending
+    global _beater, _pending
     check_choice("kind", kind, tuple(KINDS))
     params = KINDS[kind].check(params)
     me = owner()
@@ -114,10 +188,14 @@ def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
     with _lock:
         _pending += 1
         _stores.setdefault(str(engine.url), [engine, 0])[1] += 1
-        _queue.put((engine, job_id, kind, params, executor))
-        if _thread is None or not _thread.is_alive():
-            _thread = threading.Thread(target=_work, name="skyroute-jobs", daemon=True)
-            _thread.start()
+        lane = KINDS[kind].lane or kind
+        jobs, thread = _lanes.get(lane) or (queue.Queue(), None)
+        jobs.put((engine, job_id, kind, params, executor))
+        if thread is None or not thread.is_alive():
+            thread = threading.Thread(target=_work, args=(jobs,), daemon=True,
+                                      name=f"skyroute-jobs-{lane}")
+            _lanes[lane] = (jobs, thread)
+            thread.start()
         if _beater is None or not _beater.is_alive():
             _beater = threading.Thread(target=_beat_forever, name="skyroute-jobs-beat",
                                        daemon=True)
@@ -130,7 +208,8 @@ def fail_orphans(engine: sa.Engine) -> list[str]:
     servers that stopped: owners silent for :data:`DEAD_AFTER` seconds, or none; their
     ids. A job runs only in the process that took it, so none of these will ever end.
     ``skyroute serve`` calls it at start; :func:`heartbeat` while jobs run."""
-    return store.fail_orphans(engine, ORPHANED, dead_after=DEAD_AFTER)
+    ended = [o for o in store.live_owners(engine) if gone(o)]
+    return store.fail_orphans(engine, ORPHANED, dead_after=DEAD_AFTER, gone=ended)
 
 
 def heartbeat() -> None:
@@ -164,7 +243,7 @@ def get(engine: sa.Engine, job_id: str) -> dict | None:
         due = now - _reaped.get(url, -math.inf) >= HEARTBEAT_EVERY
         if due:
             _reaped[url] = now
-    if due and job_id in fail_orphans(engine):
+    if (due or gone(job["owner"])) and job_id in fail_orphans(engine):
         job = store.get_job(engine, job_id)
     return job
 
@@ -194,10 +273,10 @@ def error_line(exc: BaseException) -> str:
     return " ".join(text.split()) or type(exc).__name__
 
 
-def _work() -> None:
+def _work(jobs: queue.Queue) -> None:
     global _pending
     while True:
-        engine, job_id, kind, params, executor = _queue.get()
+        engine, job_id, kind, params, executor = jobs.get()
         try:
             _run(engine, job_id, kind, params, executor)
         except Exception:  # the store itself failed: keep serving the queue

@@ -14,7 +14,8 @@ the servers; ``skyroute db init`` upgrades to the newest).
 - ``servers(id, started, heartbeat)``: the server processes that own jobs, each beating
   (:func:`beat`) while it has jobs to run; times from the database's clock, so servers
   on hosts whose clocks differ agree on who is silent. :func:`fail_orphans` fails the
-  unfinished jobs of owners silent for longer than ``dead_after``.
+  unfinished jobs of owners silent for longer than ``dead_after``, or known to have
+  ended (``gone``: the runner tells those of its own machine by their process ids).
 - ``fleet_runs(id, job_id, scenario, params, report, events_jsonl, tracks_csv,
   packages_csv, fleet_geojson, created)``: a fleet run's ``report.json``,
   ``events.jsonl``, ``tracks.csv`` (bytes), ``packages.csv`` and ``fleet.geojson`` as
@@ -32,6 +33,7 @@ from __future__ import annotations
 import datetime as dt
 import math
 import uuid
+from collections.abc import Collection
 from pathlib import Path
 
 import sqlalchemy as sa
@@ -179,28 +181,42 @@ def beat(engine: sa.Engine, server: str) -> None:
             c.execute(servers.insert().values(id=server, started=now, heartbeat=now))
 
 
-def fail_orphans(engine: sa.Engine, error: str, *, dead_after: float) -> list[str]:
+def live_owners(engine: sa.Engine) -> list[str]:
+    """The owners of the jobs still ``queued`` or ``running`` (each once, none for the
+    jobs without an owner)."""
+    jobs = _t(engine)["jobs"]
+    with engine.connect() as c:
+        return list(c.scalars(sa.select(jobs.c.owner).distinct()
+                              .where(jobs.c.state.in_(LIVE), jobs.c.owner.is_not(None))))
+
+
+def fail_orphans(engine: sa.Engine, error: str, *, dead_after: float,
+                 gone: Collection[str] = ()) -> list[str]:
     """Mark ``failed`` with ``error`` every ``queued`` or ``running`` job whose owner
-    has not beaten for ``dead_after`` seconds (or that has no owner), delete their fleet
+    has not beaten for ``dead_after`` seconds, is one of ``gone`` (owners the caller
+    knows have ended, however recent their heartbeat) or is None; delete their fleet
     runs and forget those servers; the ids of the jobs it failed. The live servers' jobs
     are left as they are."""
     if not dead_after > 0:
         raise OptionError(f"dead_after={dead_after!r} must be a number of seconds > 0",
                           param="dead_after")
+    gone = list(gone)
     t = _t(engine)
     jobs, servers = t["jobs"], t["servers"]
     with engine.begin() as c:
         cutoff = db_now(c) - dt.timedelta(seconds=dead_after)
         alive = sa.select(servers.c.id).where(servers.c.heartbeat >= cutoff)
         orphaned = sa.and_(jobs.c.state.in_(LIVE),
-                           sa.or_(jobs.c.owner.is_(None), jobs.c.owner.not_in(alive)))
+                           sa.or_(jobs.c.owner.is_(None), jobs.c.owner.not_in(alive),
+                                  jobs.c.owner.in_(gone)))
         # RETURNING: the jobs this statement failed, not those a select saw before it
         # (a job finished in between is left done, and not reported)
         ids = list(c.scalars(jobs.update().where(orphaned)
                              .values(state="failed", error=error, updated=_now())
                              .returning(jobs.c.id)))
         _drop_runs(c, t, ids)
-        c.execute(servers.delete().where(servers.c.heartbeat < cutoff))
+        c.execute(servers.delete().where(sa.or_(servers.c.heartbeat < cutoff,
+                                                servers.c.id.in_(gone))))
     return ids
 
 

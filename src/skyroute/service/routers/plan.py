@@ -17,7 +17,7 @@ from typing import Annotated, Literal
 from fastapi import APIRouter, Depends
 from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import JSONResponse
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, model_validator
 
 from skyroute.errors import InputFormatError, QueryError, SkyrouteError
 from skyroute.service.alternatives import exactly_one
@@ -29,7 +29,10 @@ router = APIRouter(tags=["plan"])
 
 Algorithm = Literal["astar", "dijkstra", "bfs", "jps", "theta", "lazy_theta", "visibility",
                     "prm"]
-Number = Annotated[float, Field(allow_inf_nan=False)]
+# Numbers, counts and switches are strict, as skyroute.plan reads them: a JSON number
+# (an integer counts), a JSON integer, true or false; never a numeric string ("3"), a
+# boolean as a number or a number as a boolean, or 100.0 as a count (a 422 naming it).
+Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]
 Point = tuple[Number, Number]
 Pair = Annotated[list[float], Field(min_length=2, max_length=2)]
 SOURCES = ("map", "map_text", "world_text")  # exactly one of them
@@ -72,19 +75,20 @@ class PlanRequest(BaseModel):
     algorithm: Algorithm | None = Field(None, description="Default astar on maps, "
                                         "visibility on worlds.")
     connectivity: Literal[4, 8] | None = None
-    corner_cutting: bool = False
+    corner_cutting: StrictBool = False
     heuristic: Literal["octile", "euclidean", "manhattan", "zero"] | None = None
     weight: Number = Field(1.0, ge=1.0, le=1e6)
     prune: Literal["none", "collinear", "los"] | None = None
-    max_expansions: int | None = Field(None, ge=1, le=2**62, description="Stop after this "
-                                       "many expansions; capped by the server's budget.")
+    max_expansions: int | None = Field(None, strict=True, ge=1, le=2**62,
+                                       description="Stop after this many expansions; "
+                                       "capped by the server's budget.")
     resolution: Number | None = Field(None, gt=0, description="Worlds, grid algorithms: "
                                       "cell size in world units.")
-    samples: int = Field(1000, ge=1, le=10**9, description="PRM samples.")
-    neighbours: int = Field(10, ge=1, le=1000, description="PRM neighbours.")
-    prm_star: bool = False
-    seed: int = Field(0, ge=0, le=2**32 - 1, description="PRM seed.")
-    geojson: bool = Field(True, description="Add the path as GeoJSON.")
+    samples: int = Field(1000, strict=True, ge=1, le=10**9, description="PRM samples.")
+    neighbours: int = Field(10, strict=True, ge=1, le=1000, description="PRM neighbours.")
+    prm_star: StrictBool = False
+    seed: int = Field(0, strict=True, ge=0, le=2**32 - 1, description="PRM seed.")
+    geojson: StrictBool = Field(True, description="Add the path as GeoJSON.")
 
     @model_validator(mode="after")
     def _one_source(self) -> PlanRequest:
