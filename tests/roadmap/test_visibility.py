@@ -147,16 +147,17 @@ def boundary_worlds(draw):
 
 
 def reference_length(boundary, bars, s, t):
-    """Shortest length with the boundary closed (the infimum of the strict problem): every
-    vertex of the bars and the boundary, edges tested by shapely, Dijkstra by scipy."""
-    union = shapely.union_all(bars)
-    rings = [r for p in (*getattr(union, "geoms", [union]), boundary) if not p.is_empty
-             for r in (p.exterior, *p.interiors)]
+    """Shortest length with the boundary closed (the infimum of the strict problem): the
+    bars and the outside of the boundary as one union, every vertex of it, an edge where
+    shapely says the segment meets no interior of the union, Dijkstra by scipy."""
+    outside = shapely.box(*np.add(boundary.bounds, (-9, -9, 9, 9))).difference(boundary)
+    union = shapely.union_all([*bars, outside])
+    rings = [r for p in getattr(union, "geoms", [union]) for r in (p.exterior, *p.interiors)]
     pts = np.vstack([s, t, *(np.asarray(r.coords)[:-1] for r in rings)])
     rows, cols, w = [], [], []
     for i, j in itertools.combinations(range(len(pts)), 2):
         line = shapely.LineString([pts[i], pts[j]])
-        if boundary.covers(line) and not union.relate_pattern(line, "T********"):
+        if not union.relate_pattern(line, "T********"):
             rows.append(i)
             cols.append(j)
             w.append(math.dist(pts[i], pts[j]) + 1e-300)
