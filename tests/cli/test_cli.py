@@ -83,6 +83,16 @@ def test_no_path_exits_1_and_writes_nothing(monkeypatch, capsys, tmp_path):
     (["plan", "den312d", "--start", "5;x", "--goal", "1,1"], "--start '5;x' must be"),
     (["plan", *QUERY, "--bogus"], "No such option: --bogus"),
     (["plan", *QUERY, "--clearance", "-1"], "--safety -1.0"),
+    # option conflicts spoke of Python's keywords beside the flags: "algorithm='jps' needs
+    # connectivity=8 and --corner-cutting False" (a switch that takes no value)
+    (["plan", *QUERY, "--algorithm", "jps", "--corner-cutting"],
+     "error: --algorithm 'jps' needs --connectivity 8 and no corner cutting\n"),
+    (["plan", *QUERY, "--algorithm", "bfs", "--connectivity", "8"],
+     "error: --algorithm 'bfs' is 4-connected; use --connectivity 4 or --algorithm 'dijkstra'"),
+    (["plan", *QUERY, "--algorithm", "dijkstra", "--weight", "2"],
+     "error: --algorithm 'dijkstra' takes no weight; use --algorithm 'astar'\n"),
+    (["plan", *QUERY, "--algorithm", "bfs", "--heuristic", "octile"],
+     "error: --algorithm 'bfs' takes no heuristic option"),
     (["bench", "grid", "--map", "nomap", "--peers", ""], "--map nomap not found"),
     (["bench", "grid", "--algorithms", "astar,zzz", "--peers", ""], "--algorithms 'zzz'"),
     (["bench", "grid", "--per-map", "-3"], "'--per-map': -3 is not in the range x>=0"),

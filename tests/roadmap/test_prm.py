@@ -94,3 +94,24 @@ def test_options_the_world_planner_does_not_read_are_refused(algorithm, option):
     (name, _), = option.items()
     with pytest.raises(skyroute.OptionError, match=f"{name}=.*algorithm='{algorithm}'"):
         skyroute.plan(_square(), (0, 2), (4, 2), algorithm=algorithm, **option)
+
+
+@pytest.mark.parametrize("zones, start, goal", [
+    # one triangular no-fly zone between start and goal, no boundary: the way lies
+    # beyond the zone's bounds, where PRM drew no sample (no_path for every seed)
+    ([[(0, 0), (10, 0), (5, 8)]], (5, -1), (5, 9)),
+    # two walls spanning their bounds, start and goal outside them
+    ([[(0, 0), (1, 0), (1, 10), (0, 10)], [(5, 0), (6, 0), (6, 10), (5, 10)]],
+     (-1, 5), (7, 5)),
+])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_way_round_every_obstacle_is_in_the_roadmap(zones, start, goal, seed):
+    import shapely
+
+    world = skyroute.World([shapely.Polygon(z) for z in zones], 0.0, 50.0, ())
+    exact = skyroute.plan(world, start, goal)
+    r = skyroute.plan(world, start, goal, algorithm="prm", samples=300, seed=seed)
+    assert r.found, r
+    assert world.segments_free(r.path[:-1], r.path[1:]).all()
+    assert exact.cost <= r.cost == pytest.approx(
+        np.hypot(*np.diff(r.path, axis=0).T).sum(), rel=1e-12)

@@ -107,6 +107,82 @@ def test_boundary_is_strict_and_corners_outside_are_ignored():
         skyroute.plan(world, (10, 5), (8, 5))  # on the boundary counts as outside
 
 
+def test_paths_bend_round_the_corners_of_a_boundary_that_is_not_convex():
+    # an L-shaped map (and a square one with a square hole): the shortest way from one arm
+    # to the other bends at the inner corner; the graph had no node there ("no_path")
+    ell = shapely.Polygon([(0, 0), (10, 0), (10, 4), (4, 4), (4, 10), (0, 10)])
+    ring = shapely.box(0, 0, 10, 10).difference(shapely.box(3, 3, 7, 7))
+    for boundary, s, t, infimum in ((ell, (8, 2), (2, 8), 2 * math.hypot(4, 2)),
+                                    (ring, (1, 5), (9, 5), 2 * math.hypot(2, 2) + 4)):
+        world = rect_world([(20, 20, 21, 21)], boundary)  # an obstacle outside the map
+        r = skyroute.plan(world, s, t)
+        assert r.found, boundary
+        # strictly inside the boundary, so just longer than the path through the corner
+        assert infimum < r.cost < infimum + 1e-6
+        assert world.segments_free(r.path[:-1], r.path[1:]).all()
+
+
+@st.composite
+def boundary_worlds(draw):
+    """A star-shaped or comb-shaped boundary (reflex corners everywhere), a few rotated
+    bars inside, and two free points strictly inside it."""
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    if draw(st.booleans()):
+        a = np.linspace(0, 2 * np.pi, 13)[:-1]
+        r = np.where(np.arange(12) % 2, 12, rng.uniform(3, 9))
+        boundary = shapely.Polygon(np.c_[10 + r * np.cos(a), 10 + r * np.sin(a)])
+    else:
+        teeth = [shapely.box(x, 0 if x != 10 else 6, x + 1, 14 if x != 10 else 20)
+                 for x in (4, 10, 16)]
+        boundary = shapely.box(0, 0, 20, 20).difference(shapely.union_all(teeth))
+    bars = [shapely.affinity.rotate(shapely.box(x - r, y - r / 3, x + r, y + r / 3), turn)
+            for x, y, r, turn in zip(*rng.uniform(0, 20, (2, 3)), rng.uniform(0.5, 3, 3),
+                                     rng.uniform(0, 180, 3), strict=True)]
+    bars = bars[:draw(st.integers(0, 3))]
+    world = World(bars, np.full(len(bars), -np.inf), np.full(len(bars), np.inf), (),
+                  boundary, "enu")
+    pts = rng.uniform(0, 20, (400, 2))
+    pts = pts[world.is_free(pts)][:2]
+    return world, boundary, bars, pts
+
+
+def reference_length(boundary, bars, s, t):
+    """Shortest length with the boundary closed (the infimum of the strict problem): the
+    bars and the outside of the boundary as one union, every vertex of it, an edge where
+    shapely says the segment meets no interior of the union, Dijkstra by scipy."""
+    outside = shapely.box(*np.add(boundary.bounds, (-9, -9, 9, 9))).difference(boundary)
+    union = shapely.union_all([*bars, outside])
+    rings = [r for p in getattr(union, "geoms", [union]) for r in (p.exterior, *p.interiors)]
+    pts = np.vstack([s, t, *(np.asarray(r.coords)[:-1] for r in rings)])
+    rows, cols, w = [], [], []
+    for i, j in itertools.combinations(range(len(pts)), 2):
+        line = shapely.LineString([pts[i], pts[j]])
+        if not union.relate_pattern(line, "T********"):
+            rows.append(i)
+            cols.append(j)
+            w.append(math.dist(pts[i], pts[j]) + 1e-300)
+    graph = coo_matrix((w, (rows, cols)), shape=(len(pts), len(pts)))
+    return dijkstra(graph, directed=False, indices=0)[1]
+
+
+@settings(max_examples=25, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow])
+@given(boundary_worlds())
+def test_boundaries_that_are_not_convex_match_an_independent_graph(case):
+    world, boundary, bars, pts = case
+    if len(pts) < 2:
+        return
+    expected = reference_length(boundary, bars, *pts)
+    r = skyroute.plan(world, pts[0], pts[1])
+    if math.isinf(expected):
+        assert r.status is Status.NO_PATH
+        return
+    assert r.found
+    assert expected - 1e-9 <= r.cost < expected + 1e-6
+    assert r.cost == pytest.approx(np.hypot(*np.diff(r.path, axis=0).T).sum(), rel=1e-12)
+    assert world.segments_free(r.path[:-1], r.path[1:]).all()
+
+
 def test_start_inside_an_obstacle_names_it_and_a_free_point():
     world = rect_world([(1, 1, 3, 3)])
     with pytest.raises(QueryError, match=r"start \(2.00, 1.50\) lies inside obstacle "

@@ -5,6 +5,11 @@ and goal to their nearest visible samples, runs Dijkstra (scipy) on the roadmap,
 shortcuts the result by the exact segment test: greedy vertex shortcuts, random
 sub-segment shortcuts (as OMPL's path simplifier), and greedy again.
 
+Samples are drawn in the world's boundary or, without one, in the obstacles' bounds
+grown by :data:`MARGIN` of their size on every side, whose four outer corners are
+nodes too, joined in a ring: a path may have to go round every obstacle (a no-fly zone
+between start and goal), and that way is then always in the roadmap.
+
 Reproducible: the samples come from ``seed``, and each query's random shortcuts from a
 generator seeded by ``seed`` and the query's own coordinates, so the same world, query,
 options and seed give the same path on every call and in every process. ``expanded``
@@ -39,13 +44,16 @@ class PRM:
         t0 = time.perf_counter()
         self.world = world.merged()
         box = self.world.bounds
-        pts = _free_samples(self.world, box, samples, rng)
-        if len(pts) < 2 and world.boundary is None:
-            # the obstacles fill their own bounds: the free space is around them
+        ring = np.empty((0, 2))
+        if world.boundary is None:
+            # the free space goes on round the obstacles, and a path may have to go round
+            # them all (a no-fly zone, or a row of them, between start and goal): sample
+            # a margin too, and keep its outer corners, joined in a ring, as nodes
             x0, y0, x1, y1 = box
-            grow = max(x1 - x0, y1 - y0)
-            pts = _free_samples(self.world, (x0 - grow, y0 - grow, x1 + grow, y1 + grow),
-                                samples, rng)
+            grow = MARGIN * max(x1 - x0, y1 - y0)
+            box = (x0 - grow, y0 - grow, x1 + grow, y1 + grow)
+            ring = np.array([box[:2], (box[2], box[1]), box[2:], (box[0], box[3])])
+        pts = np.vstack([ring, _free_samples(self.world, box, samples, rng)])
         if len(pts) < 2:
             raise OptionError(f"PRM drew {len(pts)} free point(s) from the world's extent "
                               "and needs at least 2: its free space is empty or too thin "
@@ -55,8 +63,8 @@ class PRM:
         self.k = math.ceil(math.e * 1.5 * math.log(n)) if prm_star else neighbours
         self.tree = cKDTree(self.points)
         _, nb = self.tree.query(self.points, k=min(self.k + 1, n))
-        i = np.repeat(np.arange(n), nb.shape[1] - 1)
-        j = nb[:, 1:].ravel()
+        i = np.r_[np.repeat(np.arange(n), nb.shape[1] - 1), np.arange(len(ring))]
+        j = np.r_[nb[:, 1:].ravel(), np.roll(np.arange(len(ring)), -1)]
         a, b = np.minimum(i, j), np.maximum(i, j)
         pairs = np.unique(np.c_[a, b], axis=0)
         free = self.world.segments_free(self.points[pairs[:, 0]], self.points[pairs[:, 1]])
@@ -125,6 +133,7 @@ class PRM:
         return self.points[self.edges]
 
 
+MARGIN = 0.1  # of the obstacles' extent: sampled round them in a world with no boundary
 MAX_SAMPLES = 10**7  # 160 MB of points and far more of edges: past it, a MemoryError
 
 

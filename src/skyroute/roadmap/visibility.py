@@ -1,9 +1,13 @@
 """Visibility graph: the exact shortest path among polygon obstacles.
 
 A shortest path that avoids polygon interiors is a polyline whose bends sit on convex
-obstacle corners (interior angle below 180 degrees), and each of its edges is tangent to
-the obstacles at both ends. The graph's nodes are those corners of the union of the
-obstacles; an edge joins two corners that see each other. The graph is built eagerly,
+obstacle corners (interior angle below 180 degrees) and, inside a boundary that is not
+convex, on its reflex corners (and its holes' convex ones); each of its edges is tangent
+at both ends. The graph's nodes are those corners of the union of the obstacles and of
+the boundary; an edge joins two corners that see each other. Paths must stay strictly
+inside the boundary, so a bend at one of its corners is taken :data:`INSET` of the
+world's size inside it (:func:`bend_points`): the path is longer than the infimum, which
+touches the corner, by about that much. The graph is built eagerly,
 once per world: every bitangent pair of corners is tested by the compiled sight test of
 :mod:`skyroute.roadmap.sight_kernels` (shapely settles the few cases within rounding of
 a touch), the free ones become a CSR adjacency, and scipy labels its connected
@@ -35,11 +39,12 @@ from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.roadmap import sight_kernels as sk
 from skyroute.roadmap.corner_search import corner_astar
 from skyroute.roadmap.visibility_cache import graph_key, load_graph, save_graph
-from skyroute.world.geometry import convex_corners
+from skyroute.world.geometry import boundary_corners, convex_corners
 from skyroute.world.world import World
 
 MAX_CORNERS = 10_000  # about 12 million pairs tested: 1 GB and 8 s (see above)
 SAVE_AFTER = 0.1  # seconds: with cache=None, keep graphs that took longer to build
+INSET = 1e-9  # a bend at a boundary corner, inside it: this times the boundary's size
 
 
 class VisibilityGraph:
@@ -64,8 +69,9 @@ class VisibilityGraph:
         self.world = World(polygons, np.full(len(polygons), -np.inf),
                            np.full(len(polygons), np.inf), tuple(arrays["names"].tolist()),
                            world.boundary, world.frame, world.home, world.name, world.source)
-        self.corners, self._prev, self._next = arrays["corners"], arrays["prev"], \
-            arrays["next"]
+        # tangents are tested at the corners themselves, paths bend at bend points
+        self._at, self._prev, self._next = arrays["corners"], arrays["prev"], arrays["next"]
+        self.corners = bend_points(world, self._at, self._prev, self._next)
         self._indptr, self._indices, self._weights = arrays["indptr"], arrays["indices"], \
             arrays["weights"]
         self.labels = arrays["labels"]
@@ -98,7 +104,7 @@ class VisibilityGraph:
 
     def _seen(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Corners point p sees along a tangent: (ids, distances)."""
-        ids = sk.tangent_ids(p[0], p[1], self.corners, self._prev, self._next)
+        ids = sk.tangent_ids(p[0], p[1], self._at, self._prev, self._next)
         ids = ids[self.free(np.broadcast_to(p, (len(ids), 2)), self.corners[ids])]
         return ids, np.hypot(*(self.corners[ids] - p).T)
 
@@ -199,12 +205,39 @@ def _refuse(world: World, corners: int, *, at_least: bool = False) -> None:
 
 def _corners(world: World, merged: World) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The convex corners of the merged obstacles (inside the boundary, when there is
-    one) with their ring neighbours."""
+    one) and the boundary's corners where a path may bend (those whose bend point is
+    free), with their ring neighbours."""
     corners, prev, nxt = convex_corners(merged)
-    if world.boundary is not None and len(corners):
+    if world.boundary is not None:
         keep = merged.inside(corners)  # corners outside the boundary: useless
-        corners, prev, nxt = corners[keep], prev[keep], nxt[keep]
+        more = boundary_corners(world.boundary)
+        bend = bend_points(world, *more)
+        free = merged.is_free(bend) if len(bend) else np.empty(0, bool)
+        corners, prev, nxt = (np.concatenate([a[keep], b[free]])
+                              for a, b in zip((corners, prev, nxt), more, strict=True))
     return corners, prev, nxt
+
+
+def bend_points(world: World, corners: np.ndarray, prev: np.ndarray,
+                nxt: np.ndarray) -> np.ndarray:
+    """Where a path bends at each corner: the corner itself, or, for a corner on the
+    boundary (where a path may not go), the point :data:`INSET` times the boundary's
+    size (its width, height or farthest coordinate) inside it along the bisector of its
+    free angle."""
+    out = np.array(corners, dtype=float).reshape(-1, 2)
+    if world.boundary is None or not len(out):
+        return out
+    on = ~world.inside(out)
+    if on.any():
+        x0, y0, x1, y1 = world.boundary.bounds
+        inset = INSET * max(x1 - x0, y1 - y0, abs(x0), abs(y0), abs(x1), abs(y1))
+        c = out[on]
+        a = prev[on] - c
+        b = nxt[on] - c
+        # the blocked side lies between the two edges (a convex angle): go the other way
+        d = a / np.hypot(*a.T)[:, None] + b / np.hypot(*b.T)[:, None]
+        out[on] = c - inset * d / np.hypot(*d.T)[:, None]
+    return out
 
 
 def _build(world: World) -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -220,16 +253,17 @@ def _build(world: World) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     n = len(corners)
     index = sk.edge_index(merged.obstacles)
     i, j = sk.corner_pairs(corners, prev, nxt)
-    same = np.all(corners[i] == corners[j], axis=1)  # two obstacles meeting at a corner
+    bends = bend_points(world, corners, prev, nxt)
+    same = np.all(bends[i] == bends[j], axis=1)  # two obstacles meeting at a corner
     ok = same.copy()
-    ok[~same] = _free(merged, index, _convex(world.boundary), corners[i[~same]],
-                      corners[j[~same]])
+    ok[~same] = _free(merged, index, _convex(world.boundary), bends[i[~same]],
+                      bends[j[~same]])
     i, j = i[ok], j[ok]
     rows, cols = np.r_[i, j], np.r_[j, i]
     order = np.lexsort((cols, rows))
     rows, cols = rows[order], cols[order]
     indptr = np.searchsorted(rows, np.arange(n + 1)).astype(np.int64)
-    weights = np.hypot(*(corners[cols] - corners[rows]).T)
+    weights = np.hypot(*(bends[cols] - bends[rows]).T)
     adjacency = csr_matrix((np.ones(len(cols)), cols, indptr), shape=(n, n))
     labels = connected_components(adjacency, directed=False)[1] if n else np.empty(0)
     names = np.array(merged.names if len(merged.names) else [], dtype=str)

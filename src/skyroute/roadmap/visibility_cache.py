@@ -24,7 +24,7 @@ from skyroute.errors import SkyrouteError
 from skyroute.files import write_atomic
 from skyroute.world.world import World
 
-VERSION = 1  # bump when the build's results may change
+VERSION = 2  # bump when the build's results may change (2: boundary corners)
 ARRAYS = ("corners", "prev", "next", "indptr", "indices", "weights", "labels", "names")
 
 

@@ -64,10 +64,12 @@ def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, pr
     if algorithm == "bfs" and connectivity != 4:
         raise OptionError("algorithm='bfs' is 4-connected; use connectivity=4 or "
                           "algorithm='dijkstra' for 8-connected unit costs",
-                          param="connectivity")
+                          param=("connectivity", "algorithm"))
     if algorithm == "jps" and (connectivity != 8 or corner_cutting):
-        raise OptionError("algorithm='jps' needs connectivity=8 and corner_cutting=False",
-                          param="connectivity" if connectivity != 8 else "corner_cutting")
+        # the parameters named in the message too: the CLI speaks of them as its flags
+        raise OptionError("algorithm='jps' needs connectivity=8 and no corner cutting",
+                          param=("connectivity", "algorithm") if connectivity != 8 else
+                          ("corner_cutting", "algorithm", "connectivity"))
     if heuristic is None:
         heuristic = _default_h(algorithm, connectivity)
     check_choice("heuristic", heuristic, tuple(HEURISTICS))
@@ -75,11 +77,11 @@ def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, pr
                                                                              connectivity):
         raise OptionError(f"algorithm={algorithm!r} takes no heuristic option "
                           f"(it uses {_default_h(algorithm, connectivity)!r})",
-                          param="heuristic")
+                          param=("heuristic", "algorithm"))
     weight = real("weight", weight, low=1.0, need="a number >= 1")  # numpy's too; no bool
     if weight != 1.0 and algorithm in ("bfs", "dijkstra", "jps"):
-        raise OptionError(f"algorithm={algorithm!r} takes no weight; use 'astar'",
-                          param="weight")
+        raise OptionError(f"algorithm={algorithm!r} takes no weight; use algorithm='astar'",
+                          param=("weight", "algorithm"))
     prune = "none" if prune is None else prune
     check_choice("prune", prune, PRUNE_MODES)
     return canonical(GridOptions(algorithm, int(connectivity), bool(corner_cutting),

@@ -2,8 +2,9 @@
 
 ``collinear`` drops points where the path goes straight on (a zero determinant); the
 merged segment covers exactly the cells of the steps it replaces. ``los`` shortcuts
-greedily from each kept point to the farthest later point it can see (``los`` rule);
-by the triangle inequality the result is never longer.
+greedily: from each kept point it goes on while it sees the next point, and keeps the
+last one it saw (not the farthest visible point beyond a hidden one); by the triangle
+inequality the result is never longer.
 """
 
 from __future__ import annotations

@@ -30,19 +30,34 @@ def convex_corners(world) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         e = np.empty((0, 2))
         return e, e, e
     merged = shapely.orient_polygons(shapely.unary_union(world.obstacles))
-    corners, prevs, nexts = [], [], []
-    for poly in getattr(merged, "geoms", [merged]):
-        if poly.geom_type != "Polygon":
-            continue
-        for ring in (poly.exterior, *poly.interiors):
-            c = np.asarray(ring.coords)[:-1]
-            # exterior counter-clockwise, holes clockwise: the obstacle is on the left
-            prev, nxt = np.roll(c, 1, axis=0), np.roll(c, -1, axis=0)
-            u, v = c - prev, nxt - c
-            cross = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
-            scale = np.hypot(*u.T) * np.hypot(*v.T)
-            keep = cross > 1e-12 * scale  # convex, not collinear
-            corners.append(c[keep])
-            prevs.append(prev[keep])
-            nexts.append(nxt[keep])
+    # exterior counter-clockwise, holes clockwise: the obstacle is on the left
+    return ring_corners([np.asarray(ring.coords)[:-1]
+                         for poly in getattr(merged, "geoms", [merged])
+                         if poly.geom_type == "Polygon"
+                         for ring in (poly.exterior, *poly.interiors)])
+
+
+def boundary_corners(boundary) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(corners, previous, next) where a path kept inside ``boundary`` may have to bend:
+    the reflex corners of its exterior and the convex corners of its holes, that is the
+    convex corners of the region outside it (on the left along the rings)."""
+    b = shapely.orient_polygons(shapely.Polygon(boundary))
+    # reversed, the exterior runs clockwise and the holes counter-clockwise
+    return ring_corners([np.asarray(ring.coords)[-2::-1]
+                         for ring in (b.exterior, *b.interiors)])
+
+
+def ring_corners(rings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(corners, previous, next): the convex corners of rings ((K, 2) arrays, not closed)
+    that have the blocked side on their left, with their ring neighbours."""
+    corners, prevs, nexts = [np.empty((0, 2))], [np.empty((0, 2))], [np.empty((0, 2))]
+    for c in rings:
+        prev, nxt = np.roll(c, 1, axis=0), np.roll(c, -1, axis=0)
+        u, v = c - prev, nxt - c
+        cross = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+        scale = np.hypot(*u.T) * np.hypot(*v.T)
+        keep = cross > 1e-12 * scale  # convex, not collinear
+        corners.append(c[keep])
+        prevs.append(prev[keep])
+        nexts.append(nxt[keep])
     return np.concatenate(corners), np.concatenate(prevs), np.concatenate(nexts)
