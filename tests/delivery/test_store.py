@@ -4,10 +4,12 @@ written whole (a killed run leaves the previous day) and rerunning replaces it."
 from __future__ import annotations
 
 import datetime as dt
+import os
 import re
 import subprocess
 import sys
 import textwrap
+import uuid
 from pathlib import Path
 
 import pytest
@@ -258,3 +260,43 @@ def test_sqlite_waits_longer_than_pythons_five_seconds(tmp_path):
     e = store.connect(f"sqlite:///{tmp_path / 'x.db'}")
     with e.connect() as c:
         assert c.exec_driver_sql("pragma busy_timeout").scalar() == store.BUSY_SECONDS * 1000
+
+
+PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1:5432/test")
+
+
+@pytest.fixture
+def fresh_pg():
+    """The URL of a new, empty PostgreSQL database of this test's own, dropped after it
+    (skipped when no server answers, unless $CI is set)."""
+    base = sa.engine.make_url(PG)
+    name = f"skyroute_new_{uuid.uuid4().hex[:12]}"
+    try:
+        admin = sa.create_engine(base, isolation_level="AUTOCOMMIT")
+        with admin.connect() as c:
+            c.execute(sa.text(f"create database {name}"))
+    except sa.exc.OperationalError:
+        if os.environ.get("CI"):
+            raise
+        pytest.skip("no PostgreSQL server")
+    try:
+        yield base.set(database=name).render_as_string(hide_password=False)
+    finally:
+        with admin.connect() as c:
+            c.execute(sa.text(f"drop database if exists {name} with (force)"))
+        admin.dispose()
+
+
+def test_a_new_postgresql_store_made_by_two_runs_at_once(fresh_pg):
+    # both saw no schema and made it: the later ones failed ("not a usable store:
+    # relation "alembic_version" already exists"); making it now takes a
+    # transaction-level advisory lock first, so the others wait and find it made
+    script = textwrap.dedent(f"""
+        from skyroute.delivery import store
+        print(store.init(store.connect({fresh_pg!r})))
+    """)
+    procs = [subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True,
+                              cwd=str(Path(__file__).parents[2])) for _ in range(4)]
+    done = [(p.communicate(timeout=60), p.returncode) for p in procs]
+    assert [(out, rc) for (out, _), rc in done] == [("0003\n", 0)] * 4, done

@@ -373,7 +373,7 @@ def test_job_writers_on_one_sqlite_file_queue(tmp_path):
                 save_run(e, job)
                 assert store.finish_job(e, job, {"k": k})
                 made.append(job)
-        except Exception as exc:  # noqa: BLE001 - reported below
+        except Exception as exc:  # reported below
             errors.append(exc)
         finally:
             e.dispose()

@@ -37,6 +37,9 @@ DEFAULT_DB = "sqlite:///skyroute.db"
 BUSY_SECONDS = 30.0
 SQL_INT = (-2**31, 2**31 - 1)  # an INTEGER column: 32 bits on PostgreSQL, 64 on SQLite
 TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
+# The PostgreSQL advisory lock that :func:`init` holds while it makes or upgrades the
+# schema (any fixed 64-bit number other programs on the database are unlikely to use)
+SCHEMA_LOCK = 0x736B79726F757465  # "skyroute"
 _REFLECTED: dict[tuple[str, tuple[str, ...]], dict[str, sa.Table]] = {}
 register(_REFLECTED.clear)
 
@@ -122,7 +125,10 @@ def writing(engine: sa.Engine) -> Iterator[sa.Connection]:
 
 
 def init(engine: sa.Engine) -> str:
-    """Create or upgrade the schema to the newest migration; return its revision."""
+    """Create or upgrade the schema to the newest migration; return its revision. One
+    transaction that holds the write lock (SQLite) or the advisory lock
+    :data:`SCHEMA_LOCK` (PostgreSQL) throughout, so two first runs at once on a new store
+    make it once: the second waits, then finds it made."""
     from alembic import command
     from alembic.config import Config
     from alembic.runtime.migration import MigrationContext
@@ -133,6 +139,12 @@ def init(engine: sa.Engine) -> str:
     url = _safe(str(engine.url))
     try:
         with writing(engine) as conn:
+            if conn.dialect.name == "postgresql":
+                # PostgreSQL's counterpart of SQLite's BEGIN IMMEDIATE here: two first
+                # runs on an empty database both saw no schema and made it, and the later
+                # failed ('relation "alembic_version" already exists'); the lock is held
+                # to the end of this transaction, so the other waits and finds it made
+                conn.execute(sa.select(sa.func.pg_advisory_xact_lock(SCHEMA_LOCK)))
             cfg.attributes["connection"] = conn
             command.upgrade(cfg, "head")
     except sa.exc.DatabaseError as exc:  # e.g. a file that is not SQLite's
