@@ -289,3 +289,25 @@ def test_a_corrected_csv_is_refused_until_replace(monkeypatch, capsys, tmp_path)
     code, out, err = run(monkeypatch, capsys, "deliver", day, "--source", "http://x",
                          "--db", db, "--replace")
     assert code == 2 and "--replace replaces stored orders by those of --data DIR" in err
+
+
+def test_days_without_orders_say_so_and_exit_0(monkeypatch, capsys, tmp_path, fly_once):
+    # one such day printed a table of zeros and nothing more; a range of them ended in
+    # "error: no orders on any of these days" and exit 2 after storing the days and
+    # writing their files (exit 0 with --json)
+    db = ["--data", EXAMPLE, "--db", f"sqlite:///{tmp_path / 'e.db'}", "--out", str(tmp_path)]
+    code, out, err = run(monkeypatch, capsys, "deliver", "2024-02-01", "--no-plot", *db)
+    assert code == 0 and "orders placed" in out, err
+    assert "2024-02-01: no orders stored for this day; nothing was flown" in err
+    for extra in ([], ["--json"]):
+        code, out, err = run(monkeypatch, capsys, "deliver", "--from", "2024-02-01", "--to",
+                             "2024-02-03", *db, *extra)
+        assert code == 0, err
+        assert "nothing was flown: none of the 3 days from 2024-02-01 to 2024-02-03 had " \
+            "orders stored" in " ".join(err.split())
+    assert json.loads(out)["days_with_orders"] == 0
+    code, out, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-03", "--to",
+                         "2024-01-04", *db)
+    assert code == 0 and "2 days" in out, err
+    assert "1 of the 2 days had no orders stored (2024-01-04); nothing was flown on it" \
+        in " ".join(err.split())

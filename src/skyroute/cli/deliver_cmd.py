@@ -119,6 +119,26 @@ def deliver_command(
         _one_day(results[0], written, as_json)
     else:
         _summary(results, wall, jobs, workers, ex.kind, as_json, written)
+    _say_empty(results)
+
+
+def _say_empty(results: list[DayResult]) -> None:
+    """A line on stderr for days without orders (stored as empty days, exit 0): a
+    mistyped date or orders not imported would otherwise pass for a day flown."""
+    empty = [r.date for r in results if not r.orders]
+    if not empty:
+        return
+    n = len(results)
+    if n == 1:
+        line = f"{empty[0]}: no orders stored for this day; nothing was flown"
+    elif len(empty) == n:
+        line = (f"nothing was flown: none of the {n:,} days from {results[0].date} to "
+                f"{results[-1].date} had orders stored")
+    else:
+        shown = ", ".join(str(d) for d in empty[:5]) + (", ..." if len(empty) > 5 else "")
+        line = (f"{len(empty):,} of the {n:,} days had no orders stored ({shown}); nothing "
+                "was flown on " + ("it" if len(empty) == 1 else "them"))
+    plain_console(stderr=True).print(line, soft_wrap=True)
 
 
 def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
@@ -156,8 +176,13 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
     if as_json:
         typer.echo(json.dumps(s))
         return
-    if not s["days_with_orders"]:
-        raise SkyrouteError("no orders on any of these days")
+    if not s["days_with_orders"]:  # no table of money: _say_empty says why
+        if files:
+            plain_console().print(f"wrote {len(files):,} files to {', '.join(s['folders'])}")
+        if any(r.orders for r in results):
+            plain_console(stderr=True).print(
+                "nothing was flown: every order of these days is invalid", soft_wrap=True)
+        return
     who = f"{workers} job(s)" if kind == "local" else f"{workers} Dask worker(s)"
     t = Table(title=f"{s['days']} days, {wall:.1f} s with {who}: money delivered "
                     f"mean {s['mean_pct']:.2f}%, worst {s['min_pct']:.2f}% on {s['min_date']}")
