@@ -49,10 +49,8 @@ def import_folder(engine, data: Path, *, replace: bool):
         name, column = CSV_FIELDS.get(field, ("orders.csv", None))
         what = (f"order {no} is stored but not in the file" if field is None else
                 f"order {no}: {column} {shown(new)}, stored {shown(old)}")
-        days = ", ".join(str(d) for d in exc.days[:3])
-        if len(exc.days) > 3:
-            days += f" and {len(exc.days) - 3:,} more days"
-        raise SkyrouteError(f"{data / 'database' / name}: the orders of {days} differ from "
+        raise SkyrouteError(f"{data / 'database' / name}: the orders of {some_days(exc.days)} "
+                            "differ from "
                             f"the stored ones ({what}); --replace stores the file's orders "
                             "of " + ("that day" if len(exc.days) == 1 else "those days")
                             + ", deleting what was flown from the stored ones") from None
@@ -76,10 +74,16 @@ def db_import(
 
 
 def replaced(got) -> str:
-    """'; replaced the orders of DAYS ...' for an import that replaced days, else ''."""
+    """'; replaced the stored orders of DAYS (...)' for an import that replaced days, else
+    ''."""
     if not got.replaced:
         return ""
-    days = ", ".join(str(d) for d in got.replaced[:3])
-    if len(got.replaced) > 3:
-        days += f" and {len(got.replaced) - 3:,} more days"
-    return f"; replaced the stored orders of {days} (what was flown from them is deleted)"
+    return (f"; replaced the stored orders of {some_days(got.replaced)} (what was flown "
+            "from them is deleted)")
+
+
+def some_days(days, most: int = 3) -> str:
+    """The first ``most`` of ``days`` and how many more: '2024-01-01, 2024-01-02 and 5
+    more days'."""
+    text = ", ".join(str(d) for d in days[:most])
+    return text + (f" and {len(days) - most:,} more days" if len(days) > most else "")

@@ -11,7 +11,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from skyroute.cli.db_cmd import REPLACE_HELP
+from skyroute.cli.db_cmd import REPLACE_HELP, some_days
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
 from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.delivery.day import METHODS, DayResult
@@ -135,8 +135,8 @@ def _say_empty(results: list[DayResult]) -> None:
         line = (f"nothing was flown: none of the {n:,} days from {results[0].date} to "
                 f"{results[-1].date} had orders stored")
     else:
-        shown = ", ".join(str(d) for d in empty[:5]) + (", ..." if len(empty) > 5 else "")
-        line = (f"{len(empty):,} of the {n:,} days had no orders stored ({shown}); nothing "
+        line = (f"{len(empty):,} of the {n:,} days had no orders stored "
+                f"({some_days(empty, 5)}); nothing "
                 "was flown on " + ("it" if len(empty) == 1 else "them"))
     plain_console(stderr=True).print(line, soft_wrap=True)
 
