@@ -179,9 +179,6 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
     if not s["days_with_orders"]:  # no table of money: _say_empty says why
         if files:
             plain_console().print(f"wrote {len(files):,} files to {', '.join(s['folders'])}")
-        if any(r.orders for r in results):
-            plain_console(stderr=True).print(
-                "nothing was flown: every order of these days is invalid", soft_wrap=True)
         return
     who = f"{workers} job(s)" if kind == "local" else f"{workers} Dask worker(s)"
     t = Table(title=f"{s['days']} days, {wall:.1f} s with {who}: money delivered "
