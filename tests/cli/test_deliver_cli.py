@@ -246,3 +246,68 @@ def test_db_lines_do_not_wrap(monkeypatch, capsys, tmp_path):
     code, out, err = run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", db)
     assert code == 0 and len(out.strip().splitlines()) == 1, err
     assert out.startswith(f"{db}: 108 orders added")
+
+
+def test_a_corrected_csv_is_refused_until_replace(monkeypatch, capsys, tmp_path):
+    # the stored (wrong) orders were kept and flown, and nothing said so
+    import shutil
+
+    data = tmp_path / "lunch"
+    shutil.copytree(EXAMPLE, data)
+    db = f"sqlite:///{tmp_path / 'c.db'}"
+    assert run(monkeypatch, capsys, "db", "import", str(data), "--db", db)[0] == 0
+    orders = data / "database" / "orders.csv"
+    original = orders.read_text()
+    lines = original.splitlines(keepends=True)
+    no, day, customer, _ = lines[1].strip().split(",")
+    lines[1] = f"{no},{day},{customer},fixed.place.here\n"
+    fixed = "".join(lines)
+    orders.write_text(fixed)
+    refused = (f"{orders}: the orders of {day} differ from the stored ones (order {no}: "
+               "deliverTo 'fixed.place.here', stored ")
+    for args in (["db", "import", str(data)],
+                 ["deliver", day, "--data", str(data), "--out", str(tmp_path / "out")]):
+        code, out, err = run(monkeypatch, capsys, *args, "--db", db)
+        assert code == 2 and refused in err and "--replace stores the file's orders of " \
+            "that day" in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "out").exists()
+    orders.write_text(original)
+    details = data / "database" / "orderDetails.csv"
+    details.write_text("".join(details.read_text().splitlines(keepends=True)[:-1]))
+    last = original.splitlines()[-1].split(",")
+    code, out, err = run(monkeypatch, capsys, "db", "import", str(data), "--db", db)
+    assert code == 2 and f"{details}: the orders of {last[1]} differ from the stored ones " \
+        f"(order {last[0]}: items [" in err, err
+    orders.write_text(fixed)  # both corrections: two days
+    code, out, err = run(monkeypatch, capsys, "db", "import", str(data), "--db", db,
+                         "--replace")
+    assert code == 0, err
+    assert f"replaced the stored orders of {day}, {last[1]} (what was flown from them is " \
+        "deleted)" in " ".join(out.split())
+    code, out, err = run(monkeypatch, capsys, "db", "import", str(data), "--db", db)
+    assert code == 0 and "0 orders added, 108 already there" in " ".join(out.split())
+    code, out, err = run(monkeypatch, capsys, "deliver", day, "--source", "http://x",
+                         "--db", db, "--replace")
+    assert code == 2 and "--replace replaces stored orders by those of --data DIR" in err
+
+
+def test_days_without_orders_say_so_and_exit_0(monkeypatch, capsys, tmp_path, fly_once):
+    # one such day printed a table of zeros and nothing more; a range of them ended in
+    # "error: no orders on any of these days" and exit 2 after storing the days and
+    # writing their files (exit 0 with --json)
+    db = ["--data", EXAMPLE, "--db", f"sqlite:///{tmp_path / 'e.db'}", "--out", str(tmp_path)]
+    code, out, err = run(monkeypatch, capsys, "deliver", "2024-02-01", "--no-plot", *db)
+    assert code == 0 and "orders placed" in out, err
+    assert "2024-02-01: no orders stored for this day; nothing was flown" in err
+    for extra in ([], ["--json"]):
+        code, out, err = run(monkeypatch, capsys, "deliver", "--from", "2024-02-01", "--to",
+                             "2024-02-03", *db, *extra)
+        assert code == 0, err
+        assert "nothing was flown: none of the 3 days from 2024-02-01 to 2024-02-03 had " \
+            "orders stored" in " ".join(err.split())
+    assert json.loads(out)["days_with_orders"] == 0
+    code, out, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-03", "--to",
+                         "2024-01-04", *db)
+    assert code == 0 and "2 days" in out, err
+    assert "1 of the 2 days had no orders stored (2024-01-04); nothing was flown on it" \
+        in " ".join(err.split())

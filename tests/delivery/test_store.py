@@ -4,10 +4,12 @@ written whole (a killed run leaves the previous day) and rerunning replaces it."
 from __future__ import annotations
 
 import datetime as dt
+import os
 import re
 import subprocess
 import sys
 import textwrap
+import uuid
 from pathlib import Path
 
 import pytest
@@ -60,8 +62,8 @@ def test_init_makes_the_issues_tables_and_is_repeatable(engine):
 def test_import_is_idempotent(engine):
     orders = [Order("0000000a", DAY, "s2400001", "a.b.c", ("x", "y", "x")),
               Order("0000000b", DAY, "s2400002", "a.b.d", ("z",))]
-    assert store.import_orders(engine, orders) == (2, 0)
-    assert store.import_orders(engine, orders) == (0, 2)
+    assert store.import_orders(engine, orders)[:2] == (2, 0)
+    assert store.import_orders(engine, orders)[:2] == (0, 2)
     back = store.orders_between(engine, DAY, DAY)[DAY]
     assert back == orders  # items, repeats and order kept
 
@@ -203,19 +205,19 @@ def test_two_imports_at_once_wait_for_each_other(engine):
     # (here past its 0.2 s busy timeout: a one-line error, nothing written)
     other = store.connect(f"{engine.url}?timeout=0.2")
     seen = _import_meanwhile(engine, other, TWO)
-    assert store.import_orders(engine, TWO) == (2, 0)
+    assert store.import_orders(engine, TWO) == (2, 0, ())
     assert len(seen) == 1 and isinstance(seen[0], SkyrouteError)
     assert re.search(r"store\.db\?timeout=0\.2: the store is busy: another process kept it "
                      r"locked", str(seen[0]))
-    assert store.import_orders(other, TWO) == (0, 2)
+    assert store.import_orders(other, TWO) == (0, 2, ())
 
 
 def test_an_import_that_lost_the_race_adds_the_rest(engine, monkeypatch):
     # PostgreSQL does not serialise the two: the later insert collides, is read again
     monkeypatch.setattr(store, "writing", lambda e: e.begin(), raising=False)
     seen = _import_meanwhile(engine, store.connect(str(engine.url)), TWO[:1])
-    assert store.import_orders(engine, TWO) == (1, 1)
-    assert seen == [(1, 0)]
+    assert store.import_orders(engine, TWO) == (1, 1, ())
+    assert seen == [(1, 0, ())]
     assert store.orders_between(engine, DAY, DAY)[DAY] == TWO
 
 
@@ -258,3 +260,123 @@ def test_sqlite_waits_longer_than_pythons_five_seconds(tmp_path):
     e = store.connect(f"sqlite:///{tmp_path / 'x.db'}")
     with e.connect() as c:
         assert c.exec_driver_sql("pragma busy_timeout").scalar() == store.BUSY_SECONDS * 1000
+
+
+PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1:5432/test")
+
+
+@pytest.fixture
+def fresh_pg():
+    """The URL of a new, empty PostgreSQL database of this test's own, dropped after it
+    (skipped when no server answers, unless $CI is set)."""
+    base = sa.engine.make_url(PG)
+    name = f"skyroute_new_{uuid.uuid4().hex[:12]}"
+    try:
+        admin = sa.create_engine(base, isolation_level="AUTOCOMMIT")
+        with admin.connect() as c:
+            c.execute(sa.text(f"create database {name}"))
+    except sa.exc.OperationalError:
+        if os.environ.get("CI"):
+            raise
+        pytest.skip("no PostgreSQL server")
+    try:
+        yield base.set(database=name).render_as_string(hide_password=False)
+    finally:
+        with admin.connect() as c:
+            c.execute(sa.text(f"drop database if exists {name} with (force)"))
+        admin.dispose()
+
+
+def test_a_new_postgresql_store_made_by_two_runs_at_once(fresh_pg):
+    # both saw no schema and made it: the later ones failed ("not a usable store:
+    # relation "alembic_version" already exists"); making it now takes a
+    # transaction-level advisory lock first, so the others wait and find it made
+    script = textwrap.dedent(f"""
+        from skyroute.delivery import store
+        print(store.init(store.connect({fresh_pg!r})))
+    """)
+    procs = [subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True,
+                              cwd=str(Path(__file__).parents[2])) for _ in range(4)]
+    done = [(p.communicate(timeout=60), p.returncode) for p in procs]
+    assert [(out, rc) for (out, _), rc in done] == [("0003\n", 0)] * 4, done
+
+
+NEXT = DAY + dt.timedelta(1)
+DAYS = [*TWO, Order("0000000c", NEXT, "s2400003", "a.b.e", ("y",))]
+
+
+def fix(orders: list, no: str, **changed) -> list:
+    """``orders`` with order ``no`` changed (a corrected line of the CSV)."""
+    return [Order(**{**o.__dict__, **changed}) if o.order_no == no else o for o in orders]
+
+
+def counts(engine) -> dict[str, int]:
+    with engine.connect() as c:
+        return {t: c.execute(sa.text(f"select count(*) from {t}")).scalar_one()
+                for t in store.TABLES}
+
+
+@pytest.mark.parametrize("given, words", [
+    (fix(DAYS, "0000000b", deliver_to="a.b.x"),
+     "2024-01-01: the orders differ from the stored ones (order 0000000b: deliver_to "
+     "'a.b.x', stored 'a.b.d')"),
+    (fix(DAYS, "0000000a", items=("x", "z")),
+     "(order 0000000a: items ['x', 'z'], stored ['x'])"),
+    (fix(DAYS, "0000000c", customer="s2400009"),
+     "2024-01-02: the orders differ from the stored ones (order 0000000c: customer"),
+    (DAYS[1:], "2024-01-01: the orders differ from the stored ones (order 0000000a is "
+               "stored but not given)"),
+    (fix(DAYS, "0000000a", date=NEXT), "2024-01-01: the orders differ from the stored "
+     "ones (order 0000000a: date 2024-01-02, stored 2024-01-01) (and 1 more day(s))"),
+])
+def test_a_corrected_order_is_refused_naming_the_day(engine, given, words):
+    # the stored (wrong) orders were kept and used, and nothing said so
+    store.import_orders(engine, DAYS)
+    store.write_day(engine, DAY, run_row(3), [], moves(3))
+    before = counts(engine)
+    with pytest.raises(store.OrdersChangedError, match=re.escape(words)):
+        store.import_orders(engine, given)
+    assert counts(engine) == before
+    assert [o for v in store.orders_between(engine, DAY, NEXT).values() for o in v] == DAYS
+
+
+def test_replace_stores_the_corrected_days_whole(engine):
+    store.import_orders(engine, DAYS)
+    for day in (DAY, NEXT):
+        store.write_day(engine, day, run_row(2), [], moves(2))
+    given = [*fix(DAYS, "0000000b", deliver_to="a.b.x"),
+             Order("0000000d", NEXT, "s2400004", "a.b.f", ("z",))]
+    assert store.import_orders(engine, given, replace=True) == (3, 1, (DAY,))
+    assert store.orders_between(engine, DAY, NEXT) == {DAY: given[:2], NEXT: given[2:]}
+    # the day replaced lost what was flown from its old orders; the other kept its own
+    assert store.day_rows(engine, DAY) == {"deliveries": [], "flightpath": []}
+    assert len(store.day_rows(engine, NEXT)["flightpath"]) == 2
+    assert store.import_orders(engine, given) == (0, 4, ())  # now as stored
+    moved = fix(given, "0000000a", date=NEXT)
+    assert store.import_orders(engine, moved, replace=True) == (4, 0, (DAY, NEXT))
+    assert store.orders_between(engine, DAY, NEXT) == {
+        DAY: [moved[1]], NEXT: sorted([moved[0], *moved[2:]], key=lambda o: o.order_no)}
+
+
+def test_new_orders_of_a_stored_day_are_added(engine):
+    # orders that arrived since the last import: nothing stored differs
+    store.import_orders(engine, DAYS[:1])
+    assert store.import_orders(engine, DAYS) == (2, 1, ())
+
+
+def test_a_replace_that_fails_leaves_the_days_as_they_were(engine):
+    store.import_orders(engine, DAYS)
+    store.write_day(engine, DAY, run_row(3), [], moves(3))
+    before = counts(engine)
+
+    def fail(conn, cursor, statement, *args):
+        if statement.lstrip().upper().startswith("INSERT INTO ORDER_DETAILS"):
+            raise RuntimeError("killed")
+
+    sa.event.listen(engine, "before_cursor_execute", fail)
+    with pytest.raises(RuntimeError, match="killed"):
+        store.import_orders(engine, fix(DAYS, "0000000b", deliver_to="a.b.x"), replace=True)
+    sa.event.remove(engine, "before_cursor_execute", fail)
+    assert counts(engine) == before
+    assert store.orders_between(engine, DAY, DAY)[DAY] == TWO

@@ -11,6 +11,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
+from skyroute.cli.db_cmd import REPLACE_HELP, some_days
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
 from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.delivery.day import METHODS, DayResult
@@ -38,6 +39,8 @@ def deliver_command(
     source: Annotated[str | None, typer.Option(
         help="Read website/ from this URL instead (see 'skyroute data serve').")] = None,
     db: Annotated[str, typer.Option(help="SQLAlchemy URL of the store.")] = DEFAULT_DB,
+    replace: Annotated[bool, typer.Option("--replace", help="With --data: " + REPLACE_HELP)] =
+        False,
     out: Annotated[Path, typer.Option(help="Folder for the GeoJSON, PNG and report files.")] =
         Path("."),
     jobs: Annotated[int, typer.Option(help="Worker processes for a range of days.")] = 1,
@@ -53,12 +56,12 @@ def deliver_command(
 
     Stores deliveries and flightpath; writes drone-DD-MM-YYYY.geojson, a report, a map.
     """
+    from skyroute.cli.db_cmd import import_folder, replaced
     from skyroute.delivery.days import open_store, prepare_legs
     from skyroute.delivery.limits import check_days
-    from skyroute.delivery.orders import read_csv_orders
     from skyroute.delivery.site import load_site
     from skyroute.delivery.source import open_source
-    from skyroute.delivery.store import import_orders, order_dates
+    from skyroute.delivery.store import order_dates
     from skyroute.io.day_out import check_outputs, write_outputs
     from skyroute.jobs.deliver import days_between, run_days
 
@@ -67,6 +70,9 @@ def deliver_command(
     one_day, ranged = day is not None, d0 is not None or d1 is not None
     if one_day == ranged or (ranged and (d0 is None or d1 is None)):
         raise OptionError("give a DATE, or both --from and --to")
+    if replace and data is None:
+        raise OptionError("--replace replaces stored orders by those of --data DIR; give "
+                          "--data DIR too")
     if day is not None:
         d0 = d1 = day
     check_days(d0, d1, "--from", "--to")
@@ -83,10 +89,10 @@ def deliver_command(
     with open_from_flags(executor, dask, jobs, (d1 - d0).days + 1) as ex:
         err = plain_console(stderr=True)
         if data is not None:
-            added, _ = import_orders(engine, read_csv_orders(data))
-            if added:
-                err.print(f"imported {added:,} orders from {data / 'database'}",
-                          soft_wrap=True)
+            got = import_folder(engine, data, replace=replace)[1]
+            if got.added:
+                err.print(f"imported {got.added:,} orders from {data / 'database'}"
+                          + replaced(got), soft_wrap=True)
         elif not order_dates(engine):
             raise SkyrouteError(f"{safe_url(db)}: no orders stored; load them with 'skyroute db "
                                 "import DIR' or give --data DIR")
@@ -113,6 +119,26 @@ def deliver_command(
         _one_day(results[0], written, as_json)
     else:
         _summary(results, wall, jobs, workers, ex.kind, as_json, written)
+    _say_empty(results)
+
+
+def _say_empty(results: list[DayResult]) -> None:
+    """A line on stderr for days without orders (stored as empty days, exit 0): a
+    mistyped date or orders not imported would otherwise pass for a day flown."""
+    empty = [r.date for r in results if not r.orders]
+    if not empty:
+        return
+    n = len(results)
+    if n == 1:
+        line = f"{empty[0]}: no orders stored for this day; nothing was flown"
+    elif len(empty) == n:
+        line = (f"nothing was flown: none of the {n:,} days from {results[0].date} to "
+                f"{results[-1].date} had orders stored")
+    else:
+        line = (f"{len(empty):,} of the {n:,} days had no orders stored "
+                f"({some_days(empty, 5)}); nothing "
+                "was flown on " + ("it" if len(empty) == 1 else "them"))
+    plain_console(stderr=True).print(line, soft_wrap=True)
 
 
 def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
@@ -150,8 +176,10 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
     if as_json:
         typer.echo(json.dumps(s))
         return
-    if not s["days_with_orders"]:
-        raise SkyrouteError("no orders on any of these days")
+    if not s["days_with_orders"]:  # no table of money: _say_empty says why
+        if files:
+            plain_console().print(f"wrote {len(files):,} files to {', '.join(s['folders'])}")
+        return
     who = f"{workers} job(s)" if kind == "local" else f"{workers} Dask worker(s)"
     t = Table(title=f"{s['days']} days, {wall:.1f} s with {who}: money delivered "
                     f"mean {s['mean_pct']:.2f}%, worst {s['min_pct']:.2f}% on {s['min_date']}")

@@ -24,6 +24,7 @@ import json
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import NamedTuple
 
 import sqlalchemy as sa
 
@@ -37,6 +38,9 @@ DEFAULT_DB = "sqlite:///skyroute.db"
 BUSY_SECONDS = 30.0
 SQL_INT = (-2**31, 2**31 - 1)  # an INTEGER column: 32 bits on PostgreSQL, 64 on SQLite
 TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
+# The PostgreSQL advisory lock that :func:`init` holds while it makes or upgrades the
+# schema (any fixed 64-bit number other programs on the database are unlikely to use)
+SCHEMA_LOCK = 0x736B79726F757465  # "skyroute"
 _REFLECTED: dict[tuple[str, tuple[str, ...]], dict[str, sa.Table]] = {}
 register(_REFLECTED.clear)
 
@@ -122,7 +126,10 @@ def writing(engine: sa.Engine) -> Iterator[sa.Connection]:
 
 
 def init(engine: sa.Engine) -> str:
-    """Create or upgrade the schema to the newest migration; return its revision."""
+    """Create or upgrade the schema to the newest migration; return its revision. One
+    transaction that holds the write lock (SQLite) or the advisory lock
+    :data:`SCHEMA_LOCK` (PostgreSQL) throughout, so two first runs at once on a new store
+    make it once: the second waits, then finds it made."""
     from alembic import command
     from alembic.config import Config
     from alembic.runtime.migration import MigrationContext
@@ -133,6 +140,12 @@ def init(engine: sa.Engine) -> str:
     url = _safe(str(engine.url))
     try:
         with writing(engine) as conn:
+            if conn.dialect.name == "postgresql":
+                # PostgreSQL's counterpart of SQLite's BEGIN IMMEDIATE here: two first
+                # runs on an empty database both saw no schema and made it, and the later
+                # failed ('relation "alembic_version" already exists'); the lock is held
+                # to the end of this transaction, so the other waits and finds it made
+                conn.execute(sa.select(sa.func.pg_advisory_xact_lock(SCHEMA_LOCK)))
             cfg.attributes["connection"] = conn
             command.upgrade(cfg, "head")
     except sa.exc.DatabaseError as exc:  # e.g. a file that is not SQLite's
@@ -166,62 +179,156 @@ def check_fits(table: sa.Table, row: dict, where: str) -> None:
                                 f"INTEGER range ({SQL_INT[0]:,} to {SQL_INT[1]:,})")
 
 
-def import_orders(engine: sa.Engine, all_orders: Iterable) -> tuple[int, int]:
-    """Insert the orders (and their items) not already stored; (added, already there).
-    One transaction: an error leaves the store as it was; a value wider than its column
-    is an error naming the order (:func:`check_fits`), checked before anything is
-    written."""
+class OrdersChangedError(SkyrouteError):
+    """Orders given for import differ from the stored orders of their days: an order of
+    the same number with another date, customer, place or items, or a stored order of
+    a given day that is not given (a corrected file). Nothing was written. ``changes``:
+    ``(day, order_no, field, stored, given)`` in day order, ``field`` one of
+    :data:`ORDER_FIELDS` or None for a stored order that is not given (``given`` None);
+    ``days``: the days whose orders differ (the days ``replace=True`` replaces)."""
+
+    def __init__(self, changes: list[tuple], days: list[dt.date]) -> None:
+        day, no, field, old, new = changes[0]
+        first = (f"order {no} is stored but not given" if field is None else
+                 f"order {no}: {field} {shown(new)}, stored {shown(old)}")
+        more = f" (and {len(days) - 1} more day(s))" if len(days) > 1 else ""
+        super().__init__(f"{day}: the orders differ from the stored ones ({first}){more}; "
+                         "import with replace=True to store the given orders of those days",
+                         param="replace")
+        self.changes, self.days = changes, days
+
+
+ORDER_FIELDS = ("date", "customer", "deliver_to", "items")
+
+
+def shown(value) -> str:
+    """An order's field value for a message: a date as YYYY-MM-DD, items as a list."""
+    if isinstance(value, dt.date):
+        return str(value)
+    return repr(list(value) if isinstance(value, tuple) else value)
+
+
+class Imported(NamedTuple):
+    """What :func:`import_orders` did: orders ``added`` (new, or of a replaced day),
+    orders stored before and kept (``had``; the store now holds ``added + had``), and
+    the days whose stored orders were ``replaced``."""
+
+    added: int
+    had: int
+    replaced: tuple[dt.date, ...] = ()
+
+
+def import_orders(engine: sa.Engine, all_orders: Iterable, *,
+                  replace: bool = False) -> Imported:
+    """Insert the orders (and their items) not already stored. An order already stored
+    as given is left as it is; an order stored differently (another date, customer,
+    place or items), or a stored order of a given day that is not given, is
+    :class:`OrdersChangedError` naming the days, unless ``replace``: then each such day's
+    stored orders, with its stored deliveries, flight path and run (flown from the old
+    orders), are deleted and the given orders of that day stored. One transaction: an
+    error leaves the store as it was; a value wider than its column is an error naming
+    the order (:func:`check_fits`), checked before anything is written."""
     t = tables(engine)
-    orders, order_details = t["orders"], t["order_details"]
     all_orders = list(all_orders)
+    for o in all_orders:
+        where = f"order {o.order_no!r}: "
+        check_fits(t["orders"], {"order_no": o.order_no, "customer": o.customer,
+                                 "deliver_to": o.deliver_to}, where)
+        for k, item in enumerate(o.items):
+            check_fits(t["order_details"], {"line": k, "item": item}, where)
     try:
-        return _import(engine, orders, order_details, all_orders)
+        return _import(engine, t, all_orders, replace)
     except sa.exc.IntegrityError:
         # another process added some of these orders after this one read what was there
         # (PostgreSQL; SQLite serialises the two in writing()): read again, add the rest
-        return _import(engine, orders, order_details, all_orders)
+        return _import(engine, t, all_orders, replace)
 
 
-def _import(engine: sa.Engine, orders: sa.Table, order_details: sa.Table,
-            all_orders: list) -> tuple[int, int]:
+def _import(engine: sa.Engine, t: dict[str, sa.Table], all_orders: list,
+            replace: bool) -> Imported:
+    orders, order_details = t["orders"], t["order_details"]
     with writing(engine) as conn:
         have = set(conn.scalars(sa.select(orders.c.order_no)))
+        changes = _changes(conn, t, all_orders, have)
+        days = sorted({c[0] for c in changes})
+        if changes and not replace:
+            raise OrdersChangedError(changes, days)
+        if days:
+            gone = set(conn.scalars(sa.select(orders.c.order_no)
+                                    .where(orders.c.delivery_date.in_(days))))
+            for name in ("flightpath", "deliveries", "runs"):
+                conn.execute(t[name].delete().where(t[name].c.delivery_date.in_(days)))
+            conn.execute(order_details.delete().where(order_details.c.order_no.in_(
+                sa.select(orders.c.order_no).where(orders.c.delivery_date.in_(days)))))
+            conn.execute(orders.delete().where(orders.c.delivery_date.in_(days)))
+            have -= gone
         new = [o for o in all_orders if o.order_no not in have]
         heads = [{"order_no": o.order_no, "delivery_date": o.date, "customer": o.customer,
                   "deliver_to": o.deliver_to} for o in new]
         rows = [{"order_no": o.order_no, "line": k, "item": item}
                 for o in new for k, item in enumerate(o.items)]
-        for table, batch in ((orders, heads), (order_details, rows)):
-            for row in batch:
-                check_fits(table, row, f"order {row['order_no']!r}: ")
         if heads:
             conn.execute(orders.insert(), heads)
         if rows:
             conn.execute(order_details.insert(), rows)
-    return len(new), len(have)
+    return Imported(len(new), len(have), tuple(days))
+
+
+def _changes(conn: sa.Connection, t: dict[str, sa.Table], given: list,
+             have: set[str]) -> list[tuple]:
+    """How ``given`` differs from the stored orders of its days and numbers (see
+    :class:`OrdersChangedError`); a day an order moved from differs too."""
+    if not given:
+        return []
+    orders = t["orders"]
+    days = {o.date for o in given}
+    stored = {o.order_no: o for o in _orders_where(
+        conn, t, orders.c.delivery_date.between(min(days), max(days)))}
+    moved = sorted({o.order_no for o in given} & have - set(stored))
+    for k in range(0, len(moved), 500):
+        stored.update((o.order_no, o) for o in _orders_where(
+            conn, t, orders.c.order_no.in_(moved[k:k + 500])))
+    numbers = {o.order_no for o in given}
+    out = []
+    for o in given:
+        old = stored.get(o.order_no)
+        for field in ORDER_FIELDS if old is not None else ():
+            if getattr(old, field) != getattr(o, field):
+                out.append((o.date, o.order_no, field, getattr(old, field),
+                            getattr(o, field)))
+                if field == "date":
+                    out.append((old.date, o.order_no, field, old.date, o.date))
+    out += [(old.date, no, None, old, None) for no, old in stored.items()
+            if old.date in days and no not in numbers]
+    return sorted(out, key=lambda c: (c[0], c[1]))
+
+
+def _orders_where(conn: sa.Connection, t: dict[str, sa.Table], where) -> list:
+    """The stored orders that ``where`` (on ``orders``) picks, by order number, items in
+    their original order."""
+    from skyroute.delivery.orders import Order
+
+    orders, order_details = t["orders"], t["order_details"]
+    heads = conn.execute(sa.select(orders).where(where).order_by(orders.c.order_no)).all()
+    items: dict[str, list[str]] = {h.order_no: [] for h in heads}
+    q = sa.select(order_details.c.order_no, order_details.c.item) \
+        .join(orders, orders.c.order_no == order_details.c.order_no).where(where) \
+        .order_by(order_details.c.order_no, order_details.c.line)
+    for no, item in conn.execute(q):
+        items[no].append(item)
+    return [Order(h.order_no, h.delivery_date, h.customer, h.deliver_to,
+                  tuple(items[h.order_no])) for h in heads]
 
 
 def orders_between(engine: sa.Engine, first: dt.date, last: dt.date) -> dict[dt.date, list]:
     """The stored orders of each day from ``first`` to ``last`` (days without orders are
     absent), items in their original order."""
-    from skyroute.delivery.orders import Order
-
     t = tables(engine)
-    orders, order_details = t["orders"], t["order_details"]
-    when = orders.c.delivery_date.between(first, last)
     with engine.connect() as conn:
-        heads = conn.execute(sa.select(orders).where(when).order_by(orders.c.order_no)).all()
-        items: dict[str, list[str]] = {h.order_no: [] for h in heads}
-        q = sa.select(order_details.c.order_no, order_details.c.item) \
-            .join(orders, orders.c.order_no == order_details.c.order_no).where(when) \
-            .order_by(order_details.c.order_no, order_details.c.line)
-        for no, item in conn.execute(q):
-            items[no].append(item)
+        found = _orders_where(conn, t, t["orders"].c.delivery_date.between(first, last))
     out: dict[dt.date, list] = {}
-    for h in heads:
-        out.setdefault(h.delivery_date, []).append(
-            Order(h.order_no, h.delivery_date, h.customer, h.deliver_to,
-                  tuple(items[h.order_no])))
+    for o in found:
+        out.setdefault(o.date, []).append(o)
     return out
 
 

@@ -24,8 +24,10 @@ the servers; ``skyroute db init`` upgrades to the newest).
   failed job: failing a job deletes its runs in the same transaction, and
   :func:`save_fleet_run` refuses (:class:`JobEndedError`) a run of a job already failed.
 
-Every function takes the engine first and runs one short transaction. Lookups of an
-unknown id return None.
+Every function takes the engine first and runs one short transaction; writes go through
+:func:`skyroute.delivery.store.writing`, as the delivery store's do (on SQLite the write
+lock is taken first and a lock held past the busy timeout is one line, "the store is
+busy"). Lookups of an unknown id return None.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ from pathlib import Path
 import sqlalchemy as sa
 
 from skyroute.caches import register
-from skyroute.delivery.store import connect, tables
+from skyroute.delivery.store import connect, tables, writing
 from skyroute.errors import OptionError, SkyrouteError
 
 STATES = ("queued", "running", "done", "failed")
@@ -106,7 +108,7 @@ def create_job(engine: sa.Engine, kind: str, params: dict, *,
     :func:`beat` first); its id (a UUID string)."""
     job_id = str(uuid.uuid4())
     now = _now()
-    with engine.begin() as c:
+    with writing(engine) as c:
         c.execute(_t(engine)["jobs"].insert().values(
             id=job_id, kind=kind, params=json_safe(params), state="queued", progress=0.0,
             created=now, updated=now, owner=owner))
@@ -144,7 +146,7 @@ def _move(engine: sa.Engine, job_id: str, **values) -> bool:
     to ``failed`` loses its fleet runs in the same transaction. Whether it was written."""
     t = _t(engine)
     jobs = t["jobs"]
-    with engine.begin() as c:
+    with writing(engine) as c:
         moved = c.execute(jobs.update().where(jobs.c.id == job_id, jobs.c.state.in_(LIVE))
                           .values(**values, updated=_now())).rowcount == 1
         if moved and values["state"] == "failed":
@@ -174,7 +176,7 @@ def beat(engine: sa.Engine, server: str) -> None:
     clock), adding it to ``servers`` the first time (or again after
     :func:`fail_orphans` removed it as silent)."""
     servers = _t(engine)["servers"]
-    with engine.begin() as c:
+    with writing(engine) as c:
         now = db_now(c)
         if not c.execute(servers.update().where(servers.c.id == server)
                          .values(heartbeat=now)).rowcount:
@@ -203,7 +205,7 @@ def fail_orphans(engine: sa.Engine, error: str, *, dead_after: float,
     gone = list(gone)
     t = _t(engine)
     jobs, servers = t["jobs"], t["servers"]
-    with engine.begin() as c:
+    with writing(engine) as c:
         cutoff = db_now(c) - dt.timedelta(seconds=dead_after)
         alive = sa.select(servers.c.id).where(servers.c.heartbeat >= cutoff)
         orphaned = sa.and_(jobs.c.state.in_(LIVE),
@@ -245,7 +247,7 @@ def save_fleet_run(engine: sa.Engine, *, scenario: str, params: dict, report: di
     run_id = run_id or str(uuid.uuid4())
     t = _t(engine)
     runs, jobs = t["fleet_runs"], t["jobs"]
-    with engine.begin() as c:
+    with writing(engine) as c:
         if job_id is not None:
             # a write, not a read: it takes the job's row lock (PostgreSQL) or the write
             # lock (SQLite) before the run is written, so a failure of the job comes
