@@ -66,3 +66,22 @@ def pg_url() -> str:
             c.execute(sa.text(f"drop table if exists {t} cascade"))
     eng.dispose()
     return url
+
+
+def slow_days(monkeypatch, seconds: float = 0.3) -> None:
+    """Make each day of a delivery job take at least ``seconds`` (jobs run inline with one
+    worker): on a fast machine with warm caches a few days fly within one
+    ``runner.PROGRESS_EVERY``, so no share between 0 and 1 would ever be written, and a
+    test that looks for progress while a job runs would fail by the machine's speed."""
+    import time
+
+    from skyroute.jobs import deliver
+
+    fly = deliver.fly_day
+
+    def slow(task):
+        out = fly(task)
+        time.sleep(seconds)
+        return out
+
+    monkeypatch.setattr(deliver, "fly_day", slow)

@@ -12,7 +12,7 @@ import sqlalchemy as sa
 from skyroute.errors import OptionError
 from skyroute.jobs import runner
 from skyroute.jobs.executor import open_executor
-from tests.jobs.conftest import EXAMPLE, lunch_store
+from tests.jobs.conftest import EXAMPLE, lunch_store, slow_days
 
 
 def watch(engine, ids: list[str], timeout: float = 300) -> dict[str, list[tuple]]:
@@ -30,8 +30,9 @@ def watch(engine, ids: list[str], timeout: float = 300) -> dict[str, list[tuple]
     raise AssertionError(f"jobs still running after {timeout} s: {seen}")
 
 
-def test_states_move_from_queued_through_running_to_done(tmp_path):
+def test_states_move_from_queued_through_running_to_done(tmp_path, monkeypatch):
     engine = lunch_store(f"sqlite:///{tmp_path / 'r.db'}")
+    slow_days(monkeypatch)
     days = {"from": "2024-01-01", "to": "2024-01-04", "data": str(EXAMPLE)}
     with open_executor("local", workers=1) as ex:
         first = runner.submit(engine, "deliver", days, executor=ex)

@@ -16,6 +16,7 @@ import uuid
 import pytest
 
 from tests.fleet.test_nofly import ringed
+from tests.jobs.conftest import slow_days
 from tests.service.conftest import AUTH, DAY, EXAMPLE, make_client
 from tests.service.test_app import assert_problem
 
@@ -306,7 +307,7 @@ def test_a_delivery_job_stores_the_clis_rows(tmp_path, lunch):
 
 @needs_jobs
 @pytest.mark.slow
-def test_a_range_job_shows_its_progress_while_running(tmp_path):
+def test_a_range_job_shows_its_progress_while_running(tmp_path, monkeypatch):
     from skyroute.delivery.days import open_store
     from skyroute.delivery.orders import read_csv_orders
     from skyroute.delivery.store import import_orders, order_dates
@@ -316,6 +317,7 @@ def test_a_range_job_shows_its_progress_while_running(tmp_path):
     import_orders(eng, read_csv_orders(EXAMPLE))
     dates = order_dates(eng)
     first, last = min(dates).isoformat(), max(dates).isoformat()
+    slow_days(monkeypatch)
     with make_client(db_url=db, data_dir=EXAMPLE, job_workers=1) as c:
         r = c.post("/jobs/deliver", json={"from": first, "to": last}, headers=AUTH)
         assert r.status_code == 202, r.text
