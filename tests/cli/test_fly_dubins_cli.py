@@ -160,3 +160,17 @@ def test_plot_title_shows_the_reported_length(monkeypatch, capsys, tmp_path, ext
     length = json.loads(text)["metrics"]["length"]
     assert titles == [f"city.csv: dubins, {length:.6g} m"]
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_goal_one_quarter_turn_away_is_flown_as_that_turn(monkeypatch, capsys):
+    # a right turn of radius 8 from north ends 8 north, 8 east, heading east: the path
+    # is that arc (4 pi = 12.57), not the arc after a whole circle (62.8) as the Dubins
+    # words' rounding once made it
+    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,0", "--goal", "8,8,90",
+                          "--step", "1", "--json")
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["metrics"]["length"] == pytest.approx(8 * math.pi / 2, rel=1e-9)
+    rows = np.asarray(doc["trajectory"])
+    assert np.all(np.diff(rows[:, 2]) > 0)  # the heading only swings clockwise, 0 to 90
+    assert rows[-1].tolist() == pytest.approx([8.0, 8.0, 90.0], abs=1e-9)
