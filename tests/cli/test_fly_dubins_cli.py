@@ -174,3 +174,16 @@ def test_a_goal_one_quarter_turn_away_is_flown_as_that_turn(monkeypatch, capsys)
     rows = np.asarray(doc["trajectory"])
     assert np.all(np.diff(rows[:, 2]) > 0)  # the heading only swings clockwise, 0 to 90
     assert rows[-1].tolist() == pytest.approx([8.0, 8.0, 90.0], abs=1e-9)
+
+
+@pytest.mark.parametrize("planner", ["hybrid", "waypoints"])
+def test_a_step_too_small_to_sample_is_one_line_exit_2(monkeypatch, capsys, tmp_path,
+                                                       planner):
+    # --step 1e-12 along ~250 m was a MemoryError traceback (1e-7: gigabytes first)
+    out = tmp_path / "t.csv"
+    code, text, err = run(monkeypatch, capsys, *BASE, "--planner", planner, "--start",
+                          "0,0,90", "--goal", "120,-180", "--step", "1e-12", "--out", str(out))
+    assert code == 2 and not out.exists()
+    line = (text + err).strip()
+    assert "\n" not in line and "Traceback" not in line
+    assert "--step 1e-12 along a path" in line and "more than 10,000,000 poses" in line

@@ -375,3 +375,17 @@ def test_tour_names_a_bad_option(kw):
 
 def test_a_dubins_path_says_found_as_every_result_does():
     assert D.shortest_path((0, 0, 0), (10, 0, 0), 1.0).found is True
+
+
+def test_sampling_past_max_samples_is_an_option_error_naming_step():
+    # a step of 1e-12 along 250 m asked numpy for 2.5e14 poses: a MemoryError (or, at
+    # 1e-7, gigabytes of memory before it), never a message
+    p = D.shortest_path((0, 0, 0), (250, 0, 0), 1.0)
+    with pytest.raises(OptionError, match=r"step=1e-12 along a path 250 long makes more "
+                                          r"than 10,000,000 poses; take a step >= 2\.5e-05"):
+        p.sample(1e-12)
+    assert len(p.sample(0.5)) == 501
+    t = D.tour((0, 0, 0), [(250, 0), (250, 50)], 1.0)
+    with pytest.raises(OptionError, match=r"step=1e-12 along a path"):
+        t.sample(1e-12)
+    assert np.allclose(t.sample(1.0)[-1, :2], (250, 50))

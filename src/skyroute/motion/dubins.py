@@ -26,6 +26,7 @@ from skyroute.errors import OptionError, QueryError, flag, real, whole
 from skyroute.motion import dubins_kernel
 from skyroute.motion.dubins_batch import lengths_kernel
 from skyroute.motion.dubins_kernel import WORDS, ZERO
+from skyroute.motion.pieces import MAX_SAMPLES, check_samples
 from skyroute.motion.tour import TourResult, tour  # noqa: F401  (skyroute.motion.dubins.tour)
 from skyroute.result import Status
 from skyroute.world.points import as_points
@@ -175,8 +176,9 @@ class DubinsPath:
 
     def sample(self, step: float) -> np.ndarray:
         """Poses every ``step`` metres; the first sample is exactly the start and the last
-        exactly the goal."""
+        exactly the goal. More than :data:`MAX_SAMPLES` poses is an OptionError."""
         step = real("step", step, low=0.0, strict=True)
+        check_samples(self.length, step)
         n = math.floor(self.length / step + 1e-12)
         s = np.arange(n + 1) * step
         if s[-1] < self.length - 1e-12 or (len(s) == 1 and self.start != self.goal):
@@ -285,10 +287,6 @@ def loiter(center, radius: float, *, start_angle: float = 0.0, turns: float = 1.
     heading = ang + (-math.pi / 2 if clockwise else math.pi / 2)
     return np.c_[cx + radius * np.cos(ang), cy + radius * np.sin(ang), _mod2pi(heading)]
 
-
-
-
-MAX_SAMPLES = 10**7  # poses one loiter returns (240 MB)
 
 
 def _one_point(point, what: str) -> tuple[float, float]:
