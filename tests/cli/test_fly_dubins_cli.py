@@ -187,3 +187,22 @@ def test_a_step_too_small_to_sample_is_one_line_exit_2(monkeypatch, capsys, tmp_
     line = (text + err).strip()
     assert "\n" not in line and "Traceback" not in line
     assert "--step 1e-12 along a path" in line and "more than 10,000,000 poses" in line
+
+
+def test_waypoints_without_a_start_heading_pick_the_best(monkeypatch, capsys, tmp_path):
+    # the waypoints planner set a start without heading to 0 (north): due east to a goal
+    # 100 m away it turned right first, 106.3 m; the docs say a left-out heading is chosen
+    city = tmp_path / "one.csv"
+    city.write_text("lat0 37.792480, lon0 -122.397450\n"
+                    "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n50,50,20,10,10,20\n")
+    args = ["fly", str(city), "--frame", "ned", "--vehicle", "dubins", "--planner",
+            "waypoints", "--altitude", "5", "--radius", "10", "--goal", "0,0", "--json"]
+    code, text, err = run(monkeypatch, capsys, *args, "--start", "0,-100")
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["metrics"]["length"] == pytest.approx(100.0, abs=1e-9)
+    assert [row[2] for row in doc["trajectory"]] == pytest.approx(
+        [90.0] * len(doc["trajectory"]))  # east, all along
+    code, text, err = run(monkeypatch, capsys, *args, "--start", "0,-100,0")  # told north
+    assert code == 0, err
+    assert json.loads(text)["metrics"]["length"] > 105

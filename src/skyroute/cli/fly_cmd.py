@@ -180,7 +180,7 @@ def fly_command(
             doc, rows, xy = _fly_hybrid(world, a, b, h0, h1, radius, step, reverse,
                                         max_expansions, approach)
         elif vehicle == "dubins":
-            doc, rows, xy = _fly_dubins(world, a, b, radius, h0 or 0.0, h1, step)
+            doc, rows, xy = _fly_dubins(world, a, b, radius, h0, h1, step)
         elif vehicle == "lattice":
             doc, rows, xy = _fly_lattice(world, a, b, headings, speed, math.radians(turn_rate),
                                          h0 or 0.0, resolution)
@@ -392,8 +392,8 @@ def _fly_dubins(world, s, t, radius, h0, h1, step):
     route = plan(world, s, t)
     if not route.found:
         return _not_reached("no route between start and goal"), [], np.array([s])
-    legs = through(world.to_plane(route.path), radius,
-                   start_heading=float(world.heading_to_plane(h0)),
+    legs = through(world.to_plane(route.path), radius,  # a heading left out: the best
+                   start_heading=None if h0 is None else float(world.heading_to_plane(h0)),
                    end_heading=None if h1 is None else float(world.heading_to_plane(h1)))
     poses = np.vstack([leg.sample(step) for leg in legs])
     free = bool(world.segments_free(poses[:-1, :2], poses[1:, :2]).all())
