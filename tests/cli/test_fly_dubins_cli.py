@@ -117,6 +117,11 @@ def test_tour_visits_every_target(monkeypatch, capsys, tmp_path):
      "give the start heading once"),
     (["--start", "0,0", "--goal", "120,-180", "--approach", "20"], "--approach: give the"),
     (["--start", "0,0", "--goal", "120,-180", "--planner", "moves"], "--planner 'moves'"),
+    # these spoke of the library's start=(0.0, 0.0, inf) in radians, not of the option
+    (["--start", "0,0", "--goal", "120,-180", "--start-heading", "inf"],
+     "--start-heading inf must be a finite number"),
+    (["--start", "0,0", "--goal", "120,-180", "--goal-heading", "nan"],
+     "--goal-heading nan must be a finite number"),
 ])
 def test_bad_poses_are_one_line_exit_2(monkeypatch, capsys, tmp_path, args, words):
     out = tmp_path / "t.json"

@@ -16,7 +16,7 @@ from rich.table import Table
 from skyroute.cli import world_args as wa
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console, print_table
-from skyroute.errors import OptionError, check_choice
+from skyroute.errors import OptionError, check_choice, real
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.planner import plan
@@ -266,6 +266,8 @@ def _one_heading(typed: float | None, option: float | None, what: str) -> float 
     if typed is not None and option is not None:
         raise OptionError(f"give the {what} heading once: in --{what} A,B,HEADING or "
                           f"--{what}-heading")
+    if option is not None:  # --start A,B,HEADING is checked as it is parsed
+        option = real(f"{what}_heading", option)
     deg = typed if typed is not None else option
     return None if deg is None else math.radians(deg)
 
