@@ -35,6 +35,10 @@ from skyroute.result import Status
 from skyroute.world.points import as_points
 from skyroute.world.world import World
 
+# numba caches these kernels with dubins_kernel's code compiled in, keyed by this
+# file's date alone: edit this file when dubins_kernel changes (as for ZERO, its
+# rounding rule), or a checkout keeps running the old words from the cache.
+
 TWO_PI = 2 * math.pi
 
 
