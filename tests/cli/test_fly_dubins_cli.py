@@ -120,6 +120,11 @@ def test_tour_visits_every_target(monkeypatch, capsys, tmp_path, head):
      "give the start heading once"),
     (["--start", "0,0", "--goal", "120,-180", "--approach", "20"], "--approach: give the"),
     (["--start", "0,0", "--goal", "120,-180", "--planner", "moves"], "--planner 'moves'"),
+    # these spoke of the library's start=(0.0, 0.0, inf) in radians, not of the option
+    (["--start", "0,0", "--goal", "120,-180", "--start-heading", "inf"],
+     "--start-heading inf must be a finite number"),
+    (["--start", "0,0", "--goal", "120,-180", "--goal-heading", "nan"],
+     "--goal-heading nan must be a finite number"),
 ])
 def test_bad_poses_are_one_line_exit_2(monkeypatch, capsys, tmp_path, args, words):
     out = tmp_path / "t.json"
@@ -163,3 +168,49 @@ def test_plot_title_shows_the_reported_length(monkeypatch, capsys, tmp_path, ext
     length = json.loads(text)["metrics"]["length"]
     assert titles == [f"city.csv: dubins, {length:.6g} m"]
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_goal_one_quarter_turn_away_is_flown_as_that_turn(monkeypatch, capsys):
+    # a right turn of radius 8 from north ends 8 north, 8 east, heading east: the path
+    # is that arc (4 pi = 12.57), not the arc after a whole circle (62.8) as the Dubins
+    # words' rounding once made it
+    code, text, err = run(monkeypatch, capsys, *BASE, "--start", "0,0,0", "--goal", "8,8,90",
+                          "--step", "1", "--json")
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["metrics"]["length"] == pytest.approx(8 * math.pi / 2, rel=1e-9)
+    rows = np.asarray(doc["trajectory"])
+    assert np.all(np.diff(rows[:, 2]) > 0)  # the heading only swings clockwise, 0 to 90
+    assert rows[-1].tolist() == pytest.approx([8.0, 8.0, 90.0], abs=1e-9)
+
+
+@pytest.mark.parametrize("planner", ["hybrid", "waypoints"])
+def test_a_step_too_small_to_sample_is_one_line_exit_2(monkeypatch, capsys, tmp_path,
+                                                       planner):
+    # --step 1e-12 along ~250 m was a MemoryError traceback (1e-7: gigabytes first)
+    out = tmp_path / "t.csv"
+    code, text, err = run(monkeypatch, capsys, *BASE, "--planner", planner, "--start",
+                          "0,0,90", "--goal", "120,-180", "--step", "1e-12", "--out", str(out))
+    assert code == 2 and not out.exists()
+    line = (text + err).strip()
+    assert "\n" not in line and "Traceback" not in line
+    assert "--step 1e-12 along a path" in line and "more than 10,000,000 poses" in line
+
+
+def test_waypoints_without_a_start_heading_pick_the_best(monkeypatch, capsys, tmp_path):
+    # the waypoints planner set a start without heading to 0 (north): due east to a goal
+    # 100 m away it turned right first, 106.3 m; the docs say a left-out heading is chosen
+    city = tmp_path / "one.csv"
+    city.write_text("lat0 37.792480, lon0 -122.397450\n"
+                    "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n50,50,20,10,10,20\n")
+    args = ["fly", str(city), "--frame", "ned", "--vehicle", "dubins", "--planner",
+            "waypoints", "--altitude", "5", "--radius", "10", "--goal", "0,0", "--json"]
+    code, text, err = run(monkeypatch, capsys, *args, "--start", "0,-100")
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["metrics"]["length"] == pytest.approx(100.0, abs=1e-9)
+    assert [row[2] for row in doc["trajectory"]] == pytest.approx(
+        [90.0] * len(doc["trajectory"]))  # east, all along
+    code, text, err = run(monkeypatch, capsys, *args, "--start", "0,-100,0")  # told north
+    assert code == 0, err
+    assert json.loads(text)["metrics"]["length"] > 105

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from numba import njit
 
@@ -215,6 +215,32 @@ def test_a_goal_a_rounding_error_away_with_the_same_heading():
     assert D.shortest_path(s, g, 1.0).length == pytest.approx(ref, abs=1e-30)
 
 
+@given(r=st.sampled_from([0.5, 1.0, 2.0, 7.3, 100.0]), k=st.integers(1, 7),
+       side=st.sampled_from([1, -1]), th0=st.sampled_from([0.0, 0.3, -math.pi, 2.0]))
+@settings(max_examples=150, deadline=None, derandomize=True)
+@example(r=1.0, k=1, side=1, th0=0.0)  # 0.79 (a 45-degree left arc) came out 7.07, LRL
+@example(r=10.0, k=2, side=-1, th0=0.0)  # a quarter turn right: 15.7, came out 78.5
+def test_a_goal_on_the_turning_circle_is_one_arc(r, k, side, th0):
+    # the goal exactly where a turn of k x 45 degrees ends: the shortest path is that
+    # arc, r x angle (LSL or RSR with no straight). Its p2 = 0 rounded to -1e-16 and the
+    # word was dropped for a path round two more circles, 2 pi r longer
+    turn = k * math.pi / 4
+    s = (3.0, -2.0, th0)
+    th1 = th0 + side * turn
+    cx, cy = s[0] - side * r * math.sin(th0), s[1] + side * r * math.cos(th0)
+    g = (cx + side * r * math.sin(th1), cy - side * r * math.cos(th1), th1)
+    want = r * turn
+    p = D.shortest_path(s, g, r)
+    assert p.length == pytest.approx(want, rel=1e-9)
+    mid, end = p.sample_at(np.array([p.length / 2, p.length]))
+    assert math.hypot(mid[0] - cx, mid[1] - cy) == pytest.approx(r, rel=1e-9)
+    assert math.hypot(end[0] - g[0], end[1] - g[1]) < 1e-9 * r
+    assert D.lengths([s], [g], r)[0] == pytest.approx(want, rel=1e-9)
+    assert shortest_length(*s, *g, r) == pytest.approx(want, rel=1e-9)
+    w = D._words(np.array([s]), np.array([g]), r)[0]
+    assert np.nanmin(w.sum(axis=1)) * r == pytest.approx(want, rel=1e-9)
+
+
 @njit
 def _scalar_lengths(s, g, r):
     """The per-node kernel (branches, libm) over a batch, one query at a time."""
@@ -349,3 +375,17 @@ def test_tour_names_a_bad_option(kw):
 
 def test_a_dubins_path_says_found_as_every_result_does():
     assert D.shortest_path((0, 0, 0), (10, 0, 0), 1.0).found is True
+
+
+def test_sampling_past_max_samples_is_an_option_error_naming_step():
+    # a step of 1e-12 along 250 m asked numpy for 2.5e14 poses: a MemoryError (or, at
+    # 1e-7, gigabytes of memory before it), never a message
+    p = D.shortest_path((0, 0, 0), (250, 0, 0), 1.0)
+    with pytest.raises(OptionError, match=r"step=1e-12 along a path 250 long makes more "
+                                          r"than 10,000,000 poses; take a step >= 2\.5e-05"):
+        p.sample(1e-12)
+    assert len(p.sample(0.5)) == 501
+    t = D.tour((0, 0, 0), [(250, 0), (250, 50)], 1.0)
+    with pytest.raises(OptionError, match=r"step=1e-12 along a path"):
+        t.sample(1e-12)
+    assert np.allclose(t.sample(1.0)[-1, :2], (250, 50))

@@ -124,6 +124,14 @@ def test_empty_world_free_headings():
     check_path(world, res, (10, 10), (70, 50, 0.5), R)
 
 
+def test_sampling_past_max_samples_is_an_option_error_naming_step():
+    res = plan(make_world([]), (10, 10, 0.0), (70, 50, 0.5), R)
+    with pytest.raises(OptionError, match=r"step=1e-12 along a path .* makes more than "
+                                          r"10,000,000 poses"):
+        res.sample(1e-12)
+    assert len(res.sample(1.0)) > res.length - 1
+
+
 # -- walls, gaps, dead ends, budgets ------------------------------------------------------
 
 def test_wall_with_a_gap_wider_than_2r_is_passed():

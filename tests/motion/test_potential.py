@@ -67,6 +67,20 @@ def test_arc_mode_escapes_the_c_shape_more_smoothly_than_steps():
         run_field(world, start, goal, mode="glide")
 
 
+@pytest.mark.parametrize("max_turn", [math.pi / 6, math.pi / 4, math.pi / 18])
+def test_arc_mode_escape_moves_keep_the_turn_limit(max_turn):
+    # escape moves jumped straight to the navigation function's next cell centre, so
+    # the arc-mode trace out of the C turned 174 degrees in one move with max_turn 30
+    world, start, goal = course("hard")
+    run = run_field(world, start, goal, mode="arc", max_turn=max_turn)
+    assert run.reached and run.escaped > 0
+    assert world.segments_free(run.trace[:-1], run.trace[1:]).all()
+    chords = np.diff(run.trace, axis=0)
+    heading = np.arctan2(chords[:, 1], chords[:, 0])
+    turns = np.abs((np.diff(heading) + math.pi) % (2 * math.pi) - math.pi)
+    assert turns.max() <= max_turn + 1e-9
+
+
 def test_repr_summarises_the_run():
     world, start, goal = course("easy")
     run = run_field(world, start, goal, escape=False)

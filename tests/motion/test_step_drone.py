@@ -74,6 +74,22 @@ def test_plan_moves_from_appleton_tower_is_legal_and_arrives(world, places, name
     assert flight.moves <= flown.moves
 
 
+@pytest.mark.parametrize("scale", [1 / 20, 1 / 10, 1 / 4, 3])
+def test_follow_flies_a_path_with_any_step(world, places, scale):
+    # follow's loop test kept spots a third of the ILP step wide whatever the step, so
+    # with step < STEP / 3 every move landed on a spot already flown: no_path after 1
+    step = STEP * scale
+    goal = places["Soderberg Cafe"]
+    path = skyroute.plan(world, AT, goal, algorithm="theta").path
+    flown = follow(world, path, step=step)
+    assert flown.status is skyroute.Status.FOUND
+    assert math.dist(flown.end, goal) < step
+    hops = np.hypot(*(flown.to - flown.frm).T)
+    assert np.allclose(hops, step, rtol=0, atol=1e-12) and np.all(flown.angle % 10 == 0)
+    segs = shapely.linestrings(np.stack([flown.frm, flown.to], axis=1))
+    assert not shapely.intersects(segs, shapely.union_all(zones())).any()
+
+
 def bfs_moves(world, start, target, limit):
     """Fewest moves by breadth-first search in move space (no heuristic)."""
     angles = np.radians(np.arange(0, 360, 10))

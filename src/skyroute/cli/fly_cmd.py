@@ -16,7 +16,7 @@ from rich.table import Table
 from skyroute.cli import world_args as wa
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console, print_table
-from skyroute.errors import OptionError, check_choice
+from skyroute.errors import OptionError, check_choice, real
 from skyroute.files import write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.planner import plan
@@ -180,7 +180,7 @@ def fly_command(
             doc, rows, xy = _fly_hybrid(world, a, b, h0, h1, radius, step, reverse,
                                         max_expansions, approach)
         elif vehicle == "dubins":
-            doc, rows, xy = _fly_dubins(world, a, b, radius, h0 or 0.0, h1, step)
+            doc, rows, xy = _fly_dubins(world, a, b, radius, h0, h1, step)
         elif vehicle == "lattice":
             doc, rows, xy = _fly_lattice(world, a, b, headings, speed, math.radians(turn_rate),
                                          h0 or 0.0, resolution)
@@ -266,6 +266,8 @@ def _one_heading(typed: float | None, option: float | None, what: str) -> float 
     if typed is not None and option is not None:
         raise OptionError(f"give the {what} heading once: in --{what} A,B,HEADING or "
                           f"--{what}-heading")
+    if option is not None:  # --start A,B,HEADING is checked as it is parsed
+        option = real(f"{what}_heading", option)
     deg = typed if typed is not None else option
     return None if deg is None else math.radians(deg)
 
@@ -392,8 +394,8 @@ def _fly_dubins(world, s, t, radius, h0, h1, step):
     route = plan(world, s, t)
     if not route.found:
         return _not_reached("no route between start and goal"), [], np.array([s])
-    legs = through(world.to_plane(route.path), radius,
-                   start_heading=float(world.heading_to_plane(h0)),
+    legs = through(world.to_plane(route.path), radius,  # a heading left out: the best
+                   start_heading=None if h0 is None else float(world.heading_to_plane(h0)),
                    end_heading=None if h1 is None else float(world.heading_to_plane(h1)))
     poses = np.vstack([leg.sample(step) for leg in legs])
     free = bool(world.segments_free(poses[:-1, :2], poses[1:, :2]).all())

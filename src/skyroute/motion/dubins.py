@@ -25,7 +25,8 @@ import numpy as np
 from skyroute.errors import OptionError, QueryError, flag, real, whole
 from skyroute.motion import dubins_kernel
 from skyroute.motion.dubins_batch import lengths_kernel
-from skyroute.motion.dubins_kernel import WORDS
+from skyroute.motion.dubins_kernel import WORDS, ZERO
+from skyroute.motion.pieces import MAX_SAMPLES, check_samples
 from skyroute.motion.tour import TourResult, tour  # noqa: F401  (skyroute.motion.dubins.tour)
 from skyroute.result import Status
 from skyroute.world.points import as_points
@@ -67,39 +68,41 @@ def _words(starts: np.ndarray, goals: np.ndarray, radius: float) -> np.ndarray:
     b = _mod2pi(g[:, 2] - phi)
     sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
     cab = np.cos(a - b)
+    tol = ZERO * (4.0 + d * d)  # rounding: see dubins_kernel.ZERO
     out = np.full((len(s), 6, 3), np.nan)
     with np.errstate(invalid="ignore"):
-        # LSL
-        p2 = 2 + d * d - 2 * cab + 2 * d * (sa - sb)
-        tmp = np.arctan2(cb - ca, d + sa - sb)
-        ok = p2 >= 0
-        out[ok, 0] = np.c_[_mod2pi(-a + tmp), np.sqrt(p2), _mod2pi(b - tmp)][ok]
+        # LSL (always exists; one circle, one arc when the centres coincide: see ZERO)
+        arc = ZERO * (2.0 + d)
+        p = np.hypot(d + sa - sb, cb - ca)
+        one = p <= arc
+        tmp = np.where(one, a, np.arctan2(cb - ca, d + sa - sb))
+        out[:, 0] = np.c_[_mod2pi(-a + tmp), np.where(one, 0.0, p), _mod2pi(b - tmp)]
         # RSR
-        p2 = 2 + d * d - 2 * cab + 2 * d * (sb - sa)
-        tmp = np.arctan2(ca - cb, d - sa + sb)
-        ok = p2 >= 0
-        out[ok, 1] = np.c_[_mod2pi(a - tmp), np.sqrt(p2), _mod2pi(-b + tmp)][ok]
+        p = np.hypot(d - sa + sb, ca - cb)
+        one = p <= arc
+        tmp = np.where(one, a, np.arctan2(ca - cb, d - sa + sb))
+        out[:, 1] = np.c_[_mod2pi(a - tmp), np.where(one, 0.0, p), _mod2pi(-b + tmp)]
         # LSR
         p2 = -2 + d * d + 2 * cab + 2 * d * (sa + sb)
-        p = np.sqrt(p2)
+        p = np.sqrt(np.maximum(p2, 0.0))
         tmp = np.arctan2(-ca - cb, d + sa + sb) - np.arctan2(-2.0, p)
-        ok = p2 >= 0
+        ok = p2 >= -tol
         out[ok, 2] = np.c_[_mod2pi(-a + tmp), p, _mod2pi(-_mod2pi(b) + tmp)][ok]
         # RSL
         p2 = d * d - 2 + 2 * cab - 2 * d * (sa + sb)
-        p = np.sqrt(p2)
+        p = np.sqrt(np.maximum(p2, 0.0))
         tmp = np.arctan2(ca + cb, d - sa - sb) - np.arctan2(2.0, p)
-        ok = p2 >= 0
+        ok = p2 >= -tol
         out[ok, 3] = np.c_[_mod2pi(a - tmp), p, _mod2pi(b - tmp)][ok]
         # RLR
         c = (6.0 - d * d + 2 * cab + 2 * d * (sa - sb)) / 8.0
-        ok = np.abs(c) <= 1
+        ok = np.abs(c) <= 1 + ZERO
         p = _mod2pi(TWO_PI - np.arccos(np.clip(c, -1, 1)))
         t = _mod2pi(a - np.arctan2(ca - cb, d - sa + sb) + p / 2)
         out[ok, 4] = np.c_[t, p, _mod2pi(a - b - t + p)][ok]
         # LRL
         c = (6.0 - d * d + 2 * cab + 2 * d * (sb - sa)) / 8.0
-        ok = np.abs(c) <= 1
+        ok = np.abs(c) <= 1 + ZERO
         p = _mod2pi(TWO_PI - np.arccos(np.clip(c, -1, 1)))
         t = _mod2pi(-a - np.arctan2(ca - cb, d + sa - sb) + p / 2)
         out[ok, 5] = np.c_[t, p, _mod2pi(_mod2pi(b) - a - t + p)][ok]
@@ -173,8 +176,9 @@ class DubinsPath:
 
     def sample(self, step: float) -> np.ndarray:
         """Poses every ``step`` metres; the first sample is exactly the start and the last
-        exactly the goal."""
+        exactly the goal. More than :data:`MAX_SAMPLES` poses is an OptionError."""
         step = real("step", step, low=0.0, strict=True)
+        check_samples(self.length, step)
         n = math.floor(self.length / step + 1e-12)
         s = np.arange(n + 1) * step
         if s[-1] < self.length - 1e-12 or (len(s) == 1 and self.start != self.goal):
@@ -283,10 +287,6 @@ def loiter(center, radius: float, *, start_angle: float = 0.0, turns: float = 1.
     heading = ang + (-math.pi / 2 if clockwise else math.pi / 2)
     return np.c_[cx + radius * np.cos(ang), cy + radius * np.sin(ang), _mod2pi(heading)]
 
-
-
-
-MAX_SAMPLES = 10**7  # poses one loiter returns (240 MB)
 
 
 def _one_point(point, what: str) -> tuple[float, float]:

@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit, prange
 
 from skyroute.motion import trig
+from skyroute.motion.dubins_kernel import ZERO
 
 TWO_PI = 2 * math.pi
 BLOCK = 512  # queries per block: its scratch (14 x BLOCK doubles) stays in L1 and L2
@@ -106,30 +107,34 @@ def _block(sf, gf, r, out, lo, hi):
         dd, di = d[i] * d[i], d[i]
         cab = 1.0 if abs(a - b) < 1e-8 else ca * cb + sa * sb
         t_lsl, t_rsr = t[i], t[m + i]
-        p2 = 2 + dd - 2 * cab + 2 * di * (sa - sb)  # LSL
-        w = _wrap_near(t_lsl - a) + math.sqrt(max(p2, 0.0)) + _wrap_near(b - t_lsl)
-        best = w if p2 >= 0 else inf
-        p2 = 2 + dd - 2 * cab + 2 * di * (sb - sa)  # RSR
-        w = _wrap_near(a - t_rsr) + math.sqrt(max(p2, 0.0)) + _wrap_near(t_rsr - b)
-        best = min(best, w if p2 >= 0 else inf)
+        tol = -ZERO * (4.0 + dd)  # rounding: a word this close to existing exists
+        arc = ZERO * (2.0 + di)  # LSL and RSR: one arc when the centres coincide
+        x, y = di + sa - sb, cb - ca  # LSL
+        p = math.sqrt(x * x + y * y)
+        w = _wrap_near(t_lsl - a) + p + _wrap_near(b - t_lsl)
+        best = _wrap_near(b - a) if p <= arc else w
+        x, y = di - sa + sb, ca - cb  # RSR
+        p = math.sqrt(x * x + y * y)
+        w = _wrap_near(a - t_rsr) + p + _wrap_near(t_rsr - b)
+        best = min(best, _wrap_near(a - b) if p <= arc else w)
         p2 = -2 + dd + 2 * cab + 2 * di * (sa + sb)  # LSR
         tmp = t[2 * m + i]
         w = _wrap_near(tmp - a) + math.sqrt(max(p2, 0.0)) + _wrap_near(tmp - b)
-        best = min(best, w if p2 >= 0 else inf)
+        best = min(best, w if p2 >= tol else inf)
         p2 = dd - 2 + 2 * cab - 2 * di * (sa + sb)  # RSL
         tmp = t[3 * m + i]
         w = _wrap_near(a - tmp) + math.sqrt(max(p2, 0.0)) + _wrap_near(b - tmp)
-        best = min(best, w if p2 >= 0 else inf)
+        best = min(best, w if p2 >= tol else inf)
         c = (6.0 - dd + 2 * cab + 2 * di * (sa - sb)) / 8.0  # RLR
         p = _wrap_near(TWO_PI - t[4 * m + i])
         u = _wrap_near(a - t_rsr + p / 2)
         w = u + p + _wrap_near(a - b - u + p)
-        best = min(best, w if abs(c) <= 1 else inf)
+        best = min(best, w if abs(c) <= 1 + ZERO else inf)
         c = (6.0 - dd + 2 * cab + 2 * di * (sb - sa)) / 8.0  # LRL
         p = _wrap_near(TWO_PI - t[5 * m + i])
         u = _wrap_near(-a + t_lsl + p / 2)
         w = u + p + _wrap_near(b - a - u + p)
-        best = min(best, w if abs(c) <= 1 else inf)
+        best = min(best, w if abs(c) <= 1 + ZERO else inf)
         # the goal is the start pose: cab above rounds to 1 - ulp and drops the
         # zero-length LSR word, leaving only full circles (OMPL special-cases it too)
         same = (di == 0.0) & (_wrap_near(a - b) < 1e-12)

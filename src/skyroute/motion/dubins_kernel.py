@@ -22,6 +22,18 @@ from numba import njit
 
 TWO_PI = 2 * math.pi
 WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
+# Rounding at degenerate poses (d in radii). LSL's and RSR's straight p is the distance
+# between the two left (right) turning circles' centres, taken as the hypot of its
+# components, never the difference of terms of size 4 + d^2 that rounded to p^2 < 0 and
+# dropped the word when the goal sat exactly on the start's turning circle. There the
+# centres coincide, p and the tangent's angle are rounding noise and the path is one
+# arc, b - a: with p <= ZERO x (2 + d) it is taken as that arc (the noisy angle added a
+# full circle half the time: a 45-degree turn of r = 1 came out 7.07 long, not 0.79).
+# LSR's and RSL's p^2 (centres 2 apart: circles touching) and the CCC words' |cos| <= 1
+# are differences too: words within ZERO x (4 + d^2) and ZERO of existing are taken
+# with p = 0 (clipped cos). Both are moves of the poses by ~1e-12 radii, the size of
+# the angle snap.
+ZERO = 1e-12
 
 
 @njit(cache=True)
@@ -64,32 +76,34 @@ def words(sx, sy, sth, gx, gy, gth, r):
     sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
     cab = math.cos(a - b)
     dd = d * d
-    p2 = 2 + dd - 2 * cab + 2 * d * (sa - sb)  # LSL
-    if p2 >= 0:
-        tmp = math.atan2(cb - ca, d + sa - sb)
-        out[0, 0], out[0, 1], out[0, 2] = _m2p(-a + tmp), math.sqrt(p2), _m2p(b - tmp)
-    p2 = 2 + dd - 2 * cab + 2 * d * (sb - sa)  # RSR
-    if p2 >= 0:
-        tmp = math.atan2(ca - cb, d - sa + sb)
-        out[1, 0], out[1, 1], out[1, 2] = _m2p(a - tmp), math.sqrt(p2), _m2p(-b + tmp)
+    tol = ZERO * (4.0 + dd)
+    arc = ZERO * (2.0 + d)
+    x, y = d + sa - sb, cb - ca  # LSL: from the start's left centre to the goal's
+    p = math.sqrt(x * x + y * y)
+    tmp = a if p <= arc else math.atan2(y, x)  # one circle: no tangent, one arc
+    out[0, 0], out[0, 1], out[0, 2] = _m2p(-a + tmp), 0.0 if p <= arc else p, _m2p(b - tmp)
+    x, y = d - sa + sb, ca - cb  # RSR
+    p = math.sqrt(x * x + y * y)
+    tmp = a if p <= arc else math.atan2(y, x)
+    out[1, 0], out[1, 1], out[1, 2] = _m2p(a - tmp), 0.0 if p <= arc else p, _m2p(-b + tmp)
     p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
-    if p2 >= 0:
-        p = math.sqrt(p2)
+    if p2 >= -tol:
+        p = math.sqrt(max(p2, 0.0))
         tmp = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
         out[2, 0], out[2, 1], out[2, 2] = _m2p(-a + tmp), p, _m2p(-_m2p(b) + tmp)
     p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
-    if p2 >= 0:
-        p = math.sqrt(p2)
+    if p2 >= -tol:
+        p = math.sqrt(max(p2, 0.0))
         tmp = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
         out[3, 0], out[3, 1], out[3, 2] = _m2p(a - tmp), p, _m2p(b - tmp)
     c = (6.0 - dd + 2 * cab + 2 * d * (sa - sb)) / 8.0  # RLR
-    if abs(c) <= 1:
-        p = _m2p(TWO_PI - math.acos(c))
+    if abs(c) <= 1 + ZERO:
+        p = _m2p(TWO_PI - math.acos(min(max(c, -1.0), 1.0)))
         t = _m2p(a - math.atan2(ca - cb, d - sa + sb) + p / 2)
         out[4, 0], out[4, 1], out[4, 2] = t, p, _m2p(a - b - t + p)
     c = (6.0 - dd + 2 * cab + 2 * d * (sb - sa)) / 8.0  # LRL
-    if abs(c) <= 1:
-        p = _m2p(TWO_PI - math.acos(c))
+    if abs(c) <= 1 + ZERO:
+        p = _m2p(TWO_PI - math.acos(min(max(c, -1.0), 1.0)))
         t = _m2p(-a - math.atan2(ca - cb, d + sa - sb) + p / 2)
         out[5, 0], out[5, 1], out[5, 2] = t, p, _m2p(_m2p(b) - a - t + p)
     for k in range(6):
@@ -127,36 +141,35 @@ def shortest_length(sx, sy, sth, gx, gy, gth, r):
     # when the goal lies a rounding error from the start (d ~ 1e-45): full circles
     cab = 1.0 if abs(a - b) < 1e-8 else ca * cb + sa * sb
     dd = d * d
+    tol = ZERO * (4.0 + dd)
+    arc = ZERO * (2.0 + d)
     t_lsl = math.atan2(cb - ca, d + sa - sb)
     t_rsr = math.atan2(ca - cb, d - sa + sb)
-    best = math.inf
-    p2 = 2 + dd - 2 * cab + 2 * d * (sa - sb)  # LSL
-    if p2 >= 0:
-        best = min(best, _m2p(t_lsl - a) + math.sqrt(p2) + _m2p(b - t_lsl))
-    p2 = 2 + dd - 2 * cab + 2 * d * (sb - sa)  # RSR
-    if p2 >= 0:
-        best = min(best, _m2p(a - t_rsr) + math.sqrt(p2) + _m2p(t_rsr - b))
+    p = math.hypot(d + sa - sb, cb - ca)  # LSL (see words: one circle, one arc)
+    best = _m2p(b - a) if p <= arc else _m2p(t_lsl - a) + p + _m2p(b - t_lsl)
+    p = math.hypot(d - sa + sb, ca - cb)  # RSR
+    best = min(best, _m2p(a - b) if p <= arc else _m2p(a - t_rsr) + p + _m2p(t_rsr - b))
     p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
-    if p2 >= 0:
-        p = math.sqrt(p2)
+    if p2 >= -tol:
+        p = math.sqrt(max(p2, 0.0))
         # atan2(y, x) - atan2(-2, p), as one atan2 (angle difference, modulo 2 pi)
         y, x = -ca - cb, d + sa + sb
         tmp = math.atan2(y * p + 2 * x, x * p - 2 * y)
         best = min(best, _m2p(tmp - a) + p + _m2p(tmp - b))
     p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
-    if p2 >= 0:
-        p = math.sqrt(p2)
+    if p2 >= -tol:
+        p = math.sqrt(max(p2, 0.0))
         y, x = ca + cb, d - sa - sb  # atan2(y, x) - atan2(2, p)
         tmp = math.atan2(y * p - 2 * x, x * p + 2 * y)
         best = min(best, _m2p(a - tmp) + p + _m2p(b - tmp))
     c = (6.0 - dd + 2 * cab + 2 * d * (sa - sb)) / 8.0  # RLR
-    if abs(c) <= 1:
-        p = _m2p(TWO_PI - math.acos(c))
+    if abs(c) <= 1 + ZERO:
+        p = _m2p(TWO_PI - math.acos(min(max(c, -1.0), 1.0)))
         t = _m2p(a - t_rsr + p / 2)
         best = min(best, t + p + _m2p(a - b - t + p))
     c = (6.0 - dd + 2 * cab + 2 * d * (sb - sa)) / 8.0  # LRL
-    if abs(c) <= 1:
-        p = _m2p(TWO_PI - math.acos(c))
+    if abs(c) <= 1 + ZERO:
+        p = _m2p(TWO_PI - math.acos(min(max(c, -1.0), 1.0)))
         t = _m2p(-a + t_lsl + p / 2)
         best = min(best, t + p + _m2p(_m2p(b) - a - t + p))
     return best * r

@@ -43,6 +43,10 @@ from skyroute.motion.move_search import _sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
 
+# numba caches these kernels with dubins_kernel's code compiled in, keyed by this
+# file's date alone: edit this file when dubins_kernel changes (as for ZERO, its
+# rounding rule), or a checkout keeps running the old words from the cache.
+
 TWO_PI = 2 * math.pi
 
 

@@ -19,8 +19,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from skyroute.errors import OptionError
+
 TWO_PI = 2 * math.pi
 KINDS = {"L": 1, "S": 0, "R": -1}
+MAX_SAMPLES = 10**7  # poses one sampling returns (240 MB); more is an OptionError
+
+
+def check_samples(length: float, step: float) -> None:
+    """An OptionError naming ``step`` when a path ``length`` long sampled every ``step``
+    would come out more than :data:`MAX_SAMPLES` poses (a step of 1e-7 along 250 m
+    asked for 2.5 billion, and ended in a MemoryError after gigabytes)."""
+    if length / step > MAX_SAMPLES:
+        raise OptionError(f"step={step:g} along a path {length:g} long makes more than "
+                          f"{MAX_SAMPLES:,} poses; take a step >= {length / MAX_SAMPLES:.3g}",
+                          param="step")
 
 
 @dataclass(frozen=True)
@@ -130,7 +143,9 @@ def merge(pieces: list[Piece]) -> list[Piece]:
 
 def sample(pieces: list[Piece], step: float, start, goal=None) -> np.ndarray:
     """(K, 3) poses every ``step`` metres along the chain (and at every joint); the first
-    row is exactly ``start``, the last exactly ``goal`` when given. Headings in [0, 2 pi)."""
+    row is exactly ``start``, the last exactly ``goal`` when given. Headings in [0, 2 pi).
+    More than :data:`MAX_SAMPLES` poses is an OptionError naming ``step``."""
+    check_samples(sum(p.length for p in pieces), step)
     rows = [np.array([start], dtype=float)]
     for p in pieces:
         n = max(1, math.ceil(p.length / step - 1e-12))

@@ -195,8 +195,15 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
                 break
             escaped += 1
             on_nav = on_nav - 1 if on_nav > 0 else int(4 * sensor_range / step)
-            theta = math.atan2(*(q - p)[::-1])
-            arc = np.array([q])
+            if mode == "arc":  # turn-limited here too: steer an arc towards the cell
+                arc, theta = _arc(world, p, theta, step, (q - p) / math.dist(p, q),
+                                  max_turn)
+                if arc is None:
+                    break
+                q = arc[-1]
+            else:
+                theta = math.atan2(*(q - p)[::-1])
+                arc = np.array([q])
         else:
             if stalled:
                 break

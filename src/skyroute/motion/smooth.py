@@ -29,6 +29,10 @@ from skyroute.motion.arc_kernels import advance, chain_free, chain_reaches
 from skyroute.motion.dubins_kernel import TURNS, words
 from skyroute.motion.pieces import Piece, chain, turned_round
 
+# numba caches these kernels with dubins_kernel's code compiled in, keyed by this
+# file's date alone: edit this file when dubins_kernel changes (as for ZERO, its
+# rounding rule), or a checkout keeps running the old words from the cache.
+
 
 @njit(cache=True)
 def _locate(pl, n, s):

@@ -167,9 +167,10 @@ def _zones(world: World) -> tuple:
     return z
 
 
-def _coarse(p: np.ndarray) -> tuple[int, int]:
-    """A spot a third of a step wide, for follow()'s loop detection."""
-    return round(p[0] / (STEP / 3)), round(p[1] / (STEP / 3))
+def _coarse(p: np.ndarray, step: float) -> tuple[int, int]:
+    """A spot a third of a ``step`` wide, for follow()'s loop detection (of the step
+    flown: spots of the ILP step made any step under a third of it land on its own)."""
+    return round(p[0] / (step / 3)), round(p[1] / (step / 3))
 
 
 def plan_moves(world: World, start, goal=None, *, step: float = STEP,
@@ -240,7 +241,7 @@ def follow(world: World, path, *, step: float = STEP, max_moves: int = 1500) -> 
     target = 1
     rad = np.radians(ANGLES)
     deltas = step * np.c_[np.cos(rad), np.sin(rad)]
-    visited = {_coarse(p)}
+    visited = {_coarse(p, step)}
     stuck = False
     while target < len(pts) and len(ang) < max_moves:
         if math.hypot(*(pts[target] - p)) < step:
@@ -251,8 +252,8 @@ def follow(world: World, path, *, step: float = STEP, max_moves: int = 1500) -> 
         diff = np.abs((ANGLES - want + 180) % 360 - 180)
         order = np.argsort(diff, kind="stable")
         # nearest legal heading that does not return to a spot already flown through
-        k = next((int(k) for k in order if ok[k] and _coarse(p + deltas[k]) not in visited),
-                 None)
+        k = next((int(k) for k in order
+                  if ok[k] and _coarse(p + deltas[k], step) not in visited), None)
         if k is None:
             stuck = True
             break
@@ -261,7 +262,7 @@ def follow(world: World, path, *, step: float = STEP, max_moves: int = 1500) -> 
         ang.append(int(ANGLES[k]))
         to.append(q)
         p = q
-        visited.add(_coarse(p))
+        visited.add(_coarse(p, step))
     status = Status.FOUND if target >= len(pts) else \
         Status.NO_PATH if stuck else Status.BUDGET_EXHAUSTED
     return Flight(np.array(frm).reshape(-1, 2), np.array(ang, dtype=int),

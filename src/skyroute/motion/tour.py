@@ -29,11 +29,15 @@ from numba import njit
 from skyroute.errors import QueryError, real, whole
 from skyroute.motion import hybrid
 from skyroute.motion.dubins_kernel import TURNS, shortest_length, words
-from skyroute.motion.pieces import chain, sample
+from skyroute.motion.pieces import chain, check_samples, sample
 from skyroute.motion.tour_dp import held_karp, improve, nearest_first
 from skyroute.result import Status
 from skyroute.world.points import as_points
 from skyroute.world.world import World
+
+# numba caches these kernels with dubins_kernel's code compiled in, keyed by this
+# file's date alone: edit this file when dubins_kernel changes (as for ZERO, its
+# rounding rule), or a checkout keeps running the old words from the cache.
 
 TWO_PI = 2 * math.pi
 
@@ -68,6 +72,8 @@ class TourResult:
         """(K, 3) poses along the whole tour (the world's frame among obstacles)."""
         if not self.found:
             return np.empty((0, 3))
+        step = real("step", step, low=0.0, strict=True)
+        check_samples(self.length, step)
         parts = []
         for leg in self.legs:
             poses = leg.sample(step) if isinstance(leg, hybrid.HybridResult) else \
