@@ -526,3 +526,74 @@ def test_api_reference_renders_offline(browser, server):
         assert not outside and not errors, (outside, errors)
     finally:
         context.close()
+
+
+def _job_routes(p, job: dict) -> None:
+    """POST /jobs/fleet answers job "job-1"; GET /jobs/job-1 answers ``job`` as it is at
+    each poll (state "unreachable": no answer at all), so a test sets what the server
+    says while the page follows it."""
+    p.route("**/jobs/fleet", lambda r: r.fulfill(status=202, json={"id": "job-1"}))
+
+    def poll(r):
+        if job["state"] == "unreachable":
+            r.abort()
+        else:
+            r.fulfill(json={"id": "job-1", "kind": "fleet", "result": None, "error": None, **job})
+
+    p.route("**/jobs/job-1", poll)
+
+
+def test_fleet_job_shows_it_runs_and_survives_a_reload(open_page, server):
+    """A fleet run is one task: its job says progress 0 until it ends. The page showed
+    "Job running: 0 %" on an empty bar for the whole run, and a reload forgot the job (no
+    word of it, Start enabled). Now the bar moves (indeterminate) with the time taken,
+    and a reload goes on following the job to its run."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    pg = open_page(f"/fleet.html#run={server[1]}", "desktop")
+    p = pg.page
+    job = {"state": "running", "progress": 0.0}
+    _job_routes(p, job)
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    p.fill("#token", TOKEN)
+    p.click("#start")
+    p.wait_for_function("document.querySelector('#job-status').textContent.includes('so far')")
+    assert "0 %" not in p.inner_text("#job-status")
+    assert p.evaluate("document.querySelector('#progress').hasAttribute('value')") is False
+    assert p.is_disabled("#start")
+    p.reload()
+    p.wait_for_function("document.querySelector('#job-status').textContent.startsWith('Job running')",
+                        timeout=15_000)
+    assert p.is_disabled("#start")
+    job.update(state="running", progress=0.4)
+    p.wait_for_function("document.querySelector('#job-status').textContent.startsWith('Job running: 40 %')")
+    assert p.evaluate("document.querySelector('#progress').value") == pytest.approx(0.4)
+    job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
+                        " && !document.querySelector('#start').disabled", timeout=15_000)
+    assert p.inner_text("#job-status") == "The run is done and stored."
+    p.reload()  # the job is over: nothing to follow after another reload
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    assert p.inner_text("#job-status") == "" and not p.is_disabled("#start")
+    pg.done("fleet-job")
+
+
+def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):
+    """One unanswered poll (a server restarting, a network blip) ended the following for
+    good: the job's run never showed. Now the page says so and asks again."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    pg = open_page(f"/fleet.html#run={server[1]}", "desktop")
+    p = pg.page
+    job = {"state": "unreachable", "progress": 0.0}
+    _job_routes(p, job)
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    p.fill("#token", TOKEN)
+    p.click("#start")
+    p.wait_for_function("document.querySelector('#job-status').textContent.includes('Asking again')")
+    assert "did not answer" in p.inner_text("#job-status")
+    assert p.is_disabled("#start")
+    job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
+                        " && !document.querySelector('#start').disabled", timeout=15_000)
+
