@@ -7,6 +7,7 @@ photographed at 1280x800 and 360x740 into artefacts/screenshots/ (look at them).
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import socket
 import threading
@@ -48,8 +49,8 @@ def _fleet_run(db: str) -> str | None:
 
 @pytest.fixture(scope="module")
 def server(lunch, tmp_path_factory):
-    """(base URL, fleet run id or None): the app on a free port of 127.0.0.1, in a
-    thread, over a copy of the lunch store with the examples/lunch site."""
+    """(base URL, fleet run id or None, store URL): the app on a free port of 127.0.0.1,
+    in a thread, over a copy of the lunch store with the examples/lunch site."""
     import uvicorn
 
     from skyroute.service.app import create_app
@@ -70,7 +71,7 @@ def server(lunch, tmp_path_factory):
     while not server.started:
         assert thread.is_alive() and time.monotonic() < end, "uvicorn did not start"
         time.sleep(0.02)
-    yield f"http://127.0.0.1:{port}", run_id
+    yield f"http://127.0.0.1:{port}", run_id, db
     server.should_exit = True
     thread.join(10)
     sock.close()
@@ -596,4 +597,33 @@ def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):
     job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
                         " && !document.querySelector('#start').disabled", timeout=15_000)
+
+
+def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
+    """Runs of one preset, hours and seed were the same line in the run list (31 of them
+    could not be told apart); each line now starts with when the run was stored."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    import sqlalchemy as sa
+
+    from skyroute.jobs import store
+
+    eng = sa.create_engine(server[2])
+    run = store.get_fleet_run(eng, server[1])
+    copy = store.save_fleet_run(eng, **{k: run[k] for k in (
+        "scenario", "params", "report", "events_jsonl", "tracks_csv", "packages_csv",
+        "fleet_geojson")})
+    try:
+        pg = open_page("/fleet.html", "desktop")
+        p = pg.page
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        labels = p.locator("#run option").all_inner_texts()
+        assert len(labels) == 2 and labels[0] != labels[1], labels
+        assert p.input_value("#run") == copy  # the newest first
+        assert all(re.match(r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d · seed-3x3", x) for x in labels), labels
+        pg.done("fleet-runs")
+    finally:
+        with eng.begin() as c:
+            c.execute(sa.text("DELETE FROM fleet_runs WHERE id = :id"), {"id": copy})
+        eng.dispose()
 

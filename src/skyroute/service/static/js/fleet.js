@@ -49,7 +49,15 @@ function colour(d, count) {
   return `hsl(${(d * 137.508) % 360}, 65%, 42%)`;
 }
 
-function runLabel(r) {
+function stored(iso) {
+  const d = new Date(iso);
+  if (!iso || Number.isNaN(d.getTime())) return null;
+  const two = (n) => String(n).padStart(2, "0");
+  return `${d.getFullYear()}-${two(d.getMonth() + 1)}-${two(d.getDate())} ` +
+    `${two(d.getHours())}:${two(d.getMinutes())}:${two(d.getSeconds())}`;
+}
+
+function runLabel(r, { when = true } = {}) {
   const p = r.params || {};
   const rep = r.report || {};
   const hours = p.hours ?? rep.simulated_hours;
@@ -58,7 +66,8 @@ function runLabel(r) {
   if (hours !== undefined) parts.push(`${fmt(hours, 2)} h`);
   if (seed !== undefined) parts.push(`seed ${seed}`);
   if (rep.delivered !== undefined) parts.push(`${rep.delivered}/${rep.offered} delivered`);
-  return parts.join(" · ");
+  const at = when ? stored(r.created) : null; // runs of the same settings differ by it
+  return (at ? [at, ...parts] : parts).join(" · ");
 }
 
 async function listRuns(select = null) {
@@ -77,7 +86,12 @@ async function listRuns(select = null) {
     say(status, "No fleet run is stored yet: start one below.", "info");
     return false;
   }
-  runSelect.replaceChildren(...runs.map((r) => h("option", { value: r.id }, runLabel(r))));
+  // a label twice (runs stored in one second, or by a server without their time) gets
+  // the run's id, so that every run in the list can be told apart
+  const labels = runs.map((r) => runLabel(r));
+  const twice = new Set(labels.filter((x, i) => labels.indexOf(x) !== i));
+  runSelect.replaceChildren(...runs.map((r, i) => h("option", { value: r.id },
+    twice.has(labels[i]) ? `${labels[i]} · run ${String(r.id).slice(0, 8)}` : labels[i])));
   runSelect.disabled = false;
   const wanted = select || new URLSearchParams(location.hash.slice(1)).get("run");
   if (wanted && runs.some((r) => String(r.id) === wanted)) runSelect.value = wanted;
@@ -88,7 +102,7 @@ async function load(id) {
   player.pause();
   const entry = runs.find((r) => String(r.id) === String(id)) || { id };
   const base = `/fleet/runs/${encodeURIComponent(id)}`;
-  say(status, `Loading run ${runLabel(entry)}…`, "busy");
+  say(status, `Loading run ${runLabel(entry, { when: false })}…`, "busy");
   let detail, tracksText, eventsText, geo, routesText;
   try {
     [detail, tracksText, eventsText, geo, routesText] = await Promise.all([
@@ -141,7 +155,7 @@ async function load(id) {
   let b = bbox(pts);
   for (let i = 0; i < tracks.n; i++) b = bbox([[tracks.east[i], tracks.north[i]]], b);
   run = {
-    id, name: runLabel(entry), tracks, drones, horizon, ground,
+    id, name: runLabel(entry, { when: false }), tracks, drones, horizon, ground,
     fold: new EventFold(events, routesText ? parseRoutes(routesText) : null),
   };
   history.replaceState(null, "", `#run=${encodeURIComponent(id)}`);
