@@ -627,3 +627,19 @@ def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
             c.execute(sa.text("DELETE FROM fleet_runs WHERE id = :id"), {"id": copy})
         eng.dispose()
 
+
+@pytest.mark.parametrize(("path", "named"), [("/day.html#date=2099-01-01", "2099-01-01"),
+                                             ("/fleet.html#run=no-such-run", "no-such-run")])
+def test_a_link_to_what_is_not_stored_says_so(open_page, server, path, named):
+    """A link (an old bookmark) to a day or run the store does not hold showed another
+    day or run without a word; the status line now says the link's one is not stored."""
+    if "fleet" in path and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    pg = open_page(path, "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    text = p.inner_text("#status")
+    assert f"The link names {'run ' if 'fleet' in path else ''}{named}, which is not" in text, text
+    assert "Press Play" in text, text
+    pg.done("link-not-stored")
+

@@ -85,12 +85,15 @@ async function start() {
     `${d.date} · ${d.money_pct === null ? "no orders" : `${fmt(d.money_pct, 1)} %`}`)));
   select.disabled = false;
   const wanted = new URLSearchParams(location.hash.slice(1)).get("date");
-  if (wanted && days.some((d) => d.date === wanted)) select.value = wanted;
+  const known = wanted && days.some((d) => d.date === wanted);
+  if (known) select.value = wanted;
   select.addEventListener("change", () => load(select.value));
-  await load(select.value);
+  // a link to a day the store does not hold says so, not just shows another day
+  await load(select.value, wanted && !known ? `The link names ${wanted}, which is not a stored day; ` +
+    `this is ${select.value}. ` : "");
 }
 
-async function load(date) {
+async function load(date, note = "") {
   player.pause();
   say(status, `Loading ${date}…`, "busy");
   let detail, flight;
@@ -135,10 +138,10 @@ async function load(date) {
   fillOrders();
   player.load(moves, 1);
   if (moves) {
-    say(status, `${date}: ${moves} moves, ${detail.report.orders_delivered} of ${detail.report.orders_placed} ` +
-      `orders delivered, ${fmt(detail.report.money_pct, 1)} % of the money. Press Play to fly it.`, "ok");
+    say(status, `${note}${date}: ${moves} moves, ${detail.report.orders_delivered} of ${detail.report.orders_placed} ` +
+      `orders delivered, ${fmt(detail.report.money_pct, 1)} % of the money. Press Play to fly it.`, note ? "info" : "ok");
   } else {
-    say(status, `${date}: the drone did not fly (${detail.report.orders_placed
+    say(status, `${note}${date}: the drone did not fly (${detail.report.orders_placed
       ? `none of the ${detail.report.orders_placed} orders could be delivered` : "no orders were placed"}), ` +
       "so there is nothing to play.", "info");
   }

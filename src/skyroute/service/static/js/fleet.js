@@ -23,6 +23,7 @@ let runs = [];
 let run = null; // {id, tracks, fold, ground, drones, horizon}
 let t = 0;
 let lastTables = 0;
+let missing = null; // a run the page's link (#run=) names that the store does not hold
 
 const view = new MapView($("map"), { draw: drawMap });
 const player = new Player({
@@ -93,8 +94,10 @@ async function listRuns(select = null) {
   runSelect.replaceChildren(...runs.map((r, i) => h("option", { value: r.id },
     twice.has(labels[i]) ? `${labels[i]} · run ${String(r.id).slice(0, 8)}` : labels[i])));
   runSelect.disabled = false;
-  const wanted = select || new URLSearchParams(location.hash.slice(1)).get("run");
+  const linked = select ? null : new URLSearchParams(location.hash.slice(1)).get("run");
+  const wanted = select || linked;
   if (wanted && runs.some((r) => String(r.id) === wanted)) runSelect.value = wanted;
+  else if (linked) missing = linked;
   return true;
 }
 
@@ -166,7 +169,10 @@ async function load(id) {
   $("s-safety").textContent = rep.loiters === undefined ? "–" : `${rep.loiters}, ${rep.conflicts}`;
   view.setBounds(grow(b, 0.04, 50));
   player.load(horizon, tracks.step);
-  say(status, `${run.name}: ${clock(horizon)} of flying, ${events.length} events. Press Play or move the time slider.`, "ok");
+  const note = missing ? `The link names run ${missing}, which is not stored; this is the newest. ` : "";
+  missing = null;
+  say(status, `${note}${run.name}: ${clock(horizon)} of flying, ${events.length} events. Press Play or move the time slider.`,
+    note ? "info" : "ok");
 }
 
 function tables() {
