@@ -643,3 +643,16 @@ def test_a_link_to_what_is_not_stored_says_so(open_page, server, path, named):
     assert "Press Play" in text, text
     pg.done("link-not-stored")
 
+
+def test_world_plans_with_the_safety_typed(open_page):
+    """A negative safety margin was planned with 0 and answered "Found a path" (the page
+    replaced it); it goes to the server as typed, which refuses it naming the field."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    _load_city(pg)
+    for key, value in (("s0", 172), ("s1", -271), ("g0", -172), ("g1", 270), ("safety", -3)):
+        p.fill(f"#{key}", str(value))
+    p.click("#run")
+    text = _wait_status(p, "error")
+    assert text == "Planning failed (422): safety: Input should be greater than or equal to 0", text
+    assert p.inner_text("#r-status") == "–"

@@ -302,7 +302,9 @@ async function plan() {
   }
   const body = {
     world_text: world.text, world_format: world.format, frame: world.frame, start, goal,
-    algorithm: $("algorithm").value, safety: safety(),
+    // the margin as typed: a negative one is the server's to refuse, not the page's to
+    // replace by 0 (the drawing does, as it cannot shrink the obstacles)
+    algorithm: $("algorithm").value, safety: $("safety").value === "" ? 0 : Number($("safety").value),
   };
   if ($("altitude").value !== "") body.altitude = Number($("altitude").value);
   if (!$("resolution-field").hidden && $("resolution").value !== "") body.resolution = Number($("resolution").value);
