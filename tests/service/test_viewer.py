@@ -6,6 +6,7 @@ photographed at 1280x800 and 360x740 into artefacts/screenshots/ (look at them).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import re
 import shutil
@@ -599,11 +600,10 @@ def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):
                         " && !document.querySelector('#start').disabled", timeout=15_000)
 
 
-def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
-    """Runs of one preset, hours and seed were the same line in the run list (31 of them
-    could not be told apart); each line now starts with when the run was stored."""
-    if server[1] is None:
-        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+@contextlib.contextmanager
+def _copied_run(server):
+    """A second fleet run in the store, the module's run stored again (same settings);
+    its id. Deleted at the end."""
     import sqlalchemy as sa
 
     from skyroute.jobs import store
@@ -614,6 +614,19 @@ def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
         "scenario", "params", "report", "events_jsonl", "tracks_csv", "packages_csv",
         "fleet_geojson")})
     try:
+        yield copy
+    finally:
+        with eng.begin() as c:
+            c.execute(sa.text("DELETE FROM fleet_runs WHERE id = :id"), {"id": copy})
+        eng.dispose()
+
+
+def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
+    """Runs of one preset, hours and seed were the same line in the run list (31 of them
+    could not be told apart); each line now starts with when the run was stored."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    with _copied_run(server) as copy:
         pg = open_page("/fleet.html", "desktop")
         p = pg.page
         p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
@@ -622,10 +635,44 @@ def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
         assert p.input_value("#run") == copy  # the newest first
         assert all(re.match(r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d · seed-3x3", x) for x in labels), labels
         pg.done("fleet-runs")
-    finally:
-        with eng.begin() as c:
-            c.execute(sa.text("DELETE FROM fleet_runs WHERE id = :id"), {"id": copy})
-        eng.dispose()
+
+
+@pytest.mark.parametrize("page", ["day", "fleet"])
+def test_the_last_choice_is_shown_when_an_earlier_one_answers_late(open_page, server, page):
+    """A day or run chosen, then another before the first had arrived (a large run takes
+    seconds): the first, arriving last, was shown under the second's name in the list.
+    Now only the last choice is drawn."""
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    with contextlib.ExitStack() as stack:
+        if page == "day":
+            first, last, held_url = DAY, "2024-02-01", f"**/days/{DAY}/flightpath.geojson"
+        else:
+            first, last = stack.enter_context(_copied_run(server)), server[1]
+            held_url = f"**/fleet/runs/{first}/tracks.csv"
+        key = "date" if page == "day" else "run"
+        pg = open_page(f"/{page}.html#{key}={last}", "desktop")
+        p = pg.page
+        p.wait_for_function("document.querySelector('#status').dataset.kind !== 'busy'"
+                            " && document.querySelector('#status').textContent", timeout=15_000)
+        held = []
+        p.route(held_url, lambda r: held.append(r))  # the first choice's answer waits
+        p.select_option(f"#{key}", first)
+        for _ in range(200):  # the page asks for it
+            if held:
+                break
+            p.wait_for_timeout(50)
+        assert held and p.evaluate("document.querySelector('#status').dataset.kind") == "busy"
+        p.select_option(f"#{key}", last)
+        p.wait_for_function(f"location.hash === '#{key}={last}'"
+                            " && document.querySelector('#status').dataset.kind !== 'busy'")
+        shown = p.inner_text("#status")
+        held[0].continue_()  # now the first choice arrives, last
+        p.wait_for_timeout(1500)
+        assert p.evaluate("location.hash") == f"#{key}={last}"
+        assert p.input_value(f"#{key}") == last
+        assert p.inner_text("#status") == shown
+        assert not pg.errors, pg.errors
 
 
 @pytest.mark.parametrize(("path", "named"), [("/day.html#date=2099-01-01", "2099-01-01"),

@@ -17,6 +17,7 @@ let site = null; // {zones: [[ring, ...]], confinement: ring|null, home, shops, 
 let day = null; // the loaded day, see load()
 let proj = null;
 let t = 0;
+let loading = 0; // counts the days asked for: only the last one asked is shown
 
 const view = new MapView($("map"), { draw: drawMap });
 const player = new Player({
@@ -95,6 +96,7 @@ async function start() {
 
 async function load(date, note = "") {
   player.pause();
+  const mine = ++loading;
   say(status, `Loading ${date}…`, "busy");
   let detail, flight;
   try {
@@ -103,9 +105,10 @@ async function load(date, note = "") {
       getJSON(`/days/${encodeURIComponent(date)}/flightpath.geojson`),
     ]);
   } catch (err) {
-    say(status, explain(err, `Reading ${date}`), "error");
+    if (mine === loading) say(status, explain(err, `Reading ${date}`), "error");
     return;
   }
+  if (mine !== loading) return; // another day was chosen while this one was read
   history.replaceState(null, "", `#date=${date}`);
   const feature = flight.features[0];
   const coords = feature.geometry ? feature.geometry.coordinates : [];

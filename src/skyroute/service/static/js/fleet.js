@@ -23,6 +23,7 @@ let runs = [];
 let run = null; // {id, tracks, fold, ground, drones, horizon}
 let t = 0;
 let lastTables = 0;
+let loading = 0; // counts the runs asked for: only the last one asked is shown
 let missing = null; // a run the page's link (#run=) names that the store does not hold
 
 const view = new MapView($("map"), { draw: drawMap });
@@ -103,6 +104,7 @@ async function listRuns(select = null) {
 
 async function load(id) {
   player.pause();
+  const mine = ++loading;
   const entry = runs.find((r) => String(r.id) === String(id)) || { id };
   const base = `/fleet/runs/${encodeURIComponent(id)}`;
   say(status, `Loading run ${runLabel(entry, { when: false })}…`, "busy");
@@ -114,9 +116,10 @@ async function load(id) {
       getText(`${base}/packages.csv`).catch(() => null), // routes known from the start (else from events)
     ]);
   } catch (err) {
-    say(status, explain(err, "Reading the run"), "error");
+    if (mine === loading) say(status, explain(err, "Reading the run"), "error");
     return;
   }
+  if (mine !== loading) return; // another run was chosen while this one was read
   const scenario = [detail.scenario, (detail.params || {}).scenario, (entry.params || {}).scenario]
     .find((s) => s && typeof s === "object" && s.home_lon !== undefined);
   if (!scenario) {
