@@ -21,6 +21,7 @@ let grid = null; // {name, width, height, free: Uint8Array, image: canvas}
 let cell = 1; // CSS pixels per cell
 let results = []; // [{algorithm, colour, answer|null, error|null}]
 let round = 0; // discards answers of an older query
+let loading = 0; // counts the maps asked for: only the last one asked is shown
 
 bindToken($("token"));
 
@@ -32,14 +33,16 @@ function terrain(ch, passable) {
 }
 
 async function loadMap(name) {
+  const mine = ++loading;
   say(status, `Loading ${name}…`, "busy");
   let doc;
   try {
     doc = await getJSON(`/maps/${encodeURIComponent(name)}`);
   } catch (err) {
-    say(status, explain(err, `Reading map ${name}`), "error");
+    if (mine === loading) say(status, explain(err, `Reading map ${name}`), "error");
     return;
   }
+  if (mine !== loading) return; // another map was chosen while this one was read
   const { width, height, rows } = doc;
   const passable = doc.passable || ".G";
   const free = new Uint8Array(width * height);
