@@ -709,3 +709,26 @@ def test_world_plans_with_the_safety_typed(open_page):
     text = _wait_status(p, "error")
     assert text == "Planning failed (422): safety: Input should be greater than or equal to 0", text
     assert p.inner_text("#r-status") == "–"
+
+
+def test_planner_new_map_drops_the_old_maps_query(open_page, api):
+    """A query under way when another map was chosen ended on the new map as "Planned
+    (5, 5) -> (60, 70) with 0 algorithm: none found a path." in red, and Plan stayed
+    disabled until it did. The new map's answer is the old query's end now."""
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "Berlin_1_256")
+    held = []
+    p.route("**/plan", lambda r: held.append(r))
+    _type_cells(p, (5, 5), (60, 70))
+    p.click("#run")
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'busy'")
+    p.select_option("#map-name", "den312d")
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('den312d')")
+    assert not p.is_disabled("#run")
+    assert held
+    p.unroute("**/plan")  # (lets the held request go on)
+    p.wait_for_timeout(2000)  # the old query's answers arrive
+    assert p.inner_text("#status").startswith("den312d: 65 × 81 cells"), p.inner_text("#status")
+    assert p.locator("#results tbody tr").count() == 0
+    assert not p.is_disabled("#run")

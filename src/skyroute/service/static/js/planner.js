@@ -43,6 +43,8 @@ async function loadMap(name) {
     return;
   }
   if (mine !== loading) return; // another map was chosen while this one was read
+  round++; // a query on the old map still under way: its answers are dropped
+  $("run").disabled = false;
   const { width, height, rows } = doc;
   const passable = doc.passable || ".G";
   const free = new Uint8Array(width * height);
