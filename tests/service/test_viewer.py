@@ -732,3 +732,30 @@ def test_planner_new_map_drops_the_old_maps_query(open_page, api):
     assert p.inner_text("#status").startswith("den312d: 65 × 81 cells"), p.inner_text("#status")
     assert p.locator("#results tbody tr").count() == 0
     assert not p.is_disabled("#run")
+
+
+def test_world_new_file_drops_the_old_worlds_plan(open_page):
+    """A plan under way when another world was loaded drew its path (and length and
+    waypoints) over the new world, whose start and goal were cleared."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    _load_city(pg)
+    held = []
+    p.route("**/plan", lambda r: held.append(r))
+    for key, value in (("s0", 172), ("s1", -271), ("g0", -172), ("g1", 270)):
+        p.fill(f"#{key}", str(value))
+    p.click("#run")
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'busy'")
+    zones = {"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {},
+             "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [0.001, 0], [0.001, 0.001],
+                                                              [0, 0]]]}}]}
+    p.fill("#text", json.dumps(zones))
+    p.dispatch_event("#text", "change")
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('the pasted text')")
+    assert not p.is_disabled("#run")
+    assert held
+    p.unroute("**/plan")  # (lets the held request go on)
+    p.wait_for_timeout(2000)  # the old plan's answer arrives
+    assert p.inner_text("#status").startswith("the pasted text: 1 obstacles"), p.inner_text("#status")
+    assert p.inner_text("#r-cost") == "–"
+    assert p.locator("#waypoints tbody tr").count() == 0
