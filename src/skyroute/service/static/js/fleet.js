@@ -7,6 +7,7 @@
 
 import { ApiError, bindToken, choices, explain, getJSON, getText, postJSON } from "./api.js";
 import { EventFold, dronesAt, parseEvents, parseRoutes, parseTracks, trail } from "./fleetstate.js";
+import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
 import { PALETTE, clock, fmt, h, say } from "./ui.js";
 import { MapView, bbox, dot, grow, label, localProjection } from "./view.js";
@@ -270,29 +271,14 @@ function drawMap(ctx, v) {
 }
 
 // -- new runs as jobs --------------------------------------------------------------
-// The job being followed is kept in this tab's sessionStorage, so a reload (or a visit
-// to another page and back) goes on following it instead of forgetting it.
-const JOB_KEY = "skyroute.fleetJob";
-const POLL_MS = 500;
-const RETRY_MS = 3000; // between polls while the server does not answer
-
-function rememberJob(job) {
-  try {
-    if (job) sessionStorage.setItem(JOB_KEY, JSON.stringify(job));
-    else sessionStorage.removeItem(JOB_KEY);
-  } catch {
-    // storage refused (private mode): the job is followed until the page goes
-  }
-}
-
-function rememberedJob() {
-  try {
-    const job = JSON.parse(sessionStorage.getItem(JOB_KEY) || "null");
-    return job && typeof job.id === "string" ? job : null;
-  } catch {
-    return null;
-  }
-}
+const jobs = new JobFollower({
+  key: "skyroute.fleetJob", bar: $("progress"), line: jobStatus, button: $("start"),
+  what: "the run", done: "The run is done and stored.",
+  onDone: async (r) => {
+    const runId = r.fleet_run ?? r.run_id ?? r.id;
+    if (runId !== undefined && (await listRuns(String(runId)))) await load(runSelect.value);
+  },
+});
 
 $("job").addEventListener("submit", async (ev) => {
   ev.preventDefault();
@@ -312,65 +298,8 @@ $("job").addEventListener("submit", async (ev) => {
     $("start").disabled = false;
     return;
   }
-  const job = { id, since: Date.now() };
-  rememberJob(job);
-  await follow(job);
+  await jobs.start(id);
 });
-
-/** Poll the job until it is done or failed: its progress, or (a fleet run is one task,
- * 0 until it ends) a moving bar and the time it has taken; a server that does not
- * answer is asked again, not given up on. */
-async function follow({ id, since }) {
-  $("start").disabled = true;
-  const bar = $("progress");
-  const took = () => (since ? ` (${clock((Date.now() - since) / 1000)} so far)` : "");
-  try {
-    for (;;) {
-      let job;
-      try {
-        job = await getJSON(`/jobs/${encodeURIComponent(id)}`);
-      } catch (err) {
-        if (err.status === 0 || err.status >= 500) {
-          say(jobStatus, `${explain(err, "Following the run")} Asking again every ` +
-            `${RETRY_MS / 1000} s…`, "error");
-          await new Promise((resolve) => setTimeout(resolve, RETRY_MS));
-          continue;
-        }
-        rememberJob(null);
-        say(jobStatus, explain(err, "Following the run"), "error");
-        return;
-      }
-      if (job.state === "failed") {
-        rememberJob(null);
-        bar.value = 0;
-        say(jobStatus, `The run failed: ${job.error || "no reason given"}`, "error");
-        return;
-      }
-      if (job.state === "done") {
-        rememberJob(null);
-        bar.value = 1;
-        const r = job.result || {};
-        const runId = r.fleet_run ?? r.run_id ?? r.id;
-        say(jobStatus, "The run is done and stored.", "ok");
-        if (runId !== undefined && (await listRuns(String(runId)))) await load(runSelect.value);
-        return;
-      }
-      const share = job.progress || 0;
-      if (job.state === "running" && share > 0) {
-        bar.value = share;
-        say(jobStatus, `Job running: ${fmt(100 * share, 0)} %${took()}`, "busy");
-      } else {
-        bar.removeAttribute("value"); // indeterminate: moving, no share to show
-        say(jobStatus, job.state === "queued" ? `Job queued: waiting for a worker${took()}…`
-          : `Job running: the run reports when it is done${took()}…`, "busy");
-      }
-      await new Promise((resolve) => setTimeout(resolve, POLL_MS));
-    }
-  } finally {
-    if (!bar.hasAttribute("value")) bar.value = 0;
-    $("start").disabled = false;
-  }
-}
 
 async function start() {
   const [presets, schedulers] = await Promise.all([
@@ -381,13 +310,13 @@ async function start() {
   $("scheduler").replaceChildren(...schedulers.map((s) => h("option", { value: s }, s)));
   runSelect.addEventListener("change", () => load(runSelect.value));
   view.setBounds([0, 0, 1000, 600]);
-  const job = rememberedJob(); // a run started before a reload: followed after the list
+  const job = jobs.remembered(); // a run started before a reload: followed after the list
   if (job) {
     $("start").disabled = true;
     say(jobStatus, "Following the run started before this page was loaded…", "busy");
   }
   if (await listRuns()) await load(runSelect.value);
-  if (job) await follow(job);
+  if (job) await jobs.follow(job);
 }
 
 start();
