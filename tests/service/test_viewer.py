@@ -530,6 +530,14 @@ def test_api_reference_renders_offline(browser, server):
         context.close()
 
 
+def server_has_no_jobs() -> bool:
+    try:
+        import skyroute.jobs  # noqa: F401
+    except ImportError:
+        return True
+    return False
+
+
 def _job_routes(p, job: dict) -> None:
     """POST /jobs/fleet answers job "job-1"; GET /jobs/job-1 answers ``job`` as it is at
     each poll (state "unreachable": no answer at all), so a test sets what the server
@@ -759,3 +767,31 @@ def test_world_new_file_drops_the_old_worlds_plan(open_page):
     assert p.inner_text("#status").startswith("the pasted text: 1 obstacles"), p.inner_text("#status")
     assert p.inner_text("#r-cost") == "–"
     assert p.locator("#waypoints tbody tr").count() == 0
+
+
+def test_day_page_flies_a_day_as_a_job(open_page, api):
+    """The day page could only show days flown elsewhere (the CLI, or POST /jobs/deliver
+    by hand); it now flies a stored orders' day as a job, follows it and shows it."""
+    if server_has_no_jobs():
+        pytest.skip("skyroute.jobs is not in this tree: no jobs")
+    date = "2024-01-01"  # orders imported with the lunch day, not flown
+    pg = open_page(f"/day.html#date={DAY}", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#time').max > 0")
+    p.click("#start")
+    assert p.inner_text("#job-status") == "Give the date to fly first."
+    assert p.evaluate("document.activeElement.id") == "job-date"
+    p.fill("#job-date", date)
+    p.select_option("#method", "greedy")
+    p.fill("#token", TOKEN)
+    p.click("#start")
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
+                        " && !document.querySelector('#start').disabled", timeout=120_000)
+    assert p.inner_text("#job-status") == "The day is flown and stored."
+    p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{date}:')")
+    report = api.get(f"/days/{date}").json()["report"]
+    assert report["settings"]["method"] == "greedy"
+    assert p.input_value("#date") == date and p.evaluate("location.hash") == f"#date={date}"
+    assert p.locator("#orders tbody tr").count() == report["orders_placed"]
+    assert p.evaluate("document.querySelector('#progress').value") == 1
+    pg.done("day-job")
