@@ -572,11 +572,12 @@ def test_fleet_job_shows_it_runs_and_survives_a_reload(open_page, server):
     assert p.evaluate("document.querySelector('#progress').hasAttribute('value')") is False
     assert p.is_disabled("#start")
     p.reload()
-    p.wait_for_function("document.querySelector('#job-status').textContent.startsWith('Job running')",
-                        timeout=15_000)
+    p.wait_for_function("document.querySelector('#job-status').textContent"
+                        ".startsWith('Job running')", timeout=15_000)
     assert p.is_disabled("#start")
     job.update(state="running", progress=0.4)
-    p.wait_for_function("document.querySelector('#job-status').textContent.startsWith('Job running: 40 %')")
+    p.wait_for_function("document.querySelector('#job-status').textContent"
+                        ".startsWith('Job running: 40 %')")
     assert p.evaluate("document.querySelector('#progress').value") == pytest.approx(0.4)
     job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
@@ -600,7 +601,8 @@ def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):
     p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
     p.fill("#token", TOKEN)
     p.click("#start")
-    p.wait_for_function("document.querySelector('#job-status').textContent.includes('Asking again')")
+    p.wait_for_function("document.querySelector('#job-status').textContent"
+                        ".includes('Asking again')")
     assert "did not answer" in p.inner_text("#job-status")
     assert p.is_disabled("#start")
     job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
@@ -641,7 +643,8 @@ def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
         labels = p.locator("#run option").all_inner_texts()
         assert len(labels) == 2 and labels[0] != labels[1], labels
         assert p.input_value("#run") == copy  # the newest first
-        assert all(re.match(r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d · seed-3x3", x) for x in labels), labels
+        when = r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d · seed-3x3"
+        assert all(re.match(when, x) for x in labels), labels
         pg.done("fleet-runs")
 
 
@@ -759,12 +762,14 @@ def test_world_new_file_drops_the_old_worlds_plan(open_page):
                                                               [0, 0]]]}}]}
     p.fill("#text", json.dumps(zones))
     p.dispatch_event("#text", "change")
-    p.wait_for_function("document.querySelector('#status').textContent.startsWith('the pasted text')")
+    p.wait_for_function("document.querySelector('#status').textContent"
+                        ".startsWith('the pasted text')")
     assert not p.is_disabled("#run")
     assert held
     p.unroute("**/plan")  # (lets the held request go on)
     p.wait_for_timeout(2000)  # the old plan's answer arrives
-    assert p.inner_text("#status").startswith("the pasted text: 1 obstacles"), p.inner_text("#status")
+    text = p.inner_text("#status")
+    assert text.startswith("the pasted text: 1 obstacles"), text
     assert p.inner_text("#r-cost") == "–"
     assert p.locator("#waypoints tbody tr").count() == 0
 

@@ -93,7 +93,7 @@ async function start() {
   const job = jobs.remembered(); // a day flown before a reload: followed after the list
   if (job) {
     $("start").disabled = true;
-    say(jobStatus, "Following the day started before this page was loaded…", "busy");
+    say(jobStatus, "Following the day being flown since before this page was loaded…", "busy");
   }
   const wanted = new URLSearchParams(location.hash.slice(1)).get("date");
   if (await listDays(wanted)) {
