@@ -747,7 +747,8 @@ def test_planner_new_map_drops_the_old_maps_query(open_page, api):
 
 def test_world_new_file_drops_the_old_worlds_plan(open_page):
     """A plan under way when another world was loaded drew its path (and length and
-    waypoints) over the new world, whose start and goal were cleared."""
+    waypoints) over the new world, whose start and goal were cleared. And a pasted world
+    left the file control naming the file chosen before."""
     pg = open_page("/world.html", "desktop")
     p = pg.page
     _load_city(pg)
@@ -764,6 +765,8 @@ def test_world_new_file_drops_the_old_worlds_plan(open_page):
     p.dispatch_event("#text", "change")
     p.wait_for_function("document.querySelector('#status').textContent"
                         ".startsWith('the pasted text')")
+    # the file control no longer names city.csv, the world it no longer shows
+    assert p.evaluate("document.querySelector('#file').files.length") == 0
     assert not p.is_disabled("#run")
     assert held
     p.unroute("**/plan")  # (lets the held request go on)

@@ -279,7 +279,10 @@ $("file").addEventListener("change", async () => {
   $("text").value = text;
   loadText(text, f.name);
 });
-$("text").addEventListener("change", () => loadText($("text").value, "the pasted text"));
+$("text").addEventListener("change", () => {
+  $("file").value = ""; // the file chosen before is not the world any more
+  loadText($("text").value, "the pasted text");
+});
 $("format").addEventListener("change", () => loadText($("text").value, world ? world.name : "the text"));
 $("algorithm").addEventListener("change", () => {
   $("resolution-field").hidden = ["visibility", "prm"].includes($("algorithm").value);
