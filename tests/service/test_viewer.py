@@ -720,6 +720,7 @@ def test_world_plans_with_the_safety_typed(open_page):
     text = _wait_status(p, "error")
     assert text == "Planning failed (422): safety: Input should be greater than or equal to 0", text
     assert p.inner_text("#r-status") == "–"
+    assert p.evaluate("document.activeElement.id") == "safety"  # the field at fault
 
 
 def test_planner_new_map_drops_the_old_maps_query(open_page, api):
@@ -803,3 +804,23 @@ def test_day_page_flies_a_day_as_a_job(open_page, api):
     assert p.locator("#orders tbody tr").count() == report["orders_placed"]
     assert p.evaluate("document.querySelector('#progress').value") == 1
     pg.done("day-job")
+
+
+@pytest.mark.parametrize(("field", "value", "said"), [
+    ("hours", "-1", "hours: Input should be greater than 0"),
+    ("hours", "", "hours: Input should be greater than 0"),
+    ("seed", "1.5", "seed: Input should be a valid integer"),
+])
+def test_fleet_form_focuses_the_field_the_server_refuses(open_page, field, value, said):
+    """A refused field was said in the status line while the focus stayed on Start: the
+    field is now focused (as the Token field is for a 401), so a keyboard or screen
+    reader user is at what to fix."""
+    pg = open_page("/fleet.html", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#preset').options.length > 0")
+    p.fill("#token", TOKEN)
+    p.fill(f"#{field}", value)
+    p.click("#start")
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'error'")
+    assert said in p.inner_text("#job-status")
+    assert p.evaluate("document.activeElement.id") == field

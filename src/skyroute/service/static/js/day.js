@@ -4,7 +4,7 @@
 // Reads GET /days, /site.geojson, /days/{date} and /days/{date}/flightpath.geojson; flies
 // a day with POST /jobs/deliver and follows GET /jobs/{id}.
 
-import { ApiError, bindToken, choices, explain, getJSON, postJSON } from "./api.js";
+import { ApiError, bindToken, choices, explain, focusFault, getJSON, postJSON } from "./api.js";
 import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
 import { fmt, h, pounds, say } from "./ui.js";
@@ -145,7 +145,7 @@ $("job").addEventListener("submit", async (ev) => {
     ({ id } = await postJSON("/jobs/deliver", { date, method: $("method").value }));
   } catch (err) {
     say(jobStatus, explain(err, `Flying ${date}`), "error");
-    if (err.status === 401 || err.status === 403) $("token").focus();
+    focusFault(err, { date: "job-date", method: "method" });
     $("start").disabled = false;
     return;
   }

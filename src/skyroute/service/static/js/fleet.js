@@ -5,7 +5,7 @@
 // Reads GET /fleet/runs, /fleet/runs/{id}, its tracks.csv, events.jsonl, fleet.geojson
 // and packages.csv; starts runs with POST /jobs/fleet and follows GET /jobs/{id}.
 
-import { ApiError, bindToken, choices, explain, getJSON, getText, postJSON } from "./api.js";
+import { ApiError, bindToken, choices, explain, focusFault, getJSON, getText, postJSON } from "./api.js";
 import { EventFold, dronesAt, parseEvents, parseRoutes, parseTracks, trail } from "./fleetstate.js";
 import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
@@ -294,7 +294,7 @@ $("job").addEventListener("submit", async (ev) => {
     ({ id } = await postJSON("/jobs/fleet", body));
   } catch (err) {
     say(jobStatus, explain(err, "Starting the run"), "error");
-    if (err.status === 401 || err.status === 403) $("token").focus();
+    focusFault(err, { hours: "hours", seed: "seed", preset: "preset", scheduler: "scheduler" });
     $("start").disabled = false;
     return;
   }

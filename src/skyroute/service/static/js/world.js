@@ -5,7 +5,7 @@
 // A colliders world is planned in the "ned" frame (points are north, east metres from the
 // file's lat0, lon0); GeoJSON zones in "lonlat" (points are lon, lat).
 
-import { bindToken, choices, explain, postJSON } from "./api.js";
+import { bindToken, choices, explain, focusFault, postJSON } from "./api.js";
 import { download, fmt, h, say } from "./ui.js";
 import { MapView, bbox, grow, localProjection } from "./view.js";
 
@@ -334,7 +334,8 @@ async function plan() {
   } catch (err) {
     if (mine !== round) return;
     say(status, explain(err, "Planning"), "error");
-    if (err.status === 401 || err.status === 403) $("token").focus();
+    focusFault(err, { safety: "safety", altitude: "altitude", resolution: "resolution", start: "s0",
+      goal: "g0", algorithm: "algorithm", world_text: "text" });
   } finally {
     if (mine === round) $("run").disabled = false;
     view.render();
