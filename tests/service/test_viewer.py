@@ -824,3 +824,19 @@ def test_fleet_form_focuses_the_field_the_server_refuses(open_page, field, value
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'error'")
     assert said in p.inner_text("#job-status")
     assert p.evaluate("document.activeElement.id") == field
+
+
+@pytest.mark.parametrize(("field", "value", "said"), [
+    ("weight", "0.5", "weight: Input should be greater than or equal to 1"),
+    ("sx", "9999", "start (9999, 2) lies outside"),
+])
+def test_planner_focuses_the_field_the_server_refuses(open_page, field, value, said):
+    """As on the fleet form: the refused field gets the focus, not the lost button's."""
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "den312d")
+    _type_cells(p, (2, 2), (3, 3))
+    p.fill(f"#{field}", value)
+    p.click("#run")
+    assert said in _wait_status(p, "error")
+    assert p.evaluate("document.activeElement.id") == field

@@ -3,7 +3,7 @@
 //
 // Reads GET /maps and /maps/{name}; plans with POST /plan (one request per algorithm).
 
-import { bindToken, choices, explain, getJSON, postJSON } from "./api.js";
+import { bindToken, choices, explain, focusFault, getJSON, postJSON } from "./api.js";
 import { PALETTE, fmt, h, say } from "./ui.js";
 import { drawScaleBar } from "./view.js";
 
@@ -257,6 +257,7 @@ async function plan() {
     const every = errors.length === results.length && byText.size === 1;
     say(status, [...byText].map(([text, names]) =>
       `${every ? "Planning" : names.join(", ")} ${text}${/[.!?]$/.test(text) ? "" : "."}`).join(" "), "error");
+    focusFault(errors[0].error, { weight: "weight", start: "sx", goal: "gx" });
   } else {
     const found = results.filter((r) => r.answer.status === "found");
     say(status, `Planned (${start.join(", ")}) → (${goal.join(", ")}) with ${results.length} algorithm${results.length > 1 ? "s" : ""}: ` +
