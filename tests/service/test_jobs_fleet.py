@@ -331,6 +331,27 @@ def test_a_range_job_shows_its_progress_while_running(tmp_path, monkeypatch):
 
 
 @needs_jobs
+def test_fleet_runs_say_when_each_was_stored(tmp_path):
+    """Two runs of the same preset, hours and seed differ in the list by when they were
+    stored (the viewer's run list showed them as the same line)."""
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    db = f"sqlite:///{tmp_path / 'runs.db'}"
+    eng = make_engine(db)
+    for _ in range(2):
+        store.save_fleet_run(eng, scenario="seed-3x3", params={"preset": "seed-3x3",
+                             "hours": 0.25, "seed": 1}, report={}, events_jsonl="",
+                             tracks_csv=b"", packages_csv="", fleet_geojson="")
+    want = {r["id"]: r["created"] for r in store.list_fleet_runs(eng)}
+    eng.dispose()
+    with make_client(db_url=db) as c:
+        runs = c.get("/fleet/runs").json()
+    assert {r["id"]: r["created"] for r in runs} == want
+    assert all(want.values()) and len(set(want.values())) == 2
+
+
+@needs_jobs
 @pytest.mark.slow
 def test_a_fleet_job_stores_a_run(tmp_path, small_run):
     with make_client(db_url=f"sqlite:///{tmp_path / 'f.db'}", job_workers=1) as c:

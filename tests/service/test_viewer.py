@@ -6,7 +6,9 @@ photographed at 1280x800 and 360x740 into artefacts/screenshots/ (look at them).
 
 from __future__ import annotations
 
+import contextlib
 import json
+import re
 import shutil
 import socket
 import threading
@@ -48,8 +50,8 @@ def _fleet_run(db: str) -> str | None:
 
 @pytest.fixture(scope="module")
 def server(lunch, tmp_path_factory):
-    """(base URL, fleet run id or None): the app on a free port of 127.0.0.1, in a
-    thread, over a copy of the lunch store with the examples/lunch site."""
+    """(base URL, fleet run id or None, store URL): the app on a free port of 127.0.0.1,
+    in a thread, over a copy of the lunch store with the examples/lunch site."""
     import uvicorn
 
     from skyroute.service.app import create_app
@@ -70,7 +72,7 @@ def server(lunch, tmp_path_factory):
     while not server.started:
         assert thread.is_alive() and time.monotonic() < end, "uvicorn did not start"
         time.sleep(0.02)
-    yield f"http://127.0.0.1:{port}", run_id
+    yield f"http://127.0.0.1:{port}", run_id, db
     server.should_exit = True
     thread.join(10)
     sock.close()
@@ -526,3 +528,315 @@ def test_api_reference_renders_offline(browser, server):
         assert not outside and not errors, (outside, errors)
     finally:
         context.close()
+
+
+def server_has_no_jobs() -> bool:
+    try:
+        import skyroute.jobs  # noqa: F401
+    except ImportError:
+        return True
+    return False
+
+
+def _job_routes(p, job: dict) -> None:
+    """POST /jobs/fleet answers job "job-1"; GET /jobs/job-1 answers ``job`` as it is at
+    each poll (state "unreachable": no answer at all), so a test sets what the server
+    says while the page follows it."""
+    p.route("**/jobs/fleet", lambda r: r.fulfill(status=202, json={"id": "job-1"}))
+
+    def poll(r):
+        if job["state"] == "unreachable":
+            r.abort()
+        else:
+            r.fulfill(json={"id": "job-1", "kind": "fleet", "result": None, "error": None, **job})
+
+    p.route("**/jobs/job-1", poll)
+
+
+def test_fleet_job_shows_it_runs_and_survives_a_reload(open_page, server):
+    """A fleet run is one task: its job says progress 0 until it ends. The page showed
+    "Job running: 0 %" on an empty bar for the whole run, and a reload forgot the job (no
+    word of it, Start enabled). Now the bar moves (indeterminate) with the time taken,
+    and a reload goes on following the job to its run."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    pg = open_page(f"/fleet.html#run={server[1]}", "desktop")
+    p = pg.page
+    job = {"state": "running", "progress": 0.0}
+    _job_routes(p, job)
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    p.fill("#token", TOKEN)
+    p.click("#start")
+    p.wait_for_function("document.querySelector('#job-status').textContent.includes('so far')")
+    assert "0 %" not in p.inner_text("#job-status")
+    assert p.evaluate("document.querySelector('#progress').hasAttribute('value')") is False
+    assert p.is_disabled("#start")
+    p.reload()
+    p.wait_for_function("document.querySelector('#job-status').textContent"
+                        ".startsWith('Job running')", timeout=15_000)
+    assert p.is_disabled("#start")
+    job.update(state="running", progress=0.4)
+    p.wait_for_function("document.querySelector('#job-status').textContent"
+                        ".startsWith('Job running: 40 %')")
+    assert p.evaluate("document.querySelector('#progress').value") == pytest.approx(0.4)
+    job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
+                        " && !document.querySelector('#start').disabled", timeout=15_000)
+    assert p.inner_text("#job-status") == "The run is done and stored."
+    p.reload()  # the job is over: nothing to follow after another reload
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    assert p.inner_text("#job-status") == "" and not p.is_disabled("#start")
+    pg.done("fleet-job")
+
+
+def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):
+    """One unanswered poll (a server restarting, a network blip) ended the following for
+    good: the job's run never showed. Now the page says so and asks again."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    pg = open_page(f"/fleet.html#run={server[1]}", "desktop")
+    p = pg.page
+    job = {"state": "unreachable", "progress": 0.0}
+    _job_routes(p, job)
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    p.fill("#token", TOKEN)
+    p.click("#start")
+    p.wait_for_function("document.querySelector('#job-status').textContent"
+                        ".includes('Asking again')")
+    assert "did not answer" in p.inner_text("#job-status")
+    assert p.is_disabled("#start")
+    job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
+                        " && !document.querySelector('#start').disabled", timeout=15_000)
+
+
+@contextlib.contextmanager
+def _copied_run(server):
+    """A second fleet run in the store, the module's run stored again (same settings);
+    its id. Deleted at the end."""
+    import sqlalchemy as sa
+
+    from skyroute.jobs import store
+
+    eng = sa.create_engine(server[2])
+    run = store.get_fleet_run(eng, server[1])
+    copy = store.save_fleet_run(eng, **{k: run[k] for k in (
+        "scenario", "params", "report", "events_jsonl", "tracks_csv", "packages_csv",
+        "fleet_geojson")})
+    try:
+        yield copy
+    finally:
+        with eng.begin() as c:
+            c.execute(sa.text("DELETE FROM fleet_runs WHERE id = :id"), {"id": copy})
+        eng.dispose()
+
+
+def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
+    """Runs of one preset, hours and seed were the same line in the run list (31 of them
+    could not be told apart); each line now starts with when the run was stored."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    with _copied_run(server) as copy:
+        pg = open_page("/fleet.html", "desktop")
+        p = pg.page
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        labels = p.locator("#run option").all_inner_texts()
+        assert len(labels) == 2 and labels[0] != labels[1], labels
+        assert p.input_value("#run") == copy  # the newest first
+        when = r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d · seed-3x3"
+        assert all(re.match(when, x) for x in labels), labels
+        pg.done("fleet-runs")
+
+
+@pytest.mark.parametrize("page", ["day", "fleet", "planner"])
+def test_the_last_choice_is_shown_when_an_earlier_one_answers_late(open_page, server, page):
+    """A day, run or map chosen, then another before the first had arrived (a large run
+    takes seconds): the first, arriving last, was shown under the second's name in the
+    list. Now only the last choice is drawn."""
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    with contextlib.ExitStack() as stack:
+        if page == "day":
+            first, last, held_url = DAY, "2024-02-01", f"**/days/{DAY}/flightpath.geojson"
+        elif page == "planner":
+            first, last, held_url = "Paris_1_512", "den312d", "**/maps/Paris_1_512"
+        else:
+            first, last = stack.enter_context(_copied_run(server)), server[1]
+            held_url = f"**/fleet/runs/{first}/tracks.csv"
+        key = {"day": "date", "fleet": "run", "planner": "map-name"}[page]
+        if page == "planner":  # no address of its own: the map is chosen first
+            pg = open_page("/planner.html", "desktop")
+            _open_map(pg, last)
+        else:
+            pg = open_page(f"/{page}.html#{key}={last}", "desktop")
+        p = pg.page
+        p.wait_for_function("document.querySelector('#status').dataset.kind !== 'busy'"
+                            " && document.querySelector('#status').textContent", timeout=15_000)
+        held = []
+        p.route(held_url, lambda r: held.append(r))  # the first choice's answer waits
+        p.select_option(f"#{key}", first)
+        for _ in range(200):  # the page asks for it
+            if held:
+                break
+            p.wait_for_timeout(50)
+        assert held and p.evaluate("document.querySelector('#status').dataset.kind") == "busy"
+        p.select_option(f"#{key}", last)
+        p.wait_for_function(f"(location.hash === '#{key}={last}'"
+                            f" || document.querySelector('#status').textContent.includes('{last}'))"
+                            " && document.querySelector('#status').dataset.kind !== 'busy'")
+        shown = p.inner_text("#status"), p.evaluate("location.hash")
+        held[0].continue_()  # now the first choice arrives, last
+        p.wait_for_timeout(1500)
+        assert p.input_value(f"#{key}") == last
+        assert (p.inner_text("#status"), p.evaluate("location.hash")) == shown
+        assert not pg.errors, pg.errors
+
+
+@pytest.mark.parametrize(("path", "named"), [("/day.html#date=2099-01-01", "2099-01-01"),
+                                             ("/fleet.html#run=no-such-run", "no-such-run")])
+def test_a_link_to_what_is_not_stored_says_so(open_page, server, path, named):
+    """A link (an old bookmark) to a day or run the store does not hold showed another
+    day or run without a word; the status line now says the link's one is not stored."""
+    if "fleet" in path and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    pg = open_page(path, "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    text = p.inner_text("#status")
+    assert f"The link names {'run ' if 'fleet' in path else ''}{named}, which is not" in text, text
+    assert "Press Play" in text, text
+    pg.done("link-not-stored")
+
+
+def test_world_plans_with_the_safety_typed(open_page):
+    """A negative safety margin was planned with 0 and answered "Found a path" (the page
+    replaced it); it goes to the server as typed, which refuses it naming the field."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    _load_city(pg)
+    for key, value in (("s0", 172), ("s1", -271), ("g0", -172), ("g1", 270), ("safety", -3)):
+        p.fill(f"#{key}", str(value))
+    p.click("#run")
+    text = _wait_status(p, "error")
+    assert text == "Planning failed (422): safety: Input should be greater than or equal to 0", text
+    assert p.inner_text("#r-status") == "–"
+    assert p.evaluate("document.activeElement.id") == "safety"  # the field at fault
+
+
+def test_planner_new_map_drops_the_old_maps_query(open_page, api):
+    """A query under way when another map was chosen ended on the new map as "Planned
+    (5, 5) -> (60, 70) with 0 algorithm: none found a path." in red, and Plan stayed
+    disabled until it did. The new map's answer is the old query's end now."""
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "Berlin_1_256")
+    held = []
+    p.route("**/plan", lambda r: held.append(r))
+    _type_cells(p, (5, 5), (60, 70))
+    p.click("#run")
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'busy'")
+    p.select_option("#map-name", "den312d")
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('den312d')")
+    assert not p.is_disabled("#run")
+    assert held
+    p.unroute("**/plan")  # (lets the held request go on)
+    p.wait_for_timeout(2000)  # the old query's answers arrive
+    assert p.inner_text("#status").startswith("den312d: 65 × 81 cells"), p.inner_text("#status")
+    assert p.locator("#results tbody tr").count() == 0
+    assert not p.is_disabled("#run")
+
+
+def test_world_new_file_drops_the_old_worlds_plan(open_page):
+    """A plan under way when another world was loaded drew its path (and length and
+    waypoints) over the new world, whose start and goal were cleared. And a pasted world
+    left the file control naming the file chosen before."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    _load_city(pg)
+    held = []
+    p.route("**/plan", lambda r: held.append(r))
+    for key, value in (("s0", 172), ("s1", -271), ("g0", -172), ("g1", 270)):
+        p.fill(f"#{key}", str(value))
+    p.click("#run")
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'busy'")
+    zones = {"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {},
+             "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [0.001, 0], [0.001, 0.001],
+                                                              [0, 0]]]}}]}
+    p.fill("#text", json.dumps(zones))
+    p.dispatch_event("#text", "change")
+    p.wait_for_function("document.querySelector('#status').textContent"
+                        ".startsWith('the pasted text')")
+    # the file control no longer names city.csv, the world it no longer shows
+    assert p.evaluate("document.querySelector('#file').files.length") == 0
+    assert not p.is_disabled("#run")
+    assert held
+    p.unroute("**/plan")  # (lets the held request go on)
+    p.wait_for_timeout(2000)  # the old plan's answer arrives
+    text = p.inner_text("#status")
+    assert text.startswith("the pasted text: 1 obstacles"), text
+    assert p.inner_text("#r-cost") == "–"
+    assert p.locator("#waypoints tbody tr").count() == 0
+
+
+def test_day_page_flies_a_day_as_a_job(open_page, api):
+    """The day page could only show days flown elsewhere (the CLI, or POST /jobs/deliver
+    by hand); it now flies a stored orders' day as a job, follows it and shows it."""
+    if server_has_no_jobs():
+        pytest.skip("skyroute.jobs is not in this tree: no jobs")
+    date = "2024-01-01"  # orders imported with the lunch day, not flown
+    pg = open_page(f"/day.html#date={DAY}", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#time').max > 0")
+    p.click("#start")
+    assert p.inner_text("#job-status") == "Give the date to fly first."
+    assert p.evaluate("document.activeElement.id") == "job-date"
+    p.fill("#job-date", date)
+    p.select_option("#method", "greedy")
+    p.fill("#token", TOKEN)
+    p.click("#start")
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
+                        " && !document.querySelector('#start').disabled", timeout=120_000)
+    assert p.inner_text("#job-status") == "The day is flown and stored."
+    p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{date}:')")
+    report = api.get(f"/days/{date}").json()["report"]
+    assert report["settings"]["method"] == "greedy"
+    assert p.input_value("#date") == date and p.evaluate("location.hash") == f"#date={date}"
+    assert p.locator("#orders tbody tr").count() == report["orders_placed"]
+    assert p.evaluate("document.querySelector('#progress').value") == 1
+    pg.done("day-job")
+
+
+@pytest.mark.parametrize(("field", "value", "said"), [
+    ("hours", "-1", "hours: Input should be greater than 0"),
+    ("hours", "", "hours: Input should be greater than 0"),
+    ("seed", "1.5", "seed: Input should be a valid integer"),
+])
+def test_fleet_form_focuses_the_field_the_server_refuses(open_page, field, value, said):
+    """A refused field was said in the status line while the focus stayed on Start: the
+    field is now focused (as the Token field is for a 401), so a keyboard or screen
+    reader user is at what to fix."""
+    pg = open_page("/fleet.html", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#preset').options.length > 0")
+    p.fill("#token", TOKEN)
+    p.fill(f"#{field}", value)
+    p.click("#start")
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'error'")
+    assert said in p.inner_text("#job-status")
+    assert p.evaluate("document.activeElement.id") == field
+
+
+@pytest.mark.parametrize(("field", "value", "said"), [
+    ("weight", "0.5", "weight: Input should be greater than or equal to 1"),
+    ("sx", "9999", "start (9999, 2) lies outside"),
+])
+def test_planner_focuses_the_field_the_server_refuses(open_page, field, value, said):
+    """As on the fleet form: the refused field gets the focus, not the lost button's."""
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "den312d")
+    _type_cells(p, (2, 2), (3, 3))
+    p.fill(f"#{field}", value)
+    p.click("#run")
+    assert said in _wait_status(p, "error")
+    assert p.evaluate("document.activeElement.id") == field

@@ -26,6 +26,9 @@ class RunSummary(BaseModel):
     scenario: str | None = Field(None, description="The scenario's name.")
     params: dict[str, Any] | None = None
     report: dict[str, Any] | None = None
+    created: str | None = Field(None, description="When the run was stored (ISO 8601, "
+                                "UTC): runs of the same scenario, hours and seed differ "
+                                "by it.")
 
 
 class Run(BaseModel):
@@ -106,7 +109,7 @@ def list_runs(res: ResourcesDep) -> list[dict]:
         name = sc.get("name") if isinstance(sc, dict) else sc
         out.append({"id": str(r["id"]), "scenario": name,
                     "params": _as_dict(r.get("params")),
-                    "report": _as_dict(r.get("report"))})
+                    "report": _as_dict(r.get("report")), "created": r.get("created")})
     return out
 
 

@@ -86,6 +86,17 @@ export function explain(err, what = "the request") {
   return `${what} failed (${err.status}): ${err.detail}`;
 }
 
+/** Move the focus to the control at fault for ``err``: the Token field for a 401 or 403,
+ * else the control of the field a 422 names (``err.field``'s first part: `start` of
+ * `start[0]`) among ``controls`` ({field: element id}). */
+export function focusFault(err, controls = {}) {
+  const status = err && err.status;
+  const id = status === 401 || status === 403 ? "token"
+    : err && typeof err.field === "string" ? controls[err.field.split(/[.[]/)[0]] : undefined;
+  const el = id ? document.getElementById(id) : null;
+  if (el) el.focus();
+}
+
 let spec = null;
 
 /** The choices the server's OpenAPI schema lists for ``schema.property`` (so the pages

@@ -1,15 +1,18 @@
 // The delivery day page: a stored day's flight over the site (no-fly zones, confinement
 // area, shops, customers), animated move by move, with the orders and the money so far.
 //
-// Reads GET /days, /site.geojson, /days/{date} and /days/{date}/flightpath.geojson.
+// Reads GET /days, /site.geojson, /days/{date} and /days/{date}/flightpath.geojson; flies
+// a day with POST /jobs/deliver and follows GET /jobs/{id}.
 
-import { ApiError, explain, getJSON } from "./api.js";
+import { ApiError, bindToken, choices, explain, focusFault, getJSON, postJSON } from "./api.js";
+import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
 import { fmt, h, pounds, say } from "./ui.js";
 import { MapView, bbox, dot, grow, label, localProjection } from "./view.js";
 
 const $ = (id) => document.getElementById(id);
 const status = $("status");
+const jobStatus = $("job-status");
 const select = $("date");
 const tbody = document.querySelector("#orders tbody");
 
@@ -17,6 +20,7 @@ let site = null; // {zones: [[ring, ...]], confinement: ring|null, home, shops, 
 let day = null; // the loaded day, see load()
 let proj = null;
 let t = 0;
+let loading = 0; // counts the days asked for: only the last one asked is shown
 
 const view = new MapView($("map"), { draw: drawMap });
 const player = new Player({
@@ -59,14 +63,50 @@ function siteFrom(doc) {
   return s;
 }
 
-async function start() {
+/** Fill the day list (``wanted`` chosen when stored); false when there is none to show. */
+async function listDays(wanted = null) {
   let days;
   try {
     days = await getJSON("/days");
   } catch (err) {
     say(status, explain(err, "Reading the stored days"), "error");
-    return;
+    return false;
   }
+  if (!days.length) {
+    select.replaceChildren(h("option", {}, "no stored days"));
+    select.disabled = true;
+    say(status, "The store holds no delivery day yet: fly one below (or with `skyroute deliver DATE " +
+      "--data DIR --db URL`).", "info");
+    return false;
+  }
+  select.replaceChildren(...days.map((d) => h("option", { value: d.date },
+    `${d.date} · ${d.money_pct === null ? "no orders" : `${fmt(d.money_pct, 1)} %`}`)));
+  select.disabled = false;
+  if (wanted && days.some((d) => d.date === wanted)) select.value = wanted;
+  return true;
+}
+
+async function start() {
+  const methods = await choices("DeliverJob", "method", ["milp", "greedy"]);
+  $("method").replaceChildren(...methods.map((m) => h("option", { value: m }, m)));
+  select.addEventListener("change", () => load(select.value));
+  const job = jobs.remembered(); // a day flown before a reload: followed after the list
+  if (job) {
+    $("start").disabled = true;
+    say(jobStatus, "Following the day being flown since before this page was loaded…", "busy");
+  }
+  const wanted = new URLSearchParams(location.hash.slice(1)).get("date");
+  if (await listDays(wanted)) {
+    await loadSite();
+    // a link to a day the store does not hold says so, not just shows another day
+    await load(select.value, wanted && select.value !== wanted ? `The link names ${wanted}, which is ` +
+      `not a stored day; this is ${select.value}. ` : "");
+  }
+  if (job) await jobs.follow(job);
+}
+
+async function loadSite() {
+  if (site) return;
   try {
     site = siteFrom(await getJSON("/site.geojson"));
   } catch (err) {
@@ -75,23 +115,46 @@ async function start() {
       : explain(err, "reading the site");
     say(status, `No site to draw (${why}): the flight is shown alone.`, "info");
   }
-  if (!days.length) {
-    select.replaceChildren(h("option", {}, "no stored days"));
-    say(status, "The store holds no delivery day yet: fly one with `skyroute deliver DATE --data DIR --db URL` " +
-      "or POST /jobs/deliver.", "info");
-    return;
-  }
-  select.replaceChildren(...days.map((d) => h("option", { value: d.date },
-    `${d.date} · ${d.money_pct === null ? "no orders" : `${fmt(d.money_pct, 1)} %`}`)));
-  select.disabled = false;
-  const wanted = new URLSearchParams(location.hash.slice(1)).get("date");
-  if (wanted && days.some((d) => d.date === wanted)) select.value = wanted;
-  select.addEventListener("change", () => load(select.value));
-  await load(select.value);
 }
 
-async function load(date) {
+// -- flying a day as a job -------------------------------------------------------
+const jobs = new JobFollower({
+  key: "skyroute.dayJob", bar: $("progress"), line: jobStatus, button: $("start"),
+  what: "the day", done: "The day is flown and stored.",
+  onDone: async (r) => {
+    if (!(await listDays(r.from))) return;
+    await loadSite();
+    await load(select.value);
+  },
+});
+bindToken($("token"));
+
+$("job").addEventListener("submit", async (ev) => {
+  ev.preventDefault();
+  const date = $("job-date").value;
+  if (!date) {
+    say(jobStatus, "Give the date to fly first.", "error");
+    $("job-date").focus();
+    return;
+  }
+  $("start").disabled = true;
+  $("progress").value = 0;
+  say(jobStatus, `Submitting ${date}…`, "busy");
+  let id;
+  try {
+    ({ id } = await postJSON("/jobs/deliver", { date, method: $("method").value }));
+  } catch (err) {
+    say(jobStatus, explain(err, `Flying ${date}`), "error");
+    focusFault(err, { date: "job-date", method: "method" });
+    $("start").disabled = false;
+    return;
+  }
+  await jobs.start(id);
+});
+
+async function load(date, note = "") {
   player.pause();
+  const mine = ++loading;
   say(status, `Loading ${date}…`, "busy");
   let detail, flight;
   try {
@@ -100,9 +163,10 @@ async function load(date) {
       getJSON(`/days/${encodeURIComponent(date)}/flightpath.geojson`),
     ]);
   } catch (err) {
-    say(status, explain(err, `Reading ${date}`), "error");
+    if (mine === loading) say(status, explain(err, `Reading ${date}`), "error");
     return;
   }
+  if (mine !== loading) return; // another day was chosen while this one was read
   history.replaceState(null, "", `#date=${date}`);
   const feature = flight.features[0];
   const coords = feature.geometry ? feature.geometry.coordinates : [];
@@ -135,10 +199,10 @@ async function load(date) {
   fillOrders();
   player.load(moves, 1);
   if (moves) {
-    say(status, `${date}: ${moves} moves, ${detail.report.orders_delivered} of ${detail.report.orders_placed} ` +
-      `orders delivered, ${fmt(detail.report.money_pct, 1)} % of the money. Press Play to fly it.`, "ok");
+    say(status, `${note}${date}: ${moves} moves, ${detail.report.orders_delivered} of ${detail.report.orders_placed} ` +
+      `orders delivered, ${fmt(detail.report.money_pct, 1)} % of the money. Press Play to fly it.`, note ? "info" : "ok");
   } else {
-    say(status, `${date}: the drone did not fly (${detail.report.orders_placed
+    say(status, `${note}${date}: the drone did not fly (${detail.report.orders_placed
       ? `none of the ${detail.report.orders_placed} orders could be delivered` : "no orders were placed"}), ` +
       "so there is nothing to play.", "info");
   }

@@ -5,8 +5,9 @@
 // Reads GET /fleet/runs, /fleet/runs/{id}, its tracks.csv, events.jsonl, fleet.geojson
 // and packages.csv; starts runs with POST /jobs/fleet and follows GET /jobs/{id}.
 
-import { ApiError, bindToken, choices, explain, getJSON, getText, postJSON } from "./api.js";
+import { ApiError, bindToken, choices, explain, focusFault, getJSON, getText, postJSON } from "./api.js";
 import { EventFold, dronesAt, parseEvents, parseRoutes, parseTracks, trail } from "./fleetstate.js";
+import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
 import { PALETTE, clock, fmt, h, say } from "./ui.js";
 import { MapView, bbox, dot, grow, label, localProjection } from "./view.js";
@@ -23,6 +24,8 @@ let runs = [];
 let run = null; // {id, tracks, fold, ground, drones, horizon}
 let t = 0;
 let lastTables = 0;
+let loading = 0; // counts the runs asked for: only the last one asked is shown
+let missing = null; // a run the page's link (#run=) names that the store does not hold
 
 const view = new MapView($("map"), { draw: drawMap });
 const player = new Player({
@@ -49,7 +52,15 @@ function colour(d, count) {
   return `hsl(${(d * 137.508) % 360}, 65%, 42%)`;
 }
 
-function runLabel(r) {
+function stored(iso) {
+  const d = new Date(iso);
+  if (!iso || Number.isNaN(d.getTime())) return null;
+  const two = (n) => String(n).padStart(2, "0");
+  return `${d.getFullYear()}-${two(d.getMonth() + 1)}-${two(d.getDate())} ` +
+    `${two(d.getHours())}:${two(d.getMinutes())}:${two(d.getSeconds())}`;
+}
+
+function runLabel(r, { when = true } = {}) {
   const p = r.params || {};
   const rep = r.report || {};
   const hours = p.hours ?? rep.simulated_hours;
@@ -58,7 +69,8 @@ function runLabel(r) {
   if (hours !== undefined) parts.push(`${fmt(hours, 2)} h`);
   if (seed !== undefined) parts.push(`seed ${seed}`);
   if (rep.delivered !== undefined) parts.push(`${rep.delivered}/${rep.offered} delivered`);
-  return parts.join(" · ");
+  const at = when ? stored(r.created) : null; // runs of the same settings differ by it
+  return (at ? [at, ...parts] : parts).join(" · ");
 }
 
 async function listRuns(select = null) {
@@ -77,18 +89,26 @@ async function listRuns(select = null) {
     say(status, "No fleet run is stored yet: start one below.", "info");
     return false;
   }
-  runSelect.replaceChildren(...runs.map((r) => h("option", { value: r.id }, runLabel(r))));
+  // a label twice (runs stored in one second, or by a server without their time) gets
+  // the run's id, so that every run in the list can be told apart
+  const labels = runs.map((r) => runLabel(r));
+  const twice = new Set(labels.filter((x, i) => labels.indexOf(x) !== i));
+  runSelect.replaceChildren(...runs.map((r, i) => h("option", { value: r.id },
+    twice.has(labels[i]) ? `${labels[i]} · run ${String(r.id).slice(0, 8)}` : labels[i])));
   runSelect.disabled = false;
-  const wanted = select || new URLSearchParams(location.hash.slice(1)).get("run");
+  const linked = select ? null : new URLSearchParams(location.hash.slice(1)).get("run");
+  const wanted = select || linked;
   if (wanted && runs.some((r) => String(r.id) === wanted)) runSelect.value = wanted;
+  else if (linked) missing = linked;
   return true;
 }
 
 async function load(id) {
   player.pause();
+  const mine = ++loading;
   const entry = runs.find((r) => String(r.id) === String(id)) || { id };
   const base = `/fleet/runs/${encodeURIComponent(id)}`;
-  say(status, `Loading run ${runLabel(entry)}…`, "busy");
+  say(status, `Loading run ${runLabel(entry, { when: false })}…`, "busy");
   let detail, tracksText, eventsText, geo, routesText;
   try {
     [detail, tracksText, eventsText, geo, routesText] = await Promise.all([
@@ -97,9 +117,10 @@ async function load(id) {
       getText(`${base}/packages.csv`).catch(() => null), // routes known from the start (else from events)
     ]);
   } catch (err) {
-    say(status, explain(err, "Reading the run"), "error");
+    if (mine === loading) say(status, explain(err, "Reading the run"), "error");
     return;
   }
+  if (mine !== loading) return; // another run was chosen while this one was read
   const scenario = [detail.scenario, (detail.params || {}).scenario, (entry.params || {}).scenario]
     .find((s) => s && typeof s === "object" && s.home_lon !== undefined);
   if (!scenario) {
@@ -141,7 +162,7 @@ async function load(id) {
   let b = bbox(pts);
   for (let i = 0; i < tracks.n; i++) b = bbox([[tracks.east[i], tracks.north[i]]], b);
   run = {
-    id, name: runLabel(entry), tracks, drones, horizon, ground,
+    id, name: runLabel(entry, { when: false }), tracks, drones, horizon, ground,
     fold: new EventFold(events, routesText ? parseRoutes(routesText) : null),
   };
   history.replaceState(null, "", `#run=${encodeURIComponent(id)}`);
@@ -152,7 +173,10 @@ async function load(id) {
   $("s-safety").textContent = rep.loiters === undefined ? "–" : `${rep.loiters}, ${rep.conflicts}`;
   view.setBounds(grow(b, 0.04, 50));
   player.load(horizon, tracks.step);
-  say(status, `${run.name}: ${clock(horizon)} of flying, ${events.length} events. Press Play or move the time slider.`, "ok");
+  const note = missing ? `The link names run ${missing}, which is not stored; this is the newest. ` : "";
+  missing = null;
+  say(status, `${note}${run.name}: ${clock(horizon)} of flying, ${events.length} events. Press Play or move the time slider.`,
+    note ? "info" : "ok");
 }
 
 function tables() {
@@ -247,6 +271,15 @@ function drawMap(ctx, v) {
 }
 
 // -- new runs as jobs --------------------------------------------------------------
+const jobs = new JobFollower({
+  key: "skyroute.fleetJob", bar: $("progress"), line: jobStatus, button: $("start"),
+  what: "the run", done: "The run is done and stored.",
+  onDone: async (r) => {
+    const runId = r.fleet_run ?? r.run_id ?? r.id;
+    if (runId !== undefined && (await listRuns(String(runId)))) await load(runSelect.value);
+  },
+});
+
 $("job").addEventListener("submit", async (ev) => {
   ev.preventDefault();
   const body = {
@@ -261,42 +294,12 @@ $("job").addEventListener("submit", async (ev) => {
     ({ id } = await postJSON("/jobs/fleet", body));
   } catch (err) {
     say(jobStatus, explain(err, "Starting the run"), "error");
-    if (err.status === 401 || err.status === 403) $("token").focus();
+    focusFault(err, { hours: "hours", seed: "seed", preset: "preset", scheduler: "scheduler" });
     $("start").disabled = false;
     return;
   }
-  try {
-    await follow(id);
-  } finally {
-    $("start").disabled = false;
-  }
+  await jobs.start(id);
 });
-
-async function follow(id) {
-  for (;;) {
-    let job;
-    try {
-      job = await getJSON(`/jobs/${encodeURIComponent(id)}`);
-    } catch (err) {
-      say(jobStatus, explain(err, "Following the job"), "error");
-      return;
-    }
-    $("progress").value = job.progress || 0;
-    if (job.state === "failed") {
-      say(jobStatus, `The run failed: ${job.error || "no reason given"}`, "error");
-      return;
-    }
-    if (job.state === "done") {
-      const r = job.result || {};
-      const runId = r.fleet_run ?? r.run_id ?? r.id;
-      say(jobStatus, "The run is done and stored.", "ok");
-      if (runId !== undefined && (await listRuns(String(runId)))) await load(runSelect.value);
-      return;
-    }
-    say(jobStatus, `Job ${job.state}: ${fmt(100 * (job.progress || 0), 0)} %`, "busy");
-    await new Promise((resolve) => setTimeout(resolve, 500));
-  }
-}
 
 async function start() {
   const [presets, schedulers] = await Promise.all([
@@ -307,7 +310,13 @@ async function start() {
   $("scheduler").replaceChildren(...schedulers.map((s) => h("option", { value: s }, s)));
   runSelect.addEventListener("change", () => load(runSelect.value));
   view.setBounds([0, 0, 1000, 600]);
+  const job = jobs.remembered(); // a run started before a reload: followed after the list
+  if (job) {
+    $("start").disabled = true;
+    say(jobStatus, "Following the run started before this page was loaded…", "busy");
+  }
   if (await listRuns()) await load(runSelect.value);
+  if (job) await jobs.follow(job);
 }
 
 start();

@@ -3,7 +3,7 @@
 //
 // Reads GET /maps and /maps/{name}; plans with POST /plan (one request per algorithm).
 
-import { bindToken, choices, explain, getJSON, postJSON } from "./api.js";
+import { bindToken, choices, explain, focusFault, getJSON, postJSON } from "./api.js";
 import { PALETTE, fmt, h, say } from "./ui.js";
 import { drawScaleBar } from "./view.js";
 
@@ -21,6 +21,7 @@ let grid = null; // {name, width, height, free: Uint8Array, image: canvas}
 let cell = 1; // CSS pixels per cell
 let results = []; // [{algorithm, colour, answer|null, error|null}]
 let round = 0; // discards answers of an older query
+let loading = 0; // counts the maps asked for: only the last one asked is shown
 
 bindToken($("token"));
 
@@ -32,14 +33,18 @@ function terrain(ch, passable) {
 }
 
 async function loadMap(name) {
+  const mine = ++loading;
   say(status, `Loading ${name}…`, "busy");
   let doc;
   try {
     doc = await getJSON(`/maps/${encodeURIComponent(name)}`);
   } catch (err) {
-    say(status, explain(err, `Reading map ${name}`), "error");
+    if (mine === loading) say(status, explain(err, `Reading map ${name}`), "error");
     return;
   }
+  if (mine !== loading) return; // another map was chosen while this one was read
+  round++; // a query on the old map still under way: its answers are dropped
+  $("run").disabled = false;
   const { width, height, rows } = doc;
   const passable = doc.passable || ".G";
   const free = new Uint8Array(width * height);
@@ -252,6 +257,7 @@ async function plan() {
     const every = errors.length === results.length && byText.size === 1;
     say(status, [...byText].map(([text, names]) =>
       `${every ? "Planning" : names.join(", ")} ${text}${/[.!?]$/.test(text) ? "" : "."}`).join(" "), "error");
+    focusFault(errors[0].error, { weight: "weight", start: "sx", goal: "gx" });
   } else {
     const found = results.filter((r) => r.answer.status === "found");
     say(status, `Planned (${start.join(", ")}) → (${goal.join(", ")}) with ${results.length} algorithm${results.length > 1 ? "s" : ""}: ` +

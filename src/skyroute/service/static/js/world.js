@@ -5,7 +5,7 @@
 // A colliders world is planned in the "ned" frame (points are north, east metres from the
 // file's lat0, lon0); GeoJSON zones in "lonlat" (points are lon, lat).
 
-import { bindToken, choices, explain, postJSON } from "./api.js";
+import { bindToken, choices, explain, focusFault, postJSON } from "./api.js";
 import { download, fmt, h, say } from "./ui.js";
 import { MapView, bbox, grow, localProjection } from "./view.js";
 
@@ -67,6 +67,8 @@ function detect(text) {
 }
 
 function loadText(text, name) {
+  round++; // a plan on the old world still under way: its answer is dropped
+  $("run").disabled = false;
   answer = null;
   clearResult();
   if (!text.trim()) {
@@ -277,7 +279,10 @@ $("file").addEventListener("change", async () => {
   $("text").value = text;
   loadText(text, f.name);
 });
-$("text").addEventListener("change", () => loadText($("text").value, "the pasted text"));
+$("text").addEventListener("change", () => {
+  $("file").value = ""; // the file chosen before is not the world any more
+  loadText($("text").value, "the pasted text");
+});
 $("format").addEventListener("change", () => loadText($("text").value, world ? world.name : "the text"));
 $("algorithm").addEventListener("change", () => {
   $("resolution-field").hidden = ["visibility", "prm"].includes($("algorithm").value);
@@ -302,7 +307,9 @@ async function plan() {
   }
   const body = {
     world_text: world.text, world_format: world.format, frame: world.frame, start, goal,
-    algorithm: $("algorithm").value, safety: safety(),
+    // the margin as typed: a negative one is the server's to refuse, not the page's to
+    // replace by 0 (the drawing does, as it cannot shrink the obstacles)
+    algorithm: $("algorithm").value, safety: $("safety").value === "" ? 0 : Number($("safety").value),
   };
   if ($("altitude").value !== "") body.altitude = Number($("altitude").value);
   if (!$("resolution-field").hidden && $("resolution").value !== "") body.resolution = Number($("resolution").value);
@@ -327,7 +334,8 @@ async function plan() {
   } catch (err) {
     if (mine !== round) return;
     say(status, explain(err, "Planning"), "error");
-    if (err.status === 401 || err.status === 403) $("token").focus();
+    focusFault(err, { safety: "safety", altitude: "altitude", resolution: "resolution", start: "s0",
+      goal: "g0", algorithm: "algorithm", world_text: "text" });
   } finally {
     if (mine === round) $("run").disabled = false;
     view.render();
