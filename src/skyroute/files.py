@@ -1,4 +1,4 @@
-"""Write a file whole or not at all."""
+"""Read a text file (UTF-8, a byte-order mark read past); write a file whole or not at all."""
 
 from __future__ import annotations
 
@@ -7,9 +7,40 @@ import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import BinaryIO
+from typing import BinaryIO, TextIO
 
-from skyroute.errors import OptionError, SkyrouteError
+from skyroute.errors import InputFormatError, OptionError, SkyrouteError
+
+BOM = "\ufeff"  # a UTF-8 byte-order mark: Excel's "CSV UTF-8" and Notepad start with one
+
+
+def read_text(path: str | Path) -> str:
+    """``path``'s text, read as UTF-8 with a byte-order mark read past (every input
+    reader comes through here, so a first field never reads as ``'\\ufefforderNo'``)
+    and CRLF read as LF; a file that cannot be read or is not UTF-8 is an
+    :class:`InputFormatError` naming it."""
+    try:
+        return Path(path).read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise InputFormatError(path, f"cannot read: not UTF-8 text ({exc.reason} at "
+                               f"byte {exc.start})") from None
+
+
+def open_text(path: str | Path) -> TextIO:
+    """``path`` open for reading as :mod:`csv` wants it (``newline=""``), UTF-8 with a
+    byte-order mark read past, for a file read row by row; the caller turns OSError
+    and UnicodeDecodeError into an error naming the file."""
+    return Path(path).open(encoding="utf-8-sig", newline="")
+
+
+def strip_bom(data: str | bytes) -> str | bytes:
+    """``data`` without a leading byte-order mark: text already in hand (an upload, an
+    HTTP answer) or bytes."""
+    if isinstance(data, bytes):
+        return data.removeprefix(BOM.encode())
+    return data.removeprefix(BOM)
 
 
 def _umask() -> int:

@@ -6,6 +6,7 @@ whose own ``data synth`` command writes it.)"""
 from __future__ import annotations
 
 import json
+import shutil
 
 import pytest
 
@@ -57,6 +58,54 @@ def test_http_source_gives_the_same_day(tmp_path, fly_once):
         server.server_close()
     with pytest.raises(SkyrouteError, match="cannot reach the data server"):
         load_site(HttpSource(url))
+
+
+@pytest.fixture
+def bom_data(tmp_path):
+    """examples/lunch with every CSV, JSON and GeoJSON file saved as Excel's "CSV UTF-8"
+    and Notepad save it: a byte-order mark first, CRLF line ends."""
+    data = tmp_path / "lunch"
+    shutil.copytree(EXAMPLE, data)
+    for p in data.rglob("*"):
+        if p.is_file():
+            p.write_bytes(b"\xef\xbb\xbf" + p.read_bytes().replace(b"\n", b"\r\n"))
+    return data
+
+
+def test_orders_saved_with_a_byte_order_mark_read_the_same(bom_data):
+    # the mark was read as part of the first column's name: header ['\\ufefforderNo', ...]
+    assert read_csv_orders(bom_data) == read_csv_orders(EXAMPLE)
+
+
+@pytest.mark.parametrize("over_http", [False, True])
+def test_a_website_saved_with_byte_order_marks_reads_the_same(bom_data, over_http):
+    # menus.json, area.json and every details.json failed json.loads: "Unexpected UTF-8 BOM"
+    plain = load_site(DirSource(EXAMPLE))
+    server, url = serve_in_thread(bom_data) if over_http else (None, None)
+    try:
+        site = load_site(HttpSource(url) if over_http else DirSource(bom_data))
+        assert site.menu == plain.menu and site.shops == plain.shops
+        assert site.home == plain.home
+        assert list(site.world.obstacles) == list(plain.world.obstacles)
+    finally:
+        if server is not None:
+            server.shutdown()
+            server.server_close()
+
+
+def test_orders_not_in_utf8_are_one_line_naming_the_file(monkeypatch, capsys, tmp_path):
+    # an orders.csv saved as Latin-1 (an accented name) was a UnicodeDecodeError traceback
+    data = tmp_path / "data"
+    shutil.copytree(EXAMPLE, data)
+    p = data / "database" / "orders.csv"
+    p.write_bytes(p.read_bytes().replace(b"\n", b"\xe9\n", 2))
+    code, out, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", str(data),
+                         "--db", f"sqlite:///{tmp_path / 'x.db'}", "--out",
+                         str(tmp_path / "out"), "--no-plot")
+    assert code == 2 and out == ""
+    assert err.strip() == f"skyroute: error: {p}: cannot read: not UTF-8 text " \
+        f"(invalid continuation byte at byte {p.read_bytes().index(0xE9)})"
+    assert not (tmp_path / "out").exists()
 
 
 def test_missing_words_file_makes_the_order_invalid_not_the_day(monkeypatch, capsys, tmp_path):

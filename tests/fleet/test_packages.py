@@ -168,3 +168,17 @@ def test_poisson_takes_numpy_numbers(nine):
                          rate_per_hour=np.array(60.0))
     b = packages.poisson(nine, hours=1.0, seed=3, rate_per_hour=60.0)
     assert np.array_equal(a.t, b.t)
+
+
+def test_a_csv_saved_with_a_byte_order_mark_and_crlf_reads_the_same(tmp_path, nine):
+    # Excel's "CSV UTF-8": the mark was read as part of the first column's name, and the
+    # header refused ("header must be t,from_airport,...")
+    a, b = (x.id for x in nine.airports[:2])
+    text = HEADER + f"10,{a},0,{b},1\n20,{b},1,{a},0\n"
+    plain = packages.read_csv(write(tmp_path, text), nine)
+    p = tmp_path / "excel.csv"
+    p.write_bytes(b"\xef\xbb\xbf" + text.replace("\n", "\r\n").encode())
+    got = packages.read_csv(p, nine)
+    assert len(got) == len(plain) == 2
+    for name in ("t", "origin", "origin_gate", "destination", "destination_gate"):
+        assert np.array_equal(getattr(got, name), getattr(plain, name))

@@ -56,6 +56,24 @@ def test_toml_scenarios_load(tmp_path):
     assert s.drones == 2 and s.airport("B").north == 3000 and s.drone.rollout == 192.0
 
 
+@pytest.mark.parametrize("suffix", [".toml", ".yaml"])
+def test_a_scenario_saved_with_a_byte_order_mark_and_crlf_loads(tmp_path, suffix):
+    # Notepad's "UTF-8 with BOM": tomllib refused the mark ("not TOML: Invalid statement
+    # (at line 1, column 1)"); PyYAML reads past it on its own
+    text = ('drones = 2\n[[airports]]\nid = "A"\nnorth = 0\neast = 0\n'
+            'landing = {heading_deg = 90}\ntakeoff = {heading_deg = 180}\n'
+            '[[airports]]\nid = "B"\nnorth = 3000\neast = 0\n'
+            'landing = {heading_deg = 0}\ntakeoff = {heading_deg = 270}\n')
+    plain = tmp_path / "s.toml"
+    plain.write_text(text)
+    want = sc.load_scenario(plain)
+    if suffix == ".yaml":
+        text = sc.to_yaml(want)
+    p = tmp_path / f"bom{suffix}"
+    p.write_bytes(b"\xef\xbb\xbf" + text.replace("\n", "\r\n").encode())
+    assert sc.load_scenario(p) == want
+
+
 @pytest.mark.parametrize("edit, words", [
     (lambda y: y.replace("cruise_speed: 50.0", "cruise_sped: 50.0"),
      "drone.cruise_sped: unknown key; did you mean cruise_speed? valid: cruise_speed, "

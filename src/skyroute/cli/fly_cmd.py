@@ -17,7 +17,7 @@ from skyroute.cli import world_args as wa
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console, print_table
 from skyroute.errors import OptionError, check_choice, real
-from skyroute.files import write_atomic
+from skyroute.files import read_text, write_atomic
 from skyroute.io.geojson import dumps
 from skyroute.planner import plan
 from skyroute.result import PlanResult, Status
@@ -277,10 +277,7 @@ def _read_targets(path: Path, world) -> np.ndarray:
     list of [A, B]; errors name the file and line."""
     from skyroute.errors import InputFormatError
 
-    try:  # utf-8-sig: Excel's "CSV UTF-8" starts with a byte-order mark
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputFormatError(path, f"cannot read: {exc}") from None
+    text = read_text(path)  # Excel's "CSV UTF-8" starts with a byte-order mark
     if path.suffix.lower() == ".json":
         try:
             pts = np.asarray(json.loads(text), dtype=float)

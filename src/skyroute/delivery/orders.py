@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
+import io
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
 
 from skyroute.delivery.site import check_place
 from skyroute.errors import InputFormatError
+from skyroute.files import read_text
 
 CHARGE = 50
 MAX_ITEMS = 4
@@ -72,19 +74,18 @@ def _rows(path: Path, header: list[str]):
     """(line number, row) of a CSV with exactly ``header``'s columns."""
     if not path.is_file():
         raise InputFormatError(path, "no such file")
-    with path.open(newline="") as f:
-        reader = csv.reader(f)
-        first = next(reader, None)
-        if first != header:
-            raise InputFormatError(path, f"header {first!r}; expected {header!r}", line=1)
-        for row in reader:
-            if not row:
-                continue
-            if len(row) != len(header) or not all(v.strip() for v in row):
-                raise InputFormatError(path, f"expected {len(header)} non-empty fields "
-                                       f"({', '.join(header)}), found {row!r}",
-                                       line=reader.line_num)
-            yield reader.line_num, [v.strip() for v in row]
+    reader = csv.reader(io.StringIO(read_text(path)))  # a byte-order mark read past
+    first = next(reader, None)
+    if first != header:
+        raise InputFormatError(path, f"header {first!r}; expected {header!r}", line=1)
+    for row in reader:
+        if not row:
+            continue
+        if len(row) != len(header) or not all(v.strip() for v in row):
+            raise InputFormatError(path, f"expected {len(header)} non-empty fields "
+                                   f"({', '.join(header)}), found {row!r}",
+                                   line=reader.line_num)
+        yield reader.line_num, [v.strip() for v in row]
 
 
 def read_csv_orders(root: Path) -> list[Order]:

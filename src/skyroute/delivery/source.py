@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from skyroute.errors import InputFormatError, OptionError, SkyrouteError
+from skyroute.files import read_text, strip_bom
 
 TIMEOUT = 5.0  # seconds per request
 
@@ -28,10 +29,7 @@ class DirSource:
         p = self.root / "website" / path
         if not p.is_file():
             raise InputFormatError(p, "no such file")
-        try:
-            return p.read_text()
-        except (OSError, UnicodeDecodeError) as exc:
-            raise InputFormatError(p, f"cannot read: {exc}") from None
+        return read_text(p)  # a byte-order mark (Notepad, Excel) read past
 
 
 @dataclass(frozen=True)
@@ -56,7 +54,7 @@ class HttpSource:
             raise InputFormatError(url, "no such file (HTTP 404)")
         if r.status_code != 200:
             raise SkyrouteError(f"{url}: HTTP {r.status_code}")
-        return r.text
+        return strip_bom(r.text)
 
 
 _CLIENT = None

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError, real, whole
+from skyroute.files import open_text
 from skyroute.fleet.limits import MAX_PACKAGES, expected_packages
 from skyroute.fleet.scenario import Scenario
 
@@ -96,7 +97,7 @@ def read_csv(path: str | Path, scenario: Scenario) -> Stream:
     ids = {a.id: k for k, a in enumerate(scenario.airports)}
     rows = []
     try:
-        with p.open(newline="") as fh:
+        with open_text(p) as fh:  # a byte-order mark (Excel's "CSV UTF-8") read past
             reader = csv.reader(fh)
             header = next(reader, None)
             if header is None or tuple(h.strip() for h in header) != CSV_HEADER:

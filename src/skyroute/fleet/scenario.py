@@ -30,6 +30,7 @@ from pydantic import (
 )
 
 from skyroute.errors import InputFormatError, OptionError, real, whole
+from skyroute.files import read_text
 from skyroute.fleet.limits import (
     MAX_AIRPORTS,
     MAX_AREA_KM,
@@ -298,10 +299,7 @@ def short_takeoff_runway(airports, roll: float) -> int | None:
 def load_scenario(path: str | Path) -> Scenario:
     """Read a YAML (.yaml, .yml) or TOML (.toml) scenario; errors name file and field."""
     p = Path(path)
-    try:
-        text = p.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputFormatError(p, f"cannot read: {exc}") from None
+    text = read_text(p)  # a byte-order mark (Notepad) read past
     if p.suffix.lower() == ".toml":
         try:
             data = tomllib.loads(text)

@@ -21,6 +21,7 @@ import numpy as np
 import shapely
 
 from skyroute.errors import InputFormatError
+from skyroute.files import read_text, strip_bom
 from skyroute.geo import Home
 from skyroute.world.points import MAX_METRES
 from skyroute.world.world import World
@@ -37,13 +38,13 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
     plane is east/north metres around home at (lon0, lat0)). ``text``: the file's content,
     already in hand (an upload); ``path`` then only names it in errors."""
     source, path = str(path), Path(path)
-    try:  # utf-8-sig: Excel starts a saved CSV with a byte-order mark
-        if text is None:
+    if text is None:
+        try:
             _check_bytes(path, path.stat().st_size)
-            text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputFormatError(path, f"cannot read: {exc}") from None
-    lines = text.removeprefix("\ufeff").splitlines()
+        except OSError as exc:
+            raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
+        text = read_text(path)  # Excel starts a saved CSV with a byte-order mark
+    lines = strip_bom(text).splitlines()
     boxes = sum(1 for line in lines[2:] if line.strip())
     if boxes > MAX_BOXES:
         raise InputFormatError(path, f"{boxes:,} boxes, over the limit of {MAX_BOXES:,} in a "

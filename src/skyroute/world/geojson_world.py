@@ -23,6 +23,7 @@ import numpy as np
 import shapely
 
 from skyroute.errors import InputFormatError, OptionError, QueryError, check_choice
+from skyroute.files import read_text, strip_bom
 from skyroute.geo import FRAME_ALIASES, FRAMES, Home, lonlat_to_enu
 from skyroute.world.points import check_places
 from skyroute.world.world import World
@@ -33,13 +34,14 @@ SWAPPED = "are its coordinates (lat, lon)? GeoJSON and boundary boxes are (lon, 
 
 
 def _features(path: Path | str, text: str | None = None) -> list[dict]:
-    try:  # utf-8-sig: a byte-order mark (Windows editors) is read past
-        if text is None:
+    if text is None:
+        try:
             _check_bytes(path, Path(path).stat().st_size)
-            text = Path(path).read_text(encoding="utf-8-sig")
-        doc = json.loads(text.removeprefix("\ufeff"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputFormatError(path, f"cannot read: {exc}") from None
+        except OSError as exc:
+            raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
+        text = read_text(path)  # a byte-order mark (Windows editors) is read past
+    try:
+        doc = json.loads(strip_bom(text))
     except json.JSONDecodeError as exc:
         raise InputFormatError(path, f"not JSON: {exc.msg}", line=exc.lineno) from None
     if not isinstance(doc, dict) or doc.get("type") != "FeatureCollection" or \

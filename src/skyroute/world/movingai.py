@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import InputFormatError
+from skyroute.files import strip_bom
 from skyroute.world.grid import Grid
 
 PASSABLE = ".GS"
@@ -28,7 +29,7 @@ def _lines(path: Path, raw: bytes | None = None) -> list[str]:
             raw = path.read_bytes()
         except OSError as exc:
             raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
-    raw = raw.removeprefix(b"\xef\xbb\xbf")  # a UTF-8 byte-order mark
+    raw = strip_bom(raw)
     if not raw.strip():
         raise InputFormatError(path, "the file is empty", line=1)
     try:

@@ -14,6 +14,7 @@ import numpy as np
 from numba import njit
 
 from skyroute.errors import InputFormatError, OptionError
+from skyroute.files import read_text
 from skyroute.world.geometry import point_segment_dist2
 from skyroute.world.grid import Grid, raster_shape
 
@@ -21,10 +22,7 @@ from skyroute.world.grid import Grid, raster_shape
 def read_segments(path: str | Path) -> np.ndarray:
     """Read ``x1,y1,x2,y2`` rows (an optional header row of names is skipped) as (N, 4)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark (Excel) read past
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputFormatError(path, f"cannot read: {exc}") from None
+    text = read_text(path)
     rows = []
     for n, row in enumerate(csv.reader(text.splitlines()), start=1):
         if not row or all(not c.strip() for c in row) or row[0].lstrip().startswith("#"):
