@@ -75,6 +75,23 @@ def test_no_path_exits_1_and_writes_nothing(monkeypatch, capsys, tmp_path):
     assert not png.exists()
 
 
+@pytest.mark.parametrize("far, option, words", [
+    ("0,0,1e9,3", [], "walls.csv:3: the wall (0, 0) - (1e+09, 3) stretches the map to"),
+    ("1,1,2,2", ["--safety", "1e6"], "walls.csv: --safety 1e+06 around the walls makes"),
+    ("1,1,2,2", ["--resolution", "0"], "error: --resolution 0.0 must be a positive number\n"),
+])
+def test_a_walls_raster_too_large_names_the_line_or_the_flag(monkeypatch, capsys, tmp_path,
+                                                             far, option, words):
+    # it was "--resolution 1 over a 1e+09 x 7 extent makes ...; use a coarser resolution",
+    # with neither the file nor the line; a zero resolution spoke of "resolution=0.0"
+    p = tmp_path / "walls.csv"
+    p.write_text(f"0,0,10,0\n0,5,10,5\n{far}\n")
+    code, out, err = run(monkeypatch, capsys, "plan", str(p), "--start", "1,1", "--goal",
+                         "5,3", *option)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert err.startswith("skyroute: error: ") and words in err
+
+
 @pytest.mark.parametrize("args, words", [
     (["plan", "den312d", "--start", "0,0", "--goal", "60,13"], "start (0, 0) is on a blocked"),
     (["plan", "den312d", "--start", "50,76", "--goal", "99,9"], "goal (99, 9) lies outside"),

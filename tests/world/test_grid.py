@@ -1,5 +1,6 @@
 import copy
 import pickle
+import re
 
 import numpy as np
 import pytest
@@ -180,6 +181,34 @@ def test_a_raster_too_large_is_refused_before_it_is_allocated(segments, resoluti
                            [0], [10], ("wall",), frame="enu")
     with pytest.raises(OptionError, match="use a coarser resolution"):
         world.rasterize(resolution)
+
+
+WALLS = "x1,y1,x2,y2\n0,0,10,0\n0,5,10,5\n{far}\n2,2,4,4\n"
+
+
+@pytest.mark.parametrize("far, options, error, words", [
+    # one mistyped coordinate (1e9 for 10): its line is named, not only the resolution
+    ("0,0,1e9,3", {}, InputFormatError,
+     r"^{p}:4: the wall \(0, 0\) - \(1e\+09, 3\) stretches the map to 1e\+09 x 7 m, "
+     r"1e\+09 x 7 cells at 1 m a cell, above 67,108,864; is a coordinate wrong\?"),
+    ("-4e8,2,3,2", {}, InputFormatError, r"^{p}:4: the wall \(-4e\+08, 2\) - \(3, 2\)"),
+    # a safety margin wider than any map: safety is named, with the file
+    ("1,1,2,2", {"safety": 1e6}, OptionError,
+     r"^{p}: safety=1e\+06 around the walls makes a raster of 2\.00001e\+06 x "
+     r"2\.00001e\+06 m, .*; use a smaller safety or a coarser resolution$"),
+    # walls spread evenly at a resolution meant in kilometres: the resolution, with the file
+    ("1,1,2,2", {"resolution": 1e-5}, OptionError,
+     r"^{p}: resolution=1e-05 over a 10 x 5\.00002 extent .*; use a coarser resolution$"),
+])
+def test_a_walls_raster_too_large_names_the_file_and_the_cause(tmp_path, far, options,
+                                                               error, words):
+    p = tmp_path / "walls.csv"
+    p.write_text(WALLS.format(far=far))
+    with pytest.raises(error, match=words.format(p=re.escape(str(p)))) as info:
+        load_map(p, **options)
+    assert "\n" not in str(info.value)
+    if error is OptionError:
+        assert info.value.param == next(iter(options))
 
 
 def test_a_folder_is_not_a_map_and_does_not_hide_a_bundled_one(tmp_path, monkeypatch):

@@ -70,10 +70,9 @@ def load_map(path: str | Path, *, resolution: float | None = None, safety: float
     p = resolve_map_path(path)
     suffix = p.suffix.lower()
     if suffix == ".csv":
-        from skyroute.world.segments import rasterize_segments, read_segments
+        from skyroute.world.segments import load_segments
 
-        return rasterize_segments(read_segments(p), resolution=resolution, safety=safety,
-                                  name=p.name)
+        return load_segments(p, resolution=resolution, safety=safety)
     if suffix == ".map":
         from skyroute.world.movingai import read_map
 

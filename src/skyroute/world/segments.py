@@ -16,14 +16,78 @@ from numba import njit
 from skyroute.errors import InputFormatError, OptionError
 from skyroute.files import read_text
 from skyroute.world.geometry import point_segment_dist2
-from skyroute.world.grid import Grid, raster_shape
+from skyroute.world.grid import MAX_CELLS, Grid, raster_shape
+
+OUTLIER = 10  # a wall that makes the map this many times as long is named as the cause
 
 
 def read_segments(path: str | Path) -> np.ndarray:
     """Read ``x1,y1,x2,y2`` rows (an optional header row of names is skipped) as (N, 4)."""
+    return _read(Path(path))[0]
+
+
+def load_segments(path: str | Path, *, resolution: float, safety: float = 0.0) -> Grid:
+    """Read a walls file and rasterise it (:func:`rasterize_segments`). A raster above
+    :data:`~skyroute.world.grid.MAX_CELLS` names what made it so: the line of the one
+    wall far from the others (a mistyped coordinate), else ``safety`` when the margin
+    alone is too wide, else ``resolution``; always with the file."""
     path = Path(path)
+    seg, lines = _read(path)
+    if not (math.isfinite(resolution) and resolution > 0 and math.isfinite(safety)
+            and safety >= 0):  # rasterize_segments names the option
+        return rasterize_segments(seg, resolution=resolution, safety=safety, name=path.name)
+    try:
+        raster_shape(*_span(seg, resolution, safety), resolution)
+    except OptionError as exc:
+        raise _too_large(path, seg, lines, resolution, safety, exc) from None
+    return rasterize_segments(seg, resolution=resolution, safety=safety, name=path.name)
+
+
+def _span(seg: np.ndarray, resolution: float, safety: float) -> tuple[float, float]:
+    """Width and height (metres) of the default raster: the walls' extent, ``safety``
+    and one cell on every side (as :func:`rasterize_segments` pads it)."""
+    pad = 2 * (safety + resolution)
+    xs, ys = seg[:, [0, 2]], seg[:, [1, 3]]
+    return float(xs.max() - xs.min() + pad), float(ys.max() - ys.min() + pad)
+
+
+def _fits(span: tuple[float, float], resolution: float) -> bool:
+    try:
+        raster_shape(*span, resolution)
+    except OptionError:
+        return False
+    return True
+
+
+def _too_large(path: Path, seg: np.ndarray, lines: list[int], resolution: float,
+               safety: float, exc: OptionError) -> InputFormatError | OptionError:
+    """The error for a walls raster above MAX_CELLS (``exc``: raster_shape's)."""
+    w, h = _span(seg, resolution, safety)
+    size = f"{w:.6g} x {h:.6g} m, {w / resolution:.3g} x {h / resolution:.3g} cells at " \
+        f"{resolution:g} m a cell, above {MAX_CELLS:,}"
+    if not _fits(_span(seg[:1, [0, 1, 0, 1]], resolution, safety), resolution):
+        return OptionError(f"{path}: safety={safety:g} around the walls makes a raster "
+                           f"of {size}; use a smaller safety or a coarser resolution",
+                           param="safety")
+    # the wall reaching farthest from the median of all the ends, in either axis; it is
+    # the one to blame when the others fit and it makes the map 10 times as long
+    ends = seg.reshape(-1, 2)
+    reach = np.abs(ends - np.median(ends, axis=0)).max(axis=1).reshape(-1, 2).max(axis=1)
+    k = int(np.argmax(reach))
+    rest = np.delete(seg, k, axis=0)
+    if not len(rest) or (_fits(_span(rest, resolution, safety), resolution)
+                         and max(w, h) >= OUTLIER * max(_span(rest, resolution, safety))):
+        x1, y1, x2, y2 = seg[k]
+        return InputFormatError(path, f"the wall ({x1:g}, {y1:g}) - ({x2:g}, {y2:g}) "
+                                f"stretches the map to {size}; is a coordinate wrong? "
+                                "(else use a coarser resolution)", line=lines[k])
+    return OptionError(f"{path}: {exc}", param="resolution")
+
+
+def _read(path: Path) -> tuple[np.ndarray, list[int]]:
+    """(N, 4) segments and the line each came from."""
     text = read_text(path)
-    rows = []
+    rows, lines = [], []
     for n, row in enumerate(csv.reader(text.splitlines()), start=1):
         if not row or all(not c.strip() for c in row) or row[0].lstrip().startswith("#"):
             continue
@@ -40,9 +104,10 @@ def read_segments(path: str | Path) -> np.ndarray:
         if not all(math.isfinite(v) for v in vals):
             raise InputFormatError(path, "coordinates must be finite", line=n)
         rows.append(vals)
+        lines.append(n)
     if not rows:
         raise InputFormatError(path, "no segments")
-    return np.array(rows, dtype=np.float64)
+    return np.array(rows, dtype=np.float64), lines
 
 
 def rasterize_segments(segments: np.ndarray, *, resolution: float, safety: float = 0.0,
@@ -54,7 +119,8 @@ def rasterize_segments(segments: np.ndarray, *, resolution: float, safety: float
     safety margin and one cell on every side.
     """
     if not (math.isfinite(resolution) and resolution > 0):
-        raise OptionError(f"resolution={resolution!r} must be a positive number")
+        raise OptionError(f"resolution={resolution!r} must be a positive number",
+                          param="resolution")
     if not (math.isfinite(safety) and safety >= 0):
         raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
     seg = np.ascontiguousarray(segments, dtype=np.float64).reshape(-1, 4)
