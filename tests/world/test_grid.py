@@ -9,6 +9,7 @@ from PIL import Image
 
 import skyroute
 from skyroute import Grid, InputFormatError, OptionError, load_map
+from skyroute.world.image import from_array
 from skyroute.world.segments import rasterize_segments
 
 
@@ -161,6 +162,24 @@ def test_npy_that_is_no_array_or_holds_nan_is_one_line(tmp_path, content, words)
         load_map(p)
     assert str(err.value).startswith(f"{p}: ") and words in str(err.value)
     assert "allow_pickle" not in str(err.value)
+
+
+@pytest.mark.parametrize("make, param", [
+    (lambda a: from_array(a), "array"),
+    (lambda a: Grid(a), "blocked"),
+])
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_an_array_holding_nan_is_refused_naming_its_cell(make, param, dtype):
+    # bool(nan) is True: the NaN cell (2, 1) was read as blocked, as .npy files were
+    a = np.zeros((3, 4), dtype)
+    a[1, 2] = a[2, 0] = np.nan
+    with pytest.raises(OptionError) as err:
+        make(a)
+    assert str(err.value) == f"{param} has NaN at cell (2, 1) (x, y); use 0 for free and " \
+        "non-zero for blocked"
+    assert err.value.param == param
+    a[1, 2] = a[2, 0] = 1.0  # numbers still read as before: non-zero blocked
+    assert make(a).blocked.tolist() == (a != 0).tolist()
 
 
 def test_missing_file_lists_bundled_maps(tmp_path):

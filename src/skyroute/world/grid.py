@@ -20,6 +20,20 @@ import numpy as np
 from skyroute.errors import OptionError, QueryError, real, renamed
 from skyroute.world.points import plane_points
 
+NAN_HINT = "use 0 for free and non-zero for blocked"
+
+
+def nan_cell(values: np.ndarray) -> tuple[int, int] | None:
+    """The (x, y) cell of the first NaN (row by row) in a 2-D array of numbers, else
+    None. NaN says neither free nor blocked, and ``bool(nan)`` would read it as blocked,
+    so the array readers refuse it: :class:`Grid`, ``from_array`` and ``.npy`` files."""
+    if values.dtype.kind in "fc" and values.ndim == 2:
+        bad = np.isnan(values)
+        if bad.any():
+            row, col = np.argwhere(bad)[0]
+            return int(col), int(row)
+    return None
+
 
 @dataclass(frozen=True, eq=False, init=False)
 class Grid:
@@ -48,7 +62,11 @@ class Grid:
                  cell_size: float | None = None) -> None:
         resolution = renamed("resolution", resolution, "cell_size", cell_size)
         resolution = 1.0 if resolution is None else resolution
-        arr = np.array(blocked, dtype=bool, copy=True)
+        values = np.asarray(blocked)
+        if (cell := nan_cell(values)) is not None:
+            raise OptionError(f"blocked has NaN at cell {cell} (x, y); {NAN_HINT}",
+                              param="blocked")
+        arr = np.array(values, dtype=bool, copy=True)
         if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
             raise OptionError(f"blocked must be a non-empty 2-D array, got shape {arr.shape}")
         if real("resolution", resolution) <= 0:

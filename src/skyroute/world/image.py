@@ -6,16 +6,19 @@ from pathlib import Path
 
 import numpy as np
 
-from skyroute.errors import InputFormatError
-from skyroute.world.grid import Grid
+from skyroute.errors import InputFormatError, OptionError
+from skyroute.world.grid import NAN_HINT, Grid, nan_cell
 
 NPY_MAGIC = b"\x93NUMPY"
 
 
 def from_array(array: np.ndarray, *, resolution: float = 1.0,
                origin: tuple[float, float] = (0.0, 0.0), name: str = "array") -> Grid:
-    """A Grid from a 2-D array indexed [row, column]; non-zero / True means blocked."""
+    """A Grid from a 2-D array indexed [row, column]; non-zero / True means blocked. NaN,
+    which says neither, is an OptionError naming its cell (``bool(nan)`` is True)."""
     a = np.asarray(array)
+    if (cell := nan_cell(a)) is not None:
+        raise OptionError(f"array has NaN at cell {cell} (x, y); {NAN_HINT}", param="array")
     return Grid(a != 0, resolution, origin, name=name)
 
 
@@ -73,8 +76,6 @@ def read_npy(path: str | Path, *, resolution: float = 1.0) -> Grid:
     if arr.dtype.kind not in "biuf":
         raise InputFormatError(path, f"expected an array of numbers or booleans, got dtype "
                                f"{arr.dtype}")
-    if arr.dtype.kind == "f" and np.isnan(arr).any():
-        row, col = np.argwhere(np.isnan(arr))[0]
-        raise InputFormatError(path, f"NaN at cell ({col}, {row}) (x, y); use 0 for free and "
-                               "non-zero for blocked")
+    if (cell := nan_cell(arr)) is not None:
+        raise InputFormatError(path, f"NaN at cell {cell} (x, y); {NAN_HINT}")
     return from_array(arr, resolution=resolution, name=path.name)
