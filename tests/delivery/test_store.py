@@ -9,6 +9,8 @@ import re
 import subprocess
 import sys
 import textwrap
+import threading
+import time
 import uuid
 from pathlib import Path
 
@@ -300,6 +302,53 @@ def test_a_new_postgresql_store_made_by_two_runs_at_once(fresh_pg):
                               cwd=str(Path(__file__).parents[2])) for _ in range(4)]
     done = [(p.communicate(timeout=60), p.returncode) for p in procs]
     assert [(out, rc) for (out, _), rc in done] == [("0003\n", 0)] * 4, done
+
+
+@pytest.mark.parametrize("stored_before", [False, True])
+def test_two_runs_of_one_day_at_once_on_postgresql(fresh_pg, stored_before):
+    # the later writer's insert of the run was an IntegrityError ('duplicate key value
+    # violates unique constraint "runs_pkey"'): both had deleted the day as it was
+    e = store.connect(fresh_pg)
+    store.init(e)
+    if stored_before:
+        store.write_day(e, DAY, run_row(2), [], moves(2, "old00000"))
+    inside, release, errors = threading.Event(), threading.Event(), []
+
+    def held(n):  # the first writer's moves: it waits with its run row written
+        for k, m in enumerate(moves(n, "first000")):
+            if k == 1:
+                inside.set()
+                release.wait(30)
+            yield m
+
+    def write(n, rows):
+        try:
+            store.write_day(e, DAY, run_row(n), [], rows)
+        except Exception as exc:  # the test reports what it was
+            errors.append(f"{type(exc).__name__}: {exc}")
+
+    first = threading.Thread(target=write, args=(3, held(3)))
+    first.start()
+    assert inside.wait(30)
+    second = threading.Thread(target=write, args=(4, moves(4, "second00")))
+    second.start()
+    with e.connect() as c:  # the second is waiting for the first's transaction
+        for _ in range(300):
+            if c.execute(sa.text("select count(*) from pg_locks where not granted")
+                         ).scalar_one():
+                break
+            time.sleep(0.05)
+        else:
+            pytest.fail("the second writer never waited")
+    release.set()
+    first.join(30)
+    second.join(30)
+    assert errors == []
+    with e.connect() as c:  # the later run's rows, whole
+        assert c.execute(sa.text("select moves from runs")).all() == [(4,)]
+    assert {r[2] for r in store.day_rows(e, DAY)["flightpath"]} == {"second00"}
+    assert len(store.day_rows(e, DAY)["flightpath"]) == 4
+    e.dispose()
 
 
 NEXT = DAY + dt.timedelta(1)

@@ -41,6 +41,9 @@ TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
 # The PostgreSQL advisory lock that :func:`init` holds while it makes or upgrades the
 # schema (any fixed 64-bit number other programs on the database are unlikely to use)
 SCHEMA_LOCK = 0x736B79726F757465  # "skyroute"
+# ... and the pair (DAY_LOCK, the day's ordinal) that :func:`write_day` holds while it
+# replaces a day's rows
+DAY_LOCK = 0x736B7964  # "skyd"
 _REFLECTED: dict[tuple[str, tuple[str, ...]], dict[str, sa.Table]] = {}
 register(_REFLECTED.clear)
 
@@ -343,7 +346,9 @@ def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[d
               moves: Iterable[dict]) -> None:
     """Replace one day's results in one transaction (``moves`` may be a generator). The
     run and delivery rows are checked to fit their columns first (:func:`check_fits`:
-    money beyond a 32-bit INTEGER), so a failure leaves the day as it was."""
+    money beyond a 32-bit INTEGER), so a failure leaves the day as it was. Two writers
+    of one day at once: the later waits for the earlier's transaction, then replaces its
+    rows (SQLite: its write lock; PostgreSQL: an advisory lock on the day)."""
     t_ = tables(engine)
     flightpath, deliveries, runs = t_["flightpath"], t_["deliveries"], t_["runs"]
     head = {**run, "delivery_date": date,
@@ -353,6 +358,14 @@ def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[d
     for row in rows:
         check_fits(deliveries, row, f"{date}: order {row.get('order_no')!r}: ")
     with writing(engine) as conn:
+        if conn.dialect.name == "postgresql":
+            # two runs of one day at once both deleted the day's rows as they were, and
+            # the later's insert was an IntegrityError ('duplicate key value violates
+            # unique constraint "runs_pkey"'); the lock is held to the end of this
+            # transaction, so the later waits, then replaces the earlier's rows (as
+            # SQLite's BEGIN IMMEDIATE in writing() does); other days are not held up
+            conn.execute(sa.select(sa.func.pg_advisory_xact_lock(
+                sa.cast(DAY_LOCK, sa.Integer), sa.cast(date.toordinal(), sa.Integer))))
         for t in (flightpath, deliveries, runs):
             conn.execute(t.delete().where(t.c.delivery_date == date))
         conn.execute(runs.insert(), [head])
