@@ -143,3 +143,18 @@ def test_serve_fails_the_jobs_a_stopped_server_left(monkeypatch, capsys, tmp_pat
         assert c.get(f"/jobs/{live}").json()["state"] == "queued"
     code, _, err = run(monkeypatch, capsys, "serve", "--db", db)  # nothing left to fail
     assert len(served) == 2 and "job(s) left" not in err
+
+
+def test_a_token_file_saved_with_a_byte_order_mark_gives_the_token(tmp_path, monkeypatch):
+    """Notepad saves 'UTF-8' with a byte-order mark: it is no part of the token (else
+    every request with the token the user typed would be a 401)."""
+    from skyroute.cli.serve_cmd import TOKEN_ENV, read_token
+    from skyroute.errors import OptionError
+
+    monkeypatch.delenv(TOKEN_ENV, raising=False)
+    f = tmp_path / "token.txt"
+    f.write_bytes(b"\xef\xbb\xbfs3cret\r\n")
+    assert read_token(f) == ("s3cret", str(f))
+    f.write_bytes(b"\xff\xfes\x00")  # UTF-16: one line naming the option and the file
+    with pytest.raises(OptionError, match=r"^--token-file .*token\.txt: cannot read: not UTF-8"):
+        read_token(f)

@@ -10,7 +10,8 @@ from typing import Annotated
 import typer
 
 from skyroute.delivery.store import DEFAULT_DB
-from skyroute.errors import OptionError
+from skyroute.errors import InputFormatError, OptionError
+from skyroute.files import read_text
 
 TOKEN_ENV = "SKYROUTE_TOKEN"
 
@@ -21,11 +22,10 @@ def read_token(token_file: Path | None) -> tuple[str | None, str]:
     if os.environ.get(TOKEN_ENV):
         return os.environ[TOKEN_ENV].strip(), TOKEN_ENV
     if token_file is not None:
-        try:
-            token = token_file.read_text().strip()
-        except OSError as exc:
-            raise OptionError(f"--token-file {token_file}: cannot read: {exc.strerror}"
-                              ) from None
+        try:  # a byte-order mark (Notepad's) is no part of the token
+            token = read_text(token_file).strip()
+        except InputFormatError as exc:
+            raise OptionError(f"--token-file {exc}") from None
         if not token:
             raise OptionError(f"--token-file {token_file}: the file is empty")
         return token, str(token_file)
