@@ -149,10 +149,9 @@ def fly_command(
     _check_mode_options(ctx, vehicle, mode)
     if out is not None and out.suffix.lower() not in (".json", ".csv", ".geojson"):
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
-    if not (math.isfinite(radius) and radius > 0):
-        raise OptionError(f"--radius {radius!r} must be a number > 0")
-    if not 0 < max_turn <= 180:  # degrees here; the library's check speaks radians
-        raise OptionError(f"--max-turn {max_turn!r} must be in (0, 180] degrees")
+    real("radius", radius, low=0.0, strict=True)
+    # degrees here; the library's check speaks radians
+    real("max_turn", max_turn, low=0.0, strict=True, high=180.0, need="in (0, 180] degrees")
     if goal is None and targets is None:
         raise OptionError("give --goal A,B (or --targets FILE with --vehicle dubins)")
     frame = wa.frame_of(frame)
