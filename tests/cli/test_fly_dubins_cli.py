@@ -214,3 +214,15 @@ def test_waypoints_without_a_start_heading_pick_the_best(monkeypatch, capsys, tm
     code, text, err = run(monkeypatch, capsys, *args, "--start", "0,-100,0")  # told north
     assert code == 0, err
     assert json.loads(text)["metrics"]["length"] > 105
+
+
+def test_waypoints_from_a_point_to_itself_turn_between_the_headings(monkeypatch, capsys):
+    # the exact route from a point to itself is one point (as every planner gives it);
+    # the waypoints planner still flies the Dubins path between the two headings there
+    code, text, err = run(monkeypatch, capsys, *BASE, "--planner", "waypoints", "--start",
+                          "0,0,0", "--goal", "0,0,90", "--json")
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["trajectory"][0] == [0.0, 0.0, 0.0]
+    assert doc["trajectory"][-1] == pytest.approx([0.0, 0.0, 90.0], abs=1e-6)
+    assert doc["metrics"]["length"] > 0 and len(doc["metrics"]["words"]) == 3

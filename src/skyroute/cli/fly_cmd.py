@@ -393,7 +393,10 @@ def _fly_dubins(world, s, t, radius, h0, h1, step):
     route = plan(world, s, t)
     if not route.found:
         return _not_reached("no route between start and goal"), [], np.array([s])
-    legs = through(world.to_plane(route.path), radius,  # a heading left out: the best
+    corners = world.to_plane(route.path)
+    if len(corners) == 1:  # start == goal: still one Dubins path, between the two headings
+        corners = np.repeat(corners, 2, axis=0)
+    legs = through(corners, radius,  # a heading left out: the best
                    start_heading=None if h0 is None else float(world.heading_to_plane(h0)),
                    end_heading=None if h1 is None else float(world.heading_to_plane(h1)))
     poses = np.vstack([leg.sample(step) for leg in legs])

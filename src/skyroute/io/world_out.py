@@ -59,9 +59,12 @@ def world_path_geojson(world: World, result: PlanResult) -> dict:
     props.update(world=world.name, frame=world.frame)
     lonlat = result.path_lonlat if result.path_lonlat is not None else \
         path_lonlat(world, result.path)
+    coords = np.asarray(lonlat).tolist()
+    if len(coords) == 1:  # start == goal: a LineString needs two positions (RFC 7946)
+        coords *= 2
     return {"type": "FeatureCollection", "features": [{
         "type": "Feature",
-        "geometry": {"type": "LineString", "coordinates": np.asarray(lonlat).tolist()},
+        "geometry": {"type": "LineString", "coordinates": coords},
         "properties": props}]}
 
 
