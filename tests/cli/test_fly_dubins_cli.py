@@ -75,6 +75,26 @@ def test_no_path_within_the_budget_exits_1_and_writes_nothing(monkeypatch, capsy
     assert json.loads(text)["metrics"]["status"] == "budget_exhausted"
 
 
+def test_the_default_budget_says_which_flags_to_raise(monkeypatch, capsys):
+    # without --max-expansions the search had no budget: a radius tiny beside the city
+    # ran until the machine's memory was gone; now a default (lowered here) ends it
+    from skyroute.motion import hybrid
+
+    monkeypatch.setattr(hybrid, "MAX_NODES", 3 * 2000, raising=False)
+    code, text, err = run(monkeypatch, capsys, *BASE[:-2], "--radius", "0.5", "--start",
+                          "0,0,90", "--goal", "120,-180", "--json")
+    assert code == 1, err
+    m = json.loads(text)["metrics"]
+    assert m["status"] == "budget_exhausted" and m["expanded"] == 2000
+    assert m["why"].startswith("Hybrid A* stopped after 2,000 expansions (the default "
+                               "--max-expansions); the world is ")
+    assert m["why"].endswith("turning radii across (--radius 0.5): raise --max-expansions "
+                             "or --radius")
+    code, text, _ = run(monkeypatch, capsys, *BASE, "--start", "0,0,90", "--goal",
+                        "120,-180", "--max-expansions", "5")
+    assert code == 1 and "stopped after 5 expansions (--max-expansions)" in text
+
+
 def test_waypoints_cut_a_building_where_hybrid_finds_a_free_path(monkeypatch, capsys):
     """The issue's case: curves through the route's corners clip a building (and say so);
     Hybrid A* on the same query flies round it."""

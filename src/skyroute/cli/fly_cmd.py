@@ -102,7 +102,8 @@ def fly_command(
         "--reverse", help=_for("reverse", "the vehicle may also drive backwards (a "
                                           "car)."))] = False,
     max_expansions: Annotated[int | None, typer.Option(help=_for(
-        "max_expansions", "Hybrid A*'s expansion budget (status budget_exhausted)."))] = None,
+        "max_expansions", "Hybrid A*'s expansion budget (status budget_exhausted); default "
+        "10,000,000 (5,000,000 with --reverse)."))] = None,
     targets: Annotated[Path | None, typer.Option(help=_for(
         "targets", "visit these targets (a .csv or .json of A,B points in --frame) in the "
                    "shortest order from START; GOAL is not used."))] = None,
@@ -323,6 +324,8 @@ def _fly_hybrid(world, s, t, h0, h1, radius, step, reverse, max_expansions, appr
                       max_expansions=max_expansions, approach=approach)
     metrics = {"status": res.status.value, "length": res.length, "expanded": res.expanded,
                "seconds": res.seconds}
+    if res.status is Status.BUDGET_EXHAUSTED:
+        metrics["why"] = _budget_why(res, max_expansions)
     if not res.found:
         return ({"reached": False, "metrics": metrics, "columns": []}, [], np.array([s]))
     poses = res.sample(step)
@@ -331,6 +334,14 @@ def _fly_hybrid(world, s, t, h0, h1, radius, step, reverse, max_expansions, appr
     rows = np.c_[poses[:, :2], np.degrees(poses[:, 2])].tolist()
     return ({"reached": True, "trajectory": rows, "metrics": metrics,
              "columns": _pose_columns(world)}, rows, poses[:, :2])
+
+
+def _budget_why(res, max_expansions: int | None) -> str:
+    """A Hybrid A* search out of budget, in flags: how far it went and what to change."""
+    which = "the default --max-expansions" if max_expansions is None else "--max-expansions"
+    return (f"Hybrid A* stopped after {res.extra['budget']:,} expansions ({which}); the "
+            f"world is {res.extra['radii_across']:,.0f} turning radii across (--radius "
+            f"{res.radius:g}): raise --max-expansions or --radius")
 
 
 def _fly_tour(world, s, h0, pts, radius, step, max_expansions):
