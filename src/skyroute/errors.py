@@ -75,11 +75,15 @@ def real(name: str, value: object, *, low: float | None = None, strict: bool = F
     """``value`` as a finite float when it is a real number (a Python or numpy number, or
     a 0-d numeric array; not a bool, a string or a longer array) within ``low`` (``>``
     when ``strict``, else ``>=``) and ``high``, else an :class:`OptionError` naming
-    ``name`` (``need``: what the message says it must be, when not the default)."""
+    ``name`` (``need``: what the message says it must be, when not the default). NaN and
+    the infinities are refused as not finite, with the range beside it (``sensor_range=inf
+    must be a finite number > 0``), not as out of range."""
     x = _scalar(value)
-    if _is_bool(x) or not isinstance(x, numbers.Real) \
-            or not math.isfinite(x):
+    if _is_bool(x) or not isinstance(x, numbers.Real):
         raise OptionError(f"{name}={value!r} must be {need or 'a finite number'}",
+                          param=name)
+    if not math.isfinite(x):
+        raise OptionError(f"{name}={value!r} must be {_finite(need, low, strict, high)}",
                           param=name)
     x = float(x)
     if (low is not None and (x <= low if strict else x < low)) or \
@@ -132,6 +136,21 @@ def _scalar(value: object) -> object:
 def _is_bool(value: object) -> bool:
     """True for Python's and numpy's booleans (numbers.Integral holds Python's only)."""
     return isinstance(value, bool) or type(value).__name__ in ("bool_", "bool")
+
+
+def _finite(need: str | None, low, strict: bool, high) -> str:
+    """'a finite number' with the range a real number must also be in: ``need`` when
+    given ('> 0', 'a number >= 1', 'positive', 'in (0, pi] radians'), else the bounds."""
+    if need is None:
+        return f"a finite number {_range(low, strict, high)}".rstrip()
+    for lead in ("a finite number", "a number"):
+        if need.startswith(lead):
+            return "a finite number" + need[len(lead):]
+    if need[0] in "<>=" or need.startswith(("in ", "from ")):
+        return f"a finite number {need}"
+    if need.isalpha():  # 'positive'
+        return f"a finite {need} number"
+    return f"a finite number ({need})"
 
 
 def _range(low, strict: bool, high) -> str:

@@ -52,7 +52,8 @@ class PlanResult:
     the world's frame (``extra["frame"]``), with ``path_lonlat`` the same points as
     (lon, lat) where the world has a home. ``cost`` is the path's length (cells, with
     diagonal steps sqrt 2, on a grid; plane units, metres or degrees, on a World);
-    ``inf`` when no path was found. ``expanded`` counts nodes taken off the open list and
+    ``inf`` when no path was found; a start equal to the goal is a path of that one point,
+    cost 0, from every planner. ``expanded`` counts nodes taken off the open list and
     expanded (for PRM: roadmap nodes Dijkstra settled up to the goal), ``max_frontier``
     the largest open list, ``los_checks`` line-of-sight (segment) tests, and ``seconds``
     the wall time of the search itself.

@@ -128,6 +128,14 @@ def test_field_reports_length_like_the_other_vehicles(monkeypatch, capsys, city)
      "--max-turn 0.0 must be in (0, 180] degrees"),
     (["--vehicle", "field", "--field-mode", "arc", "--max-turn", "200"],
      "--max-turn 200.0 must be in (0, 180]"),
+    # not finite: these said "--sensor-range inf must be > 0", true of inf
+    (["--vehicle", "field", "--sensor-range", "inf"],
+     "--sensor-range inf must be a finite number > 0\n"),
+    (["--vehicle", "field", "--step", "nan"], "--step nan must be a finite number > 0\n"),
+    (["--vehicle", "lattice", "--speed", "inf"], "--speed inf must be a finite positive number"),
+    (["--vehicle", "field", "--field-mode", "arc", "--max-turn", "nan"],
+     "--max-turn nan must be a finite number in (0, 180] degrees"),
+    (["--vehicle", "dubins", "--radius", "inf"], "--radius inf must be a finite number > 0"),
 ])
 def test_each_vehicle_option_is_named_alone(monkeypatch, capsys, city, args, words):
     # these were one message naming every option at once, in the library's units

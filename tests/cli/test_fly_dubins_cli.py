@@ -75,6 +75,26 @@ def test_no_path_within_the_budget_exits_1_and_writes_nothing(monkeypatch, capsy
     assert json.loads(text)["metrics"]["status"] == "budget_exhausted"
 
 
+def test_the_default_budget_says_which_flags_to_raise(monkeypatch, capsys):
+    # without --max-expansions the search had no budget: a radius tiny beside the city
+    # ran until the machine's memory was gone; now a default (lowered here) ends it
+    from skyroute.motion import hybrid
+
+    monkeypatch.setattr(hybrid, "MAX_NODES", 3 * 2000, raising=False)
+    code, text, err = run(monkeypatch, capsys, *BASE[:-2], "--radius", "0.5", "--start",
+                          "0,0,90", "--goal", "120,-180", "--json")
+    assert code == 1, err
+    m = json.loads(text)["metrics"]
+    assert m["status"] == "budget_exhausted" and m["expanded"] == 2000
+    assert m["why"].startswith("Hybrid A* stopped after 2,000 expansions (the default "
+                               "--max-expansions); the world is ")
+    assert m["why"].endswith("turning radii across (--radius 0.5): raise --max-expansions "
+                             "or --radius")
+    code, text, _ = run(monkeypatch, capsys, *BASE, "--start", "0,0,90", "--goal",
+                        "120,-180", "--max-expansions", "5")
+    assert code == 1 and "stopped after 5 expansions (--max-expansions)" in text
+
+
 def test_waypoints_cut_a_building_where_hybrid_finds_a_free_path(monkeypatch, capsys):
     """The issue's case: curves through the route's corners clip a building (and say so);
     Hybrid A* on the same query flies round it."""
@@ -214,3 +234,15 @@ def test_waypoints_without_a_start_heading_pick_the_best(monkeypatch, capsys, tm
     code, text, err = run(monkeypatch, capsys, *args, "--start", "0,-100,0")  # told north
     assert code == 0, err
     assert json.loads(text)["metrics"]["length"] > 105
+
+
+def test_waypoints_from_a_point_to_itself_turn_between_the_headings(monkeypatch, capsys):
+    # the exact route from a point to itself is one point (as every planner gives it);
+    # the waypoints planner still flies the Dubins path between the two headings there
+    code, text, err = run(monkeypatch, capsys, *BASE, "--planner", "waypoints", "--start",
+                          "0,0,0", "--goal", "0,0,90", "--json")
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["trajectory"][0] == [0.0, 0.0, 0.0]
+    assert doc["trajectory"][-1] == pytest.approx([0.0, 0.0, 90.0], abs=1e-6)
+    assert doc["metrics"]["length"] > 0 and len(doc["metrics"]["words"]) == 3

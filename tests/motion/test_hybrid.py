@@ -171,6 +171,35 @@ def test_budget_exhausted_is_its_own_status():
     check_path(free, plan(free, start, goal, R), start, goal, R)
 
 
+@pytest.mark.parametrize("reverse, per_expansion", [(False, 3), (True, 6)])
+def test_the_default_budget_bounds_the_nodes_stored(monkeypatch, reverse, per_expansion):
+    # max_expansions=None was no budget at all: r = 0.01 m in this 100 m world filled
+    # 10 GB in 5 minutes. The default keeps the nodes stored under MAX_NODES; here it is
+    # lowered so that a search which needs more (r = 0.5 m: about 55,000 expansions)
+    # runs out, saying why.
+    from skyroute.motion import hybrid
+
+    monkeypatch.setattr(hybrid, "MAX_NODES", 6000 * per_expansion, raising=False)
+    world = make_world([(45, 0, 55, 60)])
+    res = plan(world, (20, 20, 0.0), (80, 20, 0.0), 0.5, reverse=reverse)
+    assert res.status is Status.BUDGET_EXHAUSTED and res.expanded == 6000
+    assert res.extra["budget"] == 6000 and res.extra["radii_across"] == pytest.approx(200)
+    hint = res.extra["hint"]
+    assert "6,000 expansions (the default max_expansions)" in hint
+    assert "200 turning radii across (radius=0.5)" in hint and "larger max_expansions" in hint
+    given = plan(world, (20, 20, 0.0), (80, 20, 0.0), 0.5, max_expansions=7000)
+    assert given.status is Status.BUDGET_EXHAUSTED  # a budget given is the budget
+    assert "(max_expansions)" in given.extra["hint"] and given.expanded == 7000
+
+
+def test_the_default_budget_leaves_a_found_path_alone():
+    from skyroute.motion import hybrid
+
+    assert hybrid.MAX_NODES // 6 >= 5_000_000  # well above 3,000,000 (docs/architecture.md)
+    res = plan(make_world([(45, 0, 55, 60)]), (20, 20, 0.0), (80, 20, 0.0), R)
+    assert res.found and "hint" not in res.extra
+
+
 def test_no_boundary_enclosed_goal_is_no_path():
     ring = shapely.box(30, 30, 70, 70).difference(shapely.box(35, 35, 65, 65))
     world = make_world([ring], None)

@@ -9,7 +9,9 @@ import pytest
 
 import skyroute
 from skyroute import OptionError, QueryError, Status
+from skyroute.roadmap.world_plan import WORLD_ALGORITHMS
 from skyroute.search import GRID_ALGORITHMS
+from tests.conftest import ROOT
 
 ALGS = GRID_ALGORITHMS
 
@@ -23,6 +25,39 @@ def test_start_equals_goal(algorithm):
     r = skyroute.plan(open_grid(5, 5), (2, 3), (2, 3), algorithm=algorithm)
     assert r.status is Status.FOUND and r.cost == 0.0
     np.testing.assert_array_equal(r.path, [[2, 3]])
+
+
+def _city(frame):
+    return skyroute.load_world(ROOT / "examples" / "city.csv", altitude=10, frame=frame)
+
+
+@pytest.mark.parametrize("where, algorithm", [
+    *(("grid", a) for a in ALGS),
+    *((frame, a) for frame in ("ned", "lonlat") for a in WORLD_ALGORITHMS)])
+def test_start_equals_goal_is_one_point_everywhere(where, algorithm):
+    # PlanResult: a path of (K, 2) points with cost its length. For start == goal the
+    # grid planners and PRM gave one point, the visibility graph and the grid planners
+    # on a World two (the same point twice, and so a waypoint heading north from nowhere)
+    if where == "grid":
+        space, point = open_grid(5, 5), (2, 3)
+    else:
+        space = _city(where)
+        point = tuple(space.from_plane([[0.3, -0.7]])[0])  # free: between the buildings
+    r = skyroute.plan(space, point, point, algorithm=algorithm)
+    assert r.status is Status.FOUND and r.cost == 0.0, r
+    np.testing.assert_array_equal(r.path, [point])
+    if r.path_lonlat is not None:
+        assert r.path_lonlat.shape == (1, 2)
+    if where == "grid":
+        from skyroute.io.geojson import grid_path_geojson
+
+        line = grid_path_geojson(space, r)["features"][0]["geometry"]
+    else:
+        from skyroute.io.world_out import waypoints, world_path_geojson
+
+        assert len(waypoints(space, r.path, 5.0)) == 1
+        line = world_path_geojson(space, r)["features"][0]["geometry"]
+    assert line["type"] == "LineString" and len(line["coordinates"]) == 2  # RFC 7946
 
 
 @pytest.mark.parametrize("algorithm", ALGS)

@@ -102,7 +102,8 @@ def fly_command(
         "--reverse", help=_for("reverse", "the vehicle may also drive backwards (a "
                                           "car)."))] = False,
     max_expansions: Annotated[int | None, typer.Option(help=_for(
-        "max_expansions", "Hybrid A*'s expansion budget (status budget_exhausted)."))] = None,
+        "max_expansions", "Hybrid A*'s expansion budget (status budget_exhausted); default "
+        "10,000,000 (5,000,000 with --reverse)."))] = None,
     targets: Annotated[Path | None, typer.Option(help=_for(
         "targets", "visit these targets (a .csv or .json of A,B points in --frame) in the "
                    "shortest order from START; GOAL is not used."))] = None,
@@ -149,10 +150,9 @@ def fly_command(
     _check_mode_options(ctx, vehicle, mode)
     if out is not None and out.suffix.lower() not in (".json", ".csv", ".geojson"):
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
-    if not (math.isfinite(radius) and radius > 0):
-        raise OptionError(f"--radius {radius!r} must be a number > 0")
-    if not 0 < max_turn <= 180:  # degrees here; the library's check speaks radians
-        raise OptionError(f"--max-turn {max_turn!r} must be in (0, 180] degrees")
+    real("radius", radius, low=0.0, strict=True)
+    # degrees here; the library's check speaks radians
+    real("max_turn", max_turn, low=0.0, strict=True, high=180.0, need="in (0, 180] degrees")
     if goal is None and targets is None:
         raise OptionError("give --goal A,B (or --targets FILE with --vehicle dubins)")
     frame = wa.frame_of(frame)
@@ -321,6 +321,8 @@ def _fly_hybrid(world, s, t, h0, h1, radius, step, reverse, max_expansions, appr
                       max_expansions=max_expansions, approach=approach)
     metrics = {"status": res.status.value, "length": res.length, "expanded": res.expanded,
                "seconds": res.seconds}
+    if res.status is Status.BUDGET_EXHAUSTED:
+        metrics["why"] = _budget_why(res, max_expansions)
     if not res.found:
         return ({"reached": False, "metrics": metrics, "columns": []}, [], np.array([s]))
     poses = res.sample(step)
@@ -329,6 +331,14 @@ def _fly_hybrid(world, s, t, h0, h1, radius, step, reverse, max_expansions, appr
     rows = np.c_[poses[:, :2], np.degrees(poses[:, 2])].tolist()
     return ({"reached": True, "trajectory": rows, "metrics": metrics,
              "columns": _pose_columns(world)}, rows, poses[:, :2])
+
+
+def _budget_why(res, max_expansions: int | None) -> str:
+    """A Hybrid A* search out of budget, in flags: how far it went and what to change."""
+    which = "the default --max-expansions" if max_expansions is None else "--max-expansions"
+    return (f"Hybrid A* stopped after {res.extra['budget']:,} expansions ({which}); the "
+            f"world is {res.extra['radii_across']:,.0f} turning radii across (--radius "
+            f"{res.radius:g}): raise --max-expansions or --radius")
 
 
 def _fly_tour(world, s, h0, pts, radius, step, max_expansions):
@@ -391,7 +401,10 @@ def _fly_dubins(world, s, t, radius, h0, h1, step):
     route = plan(world, s, t)
     if not route.found:
         return _not_reached("no route between start and goal"), [], np.array([s])
-    legs = through(world.to_plane(route.path), radius,  # a heading left out: the best
+    corners = world.to_plane(route.path)
+    if len(corners) == 1:  # start == goal: still one Dubins path, between the two headings
+        corners = np.repeat(corners, 2, axis=0)
+    legs = through(corners, radius,  # a heading left out: the best
                    start_heading=None if h0 is None else float(world.heading_to_plane(h0)),
                    end_heading=None if h1 is None else float(world.heading_to_plane(h1)))
     poses = np.vstack([leg.sample(step) for leg in legs])

@@ -16,6 +16,8 @@ def grid_path_geojson(grid: Grid, result: PlanResult) -> dict:
     properties say. Properties repeat the result's status, cost and statistics.
     """
     coords = grid.to_world(result.path).tolist() if result.found else []
+    if len(coords) == 1:  # start == goal: a LineString needs two positions (RFC 7946)
+        coords *= 2
     props = {k: v for k, v in result.to_dict().items() if k != "path"}
     props.update(map=grid.name, frame="grid-local metres", resolution=grid.resolution,
                  cells=result.path.tolist())

@@ -29,14 +29,25 @@ def path_north_east(world: World, path: np.ndarray) -> np.ndarray:
     return np.c_[p[:, 1], p[:, 0]]
 
 
+_SAME_POINT = 1e-9  # metres: a shorter leg is a point repeated, without a heading
+
+
 def waypoints(world: World, path: np.ndarray, altitude: float) -> list[list[float]]:
     """[[north, east, altitude, heading], ...] relative to home; heading (radians, 0 north,
-    clockwise) along the track into each point, the first taking the first leg's."""
+    clockwise) along the track into each point, the first taking the first leg's. A leg
+    of zero length (a point repeated) has no direction of its own: it keeps the heading
+    of the leg before, or of the next leg when it comes first (0 when no leg has one)."""
     ne = path_north_east(world, path)
     if len(ne) == 0:
         return []
     d = np.diff(ne, axis=0)
     legs = heading_of(d[:, 1], d[:, 0]) if len(d) else np.zeros(0)
+    moves = np.hypot(d[:, 0], d[:, 1]) > _SAME_POINT
+    if moves.any():  # each leg takes the latest moving leg's heading (the first's before it)
+        latest = np.maximum.accumulate(np.where(moves, np.arange(len(d)), -1))
+        legs = legs[np.where(latest < 0, np.argmax(moves), latest)]
+    else:
+        legs = np.zeros(len(d))
     headings = np.concatenate([legs[:1] if len(legs) else [0.0], legs])
     return [[float(n), float(e), float(altitude), float(h)]
             for (n, e), h in zip(ne, headings, strict=True)]
@@ -48,9 +59,12 @@ def world_path_geojson(world: World, result: PlanResult) -> dict:
     props.update(world=world.name, frame=world.frame)
     lonlat = result.path_lonlat if result.path_lonlat is not None else \
         path_lonlat(world, result.path)
+    coords = np.asarray(lonlat).tolist()
+    if len(coords) == 1:  # start == goal: a LineString needs two positions (RFC 7946)
+        coords *= 2
     return {"type": "FeatureCollection", "features": [{
         "type": "Feature",
-        "geometry": {"type": "LineString", "coordinates": np.asarray(lonlat).tolist()},
+        "geometry": {"type": "LineString", "coordinates": coords},
         "properties": props}]}
 
 

@@ -83,6 +83,12 @@ _WEIGHT = 1.0  # f = g + weight h; 1 keeps the search best-first on the true bou
 _REVERSE_BUDGET = 500  # expansions of the reversed search that comes first
 _BACK_COST = 1.0  # reverse=True: a metre driven backwards costs as much as one forwards
 _SWITCH = 1.0  # reverse=True: each change of direction costs this many turning radii
+#: max_expansions=None: the search stores at most this many nodes (each expansion adds at
+#: most one per primitive; about 2 GB), 10,000,000 expansions (5,000,000 with reverse).
+#: The largest searches measured that find a path used 3,000,000 (radius 5 m across the
+#: 930 m FCND city, docs/architecture.md); without a cap a radius tiny beside the world
+#: (0.01 m in 100 m) filled 10 GB in 5 minutes.
+MAX_NODES = 30_000_000
 
 
 @dataclass(frozen=True)
@@ -94,7 +100,9 @@ class HybridResult:
     ``start`` and ``goal`` the plane poses the path joins (the goal heading is the arrival
     heading when none was asked for); ``expanded`` nodes expanded; ``seconds`` wall time
     of the planning. :meth:`sample` gives poses in the world's frame. ``extra``:
-    ``raw_length`` before shortcutting, analytic ``tries``, ``shortcut_tries``.
+    ``raw_length`` before shortcutting, analytic ``tries``, ``shortcut_tries``; on
+    ``budget_exhausted``, the ``budget`` spent, ``radii_across`` (the search region's
+    longer side in turning radii) and a one-line ``hint``.
     """
 
     status: Status
@@ -179,7 +187,12 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         r times the heading change), which stays a bound with reversing.
     max_expansions : int, optional
         Stop with ``budget_exhausted`` (or with the best path found so far) after this
-        many expansions.
+        many expansions. None: :data:`MAX_NODES` divided by the primitives per expansion,
+        10,000,000 (5,000,000 with ``reverse``): about 2 GB and a few minutes at most, far
+        above the searches that find a path in city-sized worlds at radii of metres, and
+        the guard against a radius tiny beside the world, whose lattice has billions of
+        states. Running out says so in ``extra["hint"]``, with the world's size in
+        turning radii.
     approach : float, optional
         ``goal`` is a runway threshold (x, y, runway heading) and the path ends with a
         straight final approach this long along the runway (:func:`runway_goal`).
@@ -201,6 +214,8 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     """
     r, H, step, limit = _options(radius, heading_bins, step, reverse, max_expansions, seed,
                                  smooth)
+    if max_expansions is None:
+        limit = MAX_NODES // (6 if reverse else 3)
     reverse, smooth, seed = bool(reverse), bool(smooth), int(seed)
     sxy, sth = _in_plane(world, *_pose(start, "start"))
     gxy, gth = _in_plane(world, *_pose(goal, "goal"))
@@ -225,8 +240,8 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         if not ok:
             raise QueryError(f"goal: the final approach of {approach:g} m to "
                              f"({threshold[0]:.2f}, {threshold[1]:.2f}) is not free")
-    lattice = _Lattice(world, index, r, H, step, _region(world, sxy, gxy, 4 * r + 2 * step),
-                       reverse)
+    region = _region(world, sxy, gxy, 4 * r + 2 * step)
+    lattice = _Lattice(world, index, r, H, step, region, reverse)
     # Time reversal: a path from start to goal driven backwards is a forward path from
     # the goal turned round to the start turned round (with reverse gears: a path from
     # the goal to the start, every piece's direction swapped). A short search that way
@@ -247,9 +262,12 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     start_pose = (float(sxy[0]), float(sxy[1]), math.nan if sth is None else float(sth))
     goal_pose = (float(gxy[0]), float(gxy[1]), math.nan if gth is None else float(gth))
     if status is not Status.FOUND:
+        extra = {"tries": back.tries + res.tries}
+        if status is Status.BUDGET_EXHAUSTED:
+            extra.update(budget=limit, radii_across=_across(region) / r,
+                         hint=_hint(limit, max_expansions is None, _across(region) / r, r))
         return HybridResult(status, math.inf, (), start_pose, goal_pose, r, int(expanded),
-                            time.perf_counter() - t0, {"tries": back.tries + res.tries},
-                            world, given)
+                            time.perf_counter() - t0, extra, world, given)
     pieces = res.pieces
     if pieces:  # exactly the given start (a reversed search ends there within rounding)
         head = pieces[0].start[2] if sth is None else sth
@@ -390,6 +408,19 @@ def _bucket(world: World) -> float:
     xmin, ymin, xmax, ymax = world.bounds if (world.boundary is not None or
                                               len(world.obstacles)) else (0, 0, 1, 1)
     return max(xmax - xmin, ymax - ymin) / 64.0
+
+
+def _across(region) -> float:
+    """The longer side of the search region (plane units)."""
+    return float(max(region[2] - region[0], region[3] - region[1]))
+
+
+def _hint(limit: int, default: bool, across: float, r: float) -> str:
+    """Why a search ran out of its budget, and what to change."""
+    which = "the default max_expansions" if default else "max_expansions"
+    return (f"stopped after {limit:,} expansions ({which}); the world is {across:,.0f} "
+            f"turning radii across (radius={r:g}), and the states to search grow with "
+            f"its square: give a larger max_expansions, or a larger radius")
 
 
 def _turned(h: float | None) -> float | None:

@@ -119,8 +119,9 @@ class VisibilityGraph:
         n = len(self.corners)
         extra = {"corners": n, "edges": self.edge_count}
         direct = float(np.hypot(*(t - s)))
-        if self.free(s[None], t[None])[0]:
-            return PlanResult(STATUS_OF_CODE[0], np.array([s, t]), direct, 0, 1, 1,
+        if self.free(s[None], t[None])[0]:  # start == goal: one point, as every planner
+            path = np.array([s, t]) if direct else s[None].copy()
+            return PlanResult(STATUS_OF_CODE[0], path, direct, 0, 1, 1,
                               time.perf_counter() - t0, "visibility", extra)
         from_s, len_s = self._seen(s)
         to_t, len_t = self._seen(t)
