@@ -115,7 +115,7 @@ def test_fleet_runs_keep_their_files_and_replace_on_the_same_id(engine):
     one = store.get_fleet_run(engine, a, files="tracks_csv")
     assert [k for k in store.FILES if k in one] == ["tracks_csv"]
     assert one["tracks_csv"] == files["tracks_csv"]
-    with pytest.raises(OptionError, match="files='tracks'.*'tracks_csv'"):
+    with pytest.raises(OptionError, match=r"files='tracks'.*'tracks_csv'"):
         store.get_fleet_run(engine, a, files=("tracks",))
     assert [r["id"] for r in store.list_fleet_runs(engine, job_id=job_id)] == [a]
     assert {r["id"] for r in store.list_fleet_runs(engine)} == {a, b}
