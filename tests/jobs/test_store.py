@@ -109,6 +109,14 @@ def test_fleet_runs_keep_their_files_and_replace_on_the_same_id(engine):
     assert run["report"] == {"delivered": 4} and run["job_id"] == job_id
     assert {k: run[k] for k in files} == files
     assert "tracks_csv" not in store.get_fleet_run(engine, a, files=False)
+    some = store.get_fleet_run(engine, a, files=("events_jsonl", "packages_csv"))
+    assert {k for k in store.FILES if k in some} == {"events_jsonl", "packages_csv"}
+    assert some["report"] == {"delivered": 4} and some["events_jsonl"] == files["events_jsonl"]
+    one = store.get_fleet_run(engine, a, files="tracks_csv")
+    assert [k for k in store.FILES if k in one] == ["tracks_csv"]
+    assert one["tracks_csv"] == files["tracks_csv"]
+    with pytest.raises(OptionError, match=r"files='tracks'.*'tracks_csv'"):
+        store.get_fleet_run(engine, a, files=("tracks",))
     assert [r["id"] for r in store.list_fleet_runs(engine, job_id=job_id)] == [a]
     assert {r["id"] for r in store.list_fleet_runs(engine)} == {a, b}
     assert store.get_fleet_run(engine, "nope") is None

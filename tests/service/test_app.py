@@ -62,6 +62,35 @@ def test_unknown_path_and_method_are_problems(client):
     assert_problem(client.delete("/health"), 405, words="DELETE")
 
 
+BROWSER = ("text/html,application/xhtml+xml,application/xml;q=0.9,image/avif,"
+           "image/webp,*/*;q=0.8")  # Chromium's Accept when it navigates
+
+
+@pytest.mark.parametrize("path", ["/planer.html", "/no/such/thing", "/js/<b>x</b>"])
+def test_a_browser_on_a_missing_page_gets_a_page_linking_home(client, path):
+    """A browser that mistypes a page got the problem+json document as raw text."""
+    r = client.get(path, headers={"Accept": BROWSER})
+    assert r.status_code == 404 and r.headers["content-type"].startswith("text/html")
+    assert "does not exist" in r.text and '<a href="/">' in r.text
+    assert "<b>" not in r.text and "Accept" in r.headers["vary"]  # the path is escaped
+
+
+@pytest.mark.parametrize("accept", [None, "*/*", "application/json",
+                                    "application/problem+json",
+                                    "text/html;q=0.5, application/json",
+                                    "image/avif,image/webp,*/*;q=0.8"])
+def test_an_api_client_on_a_missing_page_still_gets_a_problem(client, accept):
+    headers = {} if accept is None else {"Accept": accept}
+    assert_problem(client.get("/planer.html", headers=headers), 404, words="/planer.html")
+
+
+@pytest.mark.parametrize("path", ["/fleet/nope", "/days/2024-01-03/nope", "/jobs/x/y",
+                                  "/docs/nope", "/plan/x"])
+def test_a_browser_under_the_api_gets_a_problem(client, path):
+    r = client.get(path, headers={"Accept": BROWSER})
+    assert r.status_code in (404, 405) and r.headers["content-type"] == PROBLEM, r.text
+
+
 @pytest.mark.parametrize("path", ["/plan", "/jobs/deliver", "/jobs/fleet"])
 @pytest.mark.parametrize("method", ["GET", "HEAD", "PUT", "PATCH", "DELETE", "OPTIONS"])
 def test_post_only_paths_allow_post(client, path, method):

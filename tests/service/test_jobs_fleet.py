@@ -26,11 +26,28 @@ needs_jobs = pytest.mark.skipif(not HAVE_JOBS, reason="skyroute.jobs is not inst
 
 
 # -- a stand-in for skyroute.jobs -------------------------------------------------------
+FILES = ("events_jsonl", "tracks_csv", "packages_csv", "fleet_geojson")  # the store's
+ALIASES = {"events": "events_jsonl", "tracks": "tracks_csv", "packages": "packages_csv",
+           "geojson": "fleet_geojson"}  # the same files under the brief's keys
+
+
 class FakeJobs:
     def __init__(self):
         self.jobs: dict[str, dict] = {}
         self.runs: dict[str, dict] = {}
         self.submitted: list[tuple[str, dict]] = []
+        self.reads: list[tuple[str, tuple]] = []  # (run id, the files read) per lookup
+
+    def get_fleet_run(self, engine, run_id, *, files=True):
+        """As the store's: the run's head and only the files asked for."""
+        wanted = FILES if files is True else () if files is False else tuple(files)
+        assert set(wanted) <= set(FILES), wanted
+        self.reads.append((run_id, wanted))
+        run = self.runs.get(run_id)
+        if run is None:
+            return None
+        return {k: v for k, v in run.items()
+                if ALIASES.get(k, k) not in FILES or ALIASES.get(k, k) in wanted}
 
     def install(self, monkeypatch):
         pkg = types.ModuleType("skyroute.jobs")
@@ -39,7 +56,7 @@ class FakeJobs:
         executor = types.ModuleType("skyroute.jobs.executor")
         runner.submit = self.submit
         runner.get = lambda engine, i: self.jobs.get(i)
-        store.get_fleet_run = lambda engine, i: self.runs.get(i)
+        store.get_fleet_run = self.get_fleet_run
         store.list_fleet_runs = lambda engine: list(self.runs.values())
         executor.open_executor = lambda kind="local", address=None, workers=None: \
             types.SimpleNamespace(kind=kind, close=lambda: None)
@@ -253,6 +270,33 @@ def test_fleet_run_pages_and_files(client, fake, small_run, layout):
         assert sum(k == "track" for k in kinds) == len(flights)
 
 
+@pytest.mark.parametrize("path, reads", [
+    ("", [("events_jsonl", "packages_csv")]),  # a page of events; packages.csv listed?
+    ("?offset=5&limit=2", [("events_jsonl", "packages_csv")]),
+    ("/events.jsonl", [("events_jsonl",)]),
+    ("/tracks.csv", [("tracks_csv",)]),
+    ("/packages.csv", [("packages_csv",)]),
+    ("/fleet.geojson", [("fleet_geojson",)]),
+])
+def test_each_run_route_reads_only_what_it_answers(client, fake, small_run, path, reads):
+    """The viewer pages a run's events again and again: the summary and each file read
+    their own columns, never the tracks (a big run's are about 150 MB)."""
+    fake.runs["r"] = {"id": "r", "scenario": "seed-3x3", "params": {"preset": "seed-3x3"},
+                      "report": small_run["report"], "events_jsonl": small_run["events"],
+                      "tracks_csv": small_run["tracks"].encode(), "packages_csv": "id\n",
+                      "fleet_geojson": json.dumps(small_run["geojson"])}
+    assert client.get(f"/fleet/runs/r{path}").status_code == 200
+    assert [files for _, files in fake.reads] == reads
+
+
+def test_a_geojson_rebuilt_from_the_tracks_reads_them_only_then(client, fake, small_run):
+    fake.runs["r"] = {"id": "r", "scenario": "seed-3x3", "params": {"preset": "seed-3x3"},
+                      "report": {}, "tracks": small_run["tracks"]}
+    gj = client.get("/fleet/runs/r/fleet.geojson").json()
+    assert [f["properties"]["kind"] for f in gj["features"]].count("airport") == 3
+    assert [files for _, files in fake.reads] == [("fleet_geojson",), ("tracks_csv",)]
+
+
 @pytest.mark.parametrize("query, field", [("offset=-1", "offset"), ("limit=0", "limit"),
                                           ("limit=100000", "limit")])
 def test_fleet_run_paging_is_checked(client, fake, query, field):
@@ -349,6 +393,44 @@ def test_fleet_runs_say_when_each_was_stored(tmp_path):
         runs = c.get("/fleet/runs").json()
     assert {r["id"]: r["created"] for r in runs} == want
     assert all(want.values()) and len(set(want.values())) == 2
+
+
+@needs_jobs
+def test_the_real_store_selects_the_tracks_only_for_tracks_csv(tmp_path, small_run):
+    """Every SELECT a run's routes send, seen by SQLAlchemy: only GET tracks.csv names
+    the tracks column."""
+    import sqlalchemy as sa
+
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    db = f"sqlite:///{tmp_path / 'runs.db'}"
+    eng = make_engine(db)
+    rid = store.save_fleet_run(eng, scenario="seed-3x3", params={"preset": "seed-3x3"},
+                               report=small_run["report"], events_jsonl=small_run["events"],
+                               tracks_csv=small_run["tracks"].encode(), packages_csv="id\n",
+                               fleet_geojson=json.dumps(small_run["geojson"]))
+    eng.dispose()
+    seen: list[str] = []
+
+    def record(conn, cursor, statement, *args):
+        if statement.lstrip().upper().startswith("SELECT") and "fleet_runs" in statement:
+            seen.append(statement)
+
+    sa.event.listen(sa.engine.Engine, "before_cursor_execute", record)
+    try:
+        with make_client(db_url=db) as c:
+            for path in ("", "?offset=3&limit=2", "/events.jsonl", "/packages.csv",
+                         "/fleet.geojson", "/tracks.csv"):
+                del seen[:]
+                r = c.get(f"/fleet/runs/{rid}{path}")
+                assert r.status_code == 200, r.text
+                assert seen, path
+                assert any("tracks_csv" in q for q in seen) == (path == "/tracks.csv"), \
+                    (path, seen)
+            assert r.text == small_run["tracks"]
+    finally:
+        sa.event.remove(sa.engine.Engine, "before_cursor_execute", record)
 
 
 @needs_jobs

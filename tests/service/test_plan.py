@@ -176,6 +176,13 @@ CITY_BODY = {"world_format": "colliders", "altitude": 10, "safety": 2,
     ({**CITY_BODY, "algorithm": "astar", "resolution": 0.001}, "resolution",
      "this server's limit"),
     ({**CITY_BODY, "algorithm": "prm", "samples": 10**6}, "samples", "limit of 20,000"),
+    # a cell past the whole local plane: the schema's bound; a raster reaching past it:
+    # the planner's (both answered "path (...) lies more than 1e+07 m from home", or a
+    # path through far-off lon/lat, without naming resolution)
+    ({**CITY_BODY, "algorithm": "astar", "resolution": 1e9}, "resolution",
+     "less than or equal to 10000000"),
+    ({**CITY_BODY, "algorithm": "theta", "resolution": 2e6}, "resolution",
+     "makes a raster reaching 1.6e+07 m from home"),
 ])
 def test_bad_input_is_422_naming_the_field(client, body, field, words):
     if "world_format" in body and "world_text" not in body:

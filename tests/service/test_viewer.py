@@ -708,6 +708,26 @@ def test_a_link_to_what_is_not_stored_says_so(open_page, server, path, named):
     pg.done("link-not-stored")
 
 
+def test_a_mistyped_page_says_so_and_links_home(browser, server):
+    """A mistyped page showed the 404 problem document as raw JSON text."""
+    context = browser.new_context(viewport=VIEWPORTS["phone"])
+    try:
+        page = context.new_page()
+        answer = page.goto(server[0] + "/planer.html")
+        assert answer.status == 404
+        assert page.inner_text("h1") == "Page not found"
+        assert "/planer.html does not exist" in page.inner_text("main")
+        wide = page.evaluate("document.documentElement.scrollWidth - window.innerWidth")
+        assert wide <= 0
+        SHOTS.mkdir(parents=True, exist_ok=True)
+        page.screenshot(path=str(SHOTS / "not-found-phone.png"), full_page=True)
+        page.click("text=Go to the skyroute start page")
+        page.wait_for_url(server[0] + "/")
+        assert page.locator("a[href='/planner.html']").count() >= 1
+    finally:
+        context.close()
+
+
 def test_world_plans_with_the_safety_typed(open_page):
     """A negative safety margin was planned with 0 and answered "Found a path" (the page
     replaced it); it goes to the server as typed, which refuses it naming the field."""

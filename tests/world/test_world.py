@@ -10,7 +10,7 @@ import shapely
 import skyroute
 from skyroute import InputFormatError, OptionError, QueryError
 from skyroute.geo import lonlat_to_enu
-from tests.conftest import SHARED
+from tests.conftest import ROOT, SHARED
 
 FCND = SHARED / "fcnd" / "colliders.csv"
 ILP = SHARED / "ilp2021"
@@ -161,6 +161,22 @@ def test_grid_planners_pass_round_an_obstacle_that_spans_an_unbounded_world(algo
     exact = skyroute.plan(_tower(), (0, 2), (4, 2))
     r = skyroute.plan(_tower(), (0, 2), (4, 2), algorithm=algorithm, resolution=0.1)
     assert r.found and exact.cost - 1e-9 <= r.cost <= exact.cost * 1.1
+
+
+@pytest.mark.parametrize("algorithm", ["astar", "theta"])
+@pytest.mark.parametrize("frame", ["ned", "lonlat"])
+def test_a_raster_past_the_local_plane_is_refused_naming_resolution(algorithm, frame):
+    """A resolution whose raster (8 cells round the obstacles and points) reaches past
+    the 1e7 m of a local plane: a path "more than 1e+07 m from home" (ned), or through
+    far-off lon/lat, came back instead."""
+    w = skyroute.load_world(ROOT / "examples" / "city.csv", altitude=10, frame=frame)
+    a, b = (w.from_plane([p])[0] for p in ((0.0, 0.0), (100.0, 100.0)))
+    with pytest.raises(OptionError, match=r"resolution=2e\+06 makes a raster reaching "
+                       r"1.6e\+07 m from home.*finer resolution") as info:
+        skyroute.plan(w, a, b, algorithm=algorithm, resolution=2e6)
+    assert info.value.param == "resolution"
+    r = skyroute.plan(w, a, b, algorithm=algorithm, resolution=1e6)  # 8e6 m: in the plane
+    assert r.found and np.abs(w.to_plane(r.path)).max() <= 1e7
 
 
 @pytest.mark.parametrize("kw", [{"resolution": "1"}, {"resolution": [1]},

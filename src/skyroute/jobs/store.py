@@ -42,7 +42,7 @@ import sqlalchemy as sa
 
 from skyroute.caches import register
 from skyroute.delivery.store import connect, tables, writing
-from skyroute.errors import OptionError, SkyrouteError
+from skyroute.errors import OptionError, SkyrouteError, check_choice
 
 STATES = ("queued", "running", "done", "failed")
 LIVE = ("queued", "running")  # the states a job may still leave
@@ -281,12 +281,24 @@ def _run_dict(r) -> dict:
     return out
 
 
-def get_fleet_run(engine: sa.Engine, run_id: str, *, files: bool = True) -> dict | None:
+def get_fleet_run(engine: sa.Engine, run_id: str, *,
+                  files: bool | Collection[str] = True) -> dict | None:
     """``{"id", "job_id", "scenario", "params", "report", "created"}`` and, with
-    ``files``, ``events_jsonl`` (text), ``tracks_csv`` (bytes) and ``packages_csv``
-    (text); None for an unknown id."""
+    ``files``, ``events_jsonl`` (text), ``tracks_csv`` (bytes), ``packages_csv`` (text)
+    and ``fleet_geojson`` (text); None for an unknown id. ``files`` may also name the
+    files wanted (of :data:`FILES`): only their columns are read, so a run's summary or
+    one of its files does not load its tracks (about 150 MB for a big run)."""
+    if isinstance(files, bool):
+        wanted = FILES if files else ()
+    elif isinstance(files, str):
+        check_choice("files", files, FILES)
+        wanted = (files,)
+    else:
+        wanted = tuple(files)
+        for k in wanted:
+            check_choice("files", k, FILES)
     runs = _t(engine)["fleet_runs"]
-    cols = [runs.c[k] for k in (*_HEAD, *(FILES if files else ()))]
+    cols = [runs.c[k] for k in (*_HEAD, *wanted)]
     with engine.connect() as c:
         r = c.execute(sa.select(*cols).where(runs.c.id == str(run_id))).mappings().first()
     return None if r is None else _run_dict(r)

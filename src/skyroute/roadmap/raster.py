@@ -22,6 +22,7 @@ from skyroute.result import PlanResult, Status
 from skyroute.roadmap.simplify import shortcut
 from skyroute.search.grid_plan import plan_grid
 from skyroute.world.grid import Grid
+from skyroute.world.points import MAX_METRES
 from skyroute.world.world import World
 
 _RASTERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -45,6 +46,21 @@ def raster_box(world: World, s, t, r: float) -> tuple[float, float, float, float
     return box
 
 
+def check_reach(world: World, box, r: float) -> None:
+    """An OptionError naming ``resolution`` when a raster of cell size ``r`` over plane
+    ``box`` reaches past a local plane's :data:`~skyroute.world.points.MAX_METRES` from
+    home: its cells' centres, a path's corners, would be no points of the world (a path
+    "more than 1e+07 m from home", or far-off lon/lat, came back instead)."""
+    if world.plane != "metres":
+        return
+    reach = max(abs(v) for v in box)
+    if reach > MAX_METRES:
+        raise OptionError(f"resolution={r:g} makes a raster reaching {reach:.3g} m from "
+                          f"home, past the {MAX_METRES:.0e} m of this world's local "
+                          "plane (it grows 8 cells round the obstacles and points); use "
+                          "a finer resolution", param="resolution")
+
+
 def world_raster(world: World, s: np.ndarray, t: np.ndarray,
                  resolution: float | None) -> Grid:
     """The world's plane rasterised with a half-diagonal clearance, holding plane points
@@ -57,6 +73,8 @@ def world_raster(world: World, s: np.ndarray, t: np.ndarray,
             raise OptionError(f"resolution={resolution!r} must be a positive number",
                               param="resolution")
     box = raster_box(world, s, t, r)
+    if resolution is not None:
+        check_reach(world, box, r)
     per_world = _RASTERS.setdefault(world, {})
     key = (r, box)
     if key not in per_world:

@@ -58,12 +58,18 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     problems.install(app)
     problems.document(app)
     app.include_router(_post_only(POST_ONLY))  # first: /jobs/fleet is not /jobs/{job_id}
-    for module in (health, maps, days, orders, site, plan, jobs, fleet, fleet_packages):
+    modules = (health, maps, days, orders, site, plan, jobs, fleet, fleet_packages)
+    for module in modules:
         app.include_router(module.router)
     app.add_middleware(ServerTiming)  # inside the body limit: the body is in hand
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
     app.add_middleware(HeadAsGet)
     app.mount("/", StaticFiles(directory=STATIC, html=True), name="static")
+    # the API's first path segments: a browser asking for any other missing path gets
+    # an HTML page, not the problem document (the routers' own routes are listed, as
+    # the app keeps included routers unexpanded)
+    app.state.api_heads = problems.api_heads(
+        [*app.routes, *(r for m in modules for r in m.router.routes)])
     return app
 
 

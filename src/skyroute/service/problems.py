@@ -6,11 +6,12 @@ answered by a generic 500.
 
 from __future__ import annotations
 
+import html
 import logging
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
-from fastapi.responses import JSONResponse
+from fastapi.responses import HTMLResponse, JSONResponse, Response
 from pydantic import BaseModel, Field
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
@@ -143,9 +144,80 @@ async def _problem(request: Request, exc: Problem) -> JSONResponse:
                             headers=exc.headers)
 
 
-async def _http(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+def _quality(accept: str, media: str) -> float:
+    """The q an Accept header gives ``media``: its most specific matching range's (RFC
+    9110: exact, then type/*, then */*), 0 when none matches."""
+    main = media.split("/")[0]
+    best, q = -1, 0.0
+    for part in accept.split(","):
+        rng, *params = (x.strip() for x in part.split(";"))
+        rng = rng.lower()
+        rank = 2 if rng == media else 1 if rng == f"{main}/*" else 0 if rng == "*/*" else -1
+        if rank > best:
+            value = next((p[2:] for p in params if p.lower().startswith("q=")), "1")
+            try:
+                best, q = rank, float(value)
+            except ValueError:
+                best, q = rank, 0.0
+    return q
+
+
+def prefers_html(request: Request) -> bool:
+    """Whether the client would rather have an HTML page than JSON: a browser navigating
+    (``text/html`` over ``application/json``); no Accept header, or ``*/*``, is no."""
+    accept = request.headers.get("accept", "")
+    html = max(_quality(accept, m) for m in ("text/html", "application/xhtml+xml"))
+    json = max(_quality(accept, m) for m in ("application/json", MEDIA_TYPE))
+    return html > json
+
+
+def api_heads(routes) -> frozenset[str]:
+    """The first path segments of ``routes`` (plan, days, fleet, docs, openapi.json, ...;
+    not the viewer's mount at /): the app factory keeps them as ``state.api_heads``."""
+    paths = (getattr(r, "path", "") for r in routes)
+    return frozenset(p.split("/")[1] for p in paths if p.startswith("/") and len(p) > 1)
+
+
+def api_path(request: Request) -> bool:
+    """Whether the request's path lies under the API (see :func:`api_heads`), not among
+    the viewer's pages."""
+    heads = getattr(request.app.state, "api_heads", None)
+    if heads is None:
+        heads = api_heads(request.app.routes)
+    return request.url.path.split("/")[1] in heads
+
+
+NOT_FOUND_PAGE = """<!doctype html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>Page not found - skyroute</title>
+<link rel="icon" href="/favicon.svg" type="image/svg+xml">
+<link rel="stylesheet" href="/viewer.css">
+</head>
+<body>
+<main id="main">
+<h1>Page not found</h1>
+<p>The page <code>{path}</code> does not exist.</p>
+<p><a href="/">Go to the skyroute start page</a></p>
+</main>
+</body>
+</html>
+"""
+
+
+async def _http(request: Request, exc: StarletteHTTPException) -> Response:
     detail = exc.detail if isinstance(exc.detail, str) else TITLES.get(exc.status_code,
                                                                         "error")
+    if exc.status_code == 404 and detail == "Not Found" and not api_path(request):
+        # a page of the viewer that is not there: a browser gets a page, API clients
+        # the problem document; either may be cached only by the Accept it was asked with
+        if prefers_html(request):
+            return HTMLResponse(NOT_FOUND_PAGE.format(path=html.escape(request.url.path)),
+                                status_code=404, headers={"Vary": "Accept"})
+        return problem_response(404, f"no such resource: {request.url.path}",
+                                headers={"Vary": "Accept"})
     if exc.status_code == 404 and detail == "Not Found":
         detail = f"no such resource: {request.url.path}"
     elif exc.status_code == 400 and detail == "There was an error parsing the body":

@@ -54,8 +54,11 @@ def _store():
     return store
 
 
-def _run(res: Resources, run_id: str) -> dict:
-    run = _store().get_fleet_run(res.engine(), run_id)
+def _run(res: Resources, run_id: str, *files: str) -> dict:
+    """The run's summary and only the ``files`` named (the store's column names): a
+    route reads what it answers, never the tracks (about 150 MB for a big run) to page
+    its events."""
+    run = _store().get_fleet_run(res.engine(), run_id, files=files)
     if run is None:
         raise Problem(404, f"no fleet run {run_id!r}; GET /fleet/runs lists them",
                       kind="unknown-run")
@@ -118,7 +121,7 @@ def list_runs(res: ResourcesDep) -> list[dict]:
 def get_run(run_id: RunId, res: ResourcesDep,
             offset: Annotated[int, Query(ge=0)] = 0,
             limit: Annotated[int, Query(ge=1, le=10_000)] = 1000) -> dict:
-    run = _run(res, run_id)
+    run = _run(res, run_id, "events_jsonl", "packages_csv")
     lines = _text(run, "events", "events_jsonl").splitlines()
     page = [json.loads(x) for x in lines[offset:offset + limit]]
     base = f"/fleet/runs/{run_id}"
@@ -131,7 +134,17 @@ def get_run(run_id: RunId, res: ResourcesDep,
             "files": {k: f"{base}/{k}" for k in names}}
 
 
-def _file(content: str, media_type: str, name: str) -> Response:
+def _raw(run: dict, *keys: str) -> bytes | str:
+    """A stored file as the store holds it (the tracks as bytes: sent without a copy
+    decoded to text and encoded back)."""
+    for k in keys:
+        v = run.get(k)
+        if v is not None:
+            return bytes(v) if isinstance(v, memoryview) else v
+    return ""
+
+
+def _file(content: str | bytes, media_type: str, name: str) -> Response:
     return Response(content, media_type=media_type,
                     headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
@@ -140,15 +153,16 @@ def _file(content: str, media_type: str, name: str) -> Response:
             responses={200: {"content": {"application/x-ndjson": {}}}, **responses(404, 503)},
             summary="A fleet run's events, one JSON object a line")
 def get_events(run_id: RunId, res: ResourcesDep) -> Response:
-    return _file(_text(_run(res, run_id), "events", "events_jsonl"), "application/x-ndjson",
-                 "events.jsonl")
+    return _file(_text(_run(res, run_id, "events_jsonl"), "events", "events_jsonl"),
+                 "application/x-ndjson", "events.jsonl")
 
 
 @router.get("/fleet/runs/{run_id}/tracks.csv", response_class=Response,
             responses={200: {"content": {"text/csv": {}}}, **responses(404, 503)},
             summary="A fleet run's tracks (one row per drone and time step)")
 def get_tracks(run_id: RunId, res: ResourcesDep) -> Response:
-    return _file(_text(_run(res, run_id), "tracks", "tracks_csv"), "text/csv", "tracks.csv")
+    return _file(_raw(_run(res, run_id, "tracks_csv"), "tracks", "tracks_csv"), "text/csv",
+                 "tracks.csv")
 
 
 @router.get("/fleet/runs/{run_id}/fleet.geojson", response_class=Response,
@@ -156,12 +170,13 @@ def get_tracks(run_id: RunId, res: ResourcesDep) -> Response:
                        **responses(404, 503)},
             summary="A fleet run's airports, runways and tracks in lon/lat")
 def get_geojson(run_id: RunId, res: ResourcesDep) -> Response:
-    run = _run(res, run_id)
+    run = _run(res, run_id, "fleet_geojson")
     text = _text(run, "fleet_geojson", "geojson")
-    if not text:
+    if not text:  # a run stored without it: rebuilt from its tracks, read only then
         from skyroute.fleet.scenario import parse_scenario
         from skyroute.io.fleet_out import fleet_geojson_from_tracks
 
+        run = _run(res, run_id, "tracks_csv")
         scenario = parse_scenario(_scenario(run), "scenario")
         text = json.dumps(fleet_geojson_from_tracks(scenario, _text(run, "tracks",
                                                                     "tracks_csv")))

@@ -21,7 +21,7 @@ router = APIRouter(tags=["fleet"])
             responses={200: {"content": {"text/csv": {}}}, **responses(404, 503)},
             summary="A fleet run's packages (one row per package)")
 def get_packages(run_id: RunId, res: ResourcesDep) -> Response:
-    text = _text(_run(res, run_id), "packages_csv", "packages")
+    text = _text(_run(res, run_id, "packages_csv"), "packages_csv", "packages")
     if not text:
         raise Problem(404, f"fleet run {run_id!r} has no packages.csv", kind="no-packages")
     return _file(text, "text/csv", "packages.csv")

@@ -24,6 +24,7 @@ from skyroute.service.alternatives import exactly_one
 from skyroute.service.auth import require_token
 from skyroute.service.problems import Problem, from_skyrouteerror, responses
 from skyroute.service.resources import Resources, ResourcesDep
+from skyroute.world.points import MAX_METRES
 
 router = APIRouter(tags=["plan"])
 
@@ -82,8 +83,10 @@ class PlanRequest(BaseModel):
     max_expansions: int | None = Field(None, strict=True, ge=1, le=2**62,
                                        description="Stop after this many expansions; "
                                        "capped by the server's budget.")
-    resolution: Number | None = Field(None, gt=0, description="Worlds, grid algorithms: "
-                                      "cell size in world units.")
+    resolution: Number | None = Field(None, gt=0, le=MAX_METRES, description="Worlds, "
+                                      "grid algorithms: cell size in world units (at most "
+                                      "a local plane's 1e7 m; the raster, 8 cells round "
+                                      "the obstacles and points, must lie within it).")
     samples: int = Field(1000, strict=True, ge=1, le=10**9, description="PRM samples.")
     neighbours: int = Field(10, strict=True, ge=1, le=1000, description="PRM neighbours.")
     prm_star: StrictBool = False
