@@ -207,3 +207,23 @@ def test_a_flight_the_zones_block_names_the_scenario_file_when_read():
         check_flights(s, "two.yaml")
     assert str(err.value) == ("two.yaml: no_fly_zones: airport E's final approach from 80 m "
                               "crosses no-fly zone 'wall'")
+
+
+def test_a_cruise_search_out_of_budget_says_so_not_that_none_exists(monkeypatch):
+    from skyroute.fleet.nofly import cruise
+    from skyroute.motion import hybrid
+    from skyroute.motion.dubins import shortest_path
+
+    s = _two_airports(ZONE)
+    start, goal = (-2000.0, 0.0, 0.0), (2000.0, 0.0, 0.0)  # (east, north, heading)
+    path = shortest_path(start, goal, 100.0)  # straight through the wall
+    assert cruise(s, start, goal, 100.0, path)  # round it, with the default budget
+    monkeypatch.setattr(hybrid, "MAX_NODES", 30)
+    with pytest.raises(QueryError) as err:
+        cruise(s, start, goal, 100.0, path, what="flight W -> E at 50 m")
+    assert str(err.value) == (
+        "flight W -> E at 50 m: the search for a cruise with a 100 m turning radius round "
+        "the no-fly zones from the climb-out (0 N, -2000 E) to the approach gate (0 N, "
+        "2000 E) ran out of its budget (10 expansions): it found none, nor showed that "
+        "none exists")
+    assert err.value.param == "no_fly_zones"

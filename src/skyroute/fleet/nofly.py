@@ -24,6 +24,7 @@ from skyroute.errors import InputFormatError, QueryError
 from skyroute.motion import hybrid
 from skyroute.motion.dubins import DubinsPath
 from skyroute.motion.pieces import KINDS, chain
+from skyroute.result import Status
 from skyroute.world.world import World
 
 
@@ -81,11 +82,16 @@ def cruise(scenario, start, goal, radius: float, path: DubinsPath, *,
     if hybrid.path_free(world, pieces):
         return words
     res = hybrid.plan(world, start, goal, radius)
+    pair = (f"from the climb-out ({start[1]:.0f} N, {start[0]:.0f} E) to the approach "
+            f"gate ({goal[1]:.0f} N, {goal[0]:.0f} E)")
+    if res.status is Status.BUDGET_EXHAUSTED:  # not a proof that no cruise exists
+        raise QueryError(f"{what}: the search for a cruise with a {radius:g} m turning "
+                         f"radius round the no-fly zones {pair} ran out of its budget "
+                         f"({res.extra['budget']:,} expansions): it found none, nor "
+                         "showed that none exists", param="no_fly_zones")
     if not res.found:  # joined in the plane (check_joined), yet too narrow to turn in
         raise QueryError(f"{what}: no cruise with a {radius:g} m turning radius gets round "
-                         f"the no-fly zones from the climb-out ({start[1]:.0f} N, "
-                         f"{start[0]:.0f} E) to the approach gate ({goal[1]:.0f} N, "
-                         f"{goal[0]:.0f} E)", param="no_fly_zones")
+                         f"the no-fly zones {pair}", param="no_fly_zones")
     return [(p.kind, p.length) for p in res.segments]
 
 
