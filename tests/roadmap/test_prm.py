@@ -115,3 +115,20 @@ def test_a_way_round_every_obstacle_is_in_the_roadmap(zones, start, goal, seed):
     assert world.segments_free(r.path[:-1], r.path[1:]).all()
     assert exact.cost <= r.cost == pytest.approx(
         np.hypot(*np.diff(r.path, axis=0).T).sum(), rel=1e-12)
+
+
+def test_a_world_with_nothing_in_the_way_is_the_straight_segment():
+    """No boundary and no obstacle left at the altitude: no extent to sample, and
+    nothing to go round (as the visibility graph answers)."""
+    from tests.conftest import ROOT
+
+    world = skyroute.load_world(ROOT / "examples" / "city.csv", altitude=1000)
+    assert len(world.obstacles) == 0 and world.boundary is None
+    a, b = (-3.1890, 55.9456), (-3.1850, 55.9432)
+    r = skyroute.plan(world, a, b, algorithm="prm", samples=300, seed=3)
+    want = skyroute.plan(world, a, b, algorithm="visibility")
+    assert r.found and r.path.tolist() == [list(a), list(b)] == want.path.tolist()
+    assert r.cost == want.cost
+    same = skyroute.plan(world, a, a, algorithm="prm")
+    assert same.found and same.path.tolist() == [list(a)] and same.cost == 0.0
+    assert PRM(skyroute.World([], [], [], ())).edge_segments().shape == (0, 2, 2)

@@ -95,6 +95,20 @@ def test_city_world_equals_plan(client, frame, options):
     assert np.allclose(coords, ans["path_lonlat"])
 
 
+def test_prm_on_a_world_with_nothing_in_the_way(client):
+    """An altitude above every building and no boundary: PRM answers the straight
+    segment, as skyroute.plan does (it was a 422 naming no field)."""
+    a, b = CITY_LONLAT
+    body = {**CITY_BODY, "world_text": CITY.read_text(), "altitude": 1000,
+            "algorithm": "prm", "samples": 300, "seed": 3}
+    r = client.post("/plan", json=body, headers=AUTH)
+    assert r.status_code == 200, r.text
+    w = skyroute.load_world(CITY, altitude=1000, safety=2, frame="lonlat")
+    want = skyroute.plan(w, a, b, algorithm="prm", samples=300, seed=3)
+    same(r.json(), want)
+    assert r.json()["status"] == "found" and r.json()["path"] == [list(a), list(b)]
+
+
 def test_geojson_zones_world(client):
     zones = {"type": "FeatureCollection", "features": [
         {"type": "Feature", "properties": {"name": "block"},

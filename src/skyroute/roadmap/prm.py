@@ -8,7 +8,9 @@ sub-segment shortcuts (as OMPL's path simplifier), and greedy again.
 Samples are drawn in the world's boundary or, without one, in the obstacles' bounds
 grown by :data:`MARGIN` of their size on every side, whose four outer corners are
 nodes too, joined in a ring: a path may have to go round every obstacle (a no-fly zone
-between start and goal), and that way is then always in the roadmap.
+between start and goal), and that way is then always in the roadmap. A world with
+neither (no boundary, and no obstacle at the chosen altitude) has an empty roadmap:
+every query's path is its straight segment.
 
 Reproducible: the samples come from ``seed``, and each query's random shortcuts from a
 generator seeded by ``seed`` and the query's own coordinates, so the same world, query,
@@ -43,6 +45,13 @@ class PRM:
         rng = np.random.default_rng(self.seed)
         t0 = time.perf_counter()
         self.world = world.merged()
+        if world.boundary is None and len(self.world.obstacles) == 0:
+            # nothing in the way (say every obstacle below a high altitude) and no extent
+            # to sample: the roadmap is empty, and each query its straight segment
+            self.points, self.edges = np.empty((0, 2)), np.empty((0, 2), np.intp)
+            self.k, self.tree, self.edge_checks = 0, None, 0
+            self.build_seconds = time.perf_counter() - t0
+            return
         box = self.world.bounds
         ring = np.empty((0, 2))
         if world.boundary is None:
@@ -87,7 +96,7 @@ class PRM:
         pts = np.vstack([self.points, s, t])
         rows, cols = [self.edges[:, 0]], [self.edges[:, 1]]
         checks = 0
-        for node, p in ((n, s), (n + 1, t)):
+        for node, p in ((n, s), (n + 1, t)) if n else ():
             _, nb = self.tree.query(p, k=min(self.k, n))
             nb = np.atleast_1d(nb)
             ok = w.segments_free(np.broadcast_to(p, (len(nb), 2)), self.points[nb])
