@@ -12,9 +12,11 @@ import hashlib
 import os
 import subprocess
 import sys
+import uuid
 from pathlib import Path
 
 import pytest
+import sqlalchemy as sa
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = Path(os.environ.get("SKYROUTE_SHARED_DATA") or ROOT.parent / "shared" / "data")
@@ -134,3 +136,28 @@ def leg_cache(tmp_path_factory):
         os.environ.pop("SKYROUTE_CACHE", None)
     else:
         os.environ["SKYROUTE_CACHE"] = old
+
+
+PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1:5432/test")
+
+
+@pytest.fixture
+def fresh_pg():
+    """The URL of a new, empty PostgreSQL database of this test's own, dropped after it
+    (skipped when no server answers, unless $CI is set)."""
+    base = sa.engine.make_url(PG)
+    name = f"skyroute_new_{uuid.uuid4().hex[:12]}"
+    try:
+        admin = sa.create_engine(base, isolation_level="AUTOCOMMIT")
+        with admin.connect() as c:
+            c.execute(sa.text(f"create database {name}"))
+    except sa.exc.OperationalError:
+        if os.environ.get("CI"):
+            raise
+        pytest.skip("no PostgreSQL server")
+    try:
+        yield base.set(database=name).render_as_string(hide_password=False)
+    finally:
+        with admin.connect() as c:
+            c.execute(sa.text(f"drop database if exists {name} with (force)"))
+        admin.dispose()

@@ -89,8 +89,8 @@ def test_sqlite_and_postgresql_store_identical_rows(monkeypatch, capsys, tmp_pat
     try:
         eng = sa.create_engine(PG)
         with eng.begin() as c:  # a clean schema for this test
-            for t in ("servers", "fleet_runs", "jobs", "runs", "flightpath", "deliveries",
-                      "order_details", "orders", "alembic_version"):
+            for t in ("servers", "fleet_run_files", "fleet_runs", "jobs", "runs", "flightpath",
+                      "deliveries", "order_details", "orders", "alembic_version"):
                 c.execute(sa.text(f"drop table if exists {t} cascade"))
         eng.dispose()
     except sa.exc.OperationalError:

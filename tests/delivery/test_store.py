@@ -4,14 +4,12 @@ written whole (a killed run leaves the previous day) and rerunning replaces it."
 from __future__ import annotations
 
 import datetime as dt
-import os
 import re
 import subprocess
 import sys
 import textwrap
 import threading
 import time
-import uuid
 from pathlib import Path
 
 import pytest
@@ -50,7 +48,7 @@ def moves(n: int, label: str = "aaaaaaaa"):
 @pytest.fixture
 def engine(tmp_path):
     e = store.connect(f"sqlite:///{tmp_path / 'store.db'}")
-    assert store.init(e) == "0003"
+    assert store.init(e) == "0004"
     return e
 
 
@@ -58,7 +56,7 @@ def test_init_makes_the_issues_tables_and_is_repeatable(engine):
     insp = sa.inspect(engine)
     for table, cols in COLUMNS.items():
         assert [c["name"] for c in insp.get_columns(table)] == cols
-    assert store.init(engine) == "0003"  # again: nothing to do
+    assert store.init(engine) == "0004"  # again: nothing to do
 
 
 def test_import_is_idempotent(engine):
@@ -236,7 +234,7 @@ def test_a_new_store_made_by_two_processes_at_once(tmp_path):
                               cwd=str(Path(__file__).parents[2])) for _ in range(3)]
     outs = [p.communicate(timeout=60)[0] for p in procs]
     done = [(p.returncode, out) for p, out in zip(procs, outs, strict=True)]
-    assert done == [(0, "0003\n")] * 3
+    assert done == [(0, "0004\n")] * 3
 
 
 def test_a_store_locked_too_long_is_one_line(tmp_path):
@@ -264,31 +262,6 @@ def test_sqlite_waits_longer_than_pythons_five_seconds(tmp_path):
         assert c.exec_driver_sql("pragma busy_timeout").scalar() == store.BUSY_SECONDS * 1000
 
 
-PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1:5432/test")
-
-
-@pytest.fixture
-def fresh_pg():
-    """The URL of a new, empty PostgreSQL database of this test's own, dropped after it
-    (skipped when no server answers, unless $CI is set)."""
-    base = sa.engine.make_url(PG)
-    name = f"skyroute_new_{uuid.uuid4().hex[:12]}"
-    try:
-        admin = sa.create_engine(base, isolation_level="AUTOCOMMIT")
-        with admin.connect() as c:
-            c.execute(sa.text(f"create database {name}"))
-    except sa.exc.OperationalError:
-        if os.environ.get("CI"):
-            raise
-        pytest.skip("no PostgreSQL server")
-    try:
-        yield base.set(database=name).render_as_string(hide_password=False)
-    finally:
-        with admin.connect() as c:
-            c.execute(sa.text(f"drop database if exists {name} with (force)"))
-        admin.dispose()
-
-
 def test_a_new_postgresql_store_made_by_two_runs_at_once(fresh_pg):
     # both saw no schema and made it: the later ones failed ("not a usable store:
     # relation "alembic_version" already exists"); making it now takes a
@@ -301,7 +274,7 @@ def test_a_new_postgresql_store_made_by_two_runs_at_once(fresh_pg):
                               stderr=subprocess.PIPE, text=True,
                               cwd=str(Path(__file__).parents[2])) for _ in range(4)]
     done = [(p.communicate(timeout=60), p.returncode) for p in procs]
-    assert [(out, rc) for (out, _), rc in done] == [("0003\n", 0)] * 4, done
+    assert [(out, rc) for (out, _), rc in done] == [("0004\n", 0)] * 4, done
 
 
 @pytest.mark.parametrize("stored_before", [False, True])

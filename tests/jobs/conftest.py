@@ -61,8 +61,8 @@ def pg_url() -> str:
     url = base.set(database=PG_DB).render_as_string(hide_password=False)
     eng = sa.create_engine(url)
     with eng.begin() as c:
-        for t in ("servers", "fleet_runs", "jobs", "runs", "flightpath", "deliveries",
-                  "order_details", "orders", "alembic_version"):
+        for t in ("servers", "fleet_run_files", "fleet_runs", "jobs", "runs", "flightpath",
+                  "deliveries", "order_details", "orders", "alembic_version"):
             c.execute(sa.text(f"drop table if exists {t} cascade"))
     eng.dispose()
     return url

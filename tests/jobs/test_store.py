@@ -1,5 +1,6 @@
-"""The jobs, fleet_runs and servers tables: migrations 0002 and 0003 (also over a 0001
-store with its days and a 0002 store with its jobs), a job's life, orphans, fleet runs
+"""The jobs, fleet_runs, servers and fleet_run_files tables: migrations 0002 to 0004 (also
+over a 0001 store with its days, a 0002 store with its jobs and a 0003 store with its fleet
+runs, and back), a job's life, orphans, fleet runs
 with their files, on SQLite and PostgreSQL alike."""
 
 from __future__ import annotations
@@ -18,11 +19,11 @@ from skyroute.jobs import store
 COLUMNS = {
     "jobs": ["id", "kind", "params", "state", "progress", "result", "error", "created",
              "updated", "owner"],
-    "fleet_runs": ["id", "job_id", "scenario", "params", "report", "events_jsonl",
-                   "tracks_csv", "packages_csv", "fleet_geojson", "created"],
+    "fleet_runs": ["id", "job_id", "scenario", "params", "report", "created"],
     "servers": ["id", "started", "heartbeat"],
+    "fleet_run_files": ["run_id", "name", "data"],
 }
-HEAD = "0003"
+HEAD = "0004"
 
 
 def upgrade_to(engine, revision: str) -> None:
@@ -62,7 +63,8 @@ def test_upgrading_a_0001_store_keeps_its_days(tmp_path):
            "moves": 0, "orders_placed": 0, "orders_delivered": 0, "orders_invalid": 0,
            "money_delivered": 0, "money_placed": 0, "settings": {}}
     dstore.write_day(e, day, run, [], [])
-    with pytest.raises(SkyrouteError, match=r"no table jobs, fleet_runs, servers \(an "
+    with pytest.raises(SkyrouteError, match=r"no table jobs, fleet_runs, servers, "
+                                            r"fleet_run_files \(an "
                                             r"older schema\); run 'skyroute db init'"):
         store.get_job(e, "x")
     assert dstore.init(e) == HEAD
@@ -124,6 +126,106 @@ def test_fleet_runs_keep_their_files_and_replace_on_the_same_id(engine):
         store.list_fleet_runs(engine, limit=0)
 
 
+def _file_rows(engine) -> int:
+    with engine.connect() as c:
+        return c.execute(sa.text("select count(*) from fleet_run_files")).scalar_one()
+
+
+def test_a_runs_files_go_with_it(engine):
+    files = {"events_jsonl": "{}\n", "tracks_csv": b"t\n0\n", "packages_csv": "id\n",
+             "fleet_geojson": "{}"}
+    job_id = store.create_job(engine, "fleet", {})
+    run = store.save_fleet_run(engine, scenario="s", params={}, report={}, job_id=job_id,
+                               **files)
+    before = _file_rows(engine)  # PostgreSQL's database may hold other tests' runs
+    store.save_fleet_run(engine, scenario="s", params={}, report={}, job_id=job_id,
+                         run_id=run, **files)  # replaced, not doubled
+    assert _file_rows(engine) == before
+    store.fail_job(engine, job_id, "boom")
+    assert store.get_fleet_run(engine, run) is None
+    assert _file_rows(engine) == before - len(store.FILES)
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def new_store(request, tmp_path):
+    """An engine on a new empty store: a SQLite file, or a PostgreSQL database of this
+    test's own."""
+    url = (f"sqlite:///{tmp_path / 'new.db'}" if request.param == "sqlite"
+           else request.getfixturevalue("fresh_pg"))
+    e = dstore.connect(url)
+    yield e
+    e.dispose()
+
+
+OLD_RUNS = [  # as a 0003 skyroute stored them: text with non-ASCII, tracks any bytes
+    {"id": "run-a", "job_id": "job-a", "scenario": "seed-3x3", "params": {"hours": 0.25},
+     "report": {"delivered": 3, "note": "Pâtisserie"},
+     "events_jsonl": '{"t":0,"kind":"spawn","where":"Édinburgh ✈"}\n' * 50,
+     "tracks_csv": b"t,drone\n" + bytes(range(256)) * 40,
+     "packages_csv": "id,to\n0,Café\n", "fleet_geojson": '{"type":"FeatureCollection"}',
+     "created": dt.datetime(2024, 1, 1, 12, 0, 1)},
+    {"id": "run-b", "job_id": None, "scenario": "other", "params": {}, "report": {},
+     "events_jsonl": "", "tracks_csv": b"", "packages_csv": "", "fleet_geojson": "",
+     "created": dt.datetime(2024, 1, 1, 12, 0, 2)},
+]
+OLD_FILES = ("events_jsonl", "tracks_csv", "packages_csv", "fleet_geojson")
+
+
+def test_upgrading_a_0003_store_keeps_its_fleet_runs_and_downgrading_puts_them_back(
+        new_store):
+    e = new_store
+    upgrade_to(e, "0003")
+    md = sa.MetaData()
+    md.reflect(e, only=("jobs", "fleet_runs"))
+    t = dt.datetime(2024, 1, 1, 12)
+    with e.begin() as c:
+        c.execute(md.tables["jobs"].insert().values(
+            id="job-a", kind="fleet", params={}, state="done", progress=1.0,
+            result={"fleet_run": "run-a"}, created=t, updated=t))
+        c.execute(md.tables["fleet_runs"].insert(), OLD_RUNS)
+    with pytest.raises(SkyrouteError, match=r"no table fleet_run_files \(an older schema\)"):
+        store.list_fleet_runs(e)
+    assert dstore.init(e) == HEAD
+    assert [c["name"] for c in sa.inspect(e).get_columns("fleet_runs")] == \
+        COLUMNS["fleet_runs"]
+    assert [r["id"] for r in store.list_fleet_runs(e)] == ["run-b", "run-a"]
+    for old in OLD_RUNS:
+        run = store.get_fleet_run(e, old["id"])
+        assert {k: run[k] for k in OLD_FILES} == {k: old[k] for k in OLD_FILES}
+        assert {k: run[k] for k in ("job_id", "scenario", "params", "report")} == \
+            {k: old[k] for k in ("job_id", "scenario", "params", "report")}
+        assert run["created"] == old["created"].replace(tzinfo=dt.UTC).isoformat()
+        assert store.get_fleet_run(e, old["id"], files="packages_csv")["packages_csv"] == \
+            old["packages_csv"]
+    # a run stored at 0004 goes back too
+    new = store.save_fleet_run(e, scenario="new", params={}, report={}, events_jsonl="é",
+                               tracks_csv=b"\x00\xff", packages_csv="p",
+                               fleet_geojson="g")
+
+    from alembic import command
+    from alembic.config import Config
+
+    cfg = Config()
+    cfg.set_main_option("script_location", str(Path(dstore.__file__).parent / "migrations"))
+    with e.begin() as conn:
+        cfg.attributes["connection"] = conn
+        command.downgrade(cfg, "0003")
+    assert "fleet_run_files" not in sa.inspect(e).get_table_names()
+    cols = {c["name"]: c for c in sa.inspect(e).get_columns("fleet_runs")}
+    assert all(not cols[k]["nullable"] for k in OLD_FILES)
+    with e.connect() as c:
+        got = {r["id"]: r for r in c.execute(sa.text(
+            "select id, events_jsonl, tracks_csv, packages_csv, fleet_geojson "
+            "from fleet_runs")).mappings()}
+    for old in OLD_RUNS:
+        assert {k: got[old["id"]][k] for k in OLD_FILES} == {k: old[k] for k in OLD_FILES}
+    assert {k: got[new][k] for k in OLD_FILES} == {
+        "events_jsonl": "é", "tracks_csv": b"\x00\xff", "packages_csv": "p",
+        "fleet_geojson": "g"}
+    assert dstore.init(e) == HEAD  # and up again
+    assert store.get_fleet_run(e, "run-a")["tracks_csv"] == OLD_RUNS[0]["tracks_csv"]
+
+
 @pytest.fixture(params=["sqlite", "postgresql"])
 def empty(request, tmp_path):
     """An engine on an empty store: a new SQLite file, or the test PostgreSQL database
@@ -133,8 +235,9 @@ def empty(request, tmp_path):
     else:
         e = dstore.connect(request.getfixturevalue("pg_url"))
         with e.begin() as c:
-            for t in ("servers", "fleet_runs", "jobs", "runs", "flightpath", "deliveries",
-                      "order_details", "orders", "alembic_version"):
+            for t in ("servers", "fleet_run_files", "fleet_runs", "jobs", "runs",
+                      "flightpath", "deliveries", "order_details", "orders",
+                      "alembic_version"):
                 c.execute(sa.text(f"drop table if exists {t} cascade"))
     yield e
     e.dispose()

@@ -398,7 +398,7 @@ def test_fleet_runs_say_when_each_was_stored(tmp_path):
 @needs_jobs
 def test_the_real_store_selects_the_tracks_only_for_tracks_csv(tmp_path, small_run):
     """Every SELECT a run's routes send, seen by SQLAlchemy: only GET tracks.csv names
-    the tracks column."""
+    the tracks (the file's name is a parameter of the query)."""
     import sqlalchemy as sa
 
     from skyroute.jobs import store
@@ -413,9 +413,9 @@ def test_the_real_store_selects_the_tracks_only_for_tracks_csv(tmp_path, small_r
     eng.dispose()
     seen: list[str] = []
 
-    def record(conn, cursor, statement, *args):
+    def record(conn, cursor, statement, parameters, *args):
         if statement.lstrip().upper().startswith("SELECT") and "fleet_runs" in statement:
-            seen.append(statement)
+            seen.append(f"{statement} {parameters!r}")
 
     sa.event.listen(sa.engine.Engine, "before_cursor_execute", record)
     try:

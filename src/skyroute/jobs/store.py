@@ -1,6 +1,7 @@
 """Jobs and fleet runs in the SQL store of the delivery days (same database, same
 migrations: revision 0002 adds the jobs and fleet_runs tables, 0003 the jobs' owners and
-the servers; ``skyroute db init`` upgrades to the newest).
+the servers, 0004 moves the runs' files to fleet_run_files; ``skyroute db init`` upgrades
+to the newest).
 
 - ``jobs(id, kind, params, state, progress, result, error, created, updated, owner)``:
   ``state`` is ``queued``, ``running``, ``done`` or ``failed``; ``progress`` 0..1;
@@ -16,13 +17,16 @@ the servers; ``skyroute db init`` upgrades to the newest).
   on hosts whose clocks differ agree on who is silent. :func:`fail_orphans` fails the
   unfinished jobs of owners silent for longer than ``dead_after``, or known to have
   ended (``gone``: the runner tells those of its own machine by their process ids).
-- ``fleet_runs(id, job_id, scenario, params, report, events_jsonl, tracks_csv,
-  packages_csv, fleet_geojson, created)``: a fleet run's ``report.json``,
-  ``events.jsonl``, ``tracks.csv`` (bytes), ``packages.csv`` and ``fleet.geojson`` as
+- ``fleet_runs(id, job_id, scenario, params, report, created)``: a fleet run's
+  ``report.json`` and what made it; ``fleet_run_files(run_id, name, data)`` its files, one
+  row each (``name`` one of :data:`FILES`; ``data`` the bytes, text as UTF-8):
+  ``events.jsonl``, ``tracks.csv``, ``packages.csv`` and ``fleet.geojson`` as
   :mod:`skyroute.io.fleet_out` writes them (a big run's tracks are big: 1 s rows of 1000
-  drones for an hour are about 150 MB; use a coarser ``track_step``). No run names a
-  failed job: failing a job deletes its runs in the same transaction, and
-  :func:`save_fleet_run` refuses (:class:`JobEndedError`) a run of a job already failed.
+  drones for an hour are about 150 MB; use a coarser ``track_step``). The files live
+  apart so that listing runs or reading one file never reads through the tracks (SQLite
+  keeps a row's columns in order). No run names a failed job: failing a job deletes its
+  runs in the same transaction, and :func:`save_fleet_run` refuses
+  (:class:`JobEndedError`) a run of a job already failed.
 
 Every function takes the engine first and runs one short transaction; writes go through
 :func:`skyroute.delivery.store.writing`, as the delivery store's do (on SQLite the write
@@ -46,7 +50,7 @@ from skyroute.errors import OptionError, SkyrouteError, check_choice
 
 STATES = ("queued", "running", "done", "failed")
 LIVE = ("queued", "running")  # the states a job may still leave
-TABLES = ("jobs", "fleet_runs", "servers")
+TABLES = ("jobs", "fleet_runs", "servers", "fleet_run_files")
 
 
 _ENGINES: dict[str, sa.Engine] = {}
@@ -158,7 +162,16 @@ def _drop_runs(c: sa.Connection, t: dict[str, sa.Table], job_ids: list[str]) -> 
     """Delete the fleet runs of ``job_ids``, jobs just marked failed: no run names a
     failed job (a run saved before its job failed goes with the failure)."""
     if job_ids:
-        c.execute(t["fleet_runs"].delete().where(t["fleet_runs"].c.job_id.in_(job_ids)))
+        runs = t["fleet_runs"]
+        _drop_files(c, t, sa.select(runs.c.id).where(runs.c.job_id.in_(job_ids)))
+        c.execute(runs.delete().where(runs.c.job_id.in_(job_ids)))
+
+
+def _drop_files(c: sa.Connection, t: dict[str, sa.Table], run_ids) -> None:
+    """Delete the files of the runs ``run_ids`` (a list or a select of ids): SQLite does
+    not enforce the foreign key's ON DELETE CASCADE unless asked per connection."""
+    files = t["fleet_run_files"]
+    c.execute(files.delete().where(files.c.run_id.in_(run_ids)))
 
 
 def db_now(conn: sa.Connection) -> dt.datetime:
@@ -246,7 +259,9 @@ def save_fleet_run(engine: sa.Engine, *, scenario: str, params: dict, report: di
     ``job_id`` too (a SkyrouteError naming it)."""
     run_id = run_id or str(uuid.uuid4())
     t = _t(engine)
-    runs, jobs = t["fleet_runs"], t["jobs"]
+    runs, jobs, stored = t["fleet_runs"], t["jobs"], t["fleet_run_files"]
+    data = {"events_jsonl": events_jsonl.encode(), "tracks_csv": bytes(tracks_csv),
+            "packages_csv": packages_csv.encode(), "fleet_geojson": fleet_geojson.encode()}
     with writing(engine) as c:
         if job_id is not None:
             # a write, not a read: it takes the job's row lock (PostgreSQL) or the write
@@ -259,12 +274,13 @@ def save_fleet_run(engine: sa.Engine, *, scenario: str, params: dict, report: di
                 raise SkyrouteError(f"job_id={job_id!r}: no such job", param="job_id")
             if state == "failed":
                 raise JobEndedError(f"job {job_id} has failed; its fleet run is not stored")
+        _drop_files(c, t, [run_id])
         c.execute(runs.delete().where(runs.c.id == run_id))
         c.execute(runs.insert().values(
             id=run_id, job_id=job_id, scenario=scenario, params=json_safe(params),
-            report=json_safe(report), events_jsonl=events_jsonl,
-            tracks_csv=bytes(tracks_csv), packages_csv=packages_csv,
-            fleet_geojson=fleet_geojson, created=_now()))
+            report=json_safe(report), created=_now()))
+        for name in FILES:  # one at a time: no second copy of the tracks in a list
+            c.execute(stored.insert().values(run_id=run_id, name=name, data=data.pop(name)))
     return run_id
 
 
@@ -272,12 +288,12 @@ _HEAD = ("id", "job_id", "scenario", "params", "report", "created")
 FILES = ("events_jsonl", "tracks_csv", "packages_csv", "fleet_geojson")
 
 
-def _run_dict(r) -> dict:
+def _run_dict(r, files: dict[str, bytes] | None = None) -> dict:
     out = {k: r[k] for k in _HEAD}
     out["created"] = _iso(out["created"])
     for k in FILES:
-        if k in r:
-            out[k] = bytes(r[k]) if k == "tracks_csv" else r[k]
+        if files and k in files:
+            out[k] = bytes(files[k]) if k == "tracks_csv" else bytes(files[k]).decode()
     return out
 
 
@@ -297,11 +313,19 @@ def get_fleet_run(engine: sa.Engine, run_id: str, *,
         wanted = tuple(files)
         for k in wanted:
             check_choice("files", k, FILES)
-    runs = _t(engine)["fleet_runs"]
-    cols = [runs.c[k] for k in (*_HEAD, *wanted)]
+    t = _t(engine)
+    runs, stored = t["fleet_runs"], t["fleet_run_files"]
+    # one statement (the run and its files as one snapshot, never a run replaced in
+    # between): a row per wanted file, or one row with no file
+    q = (sa.select(*[runs.c[k] for k in _HEAD], stored.c.name, stored.c.data)
+         .select_from(runs.outerjoin(stored, sa.and_(stored.c.run_id == runs.c.id,
+                                                     stored.c.name.in_(wanted))))
+         .where(runs.c.id == str(run_id)))
     with engine.connect() as c:
-        r = c.execute(sa.select(*cols).where(runs.c.id == str(run_id))).mappings().first()
-    return None if r is None else _run_dict(r)
+        rows = c.execute(q).mappings().all()
+    if not rows:
+        return None
+    return _run_dict(rows[0], {r["name"]: r["data"] for r in rows if r["name"] is not None})
 
 
 def list_fleet_runs(engine: sa.Engine, *, job_id: str | None = None,
