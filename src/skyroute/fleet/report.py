@@ -82,9 +82,11 @@ def _delivered_in_window(run: Simulation) -> np.ndarray:
 
 
 def flights_flown(run: Simulation) -> list:
-    """The flights of the report: those that left by the horizon (a run may also hold
-    flights planned to leave after it)."""
-    return [f for f in run.flights if f.plan.depart <= run.horizon]
+    """The flights of the report: those that took off by the horizon, one ``takeoff``
+    event each in the log and one track each in ``fleet.geojson`` (a run also holds
+    flights planned to leave after it, and flights still taxiing out at its end, whose
+    departure no file shows for an empty repositioning flight)."""
+    return [f for f in run.flights if f.plan.phase("takeoff").end <= run.horizon]
 
 
 def report(run: Simulation, separation: SeparationReport | None = None) -> dict:
