@@ -217,22 +217,23 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     if max_expansions is None:
         limit = MAX_NODES // (6 if reverse else 3)
     reverse, smooth, seed = bool(reverse), bool(smooth), int(seed)
-    sxy, sth = _in_plane(world, *_pose(start, "start"))
-    gxy, gth = _in_plane(world, *_pose(goal, "goal"))
+    (s_typed, s_h), (g_typed, g_h) = _pose(start, "start"), _pose(goal, "goal")
+    sxy, sth = _in_plane(world, s_typed, s_h)
+    gxy, gth = _in_plane(world, g_typed, g_h)
     given = tuple(tuple(float(v) for v in p) for p in (start, goal))
-    world.check_plane_point(sxy, "start")
+    world.check_plane_point(sxy, "start", given=s_typed)  # shown as typed, not round-tripped
     final = None
     if approach is not None:
         if gth is None:
             raise QueryError("goal needs a runway heading (x, y, heading) with approach=")
         approach = real("approach", approach, low=0.0)
         threshold = gxy
-        world.check_plane_point(threshold, "goal")
+        world.check_plane_point(threshold, "goal", given=g_typed)
         gate, final = runway_goal(threshold, gth, approach)
         gxy = np.array(gate[:2])
         if approach == 0:
             final = None
-    world.check_plane_point(gxy, "goal")
+    world.check_plane_point(gxy, "goal", given=g_typed if approach is None else None)
     t0 = time.perf_counter()
     index = edge_index(world, _bucket(world))
     if final is not None:

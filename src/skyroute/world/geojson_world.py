@@ -25,11 +25,10 @@ import shapely
 from skyroute.errors import InputFormatError, OptionError, QueryError, check_choice
 from skyroute.files import read_text, strip_bom
 from skyroute.geo import FRAME_ALIASES, FRAMES, Home, lonlat_to_enu
-from skyroute.world.points import check_places
+from skyroute.world.points import MAX_REACH, check_places
 from skyroute.world.world import World
 
 MAX_BYTES = 10_000_000  # as a colliders file's; the ILP zones are 11 kB; read whole
-MAX_REACH = 1_000_000  # metres from home: a world up to 2,000 km across
 SWAPPED = "are its coordinates (lat, lon)? GeoJSON and boundary boxes are (lon, lat)"
 
 

@@ -33,7 +33,13 @@ from skyroute.geo import (
     lonlat_to_enu,
 )
 from skyroute.world.grid import Grid, raster_shape
-from skyroute.world.points import as_points, check_metres, check_places, plane_points
+from skyroute.world.points import (
+    MAX_REACH,
+    as_points,
+    check_metres,
+    check_places,
+    plane_points,
+)
 
 AXES = {"lonlat": ("lon", "lat"), "degrees": ("lon", "lat"), "ned": ("north", "east"),
         "enu": ("x", "y")}
@@ -353,6 +359,7 @@ class World:
         (``given``: the point as the caller wrote it, shown instead of ``p`` converted)."""
         p = np.asarray(p, dtype=float).reshape(2)
         shown = self._fmt(p) if given is None else self._fmt_frame(given)
+        self._check_reach(p, what, shown, given)
         if not self.inside([p])[0]:
             raise QueryError(f"{what} {shown} lies outside the map "
                              f"({self._extent_text()}){self._swapped_hint(given)}")
@@ -363,13 +370,64 @@ class World:
                              f"{self.names[j]!r}; nearest free point {self._fmt(near)}")
         return p
 
+    def _check_reach(self, p: np.ndarray, what: str, shown: str, given) -> None:
+        """Refuse a point of a lon/lat world with no boundary (frames "lonlat" and
+        "degrees") that lies more than :data:`~skyroute.world.points.MAX_REACH` from the
+        world's home, straight through the Earth: the reach a GeoJSON world's zones and a
+        boundary box are held to. A start typed (lat, lon) lies thousands of km away, and
+        without a boundary nothing else refuses it: it was planned through, "found".
+
+        Measured from home, not from the obstacles' extent: home is the reference every
+        other reach is measured from (a GeoJSON world's centre, a colliders city's
+        lat0/lon0, which its --boundary is checked against), the metres plane is tangent
+        there (its error grows with the distance from home), and a world with no obstacle
+        below the altitude still has one. A "degrees" world built without a home is
+        measured from the centre of its obstacles' box (none: not checked). Points in
+        "ned" and "enu" are metres, held to ``MAX_METRES`` by :meth:`to_plane`."""
+        if self.boundary is not None or self.frame not in ("lonlat", "degrees"):
+            return
+        lonlat = self.plane_to_lonlat([p])[0] if given is None else given
+        far = self._reach(lonlat)
+        if far is None or far <= MAX_REACH:
+            return
+        home = self._reach_home()
+        raise QueryError(f"{what} {shown} lies {far / 1000:,.0f} km from the world's home "
+                         f"(lon {home.lon:g}, lat {home.lat:g}), more than the "
+                         f"{MAX_REACH / 1000:,.0f} km a world with no boundary reaches"
+                         f"{self._swapped_hint(given)}")
+
+    def _reach_home(self) -> Home | None:
+        """Where :meth:`_check_reach` measures from: the home, else (a "degrees" world
+        built without one) the centre of the obstacles' box, else None."""
+        if self.home is not None or len(self.obstacles) == 0:
+            return self.home
+        x0, y0, x1, y1 = shapely.total_bounds(self.obstacles)
+        return Home((x0 + x1) / 2, (y0 + y1) / 2, 0.0)
+
+    def _reach(self, lonlat) -> float | None:
+        """Metres from :meth:`_reach_home` to a (lon, lat), straight through the Earth (as
+        GeoJSON worlds measure theirs); None when there is nothing to measure from."""
+        home = self._reach_home()
+        if home is None:
+            return None
+        lon, lat = np.asarray(lonlat, dtype=float)
+        return float(np.linalg.norm(lonlat_to_enu([lon], [lat], 0.0, home)))
+
     def _swapped_hint(self, given) -> str:
-        """'; ... (lon, lat)' when a lon/lat point outside the map would lie inside it
-        with its two numbers swapped, else ''."""
+        """'; ... (lon, lat)' when a lon/lat point outside the map (or, with no boundary,
+        past its reach) would lie inside it (within it) with its two numbers swapped,
+        else ''."""
         if given is None or self.frame not in ("lonlat", "degrees"):
             return ""
         q = np.asarray(given, dtype=float)[::-1]
-        if abs(q[0]) > 180 or abs(q[1]) > 90 or not self.inside(self.to_plane(q))[0]:
+        if abs(q[0]) > 180 or abs(q[1]) > 90:
+            return ""
+        if self.boundary is None:
+            far = self._reach(q)
+            if far is None or far > MAX_REACH:
+                return ""
+            return f"; {self._fmt_frame(q)} is within it: points are (lon, lat)"
+        if not self.inside(self.to_plane(q))[0]:
             return ""
         return f"; {self._fmt_frame(q)} is inside: points are (lon, lat)"
 
