@@ -381,6 +381,19 @@ def test_replace_stores_the_corrected_days_whole(engine):
         DAY: [moved[1]], NEXT: sorted([moved[0], *moved[2:]], key=lambda o: o.order_no)}
 
 
+def test_replace_keeps_the_other_orders_of_a_day_the_file_does_not_give(engine):
+    """A file of the next day only, whose order moved there from DAY: DAY is no day of
+    the file, so it keeps its other order; only what was flown from its old orders goes."""
+    store.import_orders(engine, DAYS)
+    store.write_day(engine, DAY, run_row(2), [], moves(2))
+    moved = Order("0000000a", NEXT, "s2400001", "a.b.c", ("x",))
+    with pytest.raises(store.OrdersChangedError):
+        store.import_orders(engine, [moved, DAYS[2]])
+    assert store.import_orders(engine, [moved, DAYS[2]], replace=True) == (2, 1, (DAY, NEXT))
+    assert store.orders_between(engine, DAY, NEXT) == {DAY: [TWO[1]], NEXT: [moved, DAYS[2]]}
+    assert store.day_rows(engine, DAY) == {"deliveries": [], "flightpath": []}
+
+
 def test_new_orders_of_a_stored_day_are_added(engine):
     # orders that arrived since the last import: nothing stored differs
     store.import_orders(engine, DAYS[:1])

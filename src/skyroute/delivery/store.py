@@ -41,8 +41,8 @@ TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
 # The PostgreSQL advisory lock that :func:`init` holds while it makes or upgrades the
 # schema (any fixed 64-bit number other programs on the database are unlikely to use)
 SCHEMA_LOCK = 0x736B79726F757465  # "skyroute"
-# ... and the pair (DAY_LOCK, the day's ordinal) that :func:`write_day` holds while it
-# replaces a day's rows
+# ... and the pair (DAY_LOCK, the day's ordinal) that :func:`write_day` and a replacing
+# :func:`import_orders` hold while they replace a day's rows (:func:`_lock_day`)
 DAY_LOCK = 0x736B7964  # "skyd"
 _REFLECTED: dict[tuple[str, tuple[str, ...]], dict[str, sa.Table]] = {}
 register(_REFLECTED.clear)
@@ -227,8 +227,10 @@ def import_orders(engine: sa.Engine, all_orders: Iterable, *,
     as given is left as it is; an order stored differently (another date, customer,
     place or items), or a stored order of a given day that is not given, is
     :class:`OrdersChangedError` naming the days, unless ``replace``: then each such day's
-    stored orders, with its stored deliveries, flight path and run (flown from the old
-    orders), are deleted and the given orders of that day stored. One transaction: an
+    stored deliveries, flight path and run (flown from the old orders) are deleted, and
+    the stored orders of each such day the given orders hold are replaced by the given
+    ones; a day they do not hold (an order moved from it to another day) loses only the
+    moved orders. One transaction: an
     error leaves the store as it was; a value wider than its column is an error naming
     the order (:func:`check_fits`), checked before anything is written."""
     t = tables(engine)
@@ -257,13 +259,19 @@ def _import(engine: sa.Engine, t: dict[str, sa.Table], all_orders: list,
         if changes and not replace:
             raise OrdersChangedError(changes, days)
         if days:
-            gone = set(conn.scalars(sa.select(orders.c.order_no)
-                                    .where(orders.c.delivery_date.in_(days))))
-            for name in ("flightpath", "deliveries", "runs"):
+            for day in days:  # a delivery of the day being stored waits (PostgreSQL)
+                _lock_day(conn, day)
+            # the days the file gives are replaced whole; a day it does not give (an
+            # order moved from it) loses only the moved orders, not its others
+            given = sorted({o.date for o in all_orders} & set(days))
+            picked = orders.c.delivery_date.in_(given) | orders.c.order_no.in_(
+                sorted({c[1] for c in changes if c[0] not in given}))
+            gone = set(conn.scalars(sa.select(orders.c.order_no).where(picked)))
+            for name in ("flightpath", "deliveries", "runs"):  # flown from the old orders
                 conn.execute(t[name].delete().where(t[name].c.delivery_date.in_(days)))
             conn.execute(order_details.delete().where(order_details.c.order_no.in_(
-                sa.select(orders.c.order_no).where(orders.c.delivery_date.in_(days)))))
-            conn.execute(orders.delete().where(orders.c.delivery_date.in_(days)))
+                sa.select(orders.c.order_no).where(picked))))
+            conn.execute(orders.delete().where(picked))
             have -= gone
         new = [o for o in all_orders if o.order_no not in have]
         heads = [{"order_no": o.order_no, "delivery_date": o.date, "customer": o.customer,
@@ -358,14 +366,7 @@ def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[d
     for row in rows:
         check_fits(deliveries, row, f"{date}: order {row.get('order_no')!r}: ")
     with writing(engine) as conn:
-        if conn.dialect.name == "postgresql":
-            # two runs of one day at once both deleted the day's rows as they were, and
-            # the later's insert was an IntegrityError ('duplicate key value violates
-            # unique constraint "runs_pkey"'); the lock is held to the end of this
-            # transaction, so the later waits, then replaces the earlier's rows (as
-            # SQLite's BEGIN IMMEDIATE in writing() does); other days are not held up
-            conn.execute(sa.select(sa.func.pg_advisory_xact_lock(
-                sa.cast(DAY_LOCK, sa.Integer), sa.cast(date.toordinal(), sa.Integer))))
+        _lock_day(conn, date)
         for t in (flightpath, deliveries, runs):
             conn.execute(t.delete().where(t.c.delivery_date == date))
         conn.execute(runs.insert(), [head])
@@ -379,6 +380,19 @@ def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[d
                 batch = []
         if batch:
             conn.execute(flightpath.insert(), batch)
+
+
+def _lock_day(conn: sa.Connection, date: dt.date) -> None:
+    """On PostgreSQL, hold the day's advisory lock to the end of ``conn``'s transaction.
+    Two runs of one day at once both deleted the day's rows as they were, and the later's
+    insert was an IntegrityError ('duplicate key value violates unique constraint
+    "runs_pkey"'); an import replacing the day could let a delivery flown from the old
+    orders land after its delete. With the lock the later waits, then replaces the
+    earlier's rows (as SQLite's BEGIN IMMEDIATE in :func:`writing` does); other days are
+    not held up."""
+    if conn.dialect.name == "postgresql":
+        conn.execute(sa.select(sa.func.pg_advisory_xact_lock(
+            sa.cast(DAY_LOCK, sa.Integer), sa.cast(date.toordinal(), sa.Integer))))
 
 
 def day_rows(engine: sa.Engine, date: dt.date) -> dict[str, list[tuple]]:

@@ -31,8 +31,9 @@ WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
 # full circle half the time: a 45-degree turn of r = 1 came out 7.07 long, not 0.79).
 # LSR's and RSL's p^2 (centres 2 apart: circles touching) and the CCC words' |cos| <= 1
 # are differences too: words within ZERO x (4 + d^2) and ZERO of existing are taken
-# with p = 0 (clipped cos). Both are moves of the poses by ~1e-12 radii, the size of
-# the angle snap.
+# with p = 0 (clipped cos). For LSR and RSL that moves the poses by ~1e-12 radii, the
+# size of the angle snap; for the CCC words by up to ~1e-6 radii, since acos near 1
+# turns a 1e-12 change of its argument into a ~1.4e-6 change of the angle.
 ZERO = 1e-12
 
 

@@ -33,6 +33,7 @@ Algorithm = Literal["astar", "dijkstra", "bfs", "jps", "theta", "lazy_theta", "v
 # Numbers, counts and switches are strict, as skyroute.plan reads them: a JSON number
 # (an integer counts), a JSON integer, true or false; never a numeric string ("3"), a
 # boolean as a number or a number as a boolean, or 100.0 as a count (a 422 naming it).
+# `connectivity` is a choice, not a count: 8.0 is taken as 8, as skyroute.plan takes it.
 Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]
 Point = tuple[Number, Number]
 Pair = Annotated[list[float], Field(min_length=2, max_length=2)]
