@@ -51,9 +51,16 @@ def test_bench_world_runs_end_to_end(early_process):
     assert rows["visibility (again)"]["length_ratio"] == 1.0
     assert rows["prm, shortcut"]["length_ratio"] >= 1.0 - 1e-9
     if ompl_available():
-        assert rows["ompl RRTConnect"]["exact"] and rows["ompl RRTConnect"]["raw_ratio"] >= 1.0
+        raw = rows["ompl RRTConnect"]
         simplified = rows["ompl RRTConnect, simplified"]  # timed with its simplification
-        assert simplified["seconds"] == pytest.approx(rows["ompl RRTConnect"]["seconds"] +
+        assert raw["exact"] and isinstance(raw["valid"], bool)
+        assert simplified["seconds"] == pytest.approx(raw["seconds"] +
                                                       simplified["simplify_seconds"])
-        assert simplified["simplified_ratio"] >= 1.0 - 1e-9
+        # OMPL checks its motions at a resolution, so its paths may cut an obstacle's
+        # corner (valid False, re-checked exactly) and then be shorter than the optimum;
+        # a path that is exactly free never is
+        if raw["valid"]:
+            assert raw["raw_ratio"] >= 1.0 - 1e-9
+        if simplified["valid"]:
+            assert simplified["simplified_ratio"] >= 1.0 - 1e-9
     assert "leaked" not in err
