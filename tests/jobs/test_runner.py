@@ -221,23 +221,29 @@ sys.stdin.read()  # runs until the test closes its stdin
 """
 
 
+def _child_running_a_job(url: str):
+    """A Python process that takes a running job in the store at ``url`` (CHILD), prints
+    its id and owner and waits for its stdin to close."""
+    import os
+    import subprocess
+    import sys
+
+    return subprocess.Popen([sys.executable, "-c", CHILD, url], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True,
+                            env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+
+
 @pytest.mark.parametrize("db", ["sqlite", "postgresql"])
 def test_a_stopped_servers_jobs_fail_at_once_on_its_machine(tmp_path, request, db):
     """A server process on this machine that has ended, a moment after its heartbeat,
     has its running job failed at the next look (a restarted server's start, or a read),
     not 60 s later; while it runs its job is left alone."""
-    import os
-    import subprocess
-    import sys
-
     from skyroute.jobs import store
 
     url = (f"sqlite:///{tmp_path / 'gone.db'}" if db == "sqlite"
            else request.getfixturevalue("pg_url"))
     engine = lunch_store(url, ())
-    child = subprocess.Popen([sys.executable, "-c", CHILD, url], stdin=subprocess.PIPE,
-                             stdout=subprocess.PIPE, text=True,
-                             env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    child = _child_running_a_job(url)
     try:
         job_id, its_owner = child.stdout.readline().split()
         assert runner.fail_orphans(engine) == []
@@ -254,15 +260,10 @@ def test_a_stopped_servers_jobs_fail_at_once_on_its_machine(tmp_path, request, d
 def test_reading_a_job_of_an_ended_process_fails_it_at_once(tmp_path):
     """``runner.get`` (GET /jobs/{id}) fails the job of a process seen to have ended
     even right after another read looked for orphans."""
-    import os
-    import subprocess
-    import sys
 
     url = f"sqlite:///{tmp_path / 'read.db'}"
     engine = lunch_store(url, ())
-    child = subprocess.Popen([sys.executable, "-c", CHILD, url], stdin=subprocess.PIPE,
-                             stdout=subprocess.PIPE, text=True,
-                             env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    child = _child_running_a_job(url)
     try:
         job_id, _ = child.stdout.readline().split()
         assert runner.get(engine, job_id)["state"] == "running"  # looked: none for 10 s

@@ -553,20 +553,28 @@ def _job_routes(p, job: dict) -> None:
     p.route("**/jobs/job-1", poll)
 
 
+def _start_fleet_job(open_page, server, job: dict):
+    """The stored run's fleet page with its job requests answered from ``job`` (which
+    the test changes as it goes), a run started with the token; the page."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    pg = open_page(f"/fleet.html#run={server[1]}", "desktop")
+    p = pg.page
+    _job_routes(p, job)
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    p.fill("#token", TOKEN)
+    p.click("#start")
+    return pg
+
+
 def test_fleet_job_shows_it_runs_and_survives_a_reload(open_page, server):
     """A fleet run is one task: its job says progress 0 until it ends. The page showed
     "Job running: 0 %" on an empty bar for the whole run, and a reload forgot the job (no
     word of it, Start enabled). Now the bar moves (indeterminate) with the time taken,
     and a reload goes on following the job to its run."""
-    if server[1] is None:
-        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
-    pg = open_page(f"/fleet.html#run={server[1]}", "desktop")
-    p = pg.page
     job = {"state": "running", "progress": 0.0}
-    _job_routes(p, job)
-    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
-    p.fill("#token", TOKEN)
-    p.click("#start")
+    pg = _start_fleet_job(open_page, server, job)
+    p = pg.page
     p.wait_for_function("document.querySelector('#job-status').textContent.includes('so far')")
     assert "0 %" not in p.inner_text("#job-status")
     assert p.evaluate("document.querySelector('#progress').hasAttribute('value')") is False
@@ -592,15 +600,9 @@ def test_fleet_job_shows_it_runs_and_survives_a_reload(open_page, server):
 def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):
     """One unanswered poll (a server restarting, a network blip) ended the following for
     good: the job's run never showed. Now the page says so and asks again."""
-    if server[1] is None:
-        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
-    pg = open_page(f"/fleet.html#run={server[1]}", "desktop")
-    p = pg.page
     job = {"state": "unreachable", "progress": 0.0}
-    _job_routes(p, job)
-    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
-    p.fill("#token", TOKEN)
-    p.click("#start")
+    pg = _start_fleet_job(open_page, server, job)
+    p = pg.page
     p.wait_for_function("document.querySelector('#job-status').textContent"
                         ".includes('Asking again')")
     assert "did not answer" in p.inner_text("#job-status")
