@@ -163,7 +163,7 @@ def _runner(space: SearchSpace, o: GridOptions):
     cells bound, so a query pays neither the dispatcher's typing of a dozen arguments
     nor the choice of kernel."""
     blk, Wp = space.blocked, space.Wp
-    tb = _tie_bits(space, o.weight) if o.algorithm != "bfs" else 0
+    fs = _f_scale(space, o.weight) if o.algorithm != "bfs" else 0.0
     floats, ints, keys = space.workspace()
     if o.algorithm == "bfs":
         call = entry_point(bfs_kernel, blk, Wp, 0, 0, o.max_expansions, floats, ints)
@@ -175,7 +175,7 @@ def _runner(space: SearchSpace, o: GridOptions):
         return run
     if o.algorithm == "jps":
         args = (space.move_mask(8, False), CANONICAL, space.jump_table(), Wp)
-        tail = (o.max_expansions, floats, ints, keys, NO_PIVOTS, tb)
+        tail = (o.max_expansions, floats, ints, keys, NO_PIVOTS, fs)
         call = entry_point(jps_kernel, *args, 0, 0, *tail)
 
         def run(s, t):
@@ -186,11 +186,11 @@ def _runner(space: SearchSpace, o: GridOptions):
     hkind = HEURISTICS[o.heuristic]
     if o.algorithm in ANY_ANGLE:
         tail = (hkind, o.weight, o.max_expansions, o.algorithm == "lazy_theta", floats,
-                ints, keys, tb)
+                ints, keys, fs)
         call = entry_point(theta_kernel, blk, mask, Wp, 0, 0, *tail)
         return lambda s, t: call(blk, mask, Wp, s, t, *tail)
     succ = CANONICAL if o.connectivity == 8 and not o.corner_cutting else EVERY
-    tail = (hkind, o.weight, o.max_expansions, floats, ints, keys, tb)
+    tail = (hkind, o.weight, o.max_expansions, floats, ints, keys, fs)
     call = entry_point(astar_kernel, mask, succ, Wp, 0, 0, *tail)
 
     def run(s, t):
@@ -199,17 +199,17 @@ def _runner(space: SearchSpace, o: GridOptions):
     return run
 
 
-def _tie_bits(space: SearchSpace, weight: float) -> int:
-    """The heap keys' tie-break bits for a search with ``weight`` on ``space``
-    (:meth:`SearchSpace.tie_bits`); an OptionError naming weight when its keys could not
+def _f_scale(space: SearchSpace, weight: float) -> float:
+    """The heap keys' unit of f for a search with ``weight`` on ``space``
+    (:meth:`SearchSpace.f_scale`); an OptionError naming weight when its keys could not
     hold every f (a weight no search needs: above about 5e8 on the largest grids)."""
-    tb = space.tie_bits(weight)
-    if tb >= 0:
-        return tb
+    fs = space.f_scale(weight)
+    if fs > 0.0:
+        return fs
     top = space.f_bound(0.0)
     span = float(space.width + space.height)
-    most = math.floor(((2.0 ** heap.KEY_BITS - 1.0) / heap.F_SCALE - top) / span)
-    while space.tie_bits(most) < 0:  # float rounding: step down to a weight that fits
+    most = math.floor((2.0 ** heap.F_BITS - 1.0 - top) / span)  # f in units of 1
+    while space.f_scale(most) == 0.0:  # float rounding: step down to a weight that fits
         most = math.floor(most * (1.0 - 1e-12)) - 1
     raise OptionError(f"weight={weight:g} is too large for this {space.width}x{space.height} "
                       f"grid: its search keys would overflow; use a weight from 1 to "

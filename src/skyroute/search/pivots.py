@@ -40,9 +40,9 @@ def distances_from(mask: np.ndarray, Wp: int, source: int, ws: tuple) -> np.ndar
     touched was expanded, with its final g. ``ws``: a :func:`space.workspace`."""
     floats, ints, keys = ws
     # f = g here, below sqrt 2 a padded cell (SearchSpace.f_bound's bound, h = 0)
-    tb = heap.tie_bits(mask.size * math.sqrt(2.0))
+    fs = heap.f_scale(mask.size * math.sqrt(2.0))
     _, expanded, _, _, _ = astar_kernel(mask, CANONICAL, Wp, source, 0, 0, 1.0,
-                                        MAX_EXPANSIONS, floats, ints, keys, tb)
+                                        MAX_EXPANSIONS, floats, ints, keys, fs)
     out = np.full(mask.size, np.inf)
     reached = ints[2][:expanded]
     out[reached] = floats[0][reached]
@@ -78,15 +78,15 @@ def pivot_distances(mask: np.ndarray, label: np.ndarray, Wp: int,
 
 
 @njit(cache=True)
-def jump_query(mask, succ, table, label, piv, floats, ints, keys, tb, Wp, s, t):
+def jump_query(mask, succ, table, label, piv, floats, ints, keys, fs, Wp, s, t):
     """One exact query from flat cell s to t for a prepared index: the component labels
-    answer "no path" at once, else JPS with the pivots' bounds (``tb``: the keys'
-    tie-break bits, :meth:`SearchSpace.tie_bits` with pivots). Returns (code, path
+    answer "no path" at once, else JPS with the pivots' bounds (``fs``: the keys'
+    unit of f, :meth:`SearchSpace.f_scale` with pivots). Returns (code, path
     (k, 2) cells, cost, expanded, max_frontier), as the subgoal queries do."""
     if label[s] != label[t]:
         return NO_PATH, np.empty((0, 2)), math.inf, 0, 0
     code, expanded, frontier, path, cost = jps_kernel(mask, succ, table, Wp, s, t,
                                                       MAX_EXPANSIONS, floats, ints, keys, piv,
-                                                      tb)
+                                                      fs)
     # same labels, so the kernel reaches t; were it not, its path is empty and cost inf
     return code, path, cost, expanded, frontier

@@ -125,11 +125,11 @@ class SearchSpace:
         g = (self._free + self.width + self.height) * math.sqrt(2.0)
         return g + weight * (g if pivots else float(self.width + self.height))
 
-    def tie_bits(self, weight: float = 1.0, *, pivots: bool = False) -> int:
-        """The heap keys' tie-break bits for a search here (:func:`heap.tie_bits` of
-        :meth:`f_bound`): 20 unless the grid is huge or ``weight`` large; -1 when its keys
-        cannot fit at all."""
-        return heap.tie_bits(self.f_bound(weight, pivots=pivots))
+    def f_scale(self, weight: float = 1.0, *, pivots: bool = False) -> float:
+        """The heap keys' unit of f for a search here (:func:`heap.f_scale` of
+        :meth:`f_bound`): 2**20 unless the grid is huge or ``weight`` large; 0.0 when its
+        keys cannot hold every f."""
+        return heap.f_scale(self.f_bound(weight, pivots=pivots))
 
     def workspace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(floats, ints, keys), allocated once: F rows g, h (float64); I rows parent, state,
