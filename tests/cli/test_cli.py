@@ -108,6 +108,8 @@ def test_a_walls_raster_too_large_names_the_line_or_the_flag(monkeypatch, capsys
      "error: --algorithm 'bfs' is 4-connected; use --connectivity 4 or --algorithm 'dijkstra'"),
     (["plan", *QUERY, "--algorithm", "dijkstra", "--weight", "2"],
      "error: --algorithm 'dijkstra' takes no weight; use --algorithm 'astar'\n"),
+    # a weight whose f overflowed the heap's int64 keys (silently) is refused
+    (["plan", *QUERY, "--weight", "1e13"], "error: --weight 1e+13 is too large for this"),
     (["plan", *QUERY, "--algorithm", "bfs", "--heuristic", "octile"],
      "error: --algorithm 'bfs' takes no heuristic option"),
     (["bench", "grid", "--map", "nomap", "--peers", ""], "--map nomap not found"),

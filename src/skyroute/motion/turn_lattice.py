@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from skyroute.errors import budget, check_choice, real
+from skyroute.errors import OptionError, budget, check_choice, real
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH, STATUS_OF_CODE, Status
 from skyroute.roadmap.raster import entry_cell, world_raster
 from skyroute.search import heap
@@ -85,7 +85,7 @@ def _forward_ok(blk, Wp, c, dx, dy, off):
 
 @njit(cache=True)
 def _lattice_kernel(blk, Wp, start, start_h, goal, H, dirs, offs, lens, turn, speed, rate,
-                    max_expansions):
+                    max_expansions, fs):
     n = blk.size * H
     g = np.full(n, np.inf)
     parent = np.full(n, -1, np.int64)
@@ -100,7 +100,7 @@ def _lattice_kernel(blk, Wp, start, start_h, goal, H, dirs, offs, lens, turn, sp
         s = start * H + h
         g[s] = 0.0
         d = math.hypot(start % Wp - gx, start // Wp - gy)
-        size = heap.push(hc, hk, state, size, s, heap.key(d / speed, 0.0))
+        size = heap.push(hc, hk, state, size, s, heap.key(d / speed, 0.0, fs))
     expanded = 0
     while size > 0:
         u, size = heap.pop(hc, hk, state, size)
@@ -131,7 +131,7 @@ def _lattice_kernel(blk, Wp, start, start_h, goal, H, dirs, offs, lens, turn, sp
                 parent[v] = u
                 vc = v // H
                 d = math.hypot(vc % Wp - gx, vc // Wp - gy)
-                size = heap.push(hc, hk, state, size, v, heap.key(gv + d / speed, gv))
+                size = heap.push(hc, hk, state, size, v, heap.key(gv + d / speed, gv, fs))
     return NO_PATH, -1, g, parent, expanded
 
 
@@ -155,10 +155,11 @@ def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
     sh = -1
     if start_heading is not None:
         sh = int(np.argmin(np.abs((ang - start_heading + np.pi) % (2 * np.pi) - np.pi)))
+    fs = _f_scale(space, headings, lens, turn, speed, turn_rate)
     t0 = time.perf_counter()
     code, end, g, parent, expanded = _lattice_kernel(
         space.blocked, space.Wp, space.index(s), sh, space.index(t), headings, dirs, offs,
-        lens, turn, speed, turn_rate, budget_)
+        lens, turn, speed, turn_rate, budget_, fs)
     seconds = time.perf_counter() - t0
     if code != FOUND:
         return LatticeResult(STATUS_OF_CODE[code], np.empty((0, 2)), np.empty(0), math.inf,
@@ -219,6 +220,24 @@ def travel_time(cells, *, speed: float = 1.0, turn_rate: float = math.pi / 2,
     if start_heading is not None:
         turns += abs((ang[0] - start_heading + np.pi) % (2 * np.pi) - np.pi)
     return float(np.hypot(*d.T).sum() / speed + turns / turn_rate)
+
+
+def _f_scale(space, headings: int, lens, turn, speed: float, rate: float) -> float:
+    """The heap keys' unit of f (:func:`heap.f_scale`) for a lattice search: every
+    f is at most one longest step or turn per (free cell, heading), plus the grid's
+    width + height over ``speed``; an OptionError naming speed and turn_rate when even
+    that f would not fit in a key (a route could take trillions of seconds)."""
+    span = float(space.width + space.height)
+    states = (space.f_bound(0.0) / math.sqrt(2.0)) * headings  # (free + span) x H
+    f_max = states * (float(lens.max()) / speed + float(turn.max()) / rate) + span / speed
+    fs = heap.f_scale(f_max)
+    if fs == 0.0:
+        limit = 2.0 ** heap.F_BITS
+        # no values: plan_turns_world and the CLI give them in other units
+        raise OptionError(f"speed and turn_rate are too small for this {space.width}x"
+                          f"{space.height} grid: a route's time could pass the {limit:.3g} s "
+                          f"its search keys hold; raise them", param=("speed", "turn_rate"))
+    return fs
 
 
 def _rates(speed, turn_rate) -> tuple[float, float]:

@@ -30,7 +30,7 @@ U0, U1, U2, U4 = np.uint64(0), np.uint64(1), np.uint64(2), np.uint64(4)  # unsig
 
 @njit(cache=True)
 def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, floats, ints,
-                 keys):
+                 keys, fs):
     """Search from flat ``start`` to ``goal``; return (status, expanded, max_frontier,
     path, length): ``path`` the (x, y) cells, empty unless found (:func:`to_cells`).
 
@@ -40,7 +40,8 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     :mod:`skyroute.search.canonical` for the move rule. The open list is a 4-ary form of
     :mod:`skyroute.search.heap`, written out in this loop: as calls (even inlined by
     numba) its operations cost about 10% more here, binary-heap calls 1.2-1.8x
-    (docs/architecture.md).
+    (docs/architecture.md). ``fs``: the keys' unit of f (:func:`heap.f_scale` of a bound
+    on every f, :meth:`SearchSpace.f_scale`).
     """
     g = floats[0]
     entered, state, touched, hc, level = ints[0], ints[1], ints[2], ints[3], ints[4]
@@ -64,7 +65,7 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
     nt = 1
     f0 = weight * h_of(hkind, abs(start % Wp - gx), abs(start // Wp - gy))
     hc[0] = start
-    keys[0] = heap.key(f0, 0.0)
+    keys[0] = heap.key(f0, 0.0, fs)
     state[start] = 1
     size = 1
     expanded = 0
@@ -152,7 +153,7 @@ def astar_kernel(mask, succ, Wp, start, goal, hkind, weight, max_expansions, flo
                 hn = max(dx, dy) + SQRT2_M1 * min(dx, dy)
             else:
                 hn = h_of(hkind, dx, dy)
-            key = (int((gn + weight * hn) * heap.F_SCALE + 0.5) << heap.TIE_BITS) | \
+            key = (int((gn + weight * hn) * fs + 0.5) << heap.TIE_BITS) | \
                 (heap.TIE_MAX - min(int(gn * 4.0), heap.TIE_MAX))
             if st == 0:
                 if can_hold and key >> heap.TIE_BITS == cf:

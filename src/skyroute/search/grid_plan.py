@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from functools import lru_cache
@@ -11,6 +12,7 @@ import numpy as np
 from skyroute.caches import register
 from skyroute.errors import OptionError, budget, check_choice, real
 from skyroute.result import STATUS_OF_CODE, PlanResult
+from skyroute.search import heap
 from skyroute.search.astar import astar_kernel
 from skyroute.search.bfs import bfs_kernel
 from skyroute.search.canonical import CANONICAL, EVERY
@@ -161,6 +163,7 @@ def _runner(space: SearchSpace, o: GridOptions):
     cells bound, so a query pays neither the dispatcher's typing of a dozen arguments
     nor the choice of kernel."""
     blk, Wp = space.blocked, space.Wp
+    fs = _f_scale(space, o.weight) if o.algorithm != "bfs" else 0.0
     floats, ints, keys = space.workspace()
     if o.algorithm == "bfs":
         call = entry_point(bfs_kernel, blk, Wp, 0, 0, o.max_expansions, floats, ints)
@@ -172,7 +175,7 @@ def _runner(space: SearchSpace, o: GridOptions):
         return run
     if o.algorithm == "jps":
         args = (space.move_mask(8, False), CANONICAL, space.jump_table(), Wp)
-        tail = (o.max_expansions, floats, ints, keys, NO_PIVOTS)
+        tail = (o.max_expansions, floats, ints, keys, NO_PIVOTS, fs)
         call = entry_point(jps_kernel, *args, 0, 0, *tail)
 
         def run(s, t):
@@ -183,14 +186,31 @@ def _runner(space: SearchSpace, o: GridOptions):
     hkind = HEURISTICS[o.heuristic]
     if o.algorithm in ANY_ANGLE:
         tail = (hkind, o.weight, o.max_expansions, o.algorithm == "lazy_theta", floats,
-                ints, keys)
+                ints, keys, fs)
         call = entry_point(theta_kernel, blk, mask, Wp, 0, 0, *tail)
         return lambda s, t: call(blk, mask, Wp, s, t, *tail)
     succ = CANONICAL if o.connectivity == 8 and not o.corner_cutting else EVERY
-    tail = (hkind, o.weight, o.max_expansions, floats, ints, keys)
+    tail = (hkind, o.weight, o.max_expansions, floats, ints, keys, fs)
     call = entry_point(astar_kernel, mask, succ, Wp, 0, 0, *tail)
 
     def run(s, t):
         code, exp, front, path, length = call(mask, succ, Wp, s, t, *tail)
         return code, exp, front, 0, path, length
     return run
+
+
+def _f_scale(space: SearchSpace, weight: float) -> float:
+    """The heap keys' unit of f for a search with ``weight`` on ``space``
+    (:meth:`SearchSpace.f_scale`); an OptionError naming weight when its keys could not
+    hold every f (a weight no search needs: above about 5e8 on the largest grids)."""
+    fs = space.f_scale(weight)
+    if fs > 0.0:
+        return fs
+    top = space.f_bound(0.0)
+    span = float(space.width + space.height)
+    most = math.floor((2.0 ** heap.F_BITS - 1.0 - top) / span)  # f in units of 1
+    while space.f_scale(most) == 0.0:  # float rounding: step down to a weight that fits
+        most = math.floor(most * (1.0 - 1e-12)) - 1
+    raise OptionError(f"weight={weight:g} is too large for this {space.width}x{space.height} "
+                      f"grid: its search keys would overflow; use a weight from 1 to "
+                      f"{most:,}", param="weight")

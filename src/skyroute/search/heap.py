@@ -3,7 +3,16 @@
 One int64 key per entry packs ``f`` (in units of 2**-20, so float noise in g + h never
 breaks ties) above a tie-break that prefers the larger ``g`` (in quarter cells): among
 equally promising nodes the one nearest the goal is expanded first, which on open grids
-cuts expansions several-fold. f must stay below 2**23 (8 million cells of path).
+cuts expansions several-fold. f's unit is a search's argument ``fs`` (f is stored as
+``int(f * fs + 0.5)``): :func:`f_scale` of an upper bound on every f the search can
+meet, which is ``F_SCALE`` (2**20, as before) while that bound stays below 2**23 (8
+million cells of path: every map the tests and benchmarks use) and the largest power of
+two that fits the key's 43 bits above (2**15 to 2**16 on 8192x8192 grids: f rounded to
+some 3e-5 there, as to 1e-6 before). A search whose f would need units coarser than 1
+is refused before it starts (an absurd ``weight``). Before, the shift wrapped past
+f = 2**23 and a long search popped keys out of f order. (The unit, not the tie-break's
+width, is the argument: a shift by a variable cost the A* kernel 3-4% on random 512
+maps, a variable multiplier nothing measurable.)
 
 The heap shares the searches' per-cell ``state`` array: ``state[c] = i + 1`` while c sits
 in heap slot i, so improving a node is a decrease-key, not a duplicate entry; 0 means
@@ -25,17 +34,33 @@ from numba import njit
 
 from skyroute.result import NO_PATH
 
-F_SCALE = 1048576.0  # 2**20
+F_SCALE = 1048576.0  # 2**20: f's finest unit, a search's whenever its keys allow
 TIE_BITS = 20
 TIE_MAX = (1 << TIE_BITS) - 1
+F_BITS = 63 - TIE_BITS  # a key is a nonnegative int64: f takes the 43 bits above the tie
 CLOSED = -1
 
 
+def f_scale(f_max: float) -> float:
+    """The unit ``fs`` of the keys of a search whose every f is at most ``f_max``:
+    ``F_SCALE`` when ``int(f_max * F_SCALE + 0.5)`` fits in ``F_BITS`` bits, else the
+    largest power of two that fits; 0.0 when not even 1 would (or ``f_max`` is not
+    finite). ``F_SCALE`` is read at each call, so a test may raise it to bring the f
+    limit down to a small grid's."""
+    fs = F_SCALE
+    if not f_max < 2.0 ** F_BITS:  # NaN and inf too
+        return 0.0
+    while fs >= 1.0 and int(f_max * fs + 0.5) >> F_BITS:  # as the kernels round
+        fs /= 2.0
+    return fs if fs >= 1.0 else 0.0
+
+
 @njit(cache=True)
-def key(f, g):
-    """Pack f and the g tie-break into one comparable int64."""
+def key(f, g, fs):
+    """Pack f (in units of 1 / ``fs``, from :func:`f_scale`) and the g tie-break into
+    one comparable int64."""
     tie = TIE_MAX - min(int(g * 4.0), TIE_MAX)
-    return (int(f * F_SCALE + 0.5) << TIE_BITS) | tie
+    return (int(f * fs + 0.5) << TIE_BITS) | tie
 
 
 @njit(cache=True, inline="always")

@@ -88,7 +88,8 @@ def _sign(v):
 
 
 @njit(cache=True)
-def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints, keys, piv):
+def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints, keys, piv,
+               fs):
     """Search from flat ``start`` to ``goal``.
 
     ``mask``: the 8-connected, no-corner-cutting move mask; ``succ``: the canonical
@@ -98,7 +99,7 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
     of :meth:`SearchSpace.workspace` (its ``state`` row all zeros on entry and on
     return). ``piv``: (cells, P) distances from P pivots (:mod:`skyroute.search.pivots`)
     whose differential bounds sharpen the octile heuristic; (0, 0) for the octile
-    distance alone.
+    distance alone. ``fs``: the keys' unit of f, as for the A* kernel.
 
     An expansion first lists its jump points (cell, x, y, entering move) in ``found``,
     prefetches their ``state``, ``g`` and pivot rows (cache misses on large maps, now
@@ -124,7 +125,7 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
     nt = 1
     sx0, sy0 = xy(start, Wp, inv)
     hc[0] = start
-    hk[0] = heap.key(h_of(1, abs(sx0 - gx), abs(sy0 - gy)), 0.0)
+    hk[0] = heap.key(h_of(1, abs(sx0 - gx), abs(sy0 - gy)), 0.0, fs)
     state[start] = 1
     size = 1
     expanded = 0
@@ -251,7 +252,7 @@ def jps_kernel(mask, succ, table, Wp, start, goal, max_expansions, floats, ints,
                 bound = abs(piv[n, pv] - dt[pv])
                 if bound > hn:
                     hn = bound
-            key = heap.key(gn + hn, gn)
+            key = heap.key(gn + hn, gn, fs)
             if st == 0:
                 if key >> heap.TIE_BITS == cf:
                     level[nl] = n

@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit
 
 from skyroute.result import NO_PATH
+from skyroute.search import heap
 from skyroute.search.astar import astar_kernel
 from skyroute.search.cache_lines import aligned_empty
 from skyroute.search.canonical import CANONICAL
@@ -38,8 +39,10 @@ def distances_from(mask: np.ndarray, Wp: int, source: int, ws: tuple) -> np.ndar
     every cell) run to exhaustion towards the blocked border cell 0; every cell it
     touched was expanded, with its final g. ``ws``: a :func:`space.workspace`."""
     floats, ints, keys = ws
+    # f = g here, below sqrt 2 a padded cell (SearchSpace.f_bound's bound, h = 0)
+    fs = heap.f_scale(mask.size * math.sqrt(2.0))
     _, expanded, _, _, _ = astar_kernel(mask, CANONICAL, Wp, source, 0, 0, 1.0,
-                                        MAX_EXPANSIONS, floats, ints, keys)
+                                        MAX_EXPANSIONS, floats, ints, keys, fs)
     out = np.full(mask.size, np.inf)
     reached = ints[2][:expanded]
     out[reached] = floats[0][reached]
@@ -75,13 +78,15 @@ def pivot_distances(mask: np.ndarray, label: np.ndarray, Wp: int,
 
 
 @njit(cache=True)
-def jump_query(mask, succ, table, label, piv, floats, ints, keys, Wp, s, t):
+def jump_query(mask, succ, table, label, piv, floats, ints, keys, fs, Wp, s, t):
     """One exact query from flat cell s to t for a prepared index: the component labels
-    answer "no path" at once, else JPS with the pivots' bounds. Returns (code, path
+    answer "no path" at once, else JPS with the pivots' bounds (``fs``: the keys'
+    unit of f, :meth:`SearchSpace.f_scale` with pivots). Returns (code, path
     (k, 2) cells, cost, expanded, max_frontier), as the subgoal queries do."""
     if label[s] != label[t]:
         return NO_PATH, np.empty((0, 2)), math.inf, 0, 0
     code, expanded, frontier, path, cost = jps_kernel(mask, succ, table, Wp, s, t,
-                                                      MAX_EXPANSIONS, floats, ints, keys, piv)
+                                                      MAX_EXPANSIONS, floats, ints, keys, piv,
+                                                      fs)
     # same labels, so the kernel reaches t; were it not, its path is empty and cost inf
     return code, path, cost, expanded, frontier

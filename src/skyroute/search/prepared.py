@@ -68,7 +68,7 @@ class PreparedGrid:
             arrays["piv"] = line_aligned(arrays["piv"])  # a loaded index: copied once
             self._args = (space.move_mask(8, False), CANONICAL, space.jump_table(),
                           arrays["label"], arrays["piv"], *workspace(self._blk.size),
-                          self.Wp)
+                          space.f_scale(pivots=True), self.Wp)
             self._call = entry_point(self._kernel, *self._args, 0, 0)
             return
         cells = arrays["cells"]

@@ -11,11 +11,13 @@ with ``Wp = width + 2``. Built once per grid and cached (plan once, query many):
 
 from __future__ import annotations
 
+import math
 import weakref
 
 import numpy as np
 
 from skyroute.caches import register
+from skyroute.search import heap
 from skyroute.search.jps import jump_tables
 from skyroute.search.moves import MDX, MDY
 from skyroute.world.grid import Grid, check_cell
@@ -36,6 +38,7 @@ class SearchSpace:
         self._masks: dict[tuple[int, bool], np.ndarray] = {}
         self._jumps: np.ndarray | None = None
         self._ws: tuple | None = None
+        self._free: int | None = None
         # per option set, keyed by id: (the set, kept alive so its id stays its own, and
         # its query call; see grid_plan)
         self.runners: dict[int, tuple] = {}
@@ -107,6 +110,26 @@ class SearchSpace:
                 table = table.astype(np.int16)
             self._jumps = table
         return self._jumps
+
+    def f_bound(self, weight: float = 1.0, *, pivots: bool = False) -> float:
+        """An upper bound on every f = g + weight * h a grid search on this grid meets.
+
+        g: an expanded cell's g is the cost of a path of distinct free cells (steps of
+        at most sqrt 2; Theta*'s shortcuts are no longer), a generated cell's one step
+        more, and for JPS one jump (at most width + height cells) more. h: the octile,
+        Euclidean or Manhattan distance is at most width + height; a pivot's bound
+        (``pivots``) at most the true distance, so at most g's bound.
+        """
+        if self._free is None:
+            self._free = int(np.count_nonzero(self.blocked == 0))
+        g = (self._free + self.width + self.height) * math.sqrt(2.0)
+        return g + weight * (g if pivots else float(self.width + self.height))
+
+    def f_scale(self, weight: float = 1.0, *, pivots: bool = False) -> float:
+        """The heap keys' unit of f for a search here (:func:`heap.f_scale` of
+        :meth:`f_bound`): 2**20 unless the grid is huge or ``weight`` large; 0.0 when its
+        keys cannot hold every f."""
+        return heap.f_scale(self.f_bound(weight, pivots=pivots))
 
     def workspace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(floats, ints, keys), allocated once: F rows g, h (float64); I rows parent, state,

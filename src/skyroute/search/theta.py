@@ -33,12 +33,12 @@ def _dist(a, b, Wp):
 
 @njit(cache=True)
 def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy,
-                 floats, ints, keys):
+                 floats, ints, keys, fs):
     """Return (status, expanded, max_frontier, los_checks, path, length): ``path`` the
     (x, y) cells (empty unless found).
 
     floats, ints, keys: the workspace of :meth:`SearchSpace.workspace` (its ``state`` row all
-    zeros on entry and on return).
+    zeros on entry and on return); ``fs``: the keys' unit of f, as for the A* kernel.
     """
     g, h = floats[0], floats[1]
     parent, state, touched, hc = ints[0], ints[1], ints[2], ints[3]
@@ -49,7 +49,7 @@ def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy
     parent[start] = start
     touched[0] = start
     nt = 1
-    size = heap.push(hc, hk, state, 0, start, heap.key(h[start], 0.0))
+    size = heap.push(hc, hk, state, 0, start, heap.key(h[start], 0.0, fs))
     expanded = 0
     max_frontier = 1
     los = 0
@@ -70,7 +70,7 @@ def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy
                 old = g[c]
                 g[c] = best
                 if best > old and size > 0:  # no longer surely the best: queue it again
-                    size = heap.push(hc, hk, state, size, c, heap.key(best + h[c], best))
+                    size = heap.push(hc, hk, state, size, c, heap.key(best + h[c], best, fs))
                     if hc[0] != c:
                         continue
                     c, size = heap.pop(hc, hk, state, size)
@@ -108,7 +108,7 @@ def theta_kernel(blk, mask, Wp, start, goal, hkind, weight, max_expansions, lazy
             if gn < g[n]:
                 g[n] = gn
                 parent[n] = par
-                size = heap.push(hc, hk, state, size, n, heap.key(gn + h[n], gn))
+                size = heap.push(hc, hk, state, size, n, heap.key(gn + h[n], gn, fs))
         if size > max_frontier:
             max_frontier = size
     code = heap.finish(code, state, touched, nt)
