@@ -131,7 +131,7 @@ class PreparedGrid:
     @property
     def nbytes(self) -> int:
         """Bytes of the index arrays, the padded grid and the query workspace."""
-        return int(sum(a.nbytes for a in self._args[:-1]))
+        return int(sum(a.nbytes for a in self._args if isinstance(a, np.ndarray)))
 
     def plan(self, start, goal) -> PlanResult:
         """The exact octile path from cell ``start`` to ``goal``, both (x, y).
