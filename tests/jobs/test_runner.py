@@ -52,7 +52,7 @@ def test_states_move_from_queued_through_running_to_done(tmp_path, monkeypatch):
     assert job["progress"] == 1.0 and job["error"] is None
     assert job["result"]["days"] == 4 and job["result"]["days_with_orders"] == 3
     assert job["params"] == {**days, "method": "milp"}
-    assert runner.pending() == 0
+    settle()  # the lane counts a job ended just after it writes the job's last state
 
 
 def test_a_failing_job_ends_failed_with_one_line(tmp_path):
