@@ -14,12 +14,17 @@ from skyroute.errors import InputFormatError, OptionError, SkyrouteError
 BOM = "\ufeff"  # a UTF-8 byte-order mark: Excel's "CSV UTF-8" and Notepad start with one
 
 
-def read_text(path: str | Path) -> str:
+def read_text(path: str | Path, *, max_bytes: int | None = None,
+              kind: str = "a file") -> str:
     """``path``'s text, read as UTF-8 with a byte-order mark read past (every input
     reader comes through here, so a first field never reads as ``'\\ufefforderNo'``)
-    and CRLF read as LF; a file that cannot be read or is not UTF-8 is an
-    :class:`InputFormatError` naming it."""
+    and CRLF read as LF; a file that cannot be read or is not UTF-8, or (before it is
+    read) one past ``max_bytes``, is an :class:`InputFormatError` naming it (``kind``:
+    what the limit is for, in that message)."""
     try:
+        if max_bytes is not None and (size := Path(path).stat().st_size) > max_bytes:
+            raise InputFormatError(path, f"{size:,} bytes, over the limit of {max_bytes:,} "
+                                   f"for {kind}")
         return Path(path).read_text(encoding="utf-8-sig")
     except OSError as exc:
         raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None

@@ -38,12 +38,9 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
     plane is east/north metres around home at (lon0, lat0)). ``text``: the file's content,
     already in hand (an upload); ``path`` then only names it in errors."""
     source, path = str(path), Path(path)
-    if text is None:
-        try:
-            _check_bytes(path, path.stat().st_size)
-        except OSError as exc:
-            raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
-        text = read_text(path)  # Excel starts a saved CSV with a byte-order mark
+    if text is None:  # Excel starts a saved CSV with a byte-order mark
+        text = read_text(path, max_bytes=MAX_BYTES,
+                         kind=f"a colliders file (at most {MAX_BOXES:,} boxes)")
     lines = strip_bom(text).splitlines()
     boxes = sum(1 for line in lines[2:] if line.strip())
     if boxes > MAX_BOXES:
@@ -81,13 +78,6 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
     names = tuple(f"box at line {n}" for n in range(3, 3 + len(rows)))
     return World(boxes, up - hu - s, up + hu + s, names, None, frame,
                  Home(lon0, lat0, 0.0), name=path.name, source=source)
-
-
-def _check_bytes(path: Path, size: int) -> None:
-    """Refuse a file of ``size`` bytes past :data:`MAX_BYTES` before it is read."""
-    if size > MAX_BYTES:
-        raise InputFormatError(path, f"{size:,} bytes, over the limit of {MAX_BYTES:,} for "
-                               f"a colliders file (at most {MAX_BOXES:,} boxes)")
 
 
 def _home(path: Path, line: str | None) -> tuple[float, float]:

@@ -33,12 +33,8 @@ SWAPPED = "are its coordinates (lat, lon)? GeoJSON and boundary boxes are (lon, 
 
 
 def _features(path: Path | str, text: str | None = None) -> list[dict]:
-    if text is None:
-        try:
-            _check_bytes(path, Path(path).stat().st_size)
-        except OSError as exc:
-            raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
-        text = read_text(path)  # a byte-order mark (Windows editors) is read past
+    if text is None:  # a byte-order mark (Windows editors) is read past
+        text = read_text(path, max_bytes=MAX_BYTES, kind="a GeoJSON file")
     try:
         doc = json.loads(strip_bom(text))
     except json.JSONDecodeError as exc:
@@ -47,13 +43,6 @@ def _features(path: Path | str, text: str | None = None) -> list[dict]:
             not isinstance(doc.get("features"), list):
         raise InputFormatError(path, "expected a GeoJSON FeatureCollection")
     return doc["features"]
-
-
-def _check_bytes(path: Path | str, size: int) -> None:
-    """Refuse a file of ``size`` bytes past :data:`MAX_BYTES` before it is read."""
-    if size > MAX_BYTES:
-        raise InputFormatError(path, f"{size:,} bytes, over the limit of {MAX_BYTES:,} for "
-                               "a GeoJSON file")
 
 
 def _polygon(path: Path, i: int, feature: dict) -> tuple[shapely.Geometry, str]:
