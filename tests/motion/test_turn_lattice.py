@@ -9,7 +9,7 @@ from hypothesis.extra.numpy import arrays
 
 import skyroute
 from skyroute.motion.turn_lattice import plan_turns, travel_time
-from tests.search.checks import assert_any_angle_path_legal
+from tests.search.checks import assert_any_angle_path_legal, two_indices
 
 SETTINGS = settings(max_examples=60, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow])
@@ -18,12 +18,15 @@ SETTINGS = settings(max_examples=60, deadline=None,
 @st.composite
 def grid_query(draw):
     h, w = draw(st.integers(2, 12)), draw(st.integers(2, 12))
-    blocked = draw(arrays(np.bool_, (h, w), elements=st.booleans()))
+    # every cell drawn (fill=nothing; with a fill most grids were all blocked or all
+    # free), a quarter of them blocked (at a half most queries were no_path)
+    blocked = draw(arrays(np.bool_, (h, w), elements=st.integers(0, 3).map(lambda v: v == 3),
+                          fill=st.nothing()))
     free = np.argwhere(~blocked)
     if len(free) < 2:
         blocked[:] = False
         free = np.argwhere(~blocked)
-    i, j = draw(st.integers(0, len(free) - 1)), draw(st.integers(0, len(free) - 1))
+    i, j = two_indices(draw, len(free))  # start != goal
     return blocked, (int(free[i][1]), int(free[i][0])), (int(free[j][1]), int(free[j][0]))
 
 

@@ -8,10 +8,14 @@ import sys
 
 import numpy as np
 import pytest
+import shapely
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
 
 import skyroute
 from skyroute.bench.world import random_rect_world
 from skyroute.roadmap.prm import PRM
+from tests.roadmap.test_visibility import assert_free, brute_force, rect_world, rect_worlds
 
 QUERY = ((5.0, 5.0), (95.0, 95.0))
 
@@ -132,3 +136,25 @@ def test_a_world_with_nothing_in_the_way_is_the_straight_segment():
     same = skyroute.plan(world, a, a, algorithm="prm")
     assert same.found and same.path.tolist() == [list(a)] and same.cost == 0.0
     assert PRM(skyroute.World([], [], [], ())).edge_segments().shape == (0, 2, 2)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@given(rect_worlds(), st.integers(0, 2**16))
+def test_a_prm_path_never_crosses_an_obstacle_and_is_never_shorter_than_the_optimum(case, seed):
+    # the invariants on random rectangle worlds, checked with shapely and the brute-force
+    # visibility graph of test_visibility (scipy), nothing of skyroute's geometry
+    boxes, s, t = case
+    world = rect_world(boxes)
+    union = shapely.unary_union(world.obstacles)
+    assume(not union.contains(shapely.Point(s)) and not union.contains(shapely.Point(t)))
+    r = skyroute.plan(world, s, t, algorithm="prm", samples=150, seed=seed)
+    optimum = brute_force(boxes, s, t)
+    if not r.found:
+        assert r.status is skyroute.Status.NO_PATH and r.path.shape == (0, 2)
+        return
+    assert np.isfinite(optimum)  # no path found where none exists
+    np.testing.assert_array_equal(r.path[[0, -1]], [s, t])
+    assert_free(boxes, r.path)
+    length = np.hypot(*np.diff(r.path, axis=0).T).sum()
+    assert r.cost == pytest.approx(length, rel=1e-12)
+    assert r.cost >= optimum - 1e-9

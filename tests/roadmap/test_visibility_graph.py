@@ -8,7 +8,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 import shapely
-from hypothesis import example, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 import skyroute
@@ -137,7 +137,14 @@ def rotated_worlds(draw):
         polys.append(shapely.affinity.translate(shapely.affinity.rotate(p, ang, use_radians=True),
                                                 cx, cy))
     pt = st.tuples(st.floats(-3, 23), st.floats(-3, 23))
-    return polys, draw(pt), draw(pt)
+    s, t = draw(pt), draw(pt)
+    if draw(st.booleans()):  # through the first obstacle, from beyond the others: a path
+        # that bends (points anywhere: 32 of 40 were a straight segment, start == goal or
+        # in an obstacle)
+        c = polys[0].representative_point()
+        s, t = (draw(st.floats(-6, -4)), c.y), (draw(st.floats(25, 27)), c.y)
+    assume(s != t)
+    return polys, s, t
 
 
 @settings(max_examples=40, deadline=None)

@@ -47,7 +47,8 @@ for _cache in (_CORNER_GRAPHS, _ZONES, _BOUNDS):
 
 @dataclass(frozen=True, eq=False)
 class Flight:
-    """Moves as data: ``frm`` and ``to`` (N, 2) lon/lat, ``angle`` (N,) ints, -999 = hover."""
+    """Moves as data: ``frm`` and ``to`` (N, 2) lon/lat, ``angle`` (N,) ints, -999 = hover;
+    ``start`` where it starts (what a flight of no moves ends at, when it is known)."""
 
     frm: np.ndarray
     angle: np.ndarray
@@ -56,6 +57,7 @@ class Flight:
     expanded: int = 0
     seconds: float = 0.0
     extra: dict = field(default_factory=dict)
+    start: np.ndarray | None = None
 
     def __repr__(self) -> str:
         """A summary, not the moves."""
@@ -75,8 +77,10 @@ class Flight:
 
     @property
     def end(self) -> np.ndarray:
-        """Where the flight ends."""
-        return self.to[-1] if len(self.to) else np.full(2, np.nan)
+        """Where the flight ends: its start if it has no moves (NaN if that is unknown)."""
+        if len(self.to):
+            return self.to[-1]
+        return np.full(2, np.nan) if self.start is None else np.array(self.start, dtype=float)
 
     def rows(self) -> list[list[float]]:
         """[[from_lon, from_lat, angle, to_lon, to_lat], ...]."""
@@ -88,11 +92,15 @@ class Flight:
         return Flight(np.vstack([self.frm, other.frm]), np.concatenate([self.angle,
                                                                          other.angle]),
                       np.vstack([self.to, other.to]), other.status,
-                      self.expanded + other.expanded, self.seconds + other.seconds)
+                      self.expanded + other.expanded, self.seconds + other.seconds,
+                      start=self.start if len(self.to) or self.start is not None
+                      else other.start)
 
     def hover(self, at=None) -> Flight:
         """This flight followed by one hover (at its end, or at ``at``)."""
         p = np.asarray(self.end if at is None else at, dtype=float).reshape(1, 2)
+        if np.isnan(p).any():  # a flight of no moves that does not know its start
+            raise QueryError("a flight of no moves needs the place to hover: hover(at=...)")
         return self.then(Flight(p, np.array([HOVER]), p.copy()))
 
 
@@ -217,12 +225,13 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     chain = np.array(chain[::-1], dtype=np.int64)
     pos = np.c_[x, y]
     return Flight(pos[parent[chain]].reshape(-1, 2), ANGLES[move[chain]].astype(int),
-                  pos[chain].reshape(-1, 2), Status.FOUND, expanded, seconds)
+                  pos[chain].reshape(-1, 2), Status.FOUND, expanded, seconds,
+                  start=s.copy())
 
 
 def _empty(s, status, expanded, seconds) -> Flight:
     e = np.empty((0, 2))
-    return Flight(e, np.empty(0, int), e.copy(), status, expanded, seconds)
+    return Flight(e, np.empty(0, int), e.copy(), status, expanded, seconds, start=s.copy())
 
 
 def follow(world: World, path, *, step: float = STEP, max_moves: int = 1500) -> Flight:
@@ -266,4 +275,5 @@ def follow(world: World, path, *, step: float = STEP, max_moves: int = 1500) -> 
     status = Status.FOUND if target >= len(pts) else \
         Status.NO_PATH if stuck else Status.BUDGET_EXHAUSTED
     return Flight(np.array(frm).reshape(-1, 2), np.array(ang, dtype=int),
-                  np.array(to).reshape(-1, 2), status, len(ang), time.perf_counter() - t0)
+                  np.array(to).reshape(-1, 2), status, len(ang), time.perf_counter() - t0,
+                  start=pts[0].copy())
