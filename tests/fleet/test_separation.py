@@ -342,6 +342,43 @@ def test_bad_options_name_the_option(option, value):
     assert err.value.param == option
 
 
+@pytest.mark.parametrize("value", ["5", True, b"5", None])
+def test_options_that_are_not_numbers_are_refused(value):
+    # float() read "5" as 5.0 and True as 1.0: every other option of skyroute refuses them
+    # (skyroute.errors.real)
+    for option in ("sep_horizontal", "sep_vertical", "tolerance"):
+        with pytest.raises(OptionError) as err:
+            check(crossing(), **{option: value})
+        assert str(err.value) == (f"{option}={value!r} must be a number "
+                                  f"{'> 0' if option == 'tolerance' else '>= 0'}")
+        assert err.value.param == option
+
+
+def test_numpy_numbers_are_options_as_floats_are():
+    assert check(crossing(), sep_horizontal=np.float32(50), sep_vertical=np.array(10),
+                 tolerance=np.float64(1e-6)) == check(crossing())
+
+
+@pytest.mark.parametrize("column, values, shown", [
+    ("t0", ["0", "0"], "t0[0]='0'"),  # numpy's float() conversion read these as numbers
+    ("alt", [100.0, "100"], "alt[1]='100'"),
+    ("drone", [True, False], "drone[0]=True"),
+    ("radius", np.array([0, False], dtype=object), "radius[1]=False"),
+])
+def test_columns_that_are_not_numbers_are_refused(column, values, shown):
+    with pytest.raises(QueryError) as err:
+        check({**_columns(), column: values})
+    assert str(err.value) == f"{shown} must be a number"
+    assert err.value.param == column
+
+
+def test_columns_of_numbers_in_any_container_are_read():
+    cols = {k: list(v) for k, v in _columns().items()}
+    cols["t1"] = np.array([100, 100], dtype=object)
+    cols["drone"] = np.array([1, 2], dtype=np.uint8)
+    assert check(cols) == check(crossing())
+
+
 def _columns(**change):
     cols = {k: np.asarray(getattr(crossing(), k)).copy() for k in crossing().__dataclass_fields__}
     for k, (row, value) in change.items():

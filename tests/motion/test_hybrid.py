@@ -518,12 +518,21 @@ def test_hybrid_takes_0d_arrays_and_numpy_bools():
 
 
 @pytest.mark.parametrize("kw", [{"smooth": "no"}, {"approach": True},
-                                {"seed": 1.5}, {"max_expansions": "5"}])
+                                {"seed": 1.5}, {"seed": -1}, {"max_expansions": "5"}])
 def test_hybrid_names_a_bad_option(kw):
     # smooth="no" and approach=True were taken
     (name, _), = kw.items()
-    with pytest.raises(OptionError, match=f"{name}="):
+    with pytest.raises(OptionError, match=f"{name}=") as err:
         plan(_tower(), (0, 2, 0), (5, 2, 0), 0.5, **kw)
+    assert err.value.param == name
+
+
+def test_hybrid_refuses_a_negative_seed_as_every_other_seed_is():
+    # seed=-1 was taken (and folded to 2**32 - 1 for the shortcutting), where PRM, the
+    # fleet runs and the data synthesis refuse it
+    with pytest.raises(OptionError) as err:
+        plan(_tower(), (0, 2, 0), (5, 2, 0), 0.5, seed=-1)
+    assert str(err.value) == "seed=-1 must be an integer >= 0"
 
 
 def test_runway_goal_names_a_bad_heading():

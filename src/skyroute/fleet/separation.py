@@ -77,7 +77,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from skyroute.errors import OptionError, QueryError
+from skyroute.errors import QueryError, real
 from skyroute.fleet.trajectory import LINE, Pieces
 
 # columns of Pieces.table()
@@ -178,14 +178,10 @@ def check(pieces: Pieces | Mapping[str, object], *, sep_horizontal: float = 50.0
 
 
 def _option(name: str, value, *, positive: bool) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        v = math.nan
-    if not (math.isfinite(v) and (v > 0 if positive else v >= 0)):
-        need = "> 0" if positive else ">= 0"
-        raise OptionError(f"{name}={value!r} must be a number {need}", param=name)
-    return v
+    """A real number (not a string or a bool: float() took "5" and True), as every
+    option of skyroute reads one (:func:`skyroute.errors.real`)."""
+    return real(name, value, low=0.0, strict=positive,
+                need="a number > 0" if positive else "a number >= 0")
 
 
 def _merge(drones: np.ndarray, ev: np.ndarray) -> tuple[Conflict, ...]:

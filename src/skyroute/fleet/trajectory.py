@@ -41,6 +41,7 @@ airports' business, not this module's).
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, fields
 from typing import NamedTuple
@@ -103,6 +104,21 @@ def _triple(name: str, value) -> tuple[float, float, float]:
     return float(v[0]), float(v[1]), float(v[2])
 
 
+def _not_number(value, raw: np.ndarray) -> tuple[int, object] | None:
+    """(index, element) of the first element of column ``value`` (read as the 1-d
+    ``raw``) that is not a real number (a string or a bool is not, as for
+    :func:`skyroute.errors.real`), or None."""
+    if raw.dtype.kind in "iuf":
+        return None
+    # element by element, as given: [100.0, "100"] is one array of strings to numpy
+    items = np.array(value, dtype=object, ndmin=1).tolist() if raw.dtype.kind != "O" \
+        else list(raw)
+    for i, x in enumerate(items):
+        if isinstance(x, bool | np.bool_) or not isinstance(x, numbers.Real):
+            return i, x.item() if isinstance(x, np.generic) else x
+    return None
+
+
 @dataclass(frozen=True, eq=False)
 class Pieces:
     """A fleet's airborne pieces as read-only columns (one row per piece).
@@ -134,15 +150,20 @@ class Pieces:
         n = None
         for name, value in cols.items():
             try:
-                raw = np.asarray(value)
-                integer = name in ("drone", "kind") and raw.dtype.kind in "iu"
-                # a copy: never share (or let anyone change) the caller's array
-                a = np.array(raw, dtype=np.int64 if integer else float, ndmin=1)
+                raw = np.array(value, ndmin=1, copy=None)
             except (TypeError, ValueError):
                 raise QueryError(f"{name} must be an array of numbers", param=name) from None
-            if a.ndim != 1:
-                raise QueryError(f"{name} must be one-dimensional, not shape {a.shape}",
+            if raw.ndim != 1:
+                raise QueryError(f"{name} must be one-dimensional, not shape {raw.shape}",
                                  param=name)
+            bad = _not_number(value, raw)
+            if bad is not None:  # float() reads "5" and True as numbers; they are not
+                raise QueryError(f"{name}[{bad[0]}]={bad[1]!r} must be a number", param=name)
+            integer = name in ("drone", "kind") and raw.dtype.kind in "iu"
+            try:  # a copy: never share (or let anyone change) the caller's array
+                a = np.array(raw, dtype=np.int64 if integer else float)
+            except (TypeError, ValueError, OverflowError):
+                raise QueryError(f"{name} must be an array of numbers", param=name) from None
             if n is None:
                 n = len(a)
             elif len(a) != n:

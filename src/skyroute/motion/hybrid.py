@@ -199,7 +199,7 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     smooth : bool
         Shortcut the path with free Dubins connections.
     seed : int
-        Seed of the shortcutting's random pairs.
+        Seed of the shortcutting's random pairs, >= 0.
 
     Returns
     -------
@@ -456,7 +456,7 @@ def _options(radius, heading_bins, step, reverse, max_expansions, seed, smooth):
                               f"(0, {math.pi * r:g}]", param="step") from None
     flag("reverse", reverse)
     flag("smooth", smooth)
-    whole("seed", seed)
+    whole("seed", seed, low=0)
     return r, H, float(step), budget(max_expansions)
 
 

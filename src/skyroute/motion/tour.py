@@ -123,7 +123,7 @@ def tour(start_pose, targets, radius: float, *, world: World | None = None,
     radius = real("radius", radius, low=0.0, strict=True)  # numpy numbers too
     headings = whole("headings", headings, low=1, high=72)
     exact_limit = whole("exact_limit", exact_limit, low=0)
-    seed = whole("seed", seed)  # as hybrid.plan reads it (also when no leg needs it)
+    seed = whole("seed", seed, low=0)  # as hybrid.plan reads it (also when no leg needs it)
     start = as_points(start_pose, "start_pose", dims=3)[0]
     pts = as_points(targets, "targets")
     if len(pts) == 0:
