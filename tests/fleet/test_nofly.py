@@ -3,6 +3,8 @@ test), what cannot bend is refused with the zone's name, and a fleet run keeps o
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 import shapely
@@ -180,6 +182,63 @@ def test_a_gap_in_the_ring_lets_the_cruise_through():
     for move in (lambda n, e: (n, e + 2e4), lambda n, e: (3000 + 4 * (n - 3000), 4 * e)):
         moved = [{**z, "points": [move(n, e) for n, e in z["points"]]} for z in RING]
         assert cut_off(parse_scenario(ringed(moved))) is None
+
+
+def hexagon_ring(turn: float) -> list[dict]:
+    """Six zones, the sectors of a hexagonal band (inner radius 1200 m, outer 1500 m)
+    round airport C of :func:`ringed`, each sharing its two side edges with its
+    neighbours; and a chain of three boxes, each touching the next, running 3 km out
+    from the top of the band. All turned by ``turn`` radians about C (so the union's
+    nodes are rounded, not exact)."""
+    c_n, c_e = 3000.0, 0.0
+
+    def turned(n, e):
+        dn, de = n - c_n, e - c_e
+        return [c_n + dn * math.cos(turn) - de * math.sin(turn),
+                c_e + dn * math.sin(turn) + de * math.cos(turn)]
+
+    # the hexagon's corners, each worked out once, so neighbours share edges exactly
+    band = [[turned(c_n + r * math.sin(t), c_e + r * math.cos(t)) for r in (1200, 1500)]
+            for t in np.radians(np.arange(0, 360, 60))]
+    zones = [{"name": f"ring{k}", "points": [band[k][0], band[k][1], band[(k + 1) % 6][1],
+                                             band[(k + 1) % 6][0]]} for k in range(6)]
+    for j, (lo, hi) in enumerate(((1250, 2300), (2300, 3300), (3300, 4300))):
+        zones.append({"name": f"spur{j}",
+                      "points": [turned(c_n + n, c_e + e)
+                                 for n, e in ((lo, -100), (lo, 100), (hi, 100), (hi, -100))]})
+    return zones
+
+
+@pytest.mark.parametrize("turn", [0.0, 0.16, 0.64, 1.93, 2.42, 3.54, 6.12])
+def test_a_ring_names_only_the_zones_that_close_it(turn):
+    # all nine zones were named: the ring's six and the three of the chain joined to it
+    from skyroute.fleet.airborne import check_flights
+    from skyroute.fleet.nofly import cut_off
+
+    zones = hexagon_ring(turn)
+    s = parse_scenario(ringed(zones))
+    inside, outside, names = cut_off(s)
+    assert (inside, outside) == (["C"], ["A", "B"])
+    assert names == [f"'ring{k}'" for k in range(6)]
+    with pytest.raises(InputFormatError) as err:
+        check_flights(s, "hex.yaml")
+    assert str(err.value) == ("hex.yaml: no_fly_zones: no cruise can join airports C and A: "
+                              "zones 'ring0', 'ring1', 'ring2', 'ring3', 'ring4', 'ring5' "
+                              "close a ring round C (zones that touch leave no gap)")
+    # independently (shapely, no growth): the six sectors alone enclose C, the chain
+    # alone does not, and any five sectors leave C joined to the outside
+    c = shapely.Point(0.0, 3000.0)
+    poly = [shapely.Polygon([(e, n) for n, e in z["points"]]) for z in zones]
+    holes = shapely.get_parts(shapely.union_all(poly[:6])).tolist()
+    assert len(holes) == 1 and shapely.Polygon(holes[0].interiors[0]).contains(c)
+    assert not any(shapely.Polygon(r).contains(c) for p in shapely.get_parts(
+        shapely.union_all(poly[6:])) for r in p.interiors)
+    for k in range(6):
+        five = shapely.union_all(poly[:k] + poly[k + 1:6])
+        assert not any(shapely.Polygon(r).contains(c) for p in shapely.get_parts(five)
+                       for r in p.interiors)
+    # the scenario without the chain names the same ring
+    assert cut_off(parse_scenario(ringed(zones[:6])))[2] == names
 
 
 def test_a_cruise_the_planner_cannot_find_names_the_flight_not_a_status():

@@ -109,13 +109,18 @@ def cut_off(scenario) -> tuple[list[str], list[str], list[str]] | None:
     approach are checked by :func:`check_line`, so the airport stands for both ends of
     its cruises.) A gap too narrow to turn in is not caught here: the planner finds no
     cruise through it when the pair is first flown.
+
+    The ring's zones are those that border the hole (their grown polygons reach its
+    boundary), not every zone joined to them: a chain of zones running out from the ring
+    closes nothing and is not named.
     """
     zones = scenario.no_fly_zones
     if not zones:
         return None
     polys = [shapely.Polygon([(e, n) for n, e in z.points]) for z in zones]
     x0, y0, x1, y1 = shapely.total_bounds(polys)
-    grown = shapely.buffer(polys, 1e-9 * max(1.0, x1 - x0, y1 - y0))
+    grow = 1e-9 * max(1.0, x1 - x0, y1 - y0)
+    grown = shapely.buffer(polys, grow)
     ports = shapely.points([(a.east, a.north) for a in scenario.airports])
     ids = [a.id for a in scenario.airports]
     names = [z.name for z in zones]
@@ -123,9 +128,13 @@ def cut_off(scenario) -> tuple[list[str], list[str], list[str]] | None:
         for ring in part.interiors:
             inside = shapely.contains(shapely.Polygon(ring), ports)
             if inside.any() and not inside.all():
+                # the union's nodes where two zones cross are rounded, so a zone that
+                # borders the hole can miss its ring by ~1e-13 m: a tolerance of half
+                # the growth, far above that and far below any zone's width
+                border = shapely.dwithin(grown, ring, grow / 2)
                 ring_zones = [repr(n) if names.count(n) == 1 else f"no_fly_zones[{k}]"
-                              for k, (n, g) in enumerate(zip(names, grown, strict=True))
-                              if g.intersects(part)]
+                              for k, (n, b) in enumerate(zip(names, border, strict=True))
+                              if b]
                 return ([i for i, x in zip(ids, inside, strict=True) if x],
                         [i for i, x in zip(ids, inside, strict=True) if not x], ring_zones)
     return None
