@@ -56,6 +56,7 @@ from skyroute.motion import dubins
 
 WARMUP_SHARE = 0.1
 SAMPLE_DT = 1.0
+TIME_DECIMALS = 3  # the event log and packages.csv write times to the millisecond
 _LOCAL = 4  # optimal dispatch: packages considered per airport beyond the oldest
 # ground holds tried before a departure, seconds after the earliest one
 _HOLDS = (0, 2, 5, 10, 15, 20, 30, 45, 60, 75, 90, 120, 150, 180, 240, 300,
@@ -63,6 +64,18 @@ _HOLDS = (0, 2, 5, 10, 15, 20, 30, 45, 60, 75, 90, 120, 150, 180, 240, 300,
 _SPAWN, _READY, _FETCH = 0, 1, 2
 KINDS = ("spawn", "assign", "pickup", "takeoff", "landing_request", "landing_denied",
          "landing_granted", "touchdown", "delivered")
+
+
+def written(t) -> np.ndarray:
+    """Times ``t`` (seconds) as the run's files write them: to :data:`TIME_DECIMALS`
+    places, exactly the floats a reader parses back from ``events.jsonl`` and
+    ``packages.csv`` (Python's ``round`` and ``f"{t:.3f}"`` are both correctly
+    rounded; numpy's ``round`` is not). NaN stays NaN. The report decides on which side
+    of the warm-up and the horizon a time falls on these, so that counts taken from the
+    files are its own."""
+    t = np.asarray(t, dtype=float)
+    return np.array([round(x, TIME_DECIMALS) for x in t.ravel().tolist()],
+                    dtype=float).reshape(t.shape)
 
 
 class SimulationError(SkyrouteError, RuntimeError):
@@ -230,7 +243,7 @@ class _Engine:
             gate=None) -> None:
         if t > self.horizon:
             return
-        e = {"t": round(float(t), 3), "kind": kind}
+        e = {"t": round(float(t), TIME_DECIMALS), "kind": kind}
         if drone is not None:
             e["drone"] = int(drone)
         if package is not None:

@@ -53,7 +53,7 @@ from skyroute.errors import OptionError, SkyrouteError
 from skyroute.files import check_writable, write_atomic
 from skyroute.fleet.flightplan import FlightPlan, gate_position, ground_position
 from skyroute.fleet.scenario import runway_ends
-from skyroute.fleet.simulate import WARMUP_SHARE, Simulation
+from skyroute.fleet.simulate import TIME_DECIMALS, WARMUP_SHARE, Simulation
 from skyroute.fleet.trajectory import position
 from skyroute.geo import Home, ned_to_lonlat
 from skyroute.io.geojson import dumps
@@ -307,13 +307,13 @@ def packages_csv(sim: Simulation) -> str:
     state = package_states(sim)
 
     def when(x: float) -> str:
-        return f"{x:.3f}" if x <= H else ""  # NaN too
+        return f"{x:.{TIME_DECIMALS}f}" if x <= H else ""  # NaN too
 
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(PACKAGE_HEADER)
     for p in np.flatnonzero(st.t < H):  # the run spawns these (one per package)
-        w.writerow([int(p), f"{st.t[p]:.3f}", ids[st.origin[p]], int(st.origin_gate[p]),
+        w.writerow([int(p), when(st.t[p]), ids[st.origin[p]], int(st.origin_gate[p]),
                     ids[st.destination[p]], int(st.destination_gate[p]),
                     when(sim.assigned[p]), when(sim.pickup[p]), when(sim.delivered[p]),
                     "" if drone[p] < 0 else int(drone[p]), state[p]])
