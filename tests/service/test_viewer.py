@@ -306,7 +306,7 @@ def test_fleet_replay_moves_drones_with_the_slider(open_page, server, size):
 
 def _wait_status(page, kind: str, timeout: int = 30_000) -> str:
     page.wait_for_function(f"document.querySelector('#status').dataset.kind === '{kind}'"
-                           " && !document.querySelector('#run').disabled", timeout=timeout)
+                           " && !document.querySelector('#run').ariaDisabled", timeout=timeout)
     return page.inner_text("#status")
 
 
@@ -538,17 +538,22 @@ def server_has_no_jobs() -> bool:
     return False
 
 
-def _job_routes(p, job: dict) -> None:
-    """POST /jobs/fleet answers job "job-1"; GET /jobs/job-1 answers ``job`` as it is at
-    each poll (state "unreachable": no answer at all), so a test sets what the server
-    says while the page follows it."""
-    p.route("**/jobs/fleet", lambda r: r.fulfill(status=202, json={"id": "job-1"}))
+def _job_routes(p, job: dict, kind: str = "fleet", posts: list | None = None) -> None:
+    """POST /jobs/{kind} answers job "job-1" (each request appended to ``posts``); GET
+    /jobs/job-1 answers ``job`` as it is at each poll (state "unreachable": no answer at
+    all), so a test sets what the server says while the page follows it."""
+    def post(r):
+        if posts is not None:
+            posts.append(r.request.post_data_json)
+        r.fulfill(status=202, json={"id": "job-1"})
+
+    p.route(f"**/jobs/{kind}", post)
 
     def poll(r):
         if job["state"] == "unreachable":
             r.abort()
         else:
-            r.fulfill(json={"id": "job-1", "kind": "fleet", "result": None, "error": None, **job})
+            r.fulfill(json={"id": "job-1", "kind": kind, "result": None, "error": None, **job})
 
     p.route("**/jobs/job-1", poll)
 
@@ -589,7 +594,7 @@ def test_fleet_job_shows_it_runs_and_survives_a_reload(open_page, server):
     assert p.evaluate("document.querySelector('#progress').value") == pytest.approx(0.4)
     job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
-                        " && !document.querySelector('#start').disabled", timeout=15_000)
+                        " && !document.querySelector('#start').ariaDisabled", timeout=15_000)
     assert p.inner_text("#job-status") == "The run is done and stored."
     p.reload()  # the job is over: nothing to follow after another reload
     p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
@@ -609,7 +614,7 @@ def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):
     assert p.is_disabled("#start")
     job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
-                        " && !document.querySelector('#start').disabled", timeout=15_000)
+                        " && !document.querySelector('#start').ariaDisabled", timeout=15_000)
 
 
 @contextlib.contextmanager
@@ -817,7 +822,7 @@ def test_day_page_flies_a_day_as_a_job(open_page, api):
     p.fill("#token", TOKEN)
     p.click("#start")
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
-                        " && !document.querySelector('#start').disabled", timeout=120_000)
+                        " && !document.querySelector('#start').ariaDisabled", timeout=120_000)
     assert p.inner_text("#job-status") == "The day is flown and stored."
     p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{date}:')")
     report = api.get(f"/days/{date}").json()["report"]
@@ -862,3 +867,70 @@ def test_planner_focuses_the_field_the_server_refuses(open_page, field, value, s
     p.click("#run")
     assert said in _wait_status(p, "error")
     assert p.evaluate("document.activeElement.id") == field
+
+
+@pytest.mark.parametrize("page", ["planner", "world", "day", "fleet"])
+def test_a_pressed_button_keeps_the_focus(open_page, server, page):
+    """Plan, Fly it and Start run were disabled while their request ran: a disabled
+    button loses the focus, which dropped to the page's body, so a keyboard user's next
+    Tab started again from the top of the page. The button keeps the focus now (it is
+    aria-disabled while busy and refuses a second press), during the request and after
+    its answer."""
+    if page in ("day", "fleet") and server_has_no_jobs():
+        pytest.skip("skyroute.jobs is not in this tree: no jobs")
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    sent, held = [], []
+    if page in ("planner", "world"):
+        pg = open_page(f"/{page}.html", "desktop")
+        p = pg.page
+        if page == "planner":
+            _open_map(pg, "den312d")
+            _type_cells(p, (50, 76), (60, 13))
+        else:
+            _load_city(pg)
+            for key, value in (("s0", 172), ("s1", -271), ("g0", -172), ("g1", 270)):
+                p.fill(f"#{key}", str(value))
+
+        def hold_first(r):  # the first plan waits until the test lets it go
+            sent.append(r.request.post_data_json)
+            if len(sent) == 1:
+                held.append(r)
+            else:
+                r.continue_()
+
+        p.route("**/plan", hold_first)
+        button = "run"
+    else:
+        job = {"state": "running", "progress": 0.0}
+        pg = open_page(f"/day.html#date={DAY}" if page == "day" else f"/fleet.html#run={server[1]}",
+                       "desktop")
+        p = pg.page
+        _job_routes(p, job, "deliver" if page == "day" else "fleet", posts=sent)
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        p.fill("#token", TOKEN)
+        if page == "day":
+            p.fill("#job-date", DAY)
+        button = "start"
+    p.focus(f"#{button}")
+    p.keyboard.press("Enter")
+    if page in ("planner", "world"):
+        p.wait_for_function("document.querySelector('#status').dataset.kind === 'busy'")
+    else:
+        p.wait_for_function("document.querySelector('#job-status').textContent"
+                            ".startsWith('Job running')")
+    assert p.evaluate("document.activeElement.id") == button  # while busy
+    assert p.get_attribute(f"#{button}", "aria-disabled") == "true"
+    p.keyboard.press("Enter")  # a second press while busy sends nothing
+    p.wait_for_timeout(300)
+    assert len(sent) == 1, sent
+    if page in ("planner", "world"):
+        held[0].continue_()
+        _wait_status(p, "ok")
+    else:
+        job.update(state="done", progress=1.0,
+                   result={"from": DAY, "to": DAY} if page == "day" else {"fleet_run": server[1]})
+        p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
+                            " && !document.querySelector('#start').ariaDisabled", timeout=15_000)
+    assert p.evaluate("document.activeElement.id") == button  # after the answer
+    assert not pg.errors, pg.errors

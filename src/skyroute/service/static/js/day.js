@@ -7,7 +7,7 @@
 import { ApiError, bindToken, choices, explain, focusFault, getJSON, postJSON } from "./api.js";
 import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
-import { fmt, h, pounds, say } from "./ui.js";
+import { fmt, h, isBusy, pounds, say, setBusy } from "./ui.js";
 import { MapView, bbox, dot, grow, label, localProjection } from "./view.js";
 
 const $ = (id) => document.getElementById(id);
@@ -92,7 +92,7 @@ async function start() {
   select.addEventListener("change", () => load(select.value));
   const job = jobs.remembered(); // a day flown before a reload: followed after the list
   if (job) {
-    $("start").disabled = true;
+    setBusy($("start"), true);
     say(jobStatus, "Following the day being flown since before this page was loaded…", "busy");
   }
   const wanted = new URLSearchParams(location.hash.slice(1)).get("date");
@@ -131,13 +131,14 @@ bindToken($("token"));
 
 $("job").addEventListener("submit", async (ev) => {
   ev.preventDefault();
+  if (isBusy($("start"))) return; // a day is being flown (Enter in a field submits too)
   const date = $("job-date").value;
   if (!date) {
     say(jobStatus, "Give the date to fly first.", "error");
     $("job-date").focus();
     return;
   }
-  $("start").disabled = true;
+  setBusy($("start"), true);
   $("progress").value = 0;
   say(jobStatus, `Submitting ${date}…`, "busy");
   let id;
@@ -146,7 +147,7 @@ $("job").addEventListener("submit", async (ev) => {
   } catch (err) {
     say(jobStatus, explain(err, `Flying ${date}`), "error");
     focusFault(err, { date: "job-date", method: "method" });
-    $("start").disabled = false;
+    setBusy($("start"), false);
     return;
   }
   await jobs.start(id);
