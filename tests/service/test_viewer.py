@@ -30,6 +30,7 @@ sync_api = pytest.importorskip("playwright.sync_api",
 
 SHOTS = ROOT / "artefacts" / "screenshots"
 VIEWPORTS = {"desktop": {"width": 1280, "height": 800}, "phone": {"width": 360, "height": 740}}
+SIZES = {**VIEWPORTS, "phone-640": {"width": 360, "height": 640}}  # (Page's other sizes)
 FLEET_SEED = 1
 
 
@@ -96,10 +97,12 @@ class Page:
     """A page in a fresh context at one viewport, with every console error and uncaught
     exception collected."""
 
-    def __init__(self, browser, url: str, size: str):
+    def __init__(self, browser, url: str, size: str, init_script: str | None = None):
         self.size = size
-        self.context = browser.new_context(viewport=VIEWPORTS[size], accept_downloads=True)
+        self.context = browser.new_context(viewport=SIZES[size], accept_downloads=True)
         self.page = self.context.new_page()
+        if init_script:
+            self.page.add_init_script(init_script)
         self.errors: list[str] = []
         self.closed = False
         self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
@@ -126,8 +129,8 @@ class Page:
 def open_page(browser, server):
     pages = []
 
-    def make(path: str, size: str) -> Page:
-        pages.append(Page(browser, server[0] + path, size))
+    def make(path: str, size: str, init_script: str | None = None) -> Page:
+        pages.append(Page(browser, server[0] + path, size, init_script))
         return pages[-1]
 
     yield make
@@ -934,3 +937,112 @@ def test_a_pressed_button_keeps_the_focus(open_page, server, page):
                             " && !document.querySelector('#start').ariaDisabled", timeout=15_000)
     assert p.evaluate("document.activeElement.id") == button  # after the answer
     assert not pg.errors, pg.errors
+
+
+# Records what the map canvas draws, in CSS pixels: the bounding box of each top-level
+# save()..restore() block with its texts (the north arrow is the block saying "N", the
+# scale bar the one saying "... m"), and each small mark drawn outside such blocks (a
+# filled or stroked path, or a filled rectangle, at most 24 px across: customer dots and
+# rings, shops, home, the drone). Each render starts with a clearRect of the whole canvas.
+CANVAS_LOG = """
+(() => {
+  const P = CanvasRenderingContext2D.prototype;
+  const log = { blocks: [], marks: [] };
+  window.canvasLog = log;
+  let depth = 0, block = null, path = null;
+  const mine = (ctx) => ctx.canvas.id === "map";
+  const at = (ctx, x, y) => {
+    const m = ctx.getTransform(), d = window.devicePixelRatio || 1;
+    return [(m.a * x + m.c * y + m.e) / d, (m.b * x + m.d * y + m.f) / d];
+  };
+  const grow = (box, [x, y]) => {
+    box[0] = Math.min(box[0], x); box[1] = Math.min(box[1], y);
+    box[2] = Math.max(box[2], x); box[3] = Math.max(box[3], y);
+  };
+  const empty = () => [Infinity, Infinity, -Infinity, -Infinity];
+  const touch = (ctx, pts) => {
+    for (const p of pts) {
+      const q = at(ctx, p[0], p[1]);
+      if (block) grow(block.box, q);
+      else if (path) grow(path, q);
+    }
+  };
+  const small = (b) => b[2] - b[0] <= 24 && b[3] - b[1] <= 24 && b[0] <= b[2];
+  const wrap = (name, before) => {
+    const f = P[name];
+    P[name] = function (...a) { if (mine(this)) before(this, ...a); return f.apply(this, a); };
+  };
+  wrap("clearRect", (ctx, x, y, w, h) => {
+    if (x === 0 && y === 0 && w * (window.devicePixelRatio || 1) >= ctx.canvas.width - 1) {
+      log.blocks = []; log.marks = [];
+    }
+  });
+  wrap("save", () => { if (depth++ === 0) block = { box: empty(), texts: [] }; });
+  wrap("restore", () => { if (--depth === 0 && block) { log.blocks.push(block); block = null; } });
+  wrap("beginPath", () => { path = empty(); });
+  wrap("moveTo", (ctx, x, y) => touch(ctx, [[x, y]]));
+  wrap("lineTo", (ctx, x, y) => touch(ctx, [[x, y]]));
+  wrap("rect", (ctx, x, y, w, h) => touch(ctx, [[x, y], [x + w, y + h]]));
+  wrap("arc", (ctx, x, y, r) => touch(ctx, [[x - r, y - r], [x + r, y + r]]));
+  const done = (ctx) => { if (!block && path && small(path)) log.marks.push(path.slice()); };
+  wrap("fill", done);
+  wrap("stroke", done);
+  wrap("fillRect", (ctx, x, y, w, h) => {
+    const b = empty();
+    grow(b, at(ctx, x, y)); grow(b, at(ctx, x + w, y + h));
+    if (block) { grow(block.box, [b[0], b[1]]); grow(block.box, [b[2], b[3]]); }
+    else if (small(b)) log.marks.push(b);
+  });
+  wrap("fillText", (ctx, text, x, y) => {
+    if (!block) return;
+    const w = ctx.measureText(text).width;
+    const x0 = ctx.textAlign === "right" || ctx.textAlign === "end" ? x - w
+      : ctx.textAlign === "center" ? x - w / 2 : x;
+    grow(block.box, at(ctx, x0, y - 12)); grow(block.box, at(ctx, x0 + w, y + 3));
+    block.texts.push(text);
+  });
+})();
+"""
+
+# The key's blocks (north arrow, scale bar) that overlap a mark, over the day's flight
+# at every tenth move (the drone moves under the corners as it flies)
+OVERLAPS = """(moves) => {
+  const hit = (a, b) => a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
+  const slider = document.querySelector('#time');
+  const out = [];
+  let marks = 0;
+  for (let k = 0; k <= moves; k += 10) {
+    slider.value = k;
+    slider.dispatchEvent(new Event('input'));
+    const log = window.canvasLog;
+    marks = Math.max(marks, log.marks.length);
+    const key = log.blocks.filter(b => b.texts.some(t => t === 'N' || / k?m$/.test(t)));
+    if (key.length !== 2) return { error: `move ${k}: key blocks ${JSON.stringify(log.blocks)}` };
+    for (const b of key) for (const m of log.marks) {
+      if (hit(b.box, m)) out.push({ move: k, key: b.texts.join(' '), box: b.box, mark: m });
+    }
+  }
+  return { overlaps: out, marks };
+}"""
+
+
+def test_map_key_covers_no_marker_on_a_phone(open_page, api):
+    """At 360 px the north arrow (drawn in the map's top right corner) covered a
+    customer of the README's day, and the scale bar (bottom left) the confinement
+    area's corner: they sit in a strip under the plotted area now, so no customer, shop,
+    home or drone is ever under them."""
+    detail = api.get(f"/days/{DAY}").json()
+    site = api.get("/site.geojson").json()["features"]
+    places = {tuple(o["lonlat"]) for o in detail["orders"] if o["lonlat"]}
+    shops = [f for f in site if f["properties"].get("kind") == "shop"]
+    moves = detail["report"]["moves"]
+    pg = open_page(f"/day.html#date={DAY}", "phone-640", init_script=CANVAS_LOG)
+    p = pg.page
+    p.wait_for_function("document.querySelector('#time').max > 0")
+    got = p.evaluate(OVERLAPS, moves)
+    assert "error" not in got, got
+    # every customer place (a dot, a ring where partly served), shop, home and the drone
+    assert got["marks"] >= len(places) + len(shops) + 2, got["marks"]
+    assert got["overlaps"] == [], got["overlaps"][:5]
+    set_slider(p, "#time", moves // 3)
+    pg.done("day-key")
