@@ -1046,3 +1046,58 @@ def test_map_key_covers_no_marker_on_a_phone(open_page, api):
     assert got["overlaps"] == [], got["overlaps"][:5]
     set_slider(p, "#time", moves // 3)
     pg.done("day-key")
+
+
+def _store_empty_day(db: str, date: str) -> None:
+    """A day stored as a mistyped date is: a run without orders or moves."""
+    import datetime as dt
+
+    from skyroute.delivery.store import connect, write_day
+
+    eng = connect(db)
+    now = dt.datetime(2024, 1, 1, 12)
+    write_day(eng, dt.date.fromisoformat(date), {
+        "started": now, "finished": now, "moves": 0, "orders_placed": 0,
+        "orders_delivered": 0, "orders_invalid": 0, "money_delivered": 0,
+        "money_placed": 0, "settings": {}}, [], [])
+    eng.dispose()
+
+
+@pytest.mark.parametrize("size", ["desktop", "phone-640"])
+def test_day_page_deletes_a_day_without_a_flight(open_page, api, server, size):
+    """An empty day stored by a mistyped date stayed in the day list for good: the page
+    had no way to remove it (nor the API). It is deleted after a confirmation now; a
+    flown day offers no delete. The focus goes to the day list, which shows the
+    deleted day's neighbour."""
+    mistyped = "2024-03-05" if size == "desktop" else "2024-03-06"
+    _store_empty_day(server[2], mistyped)
+    pg = open_page(f"/day.html#date={DAY}", size)
+    p = pg.page
+    p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{DAY}:')")
+    assert not p.is_visible("#delete")  # a flown day is kept
+    p.select_option("#date", mistyped)
+    p.wait_for_function("document.querySelector('#status').textContent"
+                        f".startsWith('{mistyped}:')")
+    assert p.is_visible("#delete")
+    dialogs: list[str] = []
+    p.once("dialog", lambda d: (dialogs.append(d.message), d.dismiss()))
+    p.focus("#delete")
+    p.keyboard.press("Enter")
+    p.wait_for_function("document.activeElement.id === 'delete'")
+    assert len(dialogs) == 1 and mistyped in dialogs[0], dialogs
+    assert mistyped in [d["date"] for d in api.get("/days").json()]  # not confirmed: kept
+    p.fill("#token", TOKEN)
+    p.once("dialog", lambda d: (dialogs.append(d.message), d.accept()))
+    p.focus("#delete")
+    p.keyboard.press("Enter")
+    p.wait_for_function("document.querySelector('#status').textContent"
+                        f".startsWith('Deleted {mistyped}.')")
+    assert len(dialogs) == 2
+    days = [d["date"] for d in api.get("/days").json()]
+    assert mistyped not in days
+    options = p.locator("#date option").evaluate_all("o => o.map(x => x.value)")
+    assert options == days
+    assert p.evaluate("document.activeElement.id") == "date"
+    assert p.input_value("#date") == days[-1]  # its neighbour (the last day before it)
+    assert p.evaluate("location.hash") == f"#date={days[-1]}"
+    pg.done("day-deleted")
