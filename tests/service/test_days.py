@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from tests.service.conftest import DAY, EXAMPLE, make_client
+from tests.service.conftest import AUTH, DAY, EXAMPLE, make_client
 from tests.service.test_app import assert_problem
 
 
@@ -169,3 +169,95 @@ def test_a_broken_site_is_503(tmp_path, lunch):
     (tmp_path / "website").mkdir()
     with make_client(db_url=lunch[0], data_dir=tmp_path) as c:
         assert_problem(c.get("/site.geojson"), 503, words="menus.json")
+
+
+
+# -- DELETE /days/{date}: a day without a flight (a mistyped date) ----------------------
+
+@pytest.fixture
+def copy_client(tmp_path, lunch):
+    """(client, store URL): the app over a copy of the lunch store, with a long
+    fresh_seconds (a flight path read is served from the cache meanwhile)."""
+    import shutil
+
+    db = f"sqlite:///{shutil.copy(lunch[0].removeprefix('sqlite:///'), tmp_path / 'c.db')}"
+    with make_client(db_url=db, data_dir=EXAMPLE, fresh_seconds=3600) as c:
+        yield c, db
+
+
+def _rows(db: str, date: str) -> dict[str, list]:
+    """The day's rows of each delivery table, read with plain SQL."""
+    import sqlalchemy as sa
+
+    eng = sa.create_engine(db)
+    try:
+        with eng.connect() as conn:
+            return {t: sorted(tuple(r) for r in conn.execute(
+                sa.text(f"SELECT * FROM {t} WHERE delivery_date = :d"), {"d": date}))
+                for t in ("runs", "deliveries", "flightpath", "orders")}
+    finally:
+        eng.dispose()
+
+
+def test_delete_removes_a_day_without_a_flight(copy_client):
+    """A day stored by a mistyped date (no orders, no flight) could not be removed: no
+    DELETE route (405). It is deleted now, the cached flight path with it."""
+    c, db = copy_client
+    empty = "2024-02-01"
+    assert c.get(f"/days/{empty}/flightpath.geojson").status_code == 200  # cached
+    assert_problem(c.delete(f"/days/{empty}"), 401, words="Bearer")
+    assert_problem(c.delete(f"/days/{empty}", headers={"Authorization": "Bearer wrong"}),
+                   403, words="token")
+    assert _rows(db, empty)["runs"]  # still stored
+    r = c.delete(f"/days/{empty}", headers=AUTH)
+    assert r.status_code == 204 and r.content == b""
+    assert _rows(db, empty) == {"runs": [], "deliveries": [], "flightpath": [], "orders": []}
+    assert [d["date"] for d in c.get("/days").json()] == [DAY]
+    assert_problem(c.get(f"/days/{empty}"), 404, words=f"{empty} is not stored")
+    assert_problem(c.get(f"/days/{empty}/flightpath.geojson"), 404,
+                   words=f"{empty} is not stored")
+    assert_problem(c.delete(f"/days/{empty}", headers=AUTH), 404,
+                   words=f"day {empty} is not stored")
+
+
+def test_delete_keeps_a_flown_day(copy_client):
+    """A day with a flight is refused (409) and left as it was: its flight and
+    deliveries are what was flown; flying the day again replaces them."""
+    c, db = copy_client
+    before = _rows(db, DAY)
+    assert before["flightpath"] and before["deliveries"]
+    doc = assert_problem(c.delete(f"/days/{DAY}", headers=AUTH), 409, words="has a flight")
+    assert doc["type"].endswith("day-flown")
+    assert f"{len(before['flightpath'])} moves" in doc["detail"]
+    assert f"{len(before['deliveries'])} orders delivered" in doc["detail"]
+    assert _rows(db, DAY) == before
+
+
+def test_delete_keeps_the_days_orders(copy_client):
+    """A day whose orders could not be flown (a run of no moves) is deleted; its orders
+    are input (``db import``) and stay."""
+    import datetime as dt
+
+    from skyroute.delivery.store import connect, write_day
+
+    c, db = copy_client
+    date = "2024-01-01"  # orders imported with the lunch day, not flown
+    orders = _rows(db, date)["orders"]
+    assert orders and not _rows(db, date)["runs"]
+    eng = connect(db)
+    now = dt.datetime(2024, 1, 1, 12)
+    write_day(eng, dt.date(2024, 1, 1), {
+        "started": now, "finished": now, "moves": 0, "orders_placed": len(orders),
+        "orders_delivered": 0, "orders_invalid": 0, "money_delivered": 0,
+        "money_placed": 100, "settings": {}}, [], [])
+    eng.dispose()
+    assert date in [d["date"] for d in c.get("/days").json()]
+    assert c.delete(f"/days/{date}", headers=AUTH).status_code == 204
+    after = _rows(db, date)
+    assert after["runs"] == [] and after["orders"] == orders
+    assert len(c.get("/orders", params={"date": date}).json()) == len(orders)
+
+
+@pytest.mark.parametrize("date", ["2024-13-01", "yesterday", "1704240000"])
+def test_delete_a_bad_date_is_422(copy_client, date):
+    assert_problem(copy_client[0].delete(f"/days/{date}", headers=AUTH), 422, "date")

@@ -30,6 +30,7 @@ sync_api = pytest.importorskip("playwright.sync_api",
 
 SHOTS = ROOT / "artefacts" / "screenshots"
 VIEWPORTS = {"desktop": {"width": 1280, "height": 800}, "phone": {"width": 360, "height": 740}}
+SIZES = {**VIEWPORTS, "phone-640": {"width": 360, "height": 640}}  # (Page's other sizes)
 FLEET_SEED = 1
 
 
@@ -96,10 +97,12 @@ class Page:
     """A page in a fresh context at one viewport, with every console error and uncaught
     exception collected."""
 
-    def __init__(self, browser, url: str, size: str):
+    def __init__(self, browser, url: str, size: str, init_script: str | None = None):
         self.size = size
-        self.context = browser.new_context(viewport=VIEWPORTS[size], accept_downloads=True)
+        self.context = browser.new_context(viewport=SIZES[size], accept_downloads=True)
         self.page = self.context.new_page()
+        if init_script:
+            self.page.add_init_script(init_script)
         self.errors: list[str] = []
         self.closed = False
         self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
@@ -126,8 +129,8 @@ class Page:
 def open_page(browser, server):
     pages = []
 
-    def make(path: str, size: str) -> Page:
-        pages.append(Page(browser, server[0] + path, size))
+    def make(path: str, size: str, init_script: str | None = None) -> Page:
+        pages.append(Page(browser, server[0] + path, size, init_script))
         return pages[-1]
 
     yield make
@@ -306,7 +309,7 @@ def test_fleet_replay_moves_drones_with_the_slider(open_page, server, size):
 
 def _wait_status(page, kind: str, timeout: int = 30_000) -> str:
     page.wait_for_function(f"document.querySelector('#status').dataset.kind === '{kind}'"
-                           " && !document.querySelector('#run').disabled", timeout=timeout)
+                           " && !document.querySelector('#run').ariaDisabled", timeout=timeout)
     return page.inner_text("#status")
 
 
@@ -538,17 +541,22 @@ def server_has_no_jobs() -> bool:
     return False
 
 
-def _job_routes(p, job: dict) -> None:
-    """POST /jobs/fleet answers job "job-1"; GET /jobs/job-1 answers ``job`` as it is at
-    each poll (state "unreachable": no answer at all), so a test sets what the server
-    says while the page follows it."""
-    p.route("**/jobs/fleet", lambda r: r.fulfill(status=202, json={"id": "job-1"}))
+def _job_routes(p, job: dict, kind: str = "fleet", posts: list | None = None) -> None:
+    """POST /jobs/{kind} answers job "job-1" (each request appended to ``posts``); GET
+    /jobs/job-1 answers ``job`` as it is at each poll (state "unreachable": no answer at
+    all), so a test sets what the server says while the page follows it."""
+    def post(r):
+        if posts is not None:
+            posts.append(r.request.post_data_json)
+        r.fulfill(status=202, json={"id": "job-1"})
+
+    p.route(f"**/jobs/{kind}", post)
 
     def poll(r):
         if job["state"] == "unreachable":
             r.abort()
         else:
-            r.fulfill(json={"id": "job-1", "kind": "fleet", "result": None, "error": None, **job})
+            r.fulfill(json={"id": "job-1", "kind": kind, "result": None, "error": None, **job})
 
     p.route("**/jobs/job-1", poll)
 
@@ -589,7 +597,7 @@ def test_fleet_job_shows_it_runs_and_survives_a_reload(open_page, server):
     assert p.evaluate("document.querySelector('#progress').value") == pytest.approx(0.4)
     job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
-                        " && !document.querySelector('#start').disabled", timeout=15_000)
+                        " && !document.querySelector('#start').ariaDisabled", timeout=15_000)
     assert p.inner_text("#job-status") == "The run is done and stored."
     p.reload()  # the job is over: nothing to follow after another reload
     p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
@@ -609,7 +617,7 @@ def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):
     assert p.is_disabled("#start")
     job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
-                        " && !document.querySelector('#start').disabled", timeout=15_000)
+                        " && !document.querySelector('#start').ariaDisabled", timeout=15_000)
 
 
 @contextlib.contextmanager
@@ -817,7 +825,7 @@ def test_day_page_flies_a_day_as_a_job(open_page, api):
     p.fill("#token", TOKEN)
     p.click("#start")
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
-                        " && !document.querySelector('#start').disabled", timeout=120_000)
+                        " && !document.querySelector('#start').ariaDisabled", timeout=120_000)
     assert p.inner_text("#job-status") == "The day is flown and stored."
     p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{date}:')")
     report = api.get(f"/days/{date}").json()["report"]
@@ -862,3 +870,234 @@ def test_planner_focuses_the_field_the_server_refuses(open_page, field, value, s
     p.click("#run")
     assert said in _wait_status(p, "error")
     assert p.evaluate("document.activeElement.id") == field
+
+
+@pytest.mark.parametrize("page", ["planner", "world", "day", "fleet"])
+def test_a_pressed_button_keeps_the_focus(open_page, server, page):
+    """Plan, Fly it and Start run were disabled while their request ran: a disabled
+    button loses the focus, which dropped to the page's body, so a keyboard user's next
+    Tab started again from the top of the page. The button keeps the focus now (it is
+    aria-disabled while busy and refuses a second press), during the request and after
+    its answer."""
+    if page in ("day", "fleet") and server_has_no_jobs():
+        pytest.skip("skyroute.jobs is not in this tree: no jobs")
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    sent, held = [], []
+    if page in ("planner", "world"):
+        pg = open_page(f"/{page}.html", "desktop")
+        p = pg.page
+        if page == "planner":
+            _open_map(pg, "den312d")
+            _type_cells(p, (50, 76), (60, 13))
+        else:
+            _load_city(pg)
+            for key, value in (("s0", 172), ("s1", -271), ("g0", -172), ("g1", 270)):
+                p.fill(f"#{key}", str(value))
+
+        def hold_first(r):  # the first plan waits until the test lets it go
+            sent.append(r.request.post_data_json)
+            if len(sent) == 1:
+                held.append(r)
+            else:
+                r.continue_()
+
+        p.route("**/plan", hold_first)
+        button = "run"
+    else:
+        job = {"state": "running", "progress": 0.0}
+        pg = open_page(f"/day.html#date={DAY}" if page == "day" else f"/fleet.html#run={server[1]}",
+                       "desktop")
+        p = pg.page
+        _job_routes(p, job, "deliver" if page == "day" else "fleet", posts=sent)
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        p.fill("#token", TOKEN)
+        if page == "day":
+            p.fill("#job-date", DAY)
+        button = "start"
+    p.focus(f"#{button}")
+    p.keyboard.press("Enter")
+    if page in ("planner", "world"):
+        p.wait_for_function("document.querySelector('#status').dataset.kind === 'busy'")
+    else:
+        p.wait_for_function("document.querySelector('#job-status').textContent"
+                            ".startsWith('Job running')")
+    assert p.evaluate("document.activeElement.id") == button  # while busy
+    assert p.get_attribute(f"#{button}", "aria-disabled") == "true"
+    p.keyboard.press("Enter")  # a second press while busy sends nothing
+    p.wait_for_timeout(300)
+    assert len(sent) == 1, sent
+    if page in ("planner", "world"):
+        held[0].continue_()
+        _wait_status(p, "ok")
+    else:
+        job.update(state="done", progress=1.0,
+                   result={"from": DAY, "to": DAY} if page == "day" else {"fleet_run": server[1]})
+        p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
+                            " && !document.querySelector('#start').ariaDisabled", timeout=15_000)
+    assert p.evaluate("document.activeElement.id") == button  # after the answer
+    assert not pg.errors, pg.errors
+
+
+# Records what the map canvas draws, in CSS pixels: the bounding box of each top-level
+# save()..restore() block with its texts (the north arrow is the block saying "N", the
+# scale bar the one saying "... m"), and each small mark drawn outside such blocks (a
+# filled or stroked path, or a filled rectangle, at most 24 px across: customer dots and
+# rings, shops, home, the drone). Each render starts with a clearRect of the whole canvas.
+CANVAS_LOG = """
+(() => {
+  const P = CanvasRenderingContext2D.prototype;
+  const log = { blocks: [], marks: [] };
+  window.canvasLog = log;
+  let depth = 0, block = null, path = null;
+  const mine = (ctx) => ctx.canvas.id === "map";
+  const at = (ctx, x, y) => {
+    const m = ctx.getTransform(), d = window.devicePixelRatio || 1;
+    return [(m.a * x + m.c * y + m.e) / d, (m.b * x + m.d * y + m.f) / d];
+  };
+  const grow = (box, [x, y]) => {
+    box[0] = Math.min(box[0], x); box[1] = Math.min(box[1], y);
+    box[2] = Math.max(box[2], x); box[3] = Math.max(box[3], y);
+  };
+  const empty = () => [Infinity, Infinity, -Infinity, -Infinity];
+  const touch = (ctx, pts) => {
+    for (const p of pts) {
+      const q = at(ctx, p[0], p[1]);
+      if (block) grow(block.box, q);
+      else if (path) grow(path, q);
+    }
+  };
+  const small = (b) => b[2] - b[0] <= 24 && b[3] - b[1] <= 24 && b[0] <= b[2];
+  const wrap = (name, before) => {
+    const f = P[name];
+    P[name] = function (...a) { if (mine(this)) before(this, ...a); return f.apply(this, a); };
+  };
+  wrap("clearRect", (ctx, x, y, w, h) => {
+    if (x === 0 && y === 0 && w * (window.devicePixelRatio || 1) >= ctx.canvas.width - 1) {
+      log.blocks = []; log.marks = [];
+    }
+  });
+  wrap("save", () => { if (depth++ === 0) block = { box: empty(), texts: [] }; });
+  wrap("restore", () => { if (--depth === 0 && block) { log.blocks.push(block); block = null; } });
+  wrap("beginPath", () => { path = empty(); });
+  wrap("moveTo", (ctx, x, y) => touch(ctx, [[x, y]]));
+  wrap("lineTo", (ctx, x, y) => touch(ctx, [[x, y]]));
+  wrap("rect", (ctx, x, y, w, h) => touch(ctx, [[x, y], [x + w, y + h]]));
+  wrap("arc", (ctx, x, y, r) => touch(ctx, [[x - r, y - r], [x + r, y + r]]));
+  const done = (ctx) => { if (!block && path && small(path)) log.marks.push(path.slice()); };
+  wrap("fill", done);
+  wrap("stroke", done);
+  wrap("fillRect", (ctx, x, y, w, h) => {
+    const b = empty();
+    grow(b, at(ctx, x, y)); grow(b, at(ctx, x + w, y + h));
+    if (block) { grow(block.box, [b[0], b[1]]); grow(block.box, [b[2], b[3]]); }
+    else if (small(b)) log.marks.push(b);
+  });
+  wrap("fillText", (ctx, text, x, y) => {
+    if (!block) return;
+    const w = ctx.measureText(text).width;
+    const x0 = ctx.textAlign === "right" || ctx.textAlign === "end" ? x - w
+      : ctx.textAlign === "center" ? x - w / 2 : x;
+    grow(block.box, at(ctx, x0, y - 12)); grow(block.box, at(ctx, x0 + w, y + 3));
+    block.texts.push(text);
+  });
+})();
+"""
+
+# The key's blocks (north arrow, scale bar) that overlap a mark, over the day's flight
+# at every tenth move (the drone moves under the corners as it flies)
+OVERLAPS = """(moves) => {
+  const hit = (a, b) => a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
+  const slider = document.querySelector('#time');
+  const out = [];
+  let marks = 0;
+  for (let k = 0; k <= moves; k += 10) {
+    slider.value = k;
+    slider.dispatchEvent(new Event('input'));
+    const log = window.canvasLog;
+    marks = Math.max(marks, log.marks.length);
+    const key = log.blocks.filter(b => b.texts.some(t => t === 'N' || / k?m$/.test(t)));
+    if (key.length !== 2) return { error: `move ${k}: key blocks ${JSON.stringify(log.blocks)}` };
+    for (const b of key) for (const m of log.marks) {
+      if (hit(b.box, m)) out.push({ move: k, key: b.texts.join(' '), box: b.box, mark: m });
+    }
+  }
+  return { overlaps: out, marks };
+}"""
+
+
+def test_map_key_covers_no_marker_on_a_phone(open_page, api):
+    """At 360 px the north arrow (drawn in the map's top right corner) covered a
+    customer of the README's day, and the scale bar (bottom left) the confinement
+    area's corner: they sit in a strip under the plotted area now, so no customer, shop,
+    home or drone is ever under them."""
+    detail = api.get(f"/days/{DAY}").json()
+    site = api.get("/site.geojson").json()["features"]
+    places = {tuple(o["lonlat"]) for o in detail["orders"] if o["lonlat"]}
+    shops = [f for f in site if f["properties"].get("kind") == "shop"]
+    moves = detail["report"]["moves"]
+    pg = open_page(f"/day.html#date={DAY}", "phone-640", init_script=CANVAS_LOG)
+    p = pg.page
+    p.wait_for_function("document.querySelector('#time').max > 0")
+    got = p.evaluate(OVERLAPS, moves)
+    assert "error" not in got, got
+    # every customer place (a dot, a ring where partly served), shop, home and the drone
+    assert got["marks"] >= len(places) + len(shops) + 2, got["marks"]
+    assert got["overlaps"] == [], got["overlaps"][:5]
+    set_slider(p, "#time", moves // 3)
+    pg.done("day-key")
+
+
+def _store_empty_day(db: str, date: str) -> None:
+    """A day stored as a mistyped date is: a run without orders or moves."""
+    import datetime as dt
+
+    from skyroute.delivery.store import connect, write_day
+
+    eng = connect(db)
+    now = dt.datetime(2024, 1, 1, 12)
+    write_day(eng, dt.date.fromisoformat(date), {
+        "started": now, "finished": now, "moves": 0, "orders_placed": 0,
+        "orders_delivered": 0, "orders_invalid": 0, "money_delivered": 0,
+        "money_placed": 0, "settings": {}}, [], [])
+    eng.dispose()
+
+
+@pytest.mark.parametrize("size", ["desktop", "phone-640"])
+def test_day_page_deletes_a_day_without_a_flight(open_page, api, server, size):
+    """An empty day stored by a mistyped date stayed in the day list for good: the page
+    had no way to remove it (nor the API). It is deleted after a confirmation now; a
+    flown day offers no delete. The focus goes to the day list, which shows the
+    deleted day's neighbour."""
+    mistyped = "2024-03-05" if size == "desktop" else "2024-03-06"
+    _store_empty_day(server[2], mistyped)
+    pg = open_page(f"/day.html#date={DAY}", size)
+    p = pg.page
+    p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{DAY}:')")
+    assert not p.is_visible("#delete")  # a flown day is kept
+    p.select_option("#date", mistyped)
+    p.wait_for_function("document.querySelector('#status').textContent"
+                        f".startsWith('{mistyped}:')")
+    assert p.is_visible("#delete")
+    dialogs: list[str] = []
+    p.once("dialog", lambda d: (dialogs.append(d.message), d.dismiss()))
+    p.focus("#delete")
+    p.keyboard.press("Enter")
+    p.wait_for_function("document.activeElement.id === 'delete'")
+    assert len(dialogs) == 1 and mistyped in dialogs[0], dialogs
+    assert mistyped in [d["date"] for d in api.get("/days").json()]  # not confirmed: kept
+    p.fill("#token", TOKEN)
+    p.once("dialog", lambda d: (dialogs.append(d.message), d.accept()))
+    p.focus("#delete")
+    p.keyboard.press("Enter")
+    p.wait_for_function("document.querySelector('#status').textContent"
+                        f".startsWith('Deleted {mistyped}.')")
+    assert len(dialogs) == 2
+    days = [d["date"] for d in api.get("/days").json()]
+    assert mistyped not in days
+    options = p.locator("#date option").evaluate_all("o => o.map(x => x.value)")
+    assert options == days
+    assert p.evaluate("document.activeElement.id") == "date"
+    assert p.input_value("#date") == days[-1]  # its neighbour (the last day before it)
+    assert p.evaluate("location.hash") == f"#date={days[-1]}"
+    pg.done("day-deleted")

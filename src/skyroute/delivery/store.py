@@ -382,6 +382,31 @@ def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[d
             conn.execute(flightpath.insert(), batch)
 
 
+def delete_unflown_day(engine: sa.Engine, date: dt.date) -> dict | None:
+    """Delete a stored day whose drone did not fly (a mistyped date, a day without
+    orders, or one whose orders could not be flown): its run, in one transaction that
+    holds the day as :func:`write_day` does. A day with a flight (moves or deliveries)
+    is kept: its flight and deliveries are what was flown (fly the day again to replace
+    them). The day's orders are input, imported by ``db import``, and always stay.
+
+    Returns None for a day not stored, else ``{"moves", "delivered", "deleted"}`` as the
+    store held them (``deleted`` False for a day with a flight)."""
+    t_ = tables(engine)
+    flightpath, deliveries, runs = t_["flightpath"], t_["deliveries"], t_["runs"]
+    with writing(engine) as conn:
+        _lock_day(conn, date)
+        moves = conn.scalar(sa.select(runs.c.moves).where(runs.c.delivery_date == date))
+        if moves is None:
+            return None
+        delivered = conn.scalar(sa.select(sa.func.count()).select_from(deliveries)
+                                .where(deliveries.c.delivery_date == date))
+        flown = moves > 0 or delivered > 0
+        if not flown:
+            for t in (flightpath, deliveries, runs):
+                conn.execute(t.delete().where(t.c.delivery_date == date))
+    return {"moves": moves, "delivered": delivered, "deleted": not flown}
+
+
 def _lock_day(conn: sa.Connection, date: dt.date) -> None:
     """On PostgreSQL, hold the day's advisory lock to the end of ``conn``'s transaction.
     Two runs of one day at once both deleted the day's rows as they were, and the later's

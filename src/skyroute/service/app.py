@@ -36,7 +36,7 @@ STATIC = Path(__file__).parent / "static"
 POST_ONLY = ("/plan", "/jobs/deliver", "/jobs/fleet")
 
 DESCRIPTION = """Plan paths on grids and worlds, read stored delivery days, run delivery
-and fleet jobs. Reads are open; writes (`POST`) need `Authorization: Bearer TOKEN`.
+and fleet jobs. Reads are open; writes (`POST`, `DELETE`) need `Authorization: Bearer TOKEN`.
 Every error is `application/problem+json` naming the field at fault."""
 
 

@@ -1,6 +1,6 @@
 """Stored delivery days: ``GET /days``, ``GET /days/{date}`` (report, deliveries and
-every order's fate) and ``GET /days/{date}/flightpath.geojson`` (the flight, as the
-``deliver`` command writes it)."""
+every order's fate), ``GET /days/{date}/flightpath.geojson`` (the flight, as the
+``deliver`` command writes it) and ``DELETE /days/{date}`` (a day without a flight)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,11 @@ import json
 import time
 from typing import Annotated
 
-from fastapi import APIRouter, Path, Request, Response
+from fastapi import APIRouter, Depends, Path, Request, Response
 from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, Field
 
+from skyroute.service.auth import require_token
 from skyroute.service.dates import IsoDate
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import EngineDep, Resources, ResourcesDep
@@ -134,6 +135,30 @@ def get_day(date: DayDate, eng: EngineDep,
         rows.append(row)
     rep["invalid"] = invalid if site is not None else None
     return {"date": date, "report": rep, "deliveries": delivered, "orders": rows}
+
+
+@router.delete("/days/{date}", status_code=204, response_class=Response,
+               dependencies=[Depends(require_token)],
+               responses=responses(401, 403, 404, 409, 422, 503),
+               summary="Delete a stored day without a flight")
+def delete_day(date: DayDate, res: ResourcesDep) -> Response:
+    """Delete a day the drone did not fly: a mistyped date, a day without orders, or one
+    whose orders could not be flown (its run; 204). A day with a flight is kept (409):
+    its flight and deliveries are what was flown, and flying the day again replaces
+    them. The day's orders stay in the store either way."""
+    from skyroute.delivery.store import delete_unflown_day
+
+    got = delete_unflown_day(res.engine(), date)
+    if got is None:
+        raise Problem(404, f"day {date} is not stored; GET /days lists the stored days",
+                      kind="unknown-date")
+    if not got["deleted"]:
+        raise Problem(409, f"day {date} has a flight ({got['moves']} moves, "
+                      f"{got['delivered']} orders delivered) and is kept: only a day "
+                      "without a flight is deleted; fly the day again to replace it",
+                      kind="day-flown")
+    res.cache.pop(f"flightpath:{date}", None)  # this process's copy of the day's file
+    return Response(status_code=204)
 
 
 @router.get("/days/{date}/flightpath.geojson", response_class=Response,

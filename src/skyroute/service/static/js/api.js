@@ -1,6 +1,7 @@
-// Talking to the skyroute service: JSON and text reads, authorised writes, the bearer
-// token (kept in this tab's sessionStorage, never in a cookie or the URL), and errors
-// (application/problem+json) turned into one sentence for the status line.
+// Talking to the skyroute service: JSON and text reads, authorised writes (POST and
+// DELETE), the bearer token (kept in this tab's sessionStorage, never in a cookie or the
+// URL), and errors (application/problem+json) turned into one sentence for the status
+// line.
 
 const TOKEN_KEY = "skyroute.token";
 
@@ -46,12 +47,20 @@ export async function getText(path) {
   return (await send(path, {})).text();
 }
 
+function authorised(headers) {
+  const token = getToken();
+  return token ? { ...headers, Authorization: `Bearer ${token}` } : headers;
+}
+
 /** POST a JSON body with the bearer token; the answer's JSON. */
 export async function postJSON(path, body) {
-  const headers = { "Content-Type": "application/json", Accept: "application/json" };
-  const token = getToken();
-  if (token) headers.Authorization = `Bearer ${token}`;
+  const headers = authorised({ "Content-Type": "application/json", Accept: "application/json" });
   return (await send(path, { method: "POST", headers, body: JSON.stringify(body) })).json();
+}
+
+/** DELETE ``path`` with the bearer token (the answer has no body). */
+export async function remove(path) {
+  await send(path, { method: "DELETE", headers: authorised({ Accept: "application/json" }) });
 }
 
 export function getToken() {

@@ -2,12 +2,13 @@
 // area, shops, customers), animated move by move, with the orders and the money so far.
 //
 // Reads GET /days, /site.geojson, /days/{date} and /days/{date}/flightpath.geojson; flies
-// a day with POST /jobs/deliver and follows GET /jobs/{id}.
+// a day with POST /jobs/deliver and follows GET /jobs/{id}; deletes a day without a
+// flight (a mistyped date) with DELETE /days/{date}.
 
-import { ApiError, bindToken, choices, explain, focusFault, getJSON, postJSON } from "./api.js";
+import { ApiError, bindToken, choices, explain, focusFault, getJSON, postJSON, remove } from "./api.js";
 import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
-import { fmt, h, pounds, say } from "./ui.js";
+import { fmt, h, isBusy, pounds, say, setBusy } from "./ui.js";
 import { MapView, bbox, dot, grow, label, localProjection } from "./view.js";
 
 const $ = (id) => document.getElementById(id);
@@ -75,6 +76,7 @@ async function listDays(wanted = null) {
   if (!days.length) {
     select.replaceChildren(h("option", {}, "no stored days"));
     select.disabled = true;
+    showNoDay();
     say(status, "The store holds no delivery day yet: fly one below (or with `skyroute deliver DATE " +
       "--data DIR --db URL`).", "info");
     return false;
@@ -92,7 +94,7 @@ async function start() {
   select.addEventListener("change", () => load(select.value));
   const job = jobs.remembered(); // a day flown before a reload: followed after the list
   if (job) {
-    $("start").disabled = true;
+    setBusy($("start"), true);
     say(jobStatus, "Following the day being flown since before this page was loaded…", "busy");
   }
   const wanted = new URLSearchParams(location.hash.slice(1)).get("date");
@@ -131,13 +133,14 @@ bindToken($("token"));
 
 $("job").addEventListener("submit", async (ev) => {
   ev.preventDefault();
+  if (isBusy($("start"))) return; // a day is being flown (Enter in a field submits too)
   const date = $("job-date").value;
   if (!date) {
     say(jobStatus, "Give the date to fly first.", "error");
     $("job-date").focus();
     return;
   }
-  $("start").disabled = true;
+  setBusy($("start"), true);
   $("progress").value = 0;
   say(jobStatus, `Submitting ${date}…`, "busy");
   let id;
@@ -146,7 +149,7 @@ $("job").addEventListener("submit", async (ev) => {
   } catch (err) {
     say(jobStatus, explain(err, `Flying ${date}`), "error");
     focusFault(err, { date: "job-date", method: "method" });
-    $("start").disabled = false;
+    setBusy($("start"), false);
     return;
   }
   await jobs.start(id);
@@ -198,6 +201,8 @@ async function load(date, note = "") {
 
   fillOrders();
   player.load(moves, 1);
+  // a day without a flight (a mistyped date, no orders to fly) may be deleted
+  $("delete-row").hidden = moves > 0 || deliveries.length > 0;
   if (moves) {
     say(status, `${note}${date}: ${moves} moves, ${detail.report.orders_delivered} of ${detail.report.orders_placed} ` +
       `orders delivered, ${fmt(detail.report.money_pct, 1)} % of the money. Press Play to fly it.`, note ? "info" : "ok");
@@ -209,6 +214,54 @@ async function load(date, note = "") {
   $("s-final").textContent = `Report: ${detail.report.orders_invalid} invalid orders, ` +
     `${detail.report.moves_left} moves of battery left at the end.`;
 }
+
+/** The page without a day (the store holds none): an empty map, table and numbers. */
+function showNoDay() {
+  day = null;
+  player.load(0, 1);
+  tbody.replaceChildren();
+  for (const id of ["s-moves", "s-orders", "s-money", "s-pct", "s-battery"]) $(id).textContent = "–";
+  $("s-final").textContent = "";
+  $("delete-row").hidden = true;
+  history.replaceState(null, "", location.pathname);
+  view.render();
+}
+
+// -- deleting a day without a flight (DELETE /days/{date}) ------------------------
+$("delete").addEventListener("click", async () => {
+  const button = $("delete");
+  if (isBusy(button) || !day) return;
+  const date = day.date;
+  if (!confirm(`Delete the stored day ${date} from the store? The drone did not fly it; ` +
+    "its orders, if any, stay.")) return;
+  const dates = [...select.options].map((o) => o.value);
+  const k = dates.indexOf(date);
+  const next = dates[k + 1] ?? dates[k - 1] ?? null; // shown next: its neighbour in the list
+  setBusy(button, true);
+  say(status, `Deleting ${date}…`, "busy");
+  let note = `Deleted ${date}. `;
+  try {
+    await remove(`/days/${encodeURIComponent(date)}`);
+  } catch (err) {
+    setBusy(button, false);
+    if (!(err instanceof ApiError && err.status === 404)) {
+      say(status, explain(err, `Deleting ${date}`), "error");
+      focusFault(err); // the Token field for a 401 or 403
+      return;
+    }
+    note = `${date} was no longer stored. `; // deleted meanwhile (another tab): the list is old
+  }
+  setBusy(button, false);
+  // the button goes with the day: the focus goes to the day list (or, with no day left,
+  // to the date to fly), not to the page's body
+  if (await listDays(next)) {
+    await load(select.value, note);
+    select.focus();
+  } else {
+    say(status, `${note}The store holds no delivery day now: fly one below.`, "ok");
+    $("job-date").focus();
+  }
+});
 
 function fillOrders() {
   const rank = { delivered: 0, not_delivered: 1, invalid: 2 };

@@ -9,7 +9,7 @@ import { ApiError, bindToken, choices, explain, focusFault, getJSON, getText, po
 import { EventFold, dronesAt, parseEvents, parseRoutes, parseTracks, trail } from "./fleetstate.js";
 import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
-import { PALETTE, clock, fmt, h, say } from "./ui.js";
+import { PALETTE, clock, fmt, h, isBusy, say, setBusy } from "./ui.js";
 import { MapView, bbox, dot, grow, label, localProjection } from "./view.js";
 
 const $ = (id) => document.getElementById(id);
@@ -282,11 +282,12 @@ const jobs = new JobFollower({
 
 $("job").addEventListener("submit", async (ev) => {
   ev.preventDefault();
+  if (isBusy($("start"))) return; // a run is under way (Enter in a field submits too)
   const body = {
     preset: $("preset").value, scheduler: $("scheduler").value,
     hours: Number($("hours").value), seed: Number($("seed").value),
   };
-  $("start").disabled = true;
+  setBusy($("start"), true);
   $("progress").value = 0;
   say(jobStatus, "Submitting the run…", "busy");
   let id;
@@ -295,7 +296,7 @@ $("job").addEventListener("submit", async (ev) => {
   } catch (err) {
     say(jobStatus, explain(err, "Starting the run"), "error");
     focusFault(err, { hours: "hours", seed: "seed", preset: "preset", scheduler: "scheduler" });
-    $("start").disabled = false;
+    setBusy($("start"), false);
     return;
   }
   await jobs.start(id);
@@ -312,7 +313,7 @@ async function start() {
   view.setBounds([0, 0, 1000, 600]);
   const job = jobs.remembered(); // a run started before a reload: followed after the list
   if (job) {
-    $("start").disabled = true;
+    setBusy($("start"), true);
     say(jobStatus, "Following the run started before this page was loaded…", "busy");
   }
   if (await listRuns()) await load(runSelect.value);

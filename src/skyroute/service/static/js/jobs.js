@@ -5,7 +5,7 @@
 // page and back) goes on following it; a server that does not answer is asked again.
 
 import { explain, getJSON } from "./api.js";
-import { clock, fmt, say } from "./ui.js";
+import { clock, fmt, say, setBusy } from "./ui.js";
 
 const POLL_MS = 500;
 export const RETRY_MS = 3000; // between polls while the server does not answer
@@ -15,7 +15,8 @@ const pause = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 export class JobFollower {
   /**
    * @param {object} parts  key (sessionStorage key of the job followed), bar (progress),
-   *   line (status element), button (the submit button, disabled while following),
+   *   line (status element), button (the submit button, busy while following: it
+   *   keeps the focus, see ``setBusy``),
    *   what ("the run": for the messages), done (the text when it is done),
    *   onDone(result) (awaited, after the line says ``done``).
    */
@@ -54,7 +55,7 @@ export class JobFollower {
     const { bar, line, button, what } = this;
     const took = () => (since ? ` (${clock((Date.now() - since) / 1000)} so far)` : "");
     const following = `Following ${what}`;
-    button.disabled = true;
+    setBusy(button, true);
     try {
       for (;;) {
         let job;
@@ -96,7 +97,7 @@ export class JobFollower {
       }
     } finally {
       if (!bar.hasAttribute("value")) bar.value = 0;
-      button.disabled = false;
+      setBusy(button, false);
     }
   }
 }

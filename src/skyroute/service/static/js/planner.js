@@ -4,7 +4,7 @@
 // Reads GET /maps and /maps/{name}; plans with POST /plan (one request per algorithm).
 
 import { bindToken, choices, explain, focusFault, getJSON, postJSON } from "./api.js";
-import { PALETTE, fmt, h, say } from "./ui.js";
+import { PALETTE, fmt, h, isBusy, say, setBusy } from "./ui.js";
 import { drawScaleBar } from "./view.js";
 
 const $ = (id) => document.getElementById(id);
@@ -44,7 +44,7 @@ async function loadMap(name) {
   }
   if (mine !== loading) return; // another map was chosen while this one was read
   round++; // a query on the old map still under way: its answers are dropped
-  $("run").disabled = false;
+  setBusy($("run"), false);
   const { width, height, rows } = doc;
   const passable = doc.passable || ".G";
   const free = new Uint8Array(width * height);
@@ -181,7 +181,7 @@ canvas.addEventListener("click", (ev) => {
 for (const id of ["sx", "sy", "gx", "gy"]) {
   $(id).addEventListener("input", () => {
     round++;
-    $("run").disabled = false;
+    setBusy($("run"), false);
     results = [];
     tbody.replaceChildren();
     draw();
@@ -191,6 +191,7 @@ for (const id of ["sx", "sy", "gx", "gy"]) {
 
 $("form").addEventListener("submit", (ev) => {
   ev.preventDefault();
+  if (isBusy($("run"))) return; // a query is under way (Enter in a field submits too)
   plan(); // says what it does (or what is missing) before its first wait
   // on a phone's one column the map and its status line are under the form: bring them up
   status.closest("figure").scrollIntoView({ block: "nearest" });
@@ -220,7 +221,7 @@ async function plan() {
   results = algorithms.map((algorithm, k) => ({ algorithm, colour: PALETTE[k % PALETTE.length], answer: null, error: null }));
   showResults();
   say(status, `Planning with ${algorithms.join(", ")}…`, "busy");
-  $("run").disabled = true;
+  setBusy($("run"), true);
   let failed = null;
   try {
     for (const r of results) {
@@ -238,7 +239,7 @@ async function plan() {
       draw();
     }
   } finally {
-    if (mine === round) $("run").disabled = false;
+    if (mine === round) setBusy($("run"), false);
   }
   if (mine !== round) return;
   if (failed) {

@@ -19,6 +19,20 @@ export function h(tag, props = {}, ...children) {
   return el;
 }
 
+/** Mark ``button`` busy (or not): it refuses its action but keeps the focus. A button
+ * made ``disabled`` while it has the focus drops the focus to the page's body, and a
+ * keyboard or screen reader user is thrown back to the top of the page; so a busy button
+ * is ``aria-disabled`` (read as "dimmed", styled as disabled) and the page's handler asks
+ * :func:`isBusy` before it acts. */
+export function setBusy(button, busy) {
+  if (busy) button.setAttribute("aria-disabled", "true");
+  else button.removeAttribute("aria-disabled");
+}
+
+export function isBusy(button) {
+  return button.getAttribute("aria-disabled") === "true";
+}
+
 /** Set the status line ``el`` (an aria-live region): kind info, ok, busy or error. */
 export function say(el, text, kind = "info") {
   el.dataset.kind = kind;

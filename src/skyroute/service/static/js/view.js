@@ -1,5 +1,6 @@
 // A map on a canvas without tiles: a plane in metres (x east, y north, north up) fitted
-// to the canvas, with a scale bar and a north arrow; and lon/lat to local metres.
+// to the canvas, with a scale bar and a north arrow in a key strip under it (never over
+// what is plotted); and lon/lat to local metres.
 
 const WGS84_A = 6378137.0;
 const WGS84_F = 1 / 298.257223563;
@@ -37,8 +38,16 @@ export function grow(b, share = 0.04, least = 1) {
   return [b[0] - m, b[1] - m, b[2] + m, b[3] + m];
 }
 
+const PAD = 14; // CSS pixels round the plotted region
+// The key strip under the plotted region: the scale bar on its left, the north arrow on
+// its right. Drawn over the plot's corners (as they were) they hid what lay there: on a
+// phone the arrow covered a customer of the README's day, the scale bar an airport's
+// runway.
+const KEY = 30;
+
 /** A canvas showing the plane region ``bounds`` (x east, y north) at the largest scale
- * that fits, redrawn by ``draw(ctx, view)`` on ``render()`` and whenever its width changes. */
+ * that fits above the key strip, redrawn by ``draw(ctx, view)`` on ``render()`` and
+ * whenever its width changes. */
 export class MapView {
   constructor(canvas, { draw, maxShare = 0.72, minHeight = 240, unit = "m", north = true } = {}) {
     this.canvas = canvas;
@@ -66,7 +75,7 @@ export class MapView {
     const w = this.canvas.clientWidth || 300;
     const ratio = (y1 - y0) / Math.max(x1 - x0, 1e-12);
     const most = Math.max(this.minHeight, window.innerHeight * this.maxShare);
-    const hpx = Math.round(Math.min(Math.max(w * ratio, this.minHeight), most));
+    const hpx = Math.round(Math.min(Math.max((w - 2 * PAD) * ratio + 2 * PAD + KEY, this.minHeight), most));
     const dpr = window.devicePixelRatio || 1;
     this.canvas.style.height = `${hpx}px`;
     this.canvas.width = Math.round(w * dpr);
@@ -74,10 +83,10 @@ export class MapView {
     this.width = w;
     this.height = hpx;
     this.dpr = dpr;
-    const pad = 14;
-    this.scale = Math.min((w - 2 * pad) / Math.max(x1 - x0, 1e-12), (hpx - 2 * pad) / Math.max(y1 - y0, 1e-12));
+    const high = hpx - KEY; // the plotted region's height, padding included
+    this.scale = Math.min((w - 2 * PAD) / Math.max(x1 - x0, 1e-12), (high - 2 * PAD) / Math.max(y1 - y0, 1e-12));
     this.ox = (w - this.scale * (x1 - x0)) / 2;
-    this.oy = (hpx - this.scale * (y1 - y0)) / 2;
+    this.oy = (high - this.scale * (y1 - y0)) / 2;
     this.render();
   }
 
@@ -104,8 +113,8 @@ export class MapView {
     ctx.fillStyle = "#fbfcfd";
     ctx.fillRect(0, 0, this.width, this.height);
     if (this.draw) this.draw(ctx, this);
-    drawScaleBar(ctx, this.scale, this.unit, 12, this.height - 14);
-    if (this.north) drawNorthArrow(ctx, this.width - 22, 14);
+    drawScaleBar(ctx, this.scale, this.unit, 12, this.height - 8);
+    if (this.north) drawNorthArrow(ctx, this.width - 14, this.height - KEY + 4);
   }
 
   /** Stroke or fill a ring or line of plane points. */
@@ -151,22 +160,22 @@ export function drawScaleBar(ctx, pxPerUnit, unit, x, y) {
   ctx.restore();
 }
 
-/** A north arrow centred at x, with its tip at y. */
+/** A north arrow of 20 px by 22 px, its right edge at x and its top at y: "N" and an
+ * arrow pointing up. */
 export function drawNorthArrow(ctx, x, y) {
   ctx.save();
-  ctx.fillStyle = "rgba(255,255,255,.85)";
-  ctx.fillRect(x - 12, y - 4, 24, 42);
   ctx.fillStyle = "#1d2433";
+  const ax = x - 5; // the arrow's middle
   ctx.beginPath();
-  ctx.moveTo(x, y);
-  ctx.lineTo(x + 7, y + 18);
-  ctx.lineTo(x, y + 13);
-  ctx.lineTo(x - 7, y + 18);
+  ctx.moveTo(ax, y);
+  ctx.lineTo(ax + 5, y + 20);
+  ctx.lineTo(ax, y + 16);
+  ctx.lineTo(ax - 5, y + 20);
   ctx.closePath();
   ctx.fill();
   ctx.font = "bold 12px system-ui, sans-serif";
-  ctx.textAlign = "center";
-  ctx.fillText("N", x, y + 32);
+  ctx.textAlign = "right";
+  ctx.fillText("N", ax - 7, y + 17);
   ctx.restore();
 }
 

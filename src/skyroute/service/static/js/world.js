@@ -6,7 +6,7 @@
 // file's lat0, lon0); GeoJSON zones in "lonlat" (points are lon, lat).
 
 import { bindToken, choices, explain, focusFault, postJSON } from "./api.js";
-import { download, fmt, h, say } from "./ui.js";
+import { download, fmt, h, isBusy, say, setBusy } from "./ui.js";
 import { MapView, bbox, grow, localProjection } from "./view.js";
 
 const $ = (id) => document.getElementById(id);
@@ -68,7 +68,7 @@ function detect(text) {
 
 function loadText(text, name) {
   round++; // a plan on the old world still under way: its answer is dropped
-  $("run").disabled = false;
+  setBusy($("run"), false);
   answer = null;
   clearResult();
   if (!text.trim()) {
@@ -265,7 +265,7 @@ $("map").addEventListener("click", (ev) => {
 for (const id of ["s0", "s1", "g0", "g1", "altitude", "safety"]) {
   $(id).addEventListener("input", () => {
     round++;
-    $("run").disabled = false;
+    setBusy($("run"), false);
     answer = null;
     clearResult();
     view.render();
@@ -289,6 +289,7 @@ $("algorithm").addEventListener("change", () => {
 });
 $("form").addEventListener("submit", (ev) => {
   ev.preventDefault();
+  if (isBusy($("run"))) return; // a plan is under way (Enter in a field submits too)
   plan(); // says what it does (or what is missing) before its first wait
   // on a phone's one column the map and its status line are under the form: bring them up
   status.closest("figure").scrollIntoView({ block: "nearest" });
@@ -317,7 +318,7 @@ async function plan() {
   answer = null; // what is shown is always the answer to the last request
   clearResult();
   view.render();
-  $("run").disabled = true;
+  setBusy($("run"), true);
   say(status, `Planning with ${body.algorithm}…`, "busy");
   try {
     const a = await postJSON("/plan", body);
@@ -337,7 +338,7 @@ async function plan() {
     focusFault(err, { safety: "safety", altitude: "altitude", resolution: "resolution", start: "s0",
       goal: "g0", algorithm: "algorithm", world_text: "text" });
   } finally {
-    if (mine === round) $("run").disabled = false;
+    if (mine === round) setBusy($("run"), false);
     view.render();
   }
 }
