@@ -107,3 +107,39 @@ def test_another_skyroute_on_the_cluster_is_refused(dask_executor, monkeypatch):
     assert str(err.value) == (f"address={address!r}: the scheduler has skyroute "
                               f"{real('skyroute')}, this machine 9.9; install the same "
                               "skyroute on the scheduler and every worker")
+
+
+@pytest.mark.parametrize("kind, workers", [("local", 2), ("local", 1), ("dask", 1)])
+def test_closing_cuts_off_another_threads_map_with_a_clear_error(kind, workers):
+    """A server shutting down closes its executor while a lane's map runs: that map ends
+    in ExecutorClosedError (not the pool's "cannot schedule new futures after shutdown"
+    RuntimeError, nor a Dask client error), and so does a map started afterwards (no new
+    pool is opened behind the close)."""
+    import threading
+
+    ex = open_executor(kind, workers=workers)
+    first = threading.Event()
+    raised: list[BaseException] = []
+
+    def lane():
+        try:
+            ex.map(time.sleep, [0.2] * 8, on_result=lambda i, r: first.set())
+        except BaseException as exc:  # what the runner's lane would see
+            raised.append(exc)
+
+    thread = threading.Thread(target=lane)
+    thread.start()
+    try:
+        assert first.wait(60), "no task ended"
+    finally:
+        ex.close()
+    thread.join(60)
+    assert not thread.is_alive()
+    assert [type(e).__name__ for e in raised] == ["ExecutorClosedError"], raised
+    assert isinstance(raised[0], SkyrouteError)
+    assert str(raised[0]) == (f"the {kind} executor was closed; the tasks not yet started "
+                              "were cancelled")
+    with pytest.raises(SkyrouteError, match=f"the {kind} executor was closed"):
+        ex.map(math.sqrt, ITEMS)
+    if kind == "local":
+        assert ex._pool is None

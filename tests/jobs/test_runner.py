@@ -134,6 +134,38 @@ def test_a_delivery_job_runs_while_a_long_fleet_job_holds_its_lane(tmp_path, mon
     settle()
 
 
+def test_a_job_cut_off_by_the_executors_close_fails_as_an_orphan(tmp_path, monkeypatch):
+    """The server shutting down closes the executor while a job's map runs in its lane:
+    the job ends failed with the orphans' message (not "RuntimeError: cannot schedule
+    new futures after shutdown"), and the job queued behind it fails so too rather than
+    opening a new pool."""
+    import threading
+
+    from skyroute.jobs import store
+
+    first = threading.Event()
+
+    def spread(engine, job_id, params, *, executor, progress):
+        executor.map(time.sleep, [0.2] * 8, on_result=lambda i, r: first.set())
+        return {"ran": True}
+
+    monkeypatch.setitem(runner.KINDS, "spread", runner.Kind(dict, spread, "fleet"))
+    engine = lunch_store(f"sqlite:///{tmp_path / 'closed.db'}", ())
+    ex = open_executor("local", workers=2)
+    try:
+        running = runner.submit(engine, "spread", {}, executor=ex)
+        queued = runner.submit(engine, "spread", {}, executor=ex)
+        assert first.wait(60), "no task ended"
+        assert store.get_job(engine, queued)["state"] == "queued"
+    finally:
+        ex.close()
+    for job_id in (running, queued):
+        job = runner.wait(engine, job_id, timeout=60)
+        assert (job["state"], job["error"], job["result"]) == \
+            ("failed", runner.ORPHANED, None), job
+    settle()
+
+
 def test_two_servers_on_one_store_fail_only_the_orphans_of_dead_ones(tmp_path, monkeypatch):
     """This process's job and a live server's job survive another server's start and
     this process's heartbeat; a silent server's job and one without an owner do not."""

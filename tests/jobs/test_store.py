@@ -1,7 +1,7 @@
-"""The jobs, fleet_runs, servers and fleet_run_files tables: migrations 0002 to 0004 (also
-over a 0001 store with its days, a 0002 store with its jobs and a 0003 store with its fleet
-runs, and back), a job's life, orphans, fleet runs
-with their files, on SQLite and PostgreSQL alike."""
+"""The jobs, fleet_runs, servers and fleet_run_files tables: migrations 0002 to 0005 (also
+over a 0001 store with its days, a 0002 store with its jobs and a 0003 or 0004 store with
+its fleet runs, and back), a job's life, orphans, fleet runs
+with their files, stored in parts and streamed, on SQLite and PostgreSQL alike."""
 
 from __future__ import annotations
 
@@ -21,9 +21,9 @@ COLUMNS = {
              "updated", "owner"],
     "fleet_runs": ["id", "job_id", "scenario", "params", "report", "created"],
     "servers": ["id", "started", "heartbeat"],
-    "fleet_run_files": ["run_id", "name", "data"],
+    "fleet_run_files": ["run_id", "name", "part", "data"],
 }
-HEAD = "0004"
+HEAD = "0005"
 
 
 def upgrade_to(engine, revision: str) -> None:
@@ -146,6 +146,89 @@ def test_a_runs_files_go_with_it(engine):
     assert _file_rows(engine) == before - len(store.FILES)
 
 
+def _big(n: int) -> bytes:
+    """``n`` bytes of every value, in no repeating order a part boundary could hide."""
+    import numpy as np
+
+    return np.random.default_rng(n).integers(0, 256, n, dtype=np.uint8).tobytes()
+
+
+def _selects(engine, run):
+    """(what ``run()`` returned, the parameters of each SELECT it sent)."""
+    seen: list = []
+
+    def record(conn, cursor, statement, parameters, *args):
+        if statement.lstrip().upper().startswith("SELECT"):
+            seen.append(parameters)
+
+    sa.event.listen(engine, "before_cursor_execute", record)
+    try:
+        return run(), seen
+    finally:
+        sa.event.remove(engine, "before_cursor_execute", record)
+
+
+@pytest.mark.parametrize("size", [0, 1, 2 * 1000, 2 * 1000 + 1, 3 * 1000 - 1])
+def test_a_stored_file_streams_part_by_part(engine, monkeypatch, size):
+    """A file is stored in parts of PART_BYTES (1000 here) and streamed one part per
+    read: the bytes as saved, no read larger than a part, as many reads as parts; an
+    empty file is one empty part."""
+    monkeypatch.setattr(store, "PART_BYTES", 1000)
+    tracks = _big(size)
+    run = store.save_fleet_run(engine, scenario="s", params={}, report={},
+                               events_jsonl="é" * 700, tracks_csv=tracks, packages_csv="",
+                               fleet_geojson="{}")
+    f = store.open_fleet_file(engine, run, "tracks_csv")
+    parts = max(1, -(-size // 1000))
+    assert (f.size, f.parts) == (size, parts)
+    chunks, selects = _selects(engine, lambda: list(f))
+    assert b"".join(chunks) == tracks
+    assert [len(c) for c in chunks] == [min(1000, size - 1000 * k) for k in range(parts)]
+    assert len(selects) == parts  # one read of one stored part each
+    with engine.connect() as c:
+        lengths = c.execute(sa.text(
+            "select part, length(data) from fleet_run_files where run_id = :r and "
+            "name = 'tracks_csv' order by part"), {"r": run}).all()
+    assert [tuple(r) for r in lengths] == [(k, len(c)) for k, c in enumerate(chunks)]
+    events = store.open_fleet_file(engine, run, "events_jsonl")  # 1400 bytes of UTF-8
+    assert events.size == 1400 and b"".join(events).decode() == "é" * 700
+    whole = store.get_fleet_run(engine, run)  # joined back whole
+    assert whole["tracks_csv"] == tracks and whole["events_jsonl"] == "é" * 700
+    assert store.open_fleet_file(engine, "nope", "tracks_csv") is None
+    with pytest.raises(OptionError, match="name='tracks' is not valid"):
+        store.open_fleet_file(engine, run, "tracks")
+
+
+def test_a_large_file_is_stored_in_parts_of_a_mebibyte(engine):
+    tracks = _big(2 * store.PART_BYTES + 7)
+    run = store.save_fleet_run(engine, scenario="s", params={}, report={}, events_jsonl="",
+                               tracks_csv=tracks, packages_csv="", fleet_geojson="")
+    f = store.open_fleet_file(engine, run, "tracks_csv")
+    chunks = list(f)
+    assert (f.size, f.parts) == (len(tracks), 3) and b"".join(chunks) == tracks
+    assert [len(c) for c in chunks] == [1 << 20, 1 << 20, 7]
+
+
+@pytest.mark.parametrize("change", ["replaced", "deleted"])
+def test_a_run_changed_while_its_file_streams_stops_the_stream(engine, monkeypatch, change):
+    """The parts read after a run is replaced (saved again under its id) or deleted are
+    an error, never the new run's bytes after the old one's."""
+    monkeypatch.setattr(store, "PART_BYTES", 10)
+    job = store.create_job(engine, "fleet", {})
+    args = dict(scenario="s", params={}, report={}, events_jsonl="", packages_csv="",
+                fleet_geojson="", job_id=job)
+    run = store.save_fleet_run(engine, tracks_csv=b"a" * 35, **args)
+    parts = iter(store.open_fleet_file(engine, run, "tracks_csv"))
+    assert next(parts) == b"a" * 10
+    if change == "replaced":
+        store.save_fleet_run(engine, tracks_csv=b"b" * 35, run_id=run, **args)
+    else:
+        store.fail_job(engine, job, "boom")
+    with pytest.raises(store.RunChangedError, match=f"fleet run '{run}' was replaced or "
+                                                    "deleted while its tracks_csv was read"):
+        next(parts)
+
+
 @pytest.fixture(params=["sqlite", "postgresql"])
 def new_store(request, tmp_path):
     """An engine on a new empty store: a SQLite file, or a PostgreSQL database of this
@@ -224,6 +307,55 @@ def test_upgrading_a_0003_store_keeps_its_fleet_runs_and_downgrading_puts_them_b
         "fleet_geojson": "g"}
     assert dstore.init(e) == HEAD  # and up again
     assert store.get_fleet_run(e, "run-a")["tracks_csv"] == OLD_RUNS[0]["tracks_csv"]
+
+
+def test_upgrading_a_0004_store_splits_its_files_and_downgrading_joins_them(new_store):
+    e = new_store
+    upgrade_to(e, "0004")
+    md = sa.MetaData()
+    md.reflect(e, only=("fleet_runs", "fleet_run_files"))
+    big = _big(2 * store.PART_BYTES + 3)
+    old = {"events_jsonl": "é\n".encode() * 10, "tracks_csv": big, "packages_csv": b"",
+           "fleet_geojson": b"{}"}
+    with e.begin() as c:
+        c.execute(md.tables["fleet_runs"].insert().values(
+            id="run-a", job_id=None, scenario="s", params={}, report={},
+            created=dt.datetime(2024, 1, 1, 12)))
+        c.execute(md.tables["fleet_run_files"].insert(),
+                  [{"run_id": "run-a", "name": k, "data": v} for k, v in old.items()])
+    assert dstore.init(e) == HEAD
+    with e.connect() as c:
+        rows = c.execute(sa.text("select name, part, length(data) from fleet_run_files "
+                                 "order by name, part")).all()
+    assert [tuple(r) for r in rows] == [
+        ("events_jsonl", 0, 30), ("fleet_geojson", 0, 2), ("packages_csv", 0, 0),
+        ("tracks_csv", 0, 1 << 20), ("tracks_csv", 1, 1 << 20), ("tracks_csv", 2, 3)]
+    assert b"".join(store.open_fleet_file(e, "run-a", "tracks_csv")) == big
+    run = store.get_fleet_run(e, "run-a")
+    assert run["tracks_csv"] == big and run["events_jsonl"] == "é\n" * 10
+    # a run stored at 0005 goes back too
+    new = store.save_fleet_run(e, scenario="new", params={}, report={}, events_jsonl="é",
+                               tracks_csv=big[:store.PART_BYTES + 1], packages_csv="",
+                               fleet_geojson="g")
+
+    from alembic import command
+    from alembic.config import Config
+
+    cfg = Config()
+    cfg.set_main_option("script_location", str(Path(dstore.__file__).parent / "migrations"))
+    with e.begin() as conn:
+        cfg.attributes["connection"] = conn
+        command.downgrade(cfg, "0004")
+    assert [c["name"] for c in sa.inspect(e).get_columns("fleet_run_files")] == \
+        ["run_id", "name", "data"]
+    with e.connect() as c:
+        got = {(r, n): bytes(d) for r, n, d in c.execute(sa.text(
+            "select run_id, name, data from fleet_run_files"))}
+    assert {n: got["run-a", n] for n in old} == old
+    assert got[new, "tracks_csv"] == big[:store.PART_BYTES + 1]
+    assert got[new, "events_jsonl"] == "é".encode()
+    assert dstore.init(e) == HEAD  # and up again
+    assert store.get_fleet_run(e, new)["tracks_csv"] == big[:store.PART_BYTES + 1]
 
 
 @pytest.fixture(params=["sqlite", "postgresql"])

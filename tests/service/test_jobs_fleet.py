@@ -1,8 +1,8 @@
 """Jobs and fleet runs through the service. The routers are checked here against a
 stand-in for ``skyroute.jobs`` (its interface: ``runner.submit/get``,
-``executor.open_executor``, ``store.get_fleet_run/list_fleet_runs``) so they are tested
-whether or not that package is installed; the tests marked ``needs_jobs`` run the real
-jobs and skip while it is missing."""
+``executor.open_executor``, ``store.get_fleet_run/open_fleet_file/list_fleet_runs``) so
+they are tested whether or not that package is installed; the tests marked ``needs_jobs``
+run the real jobs and skip while it is missing."""
 
 from __future__ import annotations
 
@@ -49,6 +49,17 @@ class FakeJobs:
         return {k: v for k, v in run.items()
                 if ALIASES.get(k, k) not in FILES or ALIASES.get(k, k) in wanted}
 
+    def open_fleet_file(self, engine, run_id, name):
+        """As the store's: the run's file ``name`` to stream (its size, then its bytes in
+        parts of FakeFile.PART); None for an unknown run."""
+        assert name in FILES, name
+        self.reads.append((run_id, (name,)))
+        run = self.runs.get(run_id)
+        if run is None:
+            return None
+        data = next((v for k, v in run.items() if ALIASES.get(k, k) == name), b"")
+        return FakeFile(data.encode() if isinstance(data, str) else bytes(data))
+
     def install(self, monkeypatch):
         pkg = types.ModuleType("skyroute.jobs")
         runner = types.ModuleType("skyroute.jobs.runner")
@@ -57,6 +68,7 @@ class FakeJobs:
         runner.submit = self.submit
         runner.get = lambda engine, i: self.jobs.get(i)
         store.get_fleet_run = self.get_fleet_run
+        store.open_fleet_file = self.open_fleet_file
         store.list_fleet_runs = lambda engine: list(self.runs.values())
         executor.open_executor = lambda kind="local", address=None, workers=None: \
             types.SimpleNamespace(kind=kind, close=lambda: None)
@@ -76,6 +88,17 @@ class FakeJobs:
         self.jobs[i] = {"id": i, "kind": kind, "state": "queued", "progress": 0.0,
                         "result": None, "error": None}
         return i
+
+
+class FakeFile:
+    PART = 1000
+
+    def __init__(self, data: bytes):
+        self.data, self.size = data, len(data)
+
+    def __iter__(self):
+        for a in range(0, max(1, self.size), self.PART):
+            yield self.data[a:a + self.PART]
 
 
 @pytest.fixture
@@ -436,6 +459,57 @@ def test_the_real_store_selects_the_tracks_only_for_tracks_csv(tmp_path, small_r
             assert r.text == small_run["tracks"]
     finally:
         sa.event.remove(sa.engine.Engine, "before_cursor_execute", record)
+
+
+@needs_jobs
+@pytest.mark.parametrize("db", ["sqlite", "postgresql"])
+def test_a_runs_files_are_streamed_as_stored(tmp_path, request, db):
+    """Each file route sends the stored bytes part by part (no piece larger than a
+    stored part, the length up front, the file's name and type), a file of a size not
+    a multiple of the part and an empty one alike; an unknown run is a 404 problem."""
+    import numpy as np
+
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    url = (f"sqlite:///{tmp_path / 'runs.db'}" if db == "sqlite"
+           else request.getfixturevalue("fresh_pg"))
+    eng = make_engine(url)
+    part = 1 << 20  # store.PART_BYTES, checked at the end
+    rng = np.random.default_rng(3)
+    tracks = rng.integers(0, 256, 2 * part + 12345, dtype=np.uint8).tobytes()
+    events = '{"t":0,"kind":"spawn","at":"Café"}\n' * (part // 20)  # over a part
+    files = {"events_jsonl": events, "tracks_csv": tracks, "packages_csv": "id\n0\n",
+             "fleet_geojson": '{"type":"FeatureCollection","features":[]}'}
+    full = store.save_fleet_run(eng, scenario="seed-3x3", params={}, report={}, **files)
+    empty = store.save_fleet_run(eng, scenario="seed-3x3", params={}, report={},
+                                 events_jsonl="", tracks_csv=b"", packages_csv="",
+                                 fleet_geojson="{}")
+    eng.dispose()
+    want = {"tracks.csv": (tracks, "text/csv; charset=utf-8"),
+            "events.jsonl": (events.encode(), "application/x-ndjson"),
+            "packages.csv": (b"id\n0\n", "text/csv; charset=utf-8"),
+            "fleet.geojson": (files["fleet_geojson"].encode(), "application/geo+json")}
+    with make_client(db_url=url) as c:
+        for name, (body, media) in [*want.items(), ("tracks.csv", (b"", None)),
+                                    ("events.jsonl", (b"", None))]:
+            rid = full if body else empty
+            with c.stream("GET", f"/fleet/runs/{rid}/{name}") as r:
+                pieces = list(r.iter_raw())
+            assert r.status_code == 200, name
+            assert b"".join(pieces) == body, name
+            sizes = [len(p) for p in pieces]
+            assert max(sizes, default=0) <= part, (name, sizes)
+            assert r.headers["content-length"] == str(len(body))
+            assert r.headers["content-disposition"] == f'attachment; filename="{name}"'
+            if media:
+                assert r.headers["content-type"] == media
+        assert sizes in ([], [0])
+        assert_problem(c.get(f"/fleet/runs/{empty}/packages.csv"), 404,
+                       words="has no packages.csv")
+        for name in want:
+            assert_problem(c.get(f"/fleet/runs/nope/{name}"), 404, words="no fleet run 'nope'")
+    assert part == store.PART_BYTES
 
 
 @needs_jobs

@@ -9,7 +9,10 @@ one small interface.
 results in item order; ``on_result(index, result)`` is called in the calling thread as
 each one finishes (in finishing order), for progress bars and job progress. An exception
 in a task is raised by ``map`` (the tasks not yet started are cancelled). ``fn`` and the
-items must pickle: ``fn`` a module-level function, the items plain data.
+items must pickle: ``fn`` a module-level function, the items plain data. ``close`` while
+another thread's ``map`` runs (a server shutting down under a job) cancels that map's
+tasks not yet started, and the map raises :class:`ExecutorClosedError`, as does a ``map``
+on a closed executor.
 
 - ``local``: ``workers`` processes started with the ``spawn`` method (a forked child of
   a process whose compiled kernels have started OpenMP threads dies), created on the
@@ -34,13 +37,23 @@ import multiprocessing
 import os
 import threading
 from collections.abc import Callable, Iterable
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, CancelledError, ProcessPoolExecutor, wait
 from typing import Any
 
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 
 KINDS = ("local", "dask")
 CONNECT_TIMEOUT = "10s"  # an existing scheduler that does not answer within this is an error
+
+
+class ExecutorClosedError(SkyrouteError):
+    """A ``map`` cut off by its executor's ``close`` (its tasks not yet started were
+    cancelled), or started after it."""
+
+
+def _closed(ex: _Executor) -> ExecutorClosedError:
+    return ExecutorClosedError(f"the {ex.kind} executor was closed; the tasks not yet "
+                               "started were cancelled")
 
 
 def open_executor(kind: str = "local", *, address: str | None = None,
@@ -65,6 +78,7 @@ def open_executor(kind: str = "local", *, address: str | None = None,
 
 class _Executor:
     workers: int
+    kind: str
 
     def map(self, fn: Callable, items: Iterable, *,
             on_result: Callable[[int, Any], None] | None = None) -> list:
@@ -89,6 +103,7 @@ class LocalExecutor(_Executor):
         self.workers = workers
         self._pool: ProcessPoolExecutor | None = None
         self._lock = threading.Lock()  # map may be called from several threads
+        self._closed = False
 
     def __repr__(self) -> str:
         return f"LocalExecutor(workers={self.workers})"
@@ -98,20 +113,36 @@ class LocalExecutor(_Executor):
         if self.workers == 1 or len(items) <= 1:
             out = []
             for i, item in enumerate(items):
+                if self._closed:  # (a task already running in this thread runs to its end)
+                    raise _closed(self)
                 out.append(fn(item))
                 if on_result:
                     on_result(i, out[-1])
             return out
         with self._lock:
+            if self._closed:  # not a new pool that nothing would close
+                raise _closed(self)
             if self._pool is None:
                 self._pool = ProcessPoolExecutor(
                     self.workers, mp_context=multiprocessing.get_context("spawn"))
             pool = self._pool
-        return _gather(lambda item: pool.submit(fn, item), items, 2 * self.workers,
-                       on_result)
+
+        def submit(item):
+            with self._lock:  # never into a pool being shut down
+                if self._closed:
+                    raise _closed(self)
+                return pool.submit(fn, item)
+
+        try:
+            return _gather(submit, items, 2 * self.workers, on_result)
+        except (CancelledError, RuntimeError):  # cancelled or refused by close
+            if self._closed:
+                raise _closed(self) from None
+            raise
 
     def close(self) -> None:
         with self._lock:
+            self._closed = True
             if self._pool is not None:
                 self._pool.shutdown(wait=False, cancel_futures=True)
                 self._pool = None
@@ -163,6 +194,7 @@ class DaskExecutor(_Executor):
                                 "(pip install 'dask[distributed]')") from None
         self.address = address
         self._cluster = None
+        self._closed = False
         # A Client left to the garbage collector (one whose connection failed is left in
         # a reference cycle) closes itself in __del__, taking distributed's class-wide
         # LoopRunner lock; collected while a new Client starts under that lock, it
@@ -224,6 +256,8 @@ class DaskExecutor(_Executor):
         from distributed import as_completed
 
         items = list(items)
+        if self._closed:
+            raise _closed(self)
         if not items:
             return []
         # pure=False: a task is run each time it is asked for, never served from an
@@ -237,21 +271,25 @@ class DaskExecutor(_Executor):
                 out[i] = f.result()
                 if on_result:
                     on_result(i, out[i])
-        except RuntimeError as exc:
+        except Exception as exc:
+            if self._closed:  # the client closed under this map: nothing left to cancel
+                raise _closed(self) from None
             self.client.cancel(futures)
-            if "deserializ" not in str(exc):
+            if not isinstance(exc, RuntimeError) or "deserializ" not in str(exc):
                 raise
             raise SkyrouteError(f"the Dask scheduler at {self.client.scheduler.address} "
                                 "cannot read skyroute's tasks; install the same skyroute on "
                                 "the scheduler and every worker") from None
         except BaseException:
-            self.client.cancel(futures)
+            if not self._closed:
+                self.client.cancel(futures)
             raise
         finally:
             del futures
         return out
 
     def close(self) -> None:
+        self._closed = True
         self.client.close()
         if self._cluster is not None:
             self._cluster.close()

@@ -32,7 +32,10 @@ progress, the share of its tasks done (a fleet run is one task: 0, then 1). It e
 ``done`` with its result, or ``failed`` with a one-line error: a SkyrouteError's message,
 else the exception's type and message; the traceback goes to the ``skyroute.jobs``
 logger, never into the store. The thread is a daemon: a job still queued or running
-when the process ends is left so in the store, and is failed later as an orphan.
+when the process ends is left so in the store, and is failed later as an orphan. A job
+whose executor is closed under it (the server shutting down while another lane's job
+runs: :class:`~skyroute.jobs.executor.ExecutorClosedError`), and a queued one that
+reaches a closed executor, ends ``failed`` with the orphans' :data:`ORPHANED` at once.
 
 Several servers (and each server's ``--workers`` processes) may share one store. Each
 job names its owner, the process that took it (:func:`owner`: host, process id and a
@@ -73,6 +76,7 @@ import sqlalchemy as sa
 
 from skyroute.errors import SkyrouteError, check_choice
 from skyroute.jobs import deliver, fleet, store
+from skyroute.jobs.executor import ExecutorClosedError
 
 log = logging.getLogger("skyroute.jobs")
 PROGRESS_EVERY = 0.2  # seconds between progress writes (the last one always goes)
@@ -315,6 +319,11 @@ def _run(engine, job_id: str, kind: str, params: dict, executor) -> None:
                                  progress=progress)
     except store.JobEndedError:  # from progress, or from a worker storing a fleet run
         _ended(engine, job_id, "it is stopped")
+        return
+    except ExecutorClosedError:  # the server shutting down closed the executor under it
+        log.info("job %s (%s) cut off by the executor's close", job_id, kind)
+        if not store.fail_job(engine, job_id, ORPHANED):  # as its orphans are failed
+            _ended(engine, job_id, "its cut-off is not recorded")
         return
     except Exception as exc:
         expected = isinstance(exc, SkyrouteError)

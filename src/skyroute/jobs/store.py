@@ -1,7 +1,7 @@
 """Jobs and fleet runs in the SQL store of the delivery days (same database, same
 migrations: revision 0002 adds the jobs and fleet_runs tables, 0003 the jobs' owners and
-the servers, 0004 moves the runs' files to fleet_run_files; ``skyroute db init`` upgrades
-to the newest).
+the servers, 0004 moves the runs' files to fleet_run_files, 0005 splits them in parts;
+``skyroute db init`` upgrades to the newest).
 
 - ``jobs(id, kind, params, state, progress, result, error, created, updated, owner)``:
   ``state`` is ``queued``, ``running``, ``done`` or ``failed``; ``progress`` 0..1;
@@ -18,15 +18,18 @@ to the newest).
   unfinished jobs of owners silent for longer than ``dead_after``, or known to have
   ended (``gone``: the runner tells those of its own machine by their process ids).
 - ``fleet_runs(id, job_id, scenario, params, report, created)``: a fleet run's
-  ``report.json`` and what made it; ``fleet_run_files(run_id, name, data)`` its files, one
-  row each (``name`` one of :data:`FILES`; ``data`` the bytes, text as UTF-8):
-  ``events.jsonl``, ``tracks.csv``, ``packages.csv`` and ``fleet.geojson`` as
-  :mod:`skyroute.io.fleet_out` writes them (a big run's tracks are big: 1 s rows of 1000
-  drones for an hour are about 150 MB; use a coarser ``track_step``). The files live
-  apart so that listing runs or reading one file never reads through the tracks (SQLite
-  keeps a row's columns in order). No run names a failed job: failing a job deletes its
-  runs in the same transaction, and :func:`save_fleet_run` refuses
-  (:class:`JobEndedError`) a run of a job already failed.
+  ``report.json`` and what made it; ``fleet_run_files(run_id, name, part, data)`` its
+  files in parts of at most :data:`PART_BYTES`, one row each (``name`` one of
+  :data:`FILES`; ``part`` 0, 1, ...; ``data`` the part's bytes, text as UTF-8; an empty
+  file is one empty part): ``events.jsonl``, ``tracks.csv``, ``packages.csv`` and
+  ``fleet.geojson`` as :mod:`skyroute.io.fleet_out` writes them (a big run's tracks are
+  big: 1 s rows of 1000 drones for an hour are about 150 MB; use a coarser
+  ``track_step``). The files live apart so that listing runs or reading one file never
+  reads through the tracks (SQLite keeps a row's columns in order), and in parts so
+  that :func:`open_fleet_file` streams one part per read (a slice of one big value costs
+  a read of the value up to the slice on both databases). No run names a failed job:
+  failing a job deletes its runs in the same transaction, and :func:`save_fleet_run`
+  refuses (:class:`JobEndedError`) a run of a job already failed.
 
 Every function takes the engine first and runs one short transaction; writes go through
 :func:`skyroute.delivery.store.writing`, as the delivery store's do (on SQLite the write
@@ -39,7 +42,7 @@ from __future__ import annotations
 import datetime as dt
 import math
 import uuid
-from collections.abc import Collection
+from collections.abc import Collection, Iterator
 from pathlib import Path
 
 import sqlalchemy as sa
@@ -60,6 +63,11 @@ register(_ENGINES.clear)
 class JobEndedError(SkyrouteError):
     """A write for a job that has already ended (failed, say as an orphan of a stalled
     server): nothing was written."""
+
+
+class RunChangedError(SkyrouteError):
+    """A fleet run replaced (saved again under its id) or deleted while one of its files
+    was streamed: the rest of the file is not sent."""
 
 
 def worker_url(engine: sa.Engine) -> str:
@@ -279,13 +287,26 @@ def save_fleet_run(engine: sa.Engine, *, scenario: str, params: dict, report: di
         c.execute(runs.insert().values(
             id=run_id, job_id=job_id, scenario=scenario, params=json_safe(params),
             report=json_safe(report), created=_now()))
-        for name in FILES:  # one at a time: no second copy of the tracks in a list
-            c.execute(stored.insert().values(run_id=run_id, name=name, data=data.pop(name)))
+        for name in FILES:  # a part at a time: no second copy of the tracks in a list
+            for k, part in enumerate(_parts(data.pop(name))):
+                c.execute(stored.insert().values(run_id=run_id, name=name, part=k,
+                                                 data=part))
     return run_id
+
+
+def _parts(data: bytes) -> Iterator[bytes]:
+    """``data`` in parts of :data:`PART_BYTES` (the last one shorter); an empty file is
+    one empty part, so every stored file has a row."""
+    view = memoryview(data)
+    for a in range(0, max(1, len(view)), PART_BYTES):
+        yield bytes(view[a:a + PART_BYTES])
 
 
 _HEAD = ("id", "job_id", "scenario", "params", "report", "created")
 FILES = ("events_jsonl", "tracks_csv", "packages_csv", "fleet_geojson")
+# the largest part of a stored file (revision 0005 split the files stored before): what one
+# read of a streamed file holds
+PART_BYTES = 1 << 20
 
 
 def _run_dict(r, files: dict[str, bytes] | None = None) -> dict:
@@ -293,7 +314,7 @@ def _run_dict(r, files: dict[str, bytes] | None = None) -> dict:
     out["created"] = _iso(out["created"])
     for k in FILES:
         if files and k in files:
-            out[k] = bytes(files[k]) if k == "tracks_csv" else bytes(files[k]).decode()
+            out[k] = files[k] if k == "tracks_csv" else files[k].decode()
     return out
 
 
@@ -316,16 +337,75 @@ def get_fleet_run(engine: sa.Engine, run_id: str, *,
     t = _t(engine)
     runs, stored = t["fleet_runs"], t["fleet_run_files"]
     # one statement (the run and its files as one snapshot, never a run replaced in
-    # between): a row per wanted file, or one row with no file
+    # between): a row per part of a wanted file, or one row with no file
     q = (sa.select(*[runs.c[k] for k in _HEAD], stored.c.name, stored.c.data)
          .select_from(runs.outerjoin(stored, sa.and_(stored.c.run_id == runs.c.id,
                                                      stored.c.name.in_(wanted))))
-         .where(runs.c.id == str(run_id)))
+         .where(runs.c.id == str(run_id)).order_by(stored.c.name, stored.c.part))
     with engine.connect() as c:
         rows = c.execute(q).mappings().all()
     if not rows:
         return None
-    return _run_dict(rows[0], {r["name"]: r["data"] for r in rows if r["name"] is not None})
+    parts: dict[str, list] = {}
+    for r in rows:
+        if r["name"] is not None:
+            parts.setdefault(r["name"], []).append(r["data"])
+    head = rows[0]
+    del rows
+    return _run_dict(head, {k: b"".join(v) for k, v in parts.items()})
+
+
+class StoredFile:
+    """One of a fleet run's files as :func:`open_fleet_file` finds it: ``size`` (bytes)
+    and ``parts``; iterating reads it part by part, each part (at most
+    :data:`PART_BYTES`) by its key in a short transaction of its own, so a slow reader
+    holds no connection and no lock between parts. A run replaced or deleted meanwhile
+    is :class:`RunChangedError` at the next part, never bytes of two versions."""
+
+    def __init__(self, engine: sa.Engine, run_id: str, name: str, created, size: int,
+                 parts: int) -> None:
+        self._engine, self._created = engine, created
+        self.run_id, self.name, self.size, self.parts = run_id, name, size, parts
+
+    def __repr__(self) -> str:
+        return (f"StoredFile(run_id={self.run_id!r}, name={self.name!r}, "
+                f"size={self.size}, parts={self.parts})")
+
+    def __iter__(self) -> Iterator[bytes]:
+        t = _t(self._engine)
+        runs, stored = t["fleet_runs"], t["fleet_run_files"]
+        k = sa.bindparam("k")
+        q = (sa.select(stored.c.data)
+             .select_from(stored.join(runs, runs.c.id == stored.c.run_id))
+             .where(stored.c.run_id == self.run_id, stored.c.name == self.name,
+                    stored.c.part == k, runs.c.created == self._created))
+        for part in range(self.parts):
+            with self._engine.connect() as c:
+                data = c.execute(q, {"k": part}).scalar_one_or_none()
+            if data is None:
+                raise RunChangedError(f"fleet run {self.run_id!r} was replaced or deleted "
+                                      f"while its {self.name} was read")
+            yield bytes(data)
+
+
+def open_fleet_file(engine: sa.Engine, run_id: str, name: str) -> StoredFile | None:
+    """The fleet run's file ``name`` (one of :data:`FILES`) to stream: its size and
+    parts, read now in one statement, its bytes as it is iterated (:class:`StoredFile`);
+    a file the run lacks is empty; None for an unknown run."""
+    check_choice("name", name, FILES)
+    t = _t(engine)
+    runs, stored = t["fleet_runs"], t["fleet_run_files"]
+    q = (sa.select(runs.c.created, sa.func.count(stored.c.part),
+                   sa.func.coalesce(sa.func.sum(sa.func.length(stored.c.data)), 0))
+         .select_from(runs.outerjoin(stored, sa.and_(stored.c.run_id == runs.c.id,
+                                                     stored.c.name == name)))
+         .where(runs.c.id == str(run_id)).group_by(runs.c.id, runs.c.created))
+    with engine.connect() as c:
+        row = c.execute(q).first()
+    if row is None:
+        return None
+    created, parts, size = row
+    return StoredFile(engine, str(run_id), name, created, int(size), int(parts))
 
 
 def list_fleet_runs(engine: sa.Engine, *, job_id: str | None = None,

@@ -1,6 +1,7 @@
 """Stored fleet runs: ``GET /fleet/runs``, ``GET /fleet/runs/{id}`` (report, scenario
 and a page of events: ``?offset&limit``) and the run's files ``events.jsonl``,
-``tracks.csv`` and ``fleet.geojson``.
+``tracks.csv`` and ``fleet.geojson``, streamed from the store part by part
+(:func:`skyroute.jobs.store.open_fleet_file`) with their length up front.
 
 Runs are written by fleet jobs (:mod:`skyroute.jobs.store`, imported on first use;
 without it these endpoints answer 503).
@@ -12,6 +13,7 @@ import json
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Path, Query, Response
+from fastapi.responses import StreamingResponse
 from pydantic import BaseModel, Field
 
 from skyroute.service.problems import Problem, responses
@@ -134,35 +136,43 @@ def get_run(run_id: RunId, res: ResourcesDep,
             "files": {k: f"{base}/{k}" for k in names}}
 
 
-def _raw(run: dict, *keys: str) -> bytes | str:
-    """A stored file as the store holds it (the tracks as bytes: sent without a copy
-    decoded to text and encoded back)."""
-    for k in keys:
-        v = run.get(k)
-        if v is not None:
-            return bytes(v) if isinstance(v, memoryview) else v
-    return ""
-
-
 def _file(content: str | bytes, media_type: str, name: str) -> Response:
     return Response(content, media_type=media_type,
                     headers={"Content-Disposition": f'attachment; filename="{name}"'})
+
+
+def _stored(res: Resources, run_id: str, key: str):
+    """The run's stored file ``key`` (the store's name) to stream, its size known; 404
+    for an unknown run."""
+    f = _store().open_fleet_file(res.engine(), run_id, key)
+    if f is None:
+        raise Problem(404, f"no fleet run {run_id!r}; GET /fleet/runs lists them",
+                      kind="unknown-run")
+    return f
+
+
+def _stream(f, media_type: str, name: str) -> StreamingResponse:
+    """The stored file ``f`` sent as the store reads it, part by part (at most
+    ``PART_BYTES`` held at a time, not the whole file: a big run's tracks are about
+    150 MB), with its length up front."""
+    return StreamingResponse(iter(f), media_type=media_type, headers={
+        "Content-Length": str(f.size),
+        "Content-Disposition": f'attachment; filename="{name}"'})
 
 
 @router.get("/fleet/runs/{run_id}/events.jsonl", response_class=Response,
             responses={200: {"content": {"application/x-ndjson": {}}}, **responses(404, 503)},
             summary="A fleet run's events, one JSON object a line")
 def get_events(run_id: RunId, res: ResourcesDep) -> Response:
-    return _file(_text(_run(res, run_id, "events_jsonl"), "events", "events_jsonl"),
-                 "application/x-ndjson", "events.jsonl")
+    return _stream(_stored(res, run_id, "events_jsonl"), "application/x-ndjson",
+                   "events.jsonl")
 
 
 @router.get("/fleet/runs/{run_id}/tracks.csv", response_class=Response,
             responses={200: {"content": {"text/csv": {}}}, **responses(404, 503)},
             summary="A fleet run's tracks (one row per drone and time step)")
 def get_tracks(run_id: RunId, res: ResourcesDep) -> Response:
-    return _file(_raw(_run(res, run_id, "tracks_csv"), "tracks", "tracks_csv"), "text/csv",
-                 "tracks.csv")
+    return _stream(_stored(res, run_id, "tracks_csv"), "text/csv", "tracks.csv")
 
 
 @router.get("/fleet/runs/{run_id}/fleet.geojson", response_class=Response,
@@ -170,14 +180,14 @@ def get_tracks(run_id: RunId, res: ResourcesDep) -> Response:
                        **responses(404, 503)},
             summary="A fleet run's airports, runways and tracks in lon/lat")
 def get_geojson(run_id: RunId, res: ResourcesDep) -> Response:
-    run = _run(res, run_id, "fleet_geojson")
-    text = _text(run, "fleet_geojson", "geojson")
-    if not text:  # a run stored without it: rebuilt from its tracks, read only then
-        from skyroute.fleet.scenario import parse_scenario
-        from skyroute.io.fleet_out import fleet_geojson_from_tracks
+    stored = _stored(res, run_id, "fleet_geojson")
+    if stored.size:
+        return _stream(stored, "application/geo+json", "fleet.geojson")
+    # a run stored without it: rebuilt from its tracks, read only then
+    from skyroute.fleet.scenario import parse_scenario
+    from skyroute.io.fleet_out import fleet_geojson_from_tracks
 
-        run = _run(res, run_id, "tracks_csv")
-        scenario = parse_scenario(_scenario(run), "scenario")
-        text = json.dumps(fleet_geojson_from_tracks(scenario, _text(run, "tracks",
-                                                                    "tracks_csv")))
+    run = _run(res, run_id, "tracks_csv")
+    scenario = parse_scenario(_scenario(run), "scenario")
+    text = json.dumps(fleet_geojson_from_tracks(scenario, _text(run, "tracks", "tracks_csv")))
     return _file(text, "application/geo+json", "fleet.geojson")

@@ -12,7 +12,7 @@ from fastapi import APIRouter, Response
 
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import ResourcesDep
-from skyroute.service.routers.fleet import RunId, _file, _run, _text
+from skyroute.service.routers.fleet import RunId, _stored, _stream
 
 router = APIRouter(tags=["fleet"])
 
@@ -21,7 +21,7 @@ router = APIRouter(tags=["fleet"])
             responses={200: {"content": {"text/csv": {}}}, **responses(404, 503)},
             summary="A fleet run's packages (one row per package)")
 def get_packages(run_id: RunId, res: ResourcesDep) -> Response:
-    text = _text(_run(res, run_id, "packages_csv"), "packages_csv", "packages")
-    if not text:
+    stored = _stored(res, run_id, "packages_csv")
+    if not stored.size:
         raise Problem(404, f"fleet run {run_id!r} has no packages.csv", kind="no-packages")
-    return _file(text, "text/csv", "packages.csv")
+    return _stream(stored, "text/csv", "packages.csv")
