@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -57,6 +58,11 @@ def test_range_prints_a_monthly_table(monkeypatch, capsys, tmp_path, fly_once):
                          f"sqlite:///{tmp_path / 'r.db'}", "--out", str(tmp_path))
     assert code == 0, err
     assert "2 days" in out and "2024-01" in out and "mean %" in out
+    # the summary is one line (as the monthly table's title it wrapped at the table's
+    # width: "2 days, 1.2 s with 1 job(s): money" over "delivered mean 99.24%, worst")
+    summary = (r"2 days, [\d.]+ s with 1 job\(s\): money delivered mean [\d.]+%, "
+               r"worst [\d.]+% on 2024-01-0[12]")
+    assert any(re.fullmatch(summary, line.strip()) for line in out.splitlines()), out
     assert not list(tmp_path.glob("*.png"))  # no pictures for a range unless asked
     # where the files went (a range said nothing of them): a GeoJSON and a report a day
     assert len(list(tmp_path.glob("*-0?-01-2024.*"))) == 4

@@ -181,8 +181,12 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
             plain_console().print(f"wrote {len(files):,} files to {', '.join(s['folders'])}")
         return
     who = f"{workers} job(s)" if kind == "local" else f"{workers} Dask worker(s)"
-    t = Table(title=f"{s['days']} days, {wall:.1f} s with {who}: money delivered "
-                    f"mean {s['mean_pct']:.2f}%, worst {s['min_pct']:.2f}% on {s['min_date']}")
+    # a line of its own: as the title of the narrow monthly table it wrapped at the
+    # table's width ("... money" over "delivered mean 99.24%, worst")
+    plain_console().print(f"{s['days']} days, {wall:.1f} s with {who}: money delivered "
+                          f"mean {s['mean_pct']:.2f}%, worst {s['min_pct']:.2f}% on "
+                          f"{s['min_date']}", soft_wrap=True)
+    t = Table()
     for col in ("month", "days", "mean %", "min %"):
         t.add_column(col, justify="right")
     for m, v in s["months"].items():
