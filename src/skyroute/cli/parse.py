@@ -19,3 +19,26 @@ def parse_cell(text: str, option: str) -> tuple[int, int]:
 def parse_list(text: str | None) -> list[str]:
     """``"a,b"`` -> ["a", "b"]; empty or None -> []."""
     return [p.strip() for p in (text or "").split(",") if p.strip()]
+
+
+def check_outputs(**files) -> None:
+    """Every file a command writes (``option=path``, ``None`` for not asked; ``plot`` a
+    PNG), checked before its work: a path that cannot be written, or a picture not named
+    ``.png``, is one line naming the option. Checking them all first means that exit 2
+    leaves none written: ``plan --geojson p.geojson --plot /proc/p.png`` wrote the
+    GeoJSON and then failed on the picture; ``--plot p.jpg`` wrote PNG bytes into a
+    ``.jpg``."""
+    from skyroute.errors import SkyrouteError
+    from skyroute.files import check_writable
+
+    for name, path in files.items():
+        if path is None:
+            continue
+        flag = "--" + name.replace("_", "-")
+        if name == "plot" and path.suffix.lower() != ".png":
+            raise OptionError(f"{flag} {path}: pictures are PNG files; name it .png",
+                              param=name)
+        try:
+            check_writable(path)
+        except SkyrouteError as exc:
+            raise OptionError(f"{flag} {exc}", param=name) from None
