@@ -80,7 +80,14 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["deliver", "2024-13-01", "--data", EXAMPLE], "DATE '2024-13-01': expected a date"),
+    # a day the calendar lacks says so: "expected a date YYYY-MM-DD" named the form it has
+    (["deliver", "2024-13-01", "--data", EXAMPLE],
+     "DATE '2024-13-01': no such day (month must be in 1..12)"),
+    (["deliver", "2024-02-30", "--data", EXAMPLE],
+     "DATE '2024-02-30': no such day (day is out of range for month)"),
+    (["deliver", "03-01-2024", "--data", EXAMPLE], "DATE '03-01-2024': expected a date "
+                                                   "YYYY-MM-DD"),
+    (["data", "synth", "x", "--start", "2023-02-29"], "--start '2023-02-29': no such day"),
     (["deliver", "--from", "2024-01-02", "--data", EXAMPLE], "give a DATE, or both --from"),
     (["deliver", "2024-01-01", "--from", "2024-01-01", "--to", "2024-01-02", "--data",
       EXAMPLE], "give a DATE, or both --from"),

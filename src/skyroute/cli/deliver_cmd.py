@@ -13,6 +13,7 @@ from rich.table import Table
 
 from skyroute.cli.db_cmd import REPLACE_HELP, some_days
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
+from skyroute.cli.parse import parse_date
 from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.delivery.day import METHODS, DayResult
 from skyroute.delivery.store import DEFAULT_DB, safe_url
@@ -20,12 +21,7 @@ from skyroute.errors import OptionError, SkyrouteError, check_choice
 
 
 def _date(text: str | None, option: str) -> dt.date | None:
-    if text is None:
-        return None
-    try:
-        return dt.date.fromisoformat(text)
-    except ValueError:
-        raise OptionError(f"{option} {text!r}: expected a date YYYY-MM-DD") from None
+    return None if text is None else parse_date(text, option)
 
 
 def deliver_command(

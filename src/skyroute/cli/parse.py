@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import datetime as dt
+import re
+
 from skyroute.errors import OptionError
 
 
@@ -14,6 +17,17 @@ def parse_cell(text: str, option: str) -> tuple[int, int]:
         return int(parts[0]), int(parts[1])
     except ValueError:
         raise OptionError(f"{option} {text!r} must be two integers X,Y (column,row)") from None
+
+
+def parse_date(text: str, option: str) -> dt.date:
+    """``YYYY-MM-DD`` -> a date. A day the calendar lacks (2024-02-30, 2024-13-01) says
+    so; it was "expected a date YYYY-MM-DD", which it is."""
+    try:
+        return dt.date.fromisoformat(text)
+    except ValueError as exc:
+        if re.fullmatch(r"\d{4}-\d{2}-\d{2}", text):
+            raise OptionError(f"{option} {text!r}: no such day ({exc})") from None
+        raise OptionError(f"{option} {text!r}: expected a date YYYY-MM-DD") from None
 
 
 def parse_list(text: str | None) -> list[str]:
