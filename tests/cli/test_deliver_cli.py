@@ -100,6 +100,10 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--method", "magic"],
      "--method 'magic' is not valid"),
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "nonsense"], "not a database URL"),
+    # Heroku's and psql's spelling: a URL, of a kind SQLAlchemy does not know (it said
+    # "not a database URL")
+    (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "postgres://u@127.0.0.1/db"],
+     "--db 'postgres://u@127.0.0.1/db': SQLAlchemy knows no database 'postgres' (e.g. "),
     (["data", "serve", "/nonexistent"], "not a data folder"),
     (["data", "serve", EXAMPLE, "--port", "99999"], "is not in the range 0<=x<=65535"),
     (["data", "serve", EXAMPLE, "--port", "-1"], "is not in the range 0<=x<=65535"),
