@@ -50,8 +50,7 @@ def check_outputs(**files) -> None:
             continue
         flag = "--" + name.replace("_", "-")
         if name == "plot" and path.suffix.lower() != ".png":
-            raise OptionError(f"{flag} {path}: pictures are PNG files; name it .png",
-                              param=name)
+            raise OptionError(f"{flag} {path}: pictures are PNG files; name it .png", param=name)
         try:
             check_writable(path)
         except SkyrouteError as exc:
