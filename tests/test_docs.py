@@ -251,6 +251,37 @@ def test_fleet_md_python_example():
     assert result.attempted >= 6 and result.failed == 0
 
 
+def docs_python_blocks() -> list[tuple[str, str]]:
+    """(page, code) for each ```python block of docs/*.md written as a script (no ``>>>``
+    prompts: doctest runs those) and not marked ``<!-- not run ...: why -->`` on the line
+    before it, found rather than listed."""
+    import re
+
+    out = []
+    for path in sorted((ROOT / "docs").glob("*.md")):
+        for mark, code in re.findall(r"^(?:(<!-- not run[^\n]*-->)\n)?```python\n(.*?)^```",
+                                     path.read_text(), re.M | re.S):
+            if not mark and ">>> " not in code:
+                out.append((path.name, code))
+    return out
+
+
+def test_docs_python_blocks_are_found():
+    """The pattern finds the blocks (benchmarks.md's set-up timing) and the marked one
+    (scaling.md's, which needs a cluster) stays out."""
+    pages = [page for page, _ in docs_python_blocks()]
+    assert "benchmarks.md" in pages and "scaling.md" not in pages
+
+
+@pytest.mark.parametrize("page, code", docs_python_blocks(),
+                         ids=[f"{p}:{i}" for i, (p, _) in enumerate(docs_python_blocks())])
+def test_docs_python_blocks_run(page, code, monkeypatch, tmp_path):
+    """Each script-style Python example of docs/ runs as written (no test ran them:
+    only the README's and fleet.md's, which are doctests)."""
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, page, "exec"), {"__name__": "__main__"})
+
+
 def test_relative_links_resolve():
     """Every relative link of the README, the changelog and docs/ names a file that exists
     and, with ``#anchor``, a heading of it (GitHub's anchors: lower case, punctuation

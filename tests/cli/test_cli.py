@@ -2,6 +2,7 @@
 
 import json
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -201,3 +202,37 @@ def out_blocked_by(tmp_path, blocker: str):
     else:
         (out / blocker).mkdir(parents=True)
     return out
+
+
+_CITY = [str(Path(__file__).parents[2] / "examples" / "city.csv"), "--frame", "ned",
+         "--start", "0,0", "--goal", "120,-180"]
+
+
+@pytest.mark.parametrize("args, first, bad, words", [
+    (["plan", *QUERY], "--geojson", ["--plot", "{blocked}/p.png"], "--plot {blocked}/p.png"),
+    (["plan", *QUERY], "--geojson", ["--plot", "p.jpg"],
+     "--plot p.jpg: pictures are PNG files; name it .png"),
+    (["plan-world", *_CITY], "--waypoints", ["--plot", "{blocked}/p.png"],
+     "--plot {blocked}/p.png"),
+    (["plan-world", *_CITY], "--geojson", ["--waypoints", "{blocked}/w.json"],
+     "--waypoints {blocked}/w.json"),
+    (["fly", *_CITY, "--vehicle", "field"], "--out", ["--plot", "{blocked}/f.png"],
+     "--plot {blocked}/f.png"),
+    (["fly", *_CITY, "--vehicle", "field"], "--out", ["--plot", "f.svg"],
+     "--plot f.svg: pictures are PNG files"),
+])
+def test_an_output_that_cannot_be_written_is_refused_before_any_is(monkeypatch, capsys,
+                                                                   tmp_path, args, first,
+                                                                   bad, words):
+    """Exit 2 writes no file (docs/cli.md): every output is checked before the work. The
+    first file was written and then the second failed ('plan --geojson p.geojson --plot
+    /proc/p.png': exit 2 with p.geojson left); '--plot p.jpg' wrote PNG bytes into it."""
+    monkeypatch.chdir(tmp_path)
+    blocked = tmp_path / "file"
+    blocked.write_text("a file where a folder must be")
+    written = tmp_path / "first.json"
+    bad = [a.format(blocked=blocked) for a in bad]
+    code, _, err = run(monkeypatch, capsys, *args, first, str(written), *bad)
+    assert code == 2 and words.format(blocked=blocked) in err, err
+    assert len(err.strip().splitlines()) == 1
+    assert not written.exists() and not (tmp_path / bad[1]).exists()

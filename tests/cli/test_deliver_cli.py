@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -57,6 +58,11 @@ def test_range_prints_a_monthly_table(monkeypatch, capsys, tmp_path, fly_once):
                          f"sqlite:///{tmp_path / 'r.db'}", "--out", str(tmp_path))
     assert code == 0, err
     assert "2 days" in out and "2024-01" in out and "mean %" in out
+    # the summary is one line (as the monthly table's title it wrapped at the table's
+    # width: "2 days, 1.2 s with 1 job(s): money" over "delivered mean 99.24%, worst")
+    summary = (r"2 days, [\d.]+ s with 1 job\(s\): money delivered mean [\d.]+%, "
+               r"worst [\d.]+% on 2024-01-0[12]")
+    assert any(re.fullmatch(summary, line.strip()) for line in out.splitlines()), out
     assert not list(tmp_path.glob("*.png"))  # no pictures for a range unless asked
     # where the files went (a range said nothing of them): a GeoJSON and a report a day
     assert len(list(tmp_path.glob("*-0?-01-2024.*"))) == 4
@@ -74,7 +80,14 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["deliver", "2024-13-01", "--data", EXAMPLE], "DATE '2024-13-01': expected a date"),
+    # a day the calendar lacks says so: "expected a date YYYY-MM-DD" named the form it has
+    (["deliver", "2024-13-01", "--data", EXAMPLE],
+     "DATE '2024-13-01': no such day (month must be in 1..12)"),
+    (["deliver", "2024-02-30", "--data", EXAMPLE],
+     "DATE '2024-02-30': no such day (day is out of range for month)"),
+    (["deliver", "03-01-2024", "--data", EXAMPLE], "DATE '03-01-2024': expected a date "
+                                                   "YYYY-MM-DD"),
+    (["data", "synth", "x", "--start", "2023-02-29"], "--start '2023-02-29': no such day"),
     (["deliver", "--from", "2024-01-02", "--data", EXAMPLE], "give a DATE, or both --from"),
     (["deliver", "2024-01-01", "--from", "2024-01-01", "--to", "2024-01-02", "--data",
       EXAMPLE], "give a DATE, or both --from"),
@@ -87,6 +100,10 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--method", "magic"],
      "--method 'magic' is not valid"),
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "nonsense"], "not a database URL"),
+    # Heroku's and psql's spelling: a URL, of a kind SQLAlchemy does not know (it said
+    # "not a database URL")
+    (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "postgres://u@127.0.0.1/db"],
+     "--db 'postgres://u@127.0.0.1/db': SQLAlchemy knows no database 'postgres' (e.g. "),
     (["data", "serve", "/nonexistent"], "not a data folder"),
     (["data", "serve", EXAMPLE, "--port", "99999"], "is not in the range 0<=x<=65535"),
     (["data", "serve", EXAMPLE, "--port", "-1"], "is not in the range 0<=x<=65535"),

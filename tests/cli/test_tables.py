@@ -134,3 +134,18 @@ def test_maps_and_plan_at_80_columns(monkeypatch, capsys):
     code, out, _ = run(monkeypatch, capsys, "plan", "den312d", "--start", "10,10",
                        "--goal", "40,60")
     assert code == 0 and "67.112698" in out
+
+
+def test_bench_tables_are_160_columns_in_a_pipe(monkeypatch, capsys):
+    """docs/cli.md: the wide bench tables are 160 columns in a file or a pipe. 'bench
+    grid' (and 'bench world', 'bench motion') printed at 80 there, so a log of the README's
+    'bench grid --peers networkx' wrapped "networkx (peer)" and, with more runners,
+    dropped the speed-ups as "not shown at 80 columns"."""
+    pytest.importorskip("networkx")
+    monkeypatch.delenv("COLUMNS", raising=False)
+    code, out, err = run(monkeypatch, capsys, "bench", "grid", "--map", "den312d",
+                         "--per-map", "2", "--algorithms", "astar,jps,theta",
+                         "--peers", "networkx")
+    assert code == 0, err
+    assert "not shown" not in out and "M exp/s" in out and "networkx (peer)" in out, out
+    assert 80 < max(len(line) for line in out.splitlines()) <= 160

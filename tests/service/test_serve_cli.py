@@ -105,6 +105,28 @@ def test_bad_flags_are_one_line(monkeypatch, capsys, tmp_path, args, words):
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
 
 
+@pytest.mark.parametrize("host, words", [
+    ("127.0.0.1", "the port is in use"),
+    ("nosuch.invalid", "--host 'nosuch.invalid': not an address"),
+])
+def test_an_address_it_cannot_listen_on_is_one_line(monkeypatch, capsys, tmp_path, host,
+                                                    words):
+    """A port another server holds (a second 'serve' on 8000) or a host that is no address
+    is one line naming the option, exit 2, before the banner and the store: uvicorn logged
+    it after "skyroute service on ..." and exited 3."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SKYROUTE_TOKEN", "t")
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        code, out, err = run(monkeypatch, capsys, "serve", "--host", host, "--port",
+                             str(port), "--db", f"sqlite:///{tmp_path / 's.db'}")
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+    assert "skyroute service on" not in err + out
+    assert not (tmp_path / "s.db").exists()
+
+
 def test_serve_fails_the_jobs_a_stopped_server_left(monkeypatch, capsys, tmp_path):
     """A job runs only in the process that took it: one left queued or running by a
     server that stopped is failed when the next server starts, a finished one is kept,

@@ -44,8 +44,9 @@ def test_bench_world_runs_end_to_end(early_process):
     # In a process of its own: OMPL's bindings (nanobind) report leaked instances only
     # when the interpreter exits, which an in-process run cannot see. Started when the
     # run begins (conftest), as its OMPL solves take their full time budgets.
-    code, _, err, folder = early_process
+    code, out, err, folder = early_process
     assert code == 0, err
+    assert "visibility (1st, with build)" in out  # 160 columns in a pipe: not wrapped
     doc = json.loads((folder / "bw.json").read_text())
     rows = {r["runner"]: r for r in doc["worlds"][0]["rows"]}
     assert rows["visibility (again)"]["length_ratio"] == 1.0

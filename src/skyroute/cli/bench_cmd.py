@@ -24,7 +24,7 @@ from skyroute.bench.machine import machine
 from skyroute.bench.peers import PEERS, skip_reason
 from skyroute.bench.random_maps import parse_random
 from skyroute.cli.parse import parse_list
-from skyroute.cli.tables import plain_console, print_table, progress_bar
+from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError
 from skyroute.files import check_writable, write_atomic
 from skyroute.world.load import bundled_maps
@@ -83,7 +83,7 @@ def bench_grid(
     cases += [random_case(spec, per_map=per_map, seed=seed) for spec in randoms]
     _note_skipped_peers(console, cases, have, ours=bool(algs) or prepared)
     reports = _run(console, cases, algorithms=algs, peers=have, seed=seed, prepared=prepared)
-    out = plain_console()
+    out = wide_console()  # 160 columns in a file or a pipe, as every wide table
     for rep in reports:
         if rep.get("prepared", {}).get("build_peak_error"):
             console.print(f"{rep['map']}: {rep['prepared']['build_peak_error']}",

@@ -12,16 +12,14 @@ from rich.table import Table
 
 from skyroute.bench.machine import machine
 from skyroute.cli.bench_cmd import bench_app
+from skyroute.cli.parse import parse_date
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError
 from skyroute.files import check_writable, write_atomic
 
 
 def _day(text: str, option: str) -> dt.date:
-    try:
-        return dt.date.fromisoformat(text)
-    except ValueError:
-        raise OptionError(f"{option} {text!r}: expected a date YYYY-MM-DD") from None
+    return parse_date(text, option)
 
 
 @bench_app.command("jobs")

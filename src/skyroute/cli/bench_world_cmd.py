@@ -27,7 +27,7 @@ from skyroute.bench.world import (
 )
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_list
-from skyroute.cli.tables import plain_console, print_table, progress_bar
+from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 from skyroute.files import check_writable, write_atomic
 from skyroute.motion.step_drone import MERGE
@@ -127,7 +127,7 @@ def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, 
             reports.append(bench_query(world, s, g, seconds=seconds, planners=chosen,
                                        rrt_budgets=(0.1, 0.3, 1.0, 3.0), other=other))
             progress.advance(task)
-    out = plain_console()
+    out = wide_console()  # 160 columns in a file or a pipe, as every wide table
     for rep in reports:
         t = Table(title=f"{rep['world']}: optimum {rep['optimum']:.3f}; RRT* within 1% "
                         f"after {rep['rrtstar_budget_within_1pct'] or 'more than 3'} s")
@@ -212,7 +212,7 @@ def bench_motion(
     if curvature:
         _bench_curvature(worlds, seed, secs, city, tours, json_out)
         return
-    out = plain_console()
+    out = wide_console()  # 160 columns in a file or a pipe, as every wide table
     d = dubins_speed()
     print_table(out, _dubins_table(d))
     if dubins:
@@ -279,7 +279,7 @@ def _bench_curvature(worlds, seed, secs, city, tours, json_out) -> None:
     from skyroute.bench.curvature import curvature_queries, run_queries, summary, tour_benchmark
 
     queries = curvature_queries(worlds, seed, city=city)  # a bad --city fails here, first
-    out = plain_console()
+    out = wide_console()  # 160 columns in a file or a pipe, as every wide table
     with progress_bar(plain_console(stderr=True)) as progress:
         task = progress.add_task("planner runs", total=None)
         rows = run_queries(queries, secs, on_step=lambda r: progress.advance(task))

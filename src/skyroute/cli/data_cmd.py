@@ -2,16 +2,15 @@
 
 from __future__ import annotations
 
-import datetime as dt
 import json
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
+from skyroute.cli.parse import parse_date
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console
-from skyroute.errors import OptionError
 
 data_app = typer.Typer(help="Delivery data sets: synthesise one, serve one over HTTP.",
                        no_args_is_help=True)
@@ -28,10 +27,7 @@ def data_synth(
         min=0, help="Seed: the same seed writes the same files.")] = 1,
 ) -> None:
     """Write a synthetic data set in the ILP layout (website/, database/) in another town."""
-    try:
-        first = dt.date.fromisoformat(start)
-    except ValueError:
-        raise OptionError(f"--start {start!r}: expected a date YYYY-MM-DD") from None
+    first = parse_date(start, "--start")
     with delayed_status(f"writing a data set to {folder}"):  # imports included: seconds
         from skyroute.delivery.synth import synth
 

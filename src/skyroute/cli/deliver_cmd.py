@@ -13,6 +13,7 @@ from rich.table import Table
 
 from skyroute.cli.db_cmd import REPLACE_HELP, some_days
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
+from skyroute.cli.parse import parse_date
 from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.delivery.day import METHODS, DayResult
 from skyroute.delivery.store import DEFAULT_DB, safe_url
@@ -20,12 +21,7 @@ from skyroute.errors import OptionError, SkyrouteError, check_choice
 
 
 def _date(text: str | None, option: str) -> dt.date | None:
-    if text is None:
-        return None
-    try:
-        return dt.date.fromisoformat(text)
-    except ValueError:
-        raise OptionError(f"{option} {text!r}: expected a date YYYY-MM-DD") from None
+    return None if text is None else parse_date(text, option)
 
 
 def deliver_command(
@@ -181,8 +177,12 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
             plain_console().print(f"wrote {len(files):,} files to {', '.join(s['folders'])}")
         return
     who = f"{workers} job(s)" if kind == "local" else f"{workers} Dask worker(s)"
-    t = Table(title=f"{s['days']} days, {wall:.1f} s with {who}: money delivered "
-                    f"mean {s['mean_pct']:.2f}%, worst {s['min_pct']:.2f}% on {s['min_date']}")
+    # a line of its own: as the title of the narrow monthly table it wrapped at the
+    # table's width ("... money" over "delivered mean 99.24%, worst")
+    plain_console().print(f"{s['days']} days, {wall:.1f} s with {who}: money delivered "
+                          f"mean {s['mean_pct']:.2f}%, worst {s['min_pct']:.2f}% on "
+                          f"{s['min_date']}", soft_wrap=True)
+    t = Table()
     for col in ("month", "days", "mean %", "min %"):
         t.add_column(col, justify="right")
     for m, v in s["months"].items():

@@ -14,6 +14,7 @@ import typer
 from rich.table import Table
 
 from skyroute.cli import world_args as wa
+from skyroute.cli.parse import check_outputs
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console, print_table
 from skyroute.errors import OptionError, check_choice, real
@@ -150,6 +151,7 @@ def fly_command(
     _check_mode_options(ctx, vehicle, mode)
     if out is not None and out.suffix.lower() not in (".json", ".csv", ".geojson"):
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
+    check_outputs(out=out, plot=plot)
     real("radius", radius, low=0.0, strict=True)
     # degrees here; the library's check speaks radians
     real("max_turn", max_turn, low=0.0, strict=True, high=180.0, need="in (0, 180] degrees")

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import datetime as dt
+import re
+
 from skyroute.errors import OptionError
 
 
@@ -16,6 +19,39 @@ def parse_cell(text: str, option: str) -> tuple[int, int]:
         raise OptionError(f"{option} {text!r} must be two integers X,Y (column,row)") from None
 
 
+def parse_date(text: str, option: str) -> dt.date:
+    """``YYYY-MM-DD`` -> a date. A day the calendar lacks (2024-02-30, 2024-13-01) says
+    so; it was "expected a date YYYY-MM-DD", which it is."""
+    try:
+        return dt.date.fromisoformat(text)
+    except ValueError as exc:
+        if re.fullmatch(r"\d{4}-\d{2}-\d{2}", text):
+            raise OptionError(f"{option} {text!r}: no such day ({exc})") from None
+        raise OptionError(f"{option} {text!r}: expected a date YYYY-MM-DD") from None
+
+
 def parse_list(text: str | None) -> list[str]:
     """``"a,b"`` -> ["a", "b"]; empty or None -> []."""
     return [p.strip() for p in (text or "").split(",") if p.strip()]
+
+
+def check_outputs(**files) -> None:
+    """Every file a command writes (``option=path``, ``None`` for not asked; ``plot`` a
+    PNG), checked before its work: a path that cannot be written, or a picture not named
+    ``.png``, is one line naming the option. Checking them all first means that exit 2
+    leaves none written: ``plan --geojson p.geojson --plot /proc/p.png`` wrote the
+    GeoJSON and then failed on the picture; ``--plot p.jpg`` wrote PNG bytes into a
+    ``.jpg``."""
+    from skyroute.errors import SkyrouteError
+    from skyroute.files import check_writable
+
+    for name, path in files.items():
+        if path is None:
+            continue
+        flag = "--" + name.replace("_", "-")
+        if name == "plot" and path.suffix.lower() != ".png":
+            raise OptionError(f"{flag} {path}: pictures are PNG files; name it .png", param=name)
+        try:
+            check_writable(path)
+        except SkyrouteError as exc:
+            raise OptionError(f"{flag} {exc}", param=name) from None

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from skyroute.cli.parse import parse_cell
+from skyroute.cli.parse import check_outputs, parse_cell
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import print_table, result_table
 from skyroute.errors import OptionError
@@ -60,6 +60,7 @@ def plan_command(
     2 for bad input. Output files are written only when a path is found.
     """
     s, t = parse_cell(start, "--start"), parse_cell(goal, "--goal")
+    check_outputs(plot=plot, geojson=geojson)
     opts = grid_options(algorithm, connectivity=connectivity, corner_cutting=corner_cutting,
                         heuristic=heuristic, weight=weight, prune=prune,
                         max_expansions=max_expansions)

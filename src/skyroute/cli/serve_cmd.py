@@ -75,6 +75,7 @@ def serve_command(
         raise OptionError(f"--port {port} must be 1..65535")
     if workers < 1:
         raise OptionError(f"--workers {workers} must be at least 1")
+    check_listen(host, port)
     engine = make_engine(db)  # the store opens and is migrated before anyone asks
     orphans = _fail_orphans(engine)
     engine.dispose()
@@ -109,6 +110,34 @@ def serve_command(
         os.environ[SETTINGS_ENV] = settings.model_dump_json()
         uvicorn.run("skyroute.service.app:app_from_env", factory=True, workers=workers,
                     host=host, port=port, log_level=log_level)
+
+
+def check_listen(host: str, port: int) -> None:
+    """Bind ``host:port`` as uvicorn will, and let it go: a port another server holds, a
+    host name that does not resolve or an address not of this machine is one line naming
+    the option, before the store is opened or the banner printed (uvicorn said it in its
+    log after "skyroute service on ..." and exited 3)."""
+    import errno
+    import socket
+
+    try:
+        family, kind, proto, _, addr = socket.getaddrinfo(
+            host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)[0]
+    except (socket.gaierror, UnicodeError) as exc:
+        raise OptionError(f"--host {host!r}: not an address "
+                          f"({getattr(exc, 'strerror', None) or exc})") from None
+    with socket.socket(family, kind, proto) as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn's own bind
+        try:
+            s.bind(addr)
+        except OSError as exc:
+            why = {errno.EADDRINUSE: "the port is in use (another server?); choose another "
+                                     "--port",
+                   errno.EADDRNOTAVAIL: "the address is not one of this machine's; see "
+                                        "--host",
+                   errno.EACCES: "permission denied (ports below 1024 need privileges)"}
+            raise OptionError(f"--port {port}: cannot listen on {host}:{port}: "
+                              f"{why.get(exc.errno, exc.strerror)}") from None
 
 
 def _fail_orphans(engine) -> list[str]:

@@ -11,6 +11,7 @@ import typer
 from rich.markup import escape  # help is Rich markup: '[north, ...]' would read as a tag
 
 from skyroute.cli import world_args as wa
+from skyroute.cli.parse import check_outputs
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console, print_table, result_table
 from skyroute.errors import OptionError
@@ -71,6 +72,7 @@ def plan_world_command(
                           + " (--samples and --seed: prm; --resolution: the grid algorithms)")
     a = wa.parse_pair(start, "--start", wa.point_names(frame))
     b = wa.parse_pair(goal, "--goal", wa.point_names(frame))
+    check_outputs(waypoints=waypoints_out, geojson=geojson, plot=plot)
     with delayed_status("planning"):  # a roadmap or raster, and a first run's compiles
         world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
                            frame=frame)

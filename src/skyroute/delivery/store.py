@@ -79,6 +79,11 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
         engine = sa.create_engine(url, connect_args=busy)
         with engine.connect():
             pass
+    except sa.exc.NoSuchModuleError:  # a URL, of a kind SQLAlchemy does not know
+        kind = sa.engine.make_url(url).drivername.split("+")[0]
+        raise SkyrouteError(f"url={_safe(url)!r}: SQLAlchemy knows no database {kind!r} "
+                            "(e.g. sqlite:///skyroute.db or postgresql+psycopg://user@"
+                            "127.0.0.1:5432/test)", param="url") from None
     except sa.exc.ArgumentError:
         raise SkyrouteError(f"url={_safe(url)!r}: not a database URL (e.g. "
                             "sqlite:///skyroute.db or postgresql+psycopg://user@127.0.0.1:5432/"
