@@ -178,7 +178,8 @@ def _report_table(rep: dict, files: list[Path]) -> Table:
         ("delivered", f"{rep['delivered']} ({rep['delivered_per_hour']:.1f}/h, served "
                       f"{_fmt(rep['served_share'], '.1%')})"),
         ("capacity bound", _fmt(rep["capacity_bound_per_hour"], ".1f", "/h")
-         + f" (mean cycle {_fmt(rep['mean_cycle_s'], '.0f', ' s')})"),
+         + f" (mean cycle {_fmt(rep['mean_cycle_s'], '.0f', ' s')}, drones busy "
+           f"{_fmt(rep['busy_share'], '.1%')})"),
         ("delivery time p50 / p95", f"{_fmt(rep['p50_delivery_s'], '.0f', ' s')} / "
                                     f"{_fmt(rep['p95_delivery_s'], '.0f', ' s')}"),
         ("longest wait", _fmt(rep["max_wait_s"], ".0f", " s")),

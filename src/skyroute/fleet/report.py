@@ -17,10 +17,20 @@ gate, with nothing after the delivery. ``conflicts``, ``min_horizontal_m`` and
 ``min_vertical_m`` is the least vertical distance of pairs closer than
 ``sep_horizontal`` horizontally (infinite when no pair came that close).
 
-``capacity_bound_per_hour`` is ``drones * 3600 / mean cycle``, the cycle being the time
-a drone spends on one delivered package: the reposition flight when there was one, the
-delivery flight, the hand-over windows (gate to gate, loiters and ground holds
-included). It is what the fleet could deliver with no drone ever idle.
+``capacity_bound_per_hour`` is what the fleet would deliver in the window with no drone
+ever idle, at the drone time it spent per delivered package there: ``drones * 3600 /
+mean_cycle_s``, the cycle being the drones' **busy time** in the window divided by the
+packages delivered in it. A drone is busy with a package from its assignment to the
+hand-over at the destination (a repositioning flight, ground holds, loading, the
+delivery flight with its loiters, unloading), and idle from then until its next
+assignment; a drone works on one package at a time, so its busy spans do not overlap,
+and the fleet's busy time in the window is at most ``drones * window``. Hence
+``delivered_per_hour <= capacity_bound_per_hour`` in every run, equal when no drone was
+idle in the window: the bound is ``delivered_per_hour`` divided by ``busy_share``, the
+drones' busy time over ``drones * window``. Busy time is clipped to the window (work
+before the warm-up on a package delivered in it is not counted, work on a package still
+on its way at the end is), and taken from the assignment and hand-over times as
+``packages.csv`` writes them.
 """
 
 from __future__ import annotations
@@ -122,7 +132,12 @@ def report(run: Simulation, separation: SeparationReport | None = None) -> dict:
     loiter_s = 2 * math.pi * s.drone.turn_radius / s.drone.cruise_speed
     circles = sum(sum(1 for j in range(f.plan.loiters)
                       if f.plan.landing_request + j * loiter_s <= H) for f in flights)
-    cycle = _mean_cycle(run, done)
+    busy = _busy_seconds(run)
+    # the drones' busy share of the window: at most 1 (spans of one drone never
+    # overlap); min() only absorbs the last bits of a float sum, so that a run with no
+    # idle drone reports the bound equal to its rate, never a hair below it
+    share = min(busy / (s.drones * (H - w0)), 1.0)
+    cycle = busy / delivered if delivered else None
     out = {
         "offered": offered,
         "delivered": delivered,
@@ -137,11 +152,12 @@ def report(run: Simulation, separation: SeparationReport | None = None) -> dict:
         "min_horizontal_m": _finite(sep.min_horizontal_m),
         "min_vertical_m": _finite(sep.min_vertical_m),
         "lost": len(lost_packages(run.events, run)),
-        "capacity_bound_per_hour": s.drones * 3600.0 / cycle if cycle else None,
+        "capacity_bound_per_hour": delivered / hours / share if cycle else None,
         "simulated_hours": run.hours,
         "wall_seconds": run.wall_seconds,
         "offered_per_hour": offered / hours,
         "mean_cycle_s": cycle,
+        "busy_share": share,
         "flights": len(flights),
         "reposition_flights": sum(f.kind == "reposition" for f in flights),
         "sim_seconds_per_wall_second": H / run.wall_seconds if run.wall_seconds else None,
@@ -162,21 +178,15 @@ def _finite(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
-def _mean_cycle(run: Simulation, done: np.ndarray) -> float | None:
-    """Mean drone time per package delivered in the window (see the module docstring):
-    the union of its flights' ``[depart - handover, at gate + handover]``."""
-    H = run.scenario.handover_seconds
-    spans: dict[int, list[tuple[float, float]]] = {}
-    for f in run.flights:
-        spans.setdefault(f.package, []).append((f.plan.depart - H, f.plan.at_gate + H))
-    ids = np.flatnonzero(done)
-    if len(ids) == 0:
-        return None
-    total = []
-    for p in ids:
-        busy, end = 0.0, -math.inf
-        for a, b in sorted(spans[int(p)]):
-            busy += b - max(a, end) if b > end else 0.0
-            end = max(end, b)
-        total.append(busy)
-    return float(np.mean(total))
+def _busy_seconds(run: Simulation) -> float:
+    """The drones' busy time in the measured window (see the module docstring): for
+    every package assigned by the horizon, ``[assigned, hand-over]`` (to the horizon when
+    not handed over by then) clipped to ``[warm-up, horizon]``, times as the files write
+    them (rounding keeps their order, so one drone's spans still do not overlap)."""
+    H = run.horizon
+    a, d = run.assigned, run.delivered
+    given = a <= H  # not NaN
+    w0 = WARMUP_SHARE * H
+    start = np.clip(written(a[given]), w0, H)
+    end = np.clip(np.where(d[given] <= H, written(d[given]), H), w0, H)
+    return float((end - start).sum())
