@@ -6,6 +6,7 @@ run the real jobs and skip while it is missing."""
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import json
 import sys
@@ -510,6 +511,81 @@ def test_a_runs_files_are_streamed_as_stored(tmp_path, request, db):
         for name in want:
             assert_problem(c.get(f"/fleet/runs/nope/{name}"), 404, words="no fleet run 'nope'")
     assert part == store.PART_BYTES
+
+
+@contextlib.contextmanager
+def part_reads():
+    """The parts of a run's files read while in the block, by any engine: a part's
+    number for a statement that reads one part, "all" for one that reads a file whole."""
+    import sqlalchemy as sa
+
+    seen: list = []
+
+    def record(conn, clause, multiparams, params, execution_options):
+        cols = getattr(clause, "selected_columns", ())
+        if any(getattr(c, "name", None) == "data" and getattr(c, "table", None) is not None
+               and c.table.name == "fleet_run_files" for c in cols):
+            p = multiparams[0] if multiparams else params
+            seen.append((p or {}).get("k", "all"))
+
+    sa.event.listen(sa.engine.Engine, "before_execute", record)
+    try:
+        yield seen
+    finally:
+        sa.event.remove(sa.engine.Engine, "before_execute", record)
+
+
+def _store_big_run(url: str) -> tuple[str, dict]:
+    """A run whose files span parts: 2.1 MB of tracks, 2.5 MB of events (lines that
+    cross the parts' boundaries); its id and files as saved."""
+    import numpy as np
+
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    eng = make_engine(url)
+    part = store.PART_BYTES
+    tracks = np.random.default_rng(3).integers(0, 256, 2 * part + 12345,
+                                               dtype=np.uint8).tobytes()
+    events, i = [], 0
+    while sum(map(len, events)) < 2.5 * part:
+        events.append(json.dumps({"t": i / 8, "kind": "spawn", "at": "Café " * (i % 40),
+                                  "drone": i % 997}, separators=(",", ":")) + "\n")
+        i += 1
+    files = {"events_jsonl": "".join(events), "tracks_csv": tracks,
+             "packages_csv": "id\n0\n", "fleet_geojson": '{"type":"FeatureCollection"}'}
+    run = store.save_fleet_run(eng, scenario="seed-3x3", params={}, report={}, **files)
+    eng.dispose()
+    return run, files
+
+
+@needs_jobs
+@pytest.mark.parametrize("db", ["sqlite", "postgresql"])
+def test_a_head_of_a_runs_file_reads_no_part(tmp_path, request, db):
+    """HEAD on each file route is GET's status and headers (the length among them) from
+    the file's size alone: not one part read, where GET reads each part once."""
+    url = (f"sqlite:///{tmp_path / 'runs.db'}" if db == "sqlite"
+           else request.getfixturevalue("fresh_pg"))
+    run, files = _store_big_run(url)
+    with make_client(db_url=url) as c:
+        for name, key in [("tracks.csv", "tracks_csv"), ("events.jsonl", "events_jsonl"),
+                          ("packages.csv", "packages_csv"),
+                          ("fleet.geojson", "fleet_geojson")]:
+            size = len(files[key] if isinstance(files[key], bytes)
+                       else files[key].encode())
+            with part_reads() as reads:
+                head = c.head(f"/fleet/runs/{run}/{name}")
+            assert head.status_code == 200 and head.content == b"", name
+            assert reads == [], name
+            with part_reads() as reads:
+                get = c.get(f"/fleet/runs/{run}/{name}")
+            assert reads == list(range(-(-size // (1 << 20)))), name
+            assert len(get.content) == size == int(head.headers["content-length"])
+            assert ({k: v for k, v in head.headers.items() if k != "server-timing"}
+                    == {k: v for k, v in get.headers.items() if k != "server-timing"})
+        nope = c.head(f"/fleet/runs/nope/{name}")
+        assert nope.status_code == 404 and nope.content == b""
+        assert nope.headers["content-type"] == "application/problem+json"
 
 
 @needs_jobs

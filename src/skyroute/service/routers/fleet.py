@@ -1,7 +1,8 @@
 """Stored fleet runs: ``GET /fleet/runs``, ``GET /fleet/runs/{id}`` (report, scenario
 and a page of events: ``?offset&limit``) and the run's files ``events.jsonl``,
 ``tracks.csv`` and ``fleet.geojson``, streamed from the store part by part
-(:func:`skyroute.jobs.store.open_fleet_file`) with their length up front.
+(:func:`skyroute.jobs.store.open_fleet_file`) with their length up front; a HEAD of a
+file is its headers from the size alone, no part read.
 
 Runs are written by fleet jobs (:mod:`skyroute.jobs.store`, imported on first use;
 without it these endpoints answer 503).
@@ -16,6 +17,7 @@ from fastapi import APIRouter, Path, Query, Response
 from fastapi.responses import StreamingResponse
 from pydantic import BaseModel, Field
 
+from skyroute.service.middleware import is_head
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import Resources, ResourcesDep
 
@@ -151,11 +153,24 @@ def _stored(res: Resources, run_id: str, key: str):
     return f
 
 
+class _StoredResponse(StreamingResponse):
+    """A stored file's response: to a HEAD request only its headers (the length is known
+    up front), no part read from the store; to a GET its parts as the store reads them."""
+
+    async def __call__(self, scope, receive, send) -> None:
+        if not is_head(scope):
+            await super().__call__(scope, receive, send)
+            return
+        await send({"type": "http.response.start", "status": self.status_code,
+                    "headers": self.raw_headers})
+        await send({"type": "http.response.body", "body": b"", "more_body": False})
+
+
 def _stream(f, media_type: str, name: str) -> StreamingResponse:
     """The stored file ``f`` sent as the store reads it, part by part (at most
     ``PART_BYTES`` held at a time, not the whole file: a big run's tracks are about
-    150 MB), with its length up front."""
-    return StreamingResponse(iter(f), media_type=media_type, headers={
+    150 MB), with its length up front; to a HEAD request the same headers alone."""
+    return _StoredResponse(iter(f), media_type=media_type, headers={
         "Content-Length": str(f.size),
         "Content-Disposition": f'attachment; filename="{name}"'})
 
