@@ -1,8 +1,8 @@
 """Stored fleet runs: ``GET /fleet/runs``, ``GET /fleet/runs/{id}`` (report, scenario
-and a page of events: ``?offset&limit``) and the run's files ``events.jsonl``,
-``tracks.csv`` and ``fleet.geojson``, streamed from the store part by part
-(:func:`skyroute.jobs.store.open_fleet_file`) with their length up front; a HEAD of a
-file is its headers from the size alone, no part read.
+and a page of events: ``?offset&limit``, read from the parts of events.jsonl it lies in)
+and the run's files ``events.jsonl``, ``tracks.csv`` and ``fleet.geojson``, streamed
+from the store part by part (:func:`skyroute.jobs.store.open_fleet_file`) with their
+length up front; a HEAD of a file is its headers from the size alone, no part read.
 
 Runs are written by fleet jobs (:mod:`skyroute.jobs.store`, imported on first use;
 without it these endpoints answer 503).
@@ -120,22 +120,34 @@ def list_runs(res: ResourcesDep) -> list[dict]:
     return out
 
 
-@router.get("/fleet/runs/{run_id}", response_model=Run, responses=responses(404, 422, 503),
+@router.get("/fleet/runs/{run_id}", response_model=Run,
+            responses=responses(404, 409, 422, 503),
             summary="A fleet run: report, scenario, a page of events")
 def get_run(run_id: RunId, res: ResourcesDep,
             offset: Annotated[int, Query(ge=0)] = 0,
             limit: Annotated[int, Query(ge=1, le=10_000)] = 1000) -> dict:
-    run = _run(res, run_id, "events_jsonl", "packages_csv")
-    lines = _text(run, "events", "events_jsonl").splitlines()
-    page = [json.loads(x) for x in lines[offset:offset + limit]]
+    store = _store()
+    for _ in range(3):  # a run replaced while it was read: read the new one
+        events = _stored(res, run_id, "events_jsonl")
+        try:  # the parts the page lies in, not the whole file (hundreds of MB at most)
+            lines, total = events.lines(offset, limit)
+        except store.RunChangedError:
+            continue
+        run = _run(res, run_id)
+        packages = _stored(res, run_id, "packages_csv")
+        if run.get("created") == events.created == packages.created:
+            break
+    else:
+        raise Problem(409, f"fleet run {run_id!r} was replaced again and again while it "
+                      "was read; ask again", kind="run-changed")
     base = f"/fleet/runs/{run_id}"
     names = ["events.jsonl", "tracks.csv", "fleet.geojson"]
-    if _text(run, "packages_csv", "packages"):  # a run stored without it: a 404 there
+    if packages.size:  # a run stored without it: a 404 there
         names.append("packages.csv")
     return {"id": str(run["id"]), "report": _as_dict(run.get("report")),
             "scenario": _scenario(run), "params": _as_dict(run.get("params")),
-            "events": page, "offset": offset, "limit": limit, "events_total": len(lines),
-            "files": {k: f"{base}/{k}" for k in names}}
+            "events": [json.loads(x) for x in lines], "offset": offset, "limit": limit,
+            "events_total": total, "files": {k: f"{base}/{k}" for k in names}}
 
 
 def _file(content: str | bytes, media_type: str, name: str) -> Response:
