@@ -72,7 +72,7 @@ def test_range_prints_a_monthly_table(monkeypatch, capsys, tmp_path, fly_once):
 def test_db_init_and_import(monkeypatch, capsys, tmp_path):
     db = f"sqlite:///{tmp_path / 'i.db'}"
     code, out, _ = run(monkeypatch, capsys, "db", "init", "--db", db)
-    assert code == 0 and "revision 0005" in out
+    assert code == 0 and "revision 0006" in out
     code, out, _ = run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", db)
     assert code == 0 and "108 orders added" in " ".join(out.split())
     code, out, _ = run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", db)
@@ -259,7 +259,7 @@ def test_db_lines_do_not_wrap(monkeypatch, capsys, tmp_path):
     monkeypatch.setenv("COLUMNS", "40")
     db = f"sqlite:///{tmp_path / ('long-store-name-' * 4)}.db"
     code, out, err = run(monkeypatch, capsys, "db", "init", "--db", db)
-    assert code == 0 and out.strip() == f"{db}: schema at revision 0005", err
+    assert code == 0 and out.strip() == f"{db}: schema at revision 0006", err
     code, out, err = run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", db)
     assert code == 0 and len(out.strip().splitlines()) == 1, err
     assert out.startswith(f"{db}: 108 orders added")

@@ -48,7 +48,7 @@ def moves(n: int, label: str = "aaaaaaaa"):
 @pytest.fixture
 def engine(tmp_path):
     e = store.connect(f"sqlite:///{tmp_path / 'store.db'}")
-    assert store.init(e) == "0005"
+    assert store.init(e) == "0006"
     return e
 
 
@@ -56,7 +56,7 @@ def test_init_makes_the_issues_tables_and_is_repeatable(engine):
     insp = sa.inspect(engine)
     for table, cols in COLUMNS.items():
         assert [c["name"] for c in insp.get_columns(table)] == cols
-    assert store.init(engine) == "0005"  # again: nothing to do
+    assert store.init(engine) == "0006"  # again: nothing to do
 
 
 def test_import_is_idempotent(engine):
@@ -234,7 +234,7 @@ def test_a_new_store_made_by_two_processes_at_once(tmp_path):
                               cwd=str(Path(__file__).parents[2])) for _ in range(3)]
     outs = [p.communicate(timeout=60)[0] for p in procs]
     done = [(p.returncode, out) for p, out in zip(procs, outs, strict=True)]
-    assert done == [(0, "0005\n")] * 3
+    assert done == [(0, "0006\n")] * 3
 
 
 def test_a_store_locked_too_long_is_one_line(tmp_path):
@@ -274,7 +274,7 @@ def test_a_new_postgresql_store_made_by_two_runs_at_once(fresh_pg):
                               stderr=subprocess.PIPE, text=True,
                               cwd=str(Path(__file__).parents[2])) for _ in range(4)]
     done = [(p.communicate(timeout=60), p.returncode) for p in procs]
-    assert [(out, rc) for (out, _), rc in done] == [("0005\n", 0)] * 4, done
+    assert [(out, rc) for (out, _), rc in done] == [("0006\n", 0)] * 4, done
 
 
 @pytest.mark.parametrize("stored_before", [False, True])

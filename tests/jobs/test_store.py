@@ -1,12 +1,13 @@
-"""The jobs, fleet_runs, servers and fleet_run_files tables: migrations 0002 to 0005 (also
-over a 0001 store with its days, a 0002 store with its jobs and a 0003 or 0004 store with
-its fleet runs, and back), a job's life, orphans, fleet runs
-with their files, stored in parts and streamed, on SQLite and PostgreSQL alike."""
+"""The jobs, fleet_runs, servers and fleet_run_files tables: migrations 0002 to 0006 (also
+over a 0001 store with its days, a 0002 store with its jobs and a 0003, 0004 or 0005 store
+with its fleet runs, and back), a job's life, orphans, fleet runs with their files,
+stored in parts, streamed and paged by lines, on SQLite and PostgreSQL alike."""
 
 from __future__ import annotations
 
 import datetime as dt
 import uuid
+from functools import partial
 from pathlib import Path
 
 import pytest
@@ -21,9 +22,9 @@ COLUMNS = {
              "updated", "owner"],
     "fleet_runs": ["id", "job_id", "scenario", "params", "report", "created"],
     "servers": ["id", "started", "heartbeat"],
-    "fleet_run_files": ["run_id", "name", "part", "data"],
+    "fleet_run_files": ["run_id", "name", "part", "data", "lines"],
 }
-HEAD = "0005"
+HEAD = "0006"
 
 
 def upgrade_to(engine, revision: str) -> None:
@@ -229,6 +230,71 @@ def test_a_run_changed_while_its_file_streams_stops_the_stream(engine, monkeypat
         next(parts)
 
 
+def _part_reads(engine, run):
+    """(what ``run()`` returned, the parts whose bytes it read: a part's number for a
+    read of one part, "all" for a statement that reads a file's bytes whole)."""
+    seen: list = []
+
+    def record(conn, clause, multiparams, params, execution_options):
+        cols = getattr(clause, "selected_columns", ())
+        if any(getattr(c, "name", None) == "data" and getattr(c, "table", None) is not None
+               and c.table.name == "fleet_run_files" for c in cols):
+            p = multiparams[0] if multiparams else params
+            seen.append((p or {}).get("k", "all"))
+
+    sa.event.listen(engine, "before_execute", record)
+    try:
+        return run(), seen
+    finally:
+        sa.event.remove(engine, "before_execute", record)
+
+
+def _jsonl(n: int, end: str) -> str:
+    """``n`` JSON lines of 10 to 270 bytes (some longer than a part of 100), with
+    two-byte characters a part boundary may cut, the last one ended by ``end``."""
+    import json
+
+    import numpy as np
+
+    rng = np.random.default_rng(n)
+    return "\n".join(json.dumps({"t": i, "at": "é" * int(rng.integers(0, 130))},
+                                ensure_ascii=False) for i in range(n)) + end
+
+
+@pytest.mark.parametrize("end", ["\n", ""])
+def test_a_page_of_lines_is_read_from_the_parts_it_lies_in(engine, monkeypatch, end):
+    """StoredFile.lines(offset, limit) is splitlines()[offset:offset + limit] and its
+    length, for every offset, lines crossing parts and a last line with or without its
+    newline; it reads the parts from the one with the newline before the page's first
+    line to the one with the page's last line's end, and no other (none past the end)."""
+    monkeypatch.setattr(store, "PART_BYTES", 100)
+    text = _jsonl(40, end)
+    run = store.save_fleet_run(engine, scenario="s", params={}, report={},
+                               events_jsonl=text, tracks_csv=b"", packages_csv="",
+                               fleet_geojson="")
+    data, want = text.encode(), text.splitlines()
+    newlines = [i for i, b in enumerate(data) if b == ord("\n")]
+    f = store.open_fleet_file(engine, run, "events_jsonl")
+    assert f.parts == -(-len(data) // 100) > 25
+    for offset in range(len(want) + 2):
+        for limit in (1, 2, 7, len(want) + 5):
+            (got, total), reads = _part_reads(engine, partial(f.lines, offset, limit))
+            assert total == len(want)
+            assert [g.decode() for g in got] == want[offset:offset + limit], (offset, limit)
+            n = len(want[offset:offset + limit])
+            if not n:
+                assert reads == []
+                continue
+            first = newlines[offset - 1] // 100 if offset else 0
+            end_at = newlines[offset + n - 1] if offset + n <= len(newlines) else len(data) - 1
+            assert reads == list(range(first, end_at // 100 + 1)), (offset, limit)
+    empty = store.save_fleet_run(engine, scenario="s", params={}, report={},
+                                 events_jsonl="", tracks_csv=b"", packages_csv="",
+                                 fleet_geojson="")
+    assert _part_reads(engine, lambda: store.open_fleet_file(
+        engine, empty, "events_jsonl").lines(0, 5)) == (([], 0), [])
+
+
 @pytest.fixture(params=["sqlite", "postgresql"])
 def new_store(request, tmp_path):
     """An engine on a new empty store: a SQLite file, or a PostgreSQL database of this
@@ -356,6 +422,63 @@ def test_upgrading_a_0004_store_splits_its_files_and_downgrading_joins_them(new_
     assert got[new, "events_jsonl"] == "é".encode()
     assert dstore.init(e) == HEAD  # and up again
     assert store.get_fleet_run(e, new)["tracks_csv"] == big[:store.PART_BYTES + 1]
+
+
+def test_upgrading_a_0005_store_counts_its_events_lines_and_downgrading_drops_them(
+        new_store):
+    """0006 counts the lines of each stored part of events.jsonl (a line may cross
+    parts; the last may lack its newline) and leaves the other files' counts NULL, which
+    a page of lines then counts from the bytes; the downgrade drops the counts alone."""
+    e = new_store
+    upgrade_to(e, "0005")
+    md = sa.MetaData()
+    md.reflect(e, only=("fleet_runs", "fleet_run_files"))
+    parts = {"events_jsonl": [b'{"a":1}\n{"b', b'":"\xc3', b'\xa9"}\n\n', b'{"c":3}'],
+             "tracks_csv": [b"t,drone\n0,1\n", b"1,2\n"], "packages_csv": [b""],
+             "fleet_geojson": [b"{}"]}
+    with e.begin() as c:
+        c.execute(md.tables["fleet_runs"].insert().values(
+            id="run-a", job_id=None, scenario="s", params={}, report={},
+            created=dt.datetime(2024, 1, 1, 12)))
+        c.execute(md.tables["fleet_run_files"].insert(), [
+            {"run_id": "run-a", "name": k, "part": i, "data": d}
+            for k, v in parts.items() for i, d in enumerate(v)])
+    assert dstore.init(e) == HEAD
+    with e.connect() as c:
+        rows = c.execute(sa.text("select name, part, lines from fleet_run_files "
+                                 "order by name, part")).all()
+    assert [tuple(r) for r in rows] == [
+        ("events_jsonl", 0, 1), ("events_jsonl", 1, 0), ("events_jsonl", 2, 2),
+        ("events_jsonl", 3, 1), ("fleet_geojson", 0, None), ("packages_csv", 0, None),
+        ("tracks_csv", 0, None), ("tracks_csv", 1, None)]
+    assert "fleet_run_files_lines" in {i["name"] for i in sa.inspect(e).get_indexes(
+        "fleet_run_files")}
+    events = store.open_fleet_file(e, "run-a", "events_jsonl")
+    text = b"".join(parts["events_jsonl"]).decode()
+    assert events.lines(1, 9) == ([x.encode() for x in text.splitlines()[1:]], 4)
+    assert _part_reads(e, lambda: events.lines(3, 1)) == (([b'{"c":3}'], 4), [2, 3])
+    tracks = store.open_fleet_file(e, "run-a", "tracks_csv")  # no counts: read them
+    assert tracks.lines(1, 1) == ([b"0,1"], 3)
+
+    from alembic import command
+    from alembic.config import Config
+
+    cfg = Config()
+    cfg.set_main_option("script_location", str(Path(dstore.__file__).parent / "migrations"))
+    with e.begin() as conn:
+        cfg.attributes["connection"] = conn
+        command.downgrade(cfg, "0005")
+    assert [c["name"] for c in sa.inspect(e).get_columns("fleet_run_files")] == \
+        ["run_id", "name", "part", "data"]
+    assert "fleet_run_files_lines" not in {i["name"] for i in sa.inspect(e).get_indexes(
+        "fleet_run_files")}
+    with e.connect() as c:
+        got = c.execute(sa.text("select name, data from fleet_run_files "
+                                "order by name, part")).all()
+    assert {k: [bytes(d) for n, d in got if n == k] for k in parts} == parts
+    assert dstore.init(e) == HEAD  # and up again
+    assert store.open_fleet_file(e, "run-a", "events_jsonl").lines(0, 1) == \
+        ([b'{"a":1}'], 4)
 
 
 @pytest.fixture(params=["sqlite", "postgresql"])

@@ -6,7 +6,9 @@ run the real jobs and skip while it is missing."""
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
+import itertools
 import json
 import sys
 import time
@@ -69,6 +71,7 @@ class FakeJobs:
         runner.get = lambda engine, i: self.jobs.get(i)
         store.get_fleet_run = self.get_fleet_run
         store.open_fleet_file = self.open_fleet_file
+        store.RunChangedError = type("RunChangedError", (Exception,), {})
         store.list_fleet_runs = lambda engine: list(self.runs.values())
         executor.open_executor = lambda kind="local", address=None, workers=None: \
             types.SimpleNamespace(kind=kind, close=lambda: None)
@@ -92,9 +95,14 @@ class FakeJobs:
 
 class FakeFile:
     PART = 1000
+    created = None  # as the stand-in's runs say (they have no "created")
 
     def __init__(self, data: bytes):
         self.data, self.size = data, len(data)
+
+    def lines(self, offset: int, limit: int) -> tuple[list[bytes], int]:
+        lines = self.data.splitlines()
+        return lines[offset:offset + limit], len(lines)
 
     def __iter__(self):
         for a in range(0, max(1, self.size), self.PART):
@@ -299,8 +307,8 @@ def test_fleet_run_pages_and_files(client, fake, small_run, layout):
 
 
 @pytest.mark.parametrize("path, reads", [
-    ("", [("events_jsonl", "packages_csv")]),  # a page of events; packages.csv listed?
-    ("?offset=5&limit=2", [("events_jsonl", "packages_csv")]),
+    ("", [("events_jsonl",), (), ("packages_csv",)]),  # a page; packages.csv listed?
+    ("?offset=5&limit=2", [("events_jsonl",), (), ("packages_csv",)]),
     ("/events.jsonl", [("events_jsonl",)]),
     ("/tracks.csv", [("tracks_csv",)]),
     ("/packages.csv", [("packages_csv",)]),
@@ -510,6 +518,154 @@ def test_a_runs_files_are_streamed_as_stored(tmp_path, request, db):
         for name in want:
             assert_problem(c.get(f"/fleet/runs/nope/{name}"), 404, words="no fleet run 'nope'")
     assert part == store.PART_BYTES
+
+
+@contextlib.contextmanager
+def part_reads():
+    """The parts of a run's files read while in the block, by any engine: a part's
+    number for a statement that reads one part, "all" for one that reads a file whole."""
+    import sqlalchemy as sa
+
+    seen: list = []
+
+    def record(conn, clause, multiparams, params, execution_options):
+        cols = getattr(clause, "selected_columns", ())
+        if any(getattr(c, "name", None) == "data" and getattr(c, "table", None) is not None
+               and c.table.name == "fleet_run_files" for c in cols):
+            p = multiparams[0] if multiparams else params
+            seen.append((p or {}).get("k", "all"))
+
+    sa.event.listen(sa.engine.Engine, "before_execute", record)
+    try:
+        yield seen
+    finally:
+        sa.event.remove(sa.engine.Engine, "before_execute", record)
+
+
+def _store_big_run(url: str) -> tuple[str, dict]:
+    """A run whose files span parts: 2.1 MB of tracks, 2.5 MB of events (lines that
+    cross the parts' boundaries); its id and files as saved."""
+    import numpy as np
+
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    eng = make_engine(url)
+    part = store.PART_BYTES
+    tracks = np.random.default_rng(3).integers(0, 256, 2 * part + 12345,
+                                               dtype=np.uint8).tobytes()
+    events, i = [], 0
+    while sum(map(len, events)) < 2.5 * part:
+        events.append(json.dumps({"t": i / 8, "kind": "spawn", "at": "Café " * (i % 40),
+                                  "drone": i % 997}, separators=(",", ":")) + "\n")
+        i += 1
+    files = {"events_jsonl": "".join(events), "tracks_csv": tracks,
+             "packages_csv": "id\n0\n", "fleet_geojson": '{"type":"FeatureCollection"}'}
+    run = store.save_fleet_run(eng, scenario="seed-3x3", params={}, report={}, **files)
+    eng.dispose()
+    return run, files
+
+
+@needs_jobs
+@pytest.mark.parametrize("db", ["sqlite", "postgresql"])
+def test_a_head_of_a_runs_file_reads_no_part(tmp_path, request, db):
+    """HEAD on each file route is GET's status and headers (the length among them) from
+    the file's size alone: not one part read, where GET reads each part once."""
+    url = (f"sqlite:///{tmp_path / 'runs.db'}" if db == "sqlite"
+           else request.getfixturevalue("fresh_pg"))
+    run, files = _store_big_run(url)
+    with make_client(db_url=url) as c:
+        for name, key in [("tracks.csv", "tracks_csv"), ("events.jsonl", "events_jsonl"),
+                          ("packages.csv", "packages_csv"),
+                          ("fleet.geojson", "fleet_geojson")]:
+            size = len(files[key] if isinstance(files[key], bytes)
+                       else files[key].encode())
+            with part_reads() as reads:
+                head = c.head(f"/fleet/runs/{run}/{name}")
+            assert head.status_code == 200 and head.content == b"", name
+            assert reads == [], name
+            with part_reads() as reads:
+                get = c.get(f"/fleet/runs/{run}/{name}")
+            assert reads == list(range(-(-size // (1 << 20)))), name
+            assert len(get.content) == size == int(head.headers["content-length"])
+            assert ({k: v for k, v in head.headers.items() if k != "server-timing"}
+                    == {k: v for k, v in get.headers.items() if k != "server-timing"})
+        nope = c.head(f"/fleet/runs/nope/{name}")
+        assert nope.status_code == 404 and nope.content == b""
+        assert nope.headers["content-type"] == "application/problem+json"
+
+
+@needs_jobs
+@pytest.mark.parametrize("db", ["sqlite", "postgresql"])
+def test_a_page_of_events_reads_the_parts_it_lies_in(tmp_path, request, db):
+    """GET /fleet/runs/{id} pages events.jsonl from its stored parts: a page from the
+    start reads the first part alone, a page across a part boundary the two parts, a
+    page past the end none; each page is what splitlines() of the whole file gave (the
+    same events and events_total), lines crossing parts included."""
+    url = (f"sqlite:///{tmp_path / 'runs.db'}" if db == "sqlite"
+           else request.getfixturevalue("fresh_pg"))
+    run, files = _store_big_run(url)
+    data = files["events_jsonl"].encode()
+    lines = files["events_jsonl"].splitlines()
+    ends = list(itertools.accumulate(len(x.encode()) + 1 for x in lines))  # after "\n"
+    part = 1 << 20
+    # the first line that crosses each boundary between parts
+    crossing = [next(i for i, e in enumerate(ends) if e > b) for b in (part, 2 * part)]
+    assert all(ends[i] - len(lines[i].encode()) - 1 < b
+               for i, b in zip(crossing, (part, 2 * part), strict=True))
+    with make_client(db_url=url) as c:
+        for offset, limit, want_reads in [
+                (0, 1000, [0]), (0, 1, [0]), (5, 3, [0]),
+                (crossing[0] - 1, 3, [0, 1]), (crossing[0], 1, [0, 1]),
+                (crossing[0] + 1, 10, [1]), (crossing[1], 2, [1, 2]),
+                (len(lines) - 3, 10, [2]), (len(lines), 10, []),
+                (0, 10_000, [0, 1, 2])]:
+            with part_reads() as reads:
+                r = c.get(f"/fleet/runs/{run}?offset={offset}&limit={limit}")
+            assert r.status_code == 200, r.text
+            doc = r.json()
+            assert doc["events"] == [json.loads(x) for x in lines[offset:offset + limit]]
+            assert doc["events_total"] == len(lines)
+            assert reads == want_reads, (offset, limit, reads)
+        assert "packages.csv" in doc["files"]
+    assert len(data) > 2 * part
+
+
+@needs_jobs
+@pytest.mark.parametrize("times", [1, 3])
+def test_a_page_of_a_run_replaced_while_read_is_of_one_version(tmp_path, monkeypatch,
+                                                              times):
+    """A run saved again under its id while a page of its events is read: the page and
+    the report are read again, both of the new run (never the old run's events under
+    the new report); a run replaced on every read is a 409 problem."""
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    url = f"sqlite:///{tmp_path / 'runs.db'}"
+    eng = make_engine(url)
+    args = dict(scenario="seed-3x3", params={}, tracks_csv=b"", packages_csv="",
+                fleet_geojson="", run_id="r")
+    store.save_fleet_run(eng, report={"v": 0}, events_jsonl='{"v":0}\n', **args)
+    versions = iter(range(1, times + 1))
+    lines = store.StoredFile.lines
+
+    def replaced_meanwhile(self, offset, limit):
+        page = lines(self, offset, limit)
+        v = next(versions, None)
+        if v is not None:
+            store.save_fleet_run(eng, report={"v": v}, events_jsonl=f'{{"v":{v}}}\n',
+                                 **args)
+        return page
+
+    monkeypatch.setattr(store.StoredFile, "lines", replaced_meanwhile)
+    with make_client(db_url=url) as c:
+        r = c.get("/fleet/runs/r")
+        if times == 3:
+            assert_problem(r, 409, words="fleet run 'r' was replaced again and again")
+        else:
+            assert r.status_code == 200, r.text
+            assert (r.json()["report"], r.json()["events"]) == ({"v": 1}, [{"v": 1}])
+    eng.dispose()
 
 
 @needs_jobs

@@ -9,7 +9,8 @@ Tables (the course's schemas plus the day and order of moves):
 - ``runs(delivery_date, started, finished, moves, money_delivered, money_placed, ...)``
 
 and, from revision 0002, ``jobs`` and ``fleet_runs`` (:mod:`skyroute.jobs.store`); from
-0003, ``jobs.owner`` and ``servers``; from 0004, ``fleet_run_files`` (in parts from 0005).
+0003, ``jobs.owner`` and ``servers``; from 0004, ``fleet_run_files`` (in parts from 0005,
+with their line counts from 0006).
 
 A SQLite file by default, PostgreSQL (or any SQLAlchemy URL) by ``--db``. The schema is
 made and upgraded by Alembic migrations shipped in the package (``db init`` runs them).

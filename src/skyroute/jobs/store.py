@@ -1,7 +1,7 @@
 """Jobs and fleet runs in the SQL store of the delivery days (same database, same
 migrations: revision 0002 adds the jobs and fleet_runs tables, 0003 the jobs' owners and
-the servers, 0004 moves the runs' files to fleet_run_files, 0005 splits them in parts;
-``skyroute db init`` upgrades to the newest).
+the servers, 0004 moves the runs' files to fleet_run_files, 0005 splits them in parts,
+0006 counts each part's lines; ``skyroute db init`` upgrades to the newest).
 
 - ``jobs(id, kind, params, state, progress, result, error, created, updated, owner)``:
   ``state`` is ``queued``, ``running``, ``done`` or ``failed``; ``progress`` 0..1;
@@ -18,16 +18,19 @@ the servers, 0004 moves the runs' files to fleet_run_files, 0005 splits them in 
   unfinished jobs of owners silent for longer than ``dead_after``, or known to have
   ended (``gone``: the runner tells those of its own machine by their process ids).
 - ``fleet_runs(id, job_id, scenario, params, report, created)``: a fleet run's
-  ``report.json`` and what made it; ``fleet_run_files(run_id, name, part, data)`` its
-  files in parts of at most :data:`PART_BYTES`, one row each (``name`` one of
+  ``report.json`` and what made it; ``fleet_run_files(run_id, name, part, data, lines)``
+  its files in parts of at most :data:`PART_BYTES`, one row each (``name`` one of
   :data:`FILES`; ``part`` 0, 1, ...; ``data`` the part's bytes, text as UTF-8; an empty
-  file is one empty part): ``events.jsonl``, ``tracks.csv``, ``packages.csv`` and
-  ``fleet.geojson`` as :mod:`skyroute.io.fleet_out` writes them (a big run's tracks are
-  big: 1 s rows of 1000 drones for an hour are about 150 MB; use a coarser
-  ``track_step``). The files live apart so that listing runs or reading one file never
-  reads through the tracks (SQLite keeps a row's columns in order), and in parts so
-  that :func:`open_fleet_file` streams one part per read (a slice of one big value costs
-  a read of the value up to the slice on both databases). No run names a failed job:
+  file is one empty part; ``lines`` the lines that end in the part, :func:`part_lines`,
+  NULL in the files but events.jsonl of runs stored before 0006): ``events.jsonl``,
+  ``tracks.csv``, ``packages.csv`` and ``fleet.geojson`` as :mod:`skyroute.io.fleet_out`
+  writes them (a big run's tracks are big: 1 s rows of 1000 drones for an hour are
+  about 150 MB; use a coarser ``track_step``). The files live apart so that listing
+  runs or reading one file never reads through the tracks (SQLite keeps a row's columns
+  in order), and in parts so that :func:`open_fleet_file` streams one part per read (a
+  slice of one big value costs a read of the value up to the slice on both databases)
+  and pages a file's lines from the parts they lie in (:meth:`StoredFile.lines`; the
+  counts are read from an index of their own). No run names a failed job:
   failing a job deletes its runs in the same transaction, and :func:`save_fleet_run`
   refuses (:class:`JobEndedError`) a run of a job already failed.
 
@@ -288,18 +291,27 @@ def save_fleet_run(engine: sa.Engine, *, scenario: str, params: dict, report: di
             id=run_id, job_id=job_id, scenario=scenario, params=json_safe(params),
             report=json_safe(report), created=_now()))
         for name in FILES:  # a part at a time: no second copy of the tracks in a list
-            for k, part in enumerate(_parts(data.pop(name))):
+            for k, (part, last) in enumerate(_parts(data.pop(name))):
                 c.execute(stored.insert().values(run_id=run_id, name=name, part=k,
-                                                 data=part))
+                                                 data=part, lines=part_lines(part, last)))
     return run_id
 
 
-def _parts(data: bytes) -> Iterator[bytes]:
-    """``data`` in parts of :data:`PART_BYTES` (the last one shorter); an empty file is
-    one empty part, so every stored file has a row."""
+def _parts(data: bytes) -> Iterator[tuple[bytes, bool]]:
+    """``data`` in parts of :data:`PART_BYTES` (the last one shorter), each with whether
+    it is the last; an empty file is one empty part, so every stored file has a row."""
     view = memoryview(data)
-    for a in range(0, max(1, len(view)), PART_BYTES):
-        yield bytes(view[a:a + PART_BYTES])
+    n = max(1, len(view))
+    for a in range(0, n, PART_BYTES):
+        yield bytes(view[a:a + PART_BYTES]), a + PART_BYTES >= n
+
+
+def part_lines(data: bytes, last: bool) -> int:
+    """The lines that end in a part of a file (``fleet_run_files.lines``): its newlines,
+    and one more in the file's ``last`` part when the file ends without one. A file's
+    lines are the sum over its parts; the parts before a line hold its number of
+    newlines."""
+    return data.count(b"\n") + (1 if last and data and not data.endswith(b"\n") else 0)
 
 
 _HEAD = ("id", "job_id", "scenario", "params", "report", "created")
@@ -336,6 +348,11 @@ def get_fleet_run(engine: sa.Engine, run_id: str, *,
             check_choice("files", k, FILES)
     t = _t(engine)
     runs, stored = t["fleet_runs"], t["fleet_run_files"]
+    if not wanted:  # the run's head alone
+        with engine.connect() as c:
+            head = c.execute(sa.select(*[runs.c[k] for k in _HEAD])
+                             .where(runs.c.id == str(run_id))).mappings().first()
+        return None if head is None else _run_dict(head)
     # one statement (the run and its files as one snapshot, never a run replaced in
     # between): a row per part of a wanted file, or one row with no file
     q = (sa.select(*[runs.c[k] for k in _HEAD], stored.c.name, stored.c.data)
@@ -356,22 +373,33 @@ def get_fleet_run(engine: sa.Engine, run_id: str, *,
 
 
 class StoredFile:
-    """One of a fleet run's files as :func:`open_fleet_file` finds it: ``size`` (bytes)
-    and ``parts``; iterating reads it part by part, each part (at most
-    :data:`PART_BYTES`) by its key in a short transaction of its own, so a slow reader
-    holds no connection and no lock between parts. A run replaced or deleted meanwhile
-    is :class:`RunChangedError` at the next part, never bytes of two versions."""
+    """One of a fleet run's files as :func:`open_fleet_file` finds it: ``size`` (bytes),
+    ``parts`` and the run's ``created`` (as :func:`get_fleet_run` gives it); iterating
+    reads it part by part, each part (at most :data:`PART_BYTES`) by its key in a short
+    transaction of its own, so a slow reader holds no connection and no lock between
+    parts; :meth:`lines` reads a page of its lines from the parts it lies in. A run
+    replaced or deleted meanwhile is :class:`RunChangedError` at the next part, never
+    bytes of two versions."""
 
     def __init__(self, engine: sa.Engine, run_id: str, name: str, created, size: int,
                  parts: int) -> None:
         self._engine, self._created = engine, created
         self.run_id, self.name, self.size, self.parts = run_id, name, size, parts
+        self.created = _iso(created)
 
     def __repr__(self) -> str:
         return (f"StoredFile(run_id={self.run_id!r}, name={self.name!r}, "
                 f"size={self.size}, parts={self.parts})")
 
     def __iter__(self) -> Iterator[bytes]:
+        return self._read(0)
+
+    def _changed(self) -> RunChangedError:
+        return RunChangedError(f"fleet run {self.run_id!r} was replaced or deleted while "
+                               f"its {self.name} was read")
+
+    def _read(self, start: int) -> Iterator[bytes]:
+        """The parts from ``start`` on, one statement each."""
         t = _t(self._engine)
         runs, stored = t["fleet_runs"], t["fleet_run_files"]
         k = sa.bindparam("k")
@@ -379,13 +407,70 @@ class StoredFile:
              .select_from(stored.join(runs, runs.c.id == stored.c.run_id))
              .where(stored.c.run_id == self.run_id, stored.c.name == self.name,
                     stored.c.part == k, runs.c.created == self._created))
-        for part in range(self.parts):
+        for part in range(start, self.parts):
             with self._engine.connect() as c:
                 data = c.execute(q, {"k": part}).scalar_one_or_none()
             if data is None:
-                raise RunChangedError(f"fleet run {self.run_id!r} was replaced or deleted "
-                                      f"while its {self.name} was read")
+                raise self._changed()
             yield bytes(data)
+
+    def _line_counts(self) -> list[int]:
+        """Each part's ``lines`` (:func:`part_lines`), read from the index of the counts
+        (not the parts' bytes); counted from the bytes, a part at a time, for a file
+        stored before revision 0006 without them."""
+        t = _t(self._engine)
+        runs, stored = t["fleet_runs"], t["fleet_run_files"]
+        q = (sa.select(stored.c.lines)
+             .select_from(stored.join(runs, runs.c.id == stored.c.run_id))
+             .where(stored.c.run_id == self.run_id, stored.c.name == self.name,
+                    runs.c.created == self._created).order_by(stored.c.part))
+        with self._engine.connect() as c:
+            counts = list(c.execute(q).scalars())
+        if len(counts) != self.parts:
+            raise self._changed()
+        if None in counts:
+            counts = [part_lines(data, k == self.parts - 1)
+                      for k, data in enumerate(self._read(0))]
+        return counts
+
+    def lines(self, offset: int, limit: int) -> tuple[list[bytes], int]:
+        """Lines ``offset`` .. ``offset + limit`` of the file (each without its newline;
+        a last line without one is a line) and the number of lines it has: what
+        ``data.splitlines()[offset:offset + limit]`` and ``len(...)`` give for a file of
+        ``\\n``-ended lines, read from the parts the page lies in (a line may cross
+        parts), one part held at a time with the lines kept."""
+        if offset < 0 or limit < 1:
+            raise OptionError(f"offset={offset!r}, limit={limit!r}: need offset >= 0 and "
+                              "limit >= 1", param="offset" if offset < 0 else "limit")
+        counts = self._line_counts()
+        total = sum(counts)
+        want = min(offset + limit, total) - offset
+        if want <= 0:
+            return [], total
+        # line `offset` starts after newline number `offset`: in part `start`, after
+        # `skip` of that part's newlines (the parts before it hold `before`)
+        start, before = 0, 0
+        if offset:
+            while before + counts[start] < offset:
+                before += counts[start]
+                start += 1
+        skip = offset - before
+        out: list[bytes] = []
+        carry = b""
+        for data in self._read(start):
+            pieces = (carry + data if carry else data).split(b"\n")
+            carry = pieces.pop()  # the line that goes on into the next part
+            if skip:
+                n = min(skip, len(pieces))
+                del pieces[:n]
+                skip -= n
+            out.extend(pieces[:want - len(out)])
+            del pieces
+            if len(out) == want:
+                return out, total
+        if carry and len(out) < want:  # the file's last line, without a newline
+            out.append(carry)
+        return out, total
 
 
 def open_fleet_file(engine: sa.Engine, run_id: str, name: str) -> StoredFile | None:

@@ -104,10 +104,20 @@ class ServerTiming:
         await self.app(scope, receive, timed_send)
 
 
+HEAD_KEY = "skyroute.head"  # in the scope of a HEAD request that HeadAsGet passes on as GET
+
+
+def is_head(scope) -> bool:
+    """Whether the request came as ``HEAD`` (and reaches the app as GET): a response
+    whose headers are known before its body (a stored file's length) sends only those."""
+    return bool(scope.get(HEAD_KEY))
+
+
 class HeadAsGet:
     """Answer ``HEAD`` as ``GET`` with the body left out (RFC 9110: the same status and
     headers). FastAPI's routes take GET alone, so without this the viewer's static mount
-    answered HEAD on every API path with a 404."""
+    answered HEAD on every API path with a 404. The scope passed on says it was HEAD
+    (:func:`is_head`), so a response can skip making a body that would be dropped."""
 
     def __init__(self, app) -> None:
         self.app = app
@@ -122,4 +132,4 @@ class HeadAsGet:
                 message = {**message, "body": b""}
             await send(message)
 
-        await self.app({**scope, "method": "GET"}, receive, no_body)
+        await self.app({**scope, "method": "GET", HEAD_KEY: True}, receive, no_body)

@@ -1,7 +1,8 @@
 """Stored fleet runs: ``GET /fleet/runs``, ``GET /fleet/runs/{id}`` (report, scenario
-and a page of events: ``?offset&limit``) and the run's files ``events.jsonl``,
-``tracks.csv`` and ``fleet.geojson``, streamed from the store part by part
-(:func:`skyroute.jobs.store.open_fleet_file`) with their length up front.
+and a page of events: ``?offset&limit``, read from the parts of events.jsonl it lies in)
+and the run's files ``events.jsonl``, ``tracks.csv`` and ``fleet.geojson``, streamed
+from the store part by part (:func:`skyroute.jobs.store.open_fleet_file`) with their
+length up front; a HEAD of a file is its headers from the size alone, no part read.
 
 Runs are written by fleet jobs (:mod:`skyroute.jobs.store`, imported on first use;
 without it these endpoints answer 503).
@@ -16,6 +17,7 @@ from fastapi import APIRouter, Path, Query, Response
 from fastapi.responses import StreamingResponse
 from pydantic import BaseModel, Field
 
+from skyroute.service.middleware import is_head
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import Resources, ResourcesDep
 
@@ -118,22 +120,34 @@ def list_runs(res: ResourcesDep) -> list[dict]:
     return out
 
 
-@router.get("/fleet/runs/{run_id}", response_model=Run, responses=responses(404, 422, 503),
+@router.get("/fleet/runs/{run_id}", response_model=Run,
+            responses=responses(404, 409, 422, 503),
             summary="A fleet run: report, scenario, a page of events")
 def get_run(run_id: RunId, res: ResourcesDep,
             offset: Annotated[int, Query(ge=0)] = 0,
             limit: Annotated[int, Query(ge=1, le=10_000)] = 1000) -> dict:
-    run = _run(res, run_id, "events_jsonl", "packages_csv")
-    lines = _text(run, "events", "events_jsonl").splitlines()
-    page = [json.loads(x) for x in lines[offset:offset + limit]]
+    store = _store()
+    for _ in range(3):  # a run replaced while it was read: read the new one
+        events = _stored(res, run_id, "events_jsonl")
+        try:  # the parts the page lies in, not the whole file (hundreds of MB at most)
+            lines, total = events.lines(offset, limit)
+        except store.RunChangedError:
+            continue
+        run = _run(res, run_id)
+        packages = _stored(res, run_id, "packages_csv")
+        if run.get("created") == events.created == packages.created:
+            break
+    else:
+        raise Problem(409, f"fleet run {run_id!r} was replaced again and again while it "
+                      "was read; ask again", kind="run-changed")
     base = f"/fleet/runs/{run_id}"
     names = ["events.jsonl", "tracks.csv", "fleet.geojson"]
-    if _text(run, "packages_csv", "packages"):  # a run stored without it: a 404 there
+    if packages.size:  # a run stored without it: a 404 there
         names.append("packages.csv")
     return {"id": str(run["id"]), "report": _as_dict(run.get("report")),
             "scenario": _scenario(run), "params": _as_dict(run.get("params")),
-            "events": page, "offset": offset, "limit": limit, "events_total": len(lines),
-            "files": {k: f"{base}/{k}" for k in names}}
+            "events": [json.loads(x) for x in lines], "offset": offset, "limit": limit,
+            "events_total": total, "files": {k: f"{base}/{k}" for k in names}}
 
 
 def _file(content: str | bytes, media_type: str, name: str) -> Response:
@@ -151,11 +165,24 @@ def _stored(res: Resources, run_id: str, key: str):
     return f
 
 
+class _StoredResponse(StreamingResponse):
+    """A stored file's response: to a HEAD request only its headers (the length is known
+    up front), no part read from the store; to a GET its parts as the store reads them."""
+
+    async def __call__(self, scope, receive, send) -> None:
+        if not is_head(scope):
+            await super().__call__(scope, receive, send)
+            return
+        await send({"type": "http.response.start", "status": self.status_code,
+                    "headers": self.raw_headers})
+        await send({"type": "http.response.body", "body": b"", "more_body": False})
+
+
 def _stream(f, media_type: str, name: str) -> StreamingResponse:
     """The stored file ``f`` sent as the store reads it, part by part (at most
     ``PART_BYTES`` held at a time, not the whole file: a big run's tracks are about
-    150 MB), with its length up front."""
-    return StreamingResponse(iter(f), media_type=media_type, headers={
+    150 MB), with its length up front; to a HEAD request the same headers alone."""
+    return _StoredResponse(iter(f), media_type=media_type, headers={
         "Content-Length": str(f.size),
         "Content-Disposition": f'attachment; filename="{name}"'})
 
