@@ -161,3 +161,20 @@ def test_load_world_refuses_a_negative_altitude():
         skyroute.load_world(ROOT / "examples" / "city.csv", altitude=-0.5)
     assert info.value.param == "altitude"
     assert len(skyroute.load_world(ROOT / "examples" / "city.csv", altitude=0).obstacles) > 0
+
+
+@pytest.mark.parametrize("command", [["plan", "examples/city.csv", "--start", "0,0", "--goal",
+                                      "5,5"],
+                                     ["prepare", "examples/city.csv", "-o", "city.idx"]])
+def test_a_colliders_city_given_as_a_grid_map_points_to_plan_world(monkeypatch, capsys,
+                                                                   tmp_path, command):
+    # it said "examples/city.csv:1: expected 4 columns x1,y1,x2,y2, got 2" and no more
+    monkeypatch.chdir(ROOT)
+    command = [str(tmp_path / c) if c == "city.idx" else c for c in command]
+    code, out, err = run(monkeypatch, capsys, *command)
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert err.strip() == (
+        "skyroute: error: examples/city.csv:1: a colliders.csv city (line 1 'lat0 ..., lon0 "
+        "...'), not wall segments x1,y1,x2,y2: plan in it with 'skyroute plan-world "
+        "examples/city.csv --start LON,LAT --goal LON,LAT'")
+    assert not (tmp_path / "city.idx").exists()
