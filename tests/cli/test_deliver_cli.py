@@ -303,9 +303,6 @@ def test_a_corrected_csv_is_refused_until_replace(monkeypatch, capsys, tmp_path)
         "deleted)" in " ".join(out.split())
     code, out, err = run(monkeypatch, capsys, "db", "import", str(data), "--db", db)
     assert code == 0 and "0 orders added, 108 already there" in " ".join(out.split())
-    code, out, err = run(monkeypatch, capsys, "deliver", day, "--source", "http://x",
-                         "--db", db, "--replace")
-    assert code == 2 and "--replace replaces stored orders by those of --data DIR" in err
 
 
 def test_days_without_orders_say_so_and_exit_0(monkeypatch, capsys, tmp_path, fly_once):
@@ -328,3 +325,156 @@ def test_days_without_orders_say_so_and_exit_0(monkeypatch, capsys, tmp_path, fl
     assert code == 0 and "2 days" in out, err
     assert "1 of the 2 days had no orders stored (2024-01-04); nothing was flown on it" \
         in " ".join(err.split())
+
+
+def _other_site(dst: Path, *, places: bool = True) -> Path:
+    """``examples/lunch`` copied to ``dst`` with every menu item renamed ('Club sandwich
+    (Small)' -> 'Other club sandwich (Small)'); with ``places`` as another site whose
+    orders are its own: every place renamed too (each address's first word gains an
+    'x'), and its orders' items, places, numbers ('z' for the first hex digit) and
+    dates (a year earlier) to match; without, the same orders as the example's."""
+    import shutil
+
+    shutil.copytree(EXAMPLE, dst)
+    web, db = dst / "website", dst / "database"
+
+    def item(name: str) -> str:
+        return "Other " + name[0].lower() + name[1:]
+
+    def place(words: str) -> str:
+        return words.replace(".", "x.", 1) if places else words
+
+    if places:
+        for d in list((web / "words").iterdir()):
+            d.rename(d.with_name(d.name + "x"))
+        area = json.loads((web / "area.json").read_text())
+        area["home"] = place(area["home"])
+        (web / "area.json").write_text(json.dumps(area))
+    menus = json.loads((web / "menus" / "menus.json").read_text())
+    for shop in menus:
+        shop["location"] = place(shop["location"])
+        for it in shop["menu"]:
+            it["item"] = item(it["item"])
+    (web / "menus" / "menus.json").write_text(json.dumps(menus))
+    if not places:
+        return dst
+    lines = (db / "orders.csv").read_text().splitlines()
+    rows = [r.split(",") for r in lines[1:]]
+    (db / "orders.csv").write_text("\n".join([lines[0], *(
+        f"z{no[1:]},{day.replace('2024', '2023')},{who},{place(to)}"
+        for no, day, who, to in rows)]) + "\n")
+    lines = (db / "orderDetails.csv").read_text().splitlines()
+    (db / "orderDetails.csv").write_text("\n".join([lines[0], *(
+        f"z{no[1:]},{item(it)}" for no, it in (r.split(",", 1) for r in lines[1:]))]) + "\n")
+    return dst
+
+
+def _stored_day(path, day: str) -> tuple:
+    """The day's run (delivered, invalid), deliveries, moves and the orders stored."""
+    import sqlite3
+
+    with sqlite3.connect(path) as c:
+        return (c.execute("select orders_delivered, orders_invalid from runs where "
+                          "delivery_date = ?", (day,)).fetchall(),
+                c.execute("select count(*) from deliveries where delivery_date = ?",
+                          (day,)).fetchone()[0],
+                c.execute("select count(*) from flightpath where delivery_date = ?",
+                          (day,)).fetchone()[0],
+                c.execute("select count(*) from orders").fetchone()[0])
+
+
+def test_another_sites_folder_is_refused_before_anything_is_written(monkeypatch, capsys,
+                                                                    tmp_path, fly_once):
+    # a store of the lunch orders flown with another site's --data folder: its orders
+    # were imported, the day flown with every order 'unknown item' and stored over the
+    # day's real flight, exit 0
+    db = tmp_path / "s.db"
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data", EXAMPLE,
+                       "--db", f"sqlite:///{db}", "--out", str(tmp_path / "good"), "--no-plot")
+    assert code == 0, err
+    good = _stored_day(db, "2024-01-03")
+    assert good[0][0][0] > 0 and good[1] > 0 and good[3] == 108
+    other = _other_site(tmp_path / "other")
+    menus = other / "website" / "menus" / "menus.json"
+    for dates, more in ((["2024-01-03"], ""),
+                        (["--from", "2024-01-01", "--to", "2024-01-03"],
+                         " (and 2 more of the days)")):
+        first = dates[0] if len(dates) == 1 else dates[1]
+        code, _, err = run(monkeypatch, capsys, "deliver", *dates, "--data", str(other),
+                           "--db", f"sqlite:///{db}", "--out", str(tmp_path / "o"))
+        assert code == 2 and len(err.strip().splitlines()) == 1, err
+        assert f"{menus}: none of the 36 orders stored for {first} in sqlite:///{db}{more} " \
+            "is on these menus or goes to a place of this site (e.g. item '" in err, err
+        assert "they are another site's orders: give the --data folder they were " \
+            "imported from; nothing was imported or flown" in err
+        assert _stored_day(db, "2024-01-03") == good  # the day, and no orders imported
+        assert not (tmp_path / "o").exists()
+    # a folder whose own orders are of another site than its website
+    import shutil
+
+    mixed = tmp_path / "mixed"
+    shutil.copytree(EXAMPLE, mixed)
+    shutil.rmtree(mixed / "database")
+    shutil.copytree(other / "database", mixed / "database")
+    code, _, err = run(monkeypatch, capsys, "deliver", "2023-01-02", "--data", str(mixed),
+                       "--db", f"sqlite:///{db}", "--out", str(tmp_path / "o"))
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert f"none of the 36 orders of 2023-01-02 in {mixed / 'database' / 'orders.csv'} is " \
+        "on these menus" in err and "the folder's orders and website are not of one " \
+        "site" in err, err
+    assert _stored_day(db, "2024-01-03") == good
+    # the other site with its own orders is flown as before
+    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", _no_flying)
+    with pytest.raises(AssertionError, match="a day was flown"):
+        run(monkeypatch, capsys, "deliver", "2023-01-02", "--data", str(other),
+            "--db", f"sqlite:///{tmp_path / 'o.db'}", "--out", str(tmp_path / "o"))
+
+
+@pytest.mark.shared_data
+def test_the_ilp_folder_with_a_store_of_lunch_orders_is_refused(monkeypatch, capsys,
+                                                               tmp_path, fly_once):
+    # the README's day flown into a store, then --data pointed at the ILP folder: 11,334
+    # ILP orders were imported and the day's 36 lunch orders flown as 'unknown item'
+    # (two lunch items share their names with ILP items: one item is not enough)
+    from tests.conftest import SHARED
+
+    db = tmp_path / "s.db"
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data", EXAMPLE,
+                       "--db", f"sqlite:///{db}", "--out", str(tmp_path), "--no-plot")
+    assert code == 0, err
+    good = _stored_day(db, "2024-01-03")
+    ilp = SHARED / "ilp2021"
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data", str(ilp),
+                       "--db", f"sqlite:///{db}", "--out", str(tmp_path / "o"))
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert f"{ilp / 'website' / 'menus' / 'menus.json'}: none of the 36 orders stored for " \
+        "2024-01-03" in err
+    assert _stored_day(db, "2024-01-03") == good
+
+
+def test_a_day_of_invalid_orders_keeps_the_stored_flight_until_replace(monkeypatch, capsys,
+                                                                       tmp_path, fly_once):
+    # the site's items renamed (its places are its own): every order is 'unknown item';
+    # that day replaced the stored flight with nothing and said so only order by order
+    db = tmp_path / "s.db"
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data", EXAMPLE,
+                       "--db", f"sqlite:///{db}", "--out", str(tmp_path / "good"), "--no-plot")
+    assert code == 0, err
+    good = _stored_day(db, "2024-01-03")
+    renamed = _other_site(tmp_path / "renamed", places=False)
+    to = ["--db", f"sqlite:///{db}", "--out", str(tmp_path / "o"), "--no-plot"]
+    for args in (["2024-01-03"], ["--from", "2024-01-03", "--to", "2024-01-03"]):
+        code, _, err = run(monkeypatch, capsys, "deliver", *args, "--data", str(renamed), *to)
+        assert code == 2 and len(err.strip().splitlines()) == 1, err
+        assert "2024-01-03: every one of the day's 36 orders is invalid (order " in err
+        assert ": unknown item '" in err
+        assert f"so the day's stored flight, which delivered {good[0][0][0]} orders, is " \
+            "kept (nothing was written for the day); --replace stores the day as flown " \
+            "now" in err, err
+        assert _stored_day(db, "2024-01-03") == good
+        assert not list((tmp_path / "o").glob("*03-01-2024*"))
+    code, out, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data",
+                         str(renamed), *to, "--replace", "--json")
+    assert code == 0, err
+    assert json.loads(out)["orders_invalid"] == 36
+    assert _stored_day(db, "2024-01-03") == ([(0, 36)], 0, 0, 108)

@@ -223,6 +223,12 @@ def test_scenario_names_the_bad_option(monkeypatch, capsys, args, words):
     (["--rates", "1e5", "--hours", "4"], "--rates 100000 with --hours 4 would spawn about "
                                          "4e+05 packages"),
     (["--hours", "1e9"], "--hours 1e+09 is over the limit of 168"),
+    # an empty item was passed over: 20,,60 swept two rates, not the three meant
+    (["--rates", "20,,60"], "--rates '20,,60': item 2 is empty (a stray comma?)"),
+    (["--rates", "20,60,"], "--rates '20,60,': item 3 is empty"),
+    (["--seeds", "0,,4"], "--seeds '0,,4': item 2 is empty"),
+    (["--scheduler", "seed,,optimal"], "--scheduler 'seed,,optimal': item 2 is empty"),
+    (["--airspace", ",shared"], "--airspace ',shared': item 1 is empty"),
     # every seed and rate within its limit, their product not
     (["--seeds", "0-999", "--rates", "10,20,30"], "2 scheduler(s) x 2 airspace(s) x 3 rate(s) "
      "x 1,000 seed(s) is 12,000 runs, over the limit of 10,000 in one sweep; give fewer "

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from tests.cli.test_cli import run
-from tests.conftest import SHARED
+from tests.conftest import ROOT, SHARED
 
 FCND = str(SHARED / "fcnd" / "colliders.csv")
 ZONES = str(SHARED / "ilp2021" / "website" / "buildings" / "no-fly-zones.geojson")
@@ -130,3 +130,51 @@ def test_a_colliders_file_of_too_many_boxes_is_one_line(monkeypatch, capsys, tmp
     assert code == 2 and out == ""
     assert err == (f"skyroute: error: {city}: 50,001 boxes, over the limit of 50,000 in a "
                    "colliders file\n")
+
+
+@pytest.mark.parametrize("command", [
+    ["plan-world", "examples/city.csv", "--frame", "ned", "--start", "0,0", "--goal",
+     "120,-180"],
+    ["fly", "examples/city.csv", "--frame", "ned", "--vehicle", "lattice", "--start", "0,0",
+     "--goal", "120,-180"],
+    ["bench", "world", "--city", "examples/city.csv"],
+])
+def test_a_negative_altitude_is_refused_alike(monkeypatch, capsys, command):
+    # bench world refused --altitude -5; plan-world and fly kept no building of the city
+    # (they all stand on the ground) and planned straight through them, exit 0
+    monkeypatch.chdir(ROOT)
+    monkeypatch.setattr("skyroute.cli.bench_world_cmd._bench_world", _no_run)
+    code, out, err = run(monkeypatch, capsys, *command, "--altitude", "-5")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert "skyroute: error: --altitude -5.0 must be a finite number >= 0" in err
+
+
+def _no_run(*_args, **_kwargs):
+    raise AssertionError("ran with a negative altitude")
+
+
+def test_load_world_refuses_a_negative_altitude():
+    import skyroute
+    from skyroute.errors import OptionError
+
+    with pytest.raises(OptionError, match=r"altitude=-0\.5 must be a finite number >= 0") as info:
+        skyroute.load_world(ROOT / "examples" / "city.csv", altitude=-0.5)
+    assert info.value.param == "altitude"
+    assert len(skyroute.load_world(ROOT / "examples" / "city.csv", altitude=0).obstacles) > 0
+
+
+@pytest.mark.parametrize("command", [["plan", "examples/city.csv", "--start", "0,0", "--goal",
+                                      "5,5"],
+                                     ["prepare", "examples/city.csv", "-o", "city.idx"]])
+def test_a_colliders_city_given_as_a_grid_map_points_to_plan_world(monkeypatch, capsys,
+                                                                   tmp_path, command):
+    # it said "examples/city.csv:1: expected 4 columns x1,y1,x2,y2, got 2" and no more
+    monkeypatch.chdir(ROOT)
+    command = [str(tmp_path / c) if c == "city.idx" else c for c in command]
+    code, out, err = run(monkeypatch, capsys, *command)
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert err.strip() == (
+        "skyroute: error: examples/city.csv:1: a colliders.csv city (line 1 'lat0 ..., lon0 "
+        "...'), not wall segments x1,y1,x2,y2: plan in it with 'skyroute plan-world "
+        "examples/city.csv --start LON,LAT --goal LON,LAT'")
+    assert not (tmp_path / "city.idx").exists()

@@ -75,6 +75,29 @@ def test_rerun_replaces_the_day(engine):
     assert len(rows) == 3 and {r[2] for r in rows} == {"bbbbbbbb"}
 
 
+def test_a_run_that_must_not_replace_a_delivering_day_keeps_it(engine):
+    # a day flown with another site's menus (every order invalid) replaced the day's
+    # real flight; with ``keep`` a stored run that delivered is kept, read in the
+    # transaction that would replace it
+    import pickle
+
+    store.write_day(engine, DAY, run_row(5), [], moves(5))
+    nothing = {**run_row(0), "orders_delivered": 0, "orders_invalid": 1}
+    with pytest.raises(store.DayKeptError) as info:
+        store.write_day(engine, DAY, nothing, [], moves(0), keep="every order is invalid")
+    assert str(info.value) == ("2024-01-01: every order is invalid, so the day's stored "
+                               "flight, which delivered 1 order, is kept (nothing was "
+                               "written for the day)")
+    assert len(store.day_rows(engine, DAY)["flightpath"]) == 5
+    again = pickle.loads(pickle.dumps(info.value))  # raised in worker processes
+    assert type(again) is store.DayKeptError and str(again) == str(info.value)
+    assert (again.date, again.delivered) == (DAY, 1)
+    store.write_day(engine, DAY, nothing, [], moves(0))  # no reason given: replaced
+    assert store.day_rows(engine, DAY)["flightpath"] == []
+    store.write_day(engine, DAY, nothing, [], moves(2), keep="every order is invalid")
+    assert len(store.day_rows(engine, DAY)["flightpath"]) == 2  # it delivered nothing
+
+
 def test_killed_run_leaves_no_partial_day(engine, tmp_path):
     store.write_day(engine, DAY, run_row(5), [], moves(5))
     script = textwrap.dedent(f"""

@@ -87,3 +87,30 @@ def test_synth_takes_numpy_integers_and_names_bad_ones(tmp_path):
         with pytest.raises(OptionError, match=f"{name}="):
             synth(tmp_path / "b", **kw)
     assert not (tmp_path / "b").exists()
+
+
+def test_synth_refuses_a_folder_that_is_not_empty_until_replace(monkeypatch, capsys, tmp_path):
+    # it wrote website/ and database/ into any folder, over an earlier data set, without
+    # a word
+    out = tmp_path / "set"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep me")
+    args = ["data", "synth", str(out), "--days", "1", "--orders-per-day", "1"]
+    code, stdout, err = run(monkeypatch, capsys, *args)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and not stdout, err
+    assert f"{out}: the folder is not empty (notes.txt); --replace writes the data set " \
+        "into it, replacing files of the same names" in err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+    code, stdout, err = run(monkeypatch, capsys, *args, "--replace")
+    assert code == 0, err
+    assert json.loads(stdout)["orders"] == 1
+    assert sorted(p.name for p in out.iterdir()) == ["database", "notes.txt", "website"]
+    assert (out / "notes.txt").read_text() == "keep me"
+    code, _, err = run(monkeypatch, capsys, *args)  # a data set there now: refused too
+    assert code == 2 and "(database, notes.txt, website)" in err, err
+    code, _, err = run(monkeypatch, capsys, "data", "synth", str(out / "notes.txt"))
+    assert code == 2 and f"{out / 'notes.txt'}: not a folder" in err, err
+    (tmp_path / "empty").mkdir()  # an empty folder is written as a new one
+    code, _, err = run(monkeypatch, capsys, "data", "synth", str(tmp_path / "empty"),
+                       "--days", "1", "--orders-per-day", "1")
+    assert code == 0 and (tmp_path / "empty" / "website").is_dir(), err

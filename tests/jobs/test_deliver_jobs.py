@@ -111,3 +111,23 @@ def test_dask_workers_write_to_postgresql_what_sqlite_holds(tmp_path, pg_url, da
     dates = list(by_date)
     assert stored(engine, dates) == stored(lite, dates)
     engine.dispose()
+
+
+def test_a_deliver_job_refuses_another_sites_data(tmp_path):
+    # the store's lunch orders flown with another site's folder: every order 'unknown
+    # item', stored over the days' flights
+    from skyroute.jobs.deliver import deliver_job
+    from tests.cli.test_deliver_cli import _other_site
+
+    engine = lunch_store(f"sqlite:///{tmp_path / 'j.db'}", DATES)
+    other = _other_site(tmp_path / "other")
+    with open_executor("local", workers=1) as ex, pytest.raises(SkyrouteError) as info:
+        deliver_job(engine, "j1", {"from": "2024-01-01", "to": "2024-01-02",
+                                   "data": str(other)}, executor=ex,
+                    progress=lambda _share: None)
+    assert str(info.value).startswith(
+        f"{other / 'website' / 'menus' / 'menus.json'}: none of the orders stored for "
+        "2024-01-01 is on these menus or goes to a place of this site")
+    assert info.value.param == "data"
+    assert store.day_rows(engine, dt.date(2024, 1, 1)) == {"deliveries": [],
+                                                          "flightpath": []}

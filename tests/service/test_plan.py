@@ -184,6 +184,8 @@ CITY_BODY = {"world_format": "colliders", "altitude": 10, "safety": 2,
     ({**CITY_BODY, "frame": "polar"}, "frame", "'lonlat'"),
     ({**CITY_BODY, "frame": "degrees"}, "frame", "in metres"),
     ({**CITY_BODY, "safety": -1}, "safety", "greater than or equal to 0"),
+    # below the ground: it kept no building and planned straight through them
+    ({**CITY_BODY, "altitude": -5}, "altitude", "must be a finite number >= 0"),
     ({**CITY_BODY, "boundary": "/etc/passwd"}, "boundary", "valid"),
     ({**CITY_BODY, "boundary": [0, 0, -1, -1]}, "boundary", "min must be below max"),
     ({**CITY_BODY, "start": [-3.1890, 95.0]}, "start", ""),

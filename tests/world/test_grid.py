@@ -103,6 +103,13 @@ def test_segment_file_and_errors(tmp_path):
     p.write_text("0,0,2\n")
     with pytest.raises(InputFormatError, match=r"walls\.csv:1: expected 4 columns"):
         load_map(p)
+    # a colliders city read as walls: "expected 4 columns x1,y1,x2,y2, got 2", no way on
+    for home in ("lat0 55.944494, lon0 -3.186874", "LON0 -3.186874, LAT0 55.944494"):
+        p.write_text(f"{home}\nposX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n0,0,5,1,1,5\n")
+        with pytest.raises(InputFormatError, match=re.escape(
+                "walls.csv:1: a colliders.csv city (line 1 'lat0 ..., lon0 ...'), not wall "
+                "segments x1,y1,x2,y2: load it with skyroute.load_world")):
+            load_map(p)
     # The first file's grid: the walls' extent plus the clearance and one cell each side,
     # so 7 x 7 cells of 0.5 m from (-0.75, -0.75); blocked are the cells the walls cross
     # (y = 0 is row 1, x = 2 is column 5), no centre of another lying within 0.25 m.

@@ -19,7 +19,8 @@ from collections.abc import Callable
 import numpy as np
 import shapely
 
-from skyroute.errors import OptionError, SkyrouteError
+from skyroute.errors import OptionError, SkyrouteError, real
+from skyroute.world.load import ALTITUDE
 from skyroute.world.world import World
 
 OMPL_PLANNERS = ("PRM", "PRMstar", "RRTstar", "RRTConnect", "InformedRRTstar")
@@ -37,10 +38,9 @@ def random_rect_world(seed: int, *, count: int = 20, size: float = 100.0) -> Wor
 
 
 def check_altitude(altitude: float) -> None:
-    """An OptionError unless ``altitude`` is a finite number >= 0 (metres above ground)."""
-    if not (math.isfinite(altitude) and altitude >= 0):
-        raise OptionError(f"altitude={altitude!r} must be a finite number >= 0",
-                          param="altitude")
+    """An OptionError unless ``altitude`` is a finite number >= 0 (metres above ground),
+    worded as :func:`skyroute.world.load.load_world` words it."""
+    real("altitude", altitude, low=0, need=ALTITUDE)
 
 
 def load_city(path, *, altitude: float, safety: float) -> World:

@@ -26,7 +26,7 @@ from skyroute.bench.world import (
     random_rect_world,
 )
 from skyroute.cli.bench_cmd import bench_app
-from skyroute.cli.parse import parse_list
+from skyroute.cli.parse import parse_items, parse_list
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 from skyroute.files import check_writable, write_atomic
@@ -265,8 +265,9 @@ def _exit_past_ompl() -> None:
 
 def _budgets(budgets: str) -> tuple[float, ...]:
     """--budgets "1,5" -> (1.0, 5.0): OMPL seconds per solve, each positive and finite."""
+    items = parse_items(budgets, "--budgets")  # an OptionError, itself a ValueError
     try:
-        secs = tuple(float(b) for b in budgets.split(",") if b.strip())
+        secs = tuple(float(b) for b in items)
     except ValueError:
         raise OptionError(f"--budgets {budgets!r}: expected seconds like 1,5") from None
     if not all(math.isfinite(b) and b > 0 for b in secs):

@@ -25,15 +25,37 @@ def data_synth(
     start: Annotated[str, typer.Option(help="First day, YYYY-MM-DD.")] = "2024-01-01",
     seed: Annotated[int, typer.Option(
         min=0, help="Seed: the same seed writes the same files.")] = 1,
+    replace: Annotated[bool, typer.Option(
+        "--replace", help="Write into DIR even when it is not empty (files of the same "
+                          "names are replaced).")] = False,
 ) -> None:
     """Write a synthetic data set in the ILP layout (website/, database/) in another town."""
     first = parse_date(start, "--start")
+    _check_folder(folder, replace)
     with delayed_status(f"writing a data set to {folder}"):  # imports included: seconds
         from skyroute.delivery.synth import synth
 
         summary = synth(folder, days=days, orders_per_day=orders_per_day, seed=seed,
                         start=first, customers=customers)
     typer.echo(json.dumps(summary))  # not through Rich: no markup, no wrapping
+
+
+def _check_folder(folder: Path, replace: bool) -> None:
+    """DIR must be a folder that is new or empty, unless ``--replace``: a data set written
+    over another (an earlier one, the wrong folder) replaced its files without a word,
+    and a different seed left the old set's places among the new."""
+    from skyroute.errors import OptionError
+
+    if folder.exists() and not folder.is_dir():
+        raise OptionError(f"{folder}: not a folder")
+    if replace or not folder.is_dir():
+        return
+    names = sorted(p.name for p in folder.iterdir())
+    if names:
+        shown = ", ".join(names[:3]) + (f" and {len(names) - 3:,} more" if len(names) > 3
+                                        else "")
+        raise OptionError(f"{folder}: the folder is not empty ({shown}); --replace writes "
+                          "the data set into it, replacing files of the same names")
 
 
 @data_app.command("serve")

@@ -33,15 +33,17 @@ REPLACE_HELP = ("Store the file's orders of each day whose stored orders differ 
                 "path.")
 
 
-def import_folder(engine, data: Path, *, replace: bool):
-    """Import ``data/database``'s orders (:func:`~skyroute.delivery.store.import_orders`):
-    how many the files hold, and what was done. Stored orders that the files contradict
-    are one line naming the file, the days and ``--replace``."""
+def import_folder(engine, data: Path, *, replace: bool, orders: list | None = None):
+    """Import ``data/database``'s orders (:func:`~skyroute.delivery.store.import_orders`;
+    ``orders``: those files' orders when already read): how many the files hold, and
+    what was done. Stored orders that the files contradict are one line naming the
+    file, the days and ``--replace``."""
     from skyroute.delivery.orders import read_csv_orders
     from skyroute.delivery.store import OrdersChangedError, import_orders, shown
     from skyroute.errors import SkyrouteError
 
-    orders = read_csv_orders(data)
+    if orders is None:
+        orders = read_csv_orders(data)
     try:
         return len(orders), import_orders(engine, orders, replace=replace)
     except OrdersChangedError as exc:

@@ -35,8 +35,9 @@ def deliver_command(
     source: Annotated[str | None, typer.Option(
         help="Read website/ from this URL instead (see 'skyroute data serve').")] = None,
     db: Annotated[str, typer.Option(help="SQLAlchemy URL of the store.")] = DEFAULT_DB,
-    replace: Annotated[bool, typer.Option("--replace", help="With --data: " + REPLACE_HELP)] =
-        False,
+    replace: Annotated[bool, typer.Option("--replace", help=(
+        "Store a day whose every order is invalid over its stored flight (kept otherwise); "
+        "with --data also: " + REPLACE_HELP))] = False,
     out: Annotated[Path, typer.Option(help="Folder for the GeoJSON, PNG and report files.")] =
         Path("."),
     jobs: Annotated[int, typer.Option(help="Worker processes for a range of days.")] = 1,
@@ -55,9 +56,10 @@ def deliver_command(
     from skyroute.cli.db_cmd import import_folder, replaced
     from skyroute.delivery.days import open_store, prepare_legs
     from skyroute.delivery.limits import check_days
+    from skyroute.delivery.orders import read_csv_orders
     from skyroute.delivery.site import load_site
     from skyroute.delivery.source import open_source
-    from skyroute.delivery.store import order_dates
+    from skyroute.delivery.store import DayKeptError, order_dates
     from skyroute.io.day_out import check_outputs, write_outputs
     from skyroute.jobs.deliver import days_between, run_days
 
@@ -66,9 +68,6 @@ def deliver_command(
     one_day, ranged = day is not None, d0 is not None or d1 is not None
     if one_day == ranged or (ranged and (d0 is None or d1 is None)):
         raise OptionError("give a DATE, or both --from and --to")
-    if replace and data is None:
-        raise OptionError("--replace replaces stored orders by those of --data DIR; give "
-                          "--data DIR too")
     if day is not None:
         d0 = d1 = day
     check_days(d0, d1, "--from", "--to")
@@ -84,14 +83,23 @@ def deliver_command(
     # the executor before any work: a wrong --dask address fails at once
     with open_from_flags(executor, dask, jobs, (d1 - d0).days + 1) as ex:
         err = plain_console(stderr=True)
+        if data is None and not order_dates(engine):
+            raise SkyrouteError(f"{safe_url(db)}: no orders stored; load them with 'skyroute db "
+                                "import DIR' or give --data DIR")
+        # the orders each day will have once the files are imported: the files' own for a
+        # day they give (the import adds them, or refuses a day stored otherwise), else
+        # the stored ones; checked against the site's menus before anything is written
+        orders = read_csv_orders(data) if data is not None else []
+        given: dict[dt.date, list] = {}
+        for o in orders:
+            if d0 <= o.date <= d1:
+                given.setdefault(o.date, []).append(o)
+        _refuse_foreign(site, {**days_between(engine, d0, d1), **given}, given, db, data)
         if data is not None:
-            got = import_folder(engine, data, replace=replace)[1]
+            got = import_folder(engine, data, replace=replace, orders=orders)[1]
             if got.added:
                 err.print(f"imported {got.added:,} orders from {data / 'database'}"
                           + replaced(got), soft_wrap=True)
-        elif not order_dates(engine):
-            raise SkyrouteError(f"{safe_url(db)}: no orders stored; load them with 'skyroute db "
-                                "import DIR' or give --data DIR")
         by_date = days_between(engine, d0, d1)
         all_orders = [o for v in by_date.values() for o in v]
         with progress_bar(err) as progress:
@@ -107,8 +115,12 @@ def deliver_command(
                 written.extend(write_outputs(site, r, out, plot=draw))
                 progress.advance(days)
 
-            results = run_days(engine, src, by_date, executor=ex, method=method,
-                               on_day=finished)
+            try:
+                results = run_days(engine, src, by_date, executor=ex, method=method,
+                                   replace=replace, on_day=finished)
+            except DayKeptError as exc:
+                raise SkyrouteError(f"{exc}; --replace stores the day as flown now"
+                                    ) from None
             wall = time.perf_counter() - t0
         workers = ex.workers
     if day is not None:
@@ -116,6 +128,33 @@ def deliver_command(
     else:
         _summary(results, wall, jobs, workers, ex.kind, as_json, written)
     _say_empty(results)
+
+
+def _refuse_foreign(site, by_date: dict, given: dict, db: str, data: Path | None) -> None:
+    """One line naming the site's menus and the first day whose orders name no item on
+    them (:func:`~skyroute.delivery.days.foreign_days`): a store of one site's orders
+    flown with another site's --data folder listed every order 'unknown item' and
+    stored that over the day's flight."""
+    from skyroute.delivery.days import foreign_days
+
+    bad = foreign_days(site, by_date)
+    if not bad:
+        return
+    day = bad[0]
+    orders = by_date[day]
+    item = next(i for o in orders for i in o.items if i not in site.menu)
+    if day in given:  # the folder's own orders: its CSVs and its website disagree
+        whence = f"of {day} in {data / 'database' / 'orders.csv'}"
+        hint = "the folder's orders and website are not of one site"
+    else:
+        whence = f"stored for {day} in {safe_url(db)}"
+        hint = ("they are another site's orders: give the --data folder they were imported "
+                "from")
+    more = f" (and {len(bad) - 1:,} more of the days)" if len(bad) > 1 else ""
+    raise SkyrouteError(f"{site.source.where('menus/menus.json')}: none of the "
+                        f"{len(orders):,} orders {whence}{more} is on these menus or goes to "
+                        f"a place of this site (e.g. item {item!r}, deliverTo "
+                        f"{orders[0].deliver_to!r}); {hint}; nothing was imported or flown")
 
 
 def _say_empty(results: list[DayResult]) -> None:

@@ -11,6 +11,7 @@ import typer
 from rich.table import Table
 
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
+from skyroute.cli.parse import parse_items
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError, check_choice, real
 from skyroute.fleet.limits import MAX_DRONES, MAX_RATE, MAX_SEEDS, check_run, check_sweep
@@ -218,7 +219,7 @@ def scenario_command(
 def parse_seeds(text: str) -> list[int]:
     """``"0-29"``, ``"1,4,7"`` or a mix -> the seeds, in order, no repeats."""
     out: list[int] = []
-    for part in (p.strip() for p in text.split(",") if p.strip()):
+    for part in parse_items(text, "--seeds"):
         try:
             if "-" in part[1:]:
                 a, b = part.split("-", 1) if not part.startswith("-") else (part, "")
@@ -245,7 +246,7 @@ def parse_seeds(text: str) -> list[int]:
 
 
 def _choices(text: str, option: str, valid: tuple[str, ...]) -> list[str]:
-    items = [p.strip() for p in text.split(",") if p.strip()]
+    items = parse_items(text, option)
     for x in items:
         if x not in valid:
             raise OptionError(f"{option} {x!r} is not valid; choose from "
@@ -258,8 +259,9 @@ def _choices(text: str, option: str, valid: tuple[str, ...]) -> list[str]:
 def _rates(text: str | None) -> list[float | None]:
     if text is None:
         return [None]
+    items = parse_items(text, "--rates")  # an OptionError, itself a ValueError
     try:
-        rates = [float(p) for p in text.split(",") if p.strip()]
+        rates = [float(p) for p in items]
     except ValueError:
         raise OptionError(f"--rates {text!r}: expected numbers like 30,60,90") from None
     if not rates or not all(math.isfinite(r) and r >= 0 for r in rates):

@@ -30,6 +30,17 @@ def parse_date(text: str, option: str) -> dt.date:
         raise OptionError(f"{option} {text!r}: expected a date YYYY-MM-DD") from None
 
 
+def parse_items(text: str, option: str) -> list[str]:
+    """``"a, b"`` -> ["a", "b"]: a comma-separated option's items, each stripped; an empty
+    one (``20,,60``, a trailing comma) is an OptionError naming the option and the item,
+    where it was passed over: ``--rates 20,,60`` swept two rates, not the three meant."""
+    items = [p.strip() for p in text.split(",")]
+    for k, item in enumerate(items):
+        if not item and text.strip():
+            raise OptionError(f"{option} {text!r}: item {k + 1} is empty (a stray comma?)")
+    return [p for p in items if p]
+
+
 def parse_list(text: str | None) -> list[str]:
     """``"a,b"`` -> ["a", "b"]; empty or None -> []."""
     return [p.strip() for p in (text or "").split(",") if p.strip()]

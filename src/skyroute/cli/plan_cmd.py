@@ -11,7 +11,7 @@ import typer
 from skyroute.cli.parse import check_outputs, parse_cell
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import print_table, result_table
-from skyroute.errors import OptionError
+from skyroute.errors import InputFormatError, OptionError
 from skyroute.files import check_writable, write_atomic
 from skyroute.io.geojson import dumps, grid_path_geojson
 from skyroute.planner import plan
@@ -69,7 +69,7 @@ def plan_command(
                           "--connectivity, --corner-cutting, --heuristic, --weight, --prune "
                           "and --max-expansions at their defaults", param="index")
     with delayed_status("planning"):  # a first run compiles its kernels for seconds
-        grid = load_map(map_file, resolution=resolution, safety=safety)
+        grid = _load_grid(map_file, resolution=resolution, safety=safety)
         if index is not None:
             from skyroute.search.prepared import load_index
 
@@ -98,6 +98,17 @@ def plan_command(
         raise typer.Exit(EXIT_NOT_FOUND)
 
 
+def _load_grid(map_file: str, *, resolution: float, safety: float):
+    """:func:`load_map`; a colliders city given as MAP says to plan in it with plan-world."""
+    from skyroute.world.segments import CITY, CityNotWallsError
+
+    try:
+        return load_map(map_file, resolution=resolution, safety=safety)
+    except CityNotWallsError as exc:
+        raise InputFormatError(exc.path, f"{CITY}: plan in it with 'skyroute plan-world "
+                               f"{map_file} --start LON,LAT --goal LON,LAT'", line=1) from None
+
+
 def prepare_command(
     map_file: Annotated[str, typer.Argument(metavar="MAP", help=(
         "A grid map file (as for 'skyroute plan') or the name of a bundled map."))],
@@ -119,7 +130,7 @@ def prepare_command(
         raise OptionError(f"-o {out} is the map itself; write the index to another path "
                           "(e.g. MAP.idx)")
     check_writable(out)  # before the build, which can take a while
-    grid = load_map(map_file, resolution=resolution, safety=safety)
+    grid = _load_grid(map_file, resolution=resolution, safety=safety)
     if grid.blocked.all():
         plain_console(stderr=True).print(f"note: every cell of {grid.name} is blocked (--safety "
                                    f"{safety:g}): the index will refuse every query")

@@ -5,11 +5,13 @@ read it; and the store opened and upgraded.
 
 from __future__ import annotations
 
+import datetime as dt
 from collections.abc import Callable
 
 from skyroute.delivery import store
 from skyroute.delivery.legs import leg_table, missing_legs
 from skyroute.delivery.orders import Priced, price
+from skyroute.errors import InputFormatError
 
 
 def places_of(site, orders) -> list[tuple[float, float]]:
@@ -17,6 +19,29 @@ def places_of(site, orders) -> list[tuple[float, float]]:
     custs = sorted({p.lonlat for p in (price(site, o) for o in orders)
                     if isinstance(p, Priced)})
     return [site.home, *(s.lonlat for s in site.shops), *custs]
+
+
+def foreign_days(site, by_date: dict[dt.date, list]) -> list[dt.date]:
+    """The days of ``by_date`` with orders none of which ``site`` knows: no order has
+    every item on its menus, and no order goes to a place of its ``words/``. They are
+    another site's orders (a store filled from one data folder, flown with another's
+    site): flown, every order is invalid ('unknown item'), and storing that replaced the
+    day's real flight. Two sites may share an item name or two, so one item is not
+    enough; a day of this site with some orders made invalid (a menu that lost an item)
+    still has its places, so is not one."""
+    return sorted(d for d, orders in by_date.items()
+                  if any(o.items for o in orders)
+                  and not any(o.items and all(i in site.menu for i in o.items)
+                              for o in orders)
+                  and not any(_known_place(site, o.deliver_to) for o in orders))
+
+
+def _known_place(site, words: str) -> bool:
+    try:
+        site.locate(words)
+    except InputFormatError:
+        return False
+    return True
 
 
 def prepare_legs(site, orders, on_leg: Callable | None = None,

@@ -356,13 +356,34 @@ def order_dates(engine: sa.Engine) -> list[dt.date]:
                                  .order_by(orders.c.delivery_date)))
 
 
+class DayKeptError(SkyrouteError):
+    """A day's new results were not stored because the day's stored run delivered
+    orders and the new one must not replace it (:func:`write_day`'s ``keep``: e.g. every
+    order of the new run is invalid, as when the orders are flown with another site's
+    menus). Nothing was written; the stored day is as it was. ``date``, ``delivered``
+    (orders the stored run delivered), ``why`` (the new run's fault)."""
+
+    def __init__(self, date: dt.date, delivered: int, why: str) -> None:
+        super().__init__(f"{date}: {why}, so the day's stored flight, which delivered "
+                         f"{delivered:,} order{'' if delivered == 1 else 's'}, is kept "
+                         "(nothing was written for the day)", param="replace")
+        self.date, self.delivered, self.why = date, delivered, why
+
+    def __reduce__(self):  # raised in worker processes: rebuilt whole in the caller
+        return type(self), (self.date, self.delivered, self.why)
+
+
 def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[dict],
-              moves: Iterable[dict]) -> None:
+              moves: Iterable[dict], *, keep: str | None = None) -> None:
     """Replace one day's results in one transaction (``moves`` may be a generator). The
     run and delivery rows are checked to fit their columns first (:func:`check_fits`:
     money beyond a 32-bit INTEGER), so a failure leaves the day as it was. Two writers
     of one day at once: the later waits for the earlier's transaction, then replaces its
-    rows (SQLite: its write lock; PostgreSQL: an advisory lock on the day)."""
+    rows (SQLite: its write lock; PostgreSQL: an advisory lock on the day).
+
+    ``keep``: why this run must not replace a stored run of the day that delivered
+    orders (None: it replaces any); such a stored run is kept, and
+    :class:`DayKeptError` raised naming ``keep``, read in the same transaction."""
     t_ = tables(engine)
     flightpath, deliveries, runs = t_["flightpath"], t_["deliveries"], t_["runs"]
     head = {**run, "delivery_date": date,
@@ -373,6 +394,11 @@ def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[d
         check_fits(deliveries, row, f"{date}: order {row.get('order_no')!r}: ")
     with writing(engine) as conn:
         _lock_day(conn, date)
+        if keep is not None:
+            had = conn.scalar(sa.select(runs.c.orders_delivered)
+                              .where(runs.c.delivery_date == date))
+            if had:
+                raise DayKeptError(date, had, keep)
         for t in (flightpath, deliveries, runs):
             conn.execute(t.delete().where(t.c.delivery_date == date))
         conn.execute(runs.insert(), [head])
@@ -440,9 +466,12 @@ def day_rows(engine: sa.Engine, date: dt.date) -> dict[str, list[tuple]]:
                 .order_by(flightpath.c.seq))]}
 
 
-def store_day(engine, result) -> None:
+def store_day(engine, result, *, replace: bool = False) -> None:
     """Write a :class:`~skyroute.delivery.day.DayResult` (run, deliveries, moves) in
-    one transaction."""
+    one transaction, replacing the day's stored results; but a day whose every order is
+    invalid does not replace a stored run that delivered orders (:class:`DayKeptError`)
+    unless ``replace``: flown with the wrong site's menus, every order is 'unknown
+    item', and that silently replaced the day's real flight."""
     f = result.flight.flight
     run = {"started": dt.datetime.fromtimestamp(result.started),
            "finished": dt.datetime.fromtimestamp(result.started + result.seconds),
@@ -456,4 +485,9 @@ def store_day(engine, result) -> None:
               "from_lon": float(f.frm[k, 0]), "from_lat": float(f.frm[k, 1]),
               "angle": int(f.angle[k]), "to_lon": float(f.to[k, 0]),
               "to_lat": float(f.to[k, 1])} for k in range(f.moves))
-    write_day(engine, result.date, run, delivered, moves)
+    keep = None
+    if not replace and result.orders and len(result.invalid) == len(result.orders):
+        o, reason = result.invalid[0]
+        keep = (f"every one of the day's {len(result.orders):,} orders is invalid (order "
+                f"{o.order_no}: {reason})")
+    write_day(engine, result.date, run, delivered, moves, keep=keep)

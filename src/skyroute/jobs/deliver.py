@@ -25,7 +25,7 @@ import sqlalchemy as sa
 from skyroute.caches import register
 from skyroute.delivery import store
 from skyroute.delivery.day import METHODS, DayResult, plan_day
-from skyroute.delivery.days import prepare_legs
+from skyroute.delivery.days import foreign_days, prepare_legs
 from skyroute.delivery.orders import Order
 from skyroute.delivery.site import load_site
 from skyroute.delivery.source import DirSource, HttpSource, open_source
@@ -35,13 +35,16 @@ from skyroute.jobs.store import engine_for, worker_url
 
 @dataclass(frozen=True)
 class DayTask:
-    """One day for a worker: store URL, site source, date, its orders, method."""
+    """One day for a worker: store URL, site source, date, its orders, method, and
+    whether a day with every order invalid may replace a stored flight that delivered
+    (:func:`skyroute.delivery.store.store_day`)."""
 
     url: str
     source: DirSource | HttpSource
     date: dt.date
     orders: tuple[Order, ...]
     method: str = "milp"
+    replace: bool = False
 
 
 _SITES: dict = {}
@@ -60,11 +63,11 @@ def fly_day(task: DayTask) -> DayResult:
     result = plan_day(_site(task.source), task.date, list(task.orders), method=task.method)
     engine = engine_for(task.url)
     try:
-        store.store_day(engine, result)
+        store.store_day(engine, result, replace=task.replace)
     except sa.exc.IntegrityError:
         # a second run of this task wrote the same day at the same moment (a worker the
         # scheduler thought dead): write again after it, replacing its rows
-        store.store_day(engine, result)
+        store.store_day(engine, result, replace=task.replace)
     return result
 
 
@@ -78,14 +81,16 @@ def days_between(engine: sa.Engine, first: dt.date, last: dt.date) -> dict[dt.da
 
 
 def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executor,
-             method: str = "milp",
+             method: str = "milp", replace: bool = False,
              on_day: Callable[[DayResult], None] | None = None) -> list[DayResult]:
     """Fly and store every day of ``by_date`` as one task each on ``executor``; results
     in date order, ``on_day`` called with each as it arrives. Ends by checking that the
-    store holds every day (workers that wrote to another database are an error)."""
+    store holds every day (workers that wrote to another database are an error). A day
+    whose every order is invalid does not replace a stored flight that delivered unless
+    ``replace`` (:class:`~skyroute.delivery.store.DayKeptError`)."""
     check_choice("method", method, METHODS)
     url = worker_url(engine)
-    tasks = [DayTask(url, source, d, tuple(orders), method)
+    tasks = [DayTask(url, source, d, tuple(orders), method, replace)
              for d, orders in sorted(by_date.items())]
     results = executor.map(fly_day, tasks,
                            on_result=(lambda _i, r: on_day(r)) if on_day else None)
@@ -176,7 +181,15 @@ def deliver_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
     src = open_source(None if data is None else Path(data), p.get("source"))
     first, last = dt.date.fromisoformat(p["from"]), dt.date.fromisoformat(p["to"])
     by_date = days_between(engine, first, last)
-    prepare_legs(load_site(src), [o for v in by_date.values() for o in v])
+    site = load_site(src)
+    bad = foreign_days(site, by_date)
+    if bad:  # flown, every order would be 'unknown item', stored over the day's flight
+        raise SkyrouteError(f"{src.where('menus/menus.json')}: none of the orders stored "
+                            f"for {bad[0]} is on these menus or goes to a place of this "
+                            "site: they are another site's orders; give the data folder (or "
+                            "source) they were imported from",
+                            param=("data" if data is not None else "source"))
+    prepare_legs(site, [o for v in by_date.values() for o in v])
     done = 0
 
     def on_day(_r: DayResult) -> None:

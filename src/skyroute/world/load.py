@@ -93,6 +93,9 @@ def load_map(path: str | Path, *, resolution: float | None = None, safety: float
     return grid.inflate(safety)
 
 
+ALTITUDE = "a finite number >= 0"  # what an altitude must be: metres above the ground
+
+
 def load_world(path: str | Path, *, altitude: float | None = None, safety: float = 0.0,
                boundary: str | Path | None = None, frame: str = "lonlat",
                text: str | None = None) -> World:
@@ -104,10 +107,10 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
     ((north, east) metres from home, FCND; "local" is an alias), "enu" ((east, north)
     metres) or "degrees" ((lon, lat) on a flat plane, the ILP rules; GeoJSON only). A
     colliders file's home is its ``lat0, lon0``; a GeoJSON file's the centre of its
-    zones and boundary. ``altitude`` keeps the obstacles that count there; ``safety``
-    grows every obstacle (metres, or degrees in the degrees frame). ``text``: the file's
-    content, already in hand (an upload); ``path`` then only names it and its suffix
-    tells the format.
+    zones and boundary. ``altitude`` (metres above the ground, >= 0) keeps the obstacles
+    that count there; ``safety`` grows every obstacle (metres, or degrees in the degrees
+    frame). ``text``: the file's content, already in hand (an upload); ``path`` then only
+    names it and its suffix tells the format.
     """
     from skyroute.geo import FRAME_ALIASES, FRAMES
     from skyroute.world.colliders import read_colliders
@@ -119,7 +122,10 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
     if real("safety", safety) < 0:
         raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
     safety = float(safety)
-    altitude = None if altitude is None else real("altitude", altitude)
+    # metres above the ground, as bench.world.check_altitude has it: -5 kept no building
+    # of a city (all stand on the ground) and planned straight through them
+    if altitude is not None:
+        altitude = real("altitude", altitude, low=0, need=ALTITUDE)
     most = 180.0 if frame == "degrees" else MAX_METRES
     if safety > most:
         raise OptionError(f"safety={safety!r} must be at most {most:g} "

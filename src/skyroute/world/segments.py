@@ -19,6 +19,13 @@ from skyroute.world.geometry import point_segment_dist2
 from skyroute.world.grid import MAX_CELLS, Grid, raster_shape
 
 OUTLIER = 10  # a wall that makes the map this many times as long is named as the cause
+CITY = "a colliders.csv city (line 1 'lat0 ..., lon0 ...'), not wall segments x1,y1,x2,y2"
+
+
+class CityNotWallsError(InputFormatError):
+    """A ``colliders.csv`` city (line 1 ``lat0 ..., lon0 ...``) read as a walls map: a
+    city is a continuous world of boxes (:func:`skyroute.load_world`), not walls to
+    rasterise. It read "expected 4 columns x1,y1,x2,y2, got 2", which named no way on."""
 
 
 def read_segments(path: str | Path) -> np.ndarray:
@@ -93,6 +100,8 @@ def _read(path: Path) -> tuple[np.ndarray, list[int]]:
             continue
         if n == 1 and row[0].strip().lower() in ("x1", "x0", "x"):
             continue
+        if n == 1 and row[0].strip().lower().startswith(("lat0", "lon0")):
+            raise CityNotWallsError(path, f"{CITY}: load it with skyroute.load_world", line=1)
         if len(row) != 4:
             raise InputFormatError(path, f"expected 4 columns x1,y1,x2,y2, got {len(row)}",
                                    line=n)
