@@ -39,6 +39,17 @@ class InputFormatError(SkyrouteError, ValueError):
         super().__init__(f"{where}: {message}", param=None)
 
 
+CITY = "a colliders.csv city (line 1 'lat0 ..., lon0 ...'), not wall segments x1,y1,x2,y2"
+
+
+class CityNotWallsError(InputFormatError):
+    """A ``colliders.csv`` city (line 1 ``lat0 ..., lon0 ...``) read as a walls map: a
+    city is a continuous world of boxes (:func:`skyroute.load_world`), not walls to
+    rasterise. It read "expected 4 columns x1,y1,x2,y2, got 2", which named no way on.
+    (Here, not in :mod:`skyroute.world.segments`, so that ``skyroute plan`` can catch it
+    without importing shapely.)"""
+
+
 class QueryError(SkyrouteError, ValueError):
     """A start or goal that cannot be planned from: outside the map or on a blocked cell."""
 

@@ -100,7 +100,7 @@ def plan_command(
 
 def _load_grid(map_file: str, *, resolution: float, safety: float):
     """:func:`load_map`; a colliders city given as MAP says to plan in it with plan-world."""
-    from skyroute.world.segments import CITY, CityNotWallsError
+    from skyroute.errors import CITY, CityNotWallsError
 
     try:
         return load_map(map_file, resolution=resolution, safety=safety)

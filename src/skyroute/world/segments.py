@@ -13,19 +13,12 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from skyroute.errors import InputFormatError, OptionError
+from skyroute.errors import CITY, CityNotWallsError, InputFormatError, OptionError
 from skyroute.files import read_text
 from skyroute.world.geometry import point_segment_dist2
 from skyroute.world.grid import MAX_CELLS, Grid, raster_shape
 
 OUTLIER = 10  # a wall that makes the map this many times as long is named as the cause
-CITY = "a colliders.csv city (line 1 'lat0 ..., lon0 ...'), not wall segments x1,y1,x2,y2"
-
-
-class CityNotWallsError(InputFormatError):
-    """A ``colliders.csv`` city (line 1 ``lat0 ..., lon0 ...``) read as a walls map: a
-    city is a continuous world of boxes (:func:`skyroute.load_world`), not walls to
-    rasterise. It read "expected 4 columns x1,y1,x2,y2, got 2", which named no way on."""
 
 
 def read_segments(path: str | Path) -> np.ndarray:
