@@ -158,3 +158,30 @@ def test_ctrl_c_while_numba_compiles_is_one_line(tmp_path):
         p.kill()
     assert (p.returncode, err) == (130, "skyroute: interrupted\n")
 
+
+def test_ctrl_c_while_a_fleet_run_is_written_leaves_the_earlier_run(tmp_path):
+    # the folder holds an earlier run; Ctrl-C once the first file of the new one is
+    # written must leave that run whole, not a mix of the two (report.json new, the
+    # rest old) nor a part of the new one
+    from skyroute.io.fleet_out import RUN_FILES
+
+    out = tmp_path / "run"
+    out.mkdir()
+    for name in RUN_FILES:
+        (out / name).write_text(f"earlier {name}\n")
+    before = sorted(out.iterdir())
+    # tracks every 0.05 s: a tracks.csv of 7 MB, seconds to write after report.json
+    p = _start(["-m", "skyroute", "fleet", "simulate", "--preset", "seed-3x3", "--hours", "1",
+                "--track-step", "0.05", "--out", str(out), "--json"])
+    try:
+        while p.poll() is None and not any(
+                f.name.startswith(".report.json.") or f.read_text() != f"earlier {f.name}\n"
+                for f in out.iterdir() if f.name.startswith((".report", "report"))):
+            time.sleep(0.002)
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=30)
+    finally:
+        p.kill()
+    assert (p.returncode, err) == (130, "skyroute: interrupted\n")
+    assert sorted(out.iterdir()) == before  # no temporary file left either
+    assert all((out / n).read_text() == f"earlier {n}\n" for n in RUN_FILES)
