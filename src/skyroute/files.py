@@ -4,7 +4,7 @@ and a set of files (a run's folder, a day's files) all or none (:func:`written_t
 from __future__ import annotations
 
 import os
-import tempfile
+import secrets
 from collections.abc import Iterator
 from contextlib import contextmanager, suppress
 from contextvars import ContextVar
@@ -77,8 +77,12 @@ def open_atomic(path: str | Path) -> Iterator[BinaryIO]:
     """
     path = Path(path)
     staged = _TOGETHER.get()
-    fd, tmp, made = _temp_beside(path)
+    made = _folders_for(path)
+    # the temporary file's name is known before it exists: a Ctrl-C the moment it is
+    # made (mkstemp's name not yet returned) left it behind
+    tmp = str(path.parent / f".{path.name}.{secrets.token_hex(8)}.tmp")
     try:
+        fd = _create(tmp, path)
         with os.fdopen(fd, "wb") as f:
             yield f
         os.chmod(tmp, _MODE)
@@ -187,15 +191,18 @@ def check_writable(path: str | Path) -> Path:
     here = next(p for p in path.parents if os.path.lexists(p))
     if not here.is_dir():  # a file, or a link to nothing, where a folder must be
         raise SkyrouteError(f"{path}: cannot write: {here} is not a folder")
-    fd, tmp = _temp_in(here, path)
-    os.close(fd)
-    os.unlink(tmp)
+    # named before it is made, as in open_atomic, so a Ctrl-C cannot leave it behind
+    tmp = str(here / f".{path.name}.{secrets.token_hex(8)}.tmp")
+    try:
+        os.close(_create(tmp, path))
+    finally:
+        with suppress(FileNotFoundError):
+            os.unlink(tmp)
     return path
 
 
-def _temp_beside(path: Path) -> tuple[int, str, list[Path]]:
-    """A new temporary file in ``path``'s folder (made if missing): (fd, its path, the
-    folders made, outermost first)."""
+def _folders_for(path: Path) -> list[Path]:
+    """Make ``path``'s folder if missing; the folders made, outermost first."""
     made = [p for p in reversed(path.parents) if not os.path.lexists(p)]
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -204,13 +211,14 @@ def _temp_beside(path: Path) -> tuple[int, str, list[Path]]:
         raise SkyrouteError(f"{path}: cannot write: {blocker} is not a folder") from None
     except OSError as exc:
         raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
-    return (*_temp_in(path.parent, path), made)
+    return made
 
 
-def _temp_in(folder: Path, path: Path) -> tuple[int, str]:
-    """A new temporary file for ``path`` in ``folder`` (which exists): (fd, its path); a
+def _create(tmp: str, path: Path) -> int:
+    """Create ``tmp`` (new, owner-only, as mkstemp does) for writing ``path``; its fd. A
     failure is a SkyrouteError naming ``path``."""
     try:
-        return tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+        return os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0),
+                       0o600)
     except OSError as exc:
         raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
