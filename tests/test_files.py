@@ -85,3 +85,25 @@ def test_check_writable_fails_where_writing_would(tmp_path):
     if not os.access(tmp_path / "ro", os.W_OK):  # (root may write anywhere)
         with pytest.raises(SkyrouteError, match=r"ro/new/r.json: cannot write: Permission"):
             check_writable(tmp_path / "ro" / "new" / "r.json")
+
+
+def test_written_together_appear_together_or_not_at_all(tmp_path):
+    from skyroute.files import written_together
+
+    out = tmp_path / "run"
+    (tmp_path / "keep.txt").write_text("earlier")
+    with pytest.raises(KeyboardInterrupt), written_together():
+        write_atomic(tmp_path / "keep.txt", "new")
+        write_atomic(out / "deep" / "a.txt", "a")
+        assert not (out / "deep" / "a.txt").exists()  # nothing in place before the end
+        raise KeyboardInterrupt  # Ctrl-C before the set is whole
+    # the earlier file kept, no temporary file, no folder made for the set left behind
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.txt"]
+    assert (tmp_path / "keep.txt").read_text() == "earlier"
+    with written_together():
+        write_atomic(tmp_path / "keep.txt", "first")
+        write_atomic(out / "a.txt", "a")
+        write_atomic(tmp_path / "keep.txt", "second")  # written twice: the later wins
+    assert (tmp_path / "keep.txt").read_text() == "second"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.txt", "run"]
+    assert [p.name for p in out.iterdir()] == ["a.txt"]

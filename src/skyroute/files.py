@@ -1,11 +1,13 @@
-"""Read a text file (UTF-8, a byte-order mark read past); write a file whole or not at all."""
+"""Read a text file (UTF-8, a byte-order mark read past); write a file whole or not at all,
+and a set of files (a run's folder, a day's files) all or none (:func:`written_together`)."""
 
 from __future__ import annotations
 
 import os
-import tempfile
+import secrets
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
+from contextvars import ContextVar
 from pathlib import Path
 from typing import BinaryIO, TextIO
 
@@ -58,27 +60,107 @@ def _umask() -> int:
 _MODE = 0o666 & ~_umask()
 
 
+# the files of the innermost written_together block: (temporary file, its place, the
+# folders made for it)
+_TOGETHER: ContextVar[list[tuple[str, Path, list[Path]]] | None] = ContextVar(
+    "skyroute_together", default=None)
+
+
 @contextmanager
 def open_atomic(path: str | Path) -> Iterator[BinaryIO]:
     """A binary file to write ``path`` through: a temporary file beside it, renamed into
-    place when the block ends, removed if it raises. Parent folders are created. A
+    place when the block ends (inside :func:`written_together`, when that block ends),
+    removed if it raises. Parent folders are created. A
     folder that cannot be made or a file that cannot be written (no permission, a full
     disk, ``path`` a folder) is a SkyrouteError naming ``path``; nothing is left behind.
     The block should only write the file: an OSError raised in it is reported as such.
     """
     path = Path(path)
-    fd, tmp = _temp_beside(path)
+    staged = _TOGETHER.get()
+    made = _folders_for(path)
+    # the temporary file's name is known before it exists: a Ctrl-C the moment it is
+    # made (mkstemp's name not yet returned) left it behind
+    tmp = str(path.parent / f".{path.name}.{secrets.token_hex(8)}.tmp")
     try:
+        fd = _create(tmp, path)
         with os.fdopen(fd, "wb") as f:
             yield f
         os.chmod(tmp, _MODE)
-        os.replace(tmp, path)
+        if staged is None:
+            os.replace(tmp, path)
+        else:
+            _stage(staged, tmp, path, made)
     except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
+        _failed(staged, tmp, path, made)
         raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        _failed(staged, tmp, path, made)
         raise
+
+
+@contextmanager
+def written_together() -> Iterator[None]:
+    """Every file :func:`open_atomic` or :func:`write_atomic` writes in this block (in
+    this thread) appears when the block ends, or none does if it raises (nor a folder
+    made for one): a Ctrl-C or an error while a fleet run's folder or a delivery day's
+    files were written left some of them new and the others missing, or an earlier
+    run's. Each is written to a temporary file beside its place as the block goes, and
+    they are renamed into place one after another when it ends (a rename each,
+    microseconds). A block inside another joins it.
+    """
+    if _TOGETHER.get() is not None:
+        yield
+        return
+    staged: list[tuple[str, Path, list[Path]]] = []
+    token = _TOGETHER.set(staged)
+    try:
+        yield
+    except BaseException:
+        _TOGETHER.reset(token)
+        _discard(staged)
+        raise
+    _TOGETHER.reset(token)
+    for k, (tmp, path, _) in enumerate(staged):
+        try:
+            if tmp:
+                os.replace(tmp, path)
+        except BaseException as exc:
+            _discard(staged[k:])
+            if isinstance(exc, OSError):
+                raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
+            raise
+
+
+def _stage(staged: list, tmp: str, path: Path, made: list[Path]) -> None:
+    """Add ``tmp`` to be renamed to ``path``; a file staged for ``path`` before (written
+    twice in one block) is dropped: the later one wins, as it would have."""
+    for k, (old, place, _) in enumerate(staged):
+        if place == path:
+            if old:
+                Path(old).unlink(missing_ok=True)
+            staged[k] = (tmp, path, staged[k][2] + made)
+            return
+    staged.append((tmp, path, made))
+
+
+def _failed(staged: list | None, tmp: str, path: Path, made: list[Path]) -> None:
+    """A write that failed: its temporary file removed; in a written_together block, the
+    folders made for it are the block's to remove with the others'."""
+    Path(tmp).unlink(missing_ok=True)
+    if staged is not None:
+        staged.append(("", path, made))
+
+
+def _discard(staged: list) -> None:
+    """Remove the temporary files, then the folders made for them that are empty
+    (deepest first)."""
+    for tmp, _, _ in staged:
+        if tmp:
+            Path(tmp).unlink(missing_ok=True)
+    for folder in sorted({f for _, _, made in staged for f in made},
+                         key=lambda f: len(f.parts), reverse=True):
+        with suppress(OSError):  # not empty (another writer's file), or gone
+            folder.rmdir()
 
 
 def write_atomic(path: str | Path, data: bytes | str) -> Path:
@@ -109,14 +191,19 @@ def check_writable(path: str | Path) -> Path:
     here = next(p for p in path.parents if os.path.lexists(p))
     if not here.is_dir():  # a file, or a link to nothing, where a folder must be
         raise SkyrouteError(f"{path}: cannot write: {here} is not a folder")
-    fd, tmp = _temp_in(here, path)
-    os.close(fd)
-    os.unlink(tmp)
+    # named before it is made, as in open_atomic, so a Ctrl-C cannot leave it behind
+    tmp = str(here / f".{path.name}.{secrets.token_hex(8)}.tmp")
+    try:
+        os.close(_create(tmp, path))
+    finally:
+        with suppress(FileNotFoundError):
+            os.unlink(tmp)
     return path
 
 
-def _temp_beside(path: Path) -> tuple[int, str]:
-    """A new temporary file in ``path``'s folder (made if missing): (fd, its path)."""
+def _folders_for(path: Path) -> list[Path]:
+    """Make ``path``'s folder if missing; the folders made, outermost first."""
+    made = [p for p in reversed(path.parents) if not os.path.lexists(p)]
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except (FileExistsError, NotADirectoryError):  # a file where a folder must be
@@ -124,13 +211,14 @@ def _temp_beside(path: Path) -> tuple[int, str]:
         raise SkyrouteError(f"{path}: cannot write: {blocker} is not a folder") from None
     except OSError as exc:
         raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
-    return _temp_in(path.parent, path)
+    return made
 
 
-def _temp_in(folder: Path, path: Path) -> tuple[int, str]:
-    """A new temporary file for ``path`` in ``folder`` (which exists): (fd, its path); a
+def _create(tmp: str, path: Path) -> int:
+    """Create ``tmp`` (new, owner-only, as mkstemp does) for writing ``path``; its fd. A
     failure is a SkyrouteError naming ``path``."""
     try:
-        return tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+        return os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0),
+                       0o600)
     except OSError as exc:
         raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None

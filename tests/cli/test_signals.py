@@ -5,6 +5,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -93,3 +94,94 @@ def test_sigterm_handler_is_restored(monkeypatch):
     with pytest.raises(SystemExit):
         run_cli(_raises(KeyboardInterrupt()))
     assert signal.getsignal(signal.SIGTERM) is before
+
+
+def _start(args, env=None, **kw):
+    env = {**os.environ, "PYTHONPATH": str(SRC), **(env or {})}
+    return subprocess.Popen([sys.executable, *args], env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, **kw)
+
+
+# Ctrl-C handled inside a ctypes callback, as when it comes while numba's LLVM compiles
+# (llvmlite's object-cache hook is the next Python to run): ctypes swallows the
+# KeyboardInterrupt ("Exception ignored on calling ctypes callback function") and the
+# command went on, or failed with numba's RuntimeError traceback.
+CALLBACK = """
+import ctypes, ctypes.util, os, signal, sys, time
+import typer
+from skyroute.cli.errors import run_cli
+
+app = typer.Typer(add_completion=False)
+
+@app.command()
+def sort() -> None:
+    cmp = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(ctypes.c_int),
+                           ctypes.POINTER(ctypes.c_int))
+    def compare(a, b):
+        os.kill(os.getpid(), signal.SIGINT)  # its handler runs here, in the callback
+        return a[0] - b[0]
+    values = (ctypes.c_int * 2)(2, 1)
+    libc = ctypes.CDLL(ctypes.util.find_library("c"))
+    libc.qsort(values, 2, ctypes.sizeof(ctypes.c_int), cmp(compare))
+    print("sorted", flush=True)
+    time.sleep(20)  # the rest of the work: the interrupt must end it
+    print("finished")
+
+run_cli(app)
+"""
+
+
+def test_an_interrupt_swallowed_by_a_ctypes_callback_still_interrupts():
+    p = _start(["-c", CALLBACK])
+    try:
+        out, err = p.communicate(timeout=30)
+    finally:
+        p.kill()
+    assert (p.returncode, err) == (130, "skyroute: interrupted\n")
+    assert "finished" not in out
+
+
+def test_ctrl_c_while_numba_compiles_is_one_line(tmp_path):
+    # a first run, the kernels compiled into an empty cache; SIGINT a moment after the
+    # first one is saved, while the others compile (where it lands varies: in LLVM's
+    # callback, the old code's traceback or lost Ctrl-C, or in Python)
+    p = _start(["-m", "skyroute", "plan", "den312d", "--start", "50,76", "--goal", "60,13",
+                "--json"], env={"NUMBA_CACHE_DIR": str(tmp_path), "NUMBA_DEBUG_CACHE": "1"})
+    try:
+        for line in p.stdout:
+            if "data saved" in line:
+                break
+        time.sleep(0.15)
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=30)
+    finally:
+        p.kill()
+    assert (p.returncode, err) == (130, "skyroute: interrupted\n")
+
+
+def test_ctrl_c_while_a_fleet_run_is_written_leaves_the_earlier_run(tmp_path):
+    # the folder holds an earlier run; Ctrl-C once the first file of the new one is
+    # written must leave that run whole, not a mix of the two (report.json new, the
+    # rest old) nor a part of the new one
+    from skyroute.io.fleet_out import RUN_FILES
+
+    out = tmp_path / "run"
+    out.mkdir()
+    for name in RUN_FILES:
+        (out / name).write_text(f"earlier {name}\n")
+    before = sorted(out.iterdir())
+    # tracks every 0.05 s: a tracks.csv of 7 MB, seconds to write after report.json
+    p = _start(["-m", "skyroute", "fleet", "simulate", "--preset", "seed-3x3", "--hours", "1",
+                "--track-step", "0.05", "--out", str(out), "--json"])
+    try:
+        while p.poll() is None and not any(
+                f.name.startswith(".report.json.") or f.read_text() != f"earlier {f.name}\n"
+                for f in out.iterdir() if f.name.startswith((".report", "report"))):
+            time.sleep(0.002)
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=30)
+    finally:
+        p.kill()
+    assert (p.returncode, err) == (130, "skyroute: interrupted\n")
+    assert sorted(out.iterdir()) == before  # no temporary file left either
+    assert all((out / n).read_text() == f"earlier {n}\n" for n in RUN_FILES)

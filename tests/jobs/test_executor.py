@@ -3,6 +3,7 @@ errors raised as themselves, bad addresses one clear line."""
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 
@@ -143,3 +144,55 @@ def test_closing_cuts_off_another_threads_map_with_a_clear_error(kind, workers):
         ex.map(math.sqrt, ITEMS)
     if kind == "local":
         assert ex._pool is None
+ABORTED = """
+import os, signal, sys, time
+from pathlib import Path
+from skyroute.jobs.executor import open_executor
+
+def task(i):
+    here = Path(sys.argv[1])
+    (here / f"started-{i}").touch()
+    time.sleep(10)
+    (here / f"done-{i}").touch()  # what a task stores when it runs to its end
+    return i
+
+if __name__ == "__main__":
+    try:
+        with open_executor("local", workers=2) as ex:
+            ex.map(task, range(6))
+    except KeyboardInterrupt:
+        print("interrupted", flush=True)
+"""
+
+
+def test_ctrl_c_in_a_local_map_ends_the_running_tasks(tmp_path):
+    """Ctrl-C (to the whole process group, as a terminal sends it) while workers run
+    tasks: the workers print nothing, their tasks stop where they are, no task starts
+    after it, and the program ends with no worker left. The tasks ran to the end (a
+    range of days stored after 'interrupted', the exit waiting for them) and the
+    workers printed KeyboardInterrupt tracebacks."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import skyroute
+
+    script = tmp_path / "aborted.py"
+    script.write_text(ABORTED)
+    env = {**os.environ, "PYTHONPATH": str(Path(skyroute.__file__).resolve().parents[1])}
+    p = subprocess.Popen([sys.executable, str(script), str(tmp_path)], env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    try:
+        while len(list(tmp_path.glob("started-*"))) < 2 and p.poll() is None:
+            time.sleep(0.01)
+        os.killpg(p.pid, signal.SIGINT)
+        # communicate ends when every process holding the pipes (the workers) has ended
+        out, err = p.communicate(timeout=9)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(p.pid, signal.SIGKILL)
+    assert (out, err, p.returncode) == ("interrupted\n", "", 0)
+    assert sorted(f.name for f in tmp_path.glob("*-*")) == ["started-0", "started-1"]

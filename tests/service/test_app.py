@@ -263,3 +263,38 @@ def test_an_errors_message_is_the_detail_without_its_field(client, path, body, f
     doc = assert_problem(client.post(path, json=body, headers=AUTH), 422, field)
     message = doc["errors"][0]["message"]
     assert doc["detail"] == f"{field}: {message}" and not message.startswith(field)
+
+
+def test_shutdown_ends_the_jobs_worker_processes(tmp_path):
+    """At shutdown the jobs' workers end with their tasks (a running job stays running
+    in the store and is failed as an orphan). They ran on: 'skyroute serve' stopped by
+    SIGTERM left them behind, holding its stdout and stderr, each task to its end."""
+    import multiprocessing
+    import threading
+    import time
+
+    from skyroute.service.resources import Resources
+    from skyroute.service.settings import Settings
+
+    res = Resources(Settings(db_url=f"sqlite:///{tmp_path / 'x.db'}", job_workers=2))
+    ex = res.executor()
+    from concurrent.futures.process import BrokenProcessPool
+
+    def run() -> None:
+        with pytest.raises(BrokenProcessPool):  # what a job sees when the server stops
+            ex.map(time.sleep, [30.0, 30.0, 30.0])
+
+    others = set(multiprocessing.active_children())  # other tests' pools, ending
+
+    def ours():
+        return [p for p in multiprocessing.active_children()
+                if p not in others and p.is_alive()]
+
+    lane = threading.Thread(target=run)
+    lane.start()
+    while len(ours()) < 2:  # the workers have started, with the tasks submitted
+        time.sleep(0.01)
+    res.close()
+    lane.join(timeout=10)
+    assert not lane.is_alive()  # its map ended: the workers are gone
+    assert ours() == []

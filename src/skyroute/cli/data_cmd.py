@@ -34,9 +34,11 @@ def data_synth(
     _check_folder(folder, replace)
     with delayed_status(f"writing a data set to {folder}"):  # imports included: seconds
         from skyroute.delivery.synth import synth
+        from skyroute.files import written_together
 
-        summary = synth(folder, days=days, orders_per_day=orders_per_day, seed=seed,
-                        start=first, customers=customers)
+        with written_together():  # a Ctrl-C halfway leaves no part of a data set
+            summary = synth(folder, days=days, orders_per_day=orders_per_day, seed=seed,
+                            start=first, customers=customers)
     typer.echo(json.dumps(summary))  # not through Rich: no markup, no wrapping
 
 

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import _thread
 import os
 import re
 import signal
 import sys
 import threading
+import time
 
 import typer
 from typer.exceptions import TyperException
@@ -41,14 +43,63 @@ def in_flags(exc: SkyrouteError) -> str:
     return msg
 
 
-def _on_sigterm(main_pid: int):
-    def handler(signum, frame):
-        if os.getpid() != main_pid:  # a forked worker: die as it would have
+class _Signals:
+    """The signals that came while a command ran (SIGINT, SIGTERM), remembered apart from
+    the exception each raised: that exception can be lost on its way up. A signal that
+    arrives while C code runs (numba's LLVM compiling a kernel, most of a first run) is
+    handled at the next line of Python, which is often a ctypes callback (llvmlite's
+    object-cache hook); ctypes prints the KeyboardInterrupt as "Exception ignored on
+    calling ctypes callback function" with its traceback, and numba then failed with
+    RuntimeError ('no compiled object yet'): a traceback and exit code 1 for a Ctrl-C.
+    """
+
+    def __init__(self, main_pid: int) -> None:
+        self.main_pid = main_pid
+        self.seen: int | None = None  # the last signal (signal.SIGINT / SIGTERM)
+        self.active = True  # our handlers are in place
+
+    def on_sigint(self, signum, frame):
+        self.seen = signal.SIGINT
+        raise KeyboardInterrupt
+
+    def on_sigterm(self, signum, frame):
+        if os.getpid() != self.main_pid:  # a forked worker: die as it would have
             signal.signal(signal.SIGTERM, signal.SIG_DFL)
             os.kill(os.getpid(), signal.SIGTERM)
             return
+        self.seen = signal.SIGTERM
         raise Terminated
-    return handler
+
+    def unraisable(self, before):
+        """A ``sys.unraisablehook``: an interrupt that could not be raised where it came
+        (a ctypes callback, a ``__del__``) prints nothing and is raised again in the
+        main thread (:meth:`_raise_later`). Other unraisable errors go to ``before``, but
+        not after a signal: then they are its fallout (llvmlite's half-made objects
+        failing in ``__del__`` when the interrupt stopped their ``__init__``), each a
+        traceback after the one line."""
+        def hook(info) -> None:
+            if not isinstance(info.exc_value, KeyboardInterrupt | Terminated):
+                if self.seen is None:
+                    before(info)
+                return
+            signum = signal.SIGTERM if isinstance(info.exc_value, Terminated) else \
+                signal.SIGINT
+            try:
+                self.seen = signum
+                # a bare thread: Thread.start() waits for it, and another interrupt
+                # raised in that wait would be lost in this hook
+                _thread.start_new_thread(self._raise_later, (signum,))
+            except (KeyboardInterrupt, Terminated):  # the one raised later came early
+                _thread.start_new_thread(self._raise_later, (signum,))
+        return hook
+
+    def _raise_later(self, signum: int) -> None:
+        """Run the handler of ``signum`` in the main thread again, once the hook that
+        swallowed its exception has returned (raised there, it would be swallowed too:
+        a signal's handler runs at the next line of Python, which would be the hook's)."""
+        time.sleep(0.01)
+        if self.active:  # a real signal to the main thread wakes it from a wait too
+            signal.pthread_kill(threading.main_thread().ident, signum)
 
 
 def _interrupt(exc: BaseException) -> BaseException | None:
@@ -66,19 +117,36 @@ def _interrupt(exc: BaseException) -> BaseException | None:
 def run_cli(app: typer.Typer) -> None:
     """Run a Typer app; expected errors print ``skyroute: error: ...`` and exit 2;
     SIGINT prints ``skyroute: interrupted`` and exits 130, SIGTERM ``skyroute:
-    terminated`` and 143, after the work has unwound."""
-    before = signal.getsignal(signal.SIGTERM)
-    ours = before is signal.SIG_DFL and threading.current_thread() is threading.main_thread()
-    if ours:  # not over a handler someone else set (a test runner, an embedding program)
-        signal.signal(signal.SIGTERM, _on_sigterm(os.getpid()))
+    terminated`` and 143, after the work has unwound; also when the signal's exception
+    was swallowed on its way (:class:`_Signals`) and the work failed another way."""
+    if threading.current_thread() is not threading.main_thread():
+        _run(app, None)
+        return
+    signals = _Signals(os.getpid())
+    # not over handlers someone else set (a test runner, an embedding program)
+    handlers = {sig: ours for sig, ours, default in (
+        (signal.SIGINT, signals.on_sigint, signal.default_int_handler),
+        (signal.SIGTERM, signals.on_sigterm, signal.SIG_DFL))
+        if signal.getsignal(sig) is default}
+    before = {sig: signal.signal(sig, ours) for sig, ours in handlers.items()}
+    hook = sys.unraisablehook
+    sys.unraisablehook = signals.unraisable(hook)
     try:
-        _run(app)
+        _run(app, signals)
     finally:
-        if ours:
-            signal.signal(signal.SIGTERM, before)
+        signals.active = False
+        sys.unraisablehook = hook
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
 
 
-def _run(app: typer.Typer) -> None:
+def _signal_exit(signum) -> None:
+    term = signum == signal.SIGTERM
+    print(f"skyroute: {'terminated' if term else 'interrupted'}", file=sys.stderr)
+    sys.exit(EXIT_TERMINATED if term else EXIT_INTERRUPTED)
+
+
+def _run(app: typer.Typer, signals: _Signals | None) -> None:
     try:
         code = app(standalone_mode=False)
     except TyperException as exc:  # usage errors: unknown option, missing argument, ...
@@ -86,22 +154,23 @@ def _run(app: typer.Typer) -> None:
         hint = f" (see '{ctx.command_path} --help')" if ctx is not None else ""
         print(f"skyroute: error: {exc.format_message()}{hint}", file=sys.stderr)
         sys.exit(getattr(exc, "exit_code", EXIT_BAD_INPUT) or EXIT_BAD_INPUT)
-    except SkyrouteError as exc:
-        print(f"skyroute: error: {in_flags(exc)}", file=sys.stderr)
-        sys.exit(EXIT_BAD_INPUT)
     except (typer.Abort, KeyboardInterrupt):
-        print("skyroute: interrupted", file=sys.stderr)
-        sys.exit(EXIT_INTERRUPTED)
+        _signal_exit(signal.SIGINT)
     except Terminated:
-        print("skyroute: terminated", file=sys.stderr)
-        sys.exit(EXIT_TERMINATED)
-    except SystemError as exc:
-        signal_exc = _interrupt(exc)
-        if signal_exc is None:
-            raise
-        term = isinstance(signal_exc, Terminated)
-        print(f"skyroute: {'terminated' if term else 'interrupted'}", file=sys.stderr)
-        sys.exit(EXIT_TERMINATED if term else EXIT_INTERRUPTED)
+        _signal_exit(signal.SIGTERM)
+    except Exception as exc:
+        # the signal's own exception lost on the way (see _Signals), or wrapped: a
+        # SystemError from a numba call ('CPUDispatcher(...) returned a result with an
+        # exception set') caused by it; an error after a signal is the signal's doing
+        found = _interrupt(exc)
+        if found is not None:
+            _signal_exit(signal.SIGTERM if isinstance(found, Terminated) else signal.SIGINT)
+        if signals is not None and signals.seen is not None:
+            _signal_exit(signals.seen)
+        if isinstance(exc, SkyrouteError):
+            print(f"skyroute: error: {in_flags(exc)}", file=sys.stderr)
+            sys.exit(EXIT_BAD_INPUT)
+        raise
     if code == EXIT_INTERRUPTED:  # Typer turns Ctrl-C into exit code 130, silently
         print("skyroute: interrupted", file=sys.stderr)
     sys.exit(code if isinstance(code, int) else 0)

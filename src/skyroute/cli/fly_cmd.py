@@ -18,7 +18,7 @@ from skyroute.cli.parse import check_outputs
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console, print_table
 from skyroute.errors import OptionError, check_choice, real
-from skyroute.files import read_text, write_atomic
+from skyroute.files import read_text, write_atomic, written_together
 from skyroute.io.geojson import dumps
 from skyroute.planner import plan
 from skyroute.result import PlanResult, Status
@@ -189,22 +189,23 @@ def fly_command(
         else:
             doc, rows, xy = _fly_field(world, a, b, step, escape, sensor_range, sensor_rays,
                                        field_mode, math.radians(max_turn))
-    if out is not None and doc["reached"]:
-        write_atomic(out, _render(out, rows, doc["columns"], world.to_lonlat(xy)))
-    if plot is not None and doc["reached"]:
-        from skyroute.io.world_out import obstacles_label, plot_world_path
+    with written_together():  # both files or neither (a Ctrl-C while plotting)
+        if out is not None and doc["reached"]:
+            write_atomic(out, _render(out, rows, doc["columns"], world.to_lonlat(xy)))
+        if plot is not None and doc["reached"]:
+            from skyroute.io.world_out import obstacles_label, plot_world_path
 
-        # The title shows the length the table and --json report (a Dubins path's
-        # exact arcs); only a vehicle without one is measured along the drawn polyline,
-        # which cuts the arcs between samples and comes out shorter.
-        length = doc["metrics"].get("length")
-        if length is None:
-            plane = world.to_plane(xy)
-            length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
-        shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)
-        # --safety is in the units of the frame loaded (metres after 'step' moved to degrees)
-        plot_world_path(world, shown, a, xy[-1], plot,
-                        obstacles=obstacles_label(altitude, safety, frame))
+            # The title shows the length the table and --json report (a Dubins path's
+            # exact arcs); only a vehicle without one is measured along the drawn polyline,
+            # which cuts the arcs between samples and comes out shorter.
+            length = doc["metrics"].get("length")
+            if length is None:
+                plane = world.to_plane(xy)
+                length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
+            shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)
+            # --safety is in the units of the frame loaded (metres after 'step' moved to degrees)
+            plot_world_path(world, shown, a, xy[-1], plot,
+                            obstacles=obstacles_label(altitude, safety, frame))
     if as_json:
         typer.echo(json.dumps({k: v for k, v in doc.items() if k != "columns"}))
     else:

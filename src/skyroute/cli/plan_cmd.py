@@ -12,7 +12,7 @@ from skyroute.cli.parse import check_outputs, parse_cell
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import print_table, result_table
 from skyroute.errors import InputFormatError, OptionError
-from skyroute.files import check_writable, write_atomic
+from skyroute.files import check_writable, write_atomic, written_together
 from skyroute.io.geojson import dumps, grid_path_geojson
 from skyroute.planner import plan
 from skyroute.search.grid_plan import GRID_ALGORITHMS, grid_options
@@ -80,12 +80,13 @@ def plan_command(
                           heuristic=opts.heuristic, weight=opts.weight, prune=opts.prune,
                           max_expansions=max_expansions)
     if result.found:
-        if geojson:
-            write_atomic(geojson, dumps(grid_path_geojson(grid, result)))
-        if plot:
-            from skyroute.io.plot import plot_grid_path
+        with written_together():  # both files or neither (a Ctrl-C while plotting)
+            if geojson:
+                write_atomic(geojson, dumps(grid_path_geojson(grid, result)))
+            if plot:
+                from skyroute.io.plot import plot_grid_path
 
-            plot_grid_path(grid, result, s, t, plot, prune=opts.prune, safety=safety)
+                plot_grid_path(grid, result, s, t, plot, prune=opts.prune, safety=safety)
     if as_json:
         typer.echo(json.dumps(result.to_dict()))
     else:

@@ -15,7 +15,7 @@ from skyroute.cli.parse import check_outputs
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console, print_table, result_table
 from skyroute.errors import OptionError
-from skyroute.files import write_atomic
+from skyroute.files import write_atomic, written_together
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
     obstacles_label,
@@ -79,16 +79,17 @@ def plan_world_command(
         result = plan(world, a, b, algorithm=algorithm, **given)
     alt = 0.0 if altitude is None else altitude
     if result.found:
-        if waypoints_out:
-            write_atomic(waypoints_out, json.dumps(waypoints(world, result.path, alt)))
-        if geojson:
-            write_atomic(geojson, dumps(world_path_geojson(world, result)))
-        if plot:
-            plot_world_path(world, result, a, b, plot,
-                            edges=roadmap_edges(world, algorithm,
-                                                **{k: given[k] for k in ("samples", "seed")
-                                                   if k in given}),
-                            obstacles=obstacles_label(altitude, safety, world.frame))
+        with written_together():  # all the files or none (a Ctrl-C while plotting)
+            if waypoints_out:
+                write_atomic(waypoints_out, json.dumps(waypoints(world, result.path, alt)))
+            if geojson:
+                write_atomic(geojson, dumps(world_path_geojson(world, result)))
+            if plot:
+                plot_world_path(world, result, a, b, plot,
+                                edges=roadmap_edges(world, algorithm,
+                                                    **{k: given[k] for k in ("samples", "seed")
+                                                       if k in given}),
+                                obstacles=obstacles_label(altitude, safety, world.frame))
     if as_json:
         typer.echo(json.dumps(world_result_doc(world, result)))
     else:

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.delivery.day import DayResult
-from skyroute.files import check_writable, write_atomic
+from skyroute.files import check_writable, write_atomic, written_together
 
 
 def stem(date: dt.date) -> str:
@@ -140,8 +140,9 @@ def write_outputs(site, result: DayResult, out: Path, *, plot: bool = True) -> l
     """The day's GeoJSON, report and (optionally) PNG in ``out``
     (:func:`output_paths`)."""
     paths = output_paths(out, result.date, plot=plot)
-    write_atomic(paths[0], geojson(result, site.home))
-    write_atomic(paths[1], json.dumps(result.report(), indent=1))
-    if plot:
-        paths[2] = plot_day(site, result, paths[2])
+    with written_together():  # a Ctrl-C halfway leaves none of the day's files
+        write_atomic(paths[0], geojson(result, site.home))
+        write_atomic(paths[1], json.dumps(result.report(), indent=1))
+        if plot:
+            paths[2] = plot_day(site, result, paths[2])
     return paths

@@ -50,7 +50,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import OptionError, SkyrouteError
-from skyroute.files import check_writable, write_atomic
+from skyroute.files import check_writable, write_atomic, written_together
 from skyroute.fleet.flightplan import FlightPlan, gate_position, ground_position
 from skyroute.fleet.scenario import runway_ends
 from skyroute.fleet.simulate import TIME_DECIMALS, WARMUP_SHARE, Simulation
@@ -87,14 +87,15 @@ def write_run(sim: Simulation, rep: dict, out: str | Path, *, track_step: float 
     except (TypeError, ValueError) as exc:
         raise OptionError(f"rep cannot be written as JSON: {exc}", param="rep") from None
     paths = check_run_outputs(out, plot=plot)  # none written if one cannot be
-    write_atomic(paths[0], report_text)
-    write_atomic(paths[1], events_jsonl(sim))
-    write_atomic(paths[2], _tracks_csv(sim, track_step))
-    write_atomic(paths[3], packages_csv(sim))
-    write_atomic(paths[4], dumps(fleet_geojson(sim)))
-    if plot:
-        plot_map(sim, paths[5])
-        plot_timeline(sim, paths[6])
+    with written_together():  # a Ctrl-C halfway leaves none of them, nor a mix of runs
+        write_atomic(paths[0], report_text)
+        write_atomic(paths[1], events_jsonl(sim))
+        write_atomic(paths[2], _tracks_csv(sim, track_step))
+        write_atomic(paths[3], packages_csv(sim))
+        write_atomic(paths[4], dumps(fleet_geojson(sim)))
+        if plot:
+            plot_map(sim, paths[5])
+            plot_timeline(sim, paths[6])
     return paths
 
 

@@ -326,6 +326,10 @@ def _run(engine, job_id: str, kind: str, params: dict, executor) -> None:
             _ended(engine, job_id, "its cut-off is not recorded")
         return
     except Exception as exc:
+        if getattr(executor, "aborted", False):  # the server is stopping, its workers
+            # ended: the job stays running in the store, failed as an orphan later
+            log.info("job %s (%s) stopped with the server", job_id, kind)
+            return
         expected = isinstance(exc, SkyrouteError)
         log.log(logging.INFO if expected else logging.ERROR, "job %s (%s) failed", job_id,
                 kind, exc_info=True)

@@ -106,7 +106,11 @@ class Resources:
         return self._executor
 
     def close(self) -> None:
-        for closer in (getattr(self._executor, "close", None),
+        # abort: the jobs' worker processes end with the server. A job still running is
+        # left so in the store and failed as an orphan (skyroute.jobs.runner); closed
+        # only, the workers ran on after the server had gone (SIGTERM ends it at once,
+        # with no exit handlers), each holding the server's stdout and stderr open
+        for closer in (getattr(self._executor, "abort", None),
                        getattr(self._engine, "dispose", None)):
             if closer is not None:
                 with contextlib.suppress(Exception):  # shutting down: nothing to tell
