@@ -88,6 +88,15 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
     (["deliver", "03-01-2024", "--data", EXAMPLE], "DATE '03-01-2024': expected a date "
                                                    "YYYY-MM-DD"),
     (["data", "synth", "x", "--start", "2023-02-29"], "--start '2023-02-29': no such day"),
+    # YYYY-MM-DD only, as the service reads dates: Python 3.11's fromisoformat took the
+    # basic form and a week date as days, and other scripts' digits (Arabic-Indic here)
+    # were "no such day (Invalid isoformat string ...)"
+    (["data", "synth", "x", "--start", "20240103"], "--start '20240103': expected a date "
+                                                    "YYYY-MM-DD"),
+    (["data", "synth", "x", "--start", "2024-W01-3"], "--start '2024-W01-3': expected a "
+                                                      "date YYYY-MM-DD"),
+    (["deliver", "\u0662\u0660\u0662\u0664-\u0660\u0661-\u0660\u0663", "--data", EXAMPLE],
+     "DATE '\u0662\u0660\u0662\u0664-\u0660\u0661-\u0660\u0663': expected a date YYYY-MM-DD"),
     (["deliver", "--from", "2024-01-02", "--data", EXAMPLE], "give a DATE, or both --from"),
     (["deliver", "2024-01-01", "--from", "2024-01-01", "--to", "2024-01-02", "--data",
       EXAMPLE], "give a DATE, or both --from"),
