@@ -113,6 +113,11 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
     # "not a database URL")
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "postgres://u@127.0.0.1/db"],
      "--db 'postgres://u@127.0.0.1/db': SQLAlchemy knows no database 'postgres' (e.g. "),
+    # a driver it does not know, of a database it knows: not "knows no database
+    # 'postgresql'"
+    (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "postgresql+psycopg3://u@h/db"],
+     "--db 'postgresql+psycopg3://u@h/db': SQLAlchemy has no driver 'psycopg3' for "
+     "postgresql (e.g. "),
     (["data", "serve", "/nonexistent"], "not a data folder"),
     (["data", "serve", EXAMPLE, "--port", "99999"], "is not in the range 0<=x<=65535"),
     (["data", "serve", EXAMPLE, "--port", "-1"], "is not in the range 0<=x<=65535"),
