@@ -88,6 +88,15 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
     (["deliver", "03-01-2024", "--data", EXAMPLE], "DATE '03-01-2024': expected a date "
                                                    "YYYY-MM-DD"),
     (["data", "synth", "x", "--start", "2023-02-29"], "--start '2023-02-29': no such day"),
+    # YYYY-MM-DD only, as the service reads dates: Python 3.11's fromisoformat took the
+    # basic form and a week date as days, and other scripts' digits (Arabic-Indic here)
+    # were "no such day (Invalid isoformat string ...)"
+    (["data", "synth", "x", "--start", "20240103"], "--start '20240103': expected a date "
+                                                    "YYYY-MM-DD"),
+    (["data", "synth", "x", "--start", "2024-W01-3"], "--start '2024-W01-3': expected a "
+                                                      "date YYYY-MM-DD"),
+    (["deliver", "\u0662\u0660\u0662\u0664-\u0660\u0661-\u0660\u0663", "--data", EXAMPLE],
+     "DATE '\u0662\u0660\u0662\u0664-\u0660\u0661-\u0660\u0663': expected a date YYYY-MM-DD"),
     (["deliver", "--from", "2024-01-02", "--data", EXAMPLE], "give a DATE, or both --from"),
     (["deliver", "2024-01-01", "--from", "2024-01-01", "--to", "2024-01-02", "--data",
       EXAMPLE], "give a DATE, or both --from"),
@@ -104,6 +113,11 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
     # "not a database URL")
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "postgres://u@127.0.0.1/db"],
      "--db 'postgres://u@127.0.0.1/db': SQLAlchemy knows no database 'postgres' (e.g. "),
+    # a driver it does not know, of a database it knows: not "knows no database
+    # 'postgresql'"
+    (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "postgresql+psycopg3://u@h/db"],
+     "--db 'postgresql+psycopg3://u@h/db': SQLAlchemy has no driver 'psycopg3' for "
+     "postgresql (e.g. "),
     (["data", "serve", "/nonexistent"], "not a data folder"),
     (["data", "serve", EXAMPLE, "--port", "99999"], "is not in the range 0<=x<=65535"),
     (["data", "serve", EXAMPLE, "--port", "-1"], "is not in the range 0<=x<=65535"),

@@ -100,6 +100,22 @@ def test_post_only_paths_allow_post(client, path, method):
         assert_problem(r, 405, words=f"{method} is not allowed on {path}; use POST")
 
 
+@pytest.mark.parametrize("method, path, allow", [
+    # DELETE /days/{date} is served: the 405 (from the viewer's mount at /, which
+    # matches every path) said "GET, HEAD" for every API path
+    ("PUT", "/days/2024-01-03", "DELETE, GET, HEAD"),
+    ("PATCH", "/days/2024-01-03", "DELETE, GET, HEAD"),
+    ("DELETE", "/days", "GET, HEAD"),
+    ("DELETE", "/fleet/runs/x", "GET, HEAD"),
+    ("PUT", "/days/2024-01-03/flightpath.geojson", "GET, HEAD"),
+    ("TRACE", "/plan", "POST"),
+])
+def test_a_405_allows_the_methods_the_path_serves(client, method, path, allow):
+    r = client.request(method, path, headers=AUTH)
+    assert r.status_code == 405 and r.headers["allow"] == allow
+    assert_problem(r, 405, words=f"{method} is not allowed on {path}")
+
+
 def test_making_an_app_connects_to_nothing(tmp_path):
     """A store that cannot be opened fails the requests that need it (503), not the
     app: create_app and /health never touch it."""

@@ -12,6 +12,7 @@ import time
 import httpx
 import pytest
 
+from skyroute.errors import OptionError
 from tests.cli.test_cli import run
 from tests.conftest import ROOT
 
@@ -125,6 +126,35 @@ def test_an_address_it_cannot_listen_on_is_one_line(monkeypatch, capsys, tmp_pat
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
     assert "skyroute service on" not in err + out
     assert not (tmp_path / "s.db").exists()
+
+
+def test_a_port_held_on_any_address_of_the_host_is_one_line(monkeypatch):
+    """A name that resolves to ::1 and 127.0.0.1 (``localhost`` on most machines), with
+    another server on 127.0.0.1 only: uvicorn binds both and fails on the second, so the
+    check binds both too (it bound the first alone, passed, and uvicorn exited 3)."""
+    from skyroute.cli import serve_cmd
+
+    real = socket.getaddrinfo
+
+    def dual_stack(host, port, *args, **kwargs):
+        if host != "dual.test":
+            return real(host, port, *args, **kwargs)
+        return [(socket.AF_INET6, socket.SOCK_STREAM, 6, "", ("::1", port, 0, 0)),
+                (socket.AF_INET, socket.SOCK_STREAM, 6, "", ("127.0.0.1", port))]
+
+    monkeypatch.setattr(socket, "getaddrinfo", dual_stack)
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        try:
+            socket.create_server(("::1", port), family=socket.AF_INET6).close()
+        except OSError:
+            pytest.skip("no IPv6 loopback here, or its port is taken")
+        with pytest.raises(OptionError, match=f"--port {port}: cannot listen on "
+                                              f"dual.test:{port}: the port is in use"):
+            serve_cmd.check_listen("dual.test", port)
+    serve_cmd.check_listen("dual.test", port)  # both free now: no error
 
 
 def test_serve_fails_the_jobs_a_stopped_server_left(monkeypatch, capsys, tmp_path):

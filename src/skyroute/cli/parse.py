@@ -19,15 +19,20 @@ def parse_cell(text: str, option: str) -> tuple[int, int]:
         raise OptionError(f"{option} {text!r} must be two integers X,Y (column,row)") from None
 
 
+_DAY = re.compile(r"[0-9]{4}-[0-9]{2}-[0-9]{2}")  # ASCII digits: \d takes "٢٠٢٤" too
+
+
 def parse_date(text: str, option: str) -> dt.date:
-    """``YYYY-MM-DD`` -> a date. A day the calendar lacks (2024-02-30, 2024-13-01) says
-    so; it was "expected a date YYYY-MM-DD", which it is."""
+    """``YYYY-MM-DD`` -> a date, that form only, as the service's dates: Python 3.11's
+    ``date.fromisoformat`` also takes ``20240103`` and the week date ``2024-W01-3``. A
+    day the calendar lacks (2024-02-30, 2024-13-01) says so; it was "expected a date
+    YYYY-MM-DD", which it is."""
+    if not _DAY.fullmatch(text):
+        raise OptionError(f"{option} {text!r}: expected a date YYYY-MM-DD")
     try:
         return dt.date.fromisoformat(text)
     except ValueError as exc:
-        if re.fullmatch(r"\d{4}-\d{2}-\d{2}", text):
-            raise OptionError(f"{option} {text!r}: no such day ({exc})") from None
-        raise OptionError(f"{option} {text!r}: expected a date YYYY-MM-DD") from None
+        raise OptionError(f"{option} {text!r}: no such day ({exc})") from None
 
 
 def parse_items(text: str, option: str) -> list[str]:

@@ -116,28 +116,36 @@ def check_listen(host: str, port: int) -> None:
     """Bind ``host:port`` as uvicorn will, and let it go: a port another server holds, a
     host name that does not resolve or an address not of this machine is one line naming
     the option, before the store is opened or the banner printed (uvicorn said it in its
-    log after "skyroute service on ..." and exited 3)."""
+    log after "skyroute service on ..." and exited 3). Every address the name resolves
+    to is bound, as asyncio's ``create_server`` binds them all: ``localhost`` is often
+    ::1 and 127.0.0.1, and the first alone passed while another server held the second."""
     import errno
     import socket
+    from contextlib import ExitStack
 
     try:
-        family, kind, proto, _, addr = socket.getaddrinfo(
-            host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)[0]
+        found = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM,
+                                   flags=socket.AI_PASSIVE)
     except (socket.gaierror, UnicodeError) as exc:
         raise OptionError(f"--host {host!r}: not an address "
                           f"({getattr(exc, 'strerror', None) or exc})") from None
-    with socket.socket(family, kind, proto) as s:
-        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn's own bind
-        try:
-            s.bind(addr)
-        except OSError as exc:
-            why = {errno.EADDRINUSE: "the port is in use (another server?); choose another "
-                                     "--port",
-                   errno.EADDRNOTAVAIL: "the address is not one of this machine's; see "
-                                        "--host",
-                   errno.EACCES: "permission denied (ports below 1024 need privileges)"}
-            raise OptionError(f"--port {port}: cannot listen on {host}:{port}: "
-                              f"{why.get(exc.errno, exc.strerror)}") from None
+    with ExitStack() as held:  # all at once, as the server holds them
+        for family, kind, proto, _, addr in dict.fromkeys(found):
+            s = held.enter_context(socket.socket(family, kind, proto))
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn's own bind
+            if family == socket.AF_INET6:  # as asyncio: '::' must not take 0.0.0.0 too
+                s.setsockopt(socket.IPPROTO_IPV6, socket.IPV6_V6ONLY, 1)
+            try:
+                s.bind(addr)
+            except OSError as exc:
+                why = {errno.EADDRINUSE: "the port is in use (another server?); choose "
+                                         "another --port",
+                       errno.EADDRNOTAVAIL: "the address is not one of this machine's; see "
+                                            "--host",
+                       errno.EACCES: "permission denied (ports below 1024 need "
+                                     "privileges)"}
+                raise OptionError(f"--port {port}: cannot listen on {host}:{port}: "
+                                  f"{why.get(exc.errno, exc.strerror)}") from None
 
 
 def _fail_orphans(engine) -> list[str]:

@@ -80,10 +80,9 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
         engine = sa.create_engine(url, connect_args=busy)
         with engine.connect():
             pass
-    except sa.exc.NoSuchModuleError:  # a URL, of a kind SQLAlchemy does not know
-        kind = sa.engine.make_url(url).drivername.split("+")[0]
-        raise SkyrouteError(f"url={_safe(url)!r}: SQLAlchemy knows no database {kind!r} "
-                            "(e.g. sqlite:///skyroute.db or postgresql+psycopg://user@"
+    except sa.exc.NoSuchModuleError:  # a URL, of a kind or a driver SQLAlchemy does not know
+        raise SkyrouteError(f"url={_safe(url)!r}: {_unknown_kind(url)} (e.g. "
+                            "sqlite:///skyroute.db or postgresql+psycopg://user@"
                             "127.0.0.1:5432/test)", param="url") from None
     except sa.exc.ArgumentError:
         raise SkyrouteError(f"url={_safe(url)!r}: not a database URL (e.g. "
@@ -96,6 +95,17 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
         raise SkyrouteError(f"url={_safe(url)}: driver {exc.name!r} is not installed",
                             param="url") from None
     return engine
+
+
+def _unknown_kind(url: str) -> str:
+    """What SQLAlchemy lacks for ``url``: the database (``postgres://``), or only the
+    driver after its ``+`` (``postgresql+psycopg3://``: it knows PostgreSQL)."""
+    kind, _, driver = sa.engine.make_url(url).drivername.partition("+")
+    try:
+        sa.engine.URL.create(kind).get_dialect()
+    except sa.exc.NoSuchModuleError:
+        return f"SQLAlchemy knows no database {kind!r}"
+    return f"SQLAlchemy has no driver {driver!r} for {kind}"
 
 
 def safe_url(url: str) -> str:

@@ -12,7 +12,9 @@ in a task is raised by ``map`` (the tasks not yet started are cancelled). ``fn``
 items must pickle: ``fn`` a module-level function, the items plain data. ``close`` while
 another thread's ``map`` runs (a server shutting down under a job) cancels that map's
 tasks not yet started, and the map raises :class:`ExecutorClosedError`, as does a ``map``
-on a closed executor.
+on a closed executor. A map with no task left to cancel (all of them handed to the workers
+already: the local pool does not take back the ``workers + 1`` it has queued) runs them
+to their end and returns their results, as if the close came after it.
 
 - ``local``: ``workers`` processes started with the ``spawn`` method (a forked child of
   a process whose compiled kernels have started OpenMP threads dies), created on the

@@ -68,8 +68,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     # the API's first path segments: a browser asking for any other missing path gets
     # an HTML page, not the problem document (the routers' own routes are listed, as
     # the app keeps included routers unexpanded)
-    app.state.api_heads = problems.api_heads(
-        [*app.routes, *(r for m in modules for r in m.router.routes)])
+    routes = [*app.routes, *(r for m in modules for r in m.router.routes)]
+    app.state.api_heads = problems.api_heads(routes)
+    app.state.api_methods = problems.api_methods(routes)  # a 405's Allow
     return app
 
 

@@ -178,6 +178,27 @@ def api_heads(routes) -> frozenset[str]:
     return frozenset(p.split("/")[1] for p in paths if p.startswith("/") and len(p) > 1)
 
 
+def api_methods(routes) -> tuple:
+    """(path pattern, methods) of each of ``routes`` that names its methods: the app
+    factory keeps them as ``state.api_methods`` for the ``Allow`` of a 405."""
+    return tuple((r.path_regex, frozenset(r.methods)) for r in routes
+                 if getattr(r, "methods", None) and getattr(r, "path_regex", None))
+
+
+def allowed(request: Request) -> str | None:
+    """The ``Allow`` of a 405 on an API path: every method of the API's routes for that
+    path (HEAD with GET, as HEAD is answered as GET), or None off the API's routes. The
+    405 comes from the viewer's mount at ``/``, which matches every path and allows GET
+    and HEAD; it said "GET, HEAD" also for ``/days/{date}``, which a DELETE serves."""
+    found: set[str] = set()
+    for pattern, methods in getattr(request.app.state, "api_methods", ()):
+        if pattern.match(request.url.path):
+            found |= methods
+    if "GET" in found:
+        found.add("HEAD")
+    return ", ".join(sorted(found)) or None
+
+
 def api_path(request: Request) -> bool:
     """Whether the request's path lies under the API (see :func:`api_heads`), not among
     the viewer's pages."""
@@ -222,9 +243,13 @@ async def _http(request: Request, exc: StarletteHTTPException) -> Response:
         detail = f"no such resource: {request.url.path}"
     elif exc.status_code == 400 and detail == "There was an error parsing the body":
         detail = NOT_JSON
-    elif exc.status_code == 405:
+    headers = getattr(exc, "headers", None)
+    if exc.status_code == 405:
         detail = f"{request.method} is not allowed on {request.url.path}"
-    return problem_response(exc.status_code, detail, headers=getattr(exc, "headers", None))
+        allow = allowed(request)
+        if allow:
+            headers = {**(headers or {}), "Allow": allow}
+    return problem_response(exc.status_code, detail, headers=headers)
 
 
 async def _library(request: Request, exc: SkyrouteError) -> JSONResponse:
