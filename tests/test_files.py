@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import stat
+from pathlib import Path
 
 import pytest
 
@@ -107,3 +108,48 @@ def test_written_together_appear_together_or_not_at_all(tmp_path):
     assert (tmp_path / "keep.txt").read_text() == "second"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.txt", "run"]
     assert [p.name for p in out.iterdir()] == ["a.txt"]
+
+
+class _StopError(Exception):
+    pass
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_a_signal_while_a_set_is_renamed_into_place_leaves_it_whole(tmp_path, monkeypatch,
+                                                                    sig):
+    """The renames at the end of a written_together block are one step: Ctrl-C (or
+    SIGTERM) after the first of them left that file new and the rest as the earlier run
+    had them (the rest removed), a mix of two runs; the rename loop lasts a rename per
+    file (thousands for a data set, each a round trip on NFS). The signal now takes
+    effect once every file is in place."""
+    import signal
+
+    from skyroute import files
+
+    signum = getattr(signal, sig)
+
+    def stop(*_):
+        raise _StopError
+
+    names = [f"f{k}.txt" for k in range(5)]
+    for name in names:
+        (tmp_path / name).write_text("earlier")
+    real, renamed = os.replace, []
+
+    def replace(a, b):
+        real(a, b)
+        renamed.append(Path(b).name)
+        if len(renamed) == 1:
+            signal.raise_signal(signum)  # arrives right after the first rename
+
+    before = signal.signal(signum, stop)  # SIGTERM's default would end pytest
+    try:
+        monkeypatch.setattr(files.os, "replace", replace)
+        with pytest.raises(_StopError), files.written_together():
+            for name in names:
+                write_atomic(tmp_path / name, "new")
+        monkeypatch.undo()
+    finally:
+        signal.signal(signum, before)
+    assert renamed == names
+    assert {p.name: p.read_text() for p in tmp_path.iterdir()} == dict.fromkeys(names, "new")

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import os
 import secrets
+import signal
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager, suppress
 from contextvars import ContextVar
@@ -120,15 +122,44 @@ def written_together() -> Iterator[None]:
         _discard(staged)
         raise
     _TOGETHER.reset(token)
-    for k, (tmp, path, _) in enumerate(staged):
-        try:
-            if tmp:
-                os.replace(tmp, path)
-        except BaseException as exc:
-            _discard(staged[k:])
-            if isinstance(exc, OSError):
-                raise SkyrouteError(f"{path}: cannot write: {exc.strerror or exc}") from None
-            raise
+    done = 0  # the files renamed into place
+    try:
+        # one step: a signal in the renames (a rename each, a round trip each on NFS)
+        # left the first files new and the others removed, a mix of two runs
+        with _signals_held():
+            for tmp, path, _ in staged:
+                if tmp:
+                    os.replace(tmp, path)
+                done += 1
+    except BaseException as exc:
+        _discard(staged[done:])
+        if isinstance(exc, OSError):
+            raise SkyrouteError(f"{staged[done][1]}: cannot write: {exc.strerror or exc}"
+                                ) from None
+        raise
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM held while the block runs (in the main thread, where Python
+    runs signal handlers): one that comes is handled, by the handler it would have met,
+    when the block ends."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    came: list[int] = []
+    before: dict[int, object] = {}
+    try:
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            if signal.getsignal(sig) is None:  # set outside Python: cannot be put back
+                continue
+            before[sig] = signal.signal(sig, lambda signum, _frame: came.append(signum))
+        yield
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
+        for sig in dict.fromkeys(came):
+            signal.raise_signal(sig)
 
 
 def _stage(staged: list, tmp: str, path: Path, made: list[Path]) -> None:
