@@ -327,7 +327,9 @@ def _run(engine, job_id: str, kind: str, params: dict, executor) -> None:
         return
     except Exception as exc:
         if getattr(executor, "aborted", False):  # the server is stopping, its workers
-            # ended: the job stays running in the store, failed as an orphan later
+            # ended (a local pool's abort is ExecutorClosedError, above; this is another
+            # executor's error): the job stays running in the store, failed as an orphan
+            # later
             log.info("job %s (%s) stopped with the server", job_id, kind)
             return
         expected = isinstance(exc, SkyrouteError)
