@@ -1,5 +1,5 @@
 """Delivery days as tasks: a local run and a Dask LocalCluster store the same rows and
-give the same reports; each day is stored by its worker once."""
+give the same reports; each day is stored once, by the caller, as its result arrives."""
 
 from __future__ import annotations
 
@@ -66,19 +66,6 @@ def test_a_day_run_again_replaces_itself(tmp_path, dask_executor):
     assert tuple(n) == (2, 2) and moves == sum(r.flight.moves for r in first)
 
 
-def test_days_stored_elsewhere_are_an_error(tmp_path, monkeypatch):
-    """Workers writing to another database (a remote cluster given a SQLite path)."""
-    from skyroute.jobs import deliver
-
-    monkeypatch.setattr(deliver, "worker_url",
-                        lambda engine: f"sqlite:///{tmp_path / 'elsewhere.db'}")
-    lunch_store(f"sqlite:///{tmp_path / 'elsewhere.db'}")
-    with (open_executor("local", workers=1) as ex,
-          pytest.raises(SkyrouteError, match=r"1 day\(s\) flown but not stored here "
-                                             r"\(first 2024-02-01\); workers on other")):
-        fly(tmp_path, "here", ex, "2024-02-01", "2024-02-01")
-
-
 @pytest.mark.parametrize("params, words", [
     ({"date": "2024-13-01", "data": str(EXAMPLE)}, "date='2024-13-01': expected a date"),
     ({"from": "2024-01-02", "data": str(EXAMPLE)}, "to=None: expected a date"),
@@ -131,3 +118,4 @@ def test_a_deliver_job_refuses_another_sites_data(tmp_path):
     assert info.value.param == "data"
     assert store.day_rows(engine, dt.date(2024, 1, 1)) == {"deliveries": [],
                                                           "flightpath": []}
+
