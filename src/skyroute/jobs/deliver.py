@@ -138,12 +138,14 @@ def _date(params: dict, key: str) -> dt.date:
 def check_params(params: dict) -> dict:
     """The ``deliver`` job's parameters checked and completed: ``{"date": D}`` or
     ``{"from": D, "to": D}`` (ISO dates), exactly one of ``data`` (a folder in the ILP
-    layout) or ``source`` (an HTTP URL) naming the site, and ``method`` (``milp``
-    default, or ``greedy``). The orders must be in the store already (``skyroute db
-    import``). Errors name the field."""
+    layout) or ``source`` (an HTTP URL) naming the site, ``method`` (``milp``
+    default, or ``greedy``) and ``replace`` (false default: a day whose every order is
+    invalid keeps a stored flight that delivered and fails the job, as ``skyroute
+    deliver`` without ``--replace``). The orders must be in the store already
+    (``skyroute db import``). Errors name the field."""
     if not isinstance(params, dict):
         raise OptionError("params must be a mapping", param="params")
-    known = {"date", "from", "to", "data", "source", "method"}
+    known = {"date", "from", "to", "data", "source", "method", "replace"}
     unknown = sorted(set(params) - known)
     if unknown:
         raise OptionError(f"{unknown[0]}: unknown parameter of a deliver job; valid: "
@@ -158,9 +160,13 @@ def check_params(params: dict) -> dict:
             raise OptionError(f"to={last} is before from={first}", param="to")
     method = params.get("method", "milp")
     check_choice("method", method, METHODS)
+    replace = params.get("replace", False)
+    if not isinstance(replace, bool):
+        raise OptionError(f"replace={replace!r}: expected true or false", param="replace")
     data, source = params.get("data"), params.get("source")
     open_source(None if data is None else Path(data), source)  # validates the one given
-    out = {"from": first.isoformat(), "to": last.isoformat(), "method": method}
+    out = {"from": first.isoformat(), "to": last.isoformat(), "method": method,
+           "replace": replace}
     out.update({"data": str(data)} if data is not None else {"source": source})
     return out
 
@@ -191,6 +197,10 @@ def deliver_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
         done += 1
         progress(done / len(by_date))
 
-    results = run_days(engine, src, by_date, executor=executor, method=p["method"],
-                       on_day=on_day)
+    try:
+        results = run_days(engine, src, by_date, executor=executor, method=p["method"],
+                           replace=p["replace"], on_day=on_day)
+    except store.DayKeptError as exc:  # the job's way to say what the CLI's --replace does
+        raise SkyrouteError(f"{exc}; replace=true stores the day as flown now",
+                            param="replace") from None
     return {"from": p["from"], "to": p["to"], **summarise(results)}
