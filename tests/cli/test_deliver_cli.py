@@ -492,3 +492,98 @@ def test_a_day_of_invalid_orders_keeps_the_stored_flight_until_replace(monkeypat
     assert code == 0, err
     assert json.loads(out)["orders_invalid"] == 36
     assert _stored_day(db, "2024-01-03") == ([(0, 36)], 0, 0, 108)
+
+
+def _full_disk_png(fig, path, **_kw):
+    """``save_figure`` on a disk that fills up while the PNG is written."""
+    import errno
+
+    import matplotlib.pyplot as plt
+
+    from skyroute.files import open_atomic
+
+    plt.close(fig)
+    with open_atomic(path):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+
+def _interrupted_png(fig, _path, **_kw):
+    """``save_figure`` interrupted by Ctrl-C."""
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    raise KeyboardInterrupt
+
+
+@pytest.mark.parametrize("save, code, words", [
+    (_full_disk_png, 2, "drone-01-01-2024.png: cannot write: No space left on device"),
+    (_interrupted_png, 130, "interrupted"),
+])
+def test_a_day_whose_files_fail_is_not_stored(monkeypatch, capsys, tmp_path, fly_once, save,
+                                              code, words):
+    # the day was stored first, then its files written: a full disk or a Ctrl-C while
+    # the PNG was drawn left the day in the store without its files
+    db = tmp_path / "f.db"
+    code_, _, err = run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", f"sqlite:///{db}")
+    assert code_ == 0, err
+    monkeypatch.setattr("skyroute.io.plot.save_figure", save)
+    got, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", EXAMPLE,
+                      "--db", f"sqlite:///{db}", "--out", str(tmp_path / "out"))
+    assert got == code and words in err and len(err.strip().splitlines()) == 1, err
+    assert _stored_day(db, "2024-01-01") == ([], 0, 0, 108)  # the orders, no run
+    assert not (tmp_path / "out").exists()  # nor a file, nor the folder made for them
+
+
+class _RunAhead:
+    """A pool whose workers flew every day of the range before the command read the
+    first failure: results after it were ready (and, when workers stored their days,
+    stored), never handed to the command."""
+
+    kind, workers, aborted = "local", 2, False
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        pass
+
+    def map(self, fn, items, *, on_result=None):
+        done = []
+        for item in items:
+            try:
+                done.append((fn(item), None))
+            except Exception as exc:  # handed on in item order, as a pool does
+                done.append((None, exc))
+        out = []
+        for i, (result, exc) in enumerate(done):
+            if exc is not None:
+                raise exc
+            out.append(result)
+            if on_result:
+                on_result(i, result)
+        return out
+
+
+def test_a_range_stopped_by_a_failed_day_stores_only_days_with_files(monkeypatch, capsys,
+                                                                      tmp_path, fly_once):
+    # --jobs 2 over three days, the second failing: the third, flown and stored by its
+    # worker meanwhile, stayed in the store without its files
+    from skyroute.errors import SkyrouteError
+
+    def second_fails(site, date, orders, **kw):
+        if str(date) == "2024-01-02":
+            raise SkyrouteError("2024-01-02: the planner failed")
+        return fly_once(site, date, orders, **kw)
+
+    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", second_fails)
+    monkeypatch.setattr("skyroute.cli.deliver_cmd.open_from_flags",
+                        lambda *_a: _RunAhead())
+    db, out = tmp_path / "r.db", tmp_path / "out"
+    code, _, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
+                       "2024-01-03", "--data", EXAMPLE, "--db", f"sqlite:///{db}", "--out",
+                       str(out), "--jobs", "2")
+    assert code == 2 and "2024-01-02: the planner failed" in err, err
+    runs = _stored_day(db, "2024-01-01")[0], _stored_day(db, "2024-01-03")[0]
+    assert runs[0] and not runs[1]  # the day before the failure stored, not the one after
+    assert sorted(p.name for p in out.iterdir()) == ["drone-01-01-2024.geojson",
+                                                     "report-01-01-2024.json"]

@@ -1,5 +1,5 @@
 """Delivery days as tasks: a local run and a Dask LocalCluster store the same rows and
-give the same reports; each day is stored by its worker once."""
+give the same reports; each day is stored once, by the caller, as its result arrives."""
 
 from __future__ import annotations
 
@@ -66,19 +66,6 @@ def test_a_day_run_again_replaces_itself(tmp_path, dask_executor):
     assert tuple(n) == (2, 2) and moves == sum(r.flight.moves for r in first)
 
 
-def test_days_stored_elsewhere_are_an_error(tmp_path, monkeypatch):
-    """Workers writing to another database (a remote cluster given a SQLite path)."""
-    from skyroute.jobs import deliver
-
-    monkeypatch.setattr(deliver, "worker_url",
-                        lambda engine: f"sqlite:///{tmp_path / 'elsewhere.db'}")
-    lunch_store(f"sqlite:///{tmp_path / 'elsewhere.db'}")
-    with (open_executor("local", workers=1) as ex,
-          pytest.raises(SkyrouteError, match=r"1 day\(s\) flown but not stored here "
-                                             r"\(first 2024-02-01\); workers on other")):
-        fly(tmp_path, "here", ex, "2024-02-01", "2024-02-01")
-
-
 @pytest.mark.parametrize("params, words", [
     ({"date": "2024-13-01", "data": str(EXAMPLE)}, "date='2024-13-01': expected a date"),
     ({"from": "2024-01-02", "data": str(EXAMPLE)}, "to=None: expected a date"),
@@ -89,6 +76,8 @@ def test_days_stored_elsewhere_are_an_error(tmp_path, monkeypatch):
     ({"date": "2024-01-01"}, "give exactly one of data=DIR and source=URL"),
     ({"date": "2024-01-01", "data": str(EXAMPLE), "method": "magic"}, "method='magic'"),
     ({"date": "2024-01-01", "data": str(EXAMPLE), "jobs": 2}, "jobs: unknown parameter"),
+    ({"date": "2024-01-01", "data": str(EXAMPLE), "replace": "yes"},
+     "replace='yes': expected true or false"),
 ])
 def test_bad_deliver_params_name_the_field(params, words):
     with pytest.raises(OptionError) as err:
@@ -98,7 +87,7 @@ def test_bad_deliver_params_name_the_field(params, words):
 
 def test_deliver_params_are_completed():
     assert check_params({"date": "2024-01-03", "source": "http://h:9898"}) == {
-        "from": "2024-01-03", "to": "2024-01-03", "method": "milp",
+        "from": "2024-01-03", "to": "2024-01-03", "method": "milp", "replace": False,
         "source": "http://h:9898"}
 
 
@@ -131,3 +120,30 @@ def test_a_deliver_job_refuses_another_sites_data(tmp_path):
     assert info.value.param == "data"
     assert store.day_rows(engine, dt.date(2024, 1, 1)) == {"deliveries": [],
                                                           "flightpath": []}
+
+
+def test_a_deliver_job_replaces_a_kept_flight_when_asked(tmp_path, fly_once):
+    # a day whose every order is invalid: the job failed, and had no replace to store it
+    from skyroute.jobs.deliver import deliver_job
+    from tests.cli.test_deliver_cli import _other_site
+
+    engine = lunch_store(f"sqlite:///{tmp_path / 'k.db'}", ("2024-01-03",))
+    day = {"date": "2024-01-03"}
+    renamed = str(_other_site(tmp_path / "renamed", places=False))  # items unknown here
+
+    def job(params):
+        with open_executor("local", workers=1) as ex:
+            return deliver_job(engine, "j", params, executor=ex, progress=lambda _s: None)
+
+    job({**day, "data": str(EXAMPLE)})
+    good = store.day_rows(engine, dt.date(2024, 1, 3))
+    assert good["deliveries"]
+    with pytest.raises(SkyrouteError) as info:
+        job({**day, "data": renamed})
+    assert "2024-01-03: every one of the day's 36 orders is invalid" in str(info.value)
+    assert str(info.value).endswith("is kept (nothing was written for the day); "
+                                    "replace=true stores the day as flown now")
+    assert info.value.param == "replace"
+    assert store.day_rows(engine, dt.date(2024, 1, 3)) == good
+    assert job({**day, "data": renamed, "replace": True})["days_with_orders"] == 1
+    assert store.day_rows(engine, dt.date(2024, 1, 3)) == {"deliveries": [], "flightpath": []}

@@ -51,7 +51,7 @@ def test_states_move_from_queued_through_running_to_done(tmp_path, monkeypatch):
     job = runner.get(engine, first)
     assert job["progress"] == 1.0 and job["error"] is None
     assert job["result"]["days"] == 4 and job["result"]["days_with_orders"] == 3
-    assert job["params"] == {**days, "method": "milp"}
+    assert job["params"] == {**days, "method": "milp", "replace": False}
     settle()  # the lane counts a job ended just after it writes the job's last state
 
 

@@ -125,7 +125,7 @@ def test_deliver_job_is_202_with_an_id(site_client, fake):
     r = site_client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH)
     assert r.status_code == 202 and r.headers["location"] == f"/jobs/{r.json()['id']}"
     assert fake.submitted[-1] == ("deliver", {"from": DAY, "to": DAY, "method": "milp",
-                                              "data": str(EXAMPLE)})
+                                              "replace": False, "data": str(EXAMPLE)})
     r = site_client.post("/jobs/deliver", json={"from": "2024-01-01", "to": "2024-01-02",
                                                 "method": "greedy"}, headers=AUTH)
     assert r.status_code == 202
@@ -133,6 +133,18 @@ def test_deliver_job_is_202_with_an_id(site_client, fake):
     job = site_client.get(f"/jobs/{r.json()['id']}").json()
     assert job == {"id": r.json()["id"], "kind": "deliver", "state": "queued",
                    "progress": 0.0, "result": None, "error": None}
+
+
+def test_a_deliver_job_can_replace_a_kept_flight(site_client, fake):
+    # a day whose every order is invalid keeps its stored flight and fails the job; the
+    # job had no way to store it anyway, as the CLI's --replace does
+    r = site_client.post("/jobs/deliver", json={"date": DAY, "replace": True}, headers=AUTH)
+    assert r.status_code == 202, r.text
+    assert fake.submitted[-1] == ("deliver", {"from": DAY, "to": DAY, "method": "milp",
+                                              "replace": True, "data": str(EXAMPLE)})
+    for bad in ("yes", 1, None):  # a switch is true or false, as the plan route's are
+        assert_problem(site_client.post("/jobs/deliver", json={"date": DAY, "replace": bad},
+                                        headers=AUTH), 422, "replace")
 
 
 def test_the_queue_limit_is_429_until_a_job_ends(site_client, fake):

@@ -60,7 +60,7 @@ def deliver_command(
     from skyroute.delivery.site import load_site
     from skyroute.delivery.source import open_source
     from skyroute.delivery.store import DayKeptError, order_dates
-    from skyroute.io.day_out import check_outputs, write_outputs
+    from skyroute.io.day_out import check_outputs, output_paths, write_outputs
     from skyroute.jobs.deliver import days_between, run_days
 
     check_choice("method", method, METHODS)
@@ -111,13 +111,16 @@ def deliver_command(
             t0 = time.perf_counter()
             written: list[Path] = []  # every file, as written: the one-day table lists them
 
+            def files(r: DayResult) -> None:  # staged; in place once the day is stored
+                write_outputs(site, r, out, plot=draw)
+
             def finished(r: DayResult) -> None:
-                written.extend(write_outputs(site, r, out, plot=draw))
+                written.extend(output_paths(out, r.date, plot=draw))
                 progress.advance(days)
 
             try:
                 results = run_days(engine, src, by_date, executor=ex, method=method,
-                                   replace=replace, on_day=finished)
+                                   replace=replace, files=files, on_day=finished)
             except DayKeptError as exc:
                 raise SkyrouteError(f"{exc}; --replace stores the day as flown now"
                                     ) from None

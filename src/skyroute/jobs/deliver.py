@@ -1,12 +1,18 @@
 """A range of delivery days as tasks, one per day, on any executor with the same rows.
 
-What a worker gets (:class:`DayTask`): the store's URL, where the site is read from (a
-folder or an HTTP URL; the worker loads the site once and keeps it), the date, that day's
-orders and the method. The worker flies the day, writes it to the store itself in one
+What a worker gets (:class:`DayTask`): where the site is read from (a folder or an HTTP
+URL; the worker loads the site once and keeps it), the date, that day's orders and the
+method. The worker flies the day and sends the :class:`DayResult` back; it writes
+nothing. The caller stores each day as its result arrives (:func:`run_days`), in one
 transaction that first deletes whatever an earlier run stored for that date
-(:func:`skyroute.delivery.store.store_day`), and sends the :class:`DayResult` back. So a
-day run twice, or re-run on another worker after its worker died, is stored once, and a
-worker killed halfway leaves the previous state of that day.
+(:func:`skyroute.delivery.store.store_day`), together with the day's files when it
+writes any: they are written to temporary names first and renamed into place once the
+day is stored (:func:`skyroute.files.written_together`), so a day is stored with its
+files or, after an error or Ctrl-C, neither is. Workers that stored their days
+themselves stored days the caller then never wrote files for (a Ctrl-C, a full disk
+while a PNG was written, or another day's error in a range with ``--jobs``). A day run
+twice, or re-run on another worker after its worker died, is stored once (its first
+result to arrive), and a worker killed halfway leaves the previous state of that day.
 
 The caller fills the leg table first (:func:`skyroute.delivery.days.prepare_legs`);
 workers sharing its cache folder only read it, and a worker on another machine fills its
@@ -30,21 +36,17 @@ from skyroute.delivery.orders import Order
 from skyroute.delivery.site import load_site
 from skyroute.delivery.source import DirSource, HttpSource, open_source
 from skyroute.errors import OptionError, SkyrouteError, check_choice
-from skyroute.jobs.store import engine_for, worker_url
+from skyroute.files import written_together
 
 
 @dataclass(frozen=True)
 class DayTask:
-    """One day for a worker: store URL, site source, date, its orders, method, and
-    whether a day with every order invalid may replace a stored flight that delivered
-    (:func:`skyroute.delivery.store.store_day`)."""
+    """One day for a worker: site source, date, its orders, method."""
 
-    url: str
     source: DirSource | HttpSource
     date: dt.date
     orders: tuple[Order, ...]
     method: str = "milp"
-    replace: bool = False
 
 
 _SITES: dict = {}
@@ -58,17 +60,8 @@ def _site(source):
 
 
 def fly_day(task: DayTask) -> DayResult:
-    """The worker's task: fly the day, store it (one transaction, replacing any earlier
-    run of it), return it."""
-    result = plan_day(_site(task.source), task.date, list(task.orders), method=task.method)
-    engine = engine_for(task.url)
-    try:
-        store.store_day(engine, result, replace=task.replace)
-    except sa.exc.IntegrityError:
-        # a second run of this task wrote the same day at the same moment (a worker the
-        # scheduler thought dead): write again after it, replacing its rows
-        store.store_day(engine, result, replace=task.replace)
-    return result
+    """The worker's task: fly the day and return it (the caller stores it)."""
+    return plan_day(_site(task.source), task.date, list(task.orders), method=task.method)
 
 
 def days_between(engine: sa.Engine, first: dt.date, last: dt.date) -> dict[dt.date, list]:
@@ -82,34 +75,35 @@ def days_between(engine: sa.Engine, first: dt.date, last: dt.date) -> dict[dt.da
 
 def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executor,
              method: str = "milp", replace: bool = False,
+             files: Callable[[DayResult], object] | None = None,
              on_day: Callable[[DayResult], None] | None = None) -> list[DayResult]:
-    """Fly and store every day of ``by_date`` as one task each on ``executor``; results
-    in date order, ``on_day`` called with each as it arrives. Ends by checking that the
-    store holds every day (workers that wrote to another database are an error). A day
-    whose every order is invalid does not replace a stored flight that delivered unless
-    ``replace`` (:class:`~skyroute.delivery.store.DayKeptError`)."""
+    """Fly every day of ``by_date`` as one task each on ``executor`` and store each as
+    its result arrives; results in date order. A day whose every order is invalid does
+    not replace a stored flight that delivered unless ``replace``
+    (:class:`~skyroute.delivery.store.DayKeptError`).
+
+    ``files(result)``: writes the day's files through :func:`skyroute.files.open_atomic`
+    (:func:`skyroute.io.day_out.write_outputs`); they are written to temporary names,
+    the day is stored, then they are renamed into place (one
+    :func:`~skyroute.files.written_together` block), so an error or Ctrl-C in either
+    leaves the day's rows and files as they were. ``on_day(result)`` is called once the
+    day is stored and its files are in place.
+
+    A run stopped by an error (a day that failed, a day kept) has stored the days that
+    arrived before it, each with its files, and no other: results a worker had ready
+    are dropped with it."""
     check_choice("method", method, METHODS)
-    url = worker_url(engine)
-    tasks = [DayTask(url, source, d, tuple(orders), method, replace)
-             for d, orders in sorted(by_date.items())]
-    results = executor.map(fly_day, tasks,
-                           on_result=(lambda _i, r: on_day(r)) if on_day else None)
-    _check_stored(engine, [t.date for t in tasks])
-    return results
+    tasks = [DayTask(source, d, tuple(orders), method) for d, orders in sorted(by_date.items())]
 
+    def arrived(_i: int, result: DayResult) -> None:
+        with written_together():
+            if files is not None:
+                files(result)
+            store.store_day(engine, result, replace=replace)
+        if on_day is not None:
+            on_day(result)
 
-def _check_stored(engine: sa.Engine, dates: list[dt.date]) -> None:
-    if not dates:
-        return
-    runs = store.tables(engine)["runs"]
-    with engine.connect() as c:
-        have = set(c.scalars(sa.select(runs.c.delivery_date)
-                             .where(runs.c.delivery_date.between(min(dates), max(dates)))))
-    missing = sorted(set(dates) - have)
-    if missing:
-        raise SkyrouteError(f"{store._safe(str(engine.url))}: {len(missing)} day(s) flown "
-                            f"but not stored here (first {missing[0]}); workers on other "
-                            "machines must reach the same database (use PostgreSQL)")
+    return executor.map(fly_day, tasks, on_result=arrived)
 
 
 def summarise(results: list[DayResult]) -> dict:
@@ -144,12 +138,14 @@ def _date(params: dict, key: str) -> dt.date:
 def check_params(params: dict) -> dict:
     """The ``deliver`` job's parameters checked and completed: ``{"date": D}`` or
     ``{"from": D, "to": D}`` (ISO dates), exactly one of ``data`` (a folder in the ILP
-    layout) or ``source`` (an HTTP URL) naming the site, and ``method`` (``milp``
-    default, or ``greedy``). The orders must be in the store already (``skyroute db
-    import``). Errors name the field."""
+    layout) or ``source`` (an HTTP URL) naming the site, ``method`` (``milp``
+    default, or ``greedy``) and ``replace`` (false default: a day whose every order is
+    invalid keeps a stored flight that delivered and fails the job, as ``skyroute
+    deliver`` without ``--replace``). The orders must be in the store already
+    (``skyroute db import``). Errors name the field."""
     if not isinstance(params, dict):
         raise OptionError("params must be a mapping", param="params")
-    known = {"date", "from", "to", "data", "source", "method"}
+    known = {"date", "from", "to", "data", "source", "method", "replace"}
     unknown = sorted(set(params) - known)
     if unknown:
         raise OptionError(f"{unknown[0]}: unknown parameter of a deliver job; valid: "
@@ -164,9 +160,13 @@ def check_params(params: dict) -> dict:
             raise OptionError(f"to={last} is before from={first}", param="to")
     method = params.get("method", "milp")
     check_choice("method", method, METHODS)
+    replace = params.get("replace", False)
+    if not isinstance(replace, bool):
+        raise OptionError(f"replace={replace!r}: expected true or false", param="replace")
     data, source = params.get("data"), params.get("source")
     open_source(None if data is None else Path(data), source)  # validates the one given
-    out = {"from": first.isoformat(), "to": last.isoformat(), "method": method}
+    out = {"from": first.isoformat(), "to": last.isoformat(), "method": method,
+           "replace": replace}
     out.update({"data": str(data)} if data is not None else {"source": source})
     return out
 
@@ -197,6 +197,10 @@ def deliver_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
         done += 1
         progress(done / len(by_date))
 
-    results = run_days(engine, src, by_date, executor=executor, method=p["method"],
-                       on_day=on_day)
+    try:
+        results = run_days(engine, src, by_date, executor=executor, method=p["method"],
+                           replace=p["replace"], on_day=on_day)
+    except store.DayKeptError as exc:  # the job's way to say what the CLI's --replace does
+        raise SkyrouteError(f"{exc}; replace=true stores the day as flown now",
+                            param="replace") from None
     return {"from": p["from"], "to": p["to"], **summarise(results)}

@@ -56,6 +56,11 @@ class DeliverJob(BaseModel):
     to: IsoDate | None = Field(None, description="The range's last day, not before from "
                                "(with from, without date).")
     method: Literal["milp", "greedy"] = "milp"
+    # strict, as the plan route's switches: true or false, never "yes" or 1
+    replace: bool = Field(False, strict=True, description="Store a day whose every order "
+                          "is invalid over its stored flight that delivered (otherwise that "
+                          "flight is kept and the job fails naming the day), as the CLI's "
+                          "--replace.")
 
     @model_validator(mode="after")
     def _days(self) -> DeliverJob:
@@ -149,6 +154,7 @@ def post_deliver(body: DeliverJob, res: ResourcesDep):
     s = res.settings
     first, last = (body.date, body.date) if body.date else (body.from_, body.to)
     params = {"from": first.isoformat(), "to": last.isoformat(), "method": body.method,
+              "replace": body.replace,
               **({"data": str(s.data_dir)} if s.data_dir is not None else
                  {"source": s.source_url})}
     return _submit(res, "deliver", params)
