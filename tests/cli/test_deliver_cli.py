@@ -397,16 +397,22 @@ def _stored_day(path, day: str) -> tuple:
                 c.execute("select count(*) from orders").fetchone()[0])
 
 
+def _lunch_day_stored(monkeypatch, capsys, tmp_path):
+    """A store at ``tmp_path/s.db`` with the README's day flown: (its path, the day as
+    :func:`_stored_day` reads it)."""
+    db = tmp_path / "s.db"
+    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data", EXAMPLE,
+                       "--db", f"sqlite:///{db}", "--out", str(tmp_path / "good"), "--no-plot")
+    assert code == 0, err
+    return db, _stored_day(db, "2024-01-03")
+
+
 def test_another_sites_folder_is_refused_before_anything_is_written(monkeypatch, capsys,
                                                                     tmp_path, fly_once):
     # a store of the lunch orders flown with another site's --data folder: its orders
     # were imported, the day flown with every order 'unknown item' and stored over the
     # day's real flight, exit 0
-    db = tmp_path / "s.db"
-    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data", EXAMPLE,
-                       "--db", f"sqlite:///{db}", "--out", str(tmp_path / "good"), "--no-plot")
-    assert code == 0, err
-    good = _stored_day(db, "2024-01-03")
+    db, good = _lunch_day_stored(monkeypatch, capsys, tmp_path)
     assert good[0][0][0] > 0 and good[1] > 0 and good[3] == 108
     other = _other_site(tmp_path / "other")
     menus = other / "website" / "menus" / "menus.json"
@@ -470,11 +476,7 @@ def test_a_day_of_invalid_orders_keeps_the_stored_flight_until_replace(monkeypat
                                                                        tmp_path, fly_once):
     # the site's items renamed (its places are its own): every order is 'unknown item';
     # that day replaced the stored flight with nothing and said so only order by order
-    db = tmp_path / "s.db"
-    code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-03", "--data", EXAMPLE,
-                       "--db", f"sqlite:///{db}", "--out", str(tmp_path / "good"), "--no-plot")
-    assert code == 0, err
-    good = _stored_day(db, "2024-01-03")
+    db, good = _lunch_day_stored(monkeypatch, capsys, tmp_path)
     renamed = _other_site(tmp_path / "renamed", places=False)
     to = ["--db", f"sqlite:///{db}", "--out", str(tmp_path / "o"), "--no-plot"]
     for args in (["2024-01-03"], ["--from", "2024-01-03", "--to", "2024-01-03"]):

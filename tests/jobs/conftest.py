@@ -4,6 +4,7 @@ then import skyroute on their first task), PostgreSQL when a server answers."""
 
 from __future__ import annotations
 
+import contextlib
 import datetime as dt
 import os
 
@@ -85,3 +86,23 @@ def slow_days(monkeypatch, seconds: float = 0.3) -> None:
         return out
 
     monkeypatch.setattr(deliver, "fly_day", slow)
+
+
+@contextlib.contextmanager
+def part_reads():
+    """The parts of a run's files read while in the block, by any engine: a part's
+    number for a statement that reads one part, "all" for one that reads a file whole."""
+    seen: list = []
+
+    def record(conn, clause, multiparams, params, execution_options):
+        cols = getattr(clause, "selected_columns", ())
+        if any(getattr(c, "name", None) == "data" and getattr(c, "table", None) is not None
+               and c.table.name == "fleet_run_files" for c in cols):
+            p = multiparams[0] if multiparams else params
+            seen.append((p or {}).get("k", "all"))
+
+    sa.event.listen(sa.engine.Engine, "before_execute", record)
+    try:
+        yield seen
+    finally:
+        sa.event.remove(sa.engine.Engine, "before_execute", record)

@@ -16,6 +16,7 @@ import sqlalchemy as sa
 from skyroute.delivery import store as dstore
 from skyroute.errors import OptionError, SkyrouteError
 from skyroute.jobs import store
+from tests.jobs.conftest import part_reads
 
 COLUMNS = {
     "jobs": ["id", "kind", "params", "state", "progress", "result", "error", "created",
@@ -27,8 +28,9 @@ COLUMNS = {
 HEAD = "0006"
 
 
-def upgrade_to(engine, revision: str) -> None:
-    """The schema at ``revision`` by the shipped migrations, as an older skyroute left it."""
+def upgrade_to(engine, revision: str, *, down: bool = False) -> None:
+    """The schema at ``revision`` by the shipped migrations, as an older skyroute left it
+    (``down``: by their downgrades, from a newer schema)."""
     from alembic import command
     from alembic.config import Config
 
@@ -36,7 +38,7 @@ def upgrade_to(engine, revision: str) -> None:
     cfg.set_main_option("script_location", str(Path(dstore.__file__).parent / "migrations"))
     with engine.begin() as conn:
         cfg.attributes["connection"] = conn
-        command.upgrade(cfg, revision)
+        (command.downgrade if down else command.upgrade)(cfg, revision)
 
 
 @pytest.fixture(params=["sqlite", "postgresql"])
@@ -231,22 +233,9 @@ def test_a_run_changed_while_its_file_streams_stops_the_stream(engine, monkeypat
 
 
 def _part_reads(engine, run):
-    """(what ``run()`` returned, the parts whose bytes it read: a part's number for a
-    read of one part, "all" for a statement that reads a file's bytes whole)."""
-    seen: list = []
-
-    def record(conn, clause, multiparams, params, execution_options):
-        cols = getattr(clause, "selected_columns", ())
-        if any(getattr(c, "name", None) == "data" and getattr(c, "table", None) is not None
-               and c.table.name == "fleet_run_files" for c in cols):
-            p = multiparams[0] if multiparams else params
-            seen.append((p or {}).get("k", "all"))
-
-    sa.event.listen(engine, "before_execute", record)
-    try:
+    """(what ``run()`` returned, the parts whose bytes it read: :func:`part_reads`)."""
+    with part_reads() as seen:
         return run(), seen
-    finally:
-        sa.event.remove(engine, "before_execute", record)
 
 
 def _jsonl(n: int, end: str) -> str:
@@ -351,14 +340,7 @@ def test_upgrading_a_0003_store_keeps_its_fleet_runs_and_downgrading_puts_them_b
                                tracks_csv=b"\x00\xff", packages_csv="p",
                                fleet_geojson="g")
 
-    from alembic import command
-    from alembic.config import Config
-
-    cfg = Config()
-    cfg.set_main_option("script_location", str(Path(dstore.__file__).parent / "migrations"))
-    with e.begin() as conn:
-        cfg.attributes["connection"] = conn
-        command.downgrade(cfg, "0003")
+    upgrade_to(e, "0003", down=True)
     assert "fleet_run_files" not in sa.inspect(e).get_table_names()
     cols = {c["name"]: c for c in sa.inspect(e).get_columns("fleet_runs")}
     assert all(not cols[k]["nullable"] for k in OLD_FILES)
@@ -404,14 +386,7 @@ def test_upgrading_a_0004_store_splits_its_files_and_downgrading_joins_them(new_
                                tracks_csv=big[:store.PART_BYTES + 1], packages_csv="",
                                fleet_geojson="g")
 
-    from alembic import command
-    from alembic.config import Config
-
-    cfg = Config()
-    cfg.set_main_option("script_location", str(Path(dstore.__file__).parent / "migrations"))
-    with e.begin() as conn:
-        cfg.attributes["connection"] = conn
-        command.downgrade(cfg, "0004")
+    upgrade_to(e, "0004", down=True)
     assert [c["name"] for c in sa.inspect(e).get_columns("fleet_run_files")] == \
         ["run_id", "name", "data"]
     with e.connect() as c:
@@ -460,14 +435,7 @@ def test_upgrading_a_0005_store_counts_its_events_lines_and_downgrading_drops_th
     tracks = store.open_fleet_file(e, "run-a", "tracks_csv")  # no counts: read them
     assert tracks.lines(1, 1) == ([b"0,1"], 3)
 
-    from alembic import command
-    from alembic.config import Config
-
-    cfg = Config()
-    cfg.set_main_option("script_location", str(Path(dstore.__file__).parent / "migrations"))
-    with e.begin() as conn:
-        cfg.attributes["connection"] = conn
-        command.downgrade(cfg, "0005")
+    upgrade_to(e, "0005", down=True)
     assert [c["name"] for c in sa.inspect(e).get_columns("fleet_run_files")] == \
         ["run_id", "name", "part", "data"]
     assert "fleet_run_files_lines" not in {i["name"] for i in sa.inspect(e).get_indexes(

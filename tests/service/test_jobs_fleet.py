@@ -6,7 +6,6 @@ run the real jobs and skip while it is missing."""
 
 from __future__ import annotations
 
-import contextlib
 import importlib.util
 import itertools
 import json
@@ -18,7 +17,7 @@ import uuid
 import pytest
 
 from tests.fleet.test_nofly import ringed
-from tests.jobs.conftest import slow_days
+from tests.jobs.conftest import part_reads, slow_days
 from tests.service.conftest import AUTH, DAY, EXAMPLE, make_client
 from tests.service.test_app import assert_problem
 
@@ -530,28 +529,6 @@ def test_a_runs_files_are_streamed_as_stored(tmp_path, request, db):
         for name in want:
             assert_problem(c.get(f"/fleet/runs/nope/{name}"), 404, words="no fleet run 'nope'")
     assert part == store.PART_BYTES
-
-
-@contextlib.contextmanager
-def part_reads():
-    """The parts of a run's files read while in the block, by any engine: a part's
-    number for a statement that reads one part, "all" for one that reads a file whole."""
-    import sqlalchemy as sa
-
-    seen: list = []
-
-    def record(conn, clause, multiparams, params, execution_options):
-        cols = getattr(clause, "selected_columns", ())
-        if any(getattr(c, "name", None) == "data" and getattr(c, "table", None) is not None
-               and c.table.name == "fleet_run_files" for c in cols):
-            p = multiparams[0] if multiparams else params
-            seen.append((p or {}).get("k", "all"))
-
-    sa.event.listen(sa.engine.Engine, "before_execute", record)
-    try:
-        yield seen
-    finally:
-        sa.event.remove(sa.engine.Engine, "before_execute", record)
 
 
 def _store_big_run(url: str) -> tuple[str, dict]:
