@@ -93,14 +93,17 @@ def real(name: str, value: object, *, low: float | None = None, strict: bool = F
     if _is_bool(x) or not isinstance(x, numbers.Real):
         raise OptionError(f"{name}={value!r} must be {need or 'a finite number'}",
                           param=name)
+    try:
+        x = float(x)
+    except OverflowError:  # an int or a Fraction beyond a float's range (10**400)
+        x = math.inf
     if not math.isfinite(x):
-        raise OptionError(f"{name}={value!r} must be {_finite(need, low, strict, high)}",
-                          param=name)
-    x = float(x)
+        raise OptionError(f"{name}={_shown(value)} must be "
+                          f"{_finite(need, low, strict, high)}", param=name)
     if (low is not None and (x <= low if strict else x < low)) or \
             (high is not None and x > high):
         need = need or f"a number {_range(low, strict, high)}"
-        raise OptionError(f"{name}={value!r} must be {need}", param=name)
+        raise OptionError(f"{name}={_shown(value)} must be {need}", param=name)
     return x
 
 
@@ -113,7 +116,7 @@ def whole(name: str, value: object, *, low: int | None = None,
     if _is_bool(x) or not isinstance(x, numbers.Integral) or \
             (low is not None and x < low) or (high is not None and x > high):
         need = need or f"an integer {_range(low, False, high)}".rstrip()
-        raise OptionError(f"{name}={value!r} must be {need}", param=name)
+        raise OptionError(f"{name}={_shown(value)} must be {need}", param=name)
     return int(x)
 
 
@@ -142,6 +145,20 @@ def _scalar(value: object) -> object:
             and value.dtype.kind in "biuf":
         return value[()]
     return value
+
+
+def _shown(value: object) -> str:
+    """``repr(value)``, but an integer of more than 30 digits as its number of digits:
+    10**400 reads ``<an integer of 401 digits>`` (and Python refuses the repr of one of
+    more than 4,300 digits)."""
+    if not isinstance(value, int) or abs(value) < 10**30:
+        return repr(value)
+    digits = int(math.log10(abs(value)))  # a float's estimate, made exact below
+    while 10**digits > abs(value):
+        digits -= 1
+    while 10 ** (digits + 1) <= abs(value):
+        digits += 1
+    return f"<{'a negative' if value < 0 else 'an'} integer of {digits + 1:,} digits>"
 
 
 def _is_bool(value: object) -> bool:

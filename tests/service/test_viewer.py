@@ -30,7 +30,8 @@ sync_api = pytest.importorskip("playwright.sync_api",
 
 SHOTS = ROOT / "artefacts" / "screenshots"
 VIEWPORTS = {"desktop": {"width": 1280, "height": 800}, "phone": {"width": 360, "height": 740}}
-SIZES = {**VIEWPORTS, "phone-640": {"width": 360, "height": 640}}  # (Page's other sizes)
+SIZES = {**VIEWPORTS, "phone-640": {"width": 360, "height": 640},  # (Page's other sizes)
+         "desktop-720": {"width": 1280, "height": 720}}
 FLEET_SEED = 1
 
 
@@ -151,6 +152,17 @@ def click_canvas(page, fx: float, fy: float) -> None:
     page.mouse.click(round(box["x"] + fx * box["width"]), round(box["y"] + fy * box["height"]))
 
 
+def click_cell(page, width: int, x: float, y: float) -> None:
+    """A click on the planner's canvas at cell (x, y) of a map ``width`` cells wide (x + 0.5
+    is a cell's middle), on whole pixels: the cells are square and fill the canvas's
+    width from its top left corner; the key strip under them is no share of the map."""
+    canvas = page.locator("#map")
+    canvas.scroll_into_view_if_needed()
+    box = canvas.bounding_box()
+    px = box["width"] / width
+    page.mouse.click(round(box["x"] + x * px), round(box["y"] + y * px))
+
+
 @pytest.mark.parametrize("size", VIEWPORTS)
 def test_home_page_links_every_page(open_page, size):
     pg = open_page("/", size)
@@ -210,7 +222,7 @@ def test_planner_click_pair_matches_post_plan(open_page, api, size):
     p.wait_for_function("document.querySelector('#status').textContent.startsWith('den312d')")
     blank = p.evaluate("document.querySelector('#map').toDataURL()")
     for x, y in (start, goal):
-        click_canvas(p, (x + 0.5) / doc["width"], (y + 0.5) / doc["height"])
+        click_cell(p, doc["width"], x + 0.5, y + 0.5)
     p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'"
                         " && document.querySelector('#status').textContent.startsWith('Planned')",
                         timeout=30_000)
@@ -941,13 +953,14 @@ def test_a_pressed_button_keeps_the_focus(open_page, server, page):
 
 # Records what the map canvas draws, in CSS pixels: the bounding box of each top-level
 # save()..restore() block with its texts (the north arrow is the block saying "N", the
-# scale bar the one saying "... m"), and each small mark drawn outside such blocks (a
+# scale bar the one saying "... m"), each small mark drawn outside such blocks (a
 # filled or stroked path, or a filled rectangle, at most 24 px across: customer dots and
-# rings, shops, home, the drone). Each render starts with a clearRect of the whole canvas.
+# rings, shops, home, the drone; the planner's start and goal) and each image drawn (the
+# planner's grid of cells). Each render starts with a clearRect of the whole canvas.
 CANVAS_LOG = """
 (() => {
   const P = CanvasRenderingContext2D.prototype;
-  const log = { blocks: [], marks: [] };
+  const log = { blocks: [], marks: [], images: [] };
   window.canvasLog = log;
   let depth = 0, block = null, path = null;
   const mine = (ctx) => ctx.canvas.id === "map";
@@ -974,7 +987,7 @@ CANVAS_LOG = """
   };
   wrap("clearRect", (ctx, x, y, w, h) => {
     if (x === 0 && y === 0 && w * (window.devicePixelRatio || 1) >= ctx.canvas.width - 1) {
-      log.blocks = []; log.marks = [];
+      log.blocks = []; log.marks = []; log.images = [];
     }
   });
   wrap("save", () => { if (depth++ === 0) block = { box: empty(), texts: [] }; });
@@ -987,6 +1000,13 @@ CANVAS_LOG = """
   const done = (ctx) => { if (!block && path && small(path)) log.marks.push(path.slice()); };
   wrap("fill", done);
   wrap("stroke", done);
+  wrap("drawImage", (ctx, image, ...a) => {  // (dx, dy[, dw, dh]) or (s..., dx, dy, dw, dh)
+    const [x, y, w, h] = a.length === 8 ? a.slice(4)
+      : [a[0], a[1], a[2] ?? image.width, a[3] ?? image.height];
+    const b = empty();
+    grow(b, at(ctx, x, y)); grow(b, at(ctx, x + w, y + h));
+    log.images.push(b);
+  });
   wrap("fillRect", (ctx, x, y, w, h) => {
     const b = empty();
     grow(b, at(ctx, x, y)); grow(b, at(ctx, x + w, y + h));
@@ -1101,3 +1121,45 @@ def test_day_page_deletes_a_day_without_a_flight(open_page, api, server, size):
     assert p.input_value("#date") == days[-1]  # its neighbour (the last day before it)
     assert p.evaluate("location.hash") == f"#date={days[-1]}"
     pg.done("day-deleted")
+
+
+PLANNER_KEY = """() => {
+  const hit = (a, b) => a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
+  const log = window.canvasLog;
+  const bars = log.blocks.filter(b => b.texts.some(t => / cells$/.test(t)));
+  const c = document.querySelector('#map').getBoundingClientRect();
+  return { bars: bars.map(b => b.box), images: log.images, marks: log.marks,
+           canvas: [c.width, c.height],
+           overlaps: bars.flatMap(b => [...log.images, ...log.marks].filter(m => hit(b.box, m))) };
+}"""
+
+
+@pytest.mark.parametrize("size", ["desktop-720", "phone-640"])
+def test_planner_scale_bar_covers_no_cell(open_page, api, size):
+    """The planner drew its scale bar over the map's bottom left cells (at 1280x720 and
+    360x640 alike): it sits in a strip under the cells now, as on the other pages, and a
+    click still picks the cell under it (a start on the free cell nearest the bottom left
+    corner, its marker clear of the bar too), while a click in the strip picks none."""
+    doc = api.get("/maps/den312d").json()
+    width, height = doc["width"], doc["height"]
+    corner = max(_free_cells(doc["rows"], doc["passable"]), key=lambda c: c[1] - c[0])
+    pg = open_page("/planner.html", size, init_script=CANVAS_LOG)
+    p = pg.page
+    _open_map(pg, "den312d")
+    click_cell(p, width, corner[0] + 0.5, corner[1] + 0.5)
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('Start')")
+    assert (int(p.input_value("#sx")), int(p.input_value("#sy"))) == corner
+    got = p.evaluate(PLANNER_KEY)
+    assert len(got["bars"]) == 1 and len(got["images"]) == 1, got
+    cells = got["images"][0]  # every cell, drawn as one image: the whole map
+    cw, ch = got["canvas"]
+    assert cells[:3] == pytest.approx([0, 0, cw], abs=0.01), (cells, got["canvas"])
+    assert (cells[3] - cells[1]) * width == pytest.approx((cells[2] - cells[0]) * height)
+    assert got["marks"], got  # the start's marker (filled, then ringed)
+    assert got["overlaps"] == [], got
+    assert cells[3] < got["bars"][0][1] and got["bars"][0][3] <= ch + 0.1  # in the strip
+    click_cell(p, width, corner[0] + 0.5, height + 0.5)  # under the bottom row: the strip
+    p.wait_for_timeout(200)
+    assert (int(p.input_value("#sx")), int(p.input_value("#sy"))) == corner
+    assert p.input_value("#gx") == "" and p.inner_text("#status").startswith("Start")
+    pg.done("planner-key")

@@ -5,7 +5,7 @@
 
 import { bindToken, choices, explain, focusFault, getJSON, postJSON } from "./api.js";
 import { PALETTE, fmt, h, isBusy, say, setBusy } from "./ui.js";
-import { drawScaleBar } from "./view.js";
+import { KEY, drawScaleBar } from "./view.js";
 
 const $ = (id) => document.getElementById(id);
 const status = $("status");
@@ -18,7 +18,7 @@ const WORLD_ONLY = new Set(["visibility", "prm"]);
 const DEFAULT_ON = new Set(["astar", "jps", "theta"]);
 
 let grid = null; // {name, width, height, free: Uint8Array, image: canvas}
-let cell = 1; // CSS pixels per cell
+let cell = 1; // CSS pixels per cell; the map fills the canvas's top, the key strip its foot
 let results = []; // [{algorithm, colour, answer|null, error|null}]
 let round = 0; // discards answers of an older query
 let loading = 0; // counts the maps asked for: only the last one asked is shown
@@ -80,10 +80,10 @@ function resize() {
   if (!grid) return;
   const wrap = canvas.parentElement;
   const most = wrap.clientWidth - 18; // the figure's padding
-  const tallest = Math.max(240, window.innerHeight * 0.72);
+  const tallest = Math.max(240, window.innerHeight * 0.72) - KEY;
   cell = Math.max(Math.min(most / grid.width, tallest / grid.height), 0.25);
   const w = cell * grid.width;
-  const hgt = cell * grid.height;
+  const hgt = cell * grid.height + KEY; // the scale bar's strip under the map, as MapView's
   const dpr = window.devicePixelRatio || 1;
   canvas.style.width = `${w}px`;
   canvas.style.height = `${hgt}px`;
@@ -152,15 +152,19 @@ function draw() {
   }
   ctx.textBaseline = "alphabetic";
   ctx.textAlign = "left";
-  drawScaleBar(ctx, cell, "cells", 10, grid.height * cell - 10);
+  // in the strip under the map, not over its bottom left cells (which it hid); low in
+  // it, clear of a start or goal marker on the bottom row (which reaches at most 6 px
+  // below the map while cells are at most 20 px)
+  drawScaleBar(ctx, cell, "cells", 12, grid.height * cell + KEY - 4);
 }
 
 canvas.addEventListener("click", (ev) => {
   if (!grid) return;
   const r = canvas.getBoundingClientRect();
-  const x = Math.floor(((ev.clientX - r.left) / r.width) * grid.width);
-  const y = Math.floor(((ev.clientY - r.top) / r.height) * grid.height);
-  if (x < 0 || y < 0 || x >= grid.width || y >= grid.height) return;
+  const px = r.width / grid.width; // CSS pixels per cell as shown; the strip is below them
+  const x = Math.floor((ev.clientX - r.left) / px);
+  const y = Math.floor((ev.clientY - r.top) / px);
+  if (x < 0 || y < 0 || x >= grid.width || y >= grid.height) return; // the key strip too
   if (!grid.free[y * grid.width + x]) {
     say(status, `Cell (${x}, ${y}) is blocked: pick a free (light) cell.`, "error");
     return;

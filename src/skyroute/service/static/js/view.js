@@ -43,7 +43,7 @@ const PAD = 14; // CSS pixels round the plotted region
 // its right. Drawn over the plot's corners (as they were) they hid what lay there: on a
 // phone the arrow covered a customer of the README's day, the scale bar an airport's
 // runway.
-const KEY = 30;
+export const KEY = 30; // (the planner's canvas has the same strip)
 
 /** A canvas showing the plane region ``bounds`` (x east, y north) at the largest scale
  * that fits above the key strip, redrawn by ``draw(ctx, view)`` on ``render()`` and
