@@ -115,8 +115,11 @@ def test_a_deliver_job_refuses_another_sites_data(tmp_path):
                                    "data": str(other)}, executor=ex,
                     progress=lambda _share: None)
     assert str(info.value).startswith(
-        f"{other / 'website' / 'menus' / 'menus.json'}: none of the orders stored for "
-        "2024-01-01 is on these menus or goes to a place of this site")
+        f"{other / 'website' / 'menus' / 'menus.json'}: none of the ")
+    assert "orders stored for 2024-01-01 in sqlite:///" in str(info.value)
+    assert str(info.value).endswith(
+        "they are another site's orders: give the data folder (or source) they were "
+        "imported from; nothing was imported or flown")
     assert info.value.param == "data"
     assert store.day_rows(engine, dt.date(2024, 1, 1)) == {"deliveries": [],
                                                           "flightpath": []}

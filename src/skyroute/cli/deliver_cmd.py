@@ -94,7 +94,10 @@ def deliver_command(
         for o in orders:
             if d0 <= o.date <= d1:
                 given.setdefault(o.date, []).append(o)
-        _refuse_foreign(site, {**days_between(engine, d0, d1), **given}, given, db, data)
+        from skyroute.delivery.days import refuse_foreign
+
+        refuse_foreign(site, {**days_between(engine, d0, d1), **given}, stored_in=db,
+                       given=given, data=data)
         if data is not None:
             got = import_folder(engine, data, replace=replace, orders=orders)[1]
             if got.added:
@@ -131,33 +134,6 @@ def deliver_command(
     else:
         _summary(results, wall, jobs, workers, ex.kind, as_json, written)
     _say_empty(results)
-
-
-def _refuse_foreign(site, by_date: dict, given: dict, db: str, data: Path | None) -> None:
-    """One line naming the site's menus and the first day whose orders name no item on
-    them (:func:`~skyroute.delivery.days.foreign_days`): a store of one site's orders
-    flown with another site's --data folder listed every order 'unknown item' and
-    stored that over the day's flight."""
-    from skyroute.delivery.days import foreign_days
-
-    bad = foreign_days(site, by_date)
-    if not bad:
-        return
-    day = bad[0]
-    orders = by_date[day]
-    item = next(i for o in orders for i in o.items if i not in site.menu)
-    if day in given:  # the folder's own orders: its CSVs and its website disagree
-        whence = f"of {day} in {data / 'database' / 'orders.csv'}"
-        hint = "the folder's orders and website are not of one site"
-    else:
-        whence = f"stored for {day} in {safe_url(db)}"
-        hint = ("they are another site's orders: give the --data folder they were imported "
-                "from")
-    more = f" (and {len(bad) - 1:,} more of the days)" if len(bad) > 1 else ""
-    raise SkyrouteError(f"{site.source.where('menus/menus.json')}: none of the "
-                        f"{len(orders):,} orders {whence}{more} is on these menus or goes to "
-                        f"a place of this site (e.g. item {item!r}, deliverTo "
-                        f"{orders[0].deliver_to!r}); {hint}; nothing was imported or flown")
 
 
 def _say_empty(results: list[DayResult]) -> None:

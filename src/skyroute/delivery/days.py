@@ -11,7 +11,7 @@ from collections.abc import Callable
 from skyroute.delivery import store
 from skyroute.delivery.legs import leg_table, missing_legs
 from skyroute.delivery.orders import Priced, price
-from skyroute.errors import InputFormatError
+from skyroute.errors import InputFormatError, SkyrouteError
 
 
 def places_of(site, orders) -> list[tuple[float, float]]:
@@ -34,6 +34,35 @@ def foreign_days(site, by_date: dict[dt.date, list]) -> list[dt.date]:
                   and not any(o.items and all(i in site.menu for i in o.items)
                               for o in orders)
                   and not any(_known_place(site, o.deliver_to) for o in orders))
+
+
+def refuse_foreign(site, by_date: dict[dt.date, list], *, stored_in: str,
+                   given: dict | None = None, data=None, option: str = "--data folder",
+                   param: str | None = None) -> None:
+    """Raise one line naming ``site``'s menus and the first of :func:`foreign_days`, if
+    any: ``stored_in`` the store's URL (password hidden) for days read from it, ``given``
+    the days read from ``data``'s ``orders.csv`` instead, ``option`` what the user gives
+    the site by (the CLI's --data folder, a job's data folder or source). Nothing is
+    imported or flown before it: flown, the orders were stored as 'unknown item' over
+    the day's flight. Shared by ``skyroute deliver`` and the deliver job."""
+    bad = foreign_days(site, by_date)
+    if not bad:
+        return
+    day = bad[0]
+    orders = by_date[day]
+    item = next(i for o in orders for i in o.items if i not in site.menu)
+    if given and day in given:  # the folder's own orders: its CSVs and website disagree
+        whence = f"of {day} in {data / 'database' / 'orders.csv'}"
+        hint = "the folder's orders and website are not of one site"
+    else:
+        whence = f"stored for {day} in {store.safe_url(stored_in)}"
+        hint = f"they are another site's orders: give the {option} they were imported from"
+    more = f" (and {len(bad) - 1:,} more of the days)" if len(bad) > 1 else ""
+    raise SkyrouteError(f"{site.source.where('menus/menus.json')}: none of the "
+                        f"{len(orders):,} orders {whence}{more} is on these menus or goes to "
+                        f"a place of this site (e.g. item {item!r}, deliverTo "
+                        f"{orders[0].deliver_to!r}); {hint}; nothing was imported or flown",
+                        param=param)
 
 
 def _known_place(site, words: str) -> bool:

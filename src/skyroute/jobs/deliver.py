@@ -31,7 +31,7 @@ import sqlalchemy as sa
 from skyroute.caches import register
 from skyroute.delivery import store
 from skyroute.delivery.day import METHODS, DayResult, plan_day
-from skyroute.delivery.days import foreign_days, prepare_legs
+from skyroute.delivery.days import prepare_legs, refuse_foreign
 from skyroute.delivery.orders import Order
 from skyroute.delivery.site import load_site
 from skyroute.delivery.source import DirSource, HttpSource, open_source
@@ -182,13 +182,9 @@ def deliver_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
     first, last = dt.date.fromisoformat(p["from"]), dt.date.fromisoformat(p["to"])
     by_date = days_between(engine, first, last)
     site = load_site(src)
-    bad = foreign_days(site, by_date)
-    if bad:  # flown, every order would be 'unknown item', stored over the day's flight
-        raise SkyrouteError(f"{src.where('menus/menus.json')}: none of the orders stored "
-                            f"for {bad[0]} is on these menus or goes to a place of this "
-                            "site: they are another site's orders; give the data folder (or "
-                            "source) they were imported from",
-                            param=("data" if data is not None else "source"))
+    refuse_foreign(site, by_date, stored_in=str(engine.url),
+                   option="data folder (or source)",
+                   param="data" if data is not None else "source")
     prepare_legs(site, [o for v in by_date.values() for o in v])
     done = 0
 
