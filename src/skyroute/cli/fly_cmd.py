@@ -176,8 +176,8 @@ def fly_command(
             world, a, b = world.in_frame("degrees"), world.to_lonlat(a)[0], world.to_lonlat(b)[0]
             doc, rows, xy = _fly_step(world, a, b, planner)
         elif vehicle == "dubins" and targets is not None:
-            doc, rows, xy = _fly_tour(world, a, h0, _read_targets(targets, world), radius, step,
-                                      max_expansions)
+            visits = _read_targets(targets, world)
+            doc, rows, xy = _fly_tour(world, a, h0, visits, radius, step, max_expansions)
         elif vehicle == "dubins" and planner == "hybrid":
             doc, rows, xy = _fly_hybrid(world, a, b, h0, h1, radius, step, reverse,
                                         max_expansions, approach)
@@ -204,8 +204,14 @@ def fly_command(
                 length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
             shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)
             # --safety is in the units of the frame loaded (metres after 'step' moved to degrees)
-            plot_world_path(world, shown, a, xy[-1], plot,
-                            obstacles=obstacles_label(altitude, safety, frame))
+            # The goal as typed, where the start is: the step drone stops within a step
+            # of it, a lattice at the centre of its nearest free cell, a field within a
+            # tolerance (the goal was drawn where the vehicle stopped, and named so).
+            # A tour has no goal: its targets are drawn instead.
+            tour = targets is not None
+            plot_world_path(world, shown, a, None if tour else b, plot,
+                            obstacles=obstacles_label(altitude, safety, frame),
+                            targets=visits if tour else None)
     if as_json:
         typer.echo(json.dumps({k: v for k, v in doc.items() if k != "columns"}))
     else:
