@@ -216,13 +216,33 @@ def fly_command(
         typer.echo(json.dumps({k: v for k, v in doc.items() if k != "columns"}))
     else:
         table = Table(title=f"{world.name}: {vehicle}", show_header=False)
+        unit = "deg" if world.plane == "degrees" else "m"
         for k, v in doc["metrics"].items():
             if k != "reached":
-                table.add_row(k, f"{v:.6g}" if isinstance(v, float) else str(v))
+                table.add_row(k, _shown(k, v, unit))
         table.add_row("reached", str(doc["reached"]))
         print_table(plain_console(), table)
     if not doc["reached"]:
         raise typer.Exit(EXIT_NOT_REACHED)
+
+
+# The unit of each metric in the table ("plane": metres, or degrees in the degrees frame
+# and for the step drone); --json keeps the bare numbers.
+METRIC_UNITS = {"length": "plane", "bound": "plane", "greedy_bound": "plane",
+                "length_deg": "deg", "time": "s", "seconds": "s", "smoothness": "rad/move"}
+
+
+def _shown(name: str, value, plane_unit: str) -> str:
+    """A metric as the table shows it: floats to 6 significant digits with their unit
+    (a length read "236.451" beside plan-world's "221.383540 m"), counts with thousands
+    separators."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return str(value)
+    if isinstance(value, int):
+        return f"{value:,}"
+    unit = METRIC_UNITS.get(name)
+    unit = plane_unit if unit == "plane" else unit
+    return f"{value:.6g}" + (f" {unit}" if unit else "")
 
 
 def _check_vehicle_options(ctx: typer.Context, vehicle: str) -> None:
