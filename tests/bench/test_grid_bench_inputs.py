@@ -174,6 +174,9 @@ def test_duplicates_run_once_in_the_order_given(monkeypatch, capsys, tmp_path):
     assert [m["map"] for m in doc["maps"]] == ["tiny.map", "random-16-0.2-s0"]
     assert all([r["runner"] for r in m["rows"]] == ["astar"] for m in doc["maps"])
     assert doc["settings"]["algorithms"] == ["astar"] and doc["settings"]["random"] == ["16:0.2"]
+    # the maps named, as given: the report kept only the folder, as if all of it had run
+    assert doc["settings"]["map"] == ["tiny", "tiny.map"]
+    assert doc["settings"]["maps"] == str(tmp_path)
 
 
 @pytest.mark.parametrize("args, words", [

@@ -356,3 +356,20 @@ def test_nothing_offered_has_no_served_share(monkeypatch, capsys):
     (line,) = [x for x in out.splitlines() if " layers " in x]
     cells = [c.strip() for c in line.strip(" \u2502").split("\u2502")]
     assert cells[2:5] == ["0", "0.0 \u00b10.0", "-"], out  # offered, delivered/h, served %
+
+
+def test_bench_fleet_json_keeps_its_options(monkeypatch, capsys, tmp_path):
+    """Every bench report keeps its options under ``settings``; this one had only
+    ``machine`` and ``rows``."""
+    row = {"rate_per_hour": 600.0, "flights": 1, "sim_seconds": 1.0, "check_seconds": 0.1,
+           "sim_seconds_per_wall_second": 10.0, "delivered_per_hour": 1.0, "conflicts": 0,
+           "lost": 0}
+    monkeypatch.setattr("skyroute.cli.bench_fleet_cmd.bench_case", lambda *a, **k: row)
+    out = tmp_path / "rows.json"
+    code, _, err = run(monkeypatch, capsys, "bench", "fleet", "--case", "2", "--scheduler",
+                       "seed", "--airspace", "layers", "--seed", "4", "--json", str(out))
+    assert code == 0, err
+    doc = json.loads(out.read_text())
+    assert doc["settings"] == {"case": [2], "scheduler": "seed", "airspace": "layers",
+                               "seed": 4}
+    assert doc["machine"]["skyroute"] and len(doc["rows"]) == 1

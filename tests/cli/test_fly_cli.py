@@ -248,3 +248,22 @@ def test_cli_md_lists_the_vehicle_options_as_the_table_does():
         for flag in re.findall(r"`--([a-z-]+)", flags):
             listed[flag.replace("-", "_")] = tuple(re.findall(r"`([a-z]+)`", vehicles))
     assert listed == TAKEN_BY
+
+
+def test_the_table_gives_each_metric_its_unit(monkeypatch, capsys, city):
+    """plan-world's table said "cost 221.383540 m"; fly's said "length 230.877" and
+    "time 233.877" with no unit, and "expanded 12881" without separators."""
+    code, text, err = run(monkeypatch, capsys, "fly", city, "--frame", "ned", "--vehicle",
+                          "lattice", "--start", "0,0", "--goal", "120,-180", "--altitude",
+                          "10", "--safety", "2", "--resolution", "2")
+    assert code == 0, err
+    code, doc, err = run(monkeypatch, capsys, "fly", city, "--frame", "ned", "--vehicle",
+                         "lattice", "--start", "0,0", "--goal", "120,-180", "--altitude",
+                         "10", "--safety", "2", "--resolution", "2", "--json")
+    m = json.loads(doc)["metrics"]
+    rows = {line.split("│")[1].strip(): line.split("│")[2].strip()
+            for line in text.splitlines() if line.count("│") == 3}
+    assert rows["length"] == f"{m['length']:.6g} m" and rows["time"] == f"{m['time']:.6g} s"
+    assert rows["smoothness"] == f"{m['smoothness']:.6g} rad/move"
+    assert m["expanded"] >= 1000 and rows["expanded"] == f"{m['expanded']:,}"
+    assert rows["moves"] == str(m["moves"]) and rows["status"] == "found"

@@ -134,3 +134,11 @@ def test_version_is_the_installed_one():
     assert result.exit_code == 0
     assert result.output == f"skyroute {skyroute.__version__}\n"
     assert version("skyroute") == skyroute.__version__
+
+
+def test_deliver_replace_help_reads_as_one_sentence():
+    """It was pieced together as "...; with --data also: Store the file's orders ..."."""
+    (deliver,) = [cmd for path, cmd in COMMANDS if path == ("deliver",)]
+    (replace,) = [p for p in deliver.params if p.name == "replace"]
+    assert "(kept otherwise); with --data also store the files' orders of each day" \
+        in replace.help

@@ -167,3 +167,15 @@ def test_a_small_battery_is_never_exceeded():
         deliveries = [("2024-01-03", p.order.order_no, p.order.deliver_to, p.cost)
                       for p in r.delivered]
         assert check_day(ref, book, "2024-01-03", deliveries, rows) == []
+
+
+def test_only_the_integer_program_reports_a_proven_optimum():
+    """The greedy insertion proves nothing: its report said ``proven_optimal: true``, as
+    the integer program's, to a user comparing the two methods."""
+    site = load_site(DirSource(EXAMPLE))
+    orders = [o for o in read_csv_orders(EXAMPLE) if o.date.day == 2][:8]
+    greedy = plan_day(site, orders[0].date, orders, method="greedy")
+    assert greedy.report()["settings"] == {"method": "greedy", "battery": 1500,
+                                           "rounds": greedy.settings["rounds"],
+                                           "proven_optimal": False}
+    assert plan_day(site, orders[0].date, orders).report()["settings"]["proven_optimal"]

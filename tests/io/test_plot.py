@@ -305,3 +305,54 @@ def test_plan_prune_plot_from_the_command_line(monkeypatch, capsys, figures, tmp
                        str(tmp_path / "p.png"))
     assert code == 0, err
     assert figures[0].axes[0].get_title().endswith("expanded, pruned (los): 5 waypoints")
+
+
+@pytest.mark.parametrize("vehicle, args", [
+    # the step drone stops within a step (0.00015 degrees) of the goal, the lattice at
+    # the centre of the free cell nearest it: the star was drawn there and named so
+    ("step", ["--start=-3.1890,55.9456", "--goal=-3.1850,55.9432"]),
+    ("lattice", ["--frame", "ned", "--start", "0,0", "--goal", "120,-180", "--resolution",
+                 "5"]),
+])
+def test_fly_plot_marks_the_goal_as_typed(monkeypatch, capsys, figures, tmp_path, vehicle,
+                                          args):
+    from tests.cli.test_cli import run
+
+    code, _, err = run(monkeypatch, capsys, "fly", CITY, "--vehicle", vehicle, "--altitude",
+                       "10", "--safety", "2", *args, "--plot", str(tmp_path / "f.png"))
+    assert code == 0, err
+    goal = [t for t in _legend(figures[0]) if t.startswith("goal")]
+    assert goal == (["goal (lon -3.185, lat 55.9432)"] if vehicle == "step" else
+                    ["goal (north 120 m, east -180 m)"])
+    star = [ln for ln in figures[0].axes[0].get_lines() if ln.get_label().startswith("goal")]
+    if vehicle == "step":  # drawn on the lon/lat plane
+        world = skyroute.load_world(CITY, altitude=10, safety=2).in_frame("degrees")
+        typed = (-3.185, 55.9432)
+    else:
+        world, typed = skyroute.load_world(CITY, altitude=10, safety=2, frame="ned"), (120, -180)
+    np.testing.assert_allclose(np.ravel(star[0].get_xydata())[:2],
+                               world.to_plane(np.array([typed], dtype=float))[0], atol=1e-9)
+
+
+def test_fly_tour_plot_numbers_the_targets_and_draws_no_goal(monkeypatch, capsys, figures,
+                                                             tmp_path):
+    """A tour has no goal: its last target was drawn as one ("goal (north -60 m, ...)"),
+    and the others not at all."""
+    from tests.cli.test_cli import run
+
+    targets = tmp_path / "t.csv"
+    targets.write_text("north,east\n60,30\n-60,60\n0,-120\n")
+    code, _, err = run(monkeypatch, capsys, "fly", CITY, "--frame", "ned", "--vehicle",
+                       "dubins", "--altitude", "10", "--safety", "2", "--radius", "8",
+                       "--start", "0,0,0", "--targets", str(targets), "--plot",
+                       str(tmp_path / "t.png"))
+    assert code == 0, err
+    legend = _legend(figures[0])
+    assert "targets (3), numbered as given" in legend
+    assert not [t for t in legend if t.startswith("goal")]
+    ax = figures[0].axes[0]
+    assert sorted(t.get_text() for t in ax.texts) == ["1", "2", "3"]
+    (marks,) = [ln for ln in ax.get_lines() if ln.get_label().startswith("targets")]
+    world = skyroute.load_world(CITY, altitude=10, safety=2, frame="ned")
+    np.testing.assert_allclose(marks.get_xydata(),
+                               world.to_plane(np.array([[60, 30], [-60, 60], [0, -120]])))

@@ -117,3 +117,22 @@ def test_a_field_run_says_found_as_every_result_does():
     r = run_field(world, s, t)
     assert r.found is r.reached is True
     assert run_field(world, s, t, max_moves=3).found is False
+
+
+def test_escape_reaches_a_goal_beyond_the_obstacles_of_an_unbounded_world():
+    """The navigation raster covered the obstacles' extent only: with no boundary, a
+    robot trapped in the C (x < 34) and a goal past it (x = 80) had no cells there, and
+    the escape ended in an IndexError (a traceback from ``skyroute fly --vehicle field``
+    on a GeoJSON world whose goal lay beyond its zones)."""
+    import shapely
+
+    from skyroute.world.world import World
+
+    hard, start, _ = course("hard")
+    world = World(hard.obstacles, np.full(3, -np.inf), np.full(3, np.inf), (), None, "enu")
+    goal = np.array([80.0, 30.0])
+    assert shapely.box(*world.bounds).contains(shapely.Point(goal)) is False
+    run = run_field(world, start, goal, escape=True)
+    assert run.reached and run.escaped > 0
+    assert world.segments_free(run.path[:-1], run.path[1:]).all()
+    assert math.dist(run.path[-1], goal) < 0.5

@@ -98,3 +98,27 @@ def test_the_library_load_names_its_parameters(monkeypatch):
     assert err.value.param == "requests"
     with pytest.raises(OptionError, match=r"^workers=100 is over the limit of 64 server"):
         service.bench_flightpath(db="sqlite://", workers=100)
+
+
+def test_the_json_report_keeps_every_option(monkeypatch, capsys, tmp_path):
+    """Loads, map, planner, store and day (its password masked) beside the seed: the
+    report kept only the seed, the sizes and the client, not what was loaded."""
+    def fake(load):
+        def bench(**kw):
+            return {"load": load, "map": kw.get("map_name"), "requests_per_second": 100.0,
+                    "errors": 0}
+        return bench
+
+    monkeypatch.setattr("skyroute.bench.service.bench_plan", fake("POST /plan"))
+    monkeypatch.setattr("skyroute.bench.service.bench_flightpath", fake("GET /days"))
+    out = tmp_path / "rows.json"
+    code, _, err = run(monkeypatch, capsys, "bench", "service", "--load", "plan", "--load",
+                       "flightpath", "--map", "den312d", "--algorithm", "jps", "--db",
+                       "postgresql+psycopg://me:secret@db:5432/lunch", "--date",
+                       "2024-01-03", "--requests", "10", "--json", str(out))
+    assert code == 0, err
+    settings = json.loads(out.read_text())["settings"]
+    assert settings == {"load": ["plan", "flightpath"], "map": "den312d", "algorithm": "jps",
+                        "db": "postgresql+psycopg://me:***@db:5432/lunch",
+                        "date": "2024-01-03", "seed": 0, "requests": 10, "clients": 50,
+                        "workers": 1, "client_processes": 1, "client": "httpx"}

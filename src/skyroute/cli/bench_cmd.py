@@ -93,7 +93,11 @@ def bench_grid(
             *(f"x faster than {row['runner']}" for row in rep["rows"] if row["peer"]),
             "cost/opt max", "cost/opt mean", "M exp/s"))
     if json_out:
-        doc = {"settings": {"maps": str(folder), "per_map": per_map, "random": randoms,
+        # --map as given: a re-run of the report needs it (only "maps", the folder, was
+        # kept, so the report of two maps read as a run of every map in the folder)
+        doc = {"settings": {"maps": None if only_random else str(folder),
+                            "map": list(dict.fromkeys(map_names or ())),
+                            "per_map": per_map, "random": randoms,
                             "prepared": prepared,
                             "algorithms": algs, "peers": have, "missing_peers": missing,
                             "seed": seed},

@@ -61,4 +61,8 @@ def bench_fleet(
     # the speed is the point; the traffic columns give way first on a narrow terminal
     print_table(wide_console(), t, optional=("conflicts", "lost", "delivered/h", "offered/h"))
     if json_out:
-        write_atomic(json_out, json.dumps({"machine": machine(), "rows": rows}, indent=1))
+        # the options, as every bench report keeps them (this one had none)
+        settings = {"case": chosen, "scheduler": scheduler, "airspace": airspace,
+                    "seed": seed}
+        write_atomic(json_out, json.dumps({"settings": settings, "machine": machine(),
+                                           "rows": rows}, indent=1))

@@ -105,8 +105,20 @@ def bench_service(
                                              "client CPU ms/req"))
     if json_out:
         write_atomic(json_out, json.dumps(
-            {"settings": {"seed": seed, "requests": requests, "clients": clients,
+            {"settings": {"load": loads, "map": map_name if "plan" in loads else None,
+                          "algorithm": algorithm if "plan" in loads else None,
+                          "db": _shown_url(db), "date": date,
+                          "seed": seed, "requests": requests, "clients": clients,
                           "workers": workers, "client_processes": client_processes,
                           "client": client},
              "machine": machine(("fastapi", "uvicorn", "httpx", "sqlalchemy")), "rows": rows},
             indent=1))
+
+
+def _shown_url(url: str | None) -> str | None:
+    """A store's URL for a report, its password masked (SQLAlchemy's rendering)."""
+    if url is None:
+        return None
+    from sqlalchemy.engine import make_url
+
+    return make_url(url).render_as_string(hide_password=True)

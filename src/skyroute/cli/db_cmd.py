@@ -28,7 +28,7 @@ def db_init(db: Annotated[str, typer.Option(help="SQLAlchemy URL of the store.")
 # Where a field of an order comes from in the ILP CSVs (for messages)
 CSV_FIELDS = {"date": ("orders.csv", "deliveryDate"), "customer": ("orders.csv", "customer"),
               "deliver_to": ("orders.csv", "deliverTo"), "items": ("orderDetails.csv", "items")}
-REPLACE_HELP = ("Store the file's orders of each day whose stored orders differ (an order "
+REPLACE_HELP = ("Store the files' orders of each day whose stored orders differ (an order "
                 "corrected or removed), deleting that day's stored deliveries and flight "
                 "path.")
 

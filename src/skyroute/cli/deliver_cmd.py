@@ -37,7 +37,7 @@ def deliver_command(
     db: Annotated[str, typer.Option(help="SQLAlchemy URL of the store.")] = DEFAULT_DB,
     replace: Annotated[bool, typer.Option("--replace", help=(
         "Store a day whose every order is invalid over its stored flight (kept otherwise); "
-        "with --data also: " + REPLACE_HELP))] = False,
+        "with --data also " + REPLACE_HELP[0].lower() + REPLACE_HELP[1:]))] = False,
     out: Annotated[Path, typer.Option(help="Folder for the GeoJSON, PNG and report files.")] =
         Path("."),
     jobs: Annotated[int, typer.Option(help="Worker processes for a range of days.")] = 1,

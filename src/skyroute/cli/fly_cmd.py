@@ -176,8 +176,8 @@ def fly_command(
             world, a, b = world.in_frame("degrees"), world.to_lonlat(a)[0], world.to_lonlat(b)[0]
             doc, rows, xy = _fly_step(world, a, b, planner)
         elif vehicle == "dubins" and targets is not None:
-            doc, rows, xy = _fly_tour(world, a, h0, _read_targets(targets, world), radius, step,
-                                      max_expansions)
+            visits = _read_targets(targets, world)
+            doc, rows, xy = _fly_tour(world, a, h0, visits, radius, step, max_expansions)
         elif vehicle == "dubins" and planner == "hybrid":
             doc, rows, xy = _fly_hybrid(world, a, b, h0, h1, radius, step, reverse,
                                         max_expansions, approach)
@@ -204,19 +204,45 @@ def fly_command(
                 length = float(np.hypot(*np.diff(plane, axis=0).T).sum()) if len(xy) > 1 else 0.0
             shown = PlanResult(Status.FOUND, np.asarray(xy), length, algorithm=vehicle)
             # --safety is in the units of the frame loaded (metres after 'step' moved to degrees)
-            plot_world_path(world, shown, a, xy[-1], plot,
-                            obstacles=obstacles_label(altitude, safety, frame))
+            # The goal as typed, where the start is: the step drone stops within a step
+            # of it, a lattice at the centre of its nearest free cell, a field within a
+            # tolerance (the goal was drawn where the vehicle stopped, and named so).
+            # A tour has no goal: its targets are drawn instead.
+            tour = targets is not None
+            plot_world_path(world, shown, a, None if tour else b, plot,
+                            obstacles=obstacles_label(altitude, safety, frame),
+                            targets=visits if tour else None)
     if as_json:
         typer.echo(json.dumps({k: v for k, v in doc.items() if k != "columns"}))
     else:
         table = Table(title=f"{world.name}: {vehicle}", show_header=False)
+        unit = "deg" if world.plane == "degrees" else "m"
         for k, v in doc["metrics"].items():
             if k != "reached":
-                table.add_row(k, f"{v:.6g}" if isinstance(v, float) else str(v))
+                table.add_row(k, _shown(k, v, unit))
         table.add_row("reached", str(doc["reached"]))
         print_table(plain_console(), table)
     if not doc["reached"]:
         raise typer.Exit(EXIT_NOT_REACHED)
+
+
+# The unit of each metric in the table ("plane": metres, or degrees in the degrees frame
+# and for the step drone); --json keeps the bare numbers.
+METRIC_UNITS = {"length": "plane", "bound": "plane", "greedy_bound": "plane",
+                "length_deg": "deg", "time": "s", "seconds": "s", "smoothness": "rad/move"}
+
+
+def _shown(name: str, value, plane_unit: str) -> str:
+    """A metric as the table shows it: floats to 6 significant digits with their unit
+    (a length read "236.451" beside plan-world's "221.383540 m"), counts with thousands
+    separators."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return str(value)
+    if isinstance(value, int):
+        return f"{value:,}"
+    unit = METRIC_UNITS.get(name)
+    unit = plane_unit if unit == "plane" else unit
+    return f"{value:.6g}" + (f" {unit}" if unit else "")
 
 
 def _check_vehicle_options(ctx: typer.Context, vehicle: str) -> None:

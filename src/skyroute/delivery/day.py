@@ -104,7 +104,10 @@ def plan_day(site, date: dt.date, orders: list[Order], *, method: str = "milp",
     # over- or under-spent, keep the best flight that fits (a few rounds at most).
     # Past MAX_ROUNDS it only goes on while nothing has fitted yet: every flight over the
     # battery lowers the budget, so it ends (an empty plan always fits).
-    budget, rounds, proven, fit, tried, last, over = battery, 0, True, None, set(), None, 0
+    # Only the integer program proves its choice optimal (over the leg table); the
+    # greedy insertion never does, and its report said "proven_optimal": true.
+    proven = method == "milp"
+    budget, rounds, fit, tried, last, over = battery, 0, None, set(), None, 0
     flyable = len(priced) - int(np.count_nonzero(unreachable))
     while budget > 0 and budget not in tried and (rounds < MAX_ROUNDS or fit is None):
         tried.add(budget)

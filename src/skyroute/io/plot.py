@@ -139,10 +139,11 @@ def draw_path(ax, points, *, lw: float = 1.6, label: str = "path") -> None:
 def mark_ends(ax, start, goal, *, start_text: str = "", goal_text: str = "") -> None:
     """Start (green dot) and goal (red star) above everything else and not clipped by
     the frame (a start in a map's corner was half cut off); each legend entry names its
-    point."""
-    for xy, marker, colour, ms, name, text in ((start, "o", "tab:green", 9, "start",
-                                                start_text),
-                                               (goal, "*", "tab:red", 14, "goal", goal_text)):
+    point. A goal of None (a tour, which ends at its last target) draws no star."""
+    ends = [(start, "o", "tab:green", 9, "start", start_text)]
+    if goal is not None:
+        ends.append((goal, "*", "tab:red", 14, "goal", goal_text))
+    for xy, marker, colour, ms, name, text in ends:
         ax.plot(*np.asarray(xy, dtype=float)[:2], marker, color=colour, ms=ms,
                 markeredgecolor="white", markeredgewidth=0.8, clip_on=False, zorder=6,
                 label=f"{name} {text}".strip())

@@ -10,7 +10,14 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.geo import heading_of, lonlat_to_enu
-from skyroute.io.plot import draw_path, legend_outside, mark_ends, save_figure, set_title
+from skyroute.io.plot import (
+    draw_path,
+    legend_outside,
+    mark_ends,
+    place_labels,
+    save_figure,
+    set_title,
+)
 from skyroute.result import PlanResult
 from skyroute.world.world import AXES, World
 
@@ -70,12 +77,14 @@ def world_path_geojson(world: World, result: PlanResult) -> dict:
 
 def plot_world_path(world: World, result: PlanResult, start, goal, path: str | Path, *,
                     edges: np.ndarray | None = None, dpi: int = 150,
-                    obstacles: str = "obstacles") -> Path:
+                    obstacles: str = "obstacles", targets: np.ndarray | None = None) -> Path:
     """Draw obstacles (grey), the boundary (dashed), roadmap edges (thin, plane
     segments), the path; ``result.path``, ``start`` and ``goal`` in the world's frame
-    (the legend names start and goal as they were given). ``obstacles`` is the grey
-    shapes' legend entry: :func:`obstacles_label` says at which altitude and grown by
-    what margin the world was loaded, which the world itself does not record."""
+    (the legend names start and goal as they were given, also where a vehicle stopped
+    short of the goal). ``obstacles`` is the grey shapes' legend entry:
+    :func:`obstacles_label` says at which altitude and grown by what margin the world
+    was loaded, which the world itself does not record. ``targets`` (a tour's, in the
+    world's frame; ``goal`` None) are drawn numbered as given."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -91,12 +100,22 @@ def plot_world_path(world: World, result: PlanResult, start, goal, path: str | P
                                                f"({len(edges):,} edges)"))
     if result.found:
         draw_path(ax, world.to_plane(result.path, "path"), lw=1.8)
-    mark_ends(ax, world.to_plane(start, "start")[0], world.to_plane(goal, "goal")[0],
-              start_text=_point(world, start), goal_text=_point(world, goal))
+    mark_ends(ax, world.to_plane(start, "start")[0],
+              None if goal is None else world.to_plane(goal, "goal")[0],
+              start_text=_point(world, start),
+              goal_text="" if goal is None else _point(world, goal))
+    if targets is not None:
+        pts = world.to_plane(np.asarray(targets, dtype=float).reshape(-1, 2), "targets")
+        ax.plot(*pts.T, "D", color="tab:red", ms=7, markeredgecolor="white",
+                markeredgewidth=0.8, clip_on=False, zorder=6, linestyle="none",
+                label=f"targets ({len(pts)}), numbered as given")
     unit = "deg" if world.plane == "degrees" else "m"
     cost = f"{result.cost:.6g} {unit}" if result.found else result.status.value
     set_title(ax, [f"{world.name}: {result.algorithm}", cost])
     finish_axes(ax, world)
+    if targets is not None:
+        place_labels(ax, pts, [str(k + 1) for k in range(len(pts))],
+                     avoid=world.to_plane(start, "start"))
     return save_figure(fig, path, dpi=dpi)
 
 

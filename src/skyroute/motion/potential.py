@@ -121,12 +121,19 @@ def _edges(world: World):
     return _EDGE_CACHE[world]
 
 
-def _navigation(world: World, goal: np.ndarray, resolution: float):
-    """Wavefront distance to the goal per free cell (inf where unreachable), and the grid."""
+def _navigation(world: World, here: np.ndarray, goal: np.ndarray, resolution: float):
+    """Wavefront distance to the goal per free cell (inf where unreachable), and the grid.
+
+    The raster holds ``here`` and the goal with a few cells round them, as the grid
+    planners' does (:func:`~skyroute.roadmap.raster.raster_box`): over the obstacles'
+    extent alone, a goal or a robot beyond the obstacles had no cell (an IndexError)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 
-    grid = world.merged().rasterize(resolution, safety=resolution / math.sqrt(2))
+    from skyroute.roadmap.raster import raster_box
+
+    grid = world.merged().rasterize(resolution, safety=resolution / math.sqrt(2),
+                                    bounds=raster_box(world, here, goal, resolution))
     free = ~grid.blocked
     h, w = free.shape
     idx = np.arange(h * w).reshape(h, w)
@@ -188,8 +195,8 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
             break
         stalled = len(path) > window and math.dist(path[-1], path[-window]) < 2 * step
         if escape and (stalled or on_nav > 0):
-            if nav is None:
-                nav = _navigation(world, t, step)
+            if nav is None or not _holds(nav[0], p):  # made anew where the robot is
+                nav = _navigation(world, p, t, step)
             q = _descend(world, nav, p)
             if q is None:
                 break
@@ -284,6 +291,12 @@ def _arc(world, p, theta, step, u, max_turn):
         if ok:
             return pts, theta + turn
     return None, theta
+
+
+def _holds(grid, p: np.ndarray) -> bool:
+    """Whether plane point ``p`` lies in a cell of ``grid``."""
+    x, y = grid.to_cell([p])[0]
+    return 0 <= x < grid.width and 0 <= y < grid.height
 
 
 def _descend(world: World, nav, p: np.ndarray) -> np.ndarray | None:
