@@ -52,6 +52,10 @@ def serve_command(
         help="Search budget of one POST /plan.")] = 2_000_000,
     job_queue: Annotated[int, typer.Option(help="Jobs queued or running at once.")] = 8,
     log_level: Annotated[str, typer.Option(help="uvicorn's log level.")] = "info",
+    warm: Annotated[bool, typer.Option(
+        "--warm/--no-warm", help="Load the planners' compiled kernels in each server "
+        "process before it takes requests (about a second from numba's cache), so no "
+        "caller's first /plan waits for them.")] = True,
 ) -> None:
     """Serve the REST API (/docs) and the web viewer (/) with uvicorn.
 
@@ -86,7 +90,7 @@ def serve_command(
     try:
         settings = Settings(db_url=db, data_dir=data, source_url=source, dask_address=dask,
                             max_body_bytes=int(max_body_mb * MB),
-                            max_expansions=max_expansions, job_queue=job_queue,
+                            max_expansions=max_expansions, job_queue=job_queue, warm=warm,
                             **({"token": token} if token else {}))
     except ValidationError as exc:  # a limit out of range
         err = exc.errors()[0]

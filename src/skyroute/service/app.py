@@ -3,7 +3,9 @@ error handlers, the body limit, the timing header, the API reference at ``/docs`
 ``/redoc`` (served from local files) and the static viewer at ``/``.
 
 Making the app opens nothing; the store, the site and the job executor open on first use
-(:mod:`skyroute.service.resources`) and close when the app shuts down.
+(:mod:`skyroute.service.resources`) and close when the app shuts down. Starting it (the
+lifespan, before the server accepts a connection) warms the planners
+(:mod:`skyroute.service.warm`) unless ``Settings.warm`` is off.
 """
 
 from __future__ import annotations
@@ -46,6 +48,10 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
+        if settings.warm:  # before the first connection: no caller pays for it
+            from skyroute.service.warm import warm
+
+            app.state.warmed = warm(app.state.resources)
         yield
         app.state.resources.close()
 

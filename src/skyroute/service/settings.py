@@ -43,6 +43,9 @@ class Settings(BaseModel):
     dask_address: str | None = Field(None, description="Run jobs on this Dask scheduler "
                                      "(tcp://HOST:8786) instead of local processes.")
     job_workers: int | None = Field(None, ge=1, description="Local worker processes for jobs.")
+    warm: bool = Field(True, description="Load the planners' compiled kernels and "
+                       "libraries when the app starts, before it takes a request "
+                       "(skyroute.service.warm), not in its first POST /plan.")
 
     @model_validator(mode="after")
     def _one_site(self) -> Settings:
