@@ -43,6 +43,7 @@ busy"). Lookups of an unknown id return None.
 from __future__ import annotations
 
 import datetime as dt
+import hashlib
 import math
 import uuid
 from collections.abc import Collection, Iterator
@@ -379,7 +380,15 @@ class StoredFile:
     transaction of its own, so a slow reader holds no connection and no lock between
     parts; :meth:`lines` reads a page of its lines from the parts it lies in. A run
     replaced or deleted meanwhile is :class:`RunChangedError` at the next part, never
-    bytes of two versions."""
+    bytes of two versions.
+
+    Iterating follows a run replaced by the same bytes (a fleet task run again after its
+    worker died stores its run again, byte for byte): when the run's file now has the
+    same size and its parts read so far are the ones already yielded (compared by
+    digest), the rest comes from the new version, so the whole is the new version's
+    bytes. Any other change (other bytes, another size, the run deleted) is the error."""
+
+    FOLLOW = 3  # replacements by the same bytes one iteration follows
 
     def __init__(self, engine: sa.Engine, run_id: str, name: str, created, size: int,
                  parts: int) -> None:
@@ -392,14 +401,39 @@ class StoredFile:
                 f"size={self.size}, parts={self.parts})")
 
     def __iter__(self) -> Iterator[bytes]:
-        return self._read(0)
+        digests: list[bytes] = []  # of the parts yielded
+        follows = 0
+        while True:
+            try:
+                for data in self._read(len(digests)):
+                    digests.append(_digest(data))
+                    yield data
+                return
+            except RunChangedError:
+                follows += 1
+                if follows > self.FOLLOW or not self._follow(digests):
+                    raise
+
+    def _follow(self, digests: list[bytes]) -> bool:
+        """Whether the run's file is now the same size, in as many parts, and begins with
+        the parts of ``digests``; if so this file is now that version."""
+        now = open_fleet_file(self._engine, self.run_id, self.name)
+        if now is None or (now.size, now.parts) != (self.size, self.parts):
+            return False
+        try:
+            if [_digest(d) for d in now._read(0, len(digests))] != digests:
+                return False
+        except RunChangedError:  # replaced again: the caller may follow once more
+            return False
+        self._created, self.created = now._created, now.created
+        return True
 
     def _changed(self) -> RunChangedError:
         return RunChangedError(f"fleet run {self.run_id!r} was replaced or deleted while "
                                f"its {self.name} was read")
 
-    def _read(self, start: int) -> Iterator[bytes]:
-        """The parts from ``start`` on, one statement each."""
+    def _read(self, start: int, stop: int | None = None) -> Iterator[bytes]:
+        """The parts from ``start`` on (to ``stop``, not included), one statement each."""
         t = _t(self._engine)
         runs, stored = t["fleet_runs"], t["fleet_run_files"]
         k = sa.bindparam("k")
@@ -407,7 +441,7 @@ class StoredFile:
              .select_from(stored.join(runs, runs.c.id == stored.c.run_id))
              .where(stored.c.run_id == self.run_id, stored.c.name == self.name,
                     stored.c.part == k, runs.c.created == self._created))
-        for part in range(start, self.parts):
+        for part in range(start, self.parts if stop is None else stop):
             with self._engine.connect() as c:
                 data = c.execute(q, {"k": part}).scalar_one_or_none()
             if data is None:
@@ -471,6 +505,10 @@ class StoredFile:
         if carry and len(out) < want:  # the file's last line, without a newline
             out.append(carry)
         return out, total
+
+
+def _digest(data: bytes) -> bytes:
+    return hashlib.blake2b(data, digest_size=16).digest()
 
 
 def open_fleet_file(engine: sa.Engine, run_id: str, name: str) -> StoredFile | None:

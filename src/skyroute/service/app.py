@@ -18,7 +18,7 @@ from fastapi.staticfiles import StaticFiles
 from fastapi_offline import FastAPIOffline
 
 import skyroute
-from skyroute.service import problems
+from skyroute.service import cut, problems
 from skyroute.service.middleware import BodyLimit, HeadAsGet, ServerTiming
 from skyroute.service.resources import Resources
 from skyroute.service.routers import (
@@ -48,6 +48,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
+        cut.install()  # the server has set up its logging by now
         if settings.warm:  # before the first connection: no caller pays for it
             from skyroute.service.warm import warm
 

@@ -11,17 +11,20 @@ without it these endpoints answer 503).
 from __future__ import annotations
 
 import json
+import logging
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Path, Query, Response
 from fastapi.responses import StreamingResponse
 from pydantic import BaseModel, Field
 
+from skyroute.service import cut
 from skyroute.service.middleware import is_head
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import Resources, ResourcesDep
 
 router = APIRouter(tags=["fleet"])
+log = logging.getLogger("skyroute.service")
 RunId = Annotated[str, Path(max_length=100)]
 
 
@@ -167,14 +170,42 @@ def _stored(res: Resources, run_id: str, key: str):
 
 class _StoredResponse(StreamingResponse):
     """A stored file's response: to a HEAD request only its headers (the length is known
-    up front), no part read from the store; to a GET its parts as the store reads them."""
+    up front), no part read from the store; to a GET its parts as the store reads them.
+
+    A run replaced by other bytes or deleted while its file is sent (the store's
+    RunChangedError; the same bytes stored again are followed by the store) cuts the
+    response short: one warning in the log, and the connection closed before the body
+    reaches its Content-Length, so no client takes the part it got for the whole file
+    (:mod:`skyroute.service.cut`). Asking again gets the run as it is now."""
+
+    def __init__(self, f, media_type: str, headers: dict[str, str], changed: type) -> None:
+        super().__init__(iter(f), media_type=media_type, headers=headers)
+        self.file, self.changed = f, changed
 
     async def __call__(self, scope, receive, send) -> None:
         if not is_head(scope):
+            self.path = scope.get("path", "")
+            cut.begin()
             await super().__call__(scope, receive, send)
             return
         await send({"type": "http.response.start", "status": self.status_code,
                     "headers": self.raw_headers})
+        await send({"type": "http.response.body", "body": b"", "more_body": False})
+
+    async def stream_response(self, send) -> None:
+        await send({"type": "http.response.start", "status": self.status_code,
+                    "headers": self.raw_headers})
+        sent = 0
+        try:
+            async for chunk in self.body_iterator:
+                await send({"type": "http.response.body", "body": chunk, "more_body": True})
+                sent += len(chunk)
+        except self.changed as exc:
+            log.warning("GET %s cut short after %s of its %s bytes: %s (the client sees "
+                        "the connection closed before the end of the body)", self.path,
+                        f"{sent:,}", f"{self.file.size:,}", exc)
+            cut.mark()
+            return  # without the last message: the server closes the connection
         await send({"type": "http.response.body", "body": b"", "more_body": False})
 
 
@@ -182,9 +213,10 @@ def _stream(f, media_type: str, name: str) -> StreamingResponse:
     """The stored file ``f`` sent as the store reads it, part by part (at most
     ``PART_BYTES`` held at a time, not the whole file: a big run's tracks are about
     150 MB), with its length up front; to a HEAD request the same headers alone."""
-    return _StoredResponse(iter(f), media_type=media_type, headers={
+    return _StoredResponse(f, media_type, {
         "Content-Length": str(f.size),
-        "Content-Disposition": f'attachment; filename="{name}"'})
+        "Content-Disposition": f'attachment; filename="{name}"'},
+        changed=_store().RunChangedError)
 
 
 @router.get("/fleet/runs/{run_id}/events.jsonl", response_class=Response,
