@@ -71,7 +71,8 @@ class FakeJobs:
         store.get_fleet_run = self.get_fleet_run
         store.open_fleet_file = self.open_fleet_file
         store.RunChangedError = type("RunChangedError", (Exception,), {})
-        store.list_fleet_runs = lambda engine: list(self.runs.values())
+        store.list_fleet_runs = lambda engine, *, offset=0, limit=100: \
+            list(self.runs.values())[offset:offset + limit]
         executor.open_executor = lambda kind="local", address=None, workers=None: \
             types.SimpleNamespace(kind=kind, close=lambda: None)
         for name, mod in (("skyroute.jobs", pkg), ("skyroute.jobs.runner", runner),
@@ -672,3 +673,45 @@ def test_a_fleet_job_stores_a_run(tmp_path, small_run):
         assert c.get(doc["files"]["events.jsonl"]).text == small_run["events"]
         assert c.get(doc["files"]["tracks.csv"]).text == small_run["tracks"]
         assert c.get(doc["files"]["fleet.geojson"]).status_code == 200
+
+
+@needs_jobs
+@pytest.mark.parametrize("db", ["sqlite", "postgresql"])
+def test_fleet_runs_are_listed_a_page_at_a_time(tmp_path, request, db):
+    """GET /fleet/runs pages the runs, newest first (?offset&limit, a Link to the next
+    page while there is one); the pages together are every run once. Before, it answered
+    the newest 100 and ignored offset and limit: run 101 could not be listed."""
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    url = (f"sqlite:///{tmp_path / 'runs.db'}" if db == "sqlite"
+           else request.getfixturevalue("fresh_pg"))
+    eng = make_engine(url)
+    saved = [store.save_fleet_run(eng, scenario="seed-3x3", params={"n": i}, report={},
+                                  events_jsonl="", tracks_csv=b"", packages_csv="",
+                                  fleet_geojson="{}") for i in range(102)]
+    eng.dispose()
+    with make_client(db_url=url) as c:
+        first = c.get("/fleet/runs")
+        assert first.status_code == 200 and len(first.json()) == 100
+        assert first.headers["link"] == '</fleet/runs?offset=100&limit=100>; rel="next"'
+        rest = c.get("/fleet/runs?offset=100&limit=100")
+        assert len(rest.json()) == 2 and "link" not in rest.headers
+        newest_first = [r["id"] for r in first.json() + rest.json()]
+        assert sorted(newest_first) == sorted(saved)
+        assert newest_first == [r["id"] for r in
+                                sorted(first.json() + rest.json(),
+                                       key=lambda r: r["created"], reverse=True)]
+        pages, url_ = [], "/fleet/runs?limit=30"
+        while url_:
+            r = c.get(url_)
+            pages.append([x["id"] for x in r.json()])
+            link = r.headers.get("link")
+            url_ = link.split(">")[0].removeprefix("<") if link else None
+        assert [len(p) for p in pages] == [30, 30, 30, 12]
+        assert list(itertools.chain(*pages)) == newest_first
+        assert c.get("/fleet/runs?offset=500").json() == []
+        for query, field in [("limit=0", "limit"), ("limit=1001", "limit"),
+                             ("offset=-1", "offset"), (f"offset={2**63}", "offset"),
+                             ("limit=ten", "limit")]:
+            assert_problem(c.get(f"/fleet/runs?{query}"), 422, field)

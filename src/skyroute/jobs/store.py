@@ -531,15 +531,22 @@ def open_fleet_file(engine: sa.Engine, run_id: str, name: str) -> StoredFile | N
     return StoredFile(engine, str(run_id), name, created, int(size), int(parts))
 
 
+MAX_OFFSET = 2**62  # within a SQL BIGINT, as both databases read OFFSET and LIMIT
+
+
 def list_fleet_runs(engine: sa.Engine, *, job_id: str | None = None,
-                    limit: int = 100) -> list[dict]:
-    """The newest fleet runs first (of one job when ``job_id`` is given), without their
-    files: ``{"id", "job_id", "scenario", "params", "report", "created"}``."""
-    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
-        raise OptionError(f"limit={limit!r} must be an integer >= 1", param="limit")
+                    limit: int = 100, offset: int = 0) -> list[dict]:
+    """The newest fleet runs first (of one job when ``job_id`` is given), ``limit`` of
+    them from the ``offset``-th on, without their files: ``{"id", "job_id", "scenario",
+    "params", "report", "created"}``."""
+    for name, value, low in (("limit", limit, 1), ("offset", offset, 0)):
+        if isinstance(value, bool) or not isinstance(value, int) \
+                or not low <= value <= MAX_OFFSET:
+            raise OptionError(f"{name}={value!r} must be an integer in {low}..{MAX_OFFSET}",
+                              param=name)
     runs = _t(engine)["fleet_runs"]
     q = sa.select(*[runs.c[k] for k in _HEAD]).order_by(runs.c.created.desc(),
-                                                        runs.c.id).limit(limit)
+                                                        runs.c.id).limit(limit).offset(offset)
     if job_id is not None:
         q = q.where(runs.c.job_id == job_id)
     with engine.connect() as c:

@@ -1,4 +1,5 @@
-"""Stored fleet runs: ``GET /fleet/runs``, ``GET /fleet/runs/{id}`` (report, scenario
+"""Stored fleet runs: ``GET /fleet/runs`` (newest first, ``?offset&limit``, a ``Link``
+to the next page), ``GET /fleet/runs/{id}`` (report, scenario
 and a page of events: ``?offset&limit``, read from the parts of events.jsonl it lies in)
 and the run's files ``events.jsonl``, ``tracks.csv`` and ``fleet.geojson``, streamed
 from the store part by part (:func:`skyroute.jobs.store.open_fleet_file`) with their
@@ -110,11 +111,28 @@ def _scenario(run: dict) -> dict:
     return {}
 
 
-@router.get("/fleet/runs", response_model=list[RunSummary], responses=responses(503),
-            summary="Stored fleet runs")
-def list_runs(res: ResourcesDep) -> list[dict]:
+RUNS_PAGE = 100  # runs in a page of GET /fleet/runs unless limit says otherwise
+MAX_RUNS_PAGE = 1000
+NEXT = {"Link": {"description": 'The next page, when there is one: `</fleet/runs?offset='
+                 'N&limit=M>; rel="next"`.', "schema": {"type": "string"}}}
+
+
+@router.get("/fleet/runs", response_model=list[RunSummary],
+            responses={200: {"headers": NEXT}, **responses(422, 503)},
+            summary="Stored fleet runs, newest first, a page at a time")
+def list_runs(res: ResourcesDep, response: Response,
+              offset: Annotated[int, Query(ge=0, le=2**62, description="Runs to skip, "
+                                           "newest first.")] = 0,
+              limit: Annotated[int, Query(ge=1, le=MAX_RUNS_PAGE, description="Runs in "
+                                          "the page.")] = RUNS_PAGE) -> list[dict]:
+    # one run more than the page: whether a next page exists, without a count
+    rows = _store().list_fleet_runs(res.engine(), offset=offset, limit=limit + 1)
+    if len(rows) > limit:
+        del rows[limit:]
+        response.headers["Link"] = (f'</fleet/runs?offset={offset + limit}&limit={limit}>; '
+                                    'rel="next"')
     out = []
-    for r in _store().list_fleet_runs(res.engine()):
+    for r in rows:
         sc = r.get("scenario")
         name = sc.get("name") if isinstance(sc, dict) else sc
         out.append({"id": str(r["id"]), "scenario": name,
