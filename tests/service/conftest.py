@@ -25,9 +25,12 @@ with warnings.catch_warnings():  # starlette would rather see httpx2; httpx stil
 
 
 def make_client(**settings) -> TestClient:
+    """A client of an app with ``settings``; the app skips the warm-up (tests/service/
+    test_warm.py tests it) unless ``warm=True``: about 0.1 s an app, hundreds of apps."""
     from skyroute.service.app import create_app
     from skyroute.service.settings import Settings
 
+    settings.setdefault("warm", False)
     return TestClient(create_app(Settings(token=TOKEN, **settings)))
 
 
