@@ -10,6 +10,7 @@ import pytest
 
 from tests.cli.test_cli import out_blocked_by, run
 from tests.conftest import ROOT
+from tests.jobs.failing import failing_workers
 
 EXAMPLE = str(ROOT / "examples" / "lunch")
 
@@ -444,10 +445,12 @@ def test_another_sites_folder_is_refused_before_anything_is_written(monkeypatch,
         "site" in err, err
     assert _stored_day(db, "2024-01-03") == good
     # the other site with its own orders is flown as before
+    # (reaching the flight: a day's error is that day's failure, said with its traceback)
     monkeypatch.setattr("skyroute.jobs.deliver.plan_day", _no_flying)
-    with pytest.raises(AssertionError, match="a day was flown"):
-        run(monkeypatch, capsys, "deliver", "2023-01-02", "--data", str(other),
-            "--db", f"sqlite:///{tmp_path / 'o.db'}", "--out", str(tmp_path / "o"))
+    code, _, err = run(monkeypatch, capsys, "deliver", "2023-01-02", "--data", str(other),
+                       "--db", f"sqlite:///{tmp_path / 'o.db'}", "--out", str(tmp_path / "o"))
+    assert code == 1 and err.endswith("skyroute: error: 2023-01-02: AssertionError: a day "
+                                      "was flown before its output files were checked\n"), err
 
 
 @pytest.mark.shared_data
@@ -536,56 +539,126 @@ def test_a_day_whose_files_fail_is_not_stored(monkeypatch, capsys, tmp_path, fly
     assert not (tmp_path / "out").exists()  # nor a file, nor the folder made for them
 
 
-class _RunAhead:
-    """A pool whose workers flew every day of the range before the command read the
-    first failure: results after it were ready (and, when workers stored their days,
-    stored), never handed to the command."""
-
-    kind, workers, aborted = "local", 2, False
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc) -> None:
-        pass
-
-    def map(self, fn, items, *, on_result=None):
-        done = []
-        for item in items:
-            try:
-                done.append((fn(item), None))
-            except Exception as exc:  # handed on in item order, as a pool does
-                done.append((None, exc))
-        out = []
-        for i, (result, exc) in enumerate(done):
-            if exc is not None:
-                raise exc
-            out.append(result)
-            if on_result:
-                on_result(i, result)
-        return out
+def _files_of(out: Path) -> list[str]:
+    return sorted(p.name for p in out.iterdir())
 
 
-def test_a_range_stopped_by_a_failed_day_stores_only_days_with_files(monkeypatch, capsys,
-                                                                      tmp_path, fly_once):
-    # --jobs 2 over three days, the second failing: the third, flown and stored by its
-    # worker meanwhile, stayed in the store without its files
+def test_a_range_with_failed_days_stores_every_other_day(monkeypatch, capsys, tmp_path):
+    # --jobs 2 on a real pool, two days failing in their workers: the range stopped at
+    # the first failure it read and dropped the days the workers had flown meanwhile
+    # (here 2024-01-02, flown after the failed 2024-01-01); a month with one bad day
+    # was flown again whole. Now every other day is stored with its files, then each
+    # failed day is one line, and the exit is 2.
+    failing_workers(monkeypatch, {"2024-01-01": "skyroute", "2024-01-03": "skyroute"})
+    db, out = tmp_path / "r.db", tmp_path / "out"
+    code, stdout, err = run(monkeypatch, capsys, "deliver", "--from", "2023-12-31", "--to",
+                            "2024-01-03", "--data", EXAMPLE, "--db", f"sqlite:///{db}",
+                            "--out", str(out), "--jobs", "2")
+    # the days that did not fail: stored with their files, and summed up on stdout
+    assert _stored_day(db, "2024-01-02")[0] and _stored_day(db, "2023-12-31")[0] == [(0, 0)]
+    assert _stored_day(db, "2024-01-01")[0] == _stored_day(db, "2024-01-03")[0] == []
+    assert _files_of(out) == ["drone-02-01-2024.geojson", "drone-31-12-2023.geojson",
+                              "report-02-01-2024.json", "report-31-12-2023.json"]
+    assert code == 2, err
+    assert err.strip().splitlines()[-3:] == [
+        "skyroute: error: 2024-01-01: the planner failed",
+        "skyroute: error: 2024-01-03: the planner failed",
+        "skyroute: error: 2 of the 4 days failed and were not stored; the other 2 are "
+        "stored, with their files"], err
+    assert re.search(r"^2 of 4 days, [\d.]+ s with 2 job\(s\): money delivered mean "
+                     r"[\d.]+%, worst [\d.]+% on 2024-01-02$", stdout, re.M), stdout
+
+
+def test_a_worker_error_that_does_not_unpickle_is_one_line(monkeypatch, capsys, tmp_path):
+    # an InputFormatError raised in a pool worker does not unpickle in the command: the
+    # pool broke, a traceback ending "A process in the process pool was terminated
+    # abruptly", and the day that named the file was not said
+    failing_workers(monkeypatch, {"2024-01-01": "file"})
+    db, out = tmp_path / "p.db", tmp_path / "out"
+    code, _, err = run(monkeypatch, capsys, "deliver", "--from", "2023-12-31", "--to",
+                       "2024-01-01", "--data", EXAMPLE, "--db", f"sqlite:///{db}", "--out",
+                       str(out), "--jobs", "2")
+    assert code == 2, err
+    assert "Traceback" not in err and err.strip().splitlines()[-2:] == [
+        "skyroute: error: 2024-01-01: website/menus/menus.json: cannot read: gone",
+        "skyroute: error: 1 of the 2 days failed and was not stored; the other 1 is "
+        "stored, with its files"], err
+    assert _stored_day(db, "2023-12-31")[0] == [(0, 0)]
+    assert _files_of(out) == ["drone-31-12-2023.geojson", "report-31-12-2023.json"]
+
+
+def test_failed_days_in_json_and_a_defect_shows_its_traceback(monkeypatch, capsys,
+                                                               tmp_path, fly_once):
+    # in the command's process (--jobs 1): a defect on one day is that day's failure
+    # too; its traceback is printed (as an uncaught error's was) and the exit is 1
     from skyroute.errors import SkyrouteError
 
-    def second_fails(site, date, orders, **kw):
+    def planner(site, date, orders, **kw):
+        if str(date) == "2024-01-01":
+            return 1 / 0
         if str(date) == "2024-01-02":
-            raise SkyrouteError("2024-01-02: the planner failed")
+            raise SkyrouteError("2024-01-02: the flight failed validation: move 3")
         return fly_once(site, date, orders, **kw)
 
-    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", second_fails)
-    monkeypatch.setattr("skyroute.cli.deliver_cmd.open_from_flags",
-                        lambda *_a: _RunAhead())
-    db, out = tmp_path / "r.db", tmp_path / "out"
+    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", planner)
+    db, out = tmp_path / "j.db", tmp_path / "out"
+    code, stdout, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
+                            "2024-01-04", "--data", EXAMPLE, "--db", f"sqlite:///{db}",
+                            "--out", str(out), "--json")
+    assert code == 1, err
+    summary = json.loads(stdout)
+    assert summary["days"] == 2 and summary["days_with_orders"] == 1
+    assert summary["failed"] == [
+        {"date": "2024-01-01", "error": "2024-01-01: ZeroDivisionError: division by zero"},
+        {"date": "2024-01-02", "error": "2024-01-02: the flight failed validation: move 3"}]
+    assert "Traceback (most recent call last)" in err and "return 1 / 0" in err
+    assert err.strip().splitlines()[-3:] == [
+        "skyroute: error: 2024-01-01: ZeroDivisionError: division by zero",
+        "skyroute: error: 2024-01-02: the flight failed validation: move 3",
+        "skyroute: error: 2 of the 4 days failed and were not stored; the other 2 are "
+        "stored, with their files"]
+    assert _stored_day(db, "2024-01-03")[0] and _stored_day(db, "2024-01-04")[0]
+    assert _files_of(out) == ["drone-03-01-2024.geojson", "drone-04-01-2024.geojson",
+                              "report-03-01-2024.json", "report-04-01-2024.json"]
+    # one day: its error alone, as before, exit 2
+    code, stdout, err = run(monkeypatch, capsys, "deliver", "2024-01-02", "--data", EXAMPLE,
+                            "--db", f"sqlite:///{db}", "--out", str(out))
+    assert (code, stdout) == (2, "")
+    assert err == "skyroute: error: 2024-01-02: the flight failed validation: move 3\n"
+
+
+def _ctrl_c():
+    raise KeyboardInterrupt
+
+
+def _ctrl_c_in_a_kernel():
+    # how a Ctrl-C that came while a compiled kernel ran reaches Python
+    try:
+        raise KeyboardInterrupt
+    except KeyboardInterrupt as exc:
+        raise SystemError("CPUDispatcher(...) returned a result with an exception set") \
+            from exc
+
+
+@pytest.mark.parametrize("interrupt", [_ctrl_c, _ctrl_c_in_a_kernel])
+def test_ctrl_c_on_a_day_still_stops_the_range(monkeypatch, capsys, tmp_path, fly_once,
+                                              interrupt):
+    # a day's error no longer stops the range; a Ctrl-C while a day is flown still does
+    # (also when it surfaces as another error, as from a numba kernel): not a failed day
+    flown = []
+
+    def planner(site, date, orders, **kw):
+        flown.append(str(date))
+        if str(date) == "2024-01-02":
+            interrupt()
+        return fly_once(site, date, orders, **kw)
+
+    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", planner)
+    db, out = tmp_path / "c.db", tmp_path / "out"
     code, _, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
                        "2024-01-03", "--data", EXAMPLE, "--db", f"sqlite:///{db}", "--out",
-                       str(out), "--jobs", "2")
-    assert code == 2 and "2024-01-02: the planner failed" in err, err
-    runs = _stored_day(db, "2024-01-01")[0], _stored_day(db, "2024-01-03")[0]
-    assert runs[0] and not runs[1]  # the day before the failure stored, not the one after
-    assert sorted(p.name for p in out.iterdir()) == ["drone-01-01-2024.geojson",
-                                                     "report-01-01-2024.json"]
+                       str(out))
+    assert (code, err.strip().splitlines()[-1]) == (130, "skyroute: interrupted"), err
+    assert flown == ["2024-01-01", "2024-01-02"]  # the range stopped there
+    assert _stored_day(db, "2024-01-01")[0] and not _stored_day(db, "2024-01-02")[0]
+    assert _files_of(out) == ["drone-01-01-2024.geojson", "report-01-01-2024.json"]

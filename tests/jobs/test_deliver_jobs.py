@@ -150,3 +150,30 @@ def test_a_deliver_job_replaces_a_kept_flight_when_asked(tmp_path, fly_once):
     assert store.day_rows(engine, dt.date(2024, 1, 3)) == good
     assert job({**day, "data": renamed, "replace": True})["days_with_orders"] == 1
     assert store.day_rows(engine, dt.date(2024, 1, 3)) == {"deliveries": [], "flightpath": []}
+
+
+def test_a_deliver_job_stores_the_days_that_did_not_fail(tmp_path, monkeypatch, caplog):
+    # two real pool workers, 2024-01-01 failing in its worker by a defect: the job
+    # stopped at it and dropped the days the other worker flew meanwhile. Now every
+    # other day is stored, the job fails with one line naming the failed day, and the
+    # defect's traceback goes to the log
+    from skyroute.jobs import runner
+    from tests.jobs.failing import failing_workers
+
+    failing_workers(monkeypatch, {"2024-01-01": "bug"})
+    engine = lunch_store(f"sqlite:///{tmp_path / 'f.db'}", DATES)
+    prepare_legs(load_site(DirSource(EXAMPLE)), [o for v in days_between(
+        engine, dt.date(2024, 1, 1), dt.date(2024, 1, 2)).values() for o in v])
+    params = {"from": "2024-01-01", "to": "2024-01-03", "data": str(EXAMPLE)}
+    with open_executor("local", workers=2) as ex, caplog.at_level("ERROR", "skyroute.jobs"):
+        job = runner.wait(engine, runner.submit(engine, "deliver", params, executor=ex),
+                          timeout=300)
+    assert store.day_rows(engine, dt.date(2024, 1, 2))["flightpath"]  # flown and stored
+    with engine.connect() as c:
+        days = c.exec_driver_sql("select delivery_date from runs order by 1").scalars().all()
+    assert [str(d) for d in days] == ["2024-01-02", "2024-01-03"]
+    assert (job["state"], job["error"], job["progress"]) == (
+        "failed", "1 of the 3 days failed and was not stored (the other 2 are): "
+        "2024-01-01: ZeroDivisionError: division by zero", 1.0)
+    logged = [r.getMessage() for r in caplog.records if r.levelname == "ERROR"]
+    assert any("ZeroDivisionError" in m and "return 1 / 0" in m for m in logged), logged

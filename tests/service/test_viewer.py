@@ -1163,3 +1163,100 @@ def test_planner_scale_bar_covers_no_cell(open_page, api, size):
     assert (int(p.input_value("#sx")), int(p.input_value("#sy"))) == corner
     assert p.input_value("#gx") == "" and p.inner_text("#status").startswith("Start")
     pg.done("planner-key")
+
+
+def _store_kept_day(db: str, date: str) -> None:
+    """A day stored with a flight that delivered, whose orders are all invalid now (their
+    items are on none of the site's menus): flown again, the day is kept unless
+    replace."""
+    import datetime as dt
+
+    from skyroute.delivery.orders import Order
+    from skyroute.delivery.site import load_site
+    from skyroute.delivery.source import DirSource
+    from skyroute.delivery.store import connect, import_orders, write_day
+
+    day = dt.date.fromisoformat(date)
+    tag = date.replace("-", "")[-4:]  # order numbers of 8 characters, one set a day
+    orders = [Order(f"fe{tag}0{k}", day, "s0000001", "brook.boat.brick", ("Gone pie",))
+              for k in range(2)]
+    lon, lat = load_site(DirSource(EXAMPLE)).home
+    eng = connect(db)
+    import_orders(eng, orders)
+    now = dt.datetime(2024, 1, 1, 12)
+    write_day(eng, day, {"started": now, "finished": now, "moves": 2, "orders_placed": 2,
+                         "orders_delivered": 1, "orders_invalid": 0, "money_delivered": 150,
+                         "money_placed": 300, "settings": {"method": "milp"}},
+              [{"order_no": orders[0].order_no, "delivered_to": orders[0].deliver_to,
+                "cost_in_pence": 150}],
+              [{"seq": k, "order_no": orders[0].order_no,
+                "from_lon": lon + 0.00015 * k, "from_lat": lat, "angle": 0,
+                "to_lon": lon + 0.00015 * (k + 1), "to_lat": lat} for k in range(2)])
+    eng.dispose()
+
+
+@pytest.mark.parametrize("size", ["desktop-720", "phone-640"])
+def test_day_page_flies_a_stored_day_again_with_replace(open_page, api, server, size):
+    """The API's deliver job takes replace; the day page had no way to send it: a day
+    whose every order is invalid now failed ('...replace=true stores the day as flown
+    now') and the viewer could only show that. The job form has "Replace a kept flight":
+    the failure points to it, a stored day is replaced only after a confirmation (a
+    dismissed one sends nothing), all by keyboard, and the box is cleared once sent."""
+    if server_has_no_jobs():
+        pytest.skip("skyroute.jobs is not in this tree: no jobs")
+    date = "2023-12-20" if size == "desktop-720" else "2023-12-21"
+    _store_kept_day(server[2], date)
+    pg = open_page(f"/day.html#date={date}", size)
+    p = pg.page
+    p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{date}:"
+                        " 2 moves')")
+    posts: list = []
+    p.on("request", lambda r: r.method == "POST" and posts.append(r.post_data_json))
+    p.fill("#job-date", date)
+    p.fill("#token", TOKEN)
+    p.focus("#start")
+    p.keyboard.press("Enter")  # without replace: the stored flight is kept, the job fails
+    _wait_status_of(p, "#job-status", "error")
+    said = p.inner_text("#job-status")
+    assert f"{date}: every one of the day's 2 orders is invalid" in said, said
+    assert said.endswith("replace=true stores the day as flown now. To store the day as "
+                         "flown now, over its stored flight, tick "
+                         "“Replace a kept flight” and fly it again."), said
+    assert api.get(f"/days/{date}").json()["report"]["orders_delivered"] == 1
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    p.screenshot(path=str(SHOTS / f"day-kept-{size}.png"), full_page=True)
+    # the box by keyboard: Tab from the planner, Space to tick it
+    p.focus("#method")
+    p.keyboard.press("Tab")
+    assert p.evaluate("document.activeElement.id") == "replace"
+    p.keyboard.press("Space")
+    assert p.is_checked("#replace")
+    dialogs: list[str] = []
+    p.once("dialog", lambda d: (dialogs.append(d.message), d.dismiss()))
+    p.focus("#start")
+    p.keyboard.press("Enter")
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'info'")
+    assert len(dialogs) == 1 and date in dialogs[0] and "replaced" in dialogs[0], dialogs
+    assert p.inner_text("#job-status") == f"Not flown: the stored flight of {date} is kept."
+    assert p.evaluate("document.activeElement.id") == "start" and p.is_checked("#replace")
+    assert len(posts) == 1  # the refused one only
+    p.once("dialog", lambda d: (dialogs.append(d.message), d.accept()))
+    p.keyboard.press("Enter")
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
+                        " && !document.querySelector('#start').ariaDisabled", timeout=120_000)
+    assert len(dialogs) == 2
+    assert posts == [{"date": date, "method": "milp", "replace": False},
+                     {"date": date, "method": "milp", "replace": True}]
+    assert not p.is_checked("#replace")  # sent once; the next day flown keeps its flight
+    report = api.get(f"/days/{date}").json()["report"]
+    assert (report["orders_delivered"], report["orders_invalid"], report["moves"]) == (0, 2, 0)
+    p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{date}:"
+                        " the drone did not fly')")
+    assert p.input_value("#date") == date
+    pg.done("day-replace")
+
+
+def _wait_status_of(page, selector: str, kind: str, timeout: int = 120_000) -> None:
+    page.wait_for_function(f"document.querySelector('{selector}').dataset.kind === '{kind}'"
+                           f" && !document.querySelector('#start').ariaDisabled",
+                           timeout=timeout)

@@ -6,7 +6,7 @@ import datetime as dt
 import json
 import time
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
@@ -18,6 +18,9 @@ from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.delivery.day import METHODS, DayResult
 from skyroute.delivery.store import DEFAULT_DB, safe_url
 from skyroute.errors import OptionError, SkyrouteError, check_choice
+
+if TYPE_CHECKING:
+    from skyroute.jobs.deliver import DayFailed
 
 
 def _date(text: str | None, option: str) -> dt.date | None:
@@ -61,7 +64,7 @@ def deliver_command(
     from skyroute.delivery.source import open_source
     from skyroute.delivery.store import DayKeptError, order_dates
     from skyroute.io.day_out import check_outputs, output_paths, write_outputs
-    from skyroute.jobs.deliver import days_between, run_days
+    from skyroute.jobs.deliver import DaysFailedError, days_between, run_days
 
     check_choice("method", method, METHODS)
     day, d0, d1 = _date(date, "DATE"), _date(first, "--from"), _date(last, "--to")
@@ -121,38 +124,70 @@ def deliver_command(
                 written.extend(output_paths(out, r.date, plot=draw))
                 progress.advance(days)
 
+            failed: list[DayFailed] = []  # said once the other days are stored
             try:
                 results = run_days(engine, src, by_date, executor=ex, method=method,
-                                   replace=replace, files=files, on_day=finished)
+                                   replace=replace, files=files, on_day=finished,
+                                   on_failed=lambda _f: progress.advance(days))
             except DayKeptError as exc:
                 raise SkyrouteError(f"{exc}; --replace stores the day as flown now"
                                     ) from None
+            except DaysFailedError as exc:
+                results, failed = exc.stored, exc.failed
             wall = time.perf_counter() - t0
         workers = ex.workers
     if day is not None:
-        _one_day(results[0], written, as_json)
+        if results:
+            _one_day(results[0], written, as_json)
     else:
-        _summary(results, wall, jobs, workers, ex.kind, as_json, written)
-    _say_empty(results)
+        _summary(results, wall, jobs, workers, ex.kind, as_json, written, failed)
+    _say_empty(results, list(by_date))
+    if failed:
+        _say_failed(failed, len(by_date))
 
 
-def _say_empty(results: list[DayResult]) -> None:
+def _say_empty(results: list[DayResult], dates: list[dt.date]) -> None:
     """A line on stderr for days without orders (stored as empty days, exit 0): a
-    mistyped date or orders not imported would otherwise pass for a day flown."""
+    mistyped date or orders not imported would otherwise pass for a day flown.
+    ``dates``: every day of the run, stored or failed."""
     empty = [r.date for r in results if not r.orders]
     if not empty:
         return
-    n = len(results)
+    n = len(dates)
     if n == 1:
         line = f"{empty[0]}: no orders stored for this day; nothing was flown"
     elif len(empty) == n:
-        line = (f"nothing was flown: none of the {n:,} days from {results[0].date} to "
-                f"{results[-1].date} had orders stored")
+        line = (f"nothing was flown: none of the {n:,} days from {dates[0]} to "
+                f"{dates[-1]} had orders stored")
     else:
         line = (f"{len(empty):,} of the {n:,} days had no orders stored "
                 f"({some_days(empty, 5)}); nothing "
                 "was flown on " + ("it" if len(empty) == 1 else "them"))
     plain_console(stderr=True).print(line, soft_wrap=True)
+
+
+def _say_failed(failed: list[DayFailed], n: int) -> None:
+    """The days that failed, after the others are stored and summed up: one line each
+    on stderr (a lone day: its error alone) and exit 2; a defect (not a SkyrouteError)
+    prints the first such day's traceback before them and exits 1, as an uncaught error
+    does."""
+    bugs = [f for f in failed if not f.expected]
+    if bugs:
+        typer.echo(bugs[0].traceback.rstrip(), err=True)
+    if n == 1:
+        last = failed[0].error
+    else:
+        for f in failed:
+            typer.echo(f"skyroute: error: {f.error}", err=True)
+        rest = n - len(failed)
+        last = (f"{len(failed):,} of the {n:,} days failed and "
+                f"{'was' if len(failed) == 1 else 'were'} not stored; the other {rest:,} "
+                f"{'is' if rest == 1 else 'are'} stored, with {'its' if rest == 1 else 'their'}"
+                " files")
+    if not bugs:
+        raise SkyrouteError(last)
+    typer.echo(f"skyroute: error: {last}", err=True)
+    raise typer.Exit(1)
 
 
 def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
@@ -181,12 +216,13 @@ def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
 
 
 def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kind: str,
-             as_json: bool, files: list[Path]) -> None:
+             as_json: bool, files: list[Path], failed: list[DayFailed]) -> None:
     from skyroute.jobs.deliver import summarise
 
-    s = summarise(results)
+    s = summarise(results)  # of the days stored
     s.update(wall_seconds=wall, jobs=jobs, executor=kind, workers=workers,
-             files=len(files), folders=sorted({str(f.parent) for f in files}))
+             files=len(files), folders=sorted({str(f.parent) for f in files}),
+             failed=[{"date": f.date.isoformat(), "error": f.error} for f in failed])
     if as_json:
         typer.echo(json.dumps(s))
         return
@@ -197,7 +233,8 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
     who = f"{workers} job(s)" if kind == "local" else f"{workers} Dask worker(s)"
     # a line of its own: as the title of the narrow monthly table it wrapped at the
     # table's width ("... money" over "delivered mean 99.24%, worst")
-    plain_console().print(f"{s['days']} days, {wall:.1f} s with {who}: money delivered "
+    days = f"{s['days']} of {s['days'] + len(failed)}" if failed else f"{s['days']}"
+    plain_console().print(f"{days} days, {wall:.1f} s with {who}: money delivered "
                           f"mean {s['mean_pct']:.2f}%, worst {s['min_pct']:.2f}% on "
                           f"{s['min_date']}", soft_wrap=True)
     t = Table()

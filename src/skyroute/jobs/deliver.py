@@ -14,6 +14,13 @@ while a PNG was written, or another day's error in a range with ``--jobs``). A d
 twice, or re-run on another worker after its worker died, is stored once (its first
 result to arrive), and a worker killed halfway leaves the previous state of that day.
 
+A day whose flight fails (an error raised while the worker flies it) comes back as a
+:class:`DayFailed`, not as an error of the whole map: the other days are flown and
+stored as usual, and :func:`run_days` raises :class:`DaysFailedError` at the end,
+naming the failed days. A range stopped at its first failed day dropped the days the
+workers had flown meanwhile (and, with the days in order, never flew the rest): a month
+with one bad day was flown again whole.
+
 The caller fills the leg table first (:func:`skyroute.delivery.days.prepare_legs`);
 workers sharing its cache folder only read it, and a worker on another machine fills its
 own on first use (the legs are the same, so are the days).
@@ -22,6 +29,8 @@ own on first use (the legs are the same, so are the days).
 from __future__ import annotations
 
 import datetime as dt
+import logging
+import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,6 +46,8 @@ from skyroute.delivery.site import load_site
 from skyroute.delivery.source import DirSource, HttpSource, open_source
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 from skyroute.files import written_together
+
+log = logging.getLogger("skyroute.jobs")
 
 
 @dataclass(frozen=True)
@@ -59,9 +70,78 @@ def _site(source):
     return _SITES[source]
 
 
-def fly_day(task: DayTask) -> DayResult:
-    """The worker's task: fly the day and return it (the caller stores it)."""
-    return plan_day(_site(task.source), task.date, list(task.orders), method=task.method)
+@dataclass(frozen=True)
+class DayFailed:
+    """A day whose flight raised, sent back by its worker in place of its
+    :class:`DayResult`. ``error``: one line naming the day (a SkyrouteError's message,
+    else the exception's type and message); ``expected``: the error was a SkyrouteError
+    (bad input, a flight that failed validation), not a defect; ``traceback``: the
+    worker's traceback, for a defect. Text rather than the exception: an exception need
+    not survive the trip back (an :class:`~skyroute.errors.InputFormatError` does not
+    unpickle, and a local pool reported it as a worker 'terminated abruptly')."""
+
+    date: dt.date
+    error: str
+    expected: bool
+    traceback: str = ""
+
+
+def _failed(date: dt.date, exc: Exception) -> DayFailed:
+    text = " ".join(str(exc).split())
+    expected = isinstance(exc, SkyrouteError)
+    if not expected:
+        text = f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+    if not text.startswith(f"{date}:"):  # most of the planner's own errors name it
+        text = f"{date}: {text}"
+    trace = "" if expected else "".join(traceback.format_exception(exc))
+    return DayFailed(date, text, expected, trace)
+
+
+def _interrupted(exc: BaseException) -> bool:
+    """A Ctrl-C or SIGTERM behind ``exc``: one that came while a compiled kernel ran
+    surfaces as a SystemError caused by it (see :func:`skyroute.cli.errors.run_cli`).
+    It stops the range; it is no day's failure."""
+    seen: BaseException | None = exc
+    for _ in range(10):
+        seen = seen.__cause__ or seen.__context__
+        if seen is None:
+            return False
+        if not isinstance(seen, Exception):  # KeyboardInterrupt, the CLI's Terminated
+            return True
+    return False
+
+
+def fly_day(task: DayTask) -> DayResult | DayFailed:
+    """The worker's task: fly the day and return it (the caller stores it), or the
+    :class:`DayFailed` saying why it could not be flown."""
+    try:
+        return plan_day(_site(task.source), task.date, list(task.orders),
+                        method=task.method)
+    except Exception as exc:
+        if _interrupted(exc):
+            raise
+        return _failed(task.date, exc)
+
+
+class DaysFailedError(SkyrouteError):
+    """Some days of :func:`run_days` failed; the others were stored. ``stored``: their
+    results in date order; ``failed``: the :class:`DayFailed` days in date order;
+    ``days``: how many days were run. The message is one line: a lone day's error, or
+    how many failed, that the others are stored, and the first errors."""
+
+    SHOWN = 3  # errors in the message; the rest are counted
+
+    def __init__(self, stored: list[DayResult], failed: list[DayFailed], days: int) -> None:
+        self.stored, self.failed, self.days = stored, failed, days
+        if days == 1:
+            text = failed[0].error
+        else:
+            n, rest = len(failed), days - len(failed)
+            text = (f"{n:,} of the {days:,} days failed and {'was' if n == 1 else 'were'} "
+                    f"not stored (the other {rest:,} {'is' if rest == 1 else 'are'}): "
+                    + "; ".join(f.error for f in failed[:self.SHOWN])
+                    + (f"; and {n - self.SHOWN:,} more" if n > self.SHOWN else ""))
+        super().__init__(text)
 
 
 def days_between(engine: sa.Engine, first: dt.date, last: dt.date) -> dict[dt.date, list]:
@@ -76,7 +156,8 @@ def days_between(engine: sa.Engine, first: dt.date, last: dt.date) -> dict[dt.da
 def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executor,
              method: str = "milp", replace: bool = False,
              files: Callable[[DayResult], object] | None = None,
-             on_day: Callable[[DayResult], None] | None = None) -> list[DayResult]:
+             on_day: Callable[[DayResult], None] | None = None,
+             on_failed: Callable[[DayFailed], None] | None = None) -> list[DayResult]:
     """Fly every day of ``by_date`` as one task each on ``executor`` and store each as
     its result arrives; results in date order. A day whose every order is invalid does
     not replace a stored flight that delivered unless ``replace``
@@ -89,13 +170,22 @@ def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executo
     leaves the day's rows and files as they were. ``on_day(result)`` is called once the
     day is stored and its files are in place.
 
-    A run stopped by an error (a day that failed, a day kept) has stored the days that
-    arrived before it, each with its files, and no other: results a worker had ready
-    are dropped with it."""
+    A day whose flight fails (:class:`DayFailed`, passed to ``on_failed`` as it
+    arrives) is neither stored nor given files, and the run goes on: every other day is
+    flown and stored, then :class:`DaysFailedError` is raised with the stored days'
+    results and the failed days, each in date order. An error in the caller (storing a
+    day, writing its files, a day kept, the executor's own) or a Ctrl-C stops the run:
+    it has stored the days that arrived before it, each with its files, and no other."""
     check_choice("method", method, METHODS)
     tasks = [DayTask(source, d, tuple(orders), method) for d, orders in sorted(by_date.items())]
+    failed: list[DayFailed] = []
 
-    def arrived(_i: int, result: DayResult) -> None:
+    def arrived(_i: int, result: DayResult | DayFailed) -> None:
+        if isinstance(result, DayFailed):
+            failed.append(result)
+            if on_failed is not None:
+                on_failed(result)
+            return
         with written_together():
             if files is not None:
                 files(result)
@@ -103,7 +193,11 @@ def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executo
         if on_day is not None:
             on_day(result)
 
-    return executor.map(fly_day, tasks, on_result=arrived)
+    results = executor.map(fly_day, tasks, on_result=arrived)
+    stored = [r for r in results if not isinstance(r, DayFailed)]
+    if failed:
+        raise DaysFailedError(stored, sorted(failed, key=lambda f: f.date), len(tasks))
+    return stored
 
 
 def summarise(results: list[DayResult]) -> dict:
@@ -175,7 +269,9 @@ def deliver_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
                 progress: Callable[[float], None]) -> dict:
     """Fly ``params``' days (see :func:`check_params`) on ``executor``; the summary of
     :func:`summarise` with ``from`` and ``to``. ``progress`` gets the share of days
-    done."""
+    done (stored or failed). Days that fail are :class:`DaysFailedError` once the
+    others are stored: the job fails with one line naming them, and a defect's
+    traceback goes to the ``skyroute.jobs`` logger."""
     p = check_params(params)
     data = p.get("data")
     src = open_source(None if data is None else Path(data), p.get("source"))
@@ -188,15 +284,20 @@ def deliver_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
     prepare_legs(site, [o for v in by_date.values() for o in v])
     done = 0
 
-    def on_day(_r: DayResult) -> None:
+    def on_day(_r: DayResult | DayFailed) -> None:
         nonlocal done
         done += 1
         progress(done / len(by_date))
 
     try:
         results = run_days(engine, src, by_date, executor=executor, method=p["method"],
-                           replace=p["replace"], on_day=on_day)
+                           replace=p["replace"], on_day=on_day, on_failed=on_day)
     except store.DayKeptError as exc:  # the job's way to say what the CLI's --replace does
         raise SkyrouteError(f"{exc}; replace=true stores the day as flown now",
                             param="replace") from None
+    except DaysFailedError as exc:
+        for f in exc.failed:
+            if not f.expected:  # the job's error is one line: the rest goes to the log
+                log.error("job %s: %s\n%s", job_id, f.error, f.traceback.rstrip())
+        raise
     return {"from": p["from"], "to": p["to"], **summarise(results)}

@@ -2,8 +2,9 @@
 // area, shops, customers), animated move by move, with the orders and the money so far.
 //
 // Reads GET /days, /site.geojson, /days/{date} and /days/{date}/flightpath.geojson; flies
-// a day with POST /jobs/deliver and follows GET /jobs/{id}; deletes a day without a
-// flight (a mistyped date) with DELETE /days/{date}.
+// a day with POST /jobs/deliver (with replace, after a confirmation, over a stored flight
+// that a day of invalid orders would otherwise keep) and follows GET /jobs/{id}; deletes
+// a day without a flight (a mistyped date) with DELETE /days/{date}.
 
 import { ApiError, bindToken, choices, explain, focusFault, getJSON, postJSON, remove } from "./api.js";
 import { JobFollower } from "./jobs.js";
@@ -123,6 +124,9 @@ async function loadSite() {
 const jobs = new JobFollower({
   key: "skyroute.dayJob", bar: $("progress"), line: jobStatus, button: $("start"),
   what: "the day", done: "The day is flown and stored.",
+  // a day whose every order is invalid now keeps its stored flight: the way on is here
+  hint: (error) => (/replace=true/.test(error || "") ? "To store the day as flown now, " +
+    "over its stored flight, tick “Replace a kept flight” and fly it again." : ""),
   onDone: async (r) => {
     if (!(await listDays(r.from))) return;
     await loadSite();
@@ -140,18 +144,29 @@ $("job").addEventListener("submit", async (ev) => {
     $("job-date").focus();
     return;
   }
+  const replace = $("replace").checked;
+  // replace stores a flight that delivers nothing over one that delivered: asked first
+  // (a day not stored has no flight to lose)
+  if (replace && [...select.options].some((o) => o.value === date) &&
+      !confirm(`Fly ${date} again and store the new flight over its stored one, even if ` +
+        "every order is invalid now and it delivers nothing? The stored flight and its " +
+        "deliveries are replaced; this cannot be undone.")) {
+    say(jobStatus, `Not flown: the stored flight of ${date} is kept.`, "info");
+    return;
+  }
   setBusy($("start"), true);
   $("progress").value = 0;
   say(jobStatus, `Submitting ${date}…`, "busy");
   let id;
   try {
-    ({ id } = await postJSON("/jobs/deliver", { date, method: $("method").value }));
+    ({ id } = await postJSON("/jobs/deliver", { date, method: $("method").value, replace }));
   } catch (err) {
     say(jobStatus, explain(err, `Flying ${date}`), "error");
-    focusFault(err, { date: "job-date", method: "method" });
+    focusFault(err, { date: "job-date", method: "method", replace: "replace" });
     setBusy($("start"), false);
     return;
   }
+  $("replace").checked = false; // once: the next day flown keeps a stored flight again
   await jobs.start(id);
 });
 

@@ -18,10 +18,11 @@ export class JobFollower {
    *   line (status element), button (the submit button, busy while following: it
    *   keeps the focus, see ``setBusy``),
    *   what ("the run": for the messages), done (the text when it is done),
-   *   onDone(result) (awaited, after the line says ``done``).
+   *   onDone(result) (awaited, after the line says ``done``), hint(error) (optional:
+   *   what to do about a failed job's error, said after it; "" for nothing).
    */
-  constructor({ key, bar, line, button, what, done, onDone }) {
-    Object.assign(this, { key, bar, line, button, what, done, onDone });
+  constructor({ key, bar, line, button, what, done, onDone, hint }) {
+    Object.assign(this, { key, bar, line, button, what, done, onDone, hint });
   }
 
   remember(job) {
@@ -74,7 +75,10 @@ export class JobFollower {
         if (job.state === "failed") {
           this.remember(null);
           bar.value = 0;
-          say(line, `The job failed: ${job.error || "no reason given"}`, "error");
+          const error = job.error || "no reason given";
+          const hint = this.hint ? this.hint(job.error) : "";
+          const stop = /[.!?]$/.test(error) ? "" : "."; // the hint is a sentence of its own
+          say(line, `The job failed: ${error}${hint ? `${stop} ${hint}` : ""}`, "error");
           return;
         }
         if (job.state === "done") {
