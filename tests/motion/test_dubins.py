@@ -215,6 +215,27 @@ def test_a_goal_a_rounding_error_away_with_the_same_heading():
     assert D.shortest_path(s, g, 1.0).length == pytest.approx(ref, abs=1e-30)
 
 
+
+@pytest.mark.parametrize("span", [1.0, 10.0])
+def test_a_goal_a_micro_radius_ahead_is_not_a_loop(span):
+    # goals 1e-6 r ahead along the start heading, off its line by rounding: LSR's and
+    # RSL's p^2 was formed as (d^2 - 2) + 2 cos(a - b), whose first sum dropped d^2's
+    # digits below 2e-16 (a 2e-4 relative error at d = 1e-6): the S-curve's angle came out
+    # a hair negative, a full turn, and 58% of such queries answered 2 pi r instead of d
+    d = 1e-6
+    rng = np.random.default_rng(7)
+    th = rng.uniform(-math.pi, math.pi, 2000)
+    s = np.c_[rng.uniform(-span, span, (2000, 2)), th]
+    g = np.c_[s[:, 0] + d * np.cos(th), s[:, 1] + d * np.sin(th), th]
+    np.testing.assert_allclose(D.lengths(s, g, 1.0), d, rtol=1e-6)
+    np.testing.assert_allclose(_scalar_lengths(s, g, 1.0), d, rtol=1e-6)
+    w = D._words(s, g, 1.0)
+    np.testing.assert_allclose(np.where(np.isnan(w[..., 0]), np.inf, w.sum(axis=2)).min(1),
+                               d, rtol=1e-6)
+    # the runway's final leg, 1e-6 r long (found by hypothesis: one 2 pi r loop)
+    legs = D.runway_approach((0, 0, 0), (0, 1), 1.0, 1.0, final=d)
+    assert legs[-1].length == pytest.approx(d, rel=1e-6)
+
 @given(r=st.sampled_from([0.5, 1.0, 2.0, 7.3, 100.0]), k=st.integers(1, 7),
        side=st.sampled_from([1, -1]), th0=st.sampled_from([0.0, 0.3, -math.pi, 2.0]))
 @settings(max_examples=150, deadline=None, derandomize=True)

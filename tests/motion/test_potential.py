@@ -4,8 +4,9 @@ import math
 
 import numpy as np
 import pytest
+import shapely
 
-from skyroute import OptionError
+from skyroute import OptionError, World
 from skyroute.motion.potential import course, run_field
 
 
@@ -80,6 +81,36 @@ def test_arc_mode_escape_moves_keep_the_turn_limit(max_turn):
     turns = np.abs((np.diff(heading) + math.pi) % (2 * math.pi) - math.pi)
     assert turns.max() <= max_turn + 1e-9
 
+
+
+def _open_c(mirror: bool = False) -> World:
+    """The hard course's C with no boundary (a colliders.csv city has none): the
+    navigation function's raster then covered the obstacles' bounds alone."""
+    boxes = [(30, 15, 34, 45), (18, 41, 34, 45), (18, 15, 34, 19)]
+    if mirror:
+        boxes = [(60 - x1, y0, 60 - x0, y1) for x0, y0, x1, y1 in boxes]
+    return World(shapely.box(*np.array(boxes, float).T), np.full(3, -np.inf),
+                 np.full(3, np.inf), (), None, "enu")
+
+
+@pytest.mark.parametrize("mode", ["step", "arc"])
+@pytest.mark.parametrize("world, start, goal", [
+    (_open_c(), (5.0, 30.0), (52.0, 30.0)),     # goal east of the obstacles' bounds
+    (_open_c(True), (55.0, 30.0), (8.0, 30.0)),  # west: the cell index was negative
+    (_open_c(), (5.0, 30.0), (34.1, 30.0)),     # just behind the C, in the raster's bounds
+    (course("hard")[0], (5.0, 30.0), (34.1, 30.0)),  # the goal's own cell blocked
+], ids=["east", "west", "behind-the-c", "goal-cell-blocked"])
+def test_the_escape_reaches_goals_beyond_the_obstacles_and_beside_a_wall(world, start,
+                                                                        goal, mode):
+    # the escape's raster spanned the obstacles' bounds only: a goal beyond them raised
+    # IndexError (skyroute fly city.csv --vehicle field, a goal past the city) or, west
+    # or south of them, wrapped to a cell on the far side; a goal within the clearance of
+    # a wall sat in a blocked cell that the wavefront never left (stuck, 0 escape moves)
+    run = run_field(world, start, goal, mode=mode)
+    assert run.reached and run.escaped > 0
+    flown = run.trace if mode == "arc" else run.path
+    assert world.segments_free(flown[:-1], flown[1:]).all()
+    assert math.dist(run.path[-1], goal) < 0.5
 
 def test_repr_summarises_the_run():
     world, start, goal = course("easy")

@@ -3,7 +3,8 @@
 import math
 
 import numpy as np
-from hypothesis import HealthCheck, given, settings
+import pytest
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
@@ -57,6 +58,67 @@ def test_free_turning_gives_the_octile_optimum_and_16_never_loses(q):
         r16slow = plan_turns(grid, s, t, headings=16, turn_rate=0.7)
         assert r16slow.time <= r8slow.time + 1e-9
 
+
+
+def lattice_optimum(blocked, s, t, headings, speed, rate, first) -> float:
+    """networkx's Dijkstra over (x, y, heading) states built here from the module's
+    contract: forward one cell along the heading (8: no corner cutting; 16: knight moves
+    by the exact segment test of tests/search/checks.py), a turn to either neighbouring
+    heading costs its angle / rate; ``first`` fixes the start heading (index) or not."""
+    import networkx as nx
+
+    from skyroute.motion.turn_lattice import _DIRS
+    from tests.search.checks import segment_legal
+
+    dirs = _DIRS[headings]
+    ang = [math.atan2(dy, dx) for dx, dy in dirs]
+    h, w = blocked.shape
+    g = nx.DiGraph()
+    for y, x in np.argwhere(~blocked):
+        x, y = int(x), int(y)
+        for k, (dx, dy) in enumerate(dirs):
+            for j in ((k + 1) % headings, (k - 1) % headings):
+                g.add_edge((x, y, k), (x, y, j),
+                           weight=abs(math.remainder(ang[j] - ang[k], 2 * math.pi)) / rate)
+            u, v = x + dx, y + dy
+            if not (0 <= u < w and 0 <= v < h) or blocked[v, u]:
+                continue
+            if abs(dx) == abs(dy) == 1 and (blocked[y, u] or blocked[v, x]):
+                continue
+            if abs(dx) + abs(dy) == 3 and not segment_legal(blocked, (x, y), (u, v)):
+                continue
+            g.add_edge((x, y, k), (u, v, k), weight=math.hypot(dx, dy) / speed)
+    g.add_edges_from((("S", (*s, k)) for k in range(headings) if first in (None, k)),
+                     weight=0.0)
+    g.add_edges_from((((*t, k), "T") for k in range(headings)), weight=0.0)
+    try:
+        return nx.dijkstra_path_length(g, "S", "T")
+    except (nx.NetworkXNoPath, nx.NodeNotFound):
+        return math.inf
+
+
+@SETTINGS
+@given(grid_query(), st.sampled_from([8, 16]), st.sampled_from([0.4, 1.0, 3.0]),
+       st.sampled_from([0.3, math.pi / 2, 6.0]), st.one_of(st.none(), st.integers(0, 15)))
+@example((np.array([[1, 1, 1], [1, 0, 0]], bool), (1, 1), (2, 1)), 16, 1.0, math.pi / 2, 1)
+def test_the_time_is_the_optimum_of_an_independent_lattice_and_counts_every_turn(
+        q, headings, speed, rate, first):
+    # no test compared the lattice's time with an optimum that prices turns, nor the
+    # time it reports with its own route's (travel_time: the turns counted)
+    from skyroute.motion.turn_lattice import _DIRS
+
+    blocked, s, t = q
+    first = None if first is None else first % headings
+    start_heading = None if first is None else math.atan2(*_DIRS[headings][first][::-1])
+    r = plan_turns(skyroute.Grid(blocked), s, t, headings=headings, speed=speed,
+                   turn_rate=rate, start_heading=start_heading)
+    optimum = lattice_optimum(blocked, s, t, headings, speed, rate, first)
+    assert r.found == math.isfinite(optimum)
+    if r.found:
+        assert r.time == pytest.approx(optimum, rel=1e-12)
+        assert tuple(r.cells[0]) == s and tuple(r.cells[-1]) == t
+        assert r.time == pytest.approx(travel_time(r.cells, speed=speed, turn_rate=rate,
+                                                   start_heading=start_heading), rel=1e-12)
 
 def test_turns_cost_time_on_a_real_map():
     grid = skyroute.load_map("den312d")

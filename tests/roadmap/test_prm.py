@@ -158,3 +158,15 @@ def test_a_prm_path_never_crosses_an_obstacle_and_is_never_shorter_than_the_opti
     length = np.hypot(*np.diff(r.path, axis=0).T).sum()
     assert r.cost == pytest.approx(length, rel=1e-12)
     assert r.cost >= optimum - 1e-9
+
+
+@pytest.mark.parametrize("samples", [2, 3, 4])
+def test_fewer_samples_than_the_ring_still_plan_round_the_obstacle(samples):
+    # without a boundary the roadmap's first nodes are the 4 corners of the grown bounds,
+    # joined in a ring; with samples=2 or 3 the ring was cut to that many and its edges
+    # named the missing corners: IndexError from plan(..., algorithm="prm", samples=2)
+    world = rect_world([(0, 0, 2, 2)])
+    r = skyroute.plan(world, (-1, 1), (3, 1), algorithm="prm", samples=samples)
+    assert r.found
+    assert_free([(0, 0, 2, 2)], r.path)
+    assert r.cost >= skyroute.plan(world, (-1, 1), (3, 1)).cost - 1e-9

@@ -83,13 +83,13 @@ def _words(starts: np.ndarray, goals: np.ndarray, radius: float) -> np.ndarray:
         tmp = np.where(one, a, np.arctan2(ca - cb, d - sa + sb))
         out[:, 1] = np.c_[_mod2pi(a - tmp), np.where(one, 0.0, p), _mod2pi(-b + tmp)]
         # LSR
-        p2 = -2 + d * d + 2 * cab + 2 * d * (sa + sb)
+        p2 = d * d + 2 * (cab - 1) + 2 * d * (sa + sb)
         p = np.sqrt(np.maximum(p2, 0.0))
         tmp = np.arctan2(-ca - cb, d + sa + sb) - np.arctan2(-2.0, p)
         ok = p2 >= -tol
         out[ok, 2] = np.c_[_mod2pi(-a + tmp), p, _mod2pi(-_mod2pi(b) + tmp)][ok]
         # RSL
-        p2 = d * d - 2 + 2 * cab - 2 * d * (sa + sb)
+        p2 = d * d + 2 * (cab - 1) - 2 * d * (sa + sb)
         p = np.sqrt(np.maximum(p2, 0.0))
         tmp = np.arctan2(ca + cb, d - sa - sb) - np.arctan2(2.0, p)
         ok = p2 >= -tol

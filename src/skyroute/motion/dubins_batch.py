@@ -88,10 +88,10 @@ def _block(sf, gf, r, out, lo, hi):
         cab = 1.0 if abs(a - b) < 1e-8 else ca * cb + sa * sb
         y[i], x[i] = cb - ca, di + sa - sb  # LSL's tangent angle (and LRL's)
         y[m + i], x[m + i] = ca - cb, di - sa + sb  # RSR's (and RLR's)
-        p = math.sqrt(max(-2 + dd + 2 * cab + 2 * di * (sa + sb), 0.0))
+        p = math.sqrt(max(dd + 2 * (cab - 1.0) + 2 * di * (sa + sb), 0.0))
         yy, xx = -ca - cb, di + sa + sb  # LSR: atan2(yy, xx) - atan2(-2, p) as one atan2
         y[2 * m + i], x[2 * m + i] = yy * p + 2 * xx, xx * p - 2 * yy
-        p = math.sqrt(max(dd - 2 + 2 * cab - 2 * di * (sa + sb), 0.0))
+        p = math.sqrt(max(dd + 2 * (cab - 1.0) - 2 * di * (sa + sb), 0.0))
         yy, xx = ca + cb, di - sa - sb  # RSL: atan2(yy, xx) - atan2(2, p)
         y[3 * m + i], x[3 * m + i] = yy * p - 2 * xx, xx * p + 2 * yy
         # RLR and LRL: acos(c) as trig.acos does it, atan2(sqrt((1 - c)(1 + c)), c)
@@ -117,11 +117,11 @@ def _block(sf, gf, r, out, lo, hi):
         p = math.sqrt(x * x + y * y)
         w = _wrap_near(a - t_rsr) + p + _wrap_near(t_rsr - b)
         best = min(best, _wrap_near(a - b) if p <= arc else w)
-        p2 = -2 + dd + 2 * cab + 2 * di * (sa + sb)  # LSR
+        p2 = dd + 2 * (cab - 1.0) + 2 * di * (sa + sb)  # LSR
         tmp = t[2 * m + i]
         w = _wrap_near(tmp - a) + math.sqrt(max(p2, 0.0)) + _wrap_near(tmp - b)
         best = min(best, w if p2 >= tol else inf)
-        p2 = dd - 2 + 2 * cab - 2 * di * (sa + sb)  # RSL
+        p2 = dd + 2 * (cab - 1.0) - 2 * di * (sa + sb)  # RSL
         tmp = t[3 * m + i]
         w = _wrap_near(a - tmp) + math.sqrt(max(p2, 0.0)) + _wrap_near(b - tmp)
         best = min(best, w if p2 >= tol else inf)

@@ -34,6 +34,9 @@ WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
 # with p = 0 (clipped cos). For LSR and RSL that moves the poses by ~1e-12 radii, the
 # size of the angle snap; for the CCC words by up to ~1e-6 radii, since acos near 1
 # turns a 1e-12 change of its argument into a ~1.4e-6 change of the angle.
+# LSR's and RSL's p^2 is summed as d^2 + 2 (cos(a - b) - 1) +- ...: formed as (d^2 - 2) +
+# 2 cos(a - b), the first sum dropped d^2's digits below 2e-16, and a goal 1e-6 r
+# ahead, off the heading by rounding, got an S-curve angle a hair below 0: a full turn.
 ZERO = 1e-12
 
 
@@ -87,12 +90,12 @@ def words(sx, sy, sth, gx, gy, gth, r):
     p = math.sqrt(x * x + y * y)
     tmp = a if p <= arc else math.atan2(y, x)
     out[1, 0], out[1, 1], out[1, 2] = _m2p(a - tmp), 0.0 if p <= arc else p, _m2p(-b + tmp)
-    p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
+    p2 = dd + 2 * (cab - 1.0) + 2 * d * (sa + sb)  # LSR
     if p2 >= -tol:
         p = math.sqrt(max(p2, 0.0))
         tmp = math.atan2(-ca - cb, d + sa + sb) - math.atan2(-2.0, p)
         out[2, 0], out[2, 1], out[2, 2] = _m2p(-a + tmp), p, _m2p(-_m2p(b) + tmp)
-    p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
+    p2 = dd + 2 * (cab - 1.0) - 2 * d * (sa + sb)  # RSL
     if p2 >= -tol:
         p = math.sqrt(max(p2, 0.0))
         tmp = math.atan2(ca + cb, d - sa - sb) - math.atan2(2.0, p)
@@ -150,14 +153,14 @@ def shortest_length(sx, sy, sth, gx, gy, gth, r):
     best = _m2p(b - a) if p <= arc else _m2p(t_lsl - a) + p + _m2p(b - t_lsl)
     p = math.hypot(d - sa + sb, ca - cb)  # RSR
     best = min(best, _m2p(a - b) if p <= arc else _m2p(a - t_rsr) + p + _m2p(t_rsr - b))
-    p2 = -2 + dd + 2 * cab + 2 * d * (sa + sb)  # LSR
+    p2 = dd + 2 * (cab - 1.0) + 2 * d * (sa + sb)  # LSR
     if p2 >= -tol:
         p = math.sqrt(max(p2, 0.0))
         # atan2(y, x) - atan2(-2, p), as one atan2 (angle difference, modulo 2 pi)
         y, x = -ca - cb, d + sa + sb
         tmp = math.atan2(y * p + 2 * x, x * p - 2 * y)
         best = min(best, _m2p(tmp - a) + p + _m2p(tmp - b))
-    p2 = dd - 2 + 2 * cab - 2 * d * (sa + sb)  # RSL
+    p2 = dd + 2 * (cab - 1.0) - 2 * d * (sa + sb)  # RSL
     if p2 >= -tol:
         p = math.sqrt(max(p2, 0.0))
         y, x = ca + cb, d - sa - sb  # atan2(y, x) - atan2(2, p)

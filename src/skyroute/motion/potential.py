@@ -121,19 +121,24 @@ def _edges(world: World):
     return _EDGE_CACHE[world]
 
 
-def _navigation(world: World, here: np.ndarray, goal: np.ndarray, resolution: float):
+def _navigation(world: World, goal: np.ndarray, resolution: float, points: np.ndarray):
     """Wavefront distance to the goal per free cell (inf where unreachable), and the grid.
 
-    The raster holds ``here`` and the goal with a few cells round them, as the grid
-    planners' does (:func:`~skyroute.roadmap.raster.raster_box`): over the obstacles'
-    extent alone, a goal or a robot beyond the obstacles had no cell (an IndexError)."""
+    The raster covers the world's boundary or, without one, the obstacles, ``goal`` and
+    ``points`` (where the robot is and was) with 8 cells round them all, as the grid
+    planners' rasters do (:func:`~skyroute.roadmap.raster.raster_box`): over the
+    obstacles' bounds alone, a goal beyond them fell outside the grid (an IndexError, or
+    a negative index that silently wrapped to the far side). The goal itself is the
+    wavefront's source, joined to the free cells round it whose centres it sees, so a
+    goal in a cell the clearance blocks is still reached."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 
-    from skyroute.roadmap.raster import raster_box
-
-    grid = world.merged().rasterize(resolution, safety=resolution / math.sqrt(2),
-                                    bounds=raster_box(world, here, goal, resolution))
+    r = resolution
+    box = world.extent_with(np.vstack([points, goal]), margin=4 * r)
+    if world.boundary is None:
+        box = (box[0] - 4 * r, box[1] - 4 * r, box[2] + 4 * r, box[3] + 4 * r)
+    grid = world.merged().rasterize(r, safety=r / math.sqrt(2), bounds=box)
     free = ~grid.blocked
     h, w = free.shape
     idx = np.arange(h * w).reshape(h, w)
@@ -149,11 +154,19 @@ def _navigation(world: World, here: np.ndarray, goal: np.ndarray, resolution: fl
         ib = idx[max(0, dy):h - max(0, -dy) or None, dx:][ok]
         rows.append(ia)
         cols.append(ib)
-        lens.append(np.full(len(ia), math.hypot(dx, dy) * resolution))
-    g = coo_matrix((np.concatenate(lens), (np.concatenate(rows), np.concatenate(cols))),
-                   shape=(h * w, h * w)).tocsr()
+        lens.append(np.full(len(ia), math.hypot(dx, dy) * r))
     gx, gy = grid.to_cell([goal])[0]
-    dist = dijkstra(g, directed=False, indices=int(idx[gy, gx])).reshape(h, w)
+    near = np.array([(x, y) for y in range(gy - 1, gy + 2) for x in range(gx - 1, gx + 2)
+                     if 0 <= x < w and 0 <= y < h and free[y, x]]).reshape(-1, 2)
+    centres = grid.to_world(near)
+    sees = world.segments_free(np.broadcast_to(goal, centres.shape), centres)
+    rows.append(idx[near[sees, 1], near[sees, 0]])
+    cols.append(np.full(int(sees.sum()), h * w))  # the goal: one node past the cells
+    lens.append(np.hypot(*(centres[sees] - goal).T))
+    g = coo_matrix((np.concatenate(lens) + 1e-300,
+                    (np.concatenate(rows), np.concatenate(cols))),
+                   shape=(h * w + 1, h * w + 1)).tocsr()
+    dist = dijkstra(g, directed=False, indices=h * w)[:h * w].reshape(h, w)
     return grid, dist
 
 
@@ -196,8 +209,8 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
         stalled = len(path) > window and math.dist(path[-1], path[-window]) < 2 * step
         if escape and (stalled or on_nav > 0):
             if nav is None or not _holds(nav[0], p):  # made anew where the robot is
-                nav = _navigation(world, p, t, step)
-            q = _descend(world, nav, p)
+                nav = _navigation(world, t, step, np.array([path[0], p]))
+            q = _descend(world, nav, p, t)
             if q is None:
                 break
             escaped += 1
@@ -299,9 +312,13 @@ def _holds(grid, p: np.ndarray) -> bool:
     return 0 <= x < grid.width and 0 <= y < grid.height
 
 
-def _descend(world: World, nav, p: np.ndarray) -> np.ndarray | None:
-    """One step to the neighbouring free cell centre with the lowest wavefront value."""
+def _descend(world: World, nav, p: np.ndarray, t: np.ndarray) -> np.ndarray | None:
+    """One step to the neighbouring free cell centre with the lowest wavefront value, or
+    onto the goal ``t`` when it is in sight within a diagonal cell (near a wall the goal's
+    own cell may be blocked: the cells round it would take turns forever)."""
     grid, dist = nav
+    if math.dist(p, t) <= grid.resolution * math.sqrt(2) and world.segment_free(p, t):
+        return t.copy()
     cx, cy = grid.to_cell([p])[0]
     best, where = np.inf, None
     for dx in (-1, 0, 1):

@@ -7,8 +7,9 @@ sub-segment shortcuts (as OMPL's path simplifier), and greedy again.
 
 Samples are drawn in the world's boundary or, without one, in the obstacles' bounds
 grown by :data:`MARGIN` of their size on every side, whose four outer corners are
-nodes too, joined in a ring: a path may have to go round every obstacle (a no-fly zone
-between start and goal), and that way is then always in the roadmap. A world with
+nodes too (counted among ``samples``, and kept when it is below 4), joined in a ring:
+a path may have to go round every obstacle (a no-fly zone between start and goal),
+and that way is then always in the roadmap. A world with
 neither (no boundary, and no obstacle at the chosen altitude) has an empty roadmap:
 every query's path is its straight segment.
 
@@ -67,7 +68,9 @@ class PRM:
             raise OptionError(f"PRM drew {len(pts)} free point(s) from the world's extent "
                               "and needs at least 2: its free space is empty or too thin "
                               "to sample", param="samples")
-        self.points = pts[:samples]
+        # the ring's corners are always kept (with samples < 4 the ring's edges named
+        # nodes past the cut: IndexError)
+        self.points = pts[:max(samples, len(ring))]
         n = len(self.points)
         self.k = math.ceil(math.e * 1.5 * math.log(n)) if prm_star else neighbours
         self.tree = cKDTree(self.points)
