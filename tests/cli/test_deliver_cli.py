@@ -662,3 +662,49 @@ def test_ctrl_c_on_a_day_still_stops_the_range(monkeypatch, capsys, tmp_path, fl
     assert flown == ["2024-01-01", "2024-01-02"]  # the range stopped there
     assert _stored_day(db, "2024-01-01")[0] and not _stored_day(db, "2024-01-02")[0]
     assert _files_of(out) == ["drone-01-01-2024.geojson", "report-01-01-2024.json"]
+
+
+def _lunch_with(tmp_path, name: str, edit) -> Path:
+    """A copy of the lunch example whose database/``name`` is ``edit(text)``."""
+    import shutil
+
+    data = tmp_path / "lunch"
+    shutil.copytree(EXAMPLE, data)
+    p = data / "database" / name
+    p.write_text(edit(p.read_text()))
+    return data
+
+
+@pytest.mark.parametrize("command", ["deliver", "import"])
+@pytest.mark.parametrize("name, edit, words", [
+    ("orders.csv", lambda t: t.replace(",2024-01-01,", ",2024-13-01,", 1),
+     "orders.csv:2: deliveryDate '2024-13-01' is not YYYY-MM-DD"),
+    ("orders.csv", lambda t: "", "orders.csv:1: the file is empty; expected the header "
+     "orderNo,deliveryDate,customer,deliverTo"),
+    ("orderDetails.csv", lambda t: t + "zzzz,Club sandwich (Small)\n",
+     "is not in orders.csv"),
+])
+def test_malformed_order_files_leave_no_new_store_behind(monkeypatch, capsys, tmp_path,
+                                                         command, name, edit, words):
+    # the store was opened (its folder, file and tables made) before the CSVs were read
+    data = _lunch_with(tmp_path, name, edit)
+    store = tmp_path / "new" / "s.db"
+    args = (["deliver", "2024-01-01", "--data", str(data), "--out", str(tmp_path / "out")]
+            if command == "deliver" else ["db", "import", str(data)])
+    code, out, err = run(monkeypatch, capsys, *args, "--db", f"sqlite:///{store}")
+    assert code == 2 and out == "" and words in err and err.count("\n") == 1, err
+    assert not (tmp_path / "new").exists() and not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("edit", [
+    lambda t: t + "   \n\t\n",  # lines of spaces at the end (an editor's)
+    lambda t: t.replace("orderNo,deliveryDate,customer,deliverTo",
+                        "orderNo, deliveryDate, customer, deliverTo"),
+])
+def test_odd_but_valid_orders_files_import_as_the_plain_ones(monkeypatch, capsys, tmp_path,
+                                                             edit):
+    data = _lunch_with(tmp_path, "orders.csv", edit)
+    code, out, err = run(monkeypatch, capsys, "db", "import", str(data), "--db",
+                         f"sqlite:///{tmp_path / 's.db'}")
+    assert code == 0, err
+    assert "108 orders added" in out

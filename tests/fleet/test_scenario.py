@@ -111,6 +111,49 @@ def test_bad_scenarios_name_the_field_and_the_file(tmp_path, edit, words):
     assert str(info.value).startswith(str(p)) and words in str(info.value)
 
 
+@pytest.mark.parametrize("edit, words", [
+    # PyYAML kept the last of two equal keys silently: a second 'drones: 9' further down
+    # overrode the first unseen
+    (lambda y: y + "drones: 9\n", "key 'drones' given twice in one mapping"),
+    (lambda y: y.replace("  cruise_speed: 50.0\n", "  cruise_speed: 50.0\n  cruise_speed: 60\n"),
+     "key 'cruise_speed' given twice in one mapping"),
+])
+def test_a_key_given_twice_is_refused_naming_its_second_line(tmp_path, edit, words):
+    p = tmp_path / "twice.yaml"
+    text = edit(sc.to_yaml(sc.preset("seed-3x3")))
+    p.write_text(text)
+    second = [n for n, row in enumerate(text.splitlines(), start=1)
+              if row.strip().startswith(words.split("'")[1] + ":")][-1]
+    with pytest.raises(InputFormatError) as err:
+        sc.load_scenario(p)
+    assert str(err.value) == f"{p}:{second}: not YAML: {words}"
+
+
+def test_merge_keys_may_still_be_overridden(tmp_path):
+    y = sc.to_yaml(sc.preset("seed-3x3"))
+    p = tmp_path / "merge.yaml"
+    p.write_text(y.replace("\ndrone:\n",
+                           "\ndrone:\n  <<: {cruise_speed: 70.0, turn_radius: 300.0}\n", 1))
+    drone = sc.load_scenario(p).drone  # the keys below the merge win, as YAML has it
+    assert (drone.cruise_speed, drone.turn_radius) == (50.0, 250.0)
+    p.write_text(y.replace("  taxi_speed: 10.0\n", "").replace(
+        "\ndrone:\n", "\ndrone:\n  <<: {taxi_speed: 12.0}\n", 1))
+    assert sc.load_scenario(p).drone.taxi_speed == 12.0  # and the merge fills the rest
+
+
+@pytest.mark.parametrize("typo, words", [
+    ("Airports", "Airports: unknown key; did you mean airports? valid: name, "),
+    ("airport", "airport: unknown key; did you mean airports? valid: name, "),
+])
+def test_a_misspelt_required_key_is_named_not_reported_missing(tmp_path, typo, words):
+    # it read "airports: Field required", hiding the typo that caused it
+    p = tmp_path / "typo.yaml"
+    p.write_text(sc.to_yaml(sc.preset("seed-3x3")).replace("airports:", f"{typo}:", 1))
+    with pytest.raises(InputFormatError) as err:
+        sc.load_scenario(p)
+    assert str(err.value).startswith(f"{p}: {words}")
+
+
 def test_airports_closer_than_a_runway_are_refused():
     s = sc.preset("seed-3x3").model_dump()
     s["airports"][1]["north"] = s["airports"][0]["north"] + 100

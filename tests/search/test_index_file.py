@@ -88,6 +88,16 @@ def test_files_that_are_no_index_at_all(den312d, tmp_path):
         skyroute.load_index(tmp_path / "none.idx", grid)
 
 
+def test_another_programs_npz_says_what_it_holds(den312d, tmp_path):
+    # it read "not a skyroute index: method ''", naming an entry the file never had
+    grid, _ = den312d
+    np.savez(tmp_path / "weights.npz", w=np.zeros(3), b=np.zeros(2))
+    with pytest.raises(skyroute.InputFormatError) as err:
+        skyroute.load_index(tmp_path / "weights.npz", grid)
+    assert str(err.value) == (f"{tmp_path / 'weights.npz'}: not a skyroute index: it has "
+                              "no 'method' entry (its arrays: b, w)")
+
+
 def _with(path, key, change):
     with np.load(path) as z:
         a = z[key].copy()

@@ -128,6 +128,22 @@ def test_geojson_zones_world(client):
     assert ans["status"] == "found" and ans["cost"] > 300  # metres round the block
 
 
+def test_geojson_zones_with_heights_in_degrees(client):
+    # [lon, lat, alt] vertices: the degrees frame's visibility graph failed on them (500)
+    ring = [[0.001, -0.001], [0.002, -0.001], [0.002, 0.001], [0.001, 0.001], [0.001, -0.001]]
+    def body(coords):
+        zones = {"type": "FeatureCollection", "features": [
+            {"type": "Feature", "properties": {"name": "block"},
+             "geometry": {"type": "Polygon", "coordinates": [coords]}}]}
+        return {"world_text": json.dumps(zones), "world_format": "geojson",
+                "frame": "degrees", "boundary": [-0.01, -0.01, 0.01, 0.01],
+                "start": [0.0, 0.0], "goal": [0.003, 0.0]}
+    flat = client.post("/plan", json=body(ring), headers=AUTH).json()
+    high = client.post("/plan", json=body([[*p, 30.0] for p in ring]), headers=AUTH)
+    assert high.status_code == 200, high.text
+    assert high.json()["status"] == "found" and high.json()["cost"] == flat["cost"]
+
+
 def test_the_servers_budget_caps_each_request(tmp_path):
     with make_client(max_expansions=50) as c:
         a = c.post("/plan", json=DEN, headers=AUTH).json()
@@ -178,6 +194,10 @@ CITY_BODY = {"world_format": "colliders", "altitude": 10, "safety": 2,
     ({"map_text": "type octile\nheight 1\nwidth 2\nmap\n.Q\n", "start": [0, 0],
       "goal": [1, 0]}, "map_text", "line 5: unknown terrain 'Q'"),
     ({"map_text": "", "start": [0, 0], "goal": [1, 0]}, "map_text", "empty"),
+    # a header claiming 3 x 10**12 cells: numpy's MemoryError before, a 500
+    ({"map_text": "type octile\nheight 3\nwidth 1000000000000\nmap\n..\n..\n..\n",
+      "start": [0, 0], "goal": [1, 0]}, "map_text",
+     "line 3: the header's map is 1,000,000,000,000 x 3 cells"),
     ({**CITY_BODY, "world_format": None, "world_text": "x"}, "body", "world_format"),
     ({**CITY_BODY, "world_text": "lat0 x\n"}, "world_text", "line 1: expected 'lat0"),
     ({**CITY_BODY, "world_text": "{}", "world_format": "geojson"}, "world_text", ""),

@@ -71,3 +71,40 @@ def test_a_file_of_too_many_boxes_is_refused_before_its_rows_are_parsed(tmp_path
     # at the limit it is read (blank lines are not boxes)
     path.write_text(f"{HOME}\n{HEADER}\n\n" + "1,1,1,1,1,1\n" * colliders.MAX_BOXES)
     assert len(read_colliders(path).obstacles) == colliders.MAX_BOXES
+
+
+@pytest.mark.parametrize("home", ["lat0 +37.792480, lon0 -122.397450",
+                                  "lat0 3.7792480e1, lon0 -1.22397450E2",
+                                  "LAT0 37.792480, LON0 -122.397450",
+                                  "lat0\t37.792480 ,lon0   -122.397450"])
+@pytest.mark.parametrize("header", [HEADER, HEADER.lower(), HEADER.replace(",", ", "),
+                                    HEADER.upper()])
+def test_odd_but_valid_home_lines_and_headers_read_as_the_plain_file(tmp_path, home, header):
+    # a sign, an exponent or capitals in line 1 were "expected 'lat0 <deg>, lon0 <deg>'",
+    # and a header in other capitals was refused
+    plain, odd = tmp_path / "plain.csv", tmp_path / "odd.csv"
+    plain.write_text(f"{HOME}\n{HEADER}\n{BOXES}")
+    odd.write_text(f"{home}\n{header}\n{BOXES}")
+    a, b = read_colliders(plain, frame="enu"), read_colliders(odd, frame="enu")
+    assert (b.home.lat, b.home.lon) == (a.home.lat, a.home.lon)
+    assert list(b.obstacles) == list(a.obstacles)
+
+
+@pytest.mark.parametrize("home", ["lat0 nan, lon0 -122.39", "lat0 inf, lon0 -122.39"])
+def test_a_home_that_is_no_place_names_line_1(tmp_path, home):
+    path = tmp_path / "c.csv"
+    path.write_text(f"{home}\n{HEADER}\n{BOXES}")
+    with pytest.raises(InputFormatError, match="is not a place") as err:
+        read_colliders(path)
+    assert err.value.line == 1
+
+
+def test_boxes_are_named_by_their_own_line_after_blank_lines(tmp_path):
+    # after a blank line every box was named by the line before its own: a start inside
+    # the box of line 6 was said to be inside 'box at line 5'
+    path = tmp_path / "c.csv"
+    path.write_text(f"{HOME}\n{HEADER}\n10,0,5,2,3,5\n\n\n-20,20,40,5,5,40\n")
+    city = read_colliders(path, frame="ned")
+    assert city.names == ("box at line 3", "box at line 6")
+    with pytest.raises(skyroute.QueryError, match="inside obstacle 'box at line 6'"):
+        skyroute.plan(city.at(10), (-20, 20), (40, 40))

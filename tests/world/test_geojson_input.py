@@ -5,6 +5,7 @@ file and the feature, or read as the plain file is."""
 import json
 
 import pytest
+import shapely
 
 import skyroute
 from skyroute import InputFormatError, QueryError
@@ -161,3 +162,75 @@ def test_a_boundary_box_written_lat_lon_is_refused_for_zones_and_cities(monkeypa
                           "its coordinates (lat, lon)?")
     w = skyroute.load_world(city, boundary="-3.2,55.93,-3.18,55.96")  # the right way round
     assert skyroute.plan(w, (-3.1869, 55.9445), (-3.1868, 55.9446)).found
+
+
+# -- coordinates with a height, NaN, and documents that are not a FeatureCollection -------
+
+def lifted(feature, alt=12.5):
+    """``feature`` with a third coordinate (a height) on every vertex, as GeoJSON allows."""
+    rings = feature["geometry"]["coordinates"]
+    return {**feature, "geometry": {"type": feature["geometry"]["type"],
+                                    "coordinates": [[[*p, alt] for p in r] for r in rings]}}
+
+
+@pytest.mark.parametrize("frame", ["degrees", "lonlat", "ned", "enu"])
+@pytest.mark.parametrize("algorithm", ["visibility", "prm"])
+def test_zones_with_heights_plan_as_without(tmp_path, frame, algorithm):
+    # a [lon, lat, alt] ring failed in the degrees frame's visibility graph (numpy's
+    # "all the input array dimensions ... must match"): a traceback
+    flat = skyroute.load_world(write(tmp_path / "flat.geojson", ZONE, AREA), frame=frame)
+    high = skyroute.load_world(write(tmp_path / "high.geojson", lifted(ZONE), lifted(AREA)),
+                               frame=frame)
+    assert not any(shapely.has_z(high.obstacles)) and not shapely.has_z(high.boundary)
+    assert all(shapely.equals(high.obstacles, flat.obstacles))
+    start, goal = flat.from_plane(flat.plane_from_lonlat([(-3.1945, 55.9405),
+                                                          (-3.1855, 55.9495)]))
+    seed = {"seed": 1} if algorithm == "prm" else {}
+    a = skyroute.plan(flat, start, goal, algorithm=algorithm, **seed)
+    b = skyroute.plan(high, start, goal, algorithm=algorithm, **seed)
+    assert a.found and b.cost == a.cost
+
+
+def test_a_world_built_from_polygons_with_heights_plans_as_without():
+    # the README's World, its square given 3-D: round two of its corners, as in 2-D
+    ring = [(1, 1), (3, 1), (3, 3), (1, 3)]
+    flat = skyroute.World([shapely.Polygon(ring)], [0], [50], ("tower",))
+    high = skyroute.World([shapely.Polygon([(x, y, 9) for x, y in ring])], [0], [50],
+                          ("tower",))
+    a, b = skyroute.plan(flat, (0, 2), (4, 2)), skyroute.plan(high, (0, 2), (4, 2))
+    assert round(b.cost, 6) == 4.828427 and b.path.tolist() == a.path.tolist()
+
+
+@pytest.mark.parametrize("value", ["NaN", "Infinity", "-Infinity", "1e999"])
+def test_a_coordinate_that_is_no_json_number_names_the_feature(tmp_path, value):
+    # Python's json reads NaN and Infinity; GEOS then said "ParseException: Error parsing
+    # JSON: '[json.exception.parse_error.101] ... invalid literal; last read: '[[[N''"
+    text = json.dumps({"type": "FeatureCollection", "features": [ZONE, AREA]})
+    path = tmp_path / "z.geojson"
+    path.write_text(text.replace("-3.19,", f"{value},", 1))
+    refused(path, "feature 0 ('zone'): coordinates must be finite numbers, found NaN or "
+            "Infinity (or one too large, such as 1e999)")
+
+
+@pytest.mark.parametrize("doc, words", [
+    (ZONE, "expected a GeoJSON FeatureCollection; got one Feature (wrap it: "
+           "{\"type\": \"FeatureCollection\", \"features\": [...]})"),
+    (ZONE["geometry"], "expected a GeoJSON FeatureCollection; got a bare Polygon (make it "
+                       "the geometry of a Feature in one)"),
+    ({"type": "FeatureCollection", "features": {}},
+     "expected a GeoJSON FeatureCollection; its 'features' is not a list of features"),
+    ([ZONE], "expected a GeoJSON FeatureCollection; got a JSON array"),
+    ({"zones": [ZONE]}, "expected a GeoJSON FeatureCollection; got a JSON object with no "
+                        "GeoJSON 'type'"),
+])
+def test_a_document_that_is_not_a_feature_collection_says_what_it_is(tmp_path, doc, words):
+    path = tmp_path / "z.geojson"
+    path.write_text(json.dumps(doc))
+    assert refused(path, words) == f"{path}: {words}"
+
+
+def test_plan_world_on_zones_with_heights_in_degrees(monkeypatch, capsys, tmp_path):
+    path = write(tmp_path / "z.geojson", lifted(ZONE), lifted(AREA))
+    code, out, err = run(monkeypatch, capsys, "plan-world", str(path), "--frame", "degrees",
+                         "--start=-3.1945,55.9405", "--goal=-3.1855,55.9495", "--json")
+    assert code == 0 and err == "" and json.loads(out)["status"] == "found"

@@ -128,6 +128,26 @@ def test_segment_file_with_a_byte_order_mark_reads_as_without(tmp_path, header):
     np.testing.assert_array_equal(load_map(bom).blocked, load_map(plain).blocked)
 
 
+@pytest.mark.parametrize("lead", ["# walls of the hall\n", "\n\n", "# a\n\n  \n# b\n",
+                                  "#x1,y1,x2,y2\n"])
+@pytest.mark.parametrize("header", ["x1,y1,x2,y2\n", "X1, Y1, X2, Y2\n", ""])
+def test_a_header_under_comments_or_blank_lines_is_still_the_header(tmp_path, lead, header):
+    # under a '# walls' line the header was read as a wall of words: "walls.csv:2:
+    # x1,y1,x2,y2 must be numbers, got ['x1', 'y1', 'x2', 'y2']"
+    rows = "0,0,2,0\n2,0,2,2\n"
+    plain, odd = tmp_path / "walls.csv", tmp_path / "odd.csv"
+    plain.write_text(rows)
+    odd.write_text(lead + header + rows)
+    np.testing.assert_array_equal(load_map(odd).blocked, load_map(plain).blocked)
+
+
+def test_a_header_is_read_only_once(tmp_path):
+    p = tmp_path / "walls.csv"
+    p.write_text("# walls\nx1,y1,x2,y2\n0,0,2,0\nx1,y1,x2,y2\n")
+    with pytest.raises(InputFormatError, match=r"walls\.csv:4: x1,y1,x2,y2 must be numbers"):
+        load_map(p)
+
+
 def test_png_dark_pixels_are_blocked(tmp_path):
     img = np.full((3, 4), 255, np.uint8)
     img[1, 2] = 0

@@ -26,7 +26,7 @@ def test_terrain_characters_and_cell_order(tmp_path):
 
 
 @pytest.mark.parametrize("variant", ["crlf", "no-final-newline", "crlf-no-final", "bom",
-                                     "bom-crlf", "blank-end", "spaces-end"])
+                                     "bom-crlf", "blank-end", "spaces-end", "tab-in-type"])
 def test_line_endings(tmp_path, variant):
     text = SMALL
     if "crlf" in variant:
@@ -36,6 +36,8 @@ def test_line_endings(tmp_path, variant):
     if variant.startswith("bom"):  # Notepad's "UTF-8 with BOM"
         text = "\ufeff" + text
     text += {"blank-end": "\n\n", "spaces-end": "  \n\t\n"}.get(variant, "")
+    if variant == "tab-in-type":  # as 'height\t3' always was
+        text = text.replace("type octile", "type\toctile ")
     g = read_map(write(tmp_path, text))
     np.testing.assert_array_equal(g.blocked, read_map(write(tmp_path, SMALL, "b.map")).blocked)
 
@@ -88,7 +90,9 @@ def test_scen_columns_and_tolerance(tmp_path):
 @pytest.mark.parametrize("text, line, words", [
     ("version 2\n", 1, "version 1"),
     ("version 1\n0\tm.map\t4\t3\t0\t0\t3\t0\n", 2, "9 tab-separated"),
-    ("version 1\n0 m.map 4 3 0 0 3 0 3.0\n", 2, "9 tab-separated"),
+    ("version 1\n0 m.map 4 3 0 0 3 0 3.0\n", 2,
+     "9 tab-separated columns, got 1 (its columns are separated by spaces)"),
+    ("version 1\n0 m.map 4 3 0 0 3 0\n", 2, "9 tab-separated columns, got 1"),
     ("version 1\n0\tm.map\t4\t3\ta\t0\t3\t0\t3.0\n", 2, "integers"),
     ("version 1\n0\tm.map\t4\t3\t0\t0\t4\t0\t3.0\n", 2, "outside"),
     ("version 1\n0\tm.map\t4\t3\t0\t0\t3\t0\t3.0\n0\tm.map\t5\t3\t0\t0\t3\t0\t3.0\n", 3,

@@ -68,8 +68,11 @@ def db_import(
     """Load orders and their items; orders already stored as in the files are left as they
     are, and orders stored otherwise are an error unless --replace."""
     from skyroute.delivery.days import open_store
+    from skyroute.delivery.orders import read_csv_orders
 
-    n, got = import_folder(open_store(db), data, replace=replace)
+    # read before the store is opened: malformed files leave no new store behind
+    orders = read_csv_orders(data)
+    n, got = import_folder(open_store(db), data, replace=replace, orders=orders)
     plain_console().print(f"{safe_url(db)}: {got.added:,} orders added, {n - got.added:,} "
                           f"already there ({got.had + got.added:,} stored)" + replaced(got),
                           soft_wrap=True)

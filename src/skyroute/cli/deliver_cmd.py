@@ -82,6 +82,9 @@ def deliver_command(
                   plot=draw)
     src = open_source(data, source)
     site = load_site(src)
+    # the order files read before the store is opened: a malformed orders.csv left a new
+    # store (its file, its folder, its tables) behind
+    orders = read_csv_orders(data) if data is not None else []
     engine = open_store(db)
     # the executor before any work: a wrong --dask address fails at once
     with open_from_flags(executor, dask, jobs, (d1 - d0).days + 1) as ex:
@@ -92,7 +95,6 @@ def deliver_command(
         # the orders each day will have once the files are imported: the files' own for a
         # day they give (the import adds them, or refuses a day stored otherwise), else
         # the stored ones; checked against the site's menus before anything is written
-        orders = read_csv_orders(data) if data is not None else []
         given: dict[dt.date, list] = {}
         for o in orders:
             if d0 <= o.date <= d1:

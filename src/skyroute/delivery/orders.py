@@ -76,10 +76,14 @@ def _rows(path: Path, header: list[str]):
         raise InputFormatError(path, "no such file")
     reader = csv.reader(io.StringIO(read_text(path)))  # a byte-order mark read past
     first = next(reader, None)
-    if first != header:
+    if first is None:
+        raise InputFormatError(path, f"the file is empty; expected the header "
+                               f"{','.join(header)}", line=1)
+    # spaces around a name are read past, as around a value ("orderNo, deliveryDate")
+    if [v.strip() for v in first] != header:
         raise InputFormatError(path, f"header {first!r}; expected {header!r}", line=1)
     for row in reader:
-        if not row:
+        if not any(v.strip() for v in row):  # a blank line, or one of spaces only
             continue
         if len(row) != len(header) or not all(v.strip() for v in row):
             raise InputFormatError(path, f"expected {len(header)} non-empty fields "

@@ -109,10 +109,11 @@ def read_csv(path: str | Path, scenario: Scenario) -> Stream:
                     raise InputFormatError(p, f"more than {MAX_PACKAGES:,.0f} packages, the "
                                            "limit of one run; split the file", line=line)
                 rows.append(_row(p, line, rec, ids))
-    except OSError as exc:
-        raise InputFormatError(p, f"cannot read: {exc}") from None
-    except UnicodeDecodeError as exc:
-        raise InputFormatError(p, f"not text: {exc}") from None
+    except OSError as exc:  # strerror: the file is named once, not twice
+        raise InputFormatError(p, f"cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:  # as files.read_text words it for every other file
+        raise InputFormatError(p, f"cannot read: not UTF-8 text ({exc.reason} at byte "
+                               f"{exc.start})") from None
     if not rows:
         return _stream(*(np.empty(0) for _ in range(5)))
     return _stream(*zip(*rows, strict=True))

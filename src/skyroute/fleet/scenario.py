@@ -309,7 +309,7 @@ def load_scenario(path: str | Path) -> Scenario:
         import yaml
 
         try:
-            data = yaml.safe_load(text)
+            data = yaml.load(text, Loader=_unique_keys_loader())
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             raise InputFormatError(p, f"not YAML: {getattr(exc, 'problem', exc)}",
@@ -318,6 +318,32 @@ def load_scenario(path: str | Path) -> Scenario:
         raise InputFormatError(p, f"unknown scenario type {p.suffix!r}; valid: .yaml, .yml, "
                                ".toml")
     return parse_scenario(data, p)
+
+
+def _unique_keys_loader():
+    """PyYAML's SafeLoader, refusing a key given twice in one mapping: it kept the last
+    silently, so a second ``drones: 9`` further down overrode the first unseen."""
+    import yaml
+
+    class UniqueKeys(yaml.SafeLoader):
+        def construct_mapping(self, node, deep=False):
+            seen = set()
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":  # '<<: *defaults' may be
+                    continue                                  # overridden key by key
+                key = self.construct_object(key_node, deep=deep)
+                try:
+                    again = key in seen
+                except TypeError:  # an unhashable key: construct_mapping names it
+                    break
+                if again:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"key {key!r} given twice in one mapping",
+                        key_node.start_mark)
+                seen.add(key)
+            return super().construct_mapping(node, deep=deep)
+
+    return UniqueKeys
 
 
 def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
@@ -330,7 +356,10 @@ def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
     try:
         s = Scenario.model_validate(data)
     except ValidationError as exc:
-        err = exc.errors()[0]
+        errors = exc.errors()
+        # a misspelt key first: "Airports:" was reported as "airports: Field required",
+        # which hid the typo that caused it
+        err = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
         field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err["loc"])
         msg = err["msg"].removeprefix("Value error, ")
         if err["type"] == "extra_forbidden":  # a typo: say what the section takes

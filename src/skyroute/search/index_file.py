@@ -67,7 +67,11 @@ def read_index(path: Path, blocked: np.ndarray, name: str) -> tuple[str, dict]:
         raise InputFormatError(path, not_index) from None
     if data is None:
         raise InputFormatError(path, not_index)
-    method = _scalar(path, data, "method", str) if "method" in data else ""
+    if "method" not in data:  # another program's .npz: say what it holds instead
+        held = ", ".join(sorted(data)[:5]) + (", ..." if len(data) > 5 else "")
+        raise InputFormatError(path, "not a skyroute index: it has no 'method' entry "
+                               f"(its arrays: {held or 'none'})")
+    method = _scalar(path, data, "method", str)
     if method not in INDEX_ARRAYS:
         raise InputFormatError(path, f"not a skyroute index: method {method!r}")
     missing = [k for k in ("version", "shape", "digest", *INDEX_ARRAYS[method])

@@ -29,7 +29,9 @@ from skyroute.world.world import World
 HEADER = "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ"
 MAX_BOXES = 50_000  # 13 times the FCND city's
 MAX_BYTES = 10_000_000  # 200 bytes a box line (FCND's are 35); a file is read whole
-_HOME = re.compile(r"^\s*lat0\s+(-?[\d.]+)\s*,\s*lon0\s+(-?[\d.]+)\s*$")
+# any float Python reads (a sign, an exponent) and any case: float() and the range
+# check below judge the numbers; "lat0 +37.79" and "LAT0 ..." were refused as malformed
+_HOME = re.compile(r"^\s*lat0\s+([^\s,]+)\s*,\s*lon0\s+([^\s,]+)\s*$", re.IGNORECASE)
 
 
 def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonlat",
@@ -49,9 +51,9 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
     lat0, lon0 = _home(path, lines[0] if lines else None)
     if not (-90 <= lat0 <= 90 and -180 <= lon0 <= 180):
         raise InputFormatError(path, f"home lat0 {lat0}, lon0 {lon0} is not a place", line=1)
-    if len(lines) < 2 or lines[1].replace(" ", "") != HEADER:
+    if len(lines) < 2 or "".join(lines[1].split()).lower() != HEADER.lower():
         raise InputFormatError(path, f"expected the header {HEADER!r}", line=2)
-    rows = []
+    rows, numbers = [], []
     for n, line in enumerate(lines[2:], start=3):
         if not line.strip():
             continue
@@ -69,20 +71,21 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
             raise InputFormatError(path, f"the box reaches more than {MAX_METRES:.0e} m from "
                                    "home", line=n)
         rows.append(vals)
+        numbers.append(n)
     if not rows:
         raise InputFormatError(path, "no boxes after the header", line=3)
     b = np.array(rows)
     north, east, up, hn, he, hu = b.T
     s = float(safety)
     boxes = shapely.box(east - he - s, north - hn - s, east + he + s, north + hn + s)
-    names = tuple(f"box at line {n}" for n in range(3, 3 + len(rows)))
+    # each box named by its own line: after a blank line, counting boxes named the next
+    names = tuple(f"box at line {n}" for n in numbers)
     return World(boxes, up - hu - s, up + hu + s, names, None, frame,
                  Home(lon0, lat0, 0.0), name=path.name, source=source)
 
 
 def _home(path: Path, line: str | None) -> tuple[float, float]:
-    """(lat0, lon0) from line 1, ``lat0 <deg>, lon0 <deg>`` (None: an empty file); the
-    pattern admits digits and dots, so "37.79.2480" still fails to convert."""
+    """(lat0, lon0) from line 1, ``lat0 <deg>, lon0 <deg>`` (None: an empty file)."""
     m = _HOME.match(line) if line is not None else None
     try:
         if m is None:

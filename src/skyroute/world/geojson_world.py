@@ -41,7 +41,20 @@ def _features(path: Path | str, text: str | None = None) -> list[dict]:
         raise InputFormatError(path, f"not JSON: {exc.msg}", line=exc.lineno) from None
     if not isinstance(doc, dict) or doc.get("type") != "FeatureCollection" or \
             not isinstance(doc.get("features"), list):
-        raise InputFormatError(path, "expected a GeoJSON FeatureCollection")
+        kind = doc.get("type") if isinstance(doc, dict) else None
+        if kind == "FeatureCollection":
+            got = "its 'features' is not a list of features"
+        elif kind == "Feature":
+            got = ("got one Feature (wrap it: {\"type\": \"FeatureCollection\", "
+                   "\"features\": [...]})")
+        elif isinstance(kind, str) and kind:
+            got = f"got a bare {kind} (make it the geometry of a Feature in one)"
+        elif isinstance(doc, dict):
+            got = "got a JSON object with no GeoJSON 'type'"
+        else:
+            got = "got a JSON " + {list: "array", str: "string", bool: "boolean",
+                                   type(None): "null"}.get(type(doc), "number")
+        raise InputFormatError(path, f"expected a GeoJSON FeatureCollection; {got}")
     return doc["features"]
 
 
@@ -57,8 +70,14 @@ def _polygon(path: Path, i: int, feature: dict) -> tuple[shapely.Geometry, str]:
             "has a geometry with no type"
         raise InputFormatError(path, f"feature {i} ({name!r}) {what}; only Polygon and "
                                "MultiPolygon features are zones")
+    try:  # NaN, Infinity (Python's json reads them) and 1e999 are no JSON numbers
+        text = json.dumps(geom, allow_nan=False)
+    except ValueError:
+        raise InputFormatError(path, f"feature {i} ({name!r}): coordinates must be finite "
+                               "numbers, found NaN or Infinity (or one too large, "
+                               "such as 1e999)") from None
     try:
-        shape = shapely.from_geojson(json.dumps(geom))
+        shape = shapely.from_geojson(text)
     except shapely.errors.GEOSException as exc:
         raise InputFormatError(path, f"feature {i} ({name!r}): bad coordinates: {exc}") from None
     if shape.is_empty:

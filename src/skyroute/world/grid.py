@@ -17,7 +17,7 @@ from functools import cached_property
 
 import numpy as np
 
-from skyroute.errors import OptionError, QueryError, real, renamed
+from skyroute.errors import InputFormatError, OptionError, QueryError, real, renamed
 from skyroute.world.points import plane_points
 
 NAN_HINT = "use 0 for free and non-zero for blocked"
@@ -199,3 +199,15 @@ def raster_shape(xspan: float, yspan: float, resolution: float) -> tuple[int, in
                           f"makes {size}, above {MAX_CELLS:,}; use a coarser resolution",
                           param="resolution")
     return max(1, math.ceil(w)), max(1, math.ceil(h))
+
+
+def check_file_cells(path: object, width: int, height: int, *, line: int | None = None,
+                     what: str = "the map") -> None:
+    """An InputFormatError naming ``path`` (and ``line``) when a ``width`` x ``height``
+    grid read from it would have more than :data:`MAX_CELLS` cells: the readers of map
+    files (.map headers, .npy headers, image sizes) call it before they allocate the grid,
+    so a header that claims 3 x 10**12 cells is one line, not numpy's MemoryError."""
+    if width * height > MAX_CELLS:
+        raise InputFormatError(path, f"{what} is {width:,} x {height:,} cells "
+                               f"({width * height:,}), over the limit of {MAX_CELLS:,} "
+                               "(8192 x 8192) a grid may have", line=line)

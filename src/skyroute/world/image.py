@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError
-from skyroute.world.grid import NAN_HINT, Grid, nan_cell
+from skyroute.world.grid import MAX_CELLS, NAN_HINT, Grid, check_file_cells, nan_cell
 
 NPY_MAGIC = b"\x93NUMPY"
 
@@ -29,11 +29,24 @@ def read_image(path: str | Path, *, resolution: float = 1.0, threshold: int = 12
     are scaled to 0-255 first (Pillow's RGBA conversion would clip them at 255, so
     nearly every pixel would read as bright); floating-point images are refused.
     """
+    import warnings
+
     from PIL import Image, UnidentifiedImageError
 
     path = Path(path)
     try:
-        with Image.open(path) as img:
+        with warnings.catch_warnings():  # Pillow's DecompressionBombWarning: refused below
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            img = Image.open(path)
+    except Image.DecompressionBombError as exc:  # its header's size, over 2 x Pillow's limit
+        raise InputFormatError(path, f"{exc} (a grid may have at most {MAX_CELLS:,} "
+                               "cells, 8192 x 8192)") from None
+    except (OSError, UnidentifiedImageError) as exc:
+        raise InputFormatError(path, f"cannot read as an image: {exc}") from None
+    try:
+        with img:
+            # the header's size, before a pixel is decoded: a small PNG can claim 10**10
+            check_file_cells(path, *img.size, what="the image")
             if img.mode.startswith("I"):  # 16-bit grey ("I;16", or "I" holding it)
                 return Grid(_sixteen_bit(path, np.asarray(img)) < threshold, resolution,
                             name=path.name)
@@ -66,6 +79,8 @@ def read_npy(path: str | Path, *, resolution: float = 1.0) -> Grid:
                 raise InputFormatError(path, "not a .npy file (numpy.save writes one; it "
                                        "starts with \\x93NUMPY)")
             fh.seek(0)
+            _check_npy_shape(path, fh)
+            fh.seek(0)
             arr = np.load(fh, allow_pickle=False)
     except InputFormatError:
         raise
@@ -79,3 +94,17 @@ def read_npy(path: str | Path, *, resolution: float = 1.0) -> Grid:
     if (cell := nan_cell(arr)) is not None:
         raise InputFormatError(path, f"NaN at cell {cell} (x, y); {NAN_HINT}")
     return from_array(arr, resolution=resolution, name=path.name)
+
+
+def _check_npy_shape(path: Path, fh) -> None:
+    """Refuse a .npy file whose header's shape is not 2-D or passes MAX_CELLS, before
+    np.load allocates it: a 200-byte file claiming (10**6, 10**6) was numpy's
+    MemoryError. (Format 3.0's header is laid out as 2.0's, UTF-8 in place of latin-1.)"""
+    from numpy.lib import format as npy
+
+    major, _ = npy.read_magic(fh)
+    read = npy.read_array_header_1_0 if major == 1 else npy.read_array_header_2_0
+    shape = read(fh)[0]
+    if len(shape) != 2 or 0 in shape:
+        raise InputFormatError(path, f"expected a non-empty 2-D array, got shape {shape}")
+    check_file_cells(path, shape[1], shape[0], what="the array")

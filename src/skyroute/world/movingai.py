@@ -17,15 +17,22 @@ import numpy as np
 
 from skyroute.errors import InputFormatError
 from skyroute.files import strip_bom
-from skyroute.world.grid import Grid
+from skyroute.world.grid import MAX_CELLS, Grid, check_file_cells
 
 PASSABLE = ".GS"
 BLOCKED = "@OTW"
+# the largest file a map within MAX_CELLS can be: one byte a cell, a CRLF a row (rows of
+# one cell: 3 bytes a cell), the header and some blank lines; a larger file is refused
+# before it is read whole
+MAX_BYTES = 3 * MAX_CELLS + (1 << 20)
 
 
-def _lines(path: Path, raw: bytes | None = None) -> list[str]:
+def _lines(path: Path, raw: bytes | None = None, kind: str = "a map file") -> list[str]:
     if raw is None:
         try:
+            if (size := path.stat().st_size) > MAX_BYTES:
+                raise InputFormatError(path, f"{size:,} bytes, over the limit of "
+                                       f"{MAX_BYTES:,} for {kind}")
             raw = path.read_bytes()
         except OSError as exc:
             raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
@@ -64,11 +71,13 @@ def read_map(path: str | Path, *, text: str | bytes | None = None) -> Grid:
     """
     path = Path(path)
     lines = _lines(path, text.encode("utf-8") if isinstance(text, str) else text)
-    if not lines or lines[0].strip() != "type octile":
+    if not lines or lines[0].split() != ["type", "octile"]:
         got = lines[0].strip() if lines else "an empty file"
         raise InputFormatError(path, f"expected 'type octile', got {got!r}", line=1)
     height = _header_int(path, lines, 1, "height")
     width = _header_int(path, lines, 2, "width")
+    # before the grid is allocated: 'width 1000000000000' was numpy's MemoryError
+    check_file_cells(path, width, height, line=3, what="the header's map")
     if len(lines) < 4 or lines[3].strip() != "map":
         got = lines[3].strip() if len(lines) > 3 else "end of file"
         raise InputFormatError(path, f"expected 'map', got {got!r}", line=4)
@@ -132,7 +141,7 @@ def query_line(path: str | Path, index: int) -> int | None:
     :func:`read_scen` counts it (blank lines skipped); for error messages. None when the
     file cannot be read."""
     try:
-        lines = _lines(Path(path))
+        lines = _lines(Path(path), kind="a scenario file")
     except InputFormatError:
         return None
     numbers = [n for n, line in enumerate(lines[1:], start=2) if line.strip()]
@@ -142,7 +151,7 @@ def query_line(path: str | Path, index: int) -> int | None:
 def read_scen(path: str | Path) -> Scenario:
     """Read a MovingAI ``.scen`` file (``version 1``, 9 tab-separated columns)."""
     path = Path(path)
-    lines = _lines(path)
+    lines = _lines(path, kind="a scenario file")
     if not lines or lines[0].strip() not in ("version 1", "version 1.0"):
         got = lines[0].strip() if lines else "an empty file"
         raise InputFormatError(path, f"expected 'version 1', got {got!r}", line=1)
@@ -153,8 +162,10 @@ def read_scen(path: str | Path) -> Scenario:
             continue
         cols = line.split("\t")
         if len(cols) != 9:
-            raise InputFormatError(path, f"expected 9 tab-separated columns, got {len(cols)}",
-                                   line=n)
+            spaced = " (its columns are separated by spaces)" if len(line.split()) == 9 \
+                else ""
+            raise InputFormatError(path, f"expected 9 tab-separated columns, got "
+                                   f"{len(cols)}{spaced}", line=n)
         try:
             nums = [int(c) for c in (cols[0], *cols[2:8])]
             length = float(cols[8])

@@ -87,11 +87,14 @@ def _too_large(path: Path, seg: np.ndarray, lines: list[int], resolution: float,
 def _read(path: Path) -> tuple[np.ndarray, list[int]]:
     """(N, 4) segments and the line each came from."""
     text = read_text(path)
-    rows, lines = [], []
+    rows, lines, first = [], [], True
     for n, row in enumerate(csv.reader(text.splitlines()), start=1):
         if not row or all(not c.strip() for c in row) or row[0].lstrip().startswith("#"):
             continue
-        if n == 1 and row[0].strip().lower() in ("x1", "x0", "x"):
+        # the header is the first row that is neither blank nor a comment (under a
+        # '# walls' line it was refused as a wall of words)
+        header, first = first, False
+        if header and row[0].strip().lower() in ("x1", "x0", "x"):
             continue
         if n == 1 and row[0].strip().lower().startswith(("lat0", "lon0")):
             raise CityNotWallsError(path, f"{CITY}: load it with skyroute.load_world", line=1)

@@ -45,6 +45,19 @@ AXES = {"lonlat": ("lon", "lat"), "degrees": ("lon", "lat"), "ned": ("north", "e
         "enu": ("x", "y")}
 
 
+def _flat(geoms):
+    """Geometries (one, or an object array) without their z: a GeoJSON zone may carry a
+    height per vertex ([lon, lat, alt]), which the plane ignores (floors and ceilings
+    say the heights), and a 3-D ring failed in the visibility graph's corner code
+    (numpy's "array dimensions ... must match"). Anything not a geometry is left as it
+    is, for the planners to refuse."""
+    try:
+        has_z = bool(np.any(shapely.has_z(geoms)))
+    except TypeError:
+        return geoms
+    return shapely.force_2d(geoms) if has_z else geoms
+
+
 @dataclass(frozen=True, eq=False)
 class World:
     """Polygon obstacles (with floors and ceilings), a boundary, a frame and a home.
@@ -87,7 +100,9 @@ class World:
         names = tuple(self.names) if self.names else tuple(f"obstacle {i}" for i in range(n))
         if len(names) != n:
             raise OptionError(f"{len(names)} names for {n} obstacles")
-        object.__setattr__(self, "obstacles", obs)
+        object.__setattr__(self, "obstacles", _flat(obs))
+        if self.boundary is not None:
+            object.__setattr__(self, "boundary", _flat(self.boundary))
         object.__setattr__(self, "floors", floors)
         object.__setattr__(self, "ceilings", ceilings)
         object.__setattr__(self, "names", names)
