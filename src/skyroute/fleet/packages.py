@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from skyroute.errors import InputFormatError, OptionError, real, whole
+from skyroute.errors import InputFormatError, OptionError, check_seed, real
 from skyroute.files import open_text
 from skyroute.fleet.limits import MAX_PACKAGES, expected_packages
 from skyroute.fleet.scenario import Scenario
@@ -72,7 +72,7 @@ def poisson(scenario: Scenario, *, hours: float, seed: int = 0,
         raise OptionError(f"rate_per_hour={rate:g} with hours={h:g} would spawn about "
                           f"{n:.2g} packages (limit {MAX_PACKAGES:,g}); lower one of them",
                           param=("rate_per_hour", "hours"))
-    rng = np.random.default_rng(whole("seed", seed, low=0))
+    rng = np.random.default_rng(check_seed(seed))
     horizon = h * 3600.0
     if rate == 0:
         n = 0

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skyroute.errors import OptionError, SkyrouteError, check_choice, real, whole
+from skyroute.errors import OptionError, SkyrouteError, check_choice, check_seed, real
 from skyroute.fleet import dispatch, packages
 from skyroute.fleet.airborne import MAX_LOITERS, too_long
 from skyroute.fleet.airspace import (
@@ -153,7 +153,7 @@ def simulate(scenario: Scenario, stream: Stream, *, hours: float, seed: int = 0,
     h = real("hours", hours, low=0.0, strict=True)
     check_levels(scenario, mode)
     check_joined(scenario)  # airports no cruise joins: refused now, not mid-run
-    run = Simulation(scenario, stream, h, whole("seed", seed, low=0), scheduler, mode)
+    run = Simulation(scenario, stream, h, check_seed(seed), scheduler, mode)
     wall = time.perf_counter()
     _Engine(run, progress).go()
     run.wall_seconds = time.perf_counter() - wall

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from skyroute.errors import QueryError, real, whole
+from skyroute.errors import QueryError, check_seed, real, whole
 from skyroute.motion import hybrid
 from skyroute.motion.dubins_kernel import TURNS, shortest_length, words
 from skyroute.motion.pieces import chain, check_samples, sample
@@ -123,7 +123,7 @@ def tour(start_pose, targets, radius: float, *, world: World | None = None,
     radius = real("radius", radius, low=0.0, strict=True)  # numpy numbers too
     headings = whole("headings", headings, low=1, high=72)
     exact_limit = whole("exact_limit", exact_limit, low=0)
-    seed = whole("seed", seed, low=0)  # as hybrid.plan reads it (also when no leg needs it)
+    seed = check_seed(seed)  # as hybrid.plan reads it (also when no leg needs it)
     start = as_points(start_pose, "start_pose", dims=3)[0]
     pts = as_points(targets, "targets")
     if len(pts) == 0:
