@@ -48,8 +48,10 @@ def plan_world_command(
     seed: Annotated[int | None, typer.Option(
         min=0, max=SEED_MAX, help="PRM random seed (default 0).")] = None,
     waypoints_out: Annotated[Path | None, typer.Option(
-        "--waypoints", help=escape("Write [[north, east, altitude, heading], ...] JSON here."))] =
-        None,
+        "--waypoints", help=escape(
+            "Write [[north, east, altitude, heading], ...] JSON here: FCND waypoints, metres "
+            "from home, heading in radians clockwise from north (not degrees, as the CLI "
+            "reads headings elsewhere)."))] = None,
     geojson: Annotated[Path | None, typer.Option(help="Write the path as lon/lat GeoJSON.")] =
         None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG map here.")] = None,

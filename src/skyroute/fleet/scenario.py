@@ -94,7 +94,8 @@ def _first_bool(v) -> bool | None:
 class Runway(_Strict):
     """A straight runway through its airport's position."""
 
-    heading_deg: float = Field(ge=0, lt=360, description="compass heading of travel")
+    heading_deg: float = Field(ge=0, lt=360, description="compass heading of travel: "
+                               "degrees clockwise from north")
     length: float = Field(default=600.0, gt=0, description="metres")
 
 

@@ -122,7 +122,8 @@ class PlanAnswer(BaseModel):
     path_lonlat: list[Pair] | None = None
     frame: str | None = None
     waypoints: list[list[float]] | None = Field(
-        None, description="Worlds: [north, east, altitude, heading] per point (FCND).")
+        None, description="Worlds: [north, east, altitude, heading] per point (FCND): metres "
+        "from home, heading in radians clockwise from north along the track into the point.")
     geojson: dict | None = None
 
 
