@@ -127,6 +127,19 @@ def flag(name: str, value: object) -> bool:
     return bool(value)
 
 
+SEED_MAX = 2**32 - 1
+"""The largest seed. numba's generator (Hybrid A*'s shortcutting) and numpy's legacy one
+take 32 bits, so a larger seed would give a smaller one's stream (2**32 flew as 0): every
+``seed`` in skyroute, Python, CLI and service alike, is one integer from 0 to this."""
+
+
+def check_seed(value: object, name: str = "seed") -> int:
+    """``value`` as a seed: an integer from 0 to :data:`SEED_MAX`, else an
+    :class:`OptionError` naming ``name`` (``seed=4294967296 must be an integer from 0 to
+    4,294,967,295``), the same message wherever a seed is read."""
+    return whole(name, value, low=0, high=SEED_MAX)
+
+
 NO_BUDGET = 2**63 - 1  # max_expansions=None: no budget (an int64 for the kernels)
 
 

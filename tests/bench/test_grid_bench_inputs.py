@@ -184,7 +184,7 @@ def test_duplicates_run_once_in_the_order_given(monkeypatch, capsys, tmp_path):
     (["--algorithms", "bogus", "--peers", ""], "--algorithms 'bogus' is not valid; choose"),
     (["--random", "16:0.2", "--per-map", "0", "--peers", ""],
      "--per-map 0 (every scenario line) has no meaning for random maps"),
-    (["--seed", "-1", "--peers", ""], "'--seed': -1 is not in the range x>=0"),
+    (["--seed", "-1", "--peers", ""], "'--seed': -1 is not in the range 0<=x<=4294967295"),
 ])
 def test_bad_options_name_the_real_flag(monkeypatch, capsys, no_timing, args, words):
     code, out, err = run(monkeypatch, capsys, "bench", "grid", *args)

@@ -147,7 +147,7 @@ def test_negative_seeds_are_one_line_errors(monkeypatch, capsys, tmp_path, args)
 
 
 def test_parse_seeds_refuses_negatives():
-    with pytest.raises(OptionError, match="negative"):
+    with pytest.raises(OptionError, match="-1 is not in the range 0<=x<=4294967295"):
         parse_seeds("3,-1")
 
 

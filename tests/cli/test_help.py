@@ -53,7 +53,9 @@ def test_plan_world_help_shows_the_waypoint_format():
     result = CliRunner().invoke(app, ["plan-world", "--help"], env={"COLUMNS": "200",
                                                                     "TERMINAL_WIDTH": "200"})
     assert result.exit_code == 0, result.output
-    assert "Write [[north, east, altitude, heading], ...] JSON here." in result.output
+    assert "Write [[north, east, altitude, heading], ...] JSON here" in result.output
+    # the file's heading is FCND's, radians; the CLI reads headings in degrees elsewhere
+    assert "heading in radians clockwise from north" in " ".join(result.output.split())
 
 
 @pytest.mark.parametrize("path,cmd", COMMANDS, ids=[" ".join(p) or "skyroute" for p, _ in COMMANDS])

@@ -149,3 +149,30 @@ def test_bench_tables_are_160_columns_in_a_pipe(monkeypatch, capsys):
     assert code == 0, err
     assert "not shown" not in out and "M exp/s" in out and "networkx (peer)" in out, out
     assert 80 < max(len(line) for line in out.splitlines()) <= 160
+
+
+@pytest.mark.parametrize("columns, width", [("80", 80), ("200", 200), (None, 160),
+                                            ("wide", 160), ("0", 160)])
+def test_wide_tables_honour_columns_in_a_pipe(monkeypatch, columns, width):
+    """$COLUMNS, when set, is the width of the wide tables too: 'COLUMNS=80 skyroute bench
+    grid ... | cat' printed 160 columns. Unset (or not a width, as Rich reads it): 160."""
+    from skyroute.cli.tables import wide_console
+
+    if columns is None:
+        monkeypatch.delenv("COLUMNS", raising=False)
+    else:
+        monkeypatch.setenv("COLUMNS", columns)
+    assert wide_console().width == width
+
+
+@pytest.mark.parametrize("columns", ["72", "130"])
+def test_fleet_sweep_table_is_as_wide_as_columns(monkeypatch, capsys, columns):
+    monkeypatch.setenv("COLUMNS", columns)
+    code, out, err = run(monkeypatch, capsys, "fleet", "sweep", "--preset", "seed-3x3",
+                         "--seeds", "0-1", "--hours", "0.1", "--jobs", "1")
+    assert code == 0, err
+    widths = [len(line) for line in out.splitlines()]
+    # the title is centred over the table: its line is the table's width
+    assert max(widths) <= int(columns) and "served" in out, out
+    if columns == "72":
+        assert "not shown at 72 columns" in out

@@ -82,7 +82,7 @@ def test_fleet_and_sweep_params_are_completed():
 @pytest.mark.parametrize("params, words", [
     ({}, "give exactly one of preset (a name) or scenario (its fields)"),
     ({"preset": "seed-3x3", "scenario": {}}, "give exactly one of preset"),
-    ({"preset": "seed-3x3", "seed": -1}, "seed=-1 must be an integer >= 0"),
+    ({"preset": "seed-3x3", "seed": -1}, "seed=-1 must be an integer from 0 to 4,294,967,295"),
     ({"preset": "seed-3x3", "seed": True}, "seed=True must be an integer"),
     ({"preset": "seed-3x3", "rate_per_hour": "many"}, "rate_per_hour='many' must be a number"),
     ({"preset": "seed-3x3", "track_step": 0}, "track_step=0 must be a number > 0"),

@@ -532,7 +532,7 @@ def test_hybrid_refuses_a_negative_seed_as_every_other_seed_is():
     # fleet runs and the data synthesis refuse it
     with pytest.raises(OptionError) as err:
         plan(_tower(), (0, 2, 0), (5, 2, 0), 0.5, seed=-1)
-    assert str(err.value) == "seed=-1 must be an integer >= 0"
+    assert str(err.value) == "seed=-1 must be an integer from 0 to 4,294,967,295"
 
 
 def test_runway_goal_names_a_bad_heading():

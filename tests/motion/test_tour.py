@@ -78,7 +78,7 @@ def test_tour_among_obstacles_flies_free_hybrid_legs():
     ({"start_pose": (0, 0)}, skyroute.QueryError, "start_pose"),
     ({"headings": 0}, skyroute.OptionError, "headings=0"),
     # a negative seed was taken, where PRM, the fleet runs and the data synthesis refuse it
-    ({"seed": -1}, skyroute.OptionError, "^seed=-1 must be an integer >= 0$"),
+    ({"seed": -1}, skyroute.OptionError, "^seed=-1 must be an integer from 0 to 4,294,967,295$"),
 ])
 def test_bad_input(kwargs, error, words):
     args = {"start_pose": (0, 0, 0), "targets": [(10, 10)], "radius": 5.0, **kwargs}

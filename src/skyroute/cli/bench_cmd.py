@@ -25,7 +25,7 @@ from skyroute.bench.peers import PEERS, skip_reason
 from skyroute.bench.random_maps import parse_random
 from skyroute.cli.parse import parse_list
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
-from skyroute.errors import OptionError
+from skyroute.errors import SEED_MAX, OptionError
 from skyroute.files import check_writable, write_atomic
 from skyroute.world.load import bundled_maps
 
@@ -48,7 +48,8 @@ def bench_grid(
                                        "note, on maps over 2048x2048 cells (its graph needs "
                                        "about 1.5 KB a cell).")] =
         "pyastar2d,pathfinding,networkx",
-    seed: Annotated[int, typer.Option(min=0, help="Seed for sampling scenario lines.")] = 0,
+    seed: Annotated[int, typer.Option(
+        min=0, max=SEED_MAX, help="Seed for sampling scenario lines.")] = 0,
     random: Annotated[list[str] | None, typer.Option(
         help="Also a synthetic SIDE:SHARE map (repeatable), e.g. 512:0.2: SHARE of the cells "
              "blocked at random (numpy --seed), --per-map far queries with optima from "

@@ -13,7 +13,7 @@ from skyroute.bench.fleet import CASES, bench_case
 from skyroute.bench.machine import machine
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
-from skyroute.errors import OptionError, check_choice
+from skyroute.errors import SEED_MAX, OptionError, check_choice
 from skyroute.files import check_writable, write_atomic
 
 
@@ -24,7 +24,8 @@ def bench_fleet(
              "airports/1 h).")] = None,
     scheduler: Annotated[str, typer.Option(help="seed or optimal.")] = "optimal",
     airspace: Annotated[str, typer.Option(help="layers or shared.")] = "shared",
-    seed: Annotated[int, typer.Option(min=0, help="Seed of the package stream.")] = 0,
+    seed: Annotated[int, typer.Option(
+        min=0, max=SEED_MAX, help="Seed of the package stream.")] = 0,
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the rows here.")] =
         None,
 ) -> None:

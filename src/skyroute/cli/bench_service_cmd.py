@@ -13,7 +13,7 @@ from rich.table import Table
 
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.tables import plain_console, print_table, wide_console
-from skyroute.errors import OptionError, check_choice
+from skyroute.errors import SEED_MAX, OptionError, check_choice
 from skyroute.files import check_writable, write_atomic
 
 LOADS = ("plan", "flightpath")
@@ -40,7 +40,8 @@ def bench_service(
              "postgresql+psycopg://postgres@127.0.0.1:5432/test).")] = None,
     date: Annotated[str | None, typer.Option(help="Day for flightpath (default: the "
                                                   "first stored day with moves).")] = None,
-    seed: Annotated[int, typer.Option(min=0, help="Seed of the drawn scenario lines.")] = 0,
+    seed: Annotated[int, typer.Option(
+        min=0, max=SEED_MAX, help="Seed of the drawn scenario lines.")] = 0,
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the rows here.")] =
         None,
 ) -> None:

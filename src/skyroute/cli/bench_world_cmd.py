@@ -28,7 +28,7 @@ from skyroute.bench.world import (
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.parse import parse_items, parse_list
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
-from skyroute.errors import OptionError, SkyrouteError, check_choice
+from skyroute.errors import SEED_MAX, OptionError, SkyrouteError, check_choice
 from skyroute.files import check_writable, write_atomic
 from skyroute.motion.step_drone import MERGE
 
@@ -36,7 +36,8 @@ from skyroute.motion.step_drone import MERGE
 @bench_app.command("world")
 def bench_world(
     worlds: Annotated[int, typer.Option(min=0, help="Random 20-rectangle worlds.")] = 5,
-    seed: Annotated[int, typer.Option(min=0, help="Seed of the first world and its query.")] = 0,
+    seed: Annotated[int, typer.Option(
+        min=0, max=SEED_MAX, help="Seed of the first world and its query.")] = 0,
     city: Annotated[Path | None, typer.Option(
         help="Also a colliders.csv city (at --altitude, with --safety).")] = None,
     altitude: Annotated[float, typer.Option(help="City altitude (m).")] = 5.0,
@@ -175,7 +176,8 @@ def bench_motion(
         "--curvature", help="Hybrid A* vs OMPL RRT*/BIT* on seeded worlds (and --city), "
                             "then Dubins tours vs nearest-first.")] = False,
     worlds: Annotated[int, typer.Option(min=0, help="--curvature: seeded random worlds.")] = 10,
-    seed: Annotated[int, typer.Option(min=0, help="--curvature: seed of worlds and queries.")] = 0,
+    seed: Annotated[int, typer.Option(
+        min=0, max=SEED_MAX, help="--curvature: seed of worlds and queries.")] = 0,
     budgets: Annotated[str, typer.Option(
         help="--curvature: OMPL seconds per solve, comma-separated.")] = "1,5",
     city: Annotated[Path | None, typer.Option(

@@ -11,6 +11,7 @@ import typer
 from skyroute.cli.parse import parse_date
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console
+from skyroute.errors import SEED_MAX
 
 data_app = typer.Typer(help="Delivery data sets: synthesise one, serve one over HTTP.",
                        no_args_is_help=True)
@@ -24,7 +25,7 @@ def data_synth(
     customers: Annotated[int, typer.Option(help="Customers' delivery places.")] = 7,
     start: Annotated[str, typer.Option(help="First day, YYYY-MM-DD.")] = "2024-01-01",
     seed: Annotated[int, typer.Option(
-        min=0, help="Seed: the same seed writes the same files.")] = 1,
+        min=0, max=SEED_MAX, help="Seed: the same seed writes the same files.")] = 1,
     replace: Annotated[bool, typer.Option(
         "--replace", help="Write into DIR even when it is not empty (files of the same "
                           "names are replaced).")] = False,

@@ -13,7 +13,7 @@ from rich.table import Table
 from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
 from skyroute.cli.parse import parse_items
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
-from skyroute.errors import OptionError, check_choice, real
+from skyroute.errors import SEED_MAX, OptionError, check_choice, real
 from skyroute.fleet.limits import MAX_DRONES, MAX_RATE, MAX_SEEDS, check_run, check_sweep
 from skyroute.fleet.scenario import PRESETS, Scenario, generate, load_scenario, preset, to_yaml
 
@@ -32,8 +32,8 @@ Drones = Annotated[int | None, typer.Option(help="Number of drones (overrides th
 AreaKm = Annotated[float, typer.Option(help="Side of the square the airports are spread over "
                                             "(generated scenarios).")]
 Hours = Annotated[float, typer.Option(help="Simulated hours.")]
-Seed = Annotated[int, typer.Option(min=0, help="Seed of the package stream (and of a generated "
-                                        "scenario's layout).")]
+Seed = Annotated[int, typer.Option(min=0, max=SEED_MAX, help="Seed of the package stream "
+                                   "(and of a generated scenario's layout).")]
 
 
 def resolve_scenario(path: Path | None, preset_name: str | None, airports: int | None,
@@ -236,8 +236,9 @@ def parse_seeds(text: str) -> list[int]:
         out += range(lo, hi + 1)
     if not out:
         raise OptionError(f"--seeds {text!r}: no seed given")
-    if min(out) < 0:
-        raise OptionError(f"--seeds {text!r}: seed {min(out)} is negative; seeds are >= 0")
+    bad = next((x for x in out if not 0 <= x <= SEED_MAX), None)
+    if bad is not None:  # --seed's range and words (click's), for each seed of --seeds
+        raise OptionError(f"--seeds {text!r}: {bad} is not in the range 0<=x<={SEED_MAX}")
     seeds = list(dict.fromkeys(out))
     if len(seeds) > MAX_SEEDS:
         raise OptionError(f"--seeds {text!r}: {len(seeds):,} seeds, over the limit of "

@@ -92,7 +92,7 @@ def fly_command(
         "start_heading", "start heading, degrees in the frame's convention (clockwise from "
                          "north in lonlat and ned; anticlockwise from east in enu and "
                          "degrees); or give it as --start A,B,HEADING. dubins: free when "
-                         "left out; lattice: 0."))] = None,
+                         "left out, but 0 with --targets; lattice: 0."))] = None,
     goal_heading: Annotated[float | None, typer.Option(help=_for(
         "goal_heading", "heading at the goal (degrees), or --goal A,B,HEADING; free when "
                         "left out."))] = None,

@@ -4,6 +4,7 @@ progress shows."""
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
@@ -52,10 +53,19 @@ def plain_console(*, stderr: bool = False, width: int | None = None) -> Console:
 
 
 def wide_console() -> Console:
-    """Stdout for wide tables: at least 160 columns when it is a file or a pipe (where
-    Rich would otherwise wrap every cell at 80)."""
+    """Stdout for wide tables: ``$COLUMNS`` when set (as every console), else the
+    terminal's width, else 160 columns in a file or a pipe (where Rich would otherwise
+    wrap every cell at 80). ``COLUMNS=80 skyroute bench grid ... | cat`` was 160 wide."""
     out = plain_console()
-    return out if out.is_terminal else plain_console(width=160)
+    if out.is_terminal or _columns_set():
+        return out
+    return plain_console(width=160)
+
+
+def _columns_set() -> bool:
+    """``$COLUMNS`` holds a width, as Rich reads it (digits; 0 is no width)."""
+    columns = os.environ.get("COLUMNS", "")
+    return columns.isdigit() and int(columns) > 0
 
 
 # A word that starts like a number ("12.5", "±3.2", "(0.00%)", "256x256", "1,900"): it is

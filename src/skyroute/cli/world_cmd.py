@@ -14,7 +14,7 @@ from skyroute.cli import world_args as wa
 from skyroute.cli.parse import check_outputs
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console, print_table, result_table
-from skyroute.errors import OptionError
+from skyroute.errors import SEED_MAX, OptionError
 from skyroute.files import write_atomic, written_together
 from skyroute.io.geojson import dumps
 from skyroute.io.world_out import (
@@ -45,10 +45,13 @@ def plan_world_command(
         help="Grid algorithms: cell size in world units (default: 1000 cells across).")] =
         None,
     samples: Annotated[int | None, typer.Option(help="PRM samples (default 1000).")] = None,
-    seed: Annotated[int | None, typer.Option(help="PRM random seed (default 0).")] = None,
+    seed: Annotated[int | None, typer.Option(
+        min=0, max=SEED_MAX, help="PRM random seed (default 0).")] = None,
     waypoints_out: Annotated[Path | None, typer.Option(
-        "--waypoints", help=escape("Write [[north, east, altitude, heading], ...] JSON here."))] =
-        None,
+        "--waypoints", help=escape(
+            "Write [[north, east, altitude, heading], ...] JSON here: FCND waypoints, metres "
+            "from home, heading in radians clockwise from north (not degrees, as the CLI "
+            "reads headings elsewhere)."))] = None,
     geojson: Annotated[Path | None, typer.Option(help="Write the path as lon/lat GeoJSON.")] =
         None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG map here.")] = None,
@@ -120,7 +123,7 @@ def world_result_doc(world, result) -> dict:
 def synth_city_command(
     out: Annotated[Path, typer.Argument(metavar="OUT",
                                         help="The colliders.csv file to write.")],
-    seed: Annotated[int, typer.Option(min=0, help="Random seed.")] = 0,
+    seed: Annotated[int, typer.Option(min=0, max=SEED_MAX, help="Random seed.")] = 0,
     blocks: Annotated[int, typer.Option(help="Blocks along each side.")] = 6,
 ) -> None:
     """Write a synthetic city (random box buildings in street blocks) as colliders.csv."""

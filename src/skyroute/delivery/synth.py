@@ -16,7 +16,7 @@ import numpy as np
 import shapely
 from shapely import affinity
 
-from skyroute.errors import OptionError, whole
+from skyroute.errors import OptionError, check_seed, whole
 from skyroute.files import write_atomic
 from skyroute.motion.step_drone import STEP
 
@@ -182,7 +182,7 @@ def synth(out: Path, *, days: int = 7, orders_per_day: int = 12, seed: int = 1,
     # integers, numpy's too (a numpy days= broke timedelta), each named alone
     days, customers = whole("days", days, low=1), whole("customers", customers, low=1)
     orders_per_day = whole("orders_per_day", orders_per_day, low=0)
-    seed = whole("seed", seed, low=0)
+    seed = check_seed(seed)
     try:
         start + dt.timedelta(days=days - 1)
     except OverflowError:

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from skyroute.errors import InputFormatError, OptionError, real, whole
+from skyroute.errors import InputFormatError, OptionError, check_seed, real
 from skyroute.files import open_text
 from skyroute.fleet.limits import MAX_PACKAGES, expected_packages
 from skyroute.fleet.scenario import Scenario
@@ -55,16 +55,33 @@ def _stream(t, origin, og, dest, dg) -> Stream:
     return Stream(*cols)
 
 
-def _hours(hours) -> float:
-    """Simulated hours: a finite number > 0."""
-    return real("hours", hours, low=0.0, strict=True)
+TIME_DECIMALS = 3  # the event log and packages.csv write times to the millisecond
+
+
+def horizon_seconds(hours: float) -> float:
+    """The end of a run of ``hours``, in seconds: ``hours * 3600`` rounded to the
+    millisecond (:data:`TIME_DECIMALS`), the resolution its files write times to. Rounding
+    is monotone and the end is its own rounding, so an event at or before the end is
+    written at or before it. With the exact product, ``--hours 0.02777798611111111``
+    (100.00075 s) wrote a spawn at 100.0007 s as 100.001, after the end."""
+    return round(float(hours) * 3600.0, TIME_DECIMALS)
+
+
+def check_hours(hours) -> float:
+    """Simulated hours: a finite number > 0 whose end (:func:`horizon_seconds`) is at
+    least a millisecond."""
+    h = real("hours", hours, low=0.0, strict=True)
+    if horizon_seconds(h) <= 0:
+        raise OptionError(f"hours={h:g} is {h * 3600:.2g} s, under the millisecond a "
+                          "run's times are written to", param="hours")
+    return h
 
 
 def poisson(scenario: Scenario, *, hours: float, seed: int = 0,
             rate_per_hour: float | None = None) -> Stream:
-    """A Poisson stream over ``[0, hours * 3600)`` at ``rate_per_hour`` (default the
+    """A Poisson stream over ``[0, horizon_seconds(hours))`` at ``rate_per_hour`` (default the
     scenario's), origin and destination airports and gates uniform, airports distinct."""
-    h = _hours(hours)
+    h = check_hours(hours)
     rate = scenario.packages.rate_per_hour if rate_per_hour is None else \
         real("rate_per_hour", rate_per_hour, low=0.0)
     n = expected_packages(rate, h)
@@ -72,8 +89,8 @@ def poisson(scenario: Scenario, *, hours: float, seed: int = 0,
         raise OptionError(f"rate_per_hour={rate:g} with hours={h:g} would spawn about "
                           f"{n:.2g} packages (limit {MAX_PACKAGES:,g}); lower one of them",
                           param=("rate_per_hour", "hours"))
-    rng = np.random.default_rng(whole("seed", seed, low=0))
-    horizon = h * 3600.0
+    rng = np.random.default_rng(check_seed(seed))
+    horizon = horizon_seconds(h)
     if rate == 0:
         n = 0
         t = np.empty(0)
@@ -150,13 +167,13 @@ def for_scenario(scenario: Scenario, *, hours: float, seed: int = 0,
     """The scenario's packages over ``hours``: its CSV (a relative path read from ``base``,
     the scenario file's folder; rows at or after the horizon dropped) when it names one,
     else the Poisson stream."""
-    h = _hours(hours)
+    h = check_hours(hours)
     if scenario.packages.csv is None or rate_per_hour is not None:
         return poisson(scenario, hours=h, seed=seed, rate_per_hour=rate_per_hour)
     path = Path(scenario.packages.csv)
     if not path.is_absolute() and base is not None:
         path = Path(base) / path
     s = read_csv(path, scenario)
-    keep = s.t < h * 3600.0
+    keep = s.t < horizon_seconds(h)
     return _stream(*(getattr(s, c)[keep] for c in ("t", "origin", "origin_gate",
                                                      "destination", "destination_gate")))

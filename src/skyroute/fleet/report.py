@@ -166,7 +166,7 @@ def report(run: Simulation, separation: SeparationReport | None = None) -> dict:
             "rate_per_hour": run.rate_per_hour, "hours": run.hours, "seed": run.seed,
             "scheduler": run.scheduler, "airspace": run.airspace,
             "sep_horizontal": s.airspace.sep_horizontal,
-            "sep_vertical": s.airspace.sep_vertical, "warmup_s": w0,
+            "sep_vertical": s.airspace.sep_vertical, "warmup_s": w0, "end_s": H,
             "handover_seconds": s.handover_seconds, "reservation_step_s": SAMPLE_DT,
         },
     }

@@ -29,7 +29,7 @@ from pydantic import (
     model_validator,
 )
 
-from skyroute.errors import InputFormatError, OptionError, real, whole
+from skyroute.errors import InputFormatError, OptionError, check_seed, real, whole
 from skyroute.files import read_text
 from skyroute.fleet.limits import (
     MAX_AIRPORTS,
@@ -94,7 +94,8 @@ def _first_bool(v) -> bool | None:
 class Runway(_Strict):
     """A straight runway through its airport's position."""
 
-    heading_deg: float = Field(ge=0, lt=360, description="compass heading of travel")
+    heading_deg: float = Field(ge=0, lt=360, description="compass heading of travel: "
+                               "degrees clockwise from north")
     length: float = Field(default=600.0, gt=0, description="metres")
 
 
@@ -405,7 +406,7 @@ def generate(airports: int, drones: int, *, area_km: float = 8.0, seed: int = 0,
     if not 0 < area_km <= MAX_AREA_KM:
         raise OptionError(f"area_km={area_km:g} must be a number > 0 and <= {MAX_AREA_KM:,g}",
                           param="area_km")
-    seed = whole("seed", seed, low=0)
+    seed = check_seed(seed)
     if rate_per_hour is not None:
         rate_per_hour = real("rate_per_hour", rate_per_hour, low=0.0, high=MAX_RATE,
                              need=f"a number >= 0 and <= {MAX_RATE:,g}")

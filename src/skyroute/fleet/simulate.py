@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skyroute.errors import OptionError, SkyrouteError, check_choice, real, whole
+from skyroute.errors import OptionError, SkyrouteError, check_choice, check_seed
 from skyroute.fleet import dispatch, packages
 from skyroute.fleet.airborne import MAX_LOITERS, too_long
 from skyroute.fleet.airspace import (
@@ -47,7 +47,7 @@ from skyroute.fleet.airspace import (
 )
 from skyroute.fleet.flightplan import FlightPlan, plan_flight, takeoff_overrun
 from skyroute.fleet.nofly import check_joined
-from skyroute.fleet.packages import Stream
+from skyroute.fleet.packages import TIME_DECIMALS, Stream, horizon_seconds
 from skyroute.fleet.scenario import Scenario, runway_ends
 from skyroute.fleet.timetable import Timetable
 from skyroute.fleet.trajectory import Pieces
@@ -56,7 +56,6 @@ from skyroute.motion import dubins
 
 WARMUP_SHARE = 0.1
 SAMPLE_DT = 1.0
-TIME_DECIMALS = 3  # the event log and packages.csv write times to the millisecond
 _LOCAL = 4  # optimal dispatch: packages considered per airport beyond the oldest
 # ground holds tried before a departure, seconds after the earliest one
 _HOLDS = (0, 2, 5, 10, 15, 20, 30, 45, 60, 75, 90, 120, 150, 180, 240, 300,
@@ -114,8 +113,10 @@ class Simulation:
 
     @property
     def horizon(self) -> float:
-        """Simulated seconds."""
-        return self.hours * 3600.0
+        """Simulated seconds: the run's end, ``hours * 3600`` to the millisecond
+        (:func:`~skyroute.fleet.packages.horizon_seconds`), so that no event is written
+        after it."""
+        return horizon_seconds(self.hours)
 
     def pieces(self) -> Pieces:
         """Every airborne piece of every flight (whole flights, also past the horizon)."""
@@ -150,10 +151,10 @@ def simulate(scenario: Scenario, stream: Stream, *, hours: float, seed: int = 0,
     check_choice("scheduler", scheduler, dispatch.SCHEDULERS)
     mode = scenario.airspace.mode if airspace is None else airspace
     check_choice("airspace", mode, MODES)
-    h = real("hours", hours, low=0.0, strict=True)
+    h = packages.check_hours(hours)
     check_levels(scenario, mode)
     check_joined(scenario)  # airports no cruise joins: refused now, not mid-run
-    run = Simulation(scenario, stream, h, whole("seed", seed, low=0), scheduler, mode)
+    run = Simulation(scenario, stream, h, check_seed(seed), scheduler, mode)
     wall = time.perf_counter()
     _Engine(run, progress).go()
     run.wall_seconds = time.perf_counter() - wall

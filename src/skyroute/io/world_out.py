@@ -36,14 +36,22 @@ def path_north_east(world: World, path: np.ndarray) -> np.ndarray:
     return np.c_[p[:, 1], p[:, 0]]
 
 
-_SAME_POINT = 1e-9  # metres: a shorter leg is a point repeated, without a heading
+# metres: a shorter leg is a point repeated, without a heading of its own. A lon/lat
+# point read back into metres is off by up to about 1e-8 m (a float's last digits of
+# degrees), so a point repeated in lon/lat (a sampled Dubins path's last pose, repeated
+# at its goal) came back as a leg of 5e-9 m whose "heading" was rounding noise: the
+# last FCND waypoint turned 11 degrees away from the track. A micrometre is far above
+# that noise and far below any leg flown.
+_SAME_POINT = 1e-6
 
 
 def waypoints(world: World, path: np.ndarray, altitude: float) -> list[list[float]]:
     """[[north, east, altitude, heading], ...] relative to home; heading (radians, 0 north,
     clockwise) along the track into each point, the first taking the first leg's. A leg
     of zero length (a point repeated) has no direction of its own: it keeps the heading
-    of the leg before, or of the next leg when it comes first (0 when no leg has one)."""
+    of the leg before, or of the next leg when it comes first (0 when no leg has one);
+    a leg under a micrometre is such a point (a lon/lat point repeated comes back within
+    rounding, not exactly)."""
     ne = path_north_east(world, path)
     if len(ne) == 0:
         return []

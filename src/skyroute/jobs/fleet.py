@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import sqlalchemy as sa
 
-from skyroute.errors import InputFormatError, OptionError, check_choice, real, whole
+from skyroute.errors import InputFormatError, OptionError, check_choice, check_seed, real
 from skyroute.fleet.airborne import check_flights
 from skyroute.fleet.airspace import MODES
 from skyroute.fleet.dispatch import SCHEDULERS
@@ -203,7 +203,7 @@ def check_fleet_params(params: dict) -> dict:
                     "rate_per_hour", "track_step"}, "fleet")
     s, out = _scenario(params)
     out["hours"] = real("hours", params.get("hours", 1.0), low=0.0, strict=True)
-    out["seed"] = whole("seed", params.get("seed", 0), low=0)
+    out["seed"] = check_seed(params.get("seed", 0))
     out["scheduler"] = params.get("scheduler", "seed")
     check_choice("scheduler", out["scheduler"], SCHEDULERS)
     out["airspace"] = params.get("airspace", s.airspace.mode)
@@ -243,7 +243,7 @@ def check_sweep_params(params: dict) -> dict:
     if len(seeds) > MAX_SEEDS:
         raise OptionError(f"seeds: {len(seeds):,} seeds is over the limit of {MAX_SEEDS:,}",
                           param="seeds")
-    out["seeds"] = list(dict.fromkeys(whole("seeds", x, low=0) for x in seeds))
+    out["seeds"] = list(dict.fromkeys(check_seed(x, "seeds") for x in seeds))
     out["hours"] = real("hours", params.get("hours", 1.0), low=0.0, strict=True)
     check_sweep(schedulers=len(out["schedulers"]), airspaces=len(out["airspaces"]),
                 rates=len(rates or [None]), seeds=len(out["seeds"]))

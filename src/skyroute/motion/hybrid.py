@@ -66,7 +66,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skyroute.errors import OptionError, QueryError, budget, flag, real, whole
+from skyroute.errors import OptionError, QueryError, budget, check_seed, flag, real, whole
 from skyroute.motion import hybrid_search
 from skyroute.motion.arc_kernels import chain_free, edge_index
 from skyroute.motion.corner_distance import corner_graph
@@ -199,7 +199,8 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     smooth : bool
         Shortcut the path with free Dubins connections.
     seed : int
-        Seed of the shortcutting's random pairs, >= 0.
+        Seed of the shortcutting's random pairs, an integer from 0 to 2**32 - 1
+        (:data:`skyroute.errors.SEED_MAX`).
 
     Returns
     -------
@@ -456,7 +457,7 @@ def _options(radius, heading_bins, step, reverse, max_expansions, seed, smooth):
                               f"(0, {math.pi * r:g}]", param="step") from None
     flag("reverse", reverse)
     flag("smooth", smooth)
-    whole("seed", seed, low=0)
+    check_seed(seed)
     return r, H, float(step), budget(max_expansions)
 
 

@@ -25,6 +25,7 @@ import math
 import numpy as np
 from numba import njit
 
+from skyroute.errors import check_seed
 from skyroute.motion.arc_kernels import advance, chain_free, chain_reaches
 from skyroute.motion.dubins_kernel import TURNS, words
 from skyroute.motion.pieces import Piece, chain, turned_round
@@ -197,7 +198,7 @@ def shortcut(pieces: list[Piece], radius: float, index, *, seed: int = 0,
     px, py, pth, pk, pl, pd, tries = shortcut_kernel(
         st[:, 0].copy(), st[:, 1].copy(), st[:, 2].copy(), k, ln, d, float(radius),
         bool(reverse), float(back_cost), float(switch_cost), *index.args(),
-        int(seed) % (2**32), patience, max_tries)
+        check_seed(seed), patience, max_tries)
     out = [Piece("LSR"[1 - int(pk[i])], (float(px[i]), float(py[i]), float(pth[i])),
                  float(pl[i]), float(radius), bool(pd[i] < 0)) for i in range(len(px))]
     return out, int(tries)

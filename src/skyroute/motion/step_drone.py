@@ -47,7 +47,8 @@ for _cache in (_CORNER_GRAPHS, _ZONES, _BOUNDS):
 
 @dataclass(frozen=True, eq=False)
 class Flight:
-    """Moves as data: ``frm`` and ``to`` (N, 2) lon/lat, ``angle`` (N,) ints, -999 = hover;
+    """Moves as data: ``frm`` and ``to`` (N, 2) lon/lat, ``angle`` (N,) ints (the ILP's:
+    degrees anticlockwise from east, multiples of 10; not a compass heading), -999 = hover;
     ``start`` where it starts (what a flight of no moves ends at, when it is known)."""
 
     frm: np.ndarray

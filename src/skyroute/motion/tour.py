@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from skyroute.errors import QueryError, real, whole
+from skyroute.errors import QueryError, check_seed, real, whole
 from skyroute.motion import hybrid
 from skyroute.motion.dubins_kernel import TURNS, shortest_length, words
 from skyroute.motion.pieces import chain, check_samples, sample
@@ -44,13 +44,14 @@ TWO_PI = 2 * math.pi
 
 @dataclass(frozen=True)
 class TourResult:
-    """A tour: ``order`` (target indices as given, in visiting order), ``headings``
-    (arrival heading at each visited target, radians; the world's convention, or from +x
-    without a world), ``legs`` (free space: lists of :class:`Piece`; among obstacles:
-    :class:`~skyroute.motion.hybrid.HybridResult`), flown ``length``, ``method``
-    ("exact" or "local search"), ``bound`` (the tour's cost in the leg table: its length
-    in free space, a lower bound among obstacles) and ``greedy_bound`` (nearest-first's
-    cost in the same table)."""
+    """A tour: ``order`` (target indices as given, in visiting order), ``headings`` (the
+    arrival heading at each target in visiting order: ``headings[i]`` at
+    ``targets[order[i]]``, radians in the world's convention, or anticlockwise from +x
+    without a world; the tour ends on the last one), ``legs`` (free space: lists of
+    :class:`Piece`; among obstacles: :class:`~skyroute.motion.hybrid.HybridResult`),
+    flown ``length``, ``method`` ("exact" or "local search"), ``bound`` (the tour's cost
+    in the leg table: its length in free space, a lower bound among obstacles) and
+    ``greedy_bound`` (nearest-first's cost in the same table)."""
 
     status: Status
     order: tuple[int, ...]
@@ -114,16 +115,20 @@ def tour(start_pose, targets, radius: float, *, world: World | None = None,
          seed: int = 0) -> TourResult:
     """The shortest tour from ``start_pose`` (x, y, heading) through every target (x, y).
 
+    The start heading is given, not chosen (``fly --targets`` without one starts on 0);
+    each arrival heading is chosen among ``headings`` evenly spaced ones.
     Without ``world``: plane coordinates, heading in radians anticlockwise from +x, legs
-    are Dubins paths. With ``world``: points and headings in the world's frame, and each
-    leg is flown by :func:`skyroute.motion.hybrid.plan` (``max_expansions``, ``seed``)
-    to the chosen arrival heading; a leg it cannot fly makes the tour's status.
+    are Dubins paths. With ``world``: points in the world's frame and headings in
+    radians in its convention (clockwise from north in "lonlat" and "ned", anticlockwise
+    from +x in "enu" and "degrees"), and each leg is flown by
+    :func:`skyroute.motion.hybrid.plan` (``max_expansions``, ``seed``) to the chosen
+    arrival heading; a leg it cannot fly makes the tour's status.
     """
     t0 = time.perf_counter()
     radius = real("radius", radius, low=0.0, strict=True)  # numpy numbers too
     headings = whole("headings", headings, low=1, high=72)
     exact_limit = whole("exact_limit", exact_limit, low=0)
-    seed = whole("seed", seed, low=0)  # as hybrid.plan reads it (also when no leg needs it)
+    seed = check_seed(seed)  # as hybrid.plan reads it (also when no leg needs it)
     start = as_points(start_pose, "start_pose", dims=3)[0]
     pts = as_points(targets, "targets")
     if len(pts) == 0:

@@ -37,8 +37,10 @@ _DIRS = {
 
 @dataclass(frozen=True)
 class LatticeResult:
-    """The fastest route: ``status``, cells (K, 2) as (x, y), headings (K,) in radians,
-    travel time and distance (inf without a route), and search statistics."""
+    """The fastest route: ``status``, cells (K, 2) as (x, y), headings (K,) in radians
+    (on a grid from the x axis towards +y; from :func:`plan_turns_world` in the world's
+    convention, clockwise from north in "lonlat" and "ned"), travel time and distance
+    (inf without a route), and search statistics."""
 
     status: Status
     cells: np.ndarray

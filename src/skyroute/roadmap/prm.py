@@ -30,7 +30,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from skyroute.errors import OptionError, flag, whole
+from skyroute.errors import OptionError, check_seed, flag, whole
 from skyroute.result import PlanResult, Status
 from skyroute.roadmap.simplify import shortcut, smooth
 from skyroute.world.world import World
@@ -154,7 +154,7 @@ def prm_options(samples, neighbours, prm_star, seed) -> tuple[int, int, bool, in
     an OptionError naming the first bad one."""
     return (whole("samples", samples, low=2, high=MAX_SAMPLES),
             whole("neighbours", neighbours, low=1), flag("prm_star", prm_star),
-            whole("seed", seed, low=0))
+            check_seed(seed))
 
 
 def _free_samples(world: World, box: tuple, samples: int, rng) -> np.ndarray:

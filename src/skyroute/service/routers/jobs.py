@@ -17,7 +17,7 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from skyroute.delivery.limits import MAX_DAYS
-from skyroute.errors import SkyrouteError
+from skyroute.errors import SEED_MAX, SkyrouteError
 from skyroute.fleet.limits import (
     MAX_AIRPORTS,
     MAX_PACKAGES,
@@ -86,7 +86,7 @@ class FleetJob(BaseModel):
     scenario: dict[str, Any] | None = Field(None, description="A scenario (the fields of "
                                             "`skyroute fleet scenario`'s YAML).")
     hours: float = Field(1.0, gt=0, le=MAX_HOURS)
-    seed: int = Field(0, ge=0, le=2**32 - 1)
+    seed: int = Field(0, ge=0, le=SEED_MAX)
     scheduler: Literal["seed", "optimal"] = "seed"
     airspace: Literal["layers", "shared"] | None = None
     rate: float | None = Field(None, gt=0, le=MAX_RATE, description="Packages per hour "

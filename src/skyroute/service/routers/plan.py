@@ -19,7 +19,7 @@ from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, model_validator
 
-from skyroute.errors import InputFormatError, QueryError, SkyrouteError
+from skyroute.errors import SEED_MAX, InputFormatError, QueryError, SkyrouteError
 from skyroute.service.alternatives import exactly_one
 from skyroute.service.auth import require_token
 from skyroute.service.problems import Problem, from_skyrouteerror, responses
@@ -91,7 +91,7 @@ class PlanRequest(BaseModel):
     samples: int = Field(1000, strict=True, ge=1, le=10**9, description="PRM samples.")
     neighbours: int = Field(10, strict=True, ge=1, le=1000, description="PRM neighbours.")
     prm_star: StrictBool = False
-    seed: int = Field(0, strict=True, ge=0, le=2**32 - 1, description="PRM seed.")
+    seed: int = Field(0, strict=True, ge=0, le=SEED_MAX, description="PRM seed.")
     geojson: StrictBool = Field(True, description="Add the path as GeoJSON.")
 
     @model_validator(mode="after")
@@ -122,7 +122,8 @@ class PlanAnswer(BaseModel):
     path_lonlat: list[Pair] | None = None
     frame: str | None = None
     waypoints: list[list[float]] | None = Field(
-        None, description="Worlds: [north, east, altitude, heading] per point (FCND).")
+        None, description="Worlds: [north, east, altitude, heading] per point (FCND): metres "
+        "from home, heading in radians clockwise from north along the track into the point.")
     geojson: dict | None = None
 
 
