@@ -7,6 +7,7 @@ from __future__ import annotations
 import contextlib
 import datetime as dt
 import os
+import uuid
 
 import pytest
 import sqlalchemy as sa
@@ -15,7 +16,6 @@ from tests.conftest import ROOT
 
 EXAMPLE = ROOT / "examples" / "lunch"
 PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1:5432/test")
-PG_DB = "skyroute_jobs_test"  # a database of its own: the delivery tests reset "test"
 
 
 def lunch_store(url: str, dates: tuple[str, ...] | None = None):
@@ -44,29 +44,38 @@ def dask_executor(leg_cache):
 
 
 @pytest.fixture(scope="session")
-def pg_url() -> str:
-    """A URL of a clean database of its own on the local PostgreSQL server (skipped when
-    none answers, unless $CI is set)."""
+def _pg_database() -> str:
+    """A database of this test session's own on the local PostgreSQL server, dropped at
+    its end (skipped when none answers, unless $CI is set): a fixed name was reset by
+    every other session running beside this one, a helper's or a second terminal's."""
     base = sa.engine.make_url(PG)
+    name = f"skyroute_jobs_{uuid.uuid4().hex[:12]}"
     try:
         admin = sa.create_engine(base, isolation_level="AUTOCOMMIT")
         with admin.connect() as c:
-            if not c.scalar(sa.text("select 1 from pg_database where datname = :d"),
-                            {"d": PG_DB}):
-                c.execute(sa.text(f"create database {PG_DB}"))
-        admin.dispose()
+            c.execute(sa.text(f"create database {name}"))
     except sa.exc.OperationalError:
         if os.environ.get("CI"):
             raise
         pytest.skip("no PostgreSQL server")
-    url = base.set(database=PG_DB).render_as_string(hide_password=False)
-    eng = sa.create_engine(url)
+    try:
+        yield base.set(database=name).render_as_string(hide_password=False)
+    finally:
+        with admin.connect() as c:
+            c.execute(sa.text(f"drop database if exists {name} with (force)"))
+        admin.dispose()
+
+
+@pytest.fixture
+def pg_url(_pg_database) -> str:
+    """The URL of the session's PostgreSQL database, emptied for this test."""
+    eng = sa.create_engine(_pg_database)
     with eng.begin() as c:
         for t in ("servers", "fleet_run_files", "fleet_runs", "jobs", "runs", "flightpath",
                   "deliveries", "order_details", "orders", "alembic_version"):
             c.execute(sa.text(f"drop table if exists {t} cascade"))
     eng.dispose()
-    return url
+    return _pg_database
 
 
 def slow_days(monkeypatch, seconds: float = 0.3) -> None:
