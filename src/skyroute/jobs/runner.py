@@ -2,9 +2,10 @@
 
 ``submit(engine, kind, params, executor=ex)`` checks ``params`` (an
 :class:`~skyroute.errors.OptionError` naming the field when one is wrong), records the job
-as ``queued`` and returns its id at once; ``get(engine, job_id)`` reads it back as
-``{"id", "kind", "params", "state", "progress", "result", "error", "created",
-"updated", "owner"}`` (None for an unknown id).
+as ``queued`` and returns its id at once (``submit_once`` returns the id of a job of the
+same kind and parameters already queued or running instead, and says which it did);
+``get(engine, job_id)`` reads it back as ``{"id", "kind", "params", "state", "progress",
+"result", "error", "created", "updated", "owner"}`` (None for an unknown id).
 
 Kinds (:data:`KINDS`) and their parameters:
 
@@ -183,12 +184,43 @@ def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
     """Check ``params``, record the job (``queued``) and queue it to run on
     ``executor`` (an open :func:`~skyroute.jobs.executor.open_executor`, which the
     caller keeps open and closes); the job's id."""
+    return _submit(engine, kind, params, executor=executor, once=False)[0]
+
+
+def submit_once(engine: sa.Engine, kind: str, params: dict, *,
+                executor) -> tuple[str, bool]:
+    """As :func:`submit`, ``(id, True)``; but when a job of ``kind`` with the same
+    checked ``params`` is already queued or running on this store (this process's or
+    another server's), ``(its id, False)``, and nothing is recorded or queued. The
+    orphans are failed first (:func:`fail_orphans`), so a stopped server's job is not
+    taken for a live one. The look and the record are one transaction
+    (:func:`skyroute.jobs.store.create_job_once`)."""
+    return _submit(engine, kind, params, executor=executor, once=True)
+
+
+def live_twin(engine: sa.Engine, kind: str, params: dict) -> str | None:
+    """The id of the job :func:`submit_once` would answer with instead of a new one (a
+    job of ``kind`` with the same checked ``params`` queued or running on this store, the
+    orphans failed first), or None; nothing is recorded. ``params`` are checked as
+    :func:`submit` checks them."""
+    check_choice("kind", kind, tuple(KINDS))
+    params = KINDS[kind].check(params)
+    fail_orphans(engine)
+    return store.live_job(engine, kind, params)
+
+
+def _submit(engine: sa.Engine, kind: str, params: dict, *, executor,
+            once: bool) -> tuple[str, bool]:
     global _beater, _pending
     check_choice("kind", kind, tuple(KINDS))
     params = KINDS[kind].check(params)
     me = owner()
     store.beat(engine, me)  # alive before its job exists: no one fails it as an orphan
-    job_id = store.create_job(engine, kind, params, owner=me)
+    if once:
+        fail_orphans(engine)
+    job_id, new = store.create_job_once(engine, kind, params, owner=me, once=once)
+    if not new:
+        return job_id, False
     with _lock:
         _pending += 1
         _stores.setdefault(str(engine.url), [engine, 0])[1] += 1
@@ -204,7 +236,7 @@ def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
             _beater = threading.Thread(target=_beat_forever, name="skyroute-jobs-beat",
                                        daemon=True)
             _beater.start()
-    return job_id
+    return job_id, True
 
 
 def fail_orphans(engine: sa.Engine) -> list[str]:
