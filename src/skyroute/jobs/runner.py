@@ -31,12 +31,13 @@ kernels, whose threading layer may not take two threads at once when a job's tas
 in this process (one worker). While a job runs it is ``running`` with its
 progress, the share of its tasks done (a fleet run is one task: 0, then 1). It ends
 ``done`` with its result, or ``failed`` with a one-line error: a SkyrouteError's message,
-else the exception's type and message; the traceback goes to the ``skyroute.jobs``
-logger, never into the store. The thread is a daemon: a job still queued or running
-when the process ends is left so in the store, and is failed later as an orphan. A job
-whose executor is closed under it (the server shutting down while another lane's job
-runs: :class:`~skyroute.jobs.executor.ExecutorClosedError`), and a queued one that
-reaches a closed executor, ends ``failed`` with the orphans' :data:`ORPHANED` at once.
+else the exception's type and message; the ``skyroute.jobs`` logger gets the first at
+INFO, the traceback of any other at ERROR, never the store. The thread is a daemon: a job
+still queued or running when the process ends is left so in the store, and is failed
+later as an orphan. A job whose executor is closed under it (the server shutting down
+while another lane's job runs: :class:`~skyroute.jobs.executor.ExecutorClosedError`),
+and a queued one that reaches a closed executor, ends ``failed`` with the orphans'
+:data:`ORPHANED` at once.
 
 Several servers (and each server's ``--workers`` processes) may share one store. Each
 job names its owner, the process that took it (:func:`owner`: host, process id and a
@@ -364,9 +365,10 @@ def _run(engine, job_id: str, kind: str, params: dict, executor) -> None:
             # later
             log.info("job %s (%s) stopped with the server", job_id, kind)
             return
-        expected = isinstance(exc, SkyrouteError)
-        log.log(logging.INFO if expected else logging.ERROR, "job %s (%s) failed", job_id,
-                kind, exc_info=True)
+        if isinstance(exc, SkyrouteError):  # the job's input: its reason, no traceback
+            log.info("job %s (%s) failed: %s", job_id, kind, error_line(exc))
+        else:
+            log.error("job %s (%s) failed", job_id, kind, exc_info=True)
         if not store.fail_job(engine, job_id, error_line(exc)):
             _ended(engine, job_id, "its error is discarded")
         return
