@@ -3,7 +3,11 @@ the timing header, and that making an app connects to nothing."""
 
 from __future__ import annotations
 
+import re
+from typing import Annotated
+
 import pytest
+from fastapi import Depends, FastAPI, Query  # module level: the test app's annotations
 
 from tests.service.conftest import AUTH, TOKEN, make_client
 
@@ -319,3 +323,64 @@ def test_shutdown_ends_the_jobs_worker_processes(tmp_path):
     assert not lane.is_alive()  # its map ended: the workers are gone
     assert [type(e) for e in raised] == [ExecutorClosedError]  # the runner's orphan case
     assert ours() == []
+
+
+def _query_routes(client) -> list[tuple[str, dict]]:
+    """(path, {name: a valid value}) of every GET route of the API with query
+    parameters, from its OpenAPI document (a route added later is covered too)."""
+    sample = {"date": "2024-01-03", "integer": "1", "string": "x"}
+    out = []
+    for path, ops in client.get("/openapi.json").json()["paths"].items():
+        params = (ops.get("get") or {}).get("parameters", [])
+        query = {p["name"]: sample.get(p["schema"].get("format"), sample[p["schema"]["type"]])
+                 for p in params if p["in"] == "query"}
+        if query:
+            out.append((re.sub(r"\{[^}]+\}", "x", path), query))
+    return out
+
+
+def test_a_repeated_query_parameter_is_a_422_naming_it(client):
+    """``?date=A&date=B`` (and every other single-valued parameter given twice) used one
+    of the values and dropped the other without a word; it is a 422 naming it."""
+    routes = _query_routes(client)
+    assert {p for p, _ in routes} >= {"/orders", "/fleet/runs", "/fleet/runs/x"}
+    for path, query in routes:
+        for name, value in query.items():
+            pairs = [*query.items(), (name, value)]  # the same value twice, even
+            r = client.get(path, params=pairs)
+            assert r.status_code == 422, (path, name, r.text)
+            assert r.headers["content-type"] == "application/problem+json"
+            doc = r.json()
+            assert doc["field"] == name and doc["detail"] == \
+                f"{name}: given 2 times ({value!r}, {value!r}); give it once", doc
+    r = client.get("/orders", params=[("date", "2024-01-03"), ("date", "2024-01-04")])
+    assert r.json()["detail"] == "date: given 2 times ('2024-01-03', '2024-01-04'); " \
+                                 "give it once"
+    assert client.get("/orders", params={"date": "2024-01-03"}).status_code == 200
+    assert client.get("/health?x=1&x=2").status_code == 200  # not a parameter of it
+
+
+def _page(offset: int = 0) -> int:  # a dependency reading a query parameter
+    return offset
+
+
+def test_a_list_query_parameter_still_takes_every_value():
+    """The check reads which parameters a route takes as one value: a list takes every
+    repeat (also optional, or inside a dependency), a scalar in a dependency does not."""
+    from skyroute.service import problems, query
+    from tests.service.conftest import TestClient
+
+    app = FastAPI(dependencies=[Depends(query.one_value_each)])
+    problems.install(app)
+
+    @app.get("/many")
+    def many(tag: Annotated[list[str], Query()],
+             more: Annotated[list[int] | None, Query()] = None,
+             at: Annotated[int, Depends(_page)] = 0) -> dict:
+        return {"tag": tag, "more": more, "at": at}
+
+    c = TestClient(app)
+    r = c.get("/many?tag=a&tag=b&more=1&more=2&offset=3")
+    assert r.status_code == 200 and r.json() == {"tag": ["a", "b"], "more": [1, 2], "at": 3}
+    r = c.get("/many?tag=a&offset=3&offset=4")
+    assert r.status_code == 422 and r.json()["field"] == "offset", r.text

@@ -6,6 +6,7 @@ run the real jobs and skip while it is missing."""
 
 from __future__ import annotations
 
+import datetime as dt
 import importlib.util
 import itertools
 import json
@@ -67,6 +68,8 @@ class FakeJobs:
         store = types.ModuleType("skyroute.jobs.store")
         executor = types.ModuleType("skyroute.jobs.executor")
         runner.submit = self.submit
+        runner.submit_once = self.submit_once
+        runner.live_twin = self.live_twin
         runner.get = lambda engine, i: self.jobs.get(i)
         store.get_fleet_run = self.get_fleet_run
         store.open_fleet_file = self.open_fleet_file
@@ -91,6 +94,18 @@ class FakeJobs:
         self.jobs[i] = {"id": i, "kind": kind, "state": "queued", "progress": 0.0,
                         "result": None, "error": None}
         return i
+
+
+    def live_twin(self, engine, kind, params):
+        return next((i for i, (k, p) in zip(self.jobs, self.submitted, strict=True)
+                     if (k, p) == (kind, params)
+                     and self.jobs[i]["state"] in ("queued", "running")), None)
+
+    def submit_once(self, engine, kind, params, *, executor):
+        twin = self.live_twin(engine, kind, params)
+        if twin is not None:
+            return twin, False
+        return self.submit(engine, kind, params, executor=executor), True
 
 
 class FakeFile:
@@ -148,16 +163,51 @@ def test_a_deliver_job_can_replace_a_kept_flight(site_client, fake):
 
 
 def test_the_queue_limit_is_429_until_a_job_ends(site_client, fake):
-    ids = [site_client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH).json()["id"]
-           for _ in range(2)]
-    r = site_client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH)
+    # three different jobs (the same one again would be answered with the first's id)
+    days = [{"date": DAY}, {"date": "2024-01-01"}, {"date": "2024-01-02"}]
+    ids = [site_client.post("/jobs/deliver", json=d, headers=AUTH).json()["id"]
+           for d in days[:2]]
+    r = site_client.post("/jobs/deliver", json=days[2], headers=AUTH)
     assert_problem(r, 429, words="2 jobs are queued or running")
     assert r.headers["retry-after"] == "10"
     fake.jobs[ids[0]].update(state="done", progress=1.0, result={"days": 1})
-    assert site_client.post("/jobs/deliver", json={"date": DAY},
+    assert site_client.post("/jobs/deliver", json=days[2],
                             headers=AUTH).status_code == 202
     done = site_client.get(f"/jobs/{ids[0]}").json()
     assert done["state"] == "done" and done["result"] == {"days": 1}
+    assert len(fake.submitted) == 3
+
+
+def test_the_same_deliver_job_again_is_the_live_one(site_client, fake):
+    """The same days with the same method and replace, submitted while the first is
+    queued or running (a client retrying a POST that timed out, a double click), were
+    a second job flying the days again: they are answered 200 with the live job's id
+    and queue nothing, even with the queue full. Other options, or after it ended, are a
+    new job."""
+    first = site_client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH)
+    assert first.status_code == 202
+    job_id = first.json()["id"]
+    again = site_client.post("/jobs/deliver", json={"date": DAY, "method": "milp",
+                                                     "replace": False}, headers=AUTH)
+    assert again.status_code == 200 and again.json() == {"id": job_id}
+    assert again.headers["location"] == f"/jobs/{job_id}"
+    assert len(fake.submitted) == 1
+    # a range of the one day is the same job; another method is another
+    same = site_client.post("/jobs/deliver", json={"from": DAY, "to": DAY}, headers=AUTH)
+    assert same.status_code == 200 and same.json() == {"id": job_id}
+    other = site_client.post("/jobs/deliver", json={"date": DAY, "method": "greedy"},
+                             headers=AUTH)
+    assert other.status_code == 202 and other.json()["id"] != job_id
+    # the queue (2) is full now: the same job is still its id, a new one a 429
+    fake.jobs[job_id]["state"] = "running"
+    full = site_client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH)
+    assert full.status_code == 200 and full.json() == {"id": job_id}
+    assert_problem(site_client.post("/jobs/deliver", json={"date": "2024-01-01"},
+                                    headers=AUTH), 429)
+    fake.jobs[job_id].update(state="done", progress=1.0)
+    after = site_client.post("/jobs/deliver", json={"date": DAY}, headers=AUTH)
+    assert after.status_code == 202 and after.json()["id"] != job_id
+    assert len(fake.submitted) == 3
 
 
 def test_fleet_job_params(site_client, fake):
@@ -420,6 +470,49 @@ def test_a_range_job_shows_its_progress_while_running(tmp_path, monkeypatch):
         # some days stored while the job still ran, seen through GET /jobs/{id}
         assert any(s == "running" and 0 < p < 1 for s, p in job["seen"]), job["seen"]
         assert {d["date"] for d in c.get("/days").json()} >= {d.isoformat() for d in dates}
+
+
+@needs_jobs
+@pytest.mark.parametrize("db", ["sqlite", "postgresql"])
+def test_the_same_deliver_job_is_found_in_the_store(tmp_path, request, monkeypatch, db):
+    """The live twin is looked for in the store: a job another server (sharing it) runs
+    is answered too; one a stopped server left is failed as an orphan, not answered."""
+    import sqlalchemy as sa
+
+    from skyroute.jobs import deliver, runner, store
+    from skyroute.service.resources import make_engine
+
+    url = (f"sqlite:///{tmp_path / 'twin.db'}" if db == "sqlite"
+           else request.getfixturevalue("fresh_pg"))
+    params = deliver.check_params({"from": DAY, "to": DAY, "method": "milp",
+                                   "replace": False, "data": str(EXAMPLE)})
+    eng = make_engine(url)
+    store.beat(eng, "other-server:1:a")
+    live = store.create_job(eng, "deliver", params, owner="other-server:1:a")
+    dead = store.create_job(eng, "deliver", {**params, "method": "greedy"},
+                            owner="stopped-server:2:b")  # never beat: an orphan
+    with eng.begin() as c:  # the stopped server's last beat, long ago
+        c.execute(sa.text("INSERT INTO servers (id, started, heartbeat) VALUES "
+                          "('stopped-server:2:b', :t, :t)"),
+                  {"t": store.db_now(c) - dt.timedelta(hours=1)})
+    # the jobs queued here are never run (a lane of their own that takes one and stops)
+    queued = []
+    monkeypatch.setattr(runner, "_work", lambda jobs: queued.append(jobs.get()))
+    for name in ("_lanes", "_stores"):
+        monkeypatch.setattr(runner, name, {})
+    monkeypatch.setattr(runner, "_pending", runner._pending)
+    with make_client(db_url=url, data_dir=EXAMPLE) as c:
+        r = c.post("/jobs/deliver", json={"date": DAY}, headers=AUTH)
+        assert r.status_code == 200 and r.json() == {"id": live}, r.text
+        r = c.post("/jobs/deliver", json={"date": DAY, "method": "greedy"}, headers=AUTH)
+        assert r.status_code == 202 and r.json()["id"] not in (live, dead), r.text
+        assert store.get_job(eng, dead)["state"] == "failed"
+        again = c.post("/jobs/deliver", json={"date": DAY, "method": "greedy"},
+                       headers=AUTH)
+        assert again.status_code == 200 and again.json() == r.json()
+    with eng.connect() as c:
+        assert c.execute(sa.text("SELECT count(*) FROM jobs")).scalar_one() == 3
+    eng.dispose()
 
 
 @needs_jobs

@@ -7,7 +7,10 @@ first /plan loads the map and the compiled kernels, 0.6 s on an idle 2-core mach
 
 from __future__ import annotations
 
+import csv
 import os
+import re
+import shutil
 import signal
 import socket
 import subprocess
@@ -30,10 +33,11 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def start(tmp_path, *args: str, env: dict | None = None) -> tuple[subprocess.Popen, str]:
+def start(tmp_path, *args: str, env: dict | None = None,
+          log_level: str = "warning") -> tuple[subprocess.Popen, str]:
     port = free_port()
     cmd = [sys.executable, "-m", "skyroute", "serve", "--port", str(port), "--db",
-           f"sqlite:///{tmp_path / 's.db'}", "--log-level", "warning", *args]
+           f"sqlite:///{tmp_path / 's.db'}", "--log-level", log_level, *args]
     environ = {**os.environ, "PYTHONPATH": str(ROOT / "src"), **(env or {})}
     if env is None:
         environ.pop("SKYROUTE_TOKEN", None)
@@ -101,6 +105,68 @@ def test_serve_with_a_token_file_and_two_workers(tmp_path):
     finally:
         out, err = stop(proc)
     assert "s3cret" not in out + err and "write token from" in err
+
+
+@pytest.mark.slow
+def test_skyroute_lines_are_logged_as_uvicorn_logs_its_own(monkeypatch, capsys, tmp_path):
+    """skyroute's loggers (the warm-up's, the jobs') print as uvicorn's lines do, at
+    ``--log-level``: they had no handler, so Python's last resort printed the bare
+    message of a warning or error and no INFO line at all (not the warm-up's time, not a
+    job that failed on bad input)."""
+    # the lunch orders in the store, another town's site: a delivery job fails on input
+    monkeypatch.chdir(tmp_path)
+    db = f"sqlite:///{tmp_path / 's.db'}"
+    assert run(monkeypatch, capsys, "db", "import", str(ROOT / "examples" / "lunch"),
+               "--db", db)[0] in (0, None)
+    other = tmp_path / "other"  # the lunch site with other menus and no customers
+    shutil.copytree(ROOT / "examples" / "lunch", other)
+    menus = other / "website" / "menus" / "menus.json"
+    menus.write_text(menus.read_text().replace('"item": "', '"item": "Other '))
+    with open(other / "database" / "orders.csv") as f:
+        for row in csv.DictReader(f):
+            shutil.rmtree(other / "website" / "words" / row["deliverTo"].replace(".", "/"),
+                          ignore_errors=True)
+    env = {"SKYROUTE_TOKEN": "t0ken"}
+    for level in ("info", "warning"):
+        proc, url = start(tmp_path, "--data", str(other), env=env, log_level=level)
+        try:
+            job = httpx.post(url + "/jobs/deliver", json={"date": "2024-01-03"},
+                             headers={"Authorization": "Bearer t0ken"}, timeout=WAIT)
+            assert job.status_code == 202, job.text
+            deadline = time.monotonic() + WAIT
+            while time.monotonic() < deadline:
+                state = httpx.get(f"{url}/jobs/{job.json()['id']}", timeout=WAIT).json()
+                if state["state"] in ("done", "failed"):
+                    break
+                time.sleep(0.2)
+            assert state["state"] == "failed" and "another site's orders" in state["error"]
+        finally:
+            _, err = stop(proc)
+        lines = err.splitlines()
+        warmed = [ln for ln in lines if "warmed the planners" in ln]
+        failed = [ln for ln in lines if f"job {job.json()['id']} (deliver) failed" in ln]
+        if level == "info":  # as "INFO:     Started server process [...]"
+            assert any(ln.startswith("INFO:     Started server process") for ln in lines)
+            assert len(warmed) == 1 and re.fullmatch(
+                r"INFO:     warmed the planners in \d+\.\d s \(\d+ queries\)", warmed[0]), err
+            # the reason on the line; a traceback only for an error not of the input
+            assert len(failed) == 1 and failed[0].startswith(
+                f"INFO:     job {job.json()['id']} (deliver) failed: ") and \
+                "another site's orders" in failed[0] and "Traceback" not in err, err
+        else:
+            assert not warmed and not failed and "Started server process" not in err, err
+
+
+def test_a_log_level_not_uvicorns_is_one_line(monkeypatch, capsys, tmp_path):
+    """A --log-level uvicorn does not know was its KeyError traceback, after the banner."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SKYROUTE_TOKEN", "t")
+    code, out, err = run(monkeypatch, capsys, "serve", "--log-level", "loud", "--db",
+                         f"sqlite:///{tmp_path / 's.db'}")
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "--log-level 'loud' is not valid; choose one of critical, error, warning, " \
+           "info, debug, trace" in err
+    assert "skyroute service on" not in err + out
 
 
 @pytest.mark.parametrize("args, words", [

@@ -670,6 +670,91 @@ def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
         pg.done("fleet-runs")
 
 
+@contextlib.contextmanager
+def _newer_runs(server, n: int):
+    """``n`` runs stored after the module's run, which becomes the oldest, on the second
+    page of GET /fleet/runs (pages of 100): ``n - 1`` without files (never opened) and,
+    newest, a copy of the module's run (the page opens the newest). Their ids, newest
+    first; deleted at the end."""
+    import sqlalchemy as sa
+
+    from skyroute.jobs import store
+
+    eng = sa.create_engine(server[2])
+    ids = []
+    try:
+        for i in range(n - 1):
+            ids.append(store.save_fleet_run(
+                eng, scenario="seed-3x3", params={"hours": 0.25, "seed": 100 + i},
+                report={}, events_jsonl="", tracks_csv=b"", packages_csv="",
+                fleet_geojson="{}"))
+        run = store.get_fleet_run(eng, server[1])
+        ids.append(store.save_fleet_run(eng, **{k: run[k] for k in (
+            "scenario", "params", "report", "events_jsonl", "tracks_csv", "packages_csv",
+            "fleet_geojson")}))
+        yield ids[::-1]
+    finally:
+        with eng.begin() as c:
+            for table, key in (("fleet_run_files", "run_id"), ("fleet_runs", "id")):
+                c.execute(sa.text(f"DELETE FROM {table} WHERE {key} IN "
+                                  f"({', '.join(map(repr, ids))})"))
+        eng.dispose()
+
+
+def _options(p) -> list[str]:
+    return p.eval_on_selector_all("#run option", "os => os.map((o) => o.value)")
+
+
+@pytest.mark.parametrize("size", ["desktop-720", "phone-640"])
+def test_the_fleet_page_lists_runs_past_the_first_page(open_page, server, size):
+    """GET /fleet/runs answers a page of 100 runs (a Link to the next); the page listed
+    the first page alone, so the 101st run could not be chosen. "List older runs" (a
+    button, by keyboard too) appends the next page until the last, and a link to a run
+    older than the first page opens it."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    oldest = server[1]
+    with _newer_runs(server, 100) as newer:
+        pg = open_page("/fleet.html", size)
+        p = pg.page
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        assert _options(p) == newer and p.input_value("#run") == newer[0]
+        assert p.is_visible("#more-runs")
+        assert p.inner_text("#run-count") == \
+            "The newest 100 runs are listed; older ones follow."
+        p.focus("#run")  # the keyboard: Tab from the list to the button, Enter
+        p.keyboard.press("Tab")
+        assert p.evaluate("document.activeElement.id") == "more-runs"
+        SHOTS.mkdir(parents=True, exist_ok=True)  # the button, focused
+        p.screenshot(path=str(SHOTS / f"fleet-more-runs-{size}.png"), full_page=True)
+        p.keyboard.press("Enter")
+        p.wait_for_function("document.querySelectorAll('#run option').length === 101")
+        assert _options(p) == [*newer, oldest]
+        assert p.is_hidden("#more-runs")  # the last page: the focus moved to the list
+        assert p.evaluate("document.activeElement.id") == "run"
+        assert p.inner_text("#run-count") == \
+            "All 101 stored runs are listed, newest first."
+        p.keyboard.press("End")  # the oldest, chosen from the list by keyboard
+        p.wait_for_function(f"location.hash === '#run={oldest}'"
+                            " && document.querySelector('#status').dataset.kind === 'ok'",
+                            timeout=15_000)
+        assert p.input_value("#run") == oldest
+        pg.done("fleet-older-runs")
+
+        # a link to the 101st run (the address the page shows for it): opened, listed
+        # last until its page is listed, then in its place, once
+        pg = open_page(f"/fleet.html#run={oldest}", size)
+        p = pg.page
+        p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'"
+                            " && document.querySelector('#time').max > 0", timeout=15_000)
+        assert p.input_value("#run") == oldest and "not stored" not in p.inner_text("#status")
+        assert _options(p) == [*newer, oldest] and p.is_visible("#more-runs")
+        p.click("#more-runs")
+        p.wait_for_function("document.querySelector('#more-runs').hidden")
+        assert _options(p) == [*newer, oldest] and p.input_value("#run") == oldest
+        pg.done("fleet-older-runs-link")
+
+
 @pytest.mark.parametrize("page", ["day", "fleet", "planner"])
 def test_the_last_choice_is_shown_when_an_earlier_one_answers_late(open_page, server, page):
     """A day, run or map chosen, then another before the first had arrived (a large run

@@ -51,7 +51,9 @@ def serve_command(
     max_expansions: Annotated[int, typer.Option(
         help="Search budget of one POST /plan.")] = 2_000_000,
     job_queue: Annotated[int, typer.Option(help="Jobs queued or running at once.")] = 8,
-    log_level: Annotated[str, typer.Option(help="uvicorn's log level.")] = "info",
+    log_level: Annotated[str, typer.Option(
+        help="The lowest level logged on stderr, by uvicorn and skyroute alike: critical, "
+             "error, warning, info, debug or trace.")] = "info",
     warm: Annotated[bool, typer.Option(
         "--warm/--no-warm", help="Load the planners' compiled kernels in each server "
         "process before it takes requests (about a second from numba's cache), so no "
@@ -66,6 +68,7 @@ def serve_command(
     from pydantic import ValidationError
 
     from skyroute.service.app import SETTINGS_ENV, create_app
+    from skyroute.service.logs import LEVELS, log_config
     from skyroute.service.resources import make_engine
     from skyroute.service.settings import MB, Settings
 
@@ -75,6 +78,10 @@ def serve_command(
         from skyroute.delivery.source import open_source
 
         open_source(data, source)  # a bad folder or URL: one line now, not a 503 later
+    if log_level.lower() not in LEVELS:  # uvicorn's KeyError traceback, after the banner
+        raise OptionError(f"--log-level {log_level!r} is not valid; choose one of "
+                          f"{', '.join(LEVELS)}")
+    log_level = log_level.lower()
     if not 0 < port < 65536:
         raise OptionError(f"--port {port} must be 1..65535")
     if workers < 1:
@@ -108,12 +115,14 @@ def serve_command(
     # SIGTERM is how a server is stopped (systemd, docker): uvicorn shuts down gracefully
     # and then re-raises it, which run_cli's handler would report as "terminated", 143
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    # skyroute's loggers print as uvicorn's, at --log-level (each worker applies it)
+    logs = {"log_level": log_level, "log_config": log_config(log_level)}
     if workers == 1:
-        uvicorn.run(create_app(settings), host=host, port=port, log_level=log_level)
+        uvicorn.run(create_app(settings), host=host, port=port, **logs)
     else:
         os.environ[SETTINGS_ENV] = settings.model_dump_json()
         uvicorn.run("skyroute.service.app:app_from_env", factory=True, workers=workers,
-                    host=host, port=port, log_level=log_level)
+                    host=host, port=port, **logs)
 
 
 def check_listen(host: str, port: int) -> None:

@@ -2,9 +2,10 @@
 
 ``submit(engine, kind, params, executor=ex)`` checks ``params`` (an
 :class:`~skyroute.errors.OptionError` naming the field when one is wrong), records the job
-as ``queued`` and returns its id at once; ``get(engine, job_id)`` reads it back as
-``{"id", "kind", "params", "state", "progress", "result", "error", "created",
-"updated", "owner"}`` (None for an unknown id).
+as ``queued`` and returns its id at once (``submit_once`` returns the id of a job of the
+same kind and parameters already queued or running instead, and says which it did);
+``get(engine, job_id)`` reads it back as ``{"id", "kind", "params", "state", "progress",
+"result", "error", "created", "updated", "owner"}`` (None for an unknown id).
 
 Kinds (:data:`KINDS`) and their parameters:
 
@@ -30,12 +31,13 @@ kernels, whose threading layer may not take two threads at once when a job's tas
 in this process (one worker). While a job runs it is ``running`` with its
 progress, the share of its tasks done (a fleet run is one task: 0, then 1). It ends
 ``done`` with its result, or ``failed`` with a one-line error: a SkyrouteError's message,
-else the exception's type and message; the traceback goes to the ``skyroute.jobs``
-logger, never into the store. The thread is a daemon: a job still queued or running
-when the process ends is left so in the store, and is failed later as an orphan. A job
-whose executor is closed under it (the server shutting down while another lane's job
-runs: :class:`~skyroute.jobs.executor.ExecutorClosedError`), and a queued one that
-reaches a closed executor, ends ``failed`` with the orphans' :data:`ORPHANED` at once.
+else the exception's type and message; the ``skyroute.jobs`` logger gets the first at
+INFO, the traceback of any other at ERROR, never the store. The thread is a daemon: a job
+still queued or running when the process ends is left so in the store, and is failed
+later as an orphan. A job whose executor is closed under it (the server shutting down
+while another lane's job runs: :class:`~skyroute.jobs.executor.ExecutorClosedError`),
+and a queued one that reaches a closed executor, ends ``failed`` with the orphans'
+:data:`ORPHANED` at once.
 
 Several servers (and each server's ``--workers`` processes) may share one store. Each
 job names its owner, the process that took it (:func:`owner`: host, process id and a
@@ -183,12 +185,43 @@ def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
     """Check ``params``, record the job (``queued``) and queue it to run on
     ``executor`` (an open :func:`~skyroute.jobs.executor.open_executor`, which the
     caller keeps open and closes); the job's id."""
+    return _submit(engine, kind, params, executor=executor, once=False)[0]
+
+
+def submit_once(engine: sa.Engine, kind: str, params: dict, *,
+                executor) -> tuple[str, bool]:
+    """As :func:`submit`, ``(id, True)``; but when a job of ``kind`` with the same
+    checked ``params`` is already queued or running on this store (this process's or
+    another server's), ``(its id, False)``, and nothing is recorded or queued. The
+    orphans are failed first (:func:`fail_orphans`), so a stopped server's job is not
+    taken for a live one. The look and the record are one transaction
+    (:func:`skyroute.jobs.store.create_job_once`)."""
+    return _submit(engine, kind, params, executor=executor, once=True)
+
+
+def live_twin(engine: sa.Engine, kind: str, params: dict) -> str | None:
+    """The id of the job :func:`submit_once` would answer with instead of a new one (a
+    job of ``kind`` with the same checked ``params`` queued or running on this store, the
+    orphans failed first), or None; nothing is recorded. ``params`` are checked as
+    :func:`submit` checks them."""
+    check_choice("kind", kind, tuple(KINDS))
+    params = KINDS[kind].check(params)
+    fail_orphans(engine)
+    return store.live_job(engine, kind, params)
+
+
+def _submit(engine: sa.Engine, kind: str, params: dict, *, executor,
+            once: bool) -> tuple[str, bool]:
     global _beater, _pending
     check_choice("kind", kind, tuple(KINDS))
     params = KINDS[kind].check(params)
     me = owner()
     store.beat(engine, me)  # alive before its job exists: no one fails it as an orphan
-    job_id = store.create_job(engine, kind, params, owner=me)
+    if once:
+        fail_orphans(engine)
+    job_id, new = store.create_job_once(engine, kind, params, owner=me, once=once)
+    if not new:
+        return job_id, False
     with _lock:
         _pending += 1
         _stores.setdefault(str(engine.url), [engine, 0])[1] += 1
@@ -204,7 +237,7 @@ def submit(engine: sa.Engine, kind: str, params: dict, *, executor) -> str:
             _beater = threading.Thread(target=_beat_forever, name="skyroute-jobs-beat",
                                        daemon=True)
             _beater.start()
-    return job_id
+    return job_id, True
 
 
 def fail_orphans(engine: sa.Engine) -> list[str]:
@@ -332,9 +365,10 @@ def _run(engine, job_id: str, kind: str, params: dict, executor) -> None:
             # later
             log.info("job %s (%s) stopped with the server", job_id, kind)
             return
-        expected = isinstance(exc, SkyrouteError)
-        log.log(logging.INFO if expected else logging.ERROR, "job %s (%s) failed", job_id,
-                kind, exc_info=True)
+        if isinstance(exc, SkyrouteError):  # the job's input: its reason, no traceback
+            log.info("job %s (%s) failed: %s", job_id, kind, error_line(exc))
+        else:
+            log.error("job %s (%s) failed", job_id, kind, exc_info=True)
         if not store.fail_job(engine, job_id, error_line(exc)):
             _ended(engine, job_id, "its error is discarded")
         return

@@ -57,6 +57,8 @@ from skyroute.errors import OptionError, SkyrouteError, check_choice
 
 STATES = ("queued", "running", "done", "failed")
 LIVE = ("queued", "running")  # the states a job may still leave
+# the PostgreSQL advisory lock :func:`create_job_once` holds while it looks for a twin
+JOBS_LOCK = 0x736B796A  # "skyj"
 TABLES = ("jobs", "fleet_runs", "servers", "fleet_run_files")
 
 
@@ -122,13 +124,49 @@ def create_job(engine: sa.Engine, kind: str, params: dict, *,
                owner: str | None = None) -> str:
     """Record a new job (``queued``, progress 0) run by the server ``owner`` (which
     :func:`beat` first); its id (a UUID string)."""
+    return create_job_once(engine, kind, params, owner=owner, once=False)[0]
+
+
+def create_job_once(engine: sa.Engine, kind: str, params: dict, *,
+                    owner: str | None = None, once: bool = True) -> tuple[str, bool]:
+    """``(id, True)`` for a new job as :func:`create_job` records it; with ``once``, when
+    a job of ``kind`` with the same ``params`` is queued or running (any owner's; fail
+    the orphans first), ``(its id, False)`` instead and nothing is written. The look and
+    the insert are one transaction holding the write lock (SQLite) or the advisory lock
+    :data:`JOBS_LOCK` (PostgreSQL): two servers on one store submitting the same job at
+    once record it once."""
+    jobs = _t(engine)["jobs"]
+    stored = json_safe(params)
     job_id = str(uuid.uuid4())
     now = _now()
     with writing(engine) as c:
-        c.execute(_t(engine)["jobs"].insert().values(
-            id=job_id, kind=kind, params=json_safe(params), state="queued", progress=0.0,
+        if once:
+            if c.dialect.name == "postgresql":
+                c.execute(sa.select(sa.func.pg_advisory_xact_lock(JOBS_LOCK)))
+            twin = _twin(c, jobs, kind, stored)
+            if twin is not None:
+                return twin, False
+        c.execute(jobs.insert().values(
+            id=job_id, kind=kind, params=stored, state="queued", progress=0.0,
             created=now, updated=now, owner=owner))
-    return job_id
+    return job_id, True
+
+
+def live_job(engine: sa.Engine, kind: str, params: dict) -> str | None:
+    """The id of the oldest job of ``kind`` with these ``params`` still queued or
+    running (any owner's), or None."""
+    jobs = _t(engine)["jobs"]
+    with engine.connect() as c:
+        return _twin(c, jobs, kind, json_safe(params))
+
+
+def _twin(c: sa.Connection, jobs: sa.Table, kind: str, stored) -> str | None:
+    # few jobs are live at once (each server holds at most its queue's): the JSON
+    # parameters are compared here, the same on both databases
+    live = c.execute(sa.select(jobs.c.id, jobs.c.params)
+                     .where(jobs.c.kind == kind, jobs.c.state.in_(LIVE))
+                     .order_by(jobs.c.created, jobs.c.id)).all()
+    return next((str(i) for i, p in live if p == stored), None)
 
 
 def set_progress(engine: sa.Engine, job_id: str, progress: float) -> bool:

@@ -13,12 +13,12 @@ from __future__ import annotations
 from contextlib import asynccontextmanager
 from pathlib import Path
 
-from fastapi import APIRouter, FastAPI, Request
+from fastapi import APIRouter, Depends, FastAPI, Request
 from fastapi.staticfiles import StaticFiles
 from fastapi_offline import FastAPIOffline
 
 import skyroute
-from skyroute.service import cut, problems
+from skyroute.service import cut, problems, query
 from skyroute.service.middleware import BodyLimit, HeadAsGet, ServerTiming
 from skyroute.service.resources import Resources
 from skyroute.service.routers import (
@@ -59,7 +59,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     # /docs and /redoc from files in the fastapi-offline package, not a CDN: a server
     # in the field (no internet) still shows its API reference
     app = FastAPIOffline(title="skyroute", version=skyroute.__version__,
-                         description=DESCRIPTION, lifespan=lifespan)
+                         description=DESCRIPTION, lifespan=lifespan,
+                         # every route: a repeated single-valued query parameter is a 422
+                         dependencies=[Depends(query.one_value_each)])
     app.state.settings = settings
     app.state.resources = Resources(settings)
     problems.install(app)

@@ -71,8 +71,8 @@ def queries() -> list[dict]:
 
 def warm(res: Resources) -> dict:
     """Run :func:`queries` through ``POST /plan``'s code on ``res`` and read the bundled
-    maps into it; ``{"queries", "failed", "seconds"}``. A query that fails is logged as a
-    warning and counted, never raised."""
+    maps into it; ``{"queries", "failed", "seconds"}``, also logged at INFO. A query that
+    fails is logged as a warning and counted, never raised."""
     from skyroute.service.routers.plan import PlanRequest, _plan
     from skyroute.world.load import bundled_maps
 
@@ -89,5 +89,7 @@ def warm(res: Resources) -> dict:
                         else body["world_format"], " ".join(str(exc).split()))
     for name in bundled_maps():
         res.grid(name)
-    return {"queries": len(bodies), "failed": failed,
-            "seconds": time.perf_counter() - t0}
+    seconds = time.perf_counter() - t0
+    log.info("warmed the planners in %.1f s (%d queries%s)", seconds, len(bodies),
+             f", {failed} failed" if failed else "")
+    return {"queries": len(bodies), "failed": failed, "seconds": seconds}

@@ -1,6 +1,7 @@
 """Long work as jobs: ``POST /jobs/deliver`` (a day or a range of stored orders),
-``POST /jobs/fleet`` (a fleet run) -> 202 ``{"id"}``; ``GET /jobs/{id}`` -> its state,
-progress, result or error.
+``POST /jobs/fleet`` (a fleet run) -> 202 ``{"id"}`` (a delivery job the same as one
+queued or running -> 200 and that job's id); ``GET /jobs/{id}`` -> its state, progress,
+result or error.
 
 The jobs themselves (tables, Dask or local processes) live in :mod:`skyroute.jobs`,
 imported on first use; without it these endpoints answer 503. A server holds at most
@@ -121,7 +122,11 @@ def _jobs():
     return runner
 
 
-def _submit(res: Resources, kind: str, params: dict) -> JSONResponse:
+def _submit(res: Resources, kind: str, params: dict, *, once: bool = False
+            ) -> JSONResponse:
+    """Queue the job: 202 ``{"id"}``. With ``once``, a job of ``kind`` with the same
+    parameters already queued or running (this server's or another's on the store) is
+    answered instead: 200 with its id, nothing queued, even when the queue is full."""
     runner = _jobs()
     eng = res.engine()
     with _SUBMIT:
@@ -132,24 +137,38 @@ def _submit(res: Resources, kind: str, params: dict) -> JSONResponse:
                 res.job_ids.remove(i)
             else:
                 active += 1
-        if active >= res.settings.job_queue:
-            raise Problem(429, f"{active} jobs are queued or running, this server's limit; "
-                          "try again later", headers={"Retry-After": "10"})
         try:
-            job_id = runner.submit(eng, kind, params, executor=res.executor())
+            if active >= res.settings.job_queue:
+                job_id = runner.live_twin(eng, kind, params) if once else None
+                if job_id is None:
+                    raise Problem(429, f"{active} jobs are queued or running, this "
+                                  "server's limit; try again later",
+                                  headers={"Retry-After": "10"})
+                new = False
+            elif once:
+                job_id, new = runner.submit_once(eng, kind, params, executor=res.executor())
+            else:
+                job_id, new = runner.submit(eng, kind, params, executor=res.executor()), True
         except SkyrouteError as exc:
             raise Problem(422, str(exc), field=exc.param if isinstance(exc.param, str)
                           else None) from None
-        res.job_ids.append(job_id)
-    return JSONResponse({"id": job_id}, status_code=202,
+        if new:
+            res.job_ids.append(job_id)
+    return JSONResponse({"id": job_id}, status_code=202 if new else 200,
                         headers={"Location": f"/jobs/{job_id}"})
 
 
 @router.post("/jobs/deliver", status_code=202, response_model=JobId,
              dependencies=[Depends(require_token)],
-             responses=responses(401, 403, 404, 413, 422, 429, 503),
+             responses={200: {"model": JobId, "description": "The same job (the same "
+                              "days, method and replace) is already queued or running: "
+                              "its id; nothing new is queued"},
+                        **responses(401, 403, 404, 413, 422, 429, 503)},
              summary="Fly a day or a range of days as a job")
 def post_deliver(body: DeliverJob, res: ResourcesDep):
+    """202 and the new job's id; 200 and the id of the job already doing it when the
+    same days are queued or running with the same method and replace (a retried or
+    double-clicked submission flies them once: follow that job)."""
     res.site()  # 404 without a site: the job would fail on every day
     s = res.settings
     first, last = (body.date, body.date) if body.date else (body.from_, body.to)
@@ -157,7 +176,7 @@ def post_deliver(body: DeliverJob, res: ResourcesDep):
               "replace": body.replace,
               **({"data": str(s.data_dir)} if s.data_dir is not None else
                  {"source": s.source_url})}
-    return _submit(res, "deliver", params)
+    return _submit(res, "deliver", params, once=True)
 
 
 @router.post("/jobs/fleet", status_code=202, response_model=JobId,

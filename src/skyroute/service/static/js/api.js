@@ -43,6 +43,15 @@ export async function getJSON(path) {
   return (await send(path, { headers: { Accept: "application/json" } })).json();
 }
 
+/** A page of a paged list: ``{items, next}``, ``next`` the path of the following page
+ * (the answer's ``Link: <...>; rel="next"``) or null on the last page. */
+export async function getPage(path) {
+  const response = await send(path, { headers: { Accept: "application/json" } });
+  const link = response.headers.get("Link") || "";
+  const next = /<([^>]*)>\s*;\s*rel="?next"?/.exec(link);
+  return { items: await response.json(), next: next ? next[1] : null };
+}
+
 export async function getText(path) {
   return (await send(path, {})).text();
 }

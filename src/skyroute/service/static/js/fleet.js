@@ -2,10 +2,11 @@
 // minimap of airports, runways and gates, with a drone table and a package table that
 // follow the time slider, as the seed's testbed GUI and minimap did.
 //
-// Reads GET /fleet/runs, /fleet/runs/{id}, its tracks.csv, events.jsonl, fleet.geojson
-// and packages.csv; starts runs with POST /jobs/fleet and follows GET /jobs/{id}.
+// Reads GET /fleet/runs (a page of 100 runs at a time: "List older runs" follows its Link
+// to the next), /fleet/runs/{id}, its tracks.csv, events.jsonl, fleet.geojson and
+// packages.csv; starts runs with POST /jobs/fleet and follows GET /jobs/{id}.
 
-import { ApiError, bindToken, choices, explain, focusFault, getJSON, getText, postJSON } from "./api.js";
+import { ApiError, bindToken, choices, explain, focusFault, getJSON, getPage, getText, postJSON } from "./api.js";
 import { EventFold, dronesAt, parseEvents, parseRoutes, parseTracks, trail } from "./fleetstate.js";
 import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
@@ -16,11 +17,17 @@ const $ = (id) => document.getElementById(id);
 const status = $("status");
 const jobStatus = $("job-status");
 const runSelect = $("run");
+const moreRuns = $("more-runs");
+const runCount = $("run-count");
+const RUNS_PAGE = 100; // runs listed at a time (GET /fleet/runs pages them)
 const TRAIL_S = 90; // seconds of track drawn behind a flying drone
 const TABLE_EVERY_MS = 150; // table refreshes while playing
 const MAX_PACKAGE_ROWS = 60;
 
-let runs = [];
+let runs = []; // the runs listed, newest first
+let nextRuns = null; // the path of the page of older runs (the Link rel="next"), or null
+let outOfPage = null; // a run the page's link names, older than the pages listed: last
+let listing = 0; // counts the listings: a page of older runs for an old listing is dropped
 let run = null; // {id, tracks, fold, ground, drones, horizon}
 let t = 0;
 let lastTables = 0;
@@ -73,34 +80,90 @@ function runLabel(r, { when = true } = {}) {
   return (at ? [at, ...parts] : parts).join(" · ");
 }
 
+function showRuns() {
+  // a label twice (runs stored in one second, or by a server without their time) gets
+  // the run's id, so that every run in the list can be told apart
+  const keep = runSelect.value;
+  const labels = runs.map((r) => runLabel(r));
+  const twice = new Set(labels.filter((x, i) => labels.indexOf(x) !== i));
+  runSelect.replaceChildren(...runs.map((r, i) => h("option", { value: r.id },
+    twice.has(labels[i]) ? `${labels[i]} · run ${String(r.id).slice(0, 8)}` : labels[i])));
+  if (runs.some((r) => String(r.id) === keep)) runSelect.value = keep;
+  moreRuns.hidden = !nextRuns;
+  const n = runs.length;
+  runCount.textContent = !n ? "" : nextRuns ? `The newest ${n} runs are listed; older ones follow.`
+    : n === 1 ? "" : `All ${n} stored runs are listed, newest first.`;
+}
+
 async function listRuns(select = null) {
+  const mine = ++listing;
+  let page;
   try {
-    runs = await getJSON("/fleet/runs");
+    page = await getPage(`/fleet/runs?limit=${RUNS_PAGE}`);
   } catch (err) {
     runSelect.replaceChildren(h("option", {}, "no runs"));
+    moreRuns.hidden = true;
     const why = err instanceof ApiError && err.status === 503 ? "fleet runs are not available on this server"
       : explain(err, "Reading the fleet runs");
     say(status, why.charAt(0).toUpperCase() + why.slice(1), "error");
     return false;
   }
+  runs = page.items;
+  nextRuns = page.next;
+  outOfPage = null;
   if (!runs.length) {
     runSelect.replaceChildren(h("option", {}, "no stored runs"));
     runSelect.disabled = true;
+    showRuns();
     say(status, "No fleet run is stored yet: start one below.", "info");
     return false;
   }
-  // a label twice (runs stored in one second, or by a server without their time) gets
-  // the run's id, so that every run in the list can be told apart
-  const labels = runs.map((r) => runLabel(r));
-  const twice = new Set(labels.filter((x, i) => labels.indexOf(x) !== i));
-  runSelect.replaceChildren(...runs.map((r, i) => h("option", { value: r.id },
-    twice.has(labels[i]) ? `${labels[i]} · run ${String(r.id).slice(0, 8)}` : labels[i])));
-  runSelect.disabled = false;
   const linked = select ? null : new URLSearchParams(location.hash.slice(1)).get("run");
   const wanted = select || linked;
+  if (wanted && nextRuns && !runs.some((r) => String(r.id) === wanted)) {
+    // a run older than the first page (a link to run 101): listed last until its page is
+    try {
+      const d = await getJSON(`/fleet/runs/${encodeURIComponent(wanted)}?limit=1`);
+      if (mine !== listing) return false;
+      runs.push({ id: String(d.id), scenario: (d.scenario || {}).name, params: d.params, report: d.report });
+      outOfPage = String(d.id);
+    } catch {
+      // not stored (404) or unreadable: the newest is shown, and the note says so
+    }
+  }
+  showRuns();
+  runSelect.disabled = false;
   if (wanted && runs.some((r) => String(r.id) === wanted)) runSelect.value = wanted;
   else if (linked) missing = linked;
   return true;
+}
+
+async function listOlderRuns() {
+  if (isBusy(moreRuns) || !nextRuns) return;
+  const mine = listing;
+  setBusy(moreRuns, true);
+  runCount.textContent = "Reading older runs…";
+  let page;
+  try {
+    page = await getPage(nextRuns);
+  } catch (err) {
+    setBusy(moreRuns, false);
+    showRuns();
+    say(status, explain(err, "Reading older runs"), "error");
+    return;
+  }
+  setBusy(moreRuns, false);
+  if (mine !== listing) return; // the runs were listed anew meanwhile (a new run stored)
+  if (outOfPage && page.items.some((r) => String(r.id) === outOfPage)) {
+    runs = runs.filter((r) => String(r.id) !== outOfPage); // now in its place
+    outOfPage = null;
+  }
+  // a run stored since the first page moves the others down: one may come twice
+  const known = new Set(runs.map((r) => String(r.id)));
+  runs.push(...page.items.filter((r) => !known.has(String(r.id))));
+  nextRuns = page.next;
+  showRuns();
+  if (!nextRuns) runSelect.focus(); // the button is gone: the focus goes to the longer list
 }
 
 async function load(id) {
@@ -310,6 +373,7 @@ async function start() {
   $("preset").replaceChildren(...presets.map((p) => h("option", { value: p }, p)));
   $("scheduler").replaceChildren(...schedulers.map((s) => h("option", { value: s }, s)));
   runSelect.addEventListener("change", () => load(runSelect.value));
+  moreRuns.addEventListener("click", listOlderRuns);
   view.setBounds([0, 0, 1000, 600]);
   const job = jobs.remembered(); // a run started before a reload: followed after the list
   if (job) {
