@@ -1,5 +1,7 @@
 """Synthetic random maps for `bench grid --random`: scipy's optima are the planners'."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -28,12 +30,18 @@ def test_far_queries_optima_equal_astar_and_are_far(share):
         assert r.found and r.cost == pytest.approx(opt, abs=1e-9)
 
 
-def test_bench_grid_random_only(monkeypatch, capsys):
+def test_bench_grid_random_only(monkeypatch, capsys, tmp_path):
+    """A random map has no scenario file: its title said "4 of 4 scenario lines" and its
+    report named a "random-64-0.2-s0.scen" that does not exist."""
+    report = tmp_path / "r.json"
     code, out, err = run(monkeypatch, capsys, "bench", "grid", "--random", "64:0.2",
-                         "--per-map", "4", "--peers", "")
+                         "--per-map", "4", "--peers", "", "--json", str(report))
     assert code == 0, err
-    assert "random-64-0.2-s0 (64x64): 4 of 4" in out
+    assert "random-64-0.2-s0 (64x64): 4 far queries, optima from scipy" in out
+    assert "scenario" not in out
     assert out.count("4/4") == 2  # astar and jps match scipy's optimum on every query
+    rep, = json.loads(report.read_text())["maps"]
+    assert rep["scen"] is None and rep["scen_lines"] is None and rep["queries"] == 4
 
 
 def test_bench_grid_random_bad_spec_is_one_line(monkeypatch, capsys):

@@ -57,7 +57,7 @@ def test_plan_table_and_prune(monkeypatch, capsys):
     rows = {line.split("│")[1].strip(): line.split("│")[2].strip()
             for line in out.splitlines() if line.count("│") == 3}
     assert "den312d.map: theta" in out and rows["status"] == "found"
-    assert rows["cost"] == f"{r.cost:.6f}" and rows["waypoints"] == str(len(r.path))
+    assert rows["cost"] == f"{r.cost:.6f} cells" and rows["waypoints"] == str(len(r.path))
     assert rows["expanded"] == f"{r.expanded:,}"
     assert rows["line-of-sight checks"] == f"{r.los_checks:,}"
 

@@ -263,7 +263,7 @@ def test_the_table_gives_each_metric_its_unit(monkeypatch, capsys, city):
     m = json.loads(doc)["metrics"]
     rows = {line.split("│")[1].strip(): line.split("│")[2].strip()
             for line in text.splitlines() if line.count("│") == 3}
-    assert rows["length"] == f"{m['length']:.6g} m" and rows["time"] == f"{m['time']:.6g} s"
-    assert rows["smoothness"] == f"{m['smoothness']:.6g} rad/move"
+    assert rows["length"] == f"{m['length']:,.6f} m" and rows["time"] == f"{m['time']:,.3f} s"
+    assert rows["smoothness"] == f"{m['smoothness']:.4f} rad/move"
     assert m["expanded"] >= 1000 and rows["expanded"] == f"{m['expanded']:,}"
     assert rows["moves"] == str(m["moves"]) and rows["status"] == "found"

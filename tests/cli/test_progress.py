@@ -63,5 +63,5 @@ def test_sweep_table_wraps_numbers_instead_of_cutting_them():
                 _sweep_table(preset("seed-3x3"), 2.0, [0, 1], [row]))
     text = screen.getvalue()
     assert "…" not in text
-    for cell in ("optimal", "shared", "48.8", "±3.6", "1693", "±681", "3502", "±1373"):
+    for cell in ("optimal", "shared", "48.8", "±3.6", "1,693", "±681", "3,502", "±1,373"):
         assert cell in text, cell

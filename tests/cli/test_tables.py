@@ -62,7 +62,7 @@ def test_the_sweep_keeps_its_numbers_whole_at_80_columns():
     text = shown(table, optional=_SWEEP_OPTIONAL)
     kept = [w for w in words if w not in ("3", "±6", "37.1", "±1.6")]  # loiters, capacity
     assert_whole(kept, text)
-    assert "±10.4" in text and "1626" in text and "±1053" in text
+    assert "±10.4" in text and "1,626" in text and "±1,053" in text
     assert "not shown at 80 columns: capacity /h, loiters" in text
     # wide enough, every column shows, each mean beside its interval
     wide = shown(_sweep_table(preset("seed-3x3"), 1.0, [0, 1, 2], sweep_rows()), 160,
@@ -103,7 +103,7 @@ def test_long_paths_fold_and_numbers_stay_whole_in_the_result_table():
                         expanded=123456789, max_frontier=1234567, los_checks=987654321,
                         seconds=12.3456, extra={"setup_seconds": 2.296})
     path = "/tmp/" + "a_long_folder/" * 6 + "path.png"
-    table = result_table("den312d.map: astar", result, files=(("plot", path),))
+    table = result_table("den312d.map: astar", result, unit="cells", files=(("plot", path),))
     text = shown(table)
     assert_whole(numbers(table), text)
     assert path in unboxed(text)  # folded, not cut with "…"

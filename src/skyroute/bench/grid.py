@@ -158,12 +158,14 @@ def _peer(grid: Grid, name: str, check: Checker) -> Runner:
 @dataclass(frozen=True, eq=False)
 class Case:
     """One map to bench, read and checked: its label, grid, scenario and how many of the
-    scenario's lines to sample (0: all)."""
+    scenario's lines to sample (0: all). ``made``: the queries were made for a random map
+    (:func:`random_case`), not read from a scenario file."""
 
     label: str
     grid: Grid
     scen: Scenario
     per_map: int
+    made: bool = False
 
     @property
     def queries(self) -> int:
@@ -186,7 +188,7 @@ def random_case(spec: str, *, per_map: int, seed: int) -> Case:
     side, share = parse_random(spec)
     check_random_per_map(per_map, side)
     grid = random_grid(side, share, seed)
-    return Case(grid.name, grid, far_queries(grid, per_map, seed), 0)
+    return Case(grid.name, grid, far_queries(grid, per_map, seed), 0, made=True)
 
 
 def check_per_map(per_map: int) -> None:
@@ -247,10 +249,15 @@ def _off_free(grid: Grid, cells: np.ndarray) -> np.ndarray:
 
 def bench_case(case: Case, *, algorithms: Sequence[str], peers: Sequence[str], seed: int,
                prepared: bool = False, on_query: Callable[[], None] | None = None) -> dict:
-    """Run one checked map's queries through every runner; return its report."""
-    return bench_queries(case.grid, case.scen, case.label, per_map=case.per_map,
-                         algorithms=algorithms, peers=peers, seed=seed, prepared=prepared,
-                         on_query=on_query)
+    """Run one checked map's queries through every runner; return its report. A random
+    map's report has no scenario file: ``scen`` and ``scen_lines`` are None (they named a
+    ``random-512-0.2-s0.scen`` that does not exist, and its "lines")."""
+    report = bench_queries(case.grid, case.scen, case.label, per_map=case.per_map,
+                           algorithms=algorithms, peers=peers, seed=seed, prepared=prepared,
+                           on_query=on_query)
+    if case.made:
+        report.update(scen=None, scen_lines=None)
+    return report
 
 
 def bench_map(map_path: Path, scen_path: Path, *, per_map: int, algorithms: Sequence[str],

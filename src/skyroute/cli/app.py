@@ -132,13 +132,15 @@ def maps_command() -> None:
 
     table = Table(title="bundled maps (Sturtevant 2012, MovingAI; see CITATION.md)")
     for col in ("name", "size", "free", "scenario lines", "file"):
-        table.add_column(col, overflow="fold" if col == "file" else "ellipsis")
+        table.add_column(col, overflow="fold" if col == "file" else "ellipsis",
+                         justify="right" if col in ("size", "free", "scenario lines")
+                         else "left")
     for name, path in bundled_maps().items():
         grid = read_map(path)
         scen = path.with_name(path.name + ".scen")
         lines = len(scen.read_text().splitlines()) - 1 if scen.exists() else 0
         table.add_row(name, f"{grid.width}x{grid.height}", f"{grid.free_fraction:.0%}",
-                      str(lines), str(path))
+                      f"{lines:,}", str(path))
     print_table(plain_console(), table)
 
 

@@ -149,12 +149,15 @@ def _fmt(v, spec):
 def _table(rep: dict) -> Table:
     prep = rep.get("prepared")
     peers = [row["runner"] for row in rep["rows"] if row["peer"]]
-    caption = (f"prepared: built in {prep['build_seconds']:.3f} s, peak "
-               f"{_fmt(prep['build_peak_bytes'] and prep['build_peak_bytes'] / 1e6, '.1f')} "
-               f"MB resident, {prep['index_bytes'] / 1e6:.1f} MB (arrays' nbytes), "
+    caption = (f"prepared: built in {prep['build_seconds']:,.3f} s, peak "
+               f"{_fmt(prep['build_peak_bytes'] and prep['build_peak_bytes'] / 1e6, ',.1f')} "
+               f"MB resident, {prep['index_bytes'] / 1e6:,.1f} MB (arrays' nbytes), "
                f"{prep['index']}" if prep else None)
-    t = Table(title=f"{rep['map']} ({rep['size'][0]}x{rep['size'][1]}): "
-                    f"{rep['queries']} of {rep['scen_lines']} scenario lines", caption=caption)
+    # a random map's queries are made, with scipy's optima: it has no scenario lines
+    what = (f"{rep['queries']:,} far queries, optima from scipy" if rep["scen_lines"] is None
+            else f"{rep['queries']:,} of {rep['scen_lines']:,} scenario lines")
+    t = Table(title=f"{rep['map']} ({rep['size'][0]}x{rep['size'][1]}): {what}",
+              caption=caption)
     for col in ("runner", "median ms", "M exp/s", "matched", "invalid", "cost/opt mean",
                 "cost/opt max"):
         t.add_column(col, justify="left" if col == "runner" else "right")
@@ -163,11 +166,11 @@ def _table(rep: dict) -> Table:
     for row in rep["rows"]:
         eps = row["expansions_per_s"]
         cells = [row["runner"] + (" (peer)" if row["peer"] else ""),
-                 _fmt(row["median_ms"], ".3f"), _fmt(eps and eps / 1e6, ".2f"),
-                 f"{row['matched']}/{rep['queries']}", str(row["invalid"]),
+                 _fmt(row["median_ms"], ",.3f"), _fmt(eps and eps / 1e6, ",.2f"),
+                 f"{row['matched']:,}/{rep['queries']:,}", f"{row['invalid']:,}",
                  _fmt(row["mean_cost_ratio"], ".4f"),
                  _fmt(row["max_cost_ratio"], ".4f")]
-        cells += [_fmt(row["speedup_vs"].get(p), ".2f") if not row["peer"] else ""
+        cells += [_fmt(row["speedup_vs"].get(p), ",.2f") if not row["peer"] else ""
                   for p in peers]
         t.add_row(*cells)
     return t

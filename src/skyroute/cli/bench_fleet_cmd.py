@@ -55,10 +55,10 @@ def bench_fleet(
                 "delivered/h", "conflicts", "lost"):
         t.add_column(col, justify="left" if col == "case" else "right")
     for r in rows:
-        t.add_row(r["case"], f"{r['rate_per_hour']:.0f}", f"{r['flights']:,}",
-                  f"{r['sim_seconds']:.1f}", f"{r['check_seconds']:.2f}",
-                  f"{r['sim_seconds_per_wall_second']:,.0f}", f"{r['delivered_per_hour']:.0f}",
-                  str(r["conflicts"]), str(r["lost"]))
+        t.add_row(r["case"], f"{r['rate_per_hour']:,.0f}", f"{r['flights']:,}",
+                  f"{r['sim_seconds']:,.1f}", f"{r['check_seconds']:,.2f}",
+                  f"{r['sim_seconds_per_wall_second']:,.0f}",
+                  f"{r['delivered_per_hour']:,.0f}", f"{r['conflicts']:,}", f"{r['lost']:,}")
     # the speed is the point; the traffic columns give way first on a narrow terminal
     print_table(wide_console(), t, optional=("conflicts", "lost", "delivered/h", "offered/h"))
     if json_out:

@@ -60,11 +60,11 @@ def bench_jobs_command(
     t = Table(title=f"{n_days} delivery days ({d0} to {d1}, {method}), measured")
     for col in ("executor", "workers", "start s", "range s", "total s", "speed-up",
                 "mean %", "min %"):
-        t.add_column(col, justify="right")
+        t.add_column(col, justify="left" if col == "executor" else "right")
     for r in rows:
         total = r["start_seconds"] + r["wall_seconds"]
-        t.add_row(r["executor"], str(r["workers"]), f"{r['start_seconds']:.1f}",
-                  f"{r['wall_seconds']:.1f}", f"{total:.1f}",
+        t.add_row(r["executor"], f"{r['workers']:,}", f"{r['start_seconds']:,.1f}",
+                  f"{r['wall_seconds']:,.1f}", f"{total:,.1f}",
                   "-" if base is None else f"{base / total:.2f}x",
                   f"{r['mean_pct']:.2f}" if r["mean_pct"] is not None else "-",
                   f"{r['min_pct']:.2f}" if r["min_pct"] is not None else "-")
@@ -72,14 +72,14 @@ def bench_jobs_command(
     print_table(out, t)
     sims = simulated(rows, durations, counts) if durations and counts else []
     if sims:
-        s = Table(title=f"simulated from the local:1 task times (sum {sum(durations):.1f} s, "
-                        f"longest day {max(durations):.2f} s)")
+        s = Table(title=f"simulated from the local:1 task times (sum {sum(durations):,.1f} "
+                        f"s, longest day {max(durations):,.2f} s)")
         for col in ("workers", "local s", "speed-up", "dask s", "dask speed-up"):
             s.add_column(col, justify="right")
         for r in sims:
             dask = r["dask_seconds"] is not None
-            s.add_row(str(r["workers"]), f"{r['local_seconds']:.1f}", f"{r['speedup']:.2f}x",
-                      f"{r['dask_seconds']:.1f}" if dask else "-",
+            s.add_row(f"{r['workers']:,}", f"{r['local_seconds']:,.1f}", f"{r['speedup']:.2f}x",
+                      f"{r['dask_seconds']:,.1f}" if dask else "-",
                       f"{r['dask_speedup']:.2f}x" if dask else "-")
         print_table(out, s)
     if json_out:

@@ -89,11 +89,11 @@ def bench_service(
         t.add_column(col, justify="left" if col == "load" else "right")
 
     def ms(r: dict, key: str) -> str:
-        return f"{r[key]:.2f}" if key in r else "-"
+        return f"{r[key]:,.2f}" if key in r else "-"
 
     for r in rows:
         t.add_row(r["load"] if r["load"] != "POST /plan" else f"POST /plan {r['map']}",
-                  f"{r['requests_per_second']:,.0f}", str(r["errors"]), ms(r, "app_p50"),
+                  f"{r['requests_per_second']:,.0f}", f"{r['errors']:,}", ms(r, "app_p50"),
                   ms(r, "app_p99"), ms(r, "plan_p50"), ms(r, "plan_p99"),
                   ms(r, "client_ms_p50"), ms(r, "client_ms_p99"),
                   ms(r, "server_cpu_ms_per_request"),

@@ -137,7 +137,7 @@ def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, 
             t.add_column(col, justify="left" if col == "runner" else "right")
         for row in rep["rows"]:
             ratio = row.get("length_ratio", row.get("raw_ratio"))
-            t.add_row(row["runner"], f"{row['seconds']:.4f}",
+            t.add_row(row["runner"], f"{row['seconds']:,.4f}",
                       "-" if ratio is None else f"{ratio:.4f}",
                       "-" if row.get("simplified_ratio") is None else
                       f"{row['simplified_ratio']:.4f}",
@@ -147,16 +147,16 @@ def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, 
     if city is not None and city_queries_n > 0:
         c = city_timing = city_queries(cases[-1][0], city_queries_n,
                                        np.random.default_rng(seed), no_path=no_path)
-        out.print(f"{cases[-1][0].name}: visibility graph of {c['corners']} corners built in "
-                  f"{c['build_seconds']:.3f} s ({c['cached_build_seconds']:.3f} s from the "
-                  f"disk cache); first query {c['first_seconds'] * 1e3:.1f} ms (with the "
-                  f"build {c['first_with_build_seconds']:.3f} s); {city_queries_n} far pairs "
-                  f"(>= {c['min_dist']:.0f} m apart, {c['found']} with a path): median "
-                  f"{c['median_ms']:.2f} ms, 95th percentile {c['p95_ms']:.2f} ms, max "
-                  f"{c['max_ms']:.2f} ms; {c['no_path_pairs']} pairs in different free "
+        out.print(f"{cases[-1][0].name}: visibility graph of {c['corners']:,} corners built "
+                  f"in {c['build_seconds']:,.3f} s ({c['cached_build_seconds']:,.3f} s from "
+                  f"the disk cache); first query {c['first_seconds'] * 1e3:,.1f} ms (with the "
+                  f"build {c['first_with_build_seconds']:,.3f} s); {city_queries_n:,} far "
+                  f"pairs (>= {c['min_dist']:,.0f} m apart, {c['found']:,} with a path): "
+                  f"median {c['median_ms']:,.2f} ms, 95th percentile {c['p95_ms']:,.2f} ms, "
+                  f"max {c['max_ms']:,.2f} ms; {c['no_path_pairs']:,} pairs in different free "
                   "regions: no path in median "
                   + ("-" if c["no_path_median_ms"] is None else
-                     f"{c['no_path_median_ms']:.2f} ms, max {c['no_path_max_ms']:.2f} ms"))
+                     f"{c['no_path_median_ms']:,.2f} ms, max {c['no_path_max_ms']:,.2f} ms"))
     if json_out:
         settings = {"worlds": worlds, "seed": seed, "seconds": seconds, "planners": chosen,
                     "city": city and str(city), "altitude": altitude, "safety": safety,
@@ -228,12 +228,12 @@ def bench_motion(
         r = step_drone_pairs(*ilp, max_expansions=max_expansions, merge=merge,
                              on_pair=lambda: progress.advance(task))
     both = sum(1 for x in r["rows"] if x["moves"] is not None and x["follow"] is not None)
-    out.print(f"step drone over {r['pairs']} ordered pairs: plan_moves solved "
-              f"{r['solved']} (max expansions {max_expansions:,}, merge {merge:g}), follow "
-              f"{r['follow_solved']}; on the {both} both solved: {r['moves_total']} moves vs "
-              f"{r['follow_total']} "
-              f"(ratio {r['ratio']:.4f}); plan_moves per leg median {r['median_ms']:.1f} ms, "
-              f"p90 {r['p90_ms']:.1f} ms, max {r['max_ms']:.1f} ms")
+    out.print(f"step drone over {r['pairs']:,} ordered pairs: plan_moves solved "
+              f"{r['solved']:,} (max expansions {max_expansions:,}, merge {merge:g}), follow "
+              f"{r['follow_solved']:,}; on the {both:,} both solved: {r['moves_total']:,} "
+              f"moves vs {r['follow_total']:,} (ratio {r['ratio']:.4f}); plan_moves per leg "
+              f"median {r['median_ms']:,.1f} ms, p90 {r['p90_ms']:,.1f} ms, max "
+              f"{r['max_ms']:,.1f} ms")
     if json_out:
         write_atomic(json_out, json.dumps(
             {"settings": {"data": str(data), "max_expansions": max_expansions, "merge": merge},
@@ -250,8 +250,9 @@ def _dubins_table(d: dict) -> Table:
         table.add_column(col, justify="right")
     for row in d["rows"]:
         ompl = row.get("ompl_us")
-        table.add_row(f"{row['queries']:,}", str(row["threads"]), f"{row['skyroute_us']:.4f}",
-                      f"{row['skyroute_min_us']:.4f}", "-" if ompl is None else f"{ompl:.3f}",
+        table.add_row(f"{row['queries']:,}", f"{row['threads']:,}",
+                      f"{row['skyroute_us']:,.4f}", f"{row['skyroute_min_us']:,.4f}",
+                      "-" if ompl is None else f"{ompl:,.3f}",
                       "-" if ompl is None else f"{ompl / row['skyroute_us']:.1f}x")
     return table
 
@@ -278,6 +279,22 @@ def _budgets(budgets: str) -> tuple[float, ...]:
     return secs
 
 
+def _curvature_table(summ: dict) -> Table:
+    """The runners of ``bench motion --curvature``: solved, exactly free, median length
+    ratio, median and p95 ms; the numbers right-aligned, as in every table (they were
+    left-aligned here alone)."""
+    table = Table(title="turning radius 5 m: one query per world")
+    for col in ("runner", "solved", "exactly free", "median ratio", "median ms", "p95 ms"):
+        table.add_column(col, justify="left" if col == "runner" else "right")
+    for name, s in summ.items():
+        if "found" in s:
+            ratio = f"{s['median_ratio']:.3f}" if s["median_ratio"] is not None else "-"
+            table.add_row(name, f"{s['found']:,}/{s['queries']:,}",
+                          f"{s['valid']:,}/{s['found']:,}", ratio, f"{s['median_ms']:,.1f}",
+                          f"{s['p95_ms']:,.1f}")
+    return table
+
+
 def _bench_curvature(worlds, seed, secs, city, tours, json_out) -> None:
     from skyroute.bench.curvature import curvature_queries, run_queries, summary, tour_benchmark
 
@@ -287,15 +304,7 @@ def _bench_curvature(worlds, seed, secs, city, tours, json_out) -> None:
         task = progress.add_task("planner runs", total=None)
         rows = run_queries(queries, secs, on_step=lambda r: progress.advance(task))
     summ = summary(rows)
-    table = Table(title="turning radius 5 m: one query per world")
-    for col in ("runner", "solved", "exactly free", "median ratio", "median ms", "p95 ms"):
-        table.add_column(col)
-    for name, s in summ.items():
-        if "found" in s:
-            ratio = f"{s['median_ratio']:.3f}" if s["median_ratio"] is not None else "-"
-            table.add_row(name, f"{s['found']}/{s['queries']}", f"{s['valid']}/{s['found']}",
-                          ratio, f"{s['median_ms']:.1f}", f"{s['p95_ms']:.1f}")
-    print_table(out, table)
+    print_table(out, _curvature_table(summ))
     for name, s in summ.items():
         if "compared" in s:
             worst = f"{s['worst_ratio']:.4f}" if s["worst_ratio"] is not None else "-"
@@ -309,8 +318,8 @@ def _bench_curvature(worlds, seed, secs, city, tours, json_out) -> None:
                   f"longer on average (min {t['greedy_longer_min']:.1%}, max "
                   f"{t['greedy_longer_max']:.1%}); local search alone {t['local_gap_mean']:.2%} "
                   f"above the exact tour on average (max {t['local_gap_max']:.2%}, exact on "
-                  f"{t['local_exact']}); exact {t['exact_ms_median']:.0f} ms, local "
-                  f"{t['local_ms_median']:.0f} ms median")
+                  f"{t['local_exact']:,}); exact {t['exact_ms_median']:,.0f} ms, local "
+                  f"{t['local_ms_median']:,.0f} ms median")
     if json_out:
         settings = {"worlds": worlds, "seed": seed, "budgets": list(secs),
                     "city": city and str(city), "tours": tours}

@@ -201,11 +201,12 @@ def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
     t.add_column()
     t.add_column(overflow="fold")  # a long file path folds; numbers stay whole
     pct = rep["money_pct"]
-    rows = [("orders placed", rep["orders_placed"]), ("delivered", rep["orders_delivered"]),
-            ("invalid", rep["orders_invalid"]),
+    rows = [("orders placed", f"{rep['orders_placed']:,}"),
+            ("delivered", f"{rep['orders_delivered']:,}"),
+            ("invalid", f"{rep['orders_invalid']:,}"),
             ("money delivered", f"{rep['money_delivered']:,}p of {rep['money_placed']:,}p"
              + ("" if pct is None else f" ({pct:.2f}%)")),
-            ("moves", f"{rep['moves']} (battery left {rep['moves_left']})"),
+            ("moves", f"{rep['moves']:,} (battery left {rep['moves_left']:,})"),
             ("time", f"{rep['seconds']:.2f} s"),
             ("files", "\n".join(str(f) for f in files))]
     for k, v in rows:
@@ -235,15 +236,15 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
     who = f"{workers} job(s)" if kind == "local" else f"{workers} Dask worker(s)"
     # a line of its own: as the title of the narrow monthly table it wrapped at the
     # table's width ("... money" over "delivered mean 99.24%, worst")
-    days = f"{s['days']} of {s['days'] + len(failed)}" if failed else f"{s['days']}"
-    plain_console().print(f"{days} days, {wall:.1f} s with {who}: money delivered "
+    days = f"{s['days']:,} of {s['days'] + len(failed):,}" if failed else f"{s['days']:,}"
+    plain_console().print(f"{days} days, {wall:,.1f} s with {who}: money delivered "
                           f"mean {s['mean_pct']:.2f}%, worst {s['min_pct']:.2f}% on "
                           f"{s['min_date']}", soft_wrap=True)
     t = Table()
     for col in ("month", "days", "mean %", "min %"):
-        t.add_column(col, justify="right")
+        t.add_column(col, justify="left" if col == "month" else "right")
     for m, v in s["months"].items():
-        t.add_row(m, str(v["days"]), f"{v['mean_pct']:.2f}", f"{v['min_pct']:.2f}")
+        t.add_row(m, f"{v['days']:,}", f"{v['mean_pct']:.2f}", f"{v['min_pct']:.2f}")
     print_table(plain_console(), t)
     if files:
         plain_console().print(f"wrote {len(files):,} files to {', '.join(s['folders'])}")

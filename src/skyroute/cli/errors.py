@@ -148,7 +148,11 @@ def _signal_exit(signum) -> None:
 
 def _run(app: typer.Typer, signals: _Signals | None) -> None:
     try:
-        code = app(standalone_mode=False)
+        # One name for the program in every usage line and hint, as in the "skyroute:
+        # error:" prefix, the docs and the commands messages suggest ("plan in it with
+        # 'skyroute plan-world ...'"): Click named it "python -m skyroute" when so run,
+        # and "python -m pytest.skyroute" when main() ran inside another -m program.
+        code = app(standalone_mode=False, prog_name="skyroute")
     except TyperException as exc:  # usage errors: unknown option, missing argument, ...
         ctx = getattr(exc, "ctx", None)
         hint = f" (see '{ctx.command_path} --help')" if ctx is not None else ""

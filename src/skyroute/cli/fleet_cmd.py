@@ -174,26 +174,27 @@ def _report_table(rep: dict, files: list[Path]) -> Table:
     t.add_column(style="bold")
     t.add_column(overflow="fold")  # a long file path folds; numbers stay whole
     rows = [
-        ("offered", f"{rep['offered']} ({rep['offered_per_hour']:.1f}/h after the "
+        ("offered", f"{rep['offered']:,} ({rep['offered_per_hour']:,.1f}/h after the "
                     f"{st['warmup_s'] / 60:g} min warm-up)"),
-        ("delivered", f"{rep['delivered']} ({rep['delivered_per_hour']:.1f}/h, served "
+        ("delivered", f"{rep['delivered']:,} ({rep['delivered_per_hour']:,.1f}/h, served "
                       f"{_fmt(rep['served_share'], '.1%')})"),
-        ("capacity bound", _fmt(rep["capacity_bound_per_hour"], ".1f", "/h")
-         + f" (mean cycle {_fmt(rep['mean_cycle_s'], '.0f', ' s')}, drones busy "
+        ("capacity bound", _fmt(rep["capacity_bound_per_hour"], ",.1f", "/h")
+         + f" (mean cycle {_fmt(rep['mean_cycle_s'], ',.0f', ' s')}, drones busy "
            f"{_fmt(rep['busy_share'], '.1%')})"),
-        ("delivery time p50 / p95", f"{_fmt(rep['p50_delivery_s'], '.0f', ' s')} / "
-                                    f"{_fmt(rep['p95_delivery_s'], '.0f', ' s')}"),
-        ("longest wait", _fmt(rep["max_wait_s"], ".0f", " s")),
-        ("loiter circles", f"{rep['loiters']} ({rep['loiter_s']:.0f} s)"),
-        ("flights", f"{rep['flights']} ({rep['reposition_flights']} empty repositioning)"),
-        ("conflicts", str(rep["conflicts"])),
+        ("delivery time p50 / p95", f"{_fmt(rep['p50_delivery_s'], ',.0f', ' s')} / "
+                                    f"{_fmt(rep['p95_delivery_s'], ',.0f', ' s')}"),
+        ("longest wait", _fmt(rep["max_wait_s"], ",.0f", " s")),
+        ("loiter circles", f"{rep['loiters']:,} ({rep['loiter_s']:,.0f} s)"),
+        ("flights", f"{rep['flights']:,} ({rep['reposition_flights']:,} empty "
+                    "repositioning)"),
+        ("conflicts", f"{rep['conflicts']:,}"),
         # each least distance is taken while the other is under its minimum
-        ("closest pair", f"{_fmt(rep['min_horizontal_m'], '.1f', ' m')} horizontally within "
+        ("closest pair", f"{_fmt(rep['min_horizontal_m'], ',.1f', ' m')} horizontally within "
                          f"{st['sep_vertical']:g} m vertically; "
-                         f"{_fmt(rep['min_vertical_m'], '.1f', ' m')} vertically within "
+                         f"{_fmt(rep['min_vertical_m'], ',.1f', ' m')} vertically within "
                          f"{st['sep_horizontal']:g} m horizontally"),
-        ("lost packages", str(rep["lost"])),
-        ("wall time", f"{rep['wall_seconds']:.2f} s "
+        ("lost packages", f"{rep['lost']:,}"),
+        ("wall time", f"{rep['wall_seconds']:,.2f} s "
                       f"({_fmt(rep['sim_seconds_per_wall_second'], ',.0f')} simulated s/s)"),
     ]
     rows += [("file", str(p)) for p in files]
@@ -346,7 +347,7 @@ def _sweep_table(s: Scenario, hours: float, seeds: list[int], rows: list[dict]) 
                     f"{hours:g} h x {len(seeds)} seeds (mean ±95% CI)")
     for col in _SWEEP_COLUMNS:
         # a cell wraps before its "±" on a narrow terminal (print_table keeps words whole)
-        t.add_column(col, justify="right")
+        t.add_column(col, justify="left" if col in ("scheduler", "airspace") else "right")
 
     def pm(r, m, spec, scale=1.0):
         v, ci = r[m], r[m + "_ci95"]
@@ -356,9 +357,9 @@ def _sweep_table(s: Scenario, hours: float, seeds: list[int], rows: list[dict]) 
         return text if ci is None or math.isnan(ci) else f"{text} ±{ci * scale:{spec}}"
 
     for r in rows:
-        t.add_row(r["scheduler"], r["airspace"], _fmt(r["rate_per_hour"], ".0f"),
-                  pm(r, "delivered_per_hour", ".1f"), pm(r, "served_share", ".1f", 100.0),
-                  pm(r, "p95_delivery_s", ".0f"), pm(r, "max_wait_s", ".0f"),
-                  pm(r, "loiters", ".0f"), pm(r, "capacity_bound_per_hour", ".1f"),
-                  str(r["conflicts"]), str(r["lost"]))
+        t.add_row(r["scheduler"], r["airspace"], _fmt(r["rate_per_hour"], ",.0f"),
+                  pm(r, "delivered_per_hour", ",.1f"), pm(r, "served_share", ".1f", 100.0),
+                  pm(r, "p95_delivery_s", ",.0f"), pm(r, "max_wait_s", ",.0f"),
+                  pm(r, "loiters", ",.0f"), pm(r, "capacity_bound_per_hour", ",.1f"),
+                  f"{r['conflicts']:,}", f"{r['lost']:,}")
     return t

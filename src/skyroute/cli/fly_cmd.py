@@ -230,19 +230,25 @@ def fly_command(
 # and for the step drone); --json keeps the bare numbers.
 METRIC_UNITS = {"length": "plane", "bound": "plane", "greedy_bound": "plane",
                 "length_deg": "deg", "time": "s", "seconds": "s", "smoothness": "rad/move"}
+# Decimals by unit, as the other tables have them: lengths as plan-world's cost (6),
+# seconds to the millisecond, smoothness to 1e-4 rad
+DECIMALS = {"m": 6, "deg": 6, "s": 3, "rad/move": 4}
 
 
 def _shown(name: str, value, plane_unit: str) -> str:
-    """A metric as the table shows it: floats to 6 significant digits with their unit
-    (a length read "236.451" beside plan-world's "221.383540 m"), counts with thousands
-    separators."""
+    """A metric as the table shows it: floats with their unit, to a fixed number of
+    decimals a unit (DECIMALS) and thousands separators, as plan-world's "cost
+    1,221.383540 m" (6 significant digits made 1234567.8 m "1.23457e+06 m" and gave a
+    length 2 decimals beside plan-world's 6); counts with thousands separators."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         return str(value)
     if isinstance(value, int):
         return f"{value:,}"
     unit = METRIC_UNITS.get(name)
     unit = plane_unit if unit == "plane" else unit
-    return f"{value:.6g}" + (f" {unit}" if unit else "")
+    if unit is None:
+        return f"{value:,.6g}"
+    return f"{value:,.{DECIMALS[unit]}f} {unit}"
 
 
 def _check_vehicle_options(ctx: typer.Context, vehicle: str) -> None:

@@ -93,8 +93,11 @@ def plan_command(
         from skyroute.cli.tables import plain_console
 
         files = (("plot", plot), ("geojson", geojson)) if result.found else ()
-        print_table(plain_console(), result_table(f"{grid.name}: {result.algorithm}", result,
-                                            files=files))
+        # the cost is in cells (octile steps), as --json gives it; in metres too where a
+        # cell is not 1 m (--resolution)
+        print_table(plain_console(), result_table(
+            f"{grid.name}: {result.algorithm}", result, unit="cells",
+            metres_per_unit=grid.resolution, files=files))
     if not result.found:
         raise typer.Exit(EXIT_NOT_FOUND)
 
@@ -138,5 +141,6 @@ def prepare_command(
     with delayed_status(f"preparing {grid.name}"):  # a first run compiles for a minute
         index = prepare(grid, method=method)
     written = index.save(out)
-    plain_console().print(f"{grid.name}: {index.describe()}, built in {index.build_seconds:.3f} s, "
-                    f"{written.stat().st_size / 1e6:.2f} MB -> {written}")
+    plain_console().print(f"{grid.name}: {index.describe()}, built in "
+                          f"{index.build_seconds:,.3f} s, {written.stat().st_size / 1e6:,.2f} "
+                          f"MB -> {written}")

@@ -17,9 +17,15 @@ if TYPE_CHECKING:  # Rich is imported on use: `skyroute plan --json` prints with
     from rich.table import Table
 
 
-def result_table(title: str, result: PlanResult, *, unit: str = "",
+def result_table(title: str, result: PlanResult, *, unit: str,
+                 metres_per_unit: float | None = None,
                  files: tuple[tuple[str, object], ...] = ()) -> Table:
-    """Status, cost, waypoints, statistics and written files of one result."""
+    """Status, cost, waypoints, statistics and written files of one result.
+
+    ``unit`` names the cost's unit ("cells" on a grid map, "m" or "deg" in a world);
+    ``metres_per_unit``, when given and not 1, adds the cost in metres (a grid of
+    0.5 m cells: "6.000000 cells (3.000000 m)"). Numbers have thousands separators, and
+    as many decimals wherever they appear: costs 6, milliseconds 3."""
     from rich.table import Table
 
     table = Table(title=title, show_header=False)
@@ -27,14 +33,17 @@ def result_table(title: str, result: PlanResult, *, unit: str = "",
     table.add_column(overflow="fold")  # a long file path folds; numbers stay whole
     table.add_row("status", result.status.value)
     if result.found:
-        table.add_row("cost", f"{result.cost:.6f}" + (f" {unit}" if unit else ""))
-        table.add_row("waypoints", str(len(result.path)))
+        cost = f"{result.cost:,.6f} {unit}"
+        if metres_per_unit is not None and metres_per_unit != 1:
+            cost += f" ({result.cost * metres_per_unit:,.6f} m)"
+        table.add_row("cost", cost)
+        table.add_row("waypoints", f"{len(result.path):,}")
     table.add_row("expanded", f"{result.expanded:,}")
     table.add_row("max frontier", f"{result.max_frontier:,}")
     table.add_row("line-of-sight checks", f"{result.los_checks:,}")
-    table.add_row("search time", f"{result.seconds * 1e3:.3f} ms")
+    table.add_row("search time", f"{result.seconds * 1e3:,.3f} ms")
     if "setup_seconds" in result.extra:
-        table.add_row("set-up time", f"{result.extra['setup_seconds'] * 1e3:.3f} ms "
+        table.add_row("set-up time", f"{result.extra['setup_seconds'] * 1e3:,.3f} ms "
                       "(first query: masks, tables, compiled kernels)")
     for label, path in files:
         if path:

@@ -121,9 +121,9 @@ class PreparedGrid:
     def describe(self) -> str:
         """One line: the index kind and its size."""
         if self.method == "jump":
-            return f"jump index, {self.pivots} pivots"
-        return (f"subgoal index ({self.accelerator}), {self.subgoals} subgoals, "
-                f"{self.edges} edges")
+            return f"jump index, {self.pivots:,} pivots"
+        return (f"subgoal index ({self.accelerator}), {self.subgoals:,} subgoals, "
+                f"{self.edges:,} edges")
 
     def __repr__(self) -> str:
         return f"<PreparedGrid {self.grid.name!r}: {self.describe()}>"
