@@ -47,6 +47,21 @@ def durations(plan) -> dict[str, float]:
 
 # ------------------------------------------------------------------ a straight route
 
+@pytest.mark.parametrize("gate", [0, 1])
+def test_the_runway_times_are_when_the_taxi_passes_the_airport(gate):
+    """The simulation books the take-off runway from ``out_at_position`` and the
+    landing runway until ``in_at_position``: the drone is at the airport's position then
+    (the taxi profile, slow near the gate; 10 m/s all the way put it there 2 s earlier
+    and 3.5 s later than booked)."""
+    f = plan_flight(two_airports(), 1, "A", "B", depart=5.0, altitude=100.0,
+                    origin_gate=gate, destination_gate=gate)
+    assert ground_position(f, f.out_at_position) == pytest.approx([0.0, 0.0], abs=1e-9)
+    assert ground_position(f, f.in_at_position) == pytest.approx([0.0, 5000.0], abs=1e-9)
+    # 15 m from the gate at 1 m/s, then away at 3 m/s: there 15 s after leaving
+    assert f.out_at_position - f.depart == pytest.approx(15.0)
+    assert f.at_gate - f.in_at_position == pytest.approx(15.0)
+
+
 def test_phases_in_order_and_times_monotone(straight):
     names = [p.name for p in straight.phases]
     assert names == [n for n in PHASES if n != "loiter"]

@@ -167,6 +167,27 @@ class FlightPlan:
         """Arrival at the destination gate."""
         return self.phases[-1].end
 
+    @property
+    def out_at_position(self) -> float:
+        """When the taxi out reaches the origin airport's position, where the take-off
+        runway starts to be held: the taxi profile's time from the gate (slow near it)."""
+        route = self.taxi_out_route
+        return self.depart + self._taxi_seconds(float(np.hypot(*(route[1] - route[0]))),
+                                                self.gate_widths[0])
+
+    @property
+    def in_at_position(self) -> float:
+        """When the taxi in reaches the destination airport's position, off the landing
+        runway's roll: the taxi profile's time before the gate (slow near it)."""
+        route = self.taxi_in_route
+        return self.at_gate - self._taxi_seconds(float(np.hypot(*(route[2] - route[1]))),
+                                                 self.gate_widths[1])
+
+    def _taxi_seconds(self, distance: float, gate_width: float) -> float:
+        d = self.aircraft
+        return taxi_seconds(distance, gate_width, fast=d.taxi_speed, near=d.taxi_near_speed,
+                            slow=d.taxi_gate_speed)
+
     def loiter(self, t: float) -> Pieces:
         """One loiter circle starting at time ``t`` at the approach gate (one arc piece,
         ``loiter_seconds`` long, ending back at the gate on the approach heading)."""

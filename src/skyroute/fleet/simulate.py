@@ -48,7 +48,7 @@ from skyroute.fleet.airspace import (
 from skyroute.fleet.flightplan import FlightPlan, plan_flight, takeoff_overrun
 from skyroute.fleet.nofly import check_joined
 from skyroute.fleet.packages import TIME_DECIMALS, Stream, horizon_seconds
-from skyroute.fleet.scenario import Scenario, runway_ends
+from skyroute.fleet.scenario import Scenario
 from skyroute.fleet.timetable import Timetable
 from skyroute.fleet.trajectory import Pieces
 from skyroute.geo import heading_to_plane
@@ -385,7 +385,6 @@ class _Engine:
         if tpl is None:
             plan = plan_flight(self.s, 0, self.ids[o], self.ids[b], depart=0.0, altitude=alt,
                                origin_gate=og, destination_gate=bg)
-            d = self.s.drone
             # before the flight is sampled each second (fleet.airborne): a scenario read
             # from a file was checked on its farthest airports, this is every flight
             sp = self.s.airspace
@@ -393,16 +392,13 @@ class _Engine:
                              plan)
             if error:
                 raise SimulationError(f"scenario: {error}")
-            a_o, a_b = self.s.airports[o], self.s.airports[b]
-            thr, _ = runway_ends(a_o, a_o.takeoff)
-            # on the take-off runway from the airport's position to lift-off
-            on_rwy = plan.phase("taxi_out").end - math.hypot(
-                thr[0] - a_o.north, thr[1] - a_o.east) / d.taxi_speed
-            stop = plan.rollout_roll[1]
-            # the landing runway: from the start of the approach until the drone has
-            # rolled out and taxied back to the airport's position
-            off_rwy = plan.phase("rollout").end + math.hypot(
-                stop[0] - a_b.north, stop[1] - a_b.east) / d.taxi_speed
+            # on the take-off runway from the airport's position to lift-off; on the
+            # landing runway from the start of the approach until the drone has rolled
+            # out and taxied back to the airport's position: both timed on the taxi
+            # profile (slow near a gate; the airport's position is half a gate width
+            # from its gates), not at the full taxi speed, which put the drone on the
+            # take-off runway before its booking and on the landing runway after it
+            on_rwy, off_rwy = plan.out_at_position, plan.in_at_position
             tpl = (plan, on_rwy, plan.phase("takeoff").end, plan.landing_request, off_rwy,
                    plan.at_gate)
             self.templates[key] = tpl
