@@ -627,6 +627,35 @@ def test_failed_days_in_json_and_a_defect_shows_its_traceback(monkeypatch, capsy
     assert err == "skyroute: error: 2024-01-02: the flight failed validation: move 3\n"
 
 
+
+@pytest.mark.parametrize("as_json", [False, True])
+def test_a_range_whose_every_day_fails_says_none_was_stored(monkeypatch, capsys, tmp_path,
+                                                            as_json):
+    # the last line said "2 of the 2 days failed and were not stored; the other 0 are
+    # stored, with their files", of files and days there were none of
+    from skyroute.errors import SkyrouteError
+
+    def planner(site, date, orders, **kw):
+        raise SkyrouteError(f"{date}: the planner failed")
+
+    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", planner)
+    db, out = tmp_path / "n.db", tmp_path / "out"
+    code, stdout, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
+                            "2024-01-02", "--data", EXAMPLE, "--db", f"sqlite:///{db}",
+                            "--out", str(out), *(["--json"] if as_json else []))
+    assert code == 2, err
+    assert err.strip().splitlines()[-3:] == [
+        "skyroute: error: 2024-01-01: the planner failed",
+        "skyroute: error: 2024-01-02: the planner failed",
+        "skyroute: error: all 2 days failed and none was stored"], err
+    if as_json:
+        assert json.loads(stdout)["days"] == 0
+    else:
+        assert stdout == ""
+    assert _stored_day(db, "2024-01-01")[0] == _stored_day(db, "2024-01-02")[0] == []
+    assert not out.exists()
+
+
 def _ctrl_c():
     raise KeyboardInterrupt
 

@@ -267,3 +267,18 @@ def test_the_table_gives_each_metric_its_unit(monkeypatch, capsys, city):
     assert rows["smoothness"] == f"{m['smoothness']:.4f} rad/move"
     assert m["expanded"] >= 1000 and rows["expanded"] == f"{m['expanded']:,}"
     assert rows["moves"] == str(m["moves"]) and rows["status"] == "found"
+
+
+def test_a_field_escape_raster_too_large_names_step_not_resolution(monkeypatch, capsys,
+                                                                   tmp_path):
+    # the robot trapped in a U, its goal 14 km away: "--resolution 1 over a 10057 x 10070
+    # extent makes ...; use a coarser resolution", an option --vehicle field refuses
+    city = tmp_path / "u.csv"
+    city.write_text("lat0 37.792480, lon0 -122.397450\nposX,posY,posZ,halfSizeX,halfSizeY,"
+                    "halfSizeZ\n30,30,5,2,15,5\n43,17,5,15,2,5\n43,43,5,15,2,5\n")
+    code, out, err = run(monkeypatch, capsys, "fly", str(city), "--frame", "ned",
+                         "--vehicle", "field", "--start", "36,30", "--goal=-10000,-10000",
+                         "--altitude", "1")
+    assert (code, out) == (2, "") and err.count("\n") == 1, err
+    assert err.startswith("skyroute: error: --step 1 makes the escape's raster") and \
+        "use a larger step" in err, err

@@ -177,3 +177,19 @@ def test_a_deliver_job_stores_the_days_that_did_not_fail(tmp_path, monkeypatch, 
         "2024-01-01: ZeroDivisionError: division by zero", 1.0)
     logged = [r.getMessage() for r in caplog.records if r.levelname == "ERROR"]
     assert any("ZeroDivisionError" in m and "return 1 / 0" in m for m in logged), logged
+
+
+@pytest.mark.parametrize("failed, words", [
+    (1, "1 of the 3 days failed and was not stored (the other 2 are): 2024-01-01: no"),
+    (2, "2 of the 3 days failed and were not stored (the other 1 is): 2024-01-01: no; "
+        "2024-01-02: no"),
+    # it said "(the other 0 are)" of a job that stored nothing
+    (3, "all 3 days failed and none was stored: 2024-01-01: no; 2024-01-02: no; "
+        "2024-01-03: no"),
+])
+def test_a_failed_range_says_how_many_days_are_stored(failed, words):
+    from skyroute.jobs.deliver import DayFailed, DaysFailedError
+
+    days = [DayFailed(dt.date(2024, 1, d), f"2024-01-0{d}: no", True)
+            for d in range(1, failed + 1)]
+    assert str(DaysFailedError([], days, 3)) == words

@@ -100,6 +100,9 @@ def test_fleet_and_sweep_params_are_completed():
     # no rate given: the scenario's, so hours is to blame (rate_per_hour= was named)
     ({"scenario": BUSY, "hours": 24},
      "hours=24 at the scenario's 10000 packages/h would spawn about 2.4e+05 packages"),
+    # a run shorter than the millisecond its times are written to: the job was queued
+    # and then failed in its run (the CLI refused it at once)
+    ({"preset": "seed-3x3", "hours": 1e-7}, "hours=1e-07 is 0.00036 s, under the millisecond"),
 ])
 def test_bad_fleet_params_name_the_field(params, words):
     from skyroute.errors import OptionError
@@ -116,6 +119,7 @@ def test_bad_fleet_params_name_the_field(params, words):
     ({"preset": None, "scenario": BUSY, "hours": 24},
      "hours=24 at the scenario's 10000 packages/h would spawn about 2.4e+05 packages"),
     ({"hours": 1e9}, "hours=1e+09 is over the limit"),
+    ({"hours": 1e-7}, "hours=1e-07 is 0.00036 s, under the millisecond"),
     ({"seeds": list(range(1000)), "rates": [10, 20, 30]}, "2 scheduler(s) x 2 airspace(s) x "
      "3 rate(s) x 1,000 seed(s) is 12,000 runs, over the limit of 10,000 in one sweep; give "
      "fewer rates or seeds"),

@@ -167,3 +167,15 @@ def test_escape_reaches_a_goal_beyond_the_obstacles_of_an_unbounded_world():
     assert run.reached and run.escaped > 0
     assert world.segments_free(run.path[:-1], run.path[1:]).all()
     assert math.dist(run.path[-1], goal) < 0.5
+
+
+def test_an_escape_raster_past_the_cell_limit_names_the_step():
+    """A goal far beyond the obstacles of an unbounded world grows the escape's raster
+    (cells a step wide) past MAX_CELLS: the error named ``resolution``, which run_field
+    has not (and ``fly --vehicle field`` refuses: "does not use --resolution")."""
+    with pytest.raises(OptionError) as err:
+        run_field(_open_c(), (25.0, 30.0), (6000.0, 6000.0))
+    assert err.value.param == "step"
+    assert str(err.value).startswith("step=0.5 makes the escape's raster (cells a step wide "
+                                     "over the obstacles, the start, the robot and the goal")
+    assert str(err.value).endswith("; use a larger step, or turn the escape off")

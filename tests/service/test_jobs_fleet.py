@@ -808,3 +808,14 @@ def test_fleet_runs_are_listed_a_page_at_a_time(tmp_path, request, db):
                              ("offset=-1", "offset"), (f"offset={2**63}", "offset"),
                              ("limit=ten", "limit")]:
             assert_problem(c.get(f"/fleet/runs?{query}"), 422, field)
+
+
+
+@needs_jobs
+def test_a_run_under_a_millisecond_is_refused_before_it_is_queued(tmp_path):
+    """The runner's own check (the stand-in runner above skips it): hours=1e-7 was
+    accepted (202), queued, and failed in its run, "hours=1e-07 is 0.00036 s, under the
+    millisecond a run's times are written to"."""
+    with make_client(db_url=f"sqlite:///{tmp_path / 'h.db'}", job_workers=1) as c:
+        r = c.post("/jobs/fleet", json={"preset": "seed-3x3", "hours": 1e-7}, headers=AUTH)
+        assert_problem(r, 422, "hours", "hours=1e-07 is 0.00036 s, under the millisecond")

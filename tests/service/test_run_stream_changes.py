@@ -174,3 +174,40 @@ def test_a_stored_file_follows_only_a_replacement_by_the_same_bytes(store_url):
             assert first + b"".join(parts) == other
         store.save_fleet_run(engine, tracks_csv=data, **ARGS)
     engine.dispose()
+
+
+def test_a_stored_file_follows_a_run_saved_again_while_it_is_compared(store_url,
+                                                                       monkeypatch):
+    """The run saved with the same bytes twice in quick succession, the second save
+    landing while the first replacement's parts were compared with those already sent:
+    the comparison met the second replacement, and the stream was cut (RunChangedError)
+    although each version was the same bytes. It follows the version now instead; a run
+    that changes at every comparison still ends, in the error."""
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    engine = make_engine(store_url)
+    data = bytes(range(256)) * 14  # 4 parts
+    store.save_fleet_run(engine, tracks_csv=data, **ARGS)
+    opened = store.open_fleet_file
+    saves = []
+
+    def save_again_once_opened(*args):
+        now = opened(*args)  # the version to compare, replaced before it is read
+        if saves:
+            saves.pop()()
+        return now
+
+    monkeypatch.setattr(store, "open_fleet_file", save_again_once_opened)
+    for again, whole in ((1, True), (store.StoredFile.FOLLOW + 1, False)):
+        parts = iter(store.open_fleet_file(engine, "r", "tracks_csv"))
+        first = next(parts)
+        store.save_fleet_run(engine, tracks_csv=data, **ARGS)
+        saves[:] = [lambda: store.save_fleet_run(engine, tracks_csv=data, **ARGS)] * again
+        if whole:
+            assert first + b"".join(parts) == data
+        else:
+            with pytest.raises(store.RunChangedError):
+                list(parts)
+    engine.dispose()
+

@@ -182,7 +182,8 @@ def _say_failed(failed: list[DayFailed], n: int) -> None:
         for f in failed:
             typer.echo(f"skyroute: error: {f.error}", err=True)
         rest = n - len(failed)
-        last = (f"{len(failed):,} of the {n:,} days failed and "
+        last = f"all {n:,} days failed and none was stored" if not rest else (
+                f"{len(failed):,} of the {n:,} days failed and "
                 f"{'was' if len(failed) == 1 else 'were'} not stored; the other {rest:,} "
                 f"{'is' if rest == 1 else 'are'} stored, with {'its' if rest == 1 else 'their'}"
                 " files")

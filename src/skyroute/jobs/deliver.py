@@ -137,8 +137,9 @@ class DaysFailedError(SkyrouteError):
             text = failed[0].error
         else:
             n, rest = len(failed), days - len(failed)
-            text = (f"{n:,} of the {days:,} days failed and {'was' if n == 1 else 'were'} "
-                    f"not stored (the other {rest:,} {'is' if rest == 1 else 'are'}): "
+            text = ((f"all {days:,} days failed and none was stored: " if not rest else
+                     f"{n:,} of the {days:,} days failed and {'was' if n == 1 else 'were'} "
+                     f"not stored (the other {rest:,} {'is' if rest == 1 else 'are'}): ")
                     + "; ".join(f.error for f in failed[:self.SHOWN])
                     + (f"; and {n - self.SHOWN:,} more" if n > self.SHOWN else ""))
         super().__init__(text)

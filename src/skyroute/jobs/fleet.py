@@ -26,6 +26,7 @@ from skyroute.fleet.airborne import check_flights
 from skyroute.fleet.airspace import MODES
 from skyroute.fleet.dispatch import SCHEDULERS
 from skyroute.fleet.limits import MAX_SEEDS, check_run, check_sweep
+from skyroute.fleet.packages import check_hours
 from skyroute.fleet.report import report
 from skyroute.fleet.scenario import Scenario, parse_scenario, preset
 from skyroute.fleet.simulate import check_levels, run
@@ -202,7 +203,7 @@ def check_fleet_params(params: dict) -> dict:
     _known(params, {"preset", "scenario", "hours", "seed", "scheduler", "airspace",
                     "rate_per_hour", "track_step"}, "fleet")
     s, out = _scenario(params)
-    out["hours"] = real("hours", params.get("hours", 1.0), low=0.0, strict=True)
+    out["hours"] = check_hours(params.get("hours", 1.0))  # as simulate reads it
     out["seed"] = check_seed(params.get("seed", 0))
     out["scheduler"] = params.get("scheduler", "seed")
     check_choice("scheduler", out["scheduler"], SCHEDULERS)
@@ -244,7 +245,7 @@ def check_sweep_params(params: dict) -> dict:
         raise OptionError(f"seeds: {len(seeds):,} seeds is over the limit of {MAX_SEEDS:,}",
                           param="seeds")
     out["seeds"] = list(dict.fromkeys(check_seed(x, "seeds") for x in seeds))
-    out["hours"] = real("hours", params.get("hours", 1.0), low=0.0, strict=True)
+    out["hours"] = check_hours(params.get("hours", 1.0))  # as simulate reads it
     check_sweep(schedulers=len(out["schedulers"]), airspaces=len(out["airspaces"]),
                 rates=len(rates or [None]), seeds=len(out["seeds"]))
     for rate in rates or [s.packages.rate_per_hour]:

@@ -424,9 +424,10 @@ class StoredFile:
     worker died stores its run again, byte for byte): when the run's file now has the
     same size and its parts read so far are the ones already yielded (compared by
     digest), the rest comes from the new version, so the whole is the new version's
-    bytes. Any other change (other bytes, another size, the run deleted) is the error."""
+    bytes (also when only its parts not yet read differ). Any other change (other bytes
+    in the parts yielded, another size, the run deleted) is the error."""
 
-    FOLLOW = 3  # replacements by the same bytes one iteration follows
+    FOLLOW = 3  # replacements one iteration follows (also one met while comparing)
 
     def __init__(self, engine: sa.Engine, run_id: str, name: str, created, size: int,
                  parts: int) -> None:
@@ -448,21 +449,30 @@ class StoredFile:
                     yield data
                 return
             except RunChangedError:
-                follows += 1
-                if follows > self.FOLLOW or not self._follow(digests):
+                while True:  # the version now, unless it changes again while compared
+                    follows += 1
+                    if follows > self.FOLLOW:
+                        raise
+                    same = self._follow(digests)
+                    if same is not None:
+                        break
+                if not same:
                     raise
 
-    def _follow(self, digests: list[bytes]) -> bool:
+    def _follow(self, digests: list[bytes]) -> bool | None:
         """Whether the run's file is now the same size, in as many parts, and begins with
-        the parts of ``digests``; if so this file is now that version."""
+        the parts of ``digests``; if so this file is now that version. None when that
+        version was itself replaced while its parts were compared (saved twice in quick
+        succession): the caller asks again. (That was False: the stream was cut although
+        the run was the same bytes each time.)"""
         now = open_fleet_file(self._engine, self.run_id, self.name)
         if now is None or (now.size, now.parts) != (self.size, self.parts):
             return False
         try:
             if [_digest(d) for d in now._read(0, len(digests))] != digests:
                 return False
-        except RunChangedError:  # replaced again: the caller may follow once more
-            return False
+        except RunChangedError:
+            return None
         self._created, self.created = now._created, now.created
         return True
 

@@ -26,8 +26,9 @@ import numpy as np
 import shapely
 
 from skyroute.caches import register
-from skyroute.errors import check_choice, flag, real, whole
+from skyroute.errors import OptionError, check_choice, flag, real, whole
 from skyroute.result import Status
+from skyroute.world.grid import MAX_CELLS
 from skyroute.world.world import World
 
 COURSES = ("easy", "medium", "hard")
@@ -138,7 +139,17 @@ def _navigation(world: World, goal: np.ndarray, resolution: float, points: np.nd
     box = world.extent_with(np.vstack([points, goal]), margin=4 * r)
     if world.boundary is None:
         box = (box[0] - 4 * r, box[1] - 4 * r, box[2] + 4 * r, box[3] + 4 * r)
-    grid = world.merged().rasterize(r, safety=r / math.sqrt(2), bounds=box)
+    try:
+        grid = world.merged().rasterize(r, safety=r / math.sqrt(2), bounds=box)
+    except OptionError as exc:  # its cells are a step wide: the caller has no resolution
+        if exc.param != "resolution":
+            raise
+        over = ("the boundary" if world.boundary is not None else
+                "the obstacles, the start, the robot and the goal")
+        raise OptionError(f"step={r:g} makes the escape's raster (cells a step wide over "
+                          f"{over}, {box[2] - box[0]:.6g} x {box[3] - box[1]:.6g} across) "
+                          f"more than {MAX_CELLS:,} cells; use a larger step, or turn the "
+                          "escape off", param="step") from None
     free = ~grid.blocked
     h, w = free.shape
     idx = np.arange(h * w).reshape(h, w)
