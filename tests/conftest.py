@@ -48,7 +48,10 @@ def _early_processes(request, tmp_path_factory, leg_cache):
     """The separate processes that the selected tests marked ``early_process(*args)`` check,
     all started (``python *args``, each in a folder of its own) when the run begins: they
     then run on the second core beside the in-process tests, not after them. Each test
-    waits for its own through the ``early_process`` fixture."""
+    waits for its own through the ``early_process`` fixture. Their environment is
+    ``os.environ`` as Python holds it: a library loaded in this process sets COLUMNS=80
+    and LINES=24 in the C environment (not in ``os.environ``), which a child inherits
+    by default and which the CLI's tables honour."""
     started = {}
     for item in request.session.items:
         mark = item.get_closest_marker("early_process")
@@ -56,7 +59,7 @@ def _early_processes(request, tmp_path_factory, leg_cache):
             cwd = tmp_path_factory.mktemp("process")
             started[item.nodeid] = cwd, subprocess.Popen(
                 [sys.executable, *mark.args], cwd=cwd, stdout=subprocess.PIPE,
-                stderr=subprocess.PIPE, text=True)
+                stderr=subprocess.PIPE, text=True, env=dict(os.environ))
     yield started
     for _, proc in started.values():  # a test that never ran (-x, Ctrl-C): stop its process
         if proc.poll() is None:
