@@ -587,6 +587,50 @@ def test_a_worker_error_that_does_not_unpickle_is_one_line(monkeypatch, capsys, 
     assert _files_of(out) == ["drone-31-12-2023.geojson", "report-31-12-2023.json"]
 
 
+OOM = "killed by SIGKILL, as the out-of-memory killer does"
+
+
+def test_a_worker_that_dies_loses_only_its_own_day(monkeypatch, capsys, tmp_path):
+    # a pool worker killed (here by itself, SIGKILL, as the out-of-memory killer does)
+    # on 2024-01-01: the range ended in a BrokenProcessPool traceback, and every day not
+    # yet stored was lost (also those flown meanwhile by the other worker). Now the
+    # range goes on in a fresh pool, the days the broken pool held are flown again each
+    # alone, and only the day that kills its worker again fails, in one line
+    failing_workers(monkeypatch, {"2024-01-01": "die"})
+    db, out = tmp_path / "d.db", tmp_path / "out"
+    code, stdout, err = run(monkeypatch, capsys, "deliver", "--from", "2023-12-31", "--to",
+                            "2024-01-03", "--data", EXAMPLE, "--db", f"sqlite:///{db}",
+                            "--out", str(out), "--jobs", "2")
+    assert code == 2 and "Traceback" not in err, err
+    assert f"skyroute: a worker process died ({OOM}); the " in err
+    assert err.strip().splitlines()[-2:] == [
+        f"skyroute: error: 2024-01-01: its worker process died ({OOM}), also when run "
+        "again alone",
+        "skyroute: error: 1 of the 4 days failed and was not stored; the other 3 are "
+        "stored, with their files"], err
+    assert _stored_day(db, "2024-01-01")[0] == []
+    assert _stored_day(db, "2024-01-02")[0] and _stored_day(db, "2024-01-03")[0]
+    assert _stored_day(db, "2023-12-31")[0] == [(0, 0)]
+    assert _files_of(out) == sorted(f"{k}-{d}.{e}" for d in ("02-01-2024", "03-01-2024",
+                                                             "31-12-2023")
+                                    for k, e in (("drone", "geojson"), ("report", "json")))
+    assert re.search(r"^3 of 4 days, ", stdout, re.M), stdout
+
+
+def test_a_worker_killed_once_loses_no_day(monkeypatch, capsys, tmp_path):
+    # killed from outside once (an operator's kill; the out-of-memory killer taking
+    # the biggest process while another program ate the memory): flown again, stored
+    failing_workers(monkeypatch, {"2024-01-01": "die-once"}, marks=tmp_path)
+    db, out = tmp_path / "o.db", tmp_path / "out"
+    code, stdout, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
+                            "2024-01-02", "--data", EXAMPLE, "--db", f"sqlite:///{db}",
+                            "--out", str(out), "--jobs", "2")
+    assert code == 0 and f"skyroute: a worker process died ({OOM})" in err, err
+    assert (tmp_path / "2024-01-01").exists()  # it did die once
+    assert _stored_day(db, "2024-01-01")[0] and _stored_day(db, "2024-01-02")[0]
+    assert re.search(r"^2 days, ", stdout, re.M), stdout
+
+
 def test_failed_days_in_json_and_a_defect_shows_its_traceback(monkeypatch, capsys,
                                                                tmp_path, fly_once):
     # in the command's process (--jobs 1): a defect on one day is that day's failure

@@ -196,3 +196,43 @@ def test_ctrl_c_in_a_local_map_ends_the_running_tasks(tmp_path):
             os.killpg(p.pid, signal.SIGKILL)
     assert (out, err, p.returncode) == ("interrupted\n", "", 0)
     assert sorted(f.name for f in tmp_path.glob("*-*")) == ["started-0", "started-1"]
+
+
+def test_a_dying_local_worker_loses_only_the_task_that_kills_it(caplog):
+    """A task that kills its worker process (the out-of-memory killer, a crash): the map
+    raised BrokenProcessPool at once, with the results of the tasks in flight on the
+    other workers and of those not yet started lost. Now the others run on in a fresh
+    pool, the tasks the broken pool held run again each alone, and only those that kill
+    their process again are lost, named with how it ended."""
+    from skyroute.jobs.executor import TasksLostError
+    from tests.jobs.failing import die_below_zero
+
+    seen = []
+    with open_executor("local", workers=2) as ex:
+        with pytest.raises(TasksLostError) as info, caplog.at_level("WARNING"):
+            ex.map(die_below_zero, [1, -9, 2, 3, -3, 4, 5],
+                   on_result=lambda i, r: seen.append((i, r)))
+        assert ex.map(abs, [-1, -2]) == [1, 2]  # still usable afterwards
+    again = "also when run again alone"
+    assert info.value.lost == {
+        1: f"its worker process died (killed by SIGKILL, as the out-of-memory killer "
+           f"does), {again}",
+        4: f"its worker process died (exit code 3), {again}"}
+    assert info.value.results == [1, None, 2, 3, None, 4, 5]
+    assert sorted(seen) == [(0, 1), (2, 2), (3, 3), (5, 4), (6, 5)]  # each once
+    assert str(info.value).startswith("2 of the 7 tasks were lost: task 1: its worker "
+                                      "process died (killed by SIGKILL")
+    assert any("a worker process died" in r.getMessage() for r in caplog.records)
+
+
+def test_a_task_whose_worker_dies_once_is_run_again(tmp_path):
+    # a worker killed from outside (an operator's kill, the out-of-memory killer taking
+    # the biggest process): every task of the pool is run again, none lost
+    from tests.jobs.failing import die_once
+
+    marks = [str(tmp_path / name) for name in ("a", "die-b", "c", "d", "e", "f")]
+    seen = []
+    with open_executor("local", workers=2) as ex:
+        assert ex.map(die_once, marks, on_result=lambda i, r: seen.append(i)) == marks
+    assert (tmp_path / "die-b").exists()  # it did die once
+    assert sorted(seen) == list(range(6))
