@@ -141,6 +141,7 @@ def test_source_needs_stored_orders(monkeypatch, capsys, tmp_path):
         code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--source", url,
                            "--db", db, "--out", str(tmp_path))
         assert code == 2 and "no orders stored" in err and "skyroute db import" in err
+        assert not (tmp_path / "e.db").exists()  # refused: no new empty store left
         assert run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", db)[0] == 0
         code, out, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--source", url,
                              "--db", db, "--out", str(tmp_path), "--json", "--no-plot")
@@ -451,6 +452,49 @@ def test_another_sites_folder_is_refused_before_anything_is_written(monkeypatch,
                        "--db", f"sqlite:///{tmp_path / 'o.db'}", "--out", str(tmp_path / "o"))
     assert code == 1 and err.endswith("skyroute: error: 2023-01-02: AssertionError: a day "
                                       "was flown before its output files were checked\n"), err
+
+
+def test_a_refused_deliver_leaves_no_new_store_behind(monkeypatch, capsys, tmp_path):
+    # a folder whose orders are another site's than its website, into a store that is
+    # not there yet: refused before anything was imported or flown, but the store had
+    # been made first, and its folder, file and empty tables stayed behind
+    import shutil
+    import sqlite3
+
+    other = _other_site(tmp_path / "other")
+    mixed = tmp_path / "mixed"
+    shutil.copytree(EXAMPLE, mixed)
+    shutil.rmtree(mixed / "database")
+    shutil.copytree(other / "database", mixed / "database")
+    new = tmp_path / "new" / "s.db"
+    for dates in (["2023-01-02"], ["--from", "2023-01-01", "--to", "2023-01-03"]):
+        code, out, err = run(monkeypatch, capsys, "deliver", *dates, "--data", str(mixed),
+                             "--db", f"sqlite:///{new}", "--out", str(tmp_path / "o"))
+        assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+        assert "the folder's orders and website are not of one site" in err, err
+        assert not (tmp_path / "new").exists() and not (tmp_path / "o").exists()
+    # a store that was there (made by db init, no orders yet) is refused the same and
+    # kept as it was
+    kept = tmp_path / "kept.db"
+    assert run(monkeypatch, capsys, "db", "init", "--db", f"sqlite:///{kept}")[0] == 0
+
+    def tables() -> list:
+        with sqlite3.connect(kept) as c:
+            return c.execute("select name from sqlite_master where type = 'table' "
+                             "order by name").fetchall()
+
+    made = tables()
+    assert ("orders",) in made
+    code, _, err = run(monkeypatch, capsys, "deliver", "2023-01-02", "--data", str(mixed),
+                       "--db", f"sqlite:///{kept}", "--out", str(tmp_path / "o"))
+    assert code == 2 and "not of one site" in err, err
+    assert tables() == made
+    # and the folder's site with its own orders goes on to make the new store
+    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", _no_flying)
+    code, _, err = run(monkeypatch, capsys, "deliver", "2023-01-02", "--data", str(other),
+                       "--db", f"sqlite:///{new}", "--out", str(tmp_path / "o"))
+    assert code == 1 and "a day was flown before its output files" in err, err
+    assert _stored_day(new, "2023-01-02")[3] == 108  # imported: the store was made
 
 
 @pytest.mark.shared_data

@@ -63,6 +63,8 @@ def test_bad_executor_flags_are_one_line(monkeypatch, capsys, tmp_path, command,
     monkeypatch.chdir(tmp_path)
     code, _, err = run(monkeypatch, capsys, *command, *flags)
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+    # deliver made its store (./skyroute.db) before it tried the --dask address
+    assert not list(tmp_path.iterdir())
 
 
 def test_deliver_on_dask_with_a_failing_day_and_a_dying_worker(monkeypatch, capsys,
