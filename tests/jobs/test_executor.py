@@ -236,3 +236,65 @@ def test_a_task_whose_worker_dies_once_is_run_again(tmp_path):
         assert ex.map(die_once, marks, on_result=lambda i, r: seen.append(i)) == marks
     assert (tmp_path / "die-b").exists()  # it did die once
     assert sorted(seen) == list(range(6))
+
+
+ABORTED_ALONE = """
+import os, signal, sys, time
+from pathlib import Path
+from skyroute.jobs.executor import open_executor
+
+def task(i):
+    here = Path(sys.argv[1])
+    (here / f"started-{i}-{os.getpid()}").touch()
+    if i == 0:  # kills its worker, twice: the second time run alone
+        time.sleep(0.3)
+        os.kill(os.getpid(), signal.SIGKILL)
+    time.sleep(10)
+    (here / f"done-{i}").touch()
+    return i
+
+if __name__ == "__main__":
+    try:
+        with open_executor("local", workers=2) as ex:
+            ex.map(task, range(3))
+    except KeyboardInterrupt:
+        print("interrupted", flush=True)
+"""
+
+
+def test_ctrl_c_while_tasks_run_again_alone_ends_them(tmp_path):
+    """Ctrl-C while the tasks of a broken pool run again one at a time: the process
+    running one alone ends too (it ran to its end, the exit waiting for it)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import skyroute
+
+    script = tmp_path / "aborted.py"
+    script.write_text(ABORTED_ALONE)
+    env = {**os.environ, "PYTHONPATH": str(Path(skyroute.__file__).resolve().parents[1])}
+    p = subprocess.Popen([sys.executable, str(script), str(tmp_path)], env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+
+    def started(i: int) -> set:
+        return set(tmp_path.glob(f"started-{i}-*"))
+
+    try:
+        end = time.monotonic() + 120
+        while len(started(0)) < 2 and p.poll() is None and time.monotonic() < end:
+            time.sleep(0.01)  # task 0 has killed its process run alone: 1 runs next
+        before = started(1)
+        while started(1) == before and p.poll() is None and time.monotonic() < end:
+            time.sleep(0.01)
+        assert p.poll() is None and len(started(0)) == 2, p.communicate()
+        os.killpg(p.pid, signal.SIGINT)
+        out, err = p.communicate(timeout=9)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(p.pid, signal.SIGKILL)
+    assert (out, p.returncode) == ("interrupted\n", 0), err
+    assert not list(tmp_path.glob("done-*"))

@@ -239,11 +239,12 @@ class LocalExecutor(_Executor):
                     continue
                 if on_result:
                     on_result(i, out[i])
-        finally:
-            if pool is not None:
-                with self._lock:
-                    self._alone.discard(pool)
-                pool.shutdown(wait=False, cancel_futures=True)
+        except BaseException:  # a Ctrl-C: the pool is left to the executor's abort (or
+            raise  # close), which ends its process: shut down here, it ran on to the end
+        if pool is not None:
+            with self._lock:
+                self._alone.discard(pool)
+            pool.shutdown(wait=False)
         if lost:
             raise TasksLostError(lost, out)
         return out
