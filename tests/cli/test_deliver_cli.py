@@ -141,6 +141,7 @@ def test_source_needs_stored_orders(monkeypatch, capsys, tmp_path):
         code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--source", url,
                            "--db", db, "--out", str(tmp_path))
         assert code == 2 and "no orders stored" in err and "skyroute db import" in err
+        assert not (tmp_path / "e.db").exists()  # refused: no new empty store left
         assert run(monkeypatch, capsys, "db", "import", EXAMPLE, "--db", db)[0] == 0
         code, out, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--source", url,
                              "--db", db, "--out", str(tmp_path), "--json", "--no-plot")
@@ -453,6 +454,49 @@ def test_another_sites_folder_is_refused_before_anything_is_written(monkeypatch,
                                       "was flown before its output files were checked\n"), err
 
 
+def test_a_refused_deliver_leaves_no_new_store_behind(monkeypatch, capsys, tmp_path):
+    # a folder whose orders are another site's than its website, into a store that is
+    # not there yet: refused before anything was imported or flown, but the store had
+    # been made first, and its folder, file and empty tables stayed behind
+    import shutil
+    import sqlite3
+
+    other = _other_site(tmp_path / "other")
+    mixed = tmp_path / "mixed"
+    shutil.copytree(EXAMPLE, mixed)
+    shutil.rmtree(mixed / "database")
+    shutil.copytree(other / "database", mixed / "database")
+    new = tmp_path / "new" / "s.db"
+    for dates in (["2023-01-02"], ["--from", "2023-01-01", "--to", "2023-01-03"]):
+        code, out, err = run(monkeypatch, capsys, "deliver", *dates, "--data", str(mixed),
+                             "--db", f"sqlite:///{new}", "--out", str(tmp_path / "o"))
+        assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+        assert "the folder's orders and website are not of one site" in err, err
+        assert not (tmp_path / "new").exists() and not (tmp_path / "o").exists()
+    # a store that was there (made by db init, no orders yet) is refused the same and
+    # kept as it was
+    kept = tmp_path / "kept.db"
+    assert run(monkeypatch, capsys, "db", "init", "--db", f"sqlite:///{kept}")[0] == 0
+
+    def tables() -> list:
+        with sqlite3.connect(kept) as c:
+            return c.execute("select name from sqlite_master where type = 'table' "
+                             "order by name").fetchall()
+
+    made = tables()
+    assert ("orders",) in made
+    code, _, err = run(monkeypatch, capsys, "deliver", "2023-01-02", "--data", str(mixed),
+                       "--db", f"sqlite:///{kept}", "--out", str(tmp_path / "o"))
+    assert code == 2 and "not of one site" in err, err
+    assert tables() == made
+    # and the folder's site with its own orders goes on to make the new store
+    monkeypatch.setattr("skyroute.jobs.deliver.plan_day", _no_flying)
+    code, _, err = run(monkeypatch, capsys, "deliver", "2023-01-02", "--data", str(other),
+                       "--db", f"sqlite:///{new}", "--out", str(tmp_path / "o"))
+    assert code == 1 and "a day was flown before its output files" in err, err
+    assert _stored_day(new, "2023-01-02")[3] == 108  # imported: the store was made
+
+
 @pytest.mark.shared_data
 def test_the_ilp_folder_with_a_store_of_lunch_orders_is_refused(monkeypatch, capsys,
                                                                tmp_path, fly_once):
@@ -585,6 +629,50 @@ def test_a_worker_error_that_does_not_unpickle_is_one_line(monkeypatch, capsys, 
         "stored, with its files"], err
     assert _stored_day(db, "2023-12-31")[0] == [(0, 0)]
     assert _files_of(out) == ["drone-31-12-2023.geojson", "report-31-12-2023.json"]
+
+
+OOM = "killed by SIGKILL, as the out-of-memory killer does"
+
+
+def test_a_worker_that_dies_loses_only_its_own_day(monkeypatch, capsys, tmp_path):
+    # a pool worker killed (here by itself, SIGKILL, as the out-of-memory killer does)
+    # on 2024-01-01: the range ended in a BrokenProcessPool traceback, and every day not
+    # yet stored was lost (also those flown meanwhile by the other worker). Now the
+    # range goes on in a fresh pool, the days the broken pool held are flown again each
+    # alone, and only the day that kills its worker again fails, in one line
+    failing_workers(monkeypatch, {"2024-01-01": "die"})
+    db, out = tmp_path / "d.db", tmp_path / "out"
+    code, stdout, err = run(monkeypatch, capsys, "deliver", "--from", "2023-12-31", "--to",
+                            "2024-01-03", "--data", EXAMPLE, "--db", f"sqlite:///{db}",
+                            "--out", str(out), "--jobs", "2")
+    assert code == 2 and "Traceback" not in err, err
+    assert f"skyroute: a worker process died ({OOM}); the " in err
+    assert err.strip().splitlines()[-2:] == [
+        f"skyroute: error: 2024-01-01: its worker process died ({OOM}), also when run "
+        "again alone",
+        "skyroute: error: 1 of the 4 days failed and was not stored; the other 3 are "
+        "stored, with their files"], err
+    assert _stored_day(db, "2024-01-01")[0] == []
+    assert _stored_day(db, "2024-01-02")[0] and _stored_day(db, "2024-01-03")[0]
+    assert _stored_day(db, "2023-12-31")[0] == [(0, 0)]
+    assert _files_of(out) == sorted(f"{k}-{d}.{e}" for d in ("02-01-2024", "03-01-2024",
+                                                             "31-12-2023")
+                                    for k, e in (("drone", "geojson"), ("report", "json")))
+    assert re.search(r"^3 of 4 days, ", stdout, re.M), stdout
+
+
+def test_a_worker_killed_once_loses_no_day(monkeypatch, capsys, tmp_path):
+    # killed from outside once (an operator's kill; the out-of-memory killer taking
+    # the biggest process while another program ate the memory): flown again, stored
+    failing_workers(monkeypatch, {"2024-01-01": "die-once"}, marks=tmp_path)
+    db, out = tmp_path / "o.db", tmp_path / "out"
+    code, stdout, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
+                            "2024-01-02", "--data", EXAMPLE, "--db", f"sqlite:///{db}",
+                            "--out", str(out), "--jobs", "2")
+    assert code == 0 and f"skyroute: a worker process died ({OOM})" in err, err
+    assert (tmp_path / "2024-01-01").exists()  # it did die once
+    assert _stored_day(db, "2024-01-01")[0] and _stored_day(db, "2024-01-02")[0]
+    assert re.search(r"^2 days, ", stdout, re.M), stdout
 
 
 def test_failed_days_in_json_and_a_defect_shows_its_traceback(monkeypatch, capsys,

@@ -7,13 +7,22 @@ A test puts ``partial(fail_in_workers, {date: kind})`` in place of
 ``skyroute.jobs.executor._leave_sigint``, the initializer the local pool runs in each
 worker. Kinds: ``skyroute`` (a SkyrouteError naming the day, as the planner's own
 errors do), ``file`` (an InputFormatError naming a file: its pickle does not load, and
-a pool handed it back as a worker 'terminated abruptly'), ``bug`` (a ZeroDivisionError).
+a pool handed it back as a worker 'terminated abruptly'), ``bug`` (a ZeroDivisionError),
+``die`` (the worker kills its own process with SIGKILL, as the out-of-memory killer
+does), ``die-once`` (the same, on the first try of that date only: a file in ``marks``
+remembers it across processes).
 """
 
 from __future__ import annotations
 
+from distributed import WorkerPlugin
 
-def fail_in_workers(kinds: dict[str, str]) -> None:
+
+def fail_in_workers(kinds: dict[str, str], marks: str | None = None) -> None:
+    import os
+    import signal
+    from pathlib import Path
+
     from skyroute.errors import InputFormatError, SkyrouteError
     from skyroute.jobs import deliver, executor
 
@@ -28,12 +37,22 @@ def fail_in_workers(kinds: dict[str, str]) -> None:
             raise InputFormatError("website/menus/menus.json", "cannot read: gone")
         if kind == "bug":
             return 1 / 0
+        if kind == "die" or (kind == "die-once" and _first_try(Path(marks) / str(date))):
+            os.kill(os.getpid(), signal.SIGKILL)
         return real(site, date, orders, **kw)
 
     deliver.plan_day = plan_day
 
 
-def failing_workers(monkeypatch, kinds: dict[str, str]) -> None:
+def _first_try(mark) -> bool:
+    try:
+        mark.touch(exist_ok=False)
+    except FileExistsError:
+        return False
+    return True
+
+
+def failing_workers(monkeypatch, kinds: dict[str, str], marks=None) -> None:
     """In the test's process: the local pools started from now on run
     :func:`fail_in_workers` with ``kinds`` in each worker; two workers on any machine
     for ``--jobs 2`` (the CLI caps workers at the CPU count)."""
@@ -42,4 +61,48 @@ def failing_workers(monkeypatch, kinds: dict[str, str]) -> None:
 
     monkeypatch.setattr(os, "cpu_count", lambda: 2)
     monkeypatch.setattr("skyroute.jobs.executor._leave_sigint",
-                        partial(fail_in_workers, kinds))
+                        partial(fail_in_workers, kinds,
+                                None if marks is None else str(marks)))
+
+
+class FailingDaskWorkers(WorkerPlugin):
+    """A Dask worker plugin doing what :func:`fail_in_workers` does in each worker of a
+    cluster, also in one its nanny starts again after a death (register it with
+    ``client.register_plugin``)."""
+
+    name = "skyroute-failing-days"
+
+    def __init__(self, kinds: dict[str, str], marks: str | None = None) -> None:
+        self.kinds, self.marks = kinds, marks
+
+    def setup(self, worker) -> None:
+        fail_in_workers(self.kinds, self.marks)
+
+    def teardown(self, worker) -> None:
+        pass
+
+
+def die_below_zero(x: int) -> int:
+    """An executor task: ``x`` back; -9 kills its own process with SIGKILL, another
+    negative ``x`` ends it with exit code ``-x`` (as a crash in compiled code might)."""
+    import os
+    import signal
+
+    if x == -9:
+        os.kill(os.getpid(), signal.SIGKILL)
+    if x < 0:
+        os._exit(-x)
+    return x
+
+
+def die_once(mark: str) -> str:
+    """An executor task that returns ``mark``, a path; but if its file name starts with
+    ``die``, it first kills its own process (SIGKILL) the first time it is run for it
+    (the file made remembers it)."""
+    import os
+    import signal
+    from pathlib import Path
+
+    if Path(mark).name.startswith("die") and _first_try(Path(mark)):
+        os.kill(os.getpid(), signal.SIGKILL)
+    return mark

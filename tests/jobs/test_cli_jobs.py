@@ -63,3 +63,48 @@ def test_bad_executor_flags_are_one_line(monkeypatch, capsys, tmp_path, command,
     monkeypatch.chdir(tmp_path)
     code, _, err = run(monkeypatch, capsys, *command, *flags)
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+    # deliver made its store (./skyroute.db) before it tried the --dask address
+    assert not list(tmp_path.iterdir())
+
+
+def test_deliver_on_dask_with_a_failing_day_and_a_dying_worker(monkeypatch, capsys,
+                                                               tmp_path):
+    # on an in-process Dask cluster, 2024-01-01's worker kills itself (SIGKILL) and
+    # 2024-01-02 fails: Dask's KilledWorker ended the range in a traceback, dropping the
+    # days not yet stored. Now each failed day is one line and the others are stored.
+    # (allowed-failures 0: the first death loses the task, as the fourth does by default;
+    # worker-saturation 1.0: a worker holds only the task it runs, so the death takes
+    # no other task with it; Dask queues only a map of more than twice the worker
+    # threads: 5 days, not 4)
+    import dask
+    import distributed  # noqa: F401  (its defaults loaded, so the block only overrides)
+
+    from skyroute.jobs.executor import DaskExecutor
+    from tests.cli.test_deliver_cli import _stored_day
+    from tests.jobs.failing import FailingDaskWorkers
+
+    real = DaskExecutor.__init__
+
+    def started(self, **kw):
+        real(self, **kw)
+        self.client.register_plugin(FailingDaskWorkers({"2024-01-01": "die",
+                                                        "2024-01-02": "skyroute"}))
+
+    monkeypatch.setattr(DaskExecutor, "__init__", started)
+    db = tmp_path / "k.db"
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0,
+                          "distributed.scheduler.worker-saturation": 1.0}):
+        code, out, err = run(monkeypatch, capsys, "deliver", "--from", "2023-12-30", "--to",
+                             "2024-01-03", "--data", str(EXAMPLE), "--db", f"sqlite:///{db}",
+                             "--out", str(tmp_path / "out"), "--executor", "dask",
+                             "--jobs", "2")
+    assert code == 2 and "Traceback" not in err, err
+    assert err.strip().splitlines()[-3:] == [
+        "skyroute: error: 2024-01-01: its Dask worker died running it (KilledWorker; see "
+        "the workers' logs)",
+        "skyroute: error: 2024-01-02: the planner failed",
+        "skyroute: error: 2 of the 5 days failed and were not stored; the other 3 are "
+        "stored, with their files"], err
+    assert _stored_day(db, "2024-01-01")[0] == _stored_day(db, "2024-01-02")[0] == []
+    assert _stored_day(db, "2024-01-03")[0] and _stored_day(db, "2023-12-31")[0] == [(0, 0)]
+    assert "3 of 5 days" in out

@@ -193,3 +193,26 @@ def test_a_failed_range_says_how_many_days_are_stored(failed, words):
     days = [DayFailed(dt.date(2024, 1, d), f"2024-01-0{d}: no", True)
             for d in range(1, failed + 1)]
     assert str(DaysFailedError([], days, 3)) == words
+
+
+def test_a_deliver_job_whose_worker_dies_fails_with_one_line(tmp_path, monkeypatch):
+    # a pool worker killed under 2024-01-01 (SIGKILL, as the out-of-memory killer does):
+    # the job failed with "A process in the process pool was terminated abruptly ..."
+    # and stored none of the days not yet stored. Now it stores every other day and
+    # fails naming the lost day and how its worker ended
+    from skyroute.jobs import runner
+    from tests.jobs.failing import failing_workers
+
+    failing_workers(monkeypatch, {"2024-01-01": "die"})
+    engine = lunch_store(f"sqlite:///{tmp_path / 'w.db'}", DATES)
+    params = {"from": "2024-01-01", "to": "2024-01-03", "data": str(EXAMPLE)}
+    with open_executor("local", workers=2) as ex:
+        job = runner.wait(engine, runner.submit(engine, "deliver", params, executor=ex),
+                          timeout=300)
+    with engine.connect() as c:
+        days = c.exec_driver_sql("select delivery_date from runs order by 1").scalars().all()
+    assert [str(d) for d in days] == ["2024-01-02", "2024-01-03"]
+    assert (job["state"], job["error"], job["progress"]) == (
+        "failed", "1 of the 3 days failed and was not stored (the other 2 are): "
+        "2024-01-01: its worker process died (killed by SIGKILL, as the out-of-memory "
+        "killer does), also when run again alone", 1.0)

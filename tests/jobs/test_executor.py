@@ -196,3 +196,105 @@ def test_ctrl_c_in_a_local_map_ends_the_running_tasks(tmp_path):
             os.killpg(p.pid, signal.SIGKILL)
     assert (out, err, p.returncode) == ("interrupted\n", "", 0)
     assert sorted(f.name for f in tmp_path.glob("*-*")) == ["started-0", "started-1"]
+
+
+def test_a_dying_local_worker_loses_only_the_task_that_kills_it(caplog):
+    """A task that kills its worker process (the out-of-memory killer, a crash): the map
+    raised BrokenProcessPool at once, with the results of the tasks in flight on the
+    other workers and of those not yet started lost. Now the others run on in a fresh
+    pool, the tasks the broken pool held run again each alone, and only those that kill
+    their process again are lost, named with how it ended."""
+    from skyroute.jobs.executor import TasksLostError
+    from tests.jobs.failing import die_below_zero
+
+    seen = []
+    with open_executor("local", workers=2) as ex:
+        with pytest.raises(TasksLostError) as info, caplog.at_level("WARNING"):
+            ex.map(die_below_zero, [1, -9, 2, 3, -3, 4, 5],
+                   on_result=lambda i, r: seen.append((i, r)))
+        assert ex.map(abs, [-1, -2]) == [1, 2]  # still usable afterwards
+    again = "also when run again alone"
+    assert info.value.lost == {
+        1: f"its worker process died (killed by SIGKILL, as the out-of-memory killer "
+           f"does), {again}",
+        4: f"its worker process died (exit code 3), {again}"}
+    assert info.value.results == [1, None, 2, 3, None, 4, 5]
+    assert sorted(seen) == [(0, 1), (2, 2), (3, 3), (5, 4), (6, 5)]  # each once
+    assert str(info.value).startswith("2 of the 7 tasks were lost: task 1: its worker "
+                                      "process died (killed by SIGKILL")
+    assert any("a worker process died" in r.getMessage() for r in caplog.records)
+
+
+def test_a_task_whose_worker_dies_once_is_run_again(tmp_path):
+    # a worker killed from outside (an operator's kill, the out-of-memory killer taking
+    # the biggest process): every task of the pool is run again, none lost
+    from tests.jobs.failing import die_once
+
+    marks = [str(tmp_path / name) for name in ("a", "die-b", "c", "d", "e", "f")]
+    seen = []
+    with open_executor("local", workers=2) as ex:
+        assert ex.map(die_once, marks, on_result=lambda i, r: seen.append(i)) == marks
+    assert (tmp_path / "die-b").exists()  # it did die once
+    assert sorted(seen) == list(range(6))
+
+
+ABORTED_ALONE = """
+import os, signal, sys, time
+from pathlib import Path
+from skyroute.jobs.executor import open_executor
+
+def task(i):
+    here = Path(sys.argv[1])
+    (here / f"started-{i}-{os.getpid()}").touch()
+    if i == 0:  # kills its worker, twice: the second time run alone
+        time.sleep(0.3)
+        os.kill(os.getpid(), signal.SIGKILL)
+    time.sleep(10)
+    (here / f"done-{i}").touch()
+    return i
+
+if __name__ == "__main__":
+    try:
+        with open_executor("local", workers=2) as ex:
+            ex.map(task, range(3))
+    except KeyboardInterrupt:
+        print("interrupted", flush=True)
+"""
+
+
+def test_ctrl_c_while_tasks_run_again_alone_ends_them(tmp_path):
+    """Ctrl-C while the tasks of a broken pool run again one at a time: the process
+    running one alone ends too (it ran to its end, the exit waiting for it)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import skyroute
+
+    script = tmp_path / "aborted.py"
+    script.write_text(ABORTED_ALONE)
+    env = {**os.environ, "PYTHONPATH": str(Path(skyroute.__file__).resolve().parents[1])}
+    p = subprocess.Popen([sys.executable, str(script), str(tmp_path)], env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+
+    def started(i: int) -> set:
+        return set(tmp_path.glob(f"started-{i}-*"))
+
+    try:
+        end = time.monotonic() + 120
+        while len(started(0)) < 2 and p.poll() is None and time.monotonic() < end:
+            time.sleep(0.01)  # task 0 has killed its process run alone: 1 runs next
+        before = started(1)
+        while started(1) == before and p.poll() is None and time.monotonic() < end:
+            time.sleep(0.01)
+        assert p.poll() is None and len(started(0)) == 2, p.communicate()
+        os.killpg(p.pid, signal.SIGINT)
+        out, err = p.communicate(timeout=9)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(p.pid, signal.SIGKILL)
+    assert (out, p.returncode) == ("interrupted\n", 0), err
+    assert not list(tmp_path.glob("done-*"))

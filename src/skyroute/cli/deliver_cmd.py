@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import datetime as dt
 import json
+import logging
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -57,7 +59,7 @@ def deliver_command(
     Stores deliveries and flightpath; writes drone-DD-MM-YYYY.geojson, a report, a map.
     """
     from skyroute.cli.db_cmd import import_folder, replaced
-    from skyroute.delivery.days import open_store, prepare_legs
+    from skyroute.delivery.days import open_store, prepare_legs, refuse_foreign
     from skyroute.delivery.limits import check_days
     from skyroute.delivery.orders import read_csv_orders
     from skyroute.delivery.site import load_site
@@ -85,24 +87,27 @@ def deliver_command(
     # the order files read before the store is opened: a malformed orders.csv left a new
     # store (its file, its folder, its tables) behind
     orders = read_csv_orders(data) if data is not None else []
-    engine = open_store(db)
+    # an existing store is opened; a new one is made only once nothing below refuses the
+    # command: a refused command left a new store (file, folder, tables) behind
+    engine = open_store(db, create=False)
+    if data is None and (engine is None or not order_dates(engine)):
+        raise SkyrouteError(f"{safe_url(db)}: no orders stored; load them with 'skyroute db "
+                            "import DIR' or give --data DIR")
+    # the orders each day will have once the files are imported: the files' own for a
+    # day they give (the import adds them, or refuses a day stored otherwise), else the
+    # stored ones; checked against the site's menus before anything is written
+    given: dict[dt.date, list] = {}
+    for o in orders:
+        if d0 <= o.date <= d1:
+            given.setdefault(o.date, []).append(o)
+    stored = (days_between(engine, d0, d1) if engine is not None else
+              {d0 + dt.timedelta(k): [] for k in range((d1 - d0).days + 1)})
+    refuse_foreign(site, {**stored, **given}, stored_in=db, given=given, data=data)
     # the executor before any work: a wrong --dask address fails at once
     with open_from_flags(executor, dask, jobs, (d1 - d0).days + 1) as ex:
         err = plain_console(stderr=True)
-        if data is None and not order_dates(engine):
-            raise SkyrouteError(f"{safe_url(db)}: no orders stored; load them with 'skyroute db "
-                                "import DIR' or give --data DIR")
-        # the orders each day will have once the files are imported: the files' own for a
-        # day they give (the import adds them, or refuses a day stored otherwise), else
-        # the stored ones; checked against the site's menus before anything is written
-        given: dict[dt.date, list] = {}
-        for o in orders:
-            if d0 <= o.date <= d1:
-                given.setdefault(o.date, []).append(o)
-        from skyroute.delivery.days import refuse_foreign
-
-        refuse_foreign(site, {**days_between(engine, d0, d1), **given}, stored_in=db,
-                       given=given, data=data)
+        if engine is None:
+            engine = open_store(db)
         if data is not None:
             got = import_folder(engine, data, replace=replace, orders=orders)[1]
             if got.added:
@@ -128,9 +133,10 @@ def deliver_command(
 
             failed: list[DayFailed] = []  # said once the other days are stored
             try:
-                results = run_days(engine, src, by_date, executor=ex, method=method,
-                                   replace=replace, files=files, on_day=finished,
-                                   on_failed=lambda _f: progress.advance(days))
+                with _warnings_said(progress.console):  # e.g. a worker process died
+                    results = run_days(engine, src, by_date, executor=ex, method=method,
+                                       replace=replace, files=files, on_day=finished,
+                                       on_failed=lambda _f: progress.advance(days))
             except DayKeptError as exc:
                 raise SkyrouteError(f"{exc}; --replace stores the day as flown now"
                                     ) from None
@@ -146,6 +152,24 @@ def deliver_command(
     _say_empty(results, list(by_date))
     if failed:
         _say_failed(failed, len(by_date))
+
+
+@contextlib.contextmanager
+def _warnings_said(console):
+    """The ``skyroute.jobs`` logger's warnings (the executor's: a worker process died,
+    its tasks run again) as lines on ``console`` while in the block; the CLI sets up no
+    logging, and Python's last resort printed them over the progress bar."""
+
+    class Say(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            console.print(f"skyroute: {record.getMessage()}", soft_wrap=True)
+
+    logger, handler = logging.getLogger("skyroute.jobs"), Say(logging.WARNING)
+    logger.addHandler(handler)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
 
 
 def _say_empty(results: list[DayResult], dates: list[dt.date]) -> None:

@@ -82,8 +82,16 @@ def prepare_legs(site, orders, on_leg: Callable | None = None,
     leg_table(site.world, pts, on_leg=on_leg)
 
 
-def open_store(url: str):
-    """An engine for ``url`` with the schema created or upgraded to the newest migration."""
+def open_store(url: str, *, create: bool = True):
+    """An engine for ``url`` with the schema created or upgraded to the newest migration.
+
+    ``create=False``: ``None`` when there is no store at ``url`` yet (no SQLite file, or
+    a database without skyroute's tables), and nothing is made: a command judges what
+    it was given against the stored days first, and opens the store with ``create``
+    once nothing refuses it (a refused command left a new store, its file, folder and
+    tables, behind)."""
+    if not create and not store.exists(url):
+        return None
     engine = store.connect(url)
     store.init(engine)
     return engine

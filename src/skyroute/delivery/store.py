@@ -97,6 +97,25 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
     return engine
 
 
+def exists(url: str) -> bool:
+    """Whether ``url`` holds a store already (made by :func:`init`, perhaps at an older
+    revision), found without making anything: a SQLite file is made by connecting to
+    it, so only its path is looked at. A bad URL or an unreachable server is the error
+    of :func:`connect`."""
+    try:
+        parsed = sa.engine.make_url(url)
+    except sa.exc.ArgumentError:
+        parsed = None
+    if parsed is not None and parsed.drivername.startswith("sqlite"):
+        db = parsed.database
+        return db not in (None, "", ":memory:") and Path(db).exists()
+    engine = connect(url)
+    try:
+        return sa.inspect(engine).has_table("orders")
+    finally:
+        engine.dispose()
+
+
 def _unknown_kind(url: str) -> str:
     """What SQLAlchemy lacks for ``url``: the database (``postgres://``), or only the
     driver after its ``+`` (``postgresql+psycopg3://``: it knows PostgreSQL)."""

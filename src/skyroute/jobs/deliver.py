@@ -17,9 +17,13 @@ result to arrive), and a worker killed halfway leaves the previous state of that
 A day whose flight fails (an error raised while the worker flies it) comes back as a
 :class:`DayFailed`, not as an error of the whole map: the other days are flown and
 stored as usual, and :func:`run_days` raises :class:`DaysFailedError` at the end,
-naming the failed days. A range stopped at its first failed day dropped the days the
-workers had flown meanwhile (and, with the days in order, never flew the rest): a month
-with one bad day was flown again whole.
+naming the failed days. So does a day whose worker process died under it every time it
+was tried (:class:`~skyroute.jobs.executor.TasksLostError`: twice on a local pool, the
+second time alone; four times on Dask): the out-of-memory killer or a signal ended the
+range with a traceback (``BrokenProcessPool``), and the days not yet stored were lost.
+A range stopped at its first failed day dropped the days the workers had flown
+meanwhile (and, with the days in order, never flew the rest): a month with one bad day
+was flown again whole.
 
 The caller fills the leg table first (:func:`skyroute.delivery.days.prepare_legs`);
 workers sharing its cache folder only read it, and a worker on another machine fills its
@@ -46,6 +50,7 @@ from skyroute.delivery.site import load_site
 from skyroute.delivery.source import DirSource, HttpSource, open_source
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 from skyroute.files import written_together
+from skyroute.jobs.executor import TasksLostError
 
 log = logging.getLogger("skyroute.jobs")
 
@@ -172,7 +177,9 @@ def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executo
     day is stored and its files are in place.
 
     A day whose flight fails (:class:`DayFailed`, passed to ``on_failed`` as it
-    arrives) is neither stored nor given files, and the run goes on: every other day is
+    arrives; also a day whose worker died under it every time it was tried, see
+    :class:`~skyroute.jobs.executor.TasksLostError`, passed at the end) is neither
+    stored nor given files, and the run goes on: every other day is
     flown and stored, then :class:`DaysFailedError` is raised with the stored days'
     results and the failed days, each in date order. An error in the caller (storing a
     day, writing its files, a day kept, the executor's own) or a Ctrl-C stops the run:
@@ -194,8 +201,13 @@ def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executo
         if on_day is not None:
             on_day(result)
 
-    results = executor.map(fly_day, tasks, on_result=arrived)
-    stored = [r for r in results if not isinstance(r, DayFailed)]
+    try:
+        results = executor.map(fly_day, tasks, on_result=arrived)
+    except TasksLostError as exc:  # a worker died under these days, every time tried
+        results = exc.results
+        for i, why in exc.lost.items():
+            arrived(i, DayFailed(tasks[i].date, f"{tasks[i].date}: {why}", expected=True))
+    stored = [r for r in results if r is not None and not isinstance(r, DayFailed)]
     if failed:
         raise DaysFailedError(stored, sorted(failed, key=lambda f: f.date), len(tasks))
     return stored

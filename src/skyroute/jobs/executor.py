@@ -16,18 +16,31 @@ on a closed executor. A map with no task left to cancel (all of them handed to t
 already: the local pool does not take back the ``workers + 1`` it has queued) runs them
 to their end and returns their results, as if the close came after it.
 
+A worker process that dies under a task (the out-of-memory killer, a signal, a crash in
+compiled code) does not end the map: the other tasks run on, and a task whose worker
+died every time it was tried (see each kind) is raised at the end as
+:class:`TasksLostError`, with the results of the others (each already passed to
+``on_result``) and one line per lost task.
+
 - ``local``: ``workers`` processes started with the ``spawn`` method (a forked child of
   a process whose compiled kernels have started OpenMP threads dies), created on the
   first ``map`` and reused until ``close``; one worker runs the tasks in the calling
   process, as a plain loop. A ``map`` keeps at most twice ``workers`` of its tasks in
   the pool and hands it the next as one ends, so ``map`` calls from several threads
   (the runner's lanes) share the workers in turn: a short one started while a long one
-  runs waits for a few of its tasks, not all of them.
+  runs waits for a few of its tasks, not all of them. A worker that dies breaks the
+  whole pool (Python ends its other workers and fails every task it held, not knowing
+  which one killed it): the map goes on in a fresh pool, and runs the tasks the broken
+  pool held again once the others are done, one at a time in a process of their own,
+  so a task that kills its worker again is the one named (with the exit signal or code)
+  and takes no other task with it. A task is tried at most twice.
 - ``dask``: a ``distributed.Client`` on an existing scheduler (``address`` such as
   ``tcp://10.0.0.5:8786``) or on an in-process ``LocalCluster`` of ``workers`` worker
   processes, one thread each. Dask re-runs the tasks of a worker that dies on another
   one, so every task must be safe to run twice (each of skyroute's tasks writes its
-  result in one transaction that replaces an earlier run of the same task).
+  result in one transaction that replaces an earlier run of the same task); a task
+  whose workers died ``distributed.scheduler.allowed-failures`` + 1 times (4 by
+  default) is lost (Dask's ``KilledWorker``).
 """
 
 from __future__ import annotations
@@ -42,10 +55,12 @@ import threading
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import FIRST_COMPLETED, CancelledError, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 from skyroute.errors import OptionError, SkyrouteError, check_choice
 
+log = logging.getLogger("skyroute.jobs")
 KINDS = ("local", "dask")
 CONNECT_TIMEOUT = "10s"  # an existing scheduler that does not answer within this is an error
 
@@ -53,6 +68,20 @@ CONNECT_TIMEOUT = "10s"  # an existing scheduler that does not answer within thi
 class ExecutorClosedError(SkyrouteError):
     """A ``map`` cut off by its executor's ``close`` (its tasks not yet started were
     cancelled), or started after it."""
+
+
+class TasksLostError(SkyrouteError):
+    """Tasks of a ``map`` whose worker died under them every time they were tried; the
+    map ran every other task. ``lost``: {item index: why, a clause such as "its worker
+    process died (killed by SIGKILL), also when run again alone"}; ``results``: every
+    result in item order, ``None`` at a lost task (the others were passed to
+    ``on_result`` as they came)."""
+
+    def __init__(self, lost: dict[int, str], results: list) -> None:
+        self.lost, self.results = dict(sorted(lost.items())), results
+        first, n = next(iter(self.lost.items())), len(lost)
+        super().__init__(f"{n:,} of the {len(results):,} tasks {'was' if n == 1 else 'were'} "
+                         f"lost: task {first[0]}: {first[1]}")
 
 
 def _closed(ex: _Executor) -> ExecutorClosedError:
@@ -116,6 +145,7 @@ class LocalExecutor(_Executor):
     def __init__(self, workers: int) -> None:
         self.workers = workers
         self._pool: ProcessPoolExecutor | None = None
+        self._alone: set[ProcessPoolExecutor] = set()  # maps' pools of one (_again_alone)
         self._lock = threading.Lock()  # map may be called from several threads
         self._closed = False
 
@@ -133,34 +163,99 @@ class LocalExecutor(_Executor):
                 if on_result:
                     on_result(i, out[-1])
             return out
-        with self._lock:
-            if self._closed:  # not a new pool that nothing would close
-                raise _closed(self)
-            if self._pool is None:
-                self._pool = ProcessPoolExecutor(
-                    self.workers, mp_context=multiprocessing.get_context("spawn"),
-                    initializer=_leave_sigint)
-            pool = self._pool
+        suspects: list[int] = []  # held by a pool that broke: run again, alone
 
         def submit(item):
-            with self._lock:  # never into a pool being shut down
-                if self._closed:
+            with self._lock:  # never into a pool being shut down, nor a broken one
+                if self._closed:  # (nor a new pool that nothing would close)
                     raise _closed(self)
-                return pool.submit(fn, item)
+                for tries in (1, 2):
+                    if self._pool is not None and getattr(self._pool, "_broken", False):
+                        # (it has ended its workers and shut itself down; shutdown()
+                        # would forget them, which _how_ended reads)
+                        self._pool = None
+                    if self._pool is None:
+                        self._pool = _new_pool(self.workers)
+                    try:
+                        future = self._pool.submit(fn, item)
+                    except BrokenProcessPool:  # it broke since the look above
+                        if tries == 2:
+                            raise
+                        continue
+                    pool_of[future] = self._pool
+                    return future
+
+        pool_of: dict = {}  # future -> its pool
+        broke: list = []  # the pools that broke under our tasks
+
+        def broken(i: int, future) -> None:
+            if self._closed:  # abort() ended the workers: no task of ours killed them
+                raise _closed(self)
+            suspects.append(i)
+            if pool_of[future] not in broke:
+                broke.append(pool_of[future])
 
         try:
-            return _gather(submit, items, 2 * self.workers, on_result)
+            out = _gather(submit, items, 2 * self.workers, on_result, on_broken=broken)
+            if not suspects:
+                return out
+            log.warning("a worker process died (%s); the %d task(s) its pool held run "
+                        "again, one at a time, each alone", _how_ended(broke[0]),
+                        len(suspects))
+            return self._again_alone(fn, items, sorted(suspects), out, on_result)
         except (CancelledError, RuntimeError):  # cancelled or refused by close
             if self._closed:
                 raise _closed(self) from None
             raise
 
+    def _again_alone(self, fn, items: list, again: list[int], out: list, on_result) -> list:
+        """Run ``fn`` on the items at ``again`` (their pool broke under them) one at a
+        time, each alone in a one-process pool (a fresh one after a death): fill ``out``
+        and call ``on_result`` as in ``map``; raise :class:`TasksLostError` at the end
+        for those whose process died again."""
+        lost: dict[int, str] = {}
+        pool = None
+        try:
+            for i in again:
+                with self._lock:
+                    if self._closed:
+                        raise _closed(self)
+                    if pool is None:
+                        pool = _new_pool(1)
+                        self._alone.add(pool)
+                    future = pool.submit(fn, items[i])
+                    procs = list((getattr(pool, "_processes", None) or {}).values())
+                try:
+                    out[i] = _result(future)
+                except BrokenProcessPool:
+                    if self._closed:
+                        raise _closed(self) from None
+                    lost[i] = (f"its worker process died ({_how_ended(procs=procs)}), "
+                               "also when run again alone")
+                    with self._lock:
+                        self._alone.discard(pool)
+                    pool.shutdown(wait=False)
+                    pool = None
+                    continue
+                if on_result:
+                    on_result(i, out[i])
+        except BaseException:  # a Ctrl-C: the pool is left to the executor's abort (or
+            raise  # close), which ends its process: shut down here, it ran on to the end
+        if pool is not None:
+            with self._lock:
+                self._alone.discard(pool)
+            pool.shutdown(wait=False)
+        if lost:
+            raise TasksLostError(lost, out)
+        return out
+
     def close(self) -> None:
         with self._lock:
             self._closed = True
-            if self._pool is not None:
-                self._pool.shutdown(wait=False, cancel_futures=True)
-                self._pool = None
+            pools, self._pool = [self._pool, *self._alone], None
+        for pool in pools:
+            if pool is not None:
+                pool.shutdown(wait=False, cancel_futures=True)
 
     def abort(self) -> None:
         """Close and end the worker processes now (SIGTERM): their running tasks stop
@@ -170,25 +265,76 @@ class LocalExecutor(_Executor):
         self.aborted = True
         with self._lock:
             self._closed = True  # another thread's map ends in ExecutorClosedError
-            pool, self._pool = self._pool, None
-        if pool is None:
-            return
-        # (shutdown forgets both)
+            pools, self._pool = [self._pool, *self._alone], None
+        for pool in pools:
+            if pool is not None:
+                _end(pool)
+
+
+def _end(pool: ProcessPoolExecutor) -> None:
+    """Shut ``pool`` down, ending its worker processes now (SIGTERM)."""
+    # (shutdown forgets both)
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    manager = getattr(pool, "_executor_manager_thread", None)
+    pool.shutdown(wait=False, cancel_futures=True)
+    # the pool's thread first drops the cancelled tasks: one still listed when the
+    # workers end was set failed on top of cancelled, an InvalidStateError
+    # traceback from that thread (Python 3.11)
+    end = time.monotonic() + 2.0
+    while (manager is not None and manager.is_alive()
+           and getattr(pool, "_cancel_pending_futures", False)
+           and time.monotonic() < end):
+        time.sleep(0.005)
+    for proc in procs:
+        proc.terminate()
+    if manager is not None:  # it sees them end and closes its pipes: wait for that,
+        manager.join(timeout=5.0)  # or the exit's wake-up call races the closing
+
+
+def _new_pool(workers: int) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_leave_sigint)
+
+
+def _result(future):
+    """``future.result()`` in short waits (see :data:`WAKE_EVERY`)."""
+    while True:
+        try:
+            return future.result(timeout=WAKE_EVERY)
+        except TimeoutError:
+            continue
+        except BaseException:
+            if not future.done():  # Ctrl-C while it runs
+                future.cancel()
+            raise
+
+
+def _how_ended(pool: ProcessPoolExecutor | None = None, *, procs=None) -> str:
+    """How a broken pool's worker died: "killed by SIGKILL", "exit code 3", or
+    "exit status unknown". The pool ends its other workers with SIGTERM, so another
+    signal or code names the one that died; ``procs``: the processes, when the pool has
+    forgotten them."""
+    if procs is None:
         procs = list((getattr(pool, "_processes", None) or {}).values())
-        manager = getattr(pool, "_executor_manager_thread", None)
-        pool.shutdown(wait=False, cancel_futures=True)
-        # the pool's thread first drops the cancelled tasks: one still listed when the
-        # workers end was set failed on top of cancelled, an InvalidStateError
-        # traceback from that thread (Python 3.11)
-        end = time.monotonic() + 2.0
-        while (manager is not None and manager.is_alive()
-               and getattr(pool, "_cancel_pending_futures", False)
-               and time.monotonic() < end):
-            time.sleep(0.005)
-        for proc in procs:
-            proc.terminate()
-        if manager is not None:  # it sees them end and closes its pipes: wait for that,
-            manager.join(timeout=5.0)  # or the exit's wake-up call races the closing
+    codes = []
+    for proc in procs:
+        try:
+            proc.join(timeout=1.0)  # reaped by now, or within a moment
+            codes.append(proc.exitcode)
+        except (ValueError, AssertionError, OSError):  # a closed Process object
+            continue
+    known = [c for c in codes if c is not None]
+    code = next((c for c in known if c != -signal.SIGTERM), known[0] if known else None)
+    if code is None:
+        return "exit status unknown"
+    if code < 0:
+        try:
+            name = signal.Signals(-code).name
+        except ValueError:
+            name = f"signal {-code}"
+        return f"killed by {name}" + (", as the out-of-memory killer does"
+                                      if code == -signal.SIGKILL else "")
+    return f"exit code {code}"
 
 
 def _leave_sigint() -> None:
@@ -201,11 +347,13 @@ def _leave_sigint() -> None:
 WAKE_EVERY = 0.1  # seconds: how soon a map waiting for its tasks sees Ctrl-C
 
 
-def _gather(submit: Callable, items: list, window: int, on_result) -> list:
+def _gather(submit: Callable, items: list, window: int, on_result,
+            on_broken: Callable[[int, Any], None]) -> list:
     """Results of ``submit(item)`` (a future) for every item, in item order, at most
     ``window`` of them submitted and not yet ended at a time; ``on_result`` as each
-    ends. On an error or Ctrl-C the futures not yet started are cancelled (and the
-    items not yet submitted never are)."""
+    ends, ``on_broken(index, future)`` for each whose pool broke (its result left ``None``). On
+    an error or Ctrl-C the futures not yet started are cancelled (and the items not yet
+    submitted never are)."""
     out: list = [None] * len(items)
     todo = iter(enumerate(items))
     pending: dict = {}  # future -> index
@@ -222,7 +370,11 @@ def _gather(submit: Callable, items: list, window: int, on_result) -> list:
             done, _ = wait(pending, timeout=WAKE_EVERY, return_when=FIRST_COMPLETED)
             for f in sorted(done, key=pending.get):
                 i = pending.pop(f)
-                out[i] = f.result()
+                try:
+                    out[i] = f.result()
+                except BrokenProcessPool:
+                    on_broken(i, f)
+                    continue
                 if on_result:
                     on_result(i, out[i])
             top_up()
@@ -308,7 +460,7 @@ class DaskExecutor(_Executor):
         return len(self.client.scheduler_info(n_workers=-1)["workers"])
 
     def map(self, fn, items, *, on_result=None) -> list:
-        from distributed import as_completed
+        from distributed import KilledWorker, as_completed
 
         items = list(items)
         if self._closed:
@@ -320,10 +472,18 @@ class DaskExecutor(_Executor):
         futures = self.client.map(fn, items, pure=False)
         index = {f.key: i for i, f in enumerate(futures)}
         out: list = [None] * len(items)
+        lost: dict[int, str] = {}
         try:
             for f in as_completed(futures):
                 i = index[f.key]
-                out[i] = f.result()
+                try:
+                    out[i] = f.result()
+                except KilledWorker as exc:  # the others run on
+                    tries = exc.allowed_failures + 1
+                    lost[i] = ("its Dask worker died running it" if tries == 1 else
+                               f"its Dask worker died running it, on each of the {tries} "
+                               "workers that tried it") + " (KilledWorker; see the workers' logs)"
+                    continue
                 if on_result:
                     on_result(i, out[i])
         except Exception as exc:
@@ -341,6 +501,8 @@ class DaskExecutor(_Executor):
             raise
         finally:
             del futures
+        if lost:
+            raise TasksLostError(lost, out)
         return out
 
     def close(self) -> None:
