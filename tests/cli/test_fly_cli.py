@@ -267,3 +267,23 @@ def test_the_table_gives_each_metric_its_unit(monkeypatch, capsys, city):
     assert rows["smoothness"] == f"{m['smoothness']:.6g} rad/move"
     assert m["expanded"] >= 1000 and rows["expanded"] == f"{m['expanded']:,}"
     assert rows["moves"] == str(m["moves"]) and rows["status"] == "found"
+
+
+def test_field_arc_mode_escapes_a_blocked_start_and_says_why_without(monkeypatch, capsys):
+    """examples/city.csv, a start 9 cm from a building facing it: the arc and its half
+    are blocked, and `fly --vehicle field --field-mode arc` ended stuck after one move
+    with 0 escape moves although the escape was on; it now takes the escape. With
+    --no-escape the table and --json say why the goal was not reached."""
+    args = ["fly", str(ROOT / "examples" / "city.csv"), "--frame", "ned", "--vehicle",
+            "field", "--field-mode", "arc", "--start=-161.5762,16.8255", "--goal",
+            "12.4584,86.6758", "--altitude", "10", "--safety", "2", "--json"]
+    code, text, err = run(monkeypatch, capsys, *args)
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["reached"] and doc["metrics"]["escape_moves"] > 0
+    assert "why" not in doc["metrics"]
+    code, text, err = run(monkeypatch, capsys, *args, "--no-escape")
+    assert code == 1
+    m = json.loads(text)["metrics"]
+    assert m["status"] == "stuck" and m["why"] == ("the arc along the field and its half "
+                                                   "are blocked and the escape is off")
