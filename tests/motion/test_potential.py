@@ -346,3 +346,24 @@ def test_with_the_escape_a_reachable_goal_is_reached_or_the_run_says_why(tmp_pat
             assert run.why.startswith("the goal is not reachable from here on the "
                                       "navigation function's raster"), run.why
             assert run.metrics()["why"] == run.why
+
+
+@pytest.mark.parametrize("mode", ["step", "arc"])
+def test_a_goal_the_escape_raster_cannot_hold_is_named_not_an_index_error(mode):
+    """The goal in a slot 0.3 m wide, behind the C: every cell round it is in the
+    raster's clearance, so the wavefront's source joined no cell and the escape ended in
+    an IndexError traceback. It now ends stuck saying why; with a step short enough for
+    the slot's cells, the goal is reached."""
+    boxes = [(30, 15, 34, 45), (18, 41, 34, 45), (18, 15, 34, 19), (50, 20, 51.85, 40),
+             (52.15, 20, 54, 40)]
+    world = _box_world(boxes)
+    run = run_field(world, (5.0, 30.0), (52.0, 30.0), mode=mode)
+    assert run.status.value == "stuck"
+    assert run.why == ("the goal is not reachable from here on the navigation function's "
+                       "raster (cells of step=0.5, obstacles grown by half a cell's "
+                       "diagonal): no free cell in sight has a way to the goal (a shorter "
+                       "step makes the cells finer)")
+    assert run.metrics()["why"] == run.why and run.why in repr(run)
+    fine = run_field(world, (5.0, 30.0), (52.0, 30.0), mode=mode, step=0.1,
+                     tolerance=0.1, max_moves=5000)
+    assert fine.reached and fine.escaped > 0, fine

@@ -481,6 +481,7 @@ def _descend(world: World, nav, p: np.ndarray, t: np.ndarray,
     if seen_free:
         return None, ("the goal is not reachable from here on the navigation function's "
                       f"raster (cells of step={step:g}, obstacles grown by half a cell's "
-                      "diagonal): no free cell in sight has a way to the goal")
+                      "diagonal): no free cell in sight has a way to the goal (a "
+                      "shorter step makes the cells finer)")
     return None, (f"the escape sees no free cell of its raster (cells of step={step:g}, "
                   f"obstacles grown by half a cell's diagonal) within {ESCAPE_REACH} cells")
