@@ -287,3 +287,17 @@ def test_field_arc_mode_escapes_a_blocked_start_and_says_why_without(monkeypatch
     m = json.loads(text)["metrics"]
     assert m["status"] == "stuck" and m["why"] == ("the arc along the field and its half "
                                                    "are blocked and the escape is off")
+
+
+def test_dubins_out_writes_the_goal_once(monkeypatch, capsys, tmp_path):
+    """A Hybrid A* path on examples/city.csv ending with a 2e-18 m arc: `fly --out`
+    wrote the goal twice (the second row 5e-14 m from the first)."""
+    out = tmp_path / "d.csv"
+    code, _, err = run(monkeypatch, capsys, "fly", str(ROOT / "examples" / "city.csv"),
+                       "--frame", "enu", "--vehicle", "dubins", "--radius", "8",
+                       "--start=-35.7,-168.98", "--goal=-81.52,-27.41", "--altitude", "10",
+                       "--safety", "2", "--out", str(out))
+    assert code == 0, err
+    rows = np.array(list(csv.reader(out.open()))[1:], dtype=float)
+    assert rows[-1, :2].tolist() == [-81.52, -27.41]
+    assert (np.hypot(*np.diff(rows[:, :2], axis=0).T) > 1e-6).all()
