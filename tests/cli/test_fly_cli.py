@@ -282,3 +282,37 @@ def test_a_field_escape_raster_too_large_names_step_not_resolution(monkeypatch, 
     assert (code, out) == (2, "") and err.count("\n") == 1, err
     assert err.startswith("skyroute: error: --step 1 makes the escape's raster") and \
         "use a larger step" in err, err
+
+
+def test_field_arc_mode_escapes_a_blocked_start_and_says_why_without(monkeypatch, capsys):
+    """examples/city.csv, a start 9 cm from a building facing it: the arc and its half
+    are blocked, and `fly --vehicle field --field-mode arc` ended stuck after one move
+    with 0 escape moves although the escape was on; it now takes the escape. With
+    --no-escape the table and --json say why the goal was not reached."""
+    args = ["fly", str(ROOT / "examples" / "city.csv"), "--frame", "ned", "--vehicle",
+            "field", "--field-mode", "arc", "--start=-161.5762,16.8255", "--goal",
+            "12.4584,86.6758", "--altitude", "10", "--safety", "2", "--json"]
+    code, text, err = run(monkeypatch, capsys, *args)
+    assert code == 0, err
+    doc = json.loads(text)
+    assert doc["reached"] and doc["metrics"]["escape_moves"] > 0
+    assert "why" not in doc["metrics"]
+    code, text, err = run(monkeypatch, capsys, *args, "--no-escape")
+    assert code == 1
+    m = json.loads(text)["metrics"]
+    assert m["status"] == "stuck" and m["why"] == ("the arc along the field and its half "
+                                                   "are blocked and the escape is off")
+
+
+def test_dubins_out_writes_the_goal_once(monkeypatch, capsys, tmp_path):
+    """A Hybrid A* path on examples/city.csv ending with a 2e-18 m arc: `fly --out`
+    wrote the goal twice (the second row 5e-14 m from the first)."""
+    out = tmp_path / "d.csv"
+    code, _, err = run(monkeypatch, capsys, "fly", str(ROOT / "examples" / "city.csv"),
+                       "--frame", "enu", "--vehicle", "dubins", "--radius", "8",
+                       "--start=-35.7,-168.98", "--goal=-81.52,-27.41", "--altitude", "10",
+                       "--safety", "2", "--out", str(out))
+    assert code == 0, err
+    rows = np.array(list(csv.reader(out.open()))[1:], dtype=float)
+    assert rows[-1, :2].tolist() == [-81.52, -27.41]
+    assert (np.hypot(*np.diff(rows[:, :2], axis=0).T) > 1e-6).all()

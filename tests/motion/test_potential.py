@@ -5,6 +5,8 @@ import math
 import numpy as np
 import pytest
 import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from skyroute import OptionError, World
 from skyroute.motion.potential import course, run_field
@@ -179,3 +181,201 @@ def test_an_escape_raster_past_the_cell_limit_names_the_step():
     assert str(err.value).startswith("step=0.5 makes the escape's raster (cells a step wide "
                                      "over the obstacles, the start, the robot and the goal")
     assert str(err.value).endswith("; use a larger step, or turn the escape off")
+
+
+# -- the escape is used whenever the field cannot move on --------------------------------
+
+def _box_world(boxes, size=(60, 60)) -> World:
+    n = len(boxes)
+    return World(np.array([shapely.box(*b) for b in boxes], dtype=object),
+                 np.full(n, -np.inf), np.full(n, np.inf), (), shapely.box(0, 0, *size),
+                 "enu")
+
+
+def _flown(run):
+    return run.trace if run.trace is not None else run.path
+
+
+def test_a_blocked_step_hands_over_to_the_escape():
+    """A pebble on the line to the goal, between two of the sensor's 36 rays: the field
+    does not see it, its step and half step are blocked, and the run ended stuck with 0
+    escape moves although the escape was on."""
+    a = math.radians(5)  # half-way between the rays at 0 and 10 degrees
+    start = np.array([5.0, 30.0])
+    ahead = np.array([math.cos(a), math.sin(a)])
+    c = start + 0.2 * ahead
+    world = _box_world([(c[0] - 0.01, c[1] - 0.01, c[0] + 0.01, c[1] + 0.01)])
+    goal = start + 40 * ahead
+    run = run_field(world, start, goal)
+    assert run.reached and run.escaped > 0 and run.why == ""
+    assert world.segments_free(run.path[:-1], run.path[1:]).all()
+    off = run_field(world, start, goal, escape=False)
+    assert off.status.value == "stuck" and off.moves == 0
+    assert off.why == "the move along the field and its half are blocked and the escape is off"
+
+
+def test_a_blocked_arc_hands_over_to_the_escape():
+    """Nose to a wall 5 cm ahead: the arc turning away and its half both touch it, and
+    the arc-mode run ended stuck with 0 escape moves although the escape was on."""
+    world = _box_world([(10, 20, 12, 40)])
+    run = run_field(world, (9.95, 30.0), (52.0, 30.0), mode="arc")
+    assert run.reached and run.escaped > 0
+    assert world.segments_free(run.trace[:-1], run.trace[1:]).all()
+    chords = np.diff(run.trace, axis=0)
+    heading = np.arctan2(chords[:, 1], chords[:, 0])
+    turns = np.abs((np.diff(heading) + math.pi) % (2 * math.pi) - math.pi)
+    assert turns.max() <= math.pi / 4 + 1e-9  # the escape keeps the turn limit
+    off = run_field(world, (9.95, 30.0), (52.0, 30.0), mode="arc", escape=False)
+    assert off.status.value == "stuck" and off.moves == 0
+    assert off.why == "the arc along the field and its half are blocked and the escape is off"
+
+
+@pytest.mark.parametrize("mode", ["step", "arc"])
+def test_a_trap_the_field_falls_back_into_is_left_for_good(mode):
+    """A C 40 m deep round the start, the goal beyond its back: each escape (24 m) got
+    the robot out of the C's mouth, the field pulled it back in, and the run went round
+    until its 2,000 moves were spent. Each escape now runs twice as long as the last."""
+    world = _box_world([(100, 20, 104, 80), (60, 20, 104, 24), (60, 76, 104, 80)],
+                       size=(200, 100))
+    run = run_field(world, (80.0, 50.0), (150.0, 50.0), mode=mode)
+    assert run.reached and run.escaped > 0
+    assert world.segments_free(_flown(run)[:-1], _flown(run)[1:]).all()
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(heading=st.floats(-math.pi, math.pi), bearing=st.floats(-math.pi, math.pi),
+       far=st.floats(0.05, 3.0), step=st.floats(0.2, 2.0), max_turn=st.floats(3, 180),
+       tolerance=st.floats(0.25, 1.0), escape=st.booleans())
+def test_arc_mode_arrives_near_the_goal_instead_of_circling_it(heading, bearing, far, step,
+                                                                max_turn, tolerance,
+                                                                escape):
+    """A goal a few moves away and off to one side: the turn-limited robot went round
+    it for good, as close as a move but never within the tolerance (stuck after 40 moves
+    without the escape, out of moves with it). With a tolerance of at least a quarter
+    move, it now always arrives."""
+    world = _box_world([])
+    start = np.array([30.0, 30.0])
+    goal = start + far * step * np.array([math.cos(bearing), math.sin(bearing)])
+    run = run_field(world, start, goal, mode="arc", heading=heading, step=step,
+                    tolerance=tolerance * step, max_turn=math.radians(max_turn),
+                    escape=escape)
+    assert run.reached, run
+    assert math.dist(run.path[-1], goal) < tolerance * step
+
+
+def _free_parts(world: World, margin: float = 50.0):
+    """The connected parts of the free plane (shapely, not the planner's raster)."""
+    region = world.boundary if world.boundary is not None else \
+        shapely.box(*np.add(world.bounds, (-margin, -margin, margin, margin)))
+    free = shapely.difference(shapely.Polygon(region) if region.geom_type == "LinearRing"
+                              else region, shapely.union_all(world.obstacles))
+    return list(getattr(free, "geoms", [free]))
+
+
+def _reachable(parts, a, b) -> bool:
+    pa, pb = shapely.Point(a), shapely.Point(b)
+    return any(part.covers(pa) and part.covers(pb) for part in parts)
+
+
+def _zones_world(tmp_path) -> World:
+    """A GeoJSON world: zones, a boundary and a courtyard (a zone with a hole: the free
+    space inside it is cut off)."""
+    import json
+
+    from skyroute import load_world
+
+    lon0, lat0 = -3.186874, 55.944494
+
+    def ring(x0, y0, x1, y1):
+        return [[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]]
+
+    rng = np.random.default_rng(5)
+    feats = []
+    while len(feats) < 10:
+        cx, cy = lon0 + rng.uniform(-0.003, 0.003), lat0 + rng.uniform(-0.0018, 0.0018)
+        if abs(cx - lon0) < 0.0016 and abs(cy - lat0) < 0.001:
+            continue  # clear of the courtyard
+        i = len(feats)
+        w, h = rng.uniform(0.0002, 0.0009), rng.uniform(0.0001, 0.0005)
+        feats.append({"type": "Feature", "properties": {"name": f"zone {i}"},
+                      "geometry": {"type": "Polygon",
+                                   "coordinates": [ring(cx - w, cy - h, cx + w, cy + h)]}})
+    court = [ring(lon0 - 0.0006, lat0 - 0.0004, lon0 + 0.0006, lat0 + 0.0004),
+             ring(lon0 - 0.0004, lat0 - 0.0002, lon0 + 0.0004, lat0 + 0.0002)[::-1]]
+    feats.append({"type": "Feature", "properties": {"name": "courtyard"},
+                  "geometry": {"type": "Polygon", "coordinates": court}})
+    feats.append({"type": "Feature", "properties": {"name": "area", "boundary": True},
+                  "geometry": {"type": "Polygon", "coordinates": [
+                      ring(lon0 - 0.004, lat0 - 0.0025, lon0 + 0.004, lat0 + 0.0025)]}})
+    path = tmp_path / "zones.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": feats}))
+    return load_world(path, frame="enu")
+
+
+@pytest.mark.parametrize("which", ["city", "zones"])
+@pytest.mark.parametrize("mode", ["step", "arc"])
+def test_with_the_escape_a_reachable_goal_is_reached_or_the_run_says_why(tmp_path, which,
+                                                                        mode):
+    """Seeded start and goal pairs in examples/city.csv and a GeoJSON world, with the
+    escape on: a goal that the free plane joins to the start (shapely's connected parts,
+    not the escape's raster) is reached; one it does not (the courtyard) ends stuck
+    saying it is not reachable. Before, runs ended stuck with 0 escape moves when the
+    field's move and its half were blocked, or used up their moves going round a trap
+    or round the goal."""
+    from skyroute import load_world
+    from tests.conftest import ROOT
+
+    if which == "city":
+        world = load_world(ROOT / "examples" / "city.csv", altitude=10, safety=2,
+                           frame="enu")
+        kw = dict(step=1.0, tolerance=0.5, max_turn=math.radians(15))
+    else:
+        world = _zones_world(tmp_path)
+        kw = dict(step=2.0, tolerance=1.0, max_turn=math.radians(30))
+    parts = _free_parts(world)
+    rng = np.random.default_rng(3)
+    x0, y0, x1, y1 = world.bounds
+    pairs = []
+    while len(pairs) < 8:
+        pair = rng.uniform((x0, y0), (x1, y1), size=(2, 2))
+        if world.segments_free(pair, pair).all():
+            pairs.append(pair)
+    if which == "zones":  # two into the courtyard
+        pairs += [(pairs[0][0], (0.0, 0.0)), (pairs[1][0], (5.0, -3.0))]
+    else:  # from larger samples: in arc mode stuck with 0 escape moves (a start 9 cm
+        # from a building), out of moves going round the goal, stuck on the escape
+        pairs += [((16.8255, -161.5762), (86.6758, 12.4584)),
+                  ((-55.0629, -94.2381), (12.2775, 148.3878)),
+                  ((57.5622, 9.8137), (8.4930, 162.3644))]
+    for start, goal in pairs:
+        run = run_field(world, start, goal, mode=mode, **kw)
+        assert world.segments_free(_flown(run)[:-1], _flown(run)[1:]).all()
+        if _reachable(parts, start, goal):
+            assert run.reached, (start, goal, run)
+            assert math.dist(run.path[-1], goal) < kw["tolerance"]
+        else:
+            assert run.status.value == "stuck", (start, goal, run)
+            assert run.why.startswith("the goal is not reachable from here on the "
+                                      "navigation function's raster"), run.why
+            assert run.metrics()["why"] == run.why
+
+
+@pytest.mark.parametrize("mode", ["step", "arc"])
+def test_a_goal_the_escape_raster_cannot_hold_is_named_not_an_index_error(mode):
+    """The goal in a slot 0.3 m wide, behind the C: every cell round it is in the
+    raster's clearance, so the wavefront's source joined no cell and the escape ended in
+    an IndexError traceback. It now ends stuck saying why; with a step short enough for
+    the slot's cells, the goal is reached."""
+    boxes = [(30, 15, 34, 45), (18, 41, 34, 45), (18, 15, 34, 19), (50, 20, 51.85, 40),
+             (52.15, 20, 54, 40)]
+    world = _box_world(boxes)
+    run = run_field(world, (5.0, 30.0), (52.0, 30.0), mode=mode)
+    assert run.status.value == "stuck"
+    assert run.why == ("the goal is not reachable from here on the navigation function's "
+                       "raster (cells of step=0.5, obstacles grown by half a cell's "
+                       "diagonal): no free cell in sight has a way to the goal (a shorter "
+                       "step makes the cells finer)")
+    assert run.metrics()["why"] == run.why and run.why in repr(run)
+    fine = run_field(world, (5.0, 30.0), (52.0, 30.0), mode=mode, step=0.1,
+                     tolerance=0.1, max_moves=5000)
+    assert fine.reached and fine.escaped > 0, fine

@@ -1345,3 +1345,35 @@ def _wait_status_of(page, selector: str, kind: str, timeout: int = 120_000) -> N
     page.wait_for_function(f"document.querySelector('{selector}').dataset.kind === '{kind}'"
                            f" && !document.querySelector('#start').ariaDisabled",
                            timeout=timeout)
+
+
+def test_fleet_replay_ends_where_the_run_ends(open_page, server):
+    """A run of 0.02777798611111111 h ends at 100.001 s (hours x 3600 rounded to the
+    millisecond its files write times to: report settings.end_s), but the replay's time
+    slider ended at hours x 3600 = 100.00075 s, short of the run's end. It ends at the
+    run's own end now."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    import sqlalchemy as sa
+
+    from skyroute.fleet.packages import horizon_seconds
+    from skyroute.fleet.scenario import preset
+    from skyroute.jobs.fleet import FleetTask, RunSpec, fly_fleet
+
+    hours = 0.02777798611111111
+    run_id = fly_fleet(FleetTask(server[2], "viewer-ms-end", None,
+                                 RunSpec(preset("seed-3x3").model_dump(), hours, 1)))["id"]
+    try:
+        end = httpx.get(f"{server[0]}/fleet/runs/{run_id}").json()["report"]["settings"]["end_s"]
+        assert end == horizon_seconds(hours) == 100.001 != hours * 3600
+        pg = open_page(f"/fleet.html#run={run_id}", "desktop")
+        p = pg.page
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        assert p.input_value("#run") == run_id
+        assert float(p.get_attribute("#time", "max")) == end
+        pg.close()
+    finally:
+        eng = sa.create_engine(server[2])
+        with eng.begin() as c:
+            c.execute(sa.text("DELETE FROM fleet_runs WHERE id = :id"), {"id": run_id})
+        eng.dispose()

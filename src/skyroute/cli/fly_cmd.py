@@ -118,7 +118,8 @@ def fly_command(
     step: Annotated[float, typer.Option(help=_for(
         "step", "sampling step (dubins) or move length (field)."))] = 1.0,
     escape: Annotated[bool, typer.Option(help=_for(
-        "escape", "follow a navigation function out of local minima."))] = True,
+        "escape", "follow a navigation function whenever the field cannot move on "
+                  "(a local minimum, a blocked move)."))] = True,
     sensor_range: Annotated[float, typer.Option(help=_for(
         "sensor_range", "sensor range."))] = 6.0,
     sensor_rays: Annotated[int, typer.Option(help=_for(

@@ -71,7 +71,15 @@ from skyroute.motion import hybrid_search
 from skyroute.motion.arc_kernels import chain_free, edge_index
 from skyroute.motion.corner_distance import corner_graph
 from skyroute.motion.dubins_kernel import TURNS, tangent_heading, words
-from skyroute.motion.pieces import Piece, chain, merge, sample, time_reversed, turned_round
+from skyroute.motion.pieces import (
+    Piece,
+    chain,
+    drop_slivers,
+    merge,
+    sample,
+    time_reversed,
+    turned_round,
+)
 from skyroute.motion.smooth import length, shortcut
 from skyroute.result import FOUND, NO_PATH, STATUS_OF_CODE, Status
 from skyroute.world.world import World
@@ -285,7 +293,9 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     if smooth:
         pieces, shortcut_tries = shortcut(pieces, r, index, seed=seed, reverse=reverse,
                                           back_cost=_BACK_COST, switch_cost=_SWITCH * r)
-        pieces = merge(pieces)
+    # a piece of rounding's length (1e-15 m: a Dubins word's last arc) sampled as a
+    # repeat of the goal; gone within the 1e-12 of the extent that a path may miss by
+    pieces = drop_slivers(pieces, 1e-3 * index.eps)
     if final is not None:
         pieces.append(Piece("S", goal_pose, final.length, r))
         goal_pose = (float(threshold[0]), float(threshold[1]), goal_pose[2])

@@ -141,6 +141,14 @@ def merge(pieces: list[Piece]) -> list[Piece]:
     return out
 
 
+def drop_slivers(pieces: list[Piece], tol: float) -> list[Piece]:
+    """The chain without its pieces shorter than ``tol`` (slivers such as the 1e-15 m
+    arc a Dubins word ends with when rounding leaves it): sampled, a sliver repeats the
+    pose it starts at. The chain stays continuous to within the slivers' total length;
+    pieces that come to meet end to end are fused (:func:`merge`)."""
+    return merge([p for p in pieces if p.length >= tol])
+
+
 def sample(pieces: list[Piece], step: float, start, goal=None) -> np.ndarray:
     """(K, 3) poses every ``step`` metres along the chain (and at every joint); the first
     row is exactly ``start``, the last exactly ``goal`` when given. Headings in [0, 2 pi).

@@ -7,7 +7,9 @@ The plain field stalls in local minima: a C-shaped obstacle opening towards the 
 traps it. The escape follows a navigation function instead: the wavefront distance to
 the goal over the rasterised free space (scipy Dijkstra on the 8-connected free cells),
 which has no local minima (Barraquand & Latombe 1991), until the robot is clear, then
-hands back to the field.
+hands back to the field. It takes over whenever the field cannot move on (stalled, no
+force, or its move blocked), and runs twice as long each time the field has fallen
+back into a trap. A run that stops short says why (:attr:`FieldRun.why`).
 
 Two ways to move (``mode``): ``step`` jumps ``step`` along the force; ``arc`` gives the
 robot a heading it cannot change by more than ``max_turn`` per move, drives a circular
@@ -34,12 +36,17 @@ from skyroute.world.world import World
 COURSES = ("easy", "medium", "hard")
 MODES = ("step", "arc")
 ARC_SAMPLES = 4  # points per arc, for collision checks and the drawn trace
+#: how far (cells) the escape looks for a cell of the navigation function when none of
+#: the robot's own neighbours has a way to the goal (the robot is in the clearance that
+#: the raster takes off round the obstacles)
+ESCAPE_REACH = 4
 
 
 @dataclass(frozen=True)
 class FieldRun:
     """A run: poses (K, 2), how it ended (``status``: found when the goal was reached,
-    budget_exhausted after ``max_moves``, stuck when no move led on), and how."""
+    budget_exhausted after ``max_moves``, stuck when no move led on), how, and ``why``
+    it did not reach the goal (one sentence; empty when it did)."""
 
     path: np.ndarray  # in the world's frame
     status: Status
@@ -47,11 +54,13 @@ class FieldRun:
     trace: np.ndarray | None = None  # arc mode: the arcs sampled (world's frame), for plots
     distance: float = 0.0  # length flown, plane units (along the arcs in arc mode)
     smoothness: float = 0.0  # mean absolute heading change per move, radians
+    why: str = ""  # why the goal was not reached; empty when it was
 
     def __repr__(self) -> str:
         """A summary, not the poses."""
+        why = f": {self.why}" if self.why else ""
         return (f"<FieldRun {self.status.value}, {self.moves} moves, length "
-                f"{self.distance:.6g}, {self.escaped} escape moves>")
+                f"{self.distance:.6g}, {self.escaped} escape moves{why}>")
 
     @property
     def reached(self) -> bool:
@@ -69,10 +78,14 @@ class FieldRun:
 
 
     def metrics(self) -> dict:
-        return {"length": self.distance, "moves": self.moves,
-                "smoothness": self.smoothness, "reached": self.reached,
-                "status": self.status.value,
-                "escape_moves": self.escaped}
+        """Length, moves, smoothness, reached, status, escape moves; and ``why`` when the
+        goal was not reached."""
+        out = {"length": self.distance, "moves": self.moves,
+               "smoothness": self.smoothness, "reached": self.reached,
+               "status": self.status.value, "escape_moves": self.escaped}
+        if self.why:
+            out["why"] = self.why
+        return out
 
 
 def course(name: str) -> tuple[World, np.ndarray, np.ndarray]:
@@ -130,8 +143,9 @@ def _navigation(world: World, goal: np.ndarray, resolution: float, points: np.nd
     planners' rasters do (:func:`~skyroute.roadmap.raster.raster_box`): over the
     obstacles' bounds alone, a goal beyond them fell outside the grid (an IndexError, or
     a negative index that silently wrapped to the far side). The goal itself is the
-    wavefront's source, joined to the free cells round it whose centres it sees, so a
-    goal in a cell the clearance blocks is still reached."""
+    wavefront's source, joined to the free cells round it whose centres it sees (the
+    eight neighbours of its cell, or further out up to :data:`ESCAPE_REACH` cells when
+    none does), so a goal in a cell the clearance blocks is still reached."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 
@@ -167,10 +181,15 @@ def _navigation(world: World, goal: np.ndarray, resolution: float, points: np.nd
         cols.append(ib)
         lens.append(np.full(len(ia), math.hypot(dx, dy) * r))
     gx, gy = grid.to_cell([goal])[0]
-    near = np.array([(x, y) for y in range(gy - 1, gy + 2) for x in range(gx - 1, gx + 2)
-                     if 0 <= x < w and 0 <= y < h and free[y, x]]).reshape(-1, 2)
-    centres = grid.to_world(near)
-    sees = world.segments_free(np.broadcast_to(goal, centres.shape), centres)
+    for k in range(1, ESCAPE_REACH + 1):  # wider while no free cell round it sees it
+        near = np.array([(x, y) for y in range(gy - k, gy + k + 1)
+                         for x in range(gx - k, gx + k + 1)
+                         if 0 <= x < w and 0 <= y < h and free[y, x]],
+                        dtype=np.int64).reshape(-1, 2)
+        centres = grid.to_world(near)
+        sees = world.segments_free(np.broadcast_to(goal, centres.shape), centres)
+        if sees.any():
+            break
     rows.append(idx[near[sees, 1], near[sees, 0]])
     cols.append(np.full(int(sees.sum()), h * w))  # the goal: one node past the cells
     lens.append(np.hypot(*(centres[sees] - goal).T))
@@ -186,11 +205,16 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
               tolerance: float = 0.5, max_moves: int = 2000, escape: bool = True,
               window: int = 40, mode: str = "step", max_turn: float = math.pi / 4,
               heading: float | None = None) -> FieldRun:
-    """Descend the field from ``start``; when ``escape`` and the last ``window`` moves
-    made less than two steps of net progress, follow the navigation function instead.
-    In ``arc`` mode the robot starts on ``heading`` (radians in the world's frame's
-    convention; default towards the goal). Points come in and the run's path goes out in
-    the world's frame; distances (``step``, ``sensor_range``) are plane units."""
+    """Descend the field from ``start``; with ``escape``, follow the navigation function
+    instead whenever the field cannot move on: when the last ``window`` moves made less
+    than two steps of net progress (a local minimum, or circling), when the force
+    vanishes, or when its move (and the move half as long) is blocked. Each time the
+    robot stalls again after an escape, the next escape runs twice as long, so a trap
+    the field keeps falling back into is left for good. In ``arc`` mode the robot starts
+    on ``heading`` (radians in the world's frame's convention; default towards the
+    goal). Points come in and the run's path goes out in the world's frame; distances
+    (``step``, ``sensor_range``) are plane units. A run that does not reach the goal
+    says why in :attr:`FieldRun.why`."""
     check_choice("mode", mode, MODES)
     step, sensor_range, tolerance = (real(name, value, low=0.0, strict=True, need="> 0")
                                      for name, value in (("step", step),
@@ -213,39 +237,59 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
     trace = [p.copy()]
     nav = None
     escaped = 0
-    on_nav = 0
+    on_nav = 0  # escape moves still to make before the field takes over again
+    escapes = 0  # times the escape took over: each next one runs twice as long
+    blocked = ""  # why the field could not make its last move ("" when it could)
+    why = ""
     while len(path) <= max_moves:
         if math.dist(p, t) < tolerance:
             break
         stalled = len(path) > window and math.dist(path[-1], path[-window]) < 2 * step
-        if escape and (stalled or on_nav > 0):
+        if escape and (stalled or on_nav > 0 or blocked):
             if nav is None or not _holds(nav[0], p):  # made anew where the robot is
                 nav = _navigation(world, t, step, np.array([path[0], p]))
-            q = _descend(world, nav, p, t)
+            q, why = _descend(world, nav, p, t, step)
             if q is None:
                 break
-            escaped += 1
-            on_nav = on_nav - 1 if on_nav > 0 else int(4 * sensor_range / step)
+            if on_nav == 0:  # taking over from the field
+                on_nav = max(1, int(4 * sensor_range / step)) << min(escapes, 20)
+                escapes += 1
+            on_nav -= 1
+            blocked = ""
             if mode == "arc":  # turn-limited here too: steer an arc towards the cell
                 arc, theta = _arc(world, p, theta, step, (q - p) / math.dist(p, q),
-                                  max_turn)
+                                  max_turn, t, tolerance, escape=True,
+                                  reach=math.dist(p, q))
                 if arc is None:
+                    why = ("in arc mode the escape's arc towards the navigation "
+                           "function's next cell is blocked however short: the robot "
+                           "touches an obstacle")
                     break
                 q = arc[-1]
             else:
                 theta = math.atan2(*(q - p)[::-1])
                 arc = np.array([q])
+            escaped += 1
         else:
             if stalled:
+                why = (f"the field stalled (less than two steps of progress in the last "
+                       f"{window} moves) and the escape is off")
                 break
             force = _force(world, p, t, attract, repulse, sensor_range, sensor_rays)
             if force is None:
-                break
-            if mode == "step":
+                arc, blocked = None, "attraction and repulsion cancel"
+            elif mode == "step":
                 arc = _straight(world, p, t, step, force)
+                blocked = "" if arc is not None else "the move along the field and " \
+                                                     "its half are blocked"
             else:
-                arc, theta = _arc(world, p, theta, step, force, max_turn)
+                arc, theta = _arc(world, p, theta, step, force, max_turn, t, tolerance)
+                blocked = "" if arc is not None else "the arc along the field and " \
+                                                     "its half are blocked"
             if arc is None:
+                if escape:
+                    continue  # the escape takes the next move
+                why = f"{blocked} and the escape is off"
                 break
             q = arc[-1]
         path.append(q)
@@ -253,11 +297,31 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
         p = q
     status = Status.FOUND if math.dist(p, t) < tolerance else \
         Status.BUDGET_EXHAUSTED if len(path) > max_moves else Status.STUCK
+    if status is Status.FOUND:
+        why = ""
+    elif status is Status.BUDGET_EXHAUSTED:
+        why = _out_of_moves(path, t, max_moves, escaped, tolerance, window,
+                            step if mode == "arc" else None)
     path, trace = np.array(path), np.array(trace)
     flown = trace if mode == "arc" else path
     return FieldRun(world.from_plane(path), status, escaped,
                     world.from_plane(trace) if mode == "arc" else None,
-                    float(np.hypot(*np.diff(flown, axis=0).T).sum()), _smoothness(path))
+                    float(np.hypot(*np.diff(flown, axis=0).T).sum()), _smoothness(path),
+                    why)
+
+
+def _out_of_moves(path, t, max_moves, escaped, tolerance, window, step) -> str:
+    """Why a run that used up its moves did not arrive: where it ended, and in arc mode,
+    when its last ``window`` moves kept passing the goal closer than a move, that."""
+    why = (f"max_moves={max_moves} moves made, ending {math.dist(path[-1], t):.6g} from "
+           f"the goal ({escaped} on the escape)")
+    nearest = float(np.hypot(*(np.array(path[-window:]) - t).T).min())
+    if step is not None and nearest < step:
+        why += (f"; it kept passing the goal, within {nearest:.3g} of it but never within "
+                f"tolerance={tolerance:g}, as turns of at most max_turn per move (over a "
+                "quarter move at least) allow: give a larger tolerance or max_turn, or a "
+                "shorter step")
+    return why
 
 
 def _smoothness(path: np.ndarray) -> float:
@@ -295,26 +359,91 @@ def _straight(world, p, t, step, u) -> np.ndarray | None:
     return q[None, :]
 
 
-def _arc(world, p, theta, step, u, max_turn):
+def _arc(world, p, theta, step, u, max_turn, goal, tolerance, *, escape: bool = False,
+         reach: float = math.inf):
     """Turn towards u by at most ``max_turn`` along a circular arc whose length is
-    ``step`` x max(cos(heading error), 1/4); halve it once if blocked. Returns the
-    sampled arc (ARC_SAMPLES, 2) and the new heading, or (None, theta)."""
+    ``step`` x max(cos(heading error), 1/4) (at most ``reach``); halve it once if
+    blocked. Returns the sampled arc (ARC_SAMPLES, 2) and the new heading, or
+    (None, theta).
+
+    Near the goal, four rules keep the robot from circling it for good. An arc is no
+    longer than the goal is far (down to a quarter move). Within a move of the goal,
+    and no more than ``max_turn`` / 2 off its bearing, the arc ends on the goal (as a
+    step does in step mode). An arc that passes within ``tolerance`` of the goal stops
+    at its point nearest the goal (the robot has arrived). A goal inside the circle the
+    arc turns on (on the side it turns to) cannot be reached by turning on that circle:
+    the robot slows to a quarter move, its tightest circle, and when the goal is inside
+    even that one, first drives straight on until it is not. With ``escape``, when the
+    half arc is blocked too, the arc is cut to half the robot's clearance (its distance
+    to the nearest obstacle or boundary edge): an arc shorter than that meets no edge,
+    so a robot whose nose nearly touches a wall still turns away from it, a little at a
+    time."""
     err = (math.atan2(u[1], u[0]) - theta + math.pi) % (2 * math.pi) - math.pi
     turn = max(-max_turn, min(max_turn, err))
-    for scale in (1.0, 0.5):
-        length = scale * step * max(math.cos(err), 0.25)
-        s = np.linspace(length / ARC_SAMPLES, length, ARC_SAMPLES)
-        if abs(turn) < 1e-9:
-            pts = p + s[:, None] * np.array([math.cos(theta), math.sin(theta)])
-        else:
-            r = length / turn  # signed radius: positive turns left
-            a = theta + turn * s / length
-            pts = p + r * np.c_[np.sin(a) - math.sin(theta), math.cos(theta) - np.cos(a)]
-        ok = world.segment_free(p, pts[0]) and all(
-            world.segment_free(pts[i], pts[i + 1]) for i in range(ARC_SAMPLES - 1))
-        if ok:
+    d = math.dist(p, goal)  # no further than the goal, when it is more than a quarter move
+    length = min(step * max(math.cos(err), 0.25), reach, max(d, 0.25 * step))
+    tries = []  # (turn, length, lands on the goal)
+    bearing = (math.atan2(goal[1] - p[1], goal[0] - p[0]) - theta + math.pi) % \
+        (2 * math.pi) - math.pi
+    on = d if abs(bearing) < 1e-12 else d * bearing / math.sin(bearing)  # the arc's length
+    if on <= step and 2 * abs(bearing) <= max_turn:  # the arc through the goal
+        tries.append((2 * bearing, on, True))
+    if abs(err) > max_turn:  # it would turn further if it could
+        normal = math.copysign(1.0, turn) * np.array([-math.sin(theta), math.cos(theta)])
+        tight = 0.25 * step
+        if math.dist(p + normal * length / max_turn, goal) < length / max_turn:
+            if math.dist(p + normal * tight / max_turn, goal) < tight / max_turn:
+                tries += [(0.0, tight, False), (0.0, 0.5 * tight, False)]
+            else:
+                tries += [(turn, tight, False), (turn, 0.5 * tight, False)]
+    tries += [(turn, length, False), (turn, 0.5 * length, False)]
+    if escape:
+        clearance = float(shapely.distance(shapely.Point(p), _edges(world)))
+        if 0 < 0.5 * clearance < 0.5 * length:
+            tries.append((turn, 0.5 * clearance, False))
+    for turn, length, lands in tries:
+        pts = _arc_points(p, theta, length, turn)
+        if lands:
+            pts[-1] = goal  # on it, not within rounding of it
+        if _free(world, p, pts):
+            s = _nearest(p, theta, length, turn, goal)
+            if not lands and s < length:  # stop where it arrives, when it does
+                part = _arc_points(p, theta, s, turn * s / length)
+                if math.dist(part[-1], goal) < tolerance and _free(world, p, part):
+                    return part, theta + turn * s / length
             return pts, theta + turn
     return None, theta
+
+
+def _free(world, p, pts) -> bool:
+    """The chords from ``p`` through ``pts`` are free."""
+    return world.segment_free(p, pts[0]) and all(
+        world.segment_free(pts[i], pts[i + 1]) for i in range(len(pts) - 1))
+
+
+def _nearest(p, theta, length, turn, goal) -> float:
+    """How far along the arc (from ``p`` on heading ``theta``, turning ``turn`` over
+    ``length``) its point nearest ``goal`` lies: where the radius through the goal
+    meets it, or its end."""
+    if abs(turn) < 1e-9:
+        along = float(np.dot(goal - p, (math.cos(theta), math.sin(theta))))
+        return min(max(along, 0.0), length)
+    r = length / turn  # signed, as in _arc_points
+    c = p + r * np.array([-math.sin(theta), math.cos(theta)])
+    heading = math.atan2(goal[1] - c[1], goal[0] - c[0]) + math.copysign(math.pi / 2, turn)
+    swept = ((heading - theta) * math.copysign(1.0, turn)) % (2 * math.pi)
+    return min(swept / abs(turn) * length, length)
+
+
+def _arc_points(p, theta, length, turn) -> np.ndarray:
+    """(ARC_SAMPLES, 2) points along the arc from ``p`` on heading ``theta`` that turns
+    ``turn`` radians over ``length``."""
+    s = np.linspace(length / ARC_SAMPLES, length, ARC_SAMPLES)
+    if abs(turn) < 1e-9:
+        return p + s[:, None] * np.array([math.cos(theta), math.sin(theta)])
+    r = length / turn  # signed radius: positive turns left
+    a = theta + turn * s / length
+    return p + r * np.c_[np.sin(a) - math.sin(theta), math.cos(theta) - np.cos(a)]
 
 
 def _holds(grid, p: np.ndarray) -> bool:
@@ -323,21 +452,47 @@ def _holds(grid, p: np.ndarray) -> bool:
     return 0 <= x < grid.width and 0 <= y < grid.height
 
 
-def _descend(world: World, nav, p: np.ndarray, t: np.ndarray) -> np.ndarray | None:
-    """One step to the neighbouring free cell centre with the lowest wavefront value, or
-    onto the goal ``t`` when it is in sight within a diagonal cell (near a wall the goal's
-    own cell may be blocked: the cells round it would take turns forever)."""
+def _descend(world: World, nav, p: np.ndarray, t: np.ndarray,
+             step: float) -> tuple[np.ndarray | None, str]:
+    """Where the escape goes next, and "" (or None and why it cannot go on): the
+    neighbouring free cell centre with the lowest wavefront value that the robot sees,
+    or onto the goal ``t`` when it is in sight within a diagonal cell (near a wall the
+    goal's own cell may be blocked: the cells round it would take turns forever). A
+    robot in the raster's clearance round an obstacle may have no such neighbour: it
+    heads for the nearest cell it sees within :data:`ESCAPE_REACH` cells that has a way
+    to the goal (at most ``step`` towards it)."""
     grid, dist = nav
     if math.dist(p, t) <= grid.resolution * math.sqrt(2) and world.segment_free(p, t):
-        return t.copy()
+        return t.copy(), ""
     cx, cy = grid.to_cell([p])[0]
-    best, where = np.inf, None
-    for dx in (-1, 0, 1):
-        for dy in (-1, 0, 1):
-            x, y = cx + dx, cy + dy
-            inside = 0 <= x < grid.width and 0 <= y < grid.height
-            if (dx or dy) and inside and dist[y, x] < best:
-                q = grid.to_world([(x, y)])[0]
-                if world.segment_free(p, q):
-                    best, where = dist[y, x], q
-    return where
+    seen_free = False
+    for reach in range(1, ESCAPE_REACH + 1):
+        ring = [(cx + dx, cy + dy) for dx in range(-reach, reach + 1)
+                for dy in range(-reach, reach + 1) if max(abs(dx), abs(dy)) == reach]
+        cells = np.array([(x, y) for x, y in ring
+                          if 0 <= x < grid.width and 0 <= y < grid.height
+                          and not grid.blocked[y, x]]).reshape(-1, 2)
+        if not len(cells):
+            continue
+        value = dist[cells[:, 1], cells[:, 0]]
+        centres = grid.to_world(cells)
+        sees = world.segments_free(np.broadcast_to(p, centres.shape), centres)
+        seen_free |= bool(sees.any())
+        ok = sees & np.isfinite(value)
+        if not ok.any():
+            continue
+        if reach == 1:  # the lowest neighbour: steepest descent
+            q = centres[ok][np.argmin(value[ok])]
+            return q, ""
+        # further out: the nearest, then the lowest; no more than a move towards it
+        gap = np.hypot(*(centres[ok] - p).T)
+        q = centres[ok][np.lexsort((value[ok], gap))[0]]
+        d = math.dist(p, q)
+        return (q if d <= step else p + (q - p) * (step / d)), ""
+    if seen_free:
+        return None, ("the goal is not reachable from here on the navigation function's "
+                      f"raster (cells of step={step:g}, obstacles grown by half a cell's "
+                      "diagonal): no free cell in sight has a way to the goal (a "
+                      "shorter step makes the cells finer)")
+    return None, (f"the escape sees no free cell of its raster (cells of step={step:g}, "
+                  f"obstacles grown by half a cell's diagonal) within {ESCAPE_REACH} cells")

@@ -7,7 +7,7 @@
 // packages.csv; starts runs with POST /jobs/fleet and follows GET /jobs/{id}.
 
 import { ApiError, bindToken, choices, explain, focusFault, getJSON, getPage, getText, postJSON } from "./api.js";
-import { EventFold, dronesAt, parseEvents, parseRoutes, parseTracks, trail } from "./fleetstate.js";
+import { EventFold, dronesAt, parseEvents, parseRoutes, parseTracks, runEnd, trail } from "./fleetstate.js";
 import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
 import { PALETTE, clock, fmt, h, isBusy, say, setBusy } from "./ui.js";
@@ -218,8 +218,7 @@ async function load(id) {
   for (const d of tracks.byDrone.keys()) maxDrone = Math.max(maxDrone, d);
   const drones = Math.max(maxDrone + 1, Number((rep.settings || {}).drones) || 0);
   const lastEvent = events.length ? events[events.length - 1].t : 0;
-  const horizon = (params.hours ?? rep.simulated_hours) * 3600 ||
-    Math.max(tracks.n ? tracks.t[tracks.n - 1] : 0, lastEvent);
+  const horizon = runEnd(rep, params) || Math.max(tracks.n ? tracks.t[tracks.n - 1] : 0, lastEvent);
   const pts = [...ground.airports.map((a) => a.at), ...ground.gates.map((g) => g.at), ...ground.runways.flatMap((r) => r.line),
     ...ground.zones.flatMap((z) => z.ring)];
   let b = bbox(pts);

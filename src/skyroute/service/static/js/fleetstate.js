@@ -4,6 +4,19 @@
 
 export const PARKED = "at gate";
 
+/**
+ * When a run ends, in seconds: its report's ``settings.end_s`` (the hours times 3600
+ * rounded to the millisecond its files write times to, ``packages.horizon_seconds``);
+ * for a run stored before reports gave it, the hours (``params.hours`` or the report's
+ * ``simulated_hours``) rounded the same way; 0 when neither is known.
+ */
+export function runEnd(report, params) {
+  const end = Number(((report || {}).settings || {}).end_s);
+  if (Number.isFinite(end) && end > 0) return end;
+  const hours = Number((params || {}).hours ?? (report || {}).simulated_hours);
+  return Number.isFinite(hours) && hours > 0 ? Math.round(hours * 3600 * 1000) / 1000 : 0;
+}
+
 /** tracks.csv -> columns; ``byDrone`` maps a drone to its row numbers (in time order). */
 export function parseTracks(text) {
   const lines = text.split("\n");
