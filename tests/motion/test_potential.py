@@ -379,3 +379,17 @@ def test_a_goal_the_escape_raster_cannot_hold_is_named_not_an_index_error(mode):
     fine = run_field(world, (5.0, 30.0), (52.0, 30.0), mode=mode, step=0.1,
                      tolerance=0.1, max_moves=5000)
     assert fine.reached and fine.escaped > 0, fine
+
+
+def test_the_escape_raster_is_capped_well_below_the_grid_planners():
+    """The escape's wavefront is a scipy Dijkstra over a sparse graph of its cells, about
+    235 bytes a cell: a robot trapped in the C with its goal 1.2 km away at step 0.5 made
+    5.8 million cells (1.4 GB), and a goal 5.5 km away at step 1 took 42 s and 7.2 GB
+    (found by a review), under the grid planners' MAX_CELLS. Over ESCAPE_MAX_CELLS (2**22)
+    it is one OptionError naming step, before anything is allocated."""
+    from skyroute.motion import potential
+
+    with pytest.raises(OptionError) as err:
+        run_field(_open_c(), (25.0, 30.0), (1200.0, 1200.0))
+    assert err.value.param == "step" and "more than 4,194,304 cells" in str(err.value)
+    assert potential.ESCAPE_MAX_CELLS == 1 << 22

@@ -30,7 +30,6 @@ import shapely
 from skyroute.caches import register
 from skyroute.errors import OptionError, check_choice, flag, real, whole
 from skyroute.result import Status
-from skyroute.world.grid import MAX_CELLS
 from skyroute.world.world import World
 
 COURSES = ("easy", "medium", "hard")
@@ -40,6 +39,10 @@ ARC_SAMPLES = 4  # points per arc, for collision checks and the drawn trace
 #: the robot's own neighbours has a way to the goal (the robot is in the clearance that
 #: the raster takes off round the obstacles)
 ESCAPE_REACH = 4
+#: the most cells the escape's raster may have: its wavefront is a scipy Dijkstra over a
+#: sparse graph of the cells, about 235 bytes a cell at its peak (2,000 x 2,000 cells:
+#: 0.95 GB, 2.5 s), where the grid planners' compiled searches take MAX_CELLS
+ESCAPE_MAX_CELLS = 1 << 22
 
 
 @dataclass(frozen=True)
@@ -153,17 +156,16 @@ def _navigation(world: World, goal: np.ndarray, resolution: float, points: np.nd
     box = world.extent_with(np.vstack([points, goal]), margin=4 * r)
     if world.boundary is None:
         box = (box[0] - 4 * r, box[1] - 4 * r, box[2] + 4 * r, box[3] + 4 * r)
-    try:
-        grid = world.merged().rasterize(r, safety=r / math.sqrt(2), bounds=box)
-    except OptionError as exc:  # its cells are a step wide: the caller has no resolution
-        if exc.param != "resolution":
-            raise
+    cells = (box[2] - box[0]) / r * ((box[3] - box[1]) / r)
+    if not math.isfinite(cells) or cells > ESCAPE_MAX_CELLS:
         over = ("the boundary" if world.boundary is not None else
                 "the obstacles, the start, the robot and the goal")
+        # its cells are a step wide: the caller has no resolution to change
         raise OptionError(f"step={r:g} makes the escape's raster (cells a step wide over "
                           f"{over}, {box[2] - box[0]:.6g} x {box[3] - box[1]:.6g} across) "
-                          f"more than {MAX_CELLS:,} cells; use a larger step, or turn the "
-                          "escape off", param="step") from None
+                          f"more than {ESCAPE_MAX_CELLS:,} cells; use a larger step, or "
+                          "turn the escape off", param="step")
+    grid = world.merged().rasterize(r, safety=r / math.sqrt(2), bounds=box)
     free = ~grid.blocked
     h, w = free.shape
     idx = np.arange(h * w).reshape(h, w)
