@@ -8,6 +8,7 @@ every marked test is skipped with one reason, and the rest of the suite still ru
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import subprocess
@@ -144,12 +145,12 @@ def leg_cache(tmp_path_factory):
 PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1:5432/test")
 
 
-@pytest.fixture
-def fresh_pg():
-    """The URL of a new, empty PostgreSQL database of this test's own, dropped after it
-    (skipped when no server answers, unless $CI is set)."""
+@contextlib.contextmanager
+def new_pg_database(prefix: str):
+    """The URL of a new, empty PostgreSQL database named ``prefix`` and a random suffix,
+    dropped on leaving (a skip when no server answers, unless $CI is set)."""
     base = sa.engine.make_url(PG)
-    name = f"skyroute_new_{uuid.uuid4().hex[:12]}"
+    name = f"{prefix}_{uuid.uuid4().hex[:12]}"
     try:
         admin = sa.create_engine(base, isolation_level="AUTOCOMMIT")
         with admin.connect() as c:
@@ -164,3 +165,10 @@ def fresh_pg():
         with admin.connect() as c:
             c.execute(sa.text(f"drop database if exists {name} with (force)"))
         admin.dispose()
+
+
+@pytest.fixture
+def fresh_pg():
+    """The URL of a new, empty PostgreSQL database of this test's own, dropped after it."""
+    with new_pg_database("skyroute_new") as url:
+        yield url

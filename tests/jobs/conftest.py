@@ -6,16 +6,13 @@ from __future__ import annotations
 
 import contextlib
 import datetime as dt
-import os
-import uuid
 
 import pytest
 import sqlalchemy as sa
 
-from tests.conftest import ROOT
+from tests.conftest import ROOT, new_pg_database
 
 EXAMPLE = ROOT / "examples" / "lunch"
-PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1:5432/test")
 
 
 def lunch_store(url: str, dates: tuple[str, ...] | None = None):
@@ -45,25 +42,10 @@ def dask_executor(leg_cache):
 
 @pytest.fixture(scope="session")
 def _pg_database() -> str:
-    """A database of this test session's own on the local PostgreSQL server, dropped at
-    its end (skipped when none answers, unless $CI is set): a fixed name was reset by
-    every other session running beside this one, a helper's or a second terminal's."""
-    base = sa.engine.make_url(PG)
-    name = f"skyroute_jobs_{uuid.uuid4().hex[:12]}"
-    try:
-        admin = sa.create_engine(base, isolation_level="AUTOCOMMIT")
-        with admin.connect() as c:
-            c.execute(sa.text(f"create database {name}"))
-    except sa.exc.OperationalError:
-        if os.environ.get("CI"):
-            raise
-        pytest.skip("no PostgreSQL server")
-    try:
-        yield base.set(database=name).render_as_string(hide_password=False)
-    finally:
-        with admin.connect() as c:
-            c.execute(sa.text(f"drop database if exists {name} with (force)"))
-        admin.dispose()
+    """A database of this test session's own, dropped at its end: a fixed name was reset
+    by every other session running beside this one, a helper's or a second terminal's."""
+    with new_pg_database("skyroute_jobs") as url:
+        yield url
 
 
 @pytest.fixture

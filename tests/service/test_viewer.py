@@ -101,6 +101,9 @@ class Page:
     def __init__(self, browser, url: str, size: str, init_script: str | None = None):
         self.size = size
         self.context = browser.new_context(viewport=SIZES[size], accept_downloads=True)
+        # a page's waits get 60 s, not Playwright's 30: a job the page follows (a day
+        # flown by the server's workers) took longer on a machine loaded by other runs
+        self.context.set_default_timeout(60_000)
         self.page = self.context.new_page()
         if init_script:
             self.page.add_init_script(init_script)
@@ -1185,14 +1188,14 @@ def test_day_page_deletes_a_day_without_a_flight(open_page, api, server, size):
                         f".startsWith('{mistyped}:')")
     assert p.is_visible("#delete")
     dialogs: list[str] = []
-    p.once("dialog", lambda d: (dialogs.append(d.message), d.dismiss()))
+    _answer_next_dialog(p, dialogs, accept=False)
     p.focus("#delete")
     p.keyboard.press("Enter")
     p.wait_for_function("document.activeElement.id === 'delete'")
     assert len(dialogs) == 1 and mistyped in dialogs[0], dialogs
     assert mistyped in [d["date"] for d in api.get("/days").json()]  # not confirmed: kept
     p.fill("#token", TOKEN)
-    p.once("dialog", lambda d: (dialogs.append(d.message), d.accept()))
+    _answer_next_dialog(p, dialogs, accept=True)
     p.focus("#delete")
     p.keyboard.press("Enter")
     p.wait_for_function("document.querySelector('#status').textContent"
@@ -1317,7 +1320,7 @@ def test_day_page_flies_a_stored_day_again_with_replace(open_page, api, server, 
     p.keyboard.press("Space")
     assert p.is_checked("#replace")
     dialogs: list[str] = []
-    p.once("dialog", lambda d: (dialogs.append(d.message), d.dismiss()))
+    _answer_next_dialog(p, dialogs, accept=False)
     p.focus("#start")
     p.keyboard.press("Enter")
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'info'")
@@ -1325,7 +1328,7 @@ def test_day_page_flies_a_stored_day_again_with_replace(open_page, api, server, 
     assert p.inner_text("#job-status") == f"Not flown: the stored flight of {date} is kept."
     assert p.evaluate("document.activeElement.id") == "start" and p.is_checked("#replace")
     assert len(posts) == 1  # the refused one only
-    p.once("dialog", lambda d: (dialogs.append(d.message), d.accept()))
+    _answer_next_dialog(p, dialogs, accept=True)
     p.keyboard.press("Enter")
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
                         " && !document.querySelector('#start').ariaDisabled", timeout=120_000)
@@ -1339,6 +1342,12 @@ def test_day_page_flies_a_stored_day_again_with_replace(open_page, api, server, 
                         " the drone did not fly')")
     assert p.input_value("#date") == date
     pg.done("day-replace")
+
+
+def _answer_next_dialog(page, said: list[str], *, accept: bool) -> None:
+    """Answer the page's next confirm() (OK or Cancel) and keep its message in ``said``."""
+    page.once("dialog", lambda d: (said.append(d.message),
+                                   d.accept() if accept else d.dismiss()))
 
 
 def _wait_status_of(page, selector: str, kind: str, timeout: int = 120_000) -> None:
