@@ -106,3 +106,17 @@ def die_once(mark: str) -> str:
     if Path(mark).name.startswith("die") and _first_try(Path(mark)):
         os.kill(os.getpid(), signal.SIGKILL)
     return mark
+
+
+def die_or_raise(x: int) -> int:
+    """An executor task: -9 kills its own process with SIGKILL at once; any other ``x``
+    raises ValueError naming its process id half a second in (so it is still running
+    when a worker beside it dies)."""
+    import os
+    import signal
+    import time
+
+    if x == -9:
+        os.kill(os.getpid(), signal.SIGKILL)
+    time.sleep(0.5)
+    raise ValueError(f"task {x} failed in process {os.getpid()}")
