@@ -120,3 +120,22 @@ def die_or_raise(x: int) -> int:
         os.kill(os.getpid(), signal.SIGKILL)
     time.sleep(0.5)
     raise ValueError(f"task {x} failed in process {os.getpid()}")
+
+
+def fleet_dies_on_seed(seed: int) -> None:
+    """A local pool's initializer (in place of ``_leave_sigint``): in each worker, a fleet
+    run (a sweep's or a fleet job's) of ``seed`` kills its own process with SIGKILL."""
+    import os
+    import signal
+
+    from skyroute.jobs import executor, fleet
+
+    executor._leave_sigint()  # what the pool's own initializer does
+    real = fleet._simulate
+
+    def simulate(spec):
+        if spec.seed == seed:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return real(spec)
+
+    fleet._simulate = simulate
