@@ -106,3 +106,36 @@ def die_once(mark: str) -> str:
     if Path(mark).name.startswith("die") and _first_try(Path(mark)):
         os.kill(os.getpid(), signal.SIGKILL)
     return mark
+
+
+def die_or_raise(x: int) -> int:
+    """An executor task: -9 kills its own process with SIGKILL at once; any other ``x``
+    raises ValueError naming its process id half a second in (so it is still running
+    when a worker beside it dies)."""
+    import os
+    import signal
+    import time
+
+    if x == -9:
+        os.kill(os.getpid(), signal.SIGKILL)
+    time.sleep(0.5)
+    raise ValueError(f"task {x} failed in process {os.getpid()}")
+
+
+def fleet_dies_on_seed(seed: int) -> None:
+    """A local pool's initializer (in place of ``_leave_sigint``): in each worker, a fleet
+    run (a sweep's or a fleet job's) of ``seed`` kills its own process with SIGKILL."""
+    import os
+    import signal
+
+    from skyroute.jobs import executor, fleet
+
+    executor._leave_sigint()  # what the pool's own initializer does
+    real = fleet._simulate
+
+    def simulate(spec):
+        if spec.seed == seed:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return real(spec)
+
+    fleet._simulate = simulate

@@ -108,3 +108,26 @@ def test_deliver_on_dask_with_a_failing_day_and_a_dying_worker(monkeypatch, caps
     assert _stored_day(db, "2024-01-01")[0] == _stored_day(db, "2024-01-02")[0] == []
     assert _stored_day(db, "2024-01-03")[0] and _stored_day(db, "2023-12-31")[0] == [(0, 0)]
     assert "3 of 5 days" in out
+
+
+def test_fleet_sweep_says_a_worker_died_and_names_the_lost_run(monkeypatch, capsys):
+    # a run whose worker process dies every time: the executor's warning came out bare
+    # (Python's last resort, no "skyroute:"), and the error named "task 1" of the map
+    from functools import partial
+
+    from tests.jobs.failing import fleet_dies_on_seed
+
+    monkeypatch.setattr("os.cpu_count", lambda: 2)
+    monkeypatch.setattr("skyroute.jobs.executor._leave_sigint",
+                        partial(fleet_dies_on_seed, 1))
+    code, out, err = run(monkeypatch, capsys, "fleet", "sweep", "--preset", "seed-3x3",
+                         "--seeds", "0-1", "--hours", "0.1", "--jobs", "2", "--scheduler",
+                         "seed", "--airspace", "shared")
+    died = "(killed by SIGKILL, as the out-of-memory killer does)"
+    lines = err.strip().splitlines()
+    assert code == 2 and out == "" and "Traceback" not in err, err
+    assert any(x.startswith(f"skyroute: a worker process died {died}; the ")
+               for x in lines), err
+    assert lines[-1] == ("skyroute: error: 1 of the 2 runs was lost: scheduler seed, "
+                         f"airspace shared, seed 1: its worker process died {died}, also "
+                         "when run again alone"), err

@@ -238,6 +238,27 @@ def test_a_task_whose_worker_dies_once_is_run_again(tmp_path):
     assert sorted(seen) == list(range(6))
 
 
+def test_a_task_run_again_alone_that_raises_leaves_no_process():
+    """A task of a broken pool that raises when run again alone: its error is the
+    map's, and its one-process pool ends with it (it was kept until the executor
+    closed: on a server, an idle worker process each time, until it stopped)."""
+    import multiprocessing
+    import re
+
+    from tests.jobs.failing import die_or_raise
+
+    with open_executor("local", workers=2) as ex:
+        with pytest.raises(ValueError, match="task 1 failed in process") as info:
+            ex.map(die_or_raise, [-9, 1])
+        pid = int(re.search(r"process (\d+)", str(info.value))[1])
+        end = time.monotonic() + 10  # a bound for a slow machine, not a measurement
+        while (pid in {p.pid for p in multiprocessing.active_children()}
+               and time.monotonic() < end):
+            time.sleep(0.05)
+        assert pid not in {p.pid for p in multiprocessing.active_children()}
+        assert ex.map(abs, [-1, -2]) == [1, 2]  # still usable afterwards
+
+
 ABORTED_ALONE = """
 import os, signal, sys, time
 from pathlib import Path

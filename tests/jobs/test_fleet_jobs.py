@@ -7,6 +7,7 @@ import math
 
 import pytest
 
+from skyroute.errors import SkyrouteError
 from skyroute.fleet.report import report
 from skyroute.fleet.scenario import preset
 from skyroute.fleet.simulate import run
@@ -170,3 +171,36 @@ def test_a_level_whose_roll_overruns_a_runway_names_the_jobs_scenario():
         assert str(err.value).startswith("scenario: airport C's take-off runway (320 m) is "
                                          "shorter than the take-off roll to climb to 90 m")
         assert err.value.param == "airspace"
+
+
+def test_a_run_whose_worker_dies_is_named_by_its_settings(monkeypatch, tmp_path):
+    """A sweep's run whose worker process dies every time it is tried, and a fleet job's
+    run lost so on Dask (a one-task map runs in the calling process on the local
+    executor): the errors named the executor's task numbers ("2 of the 4 tasks were
+    lost: task 1: ...", "1 of the 1 tasks was lost: task 0: ..."), which mean nothing
+    to the user; they now name the runs by their settings."""
+    from functools import partial
+
+    from skyroute.jobs import executor
+    from skyroute.jobs.executor import TasksLostError
+    from skyroute.jobs.fleet import fleet_job
+    from tests.jobs.failing import fleet_dies_on_seed
+
+    monkeypatch.setattr(executor, "_leave_sigint", partial(fleet_dies_on_seed, 1))
+    died = "its worker process died (killed by SIGKILL, as the out-of-memory killer does)"
+    with open_executor("local", workers=2) as ex, pytest.raises(SkyrouteError) as err:
+        sweep(preset("seed-3x3"), **{**SWEEP, "hours": 0.1}, executor=ex)
+    assert str(err.value) == (f"2 of the 4 runs were lost: scheduler seed, airspace "
+                              f"shared, seed 1: {died}, also when run again alone")
+
+    class KilledOnDask:  # what DaskExecutor.map raises for a KilledWorker
+        def map(self, fn, items, *, on_result=None):
+            raise TasksLostError({0: "its Dask worker died running it (KilledWorker; see "
+                                     "the workers' logs)"}, [None])
+
+    engine = lunch_store(f"sqlite:///{tmp_path / 'f.db'}", [])
+    with pytest.raises(SkyrouteError) as err:
+        fleet_job(engine, "a-job", {"preset": "seed-3x3", "hours": 0.1},
+                  executor=KilledOnDask(), progress=lambda _p: None)
+    assert str(err.value) == ("the fleet run was lost: its Dask worker died running it "
+                              "(KilledWorker; see the workers' logs)")

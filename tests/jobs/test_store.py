@@ -746,3 +746,45 @@ def test_job_writers_on_one_sqlite_file_queue(tmp_path):
     assert {store.get_job(e, j)["state"] for j in made} == {"done"} and len(made) == 80
     assert len(store.list_fleet_runs(e, limit=1000)) == 80
     e.dispose()
+
+
+@pytest.mark.parametrize("db", ["sqlite", "postgresql"])
+def test_the_same_job_submitted_at_once_by_two_servers_is_recorded_once(tmp_path, request,
+                                                                        db):
+    """create_job_once from four connections at the same moment (servers sharing the
+    store): one records the job, the others answer its id. Without the write lock
+    (SQLite) or the advisory lock (PostgreSQL) round the look and the insert, rounds of
+    this recorded the job two to four times (measured: 3 of 10 rounds on SQLite, 10 of
+    10 on PostgreSQL)."""
+    import threading
+
+    url = (f"sqlite:///{tmp_path / 'once.db'}" if db == "sqlite"
+           else request.getfixturevalue("fresh_pg"))
+    params = {"from": "2024-01-01", "to": "2024-01-01", "method": "milp",
+              "replace": False, "data": "/orders"}
+    engine = dstore.connect(url)
+    dstore.init(engine)
+    servers = [dstore.connect(url) for _ in range(4)]
+    try:
+        for _ in range(10):
+            with engine.begin() as c:
+                c.execute(sa.text("DELETE FROM jobs"))
+            at_once, answers = threading.Barrier(len(servers)), []
+
+            def submit(eng, at_once=at_once, answers=answers):
+                at_once.wait()
+                answers.append(store.create_job_once(eng, "deliver", params, owner="s"))
+
+            threads = [threading.Thread(target=submit, args=(e,)) for e in servers]
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join()
+            with engine.connect() as c:
+                ids = c.execute(sa.text("SELECT id FROM jobs")).scalars().all()
+            assert len(ids) == 1, ids
+            assert sorted(answers, key=lambda a: not a[1]) == [
+                (ids[0], True)] + [(ids[0], False)] * (len(servers) - 1)
+    finally:
+        for e in [engine, *servers]:
+            e.dispose()

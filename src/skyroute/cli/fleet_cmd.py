@@ -10,7 +10,13 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
+from skyroute.cli.executor_args import (
+    DaskAddress,
+    Executor,
+    executor_kind,
+    executor_warnings,
+    open_from_flags,
+)
 from skyroute.cli.parse import parse_items
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import SEED_MAX, OptionError, check_choice, real
@@ -319,7 +325,8 @@ def sweep_command(
     err = plain_console(stderr=True)
     with progress_bar(err) as progress:
         task = progress.add_task("runs", total=runs)
-        with open_from_flags(executor, dask, jobs, runs) as ex:
+        with open_from_flags(executor, dask, jobs, runs) as ex, \
+                executor_warnings(progress.console):  # e.g. a worker process died
             rows = sweep(s, schedulers=scheds, airspaces=spaces, rates=rate_list,
                          seeds=seed_list, hours=hours, executor=ex,
                          on_result=lambda _i, _rep: progress.advance(task))

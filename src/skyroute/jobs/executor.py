@@ -232,22 +232,29 @@ class LocalExecutor(_Executor):
                         raise _closed(self) from None
                     lost[i] = (f"its worker process died ({_how_ended(procs=procs)}), "
                                "also when run again alone")
-                    with self._lock:
-                        self._alone.discard(pool)
-                    pool.shutdown(wait=False)
+                    self._drop_alone(pool)
                     pool = None
                     continue
                 if on_result:
                     on_result(i, out[i])
-        except BaseException:  # a Ctrl-C: the pool is left to the executor's abort (or
-            raise  # close), which ends its process: shut down here, it ran on to the end
+        except Exception:  # the task's own error, or the caller's (on_result): its
+            # process is idle now; left to the executor's close, a server kept one idle
+            # worker process each time this happened, until it stopped
+            self._drop_alone(pool)
+            raise
+        # (a Ctrl-C leaves the pool to the executor's abort, or close, which ends its
+        # process: shut down here, it ran on to the end)
+        self._drop_alone(pool)
+        if lost:
+            raise TasksLostError(lost, out)
+        return out
+
+    def _drop_alone(self, pool: ProcessPoolExecutor | None) -> None:
+        """Shut down a pool of :meth:`_again_alone` whose process runs no task now."""
         if pool is not None:
             with self._lock:
                 self._alone.discard(pool)
             pool.shutdown(wait=False)
-        if lost:
-            raise TasksLostError(lost, out)
-        return out
 
     def close(self) -> None:
         with self._lock:

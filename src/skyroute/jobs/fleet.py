@@ -21,7 +21,14 @@ from dataclasses import dataclass
 
 import sqlalchemy as sa
 
-from skyroute.errors import InputFormatError, OptionError, check_choice, check_seed, real
+from skyroute.errors import (
+    InputFormatError,
+    OptionError,
+    SkyrouteError,
+    check_choice,
+    check_seed,
+    real,
+)
 from skyroute.fleet.airborne import check_flights
 from skyroute.fleet.airspace import MODES
 from skyroute.fleet.dispatch import SCHEDULERS
@@ -33,6 +40,7 @@ from skyroute.fleet.simulate import check_levels, run
 from skyroute.io.fleet_out import events_jsonl, fleet_geojson, packages_csv, tracks_csv
 from skyroute.io.geojson import dumps
 from skyroute.jobs import store
+from skyroute.jobs.executor import TasksLostError
 
 SWEEP_METRICS = ("delivered_per_hour", "served_share", "p95_delivery_s", "max_wait_s",
                  "loiters", "capacity_bound_per_hour")
@@ -119,8 +127,23 @@ def sweep(scenario: Scenario, *, schedulers=SCHEDULERS, airspaces=MODES,
                 seeds=len(seeds))
     configs, specs = sweep_specs(scenario, schedulers=schedulers, airspaces=airspaces,
                                  rates=rates, seeds=seeds, hours=hours)
-    return sweep_rows(configs, len(seeds), executor.map(simulate_report, specs,
-                                                        on_result=on_result))
+    try:
+        reports = executor.map(simulate_report, specs, on_result=on_result)
+    except TasksLostError as exc:  # named by the executor's task numbers ("task 5")
+        raise SkyrouteError(_lost_runs(exc, specs)) from None
+    return sweep_rows(configs, len(seeds), reports)
+
+
+def _lost_runs(exc: TasksLostError, specs: list[RunSpec]) -> str:
+    """The runs whose worker died every time they were tried, the first named by its
+    settings: "1 of the 12 runs was lost: scheduler optimal, airspace layers, seed 3:
+    its worker process died (...), also when run again alone"."""
+    n, total = len(exc.lost), len(specs)
+    i, why = next(iter(exc.lost.items()))
+    s = specs[i]
+    rate = "" if s.rate_per_hour is None else f", rate {s.rate_per_hour:g}/h"
+    return (f"{n:,} of the {total:,} runs {'was' if n == 1 else 'were'} lost: scheduler "
+            f"{s.scheduler}, airspace {s.airspace}{rate}, seed {s.seed}: {why}")
 
 
 @dataclass(frozen=True)
@@ -275,7 +298,10 @@ def fleet_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
     spec = RunSpec(_resolve(p).model_dump(), p["hours"], p["seed"], p["scheduler"],
                    p["airspace"], p["rate_per_hour"])
     task = FleetTask(store.worker_url(engine), str(uuid.uuid4()), job_id, spec, p["track_step"])
-    (out,) = executor.map(fly_fleet, [task])
+    try:
+        (out,) = executor.map(fly_fleet, [task])
+    except TasksLostError as exc:  # "1 of the 1 tasks was lost: task 0: ..."
+        raise SkyrouteError(f"the fleet run was lost: {exc.lost[0]}") from None
     progress(1.0)
     return {"fleet_run": out["id"], "report": out["report"]}
 
