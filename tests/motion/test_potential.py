@@ -393,3 +393,14 @@ def test_the_escape_raster_is_capped_well_below_the_grid_planners():
         run_field(_open_c(), (25.0, 30.0), (1200.0, 1200.0))
     assert err.value.param == "step" and "more than 4,194,304 cells" in str(err.value)
     assert potential.ESCAPE_MAX_CELLS == 1 << 22
+
+
+def test_an_escape_raster_too_large_is_refused_before_the_first_move():
+    """With the escape on, a raster over ESCAPE_MAX_CELLS was refused only when the robot
+    first stalled, after it had flown (a run of many moves then ended in exit 2, its path
+    lost): it is refused at once, also for a run that would never stall."""
+    with pytest.raises(OptionError) as err:
+        run_field(_open_c(), (5.0, 30.0), (1200.0, 1200.0), max_moves=10)
+    assert err.value.param == "step"
+    run = run_field(_open_c(), (5.0, 30.0), (1200.0, 1200.0), max_moves=10, escape=False)
+    assert run.moves == 10 and not run.reached

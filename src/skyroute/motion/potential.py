@@ -138,6 +138,24 @@ def _edges(world: World):
     return _EDGE_CACHE[world]
 
 
+def _escape_box(world: World, goal: np.ndarray, r: float, points: np.ndarray) -> tuple:
+    """The escape raster's bounds (see :func:`_navigation`); an OptionError naming
+    ``step`` when it would pass :data:`ESCAPE_MAX_CELLS` cells of side ``r``."""
+    box = world.extent_with(np.vstack([points, goal]), margin=4 * r)
+    if world.boundary is None:
+        box = (box[0] - 4 * r, box[1] - 4 * r, box[2] + 4 * r, box[3] + 4 * r)
+    cells = (box[2] - box[0]) / r * ((box[3] - box[1]) / r)
+    if not math.isfinite(cells) or cells > ESCAPE_MAX_CELLS:
+        over = ("the boundary" if world.boundary is not None else
+                "the obstacles, the start, the robot and the goal")
+        # its cells are a step wide: the caller has no resolution to change
+        raise OptionError(f"step={r:g} makes the escape's raster (cells a step wide over "
+                          f"{over}, {box[2] - box[0]:.6g} x {box[3] - box[1]:.6g} across) "
+                          f"more than {ESCAPE_MAX_CELLS:,} cells; use a larger step, or "
+                          "turn the escape off", param="step")
+    return box
+
+
 def _navigation(world: World, goal: np.ndarray, resolution: float, points: np.ndarray):
     """Wavefront distance to the goal per free cell (inf where unreachable), and the grid.
 
@@ -153,18 +171,7 @@ def _navigation(world: World, goal: np.ndarray, resolution: float, points: np.nd
     from scipy.sparse.csgraph import dijkstra
 
     r = resolution
-    box = world.extent_with(np.vstack([points, goal]), margin=4 * r)
-    if world.boundary is None:
-        box = (box[0] - 4 * r, box[1] - 4 * r, box[2] + 4 * r, box[3] + 4 * r)
-    cells = (box[2] - box[0]) / r * ((box[3] - box[1]) / r)
-    if not math.isfinite(cells) or cells > ESCAPE_MAX_CELLS:
-        over = ("the boundary" if world.boundary is not None else
-                "the obstacles, the start, the robot and the goal")
-        # its cells are a step wide: the caller has no resolution to change
-        raise OptionError(f"step={r:g} makes the escape's raster (cells a step wide over "
-                          f"{over}, {box[2] - box[0]:.6g} x {box[3] - box[1]:.6g} across) "
-                          f"more than {ESCAPE_MAX_CELLS:,} cells; use a larger step, or "
-                          "turn the escape off", param="step")
+    box = _escape_box(world, goal, r, points)
     grid = world.merged().rasterize(r, safety=r / math.sqrt(2), bounds=box)
     free = ~grid.blocked
     h, w = free.shape
@@ -233,6 +240,8 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
     heading = None if heading is None else real("heading", heading)
     p = world.check_point(start, "start")
     t = world.check_point(goal, "goal")
+    if escape:  # refused now, not after the moves flown before a first stall
+        _escape_box(world, t, step, p[None, :])
     theta = math.atan2(*(t - p)[::-1]) if heading is None else \
         float(world.heading_to_plane(heading))
     path = [p.copy()]
