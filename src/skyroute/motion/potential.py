@@ -218,7 +218,7 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
     instead whenever the field cannot move on: when the last ``window`` moves made less
     than two steps of net progress (a local minimum, or circling), when the force
     vanishes, or when its move (and the move half as long) is blocked. Each time the
-    robot stalls again after an escape, the next escape runs twice as long, so a trap
+    escape takes over again, it runs twice as long as the last time, so a trap
     the field keeps falling back into is left for good. In ``arc`` mode the robot starts
     on ``heading`` (radians in the world's frame's convention; default towards the
     goal). Points come in and the run's path goes out in the world's frame; distances
