@@ -106,3 +106,16 @@ def die_once(mark: str) -> str:
     if Path(mark).name.startswith("die") and _first_try(Path(mark)):
         os.kill(os.getpid(), signal.SIGKILL)
     return mark
+
+
+def raise_days_failed(x: int) -> int:
+    """An executor task: ``x`` back, but 0 raises a :class:`DaysFailedError` (an error
+    whose constructor takes other arguments than its message)."""
+    import datetime as dt
+
+    from skyroute.jobs.deliver import DayFailed, DaysFailedError
+
+    if x == 0:
+        day = dt.date(2024, 1, 1)
+        raise DaysFailedError([], [DayFailed(day, f"{day}: the planner failed", True)], 2)
+    return x
