@@ -76,4 +76,4 @@ def test_every_skyroute_error_round_trips_through_pickle(cls):
 def test_the_children_are_found():
     names = {c.__name__ for c in _every_child()}
     assert {"OptionError", "DaysFailedError", "TasksLostError", "ExecutorClosedError",
-            "RunChangedError", "DayKeptError"} <= names
+            "RunChangedError", "DayKeptError", "RunsLostError"} <= names

@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-import contextlib
 import datetime as dt
 import json
-import logging
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -14,7 +12,13 @@ import typer
 from rich.table import Table
 
 from skyroute.cli.db_cmd import REPLACE_HELP, some_days
-from skyroute.cli.executor_args import DaskAddress, Executor, executor_kind, open_from_flags
+from skyroute.cli.executor_args import (
+    DaskAddress,
+    Executor,
+    executor_kind,
+    open_from_flags,
+    warnings_said,
+)
 from skyroute.cli.parse import parse_date
 from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.delivery.day import METHODS, DayResult
@@ -133,7 +137,7 @@ def deliver_command(
 
             failed: list[DayFailed] = []  # said once the other days are stored
             try:
-                with _warnings_said(progress.console):  # e.g. a worker process died
+                with warnings_said(progress.console):  # e.g. a worker process died
                     results = run_days(engine, src, by_date, executor=ex, method=method,
                                        replace=replace, files=files, on_day=finished,
                                        on_failed=lambda _f: progress.advance(days))
@@ -152,24 +156,6 @@ def deliver_command(
     _say_empty(results, list(by_date))
     if failed:
         _say_failed(failed, len(by_date))
-
-
-@contextlib.contextmanager
-def _warnings_said(console):
-    """The ``skyroute.jobs`` logger's warnings (the executor's: a worker process died,
-    its tasks run again) as lines on ``console`` while in the block; the CLI sets up no
-    logging, and Python's last resort printed them over the progress bar."""
-
-    class Say(logging.Handler):
-        def emit(self, record: logging.LogRecord) -> None:
-            console.print(f"skyroute: {record.getMessage()}", soft_wrap=True)
-
-    logger, handler = logging.getLogger("skyroute.jobs"), Say(logging.WARNING)
-    logger.addHandler(handler)
-    try:
-        yield
-    finally:
-        logger.removeHandler(handler)
 
 
 def _say_empty(results: list[DayResult], dates: list[dt.date]) -> None:

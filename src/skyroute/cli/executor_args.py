@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import os
 from typing import Annotated
 
@@ -40,3 +42,21 @@ def open_from_flags(executor: str | None, dask: str | None, jobs: int, tasks: in
     cap = max(1, tasks)
     workers = min(jobs, os.cpu_count() or 1, cap) if kind == "local" else min(jobs, cap)
     return open_executor(kind, address=dask, workers=None if dask else workers)
+
+
+@contextlib.contextmanager
+def warnings_said(console):
+    """The ``skyroute.jobs`` logger's warnings (the executor's: a worker process died,
+    its tasks run again) as lines on ``console`` while in the block; the CLI sets up no
+    logging, and Python's last resort printed them over the progress bar."""
+
+    class Say(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            console.print(f"skyroute: {record.getMessage()}", soft_wrap=True)
+
+    logger, handler = logging.getLogger("skyroute.jobs"), Say(logging.WARNING)
+    logger.addHandler(handler)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
