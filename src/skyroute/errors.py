@@ -24,6 +24,25 @@ class SkyrouteError(Exception):
         super().__init__(*args)
         self.param = param
 
+    def __reduce__(self):
+        """Pickled as its message and attributes, rebuilt without calling ``__init__``:
+        Python's default calls ``type(err)(*err.args)``, which fails for every child
+        whose constructor takes other arguments than the message (``DaysFailedError(stored,
+        failed, days)``: "missing 2 required positional arguments"), and a process pool
+        or a Dask worker pickles the errors its tasks raise (a local pool reported such
+        an error as its worker 'terminated abruptly'). So every child round-trips, with
+        ``param`` and whatever else it keeps (``date``, ``failed``, ...)."""
+        return _rebuilt, (type(self), self.args, self.__dict__)
+
+
+def _rebuilt(cls: type, args: tuple, state: dict) -> SkyrouteError:
+    """A :class:`SkyrouteError` (or child) unpickled: ``args`` as given (the message),
+    ``state`` its attributes; ``__init__`` is not called (see ``__reduce__``)."""
+    err = cls.__new__(cls, *args)
+    err.args = args
+    err.__dict__.update(state)
+    return err
+
 
 class InputFormatError(SkyrouteError, ValueError):
     """A file (map, scenario, segments, image) could not be read as what it claims to be.

@@ -52,7 +52,7 @@ def test_sweep_table_wraps_numbers_instead_of_cutting_them():
     from skyroute.cli.fleet_cmd import _sweep_table
     from skyroute.fleet.scenario import preset
 
-    row = {"scheduler": "optimal", "airspace": "shared", "rate_per_hour": 60.0,
+    row = {"scheduler": "optimal", "airspace": "shared", "rate_per_hour": 60.0, "runs": 2,
            "conflicts": 0, "lost": 0}
     for m, v, ci in (("delivered_per_hour", 48.8, 3.6), ("served_share", 0.849, 0.046),
                      ("p95_delivery_s", 1693, 681), ("max_wait_s", 3502, 1373),

@@ -11,6 +11,9 @@ a pool handed it back as a worker 'terminated abruptly'), ``bug`` (a ZeroDivisio
 ``die`` (the worker kills its own process with SIGKILL, as the out-of-memory killer
 does), ``die-once`` (the same, on the first try of that date only: a file in ``marks``
 remembers it across processes).
+
+The same kinds apply to a fleet sweep's runs (``skyroute.jobs.fleet._simulate``): a key
+``seed N`` matches every run of seed N, ``SCHEDULER AIRSPACE seed N`` one setting's.
 """
 
 from __future__ import annotations
@@ -24,24 +27,32 @@ def fail_in_workers(kinds: dict[str, str], marks: str | None = None) -> None:
     from pathlib import Path
 
     from skyroute.errors import InputFormatError, SkyrouteError
-    from skyroute.jobs import deliver, executor
+    from skyroute.jobs import deliver, executor, fleet
 
     executor._leave_sigint()  # what the pool's own initializer does
-    real = deliver.plan_day
+    real, real_simulate = deliver.plan_day, fleet._simulate
 
-    def plan_day(site, date, orders, **kw):
-        kind = kinds.get(str(date))
+    def fail(key: str) -> None:
+        kind = kinds.get(key)
         if kind == "skyroute":
-            raise SkyrouteError(f"{date}: the planner failed")
+            raise SkyrouteError(f"{key}: the planner failed")
         if kind == "file":
             raise InputFormatError("website/menus/menus.json", "cannot read: gone")
         if kind == "bug":
             return 1 / 0
-        if kind == "die" or (kind == "die-once" and _first_try(Path(marks) / str(date))):
+        if kind == "die" or (kind == "die-once" and _first_try(Path(marks) / key)):
             os.kill(os.getpid(), signal.SIGKILL)
+
+    def plan_day(site, date, orders, **kw):
+        fail(str(date))
         return real(site, date, orders, **kw)
 
-    deliver.plan_day = plan_day
+    def simulate(spec):
+        one = f"{spec.scheduler} {spec.airspace} seed {spec.seed}"
+        fail(one if one in kinds else f"seed {spec.seed}")
+        return real_simulate(spec)
+
+    deliver.plan_day, fleet._simulate = plan_day, simulate
 
 
 def _first_try(mark) -> bool:
@@ -139,3 +150,58 @@ def fleet_dies_on_seed(seed: int) -> None:
         return real(spec)
 
     fleet._simulate = simulate
+
+
+class LosingExecutor:
+    """An executor running its tasks in this process, one after another, that loses the
+    tasks at ``lose`` (item indices) as a pool whose worker died under them each time
+    does (their result None, :class:`~skyroute.jobs.executor.TasksLostError` at the end),
+    or raises KeyboardInterrupt before task ``interrupt_at`` (a Ctrl-C)."""
+
+    kind, workers, aborted = "local", 1, False
+
+    def __init__(self, lose=(), interrupt_at: int | None = None) -> None:
+        self.lose, self.interrupt_at = set(lose), interrupt_at
+
+    def map(self, fn, items, *, on_result=None):
+        from skyroute.jobs.executor import TasksLostError
+
+        out, lost = [], {}
+        for i, item in enumerate(items):
+            if i == self.interrupt_at:
+                raise KeyboardInterrupt
+            if i in self.lose:
+                out.append(None)
+                lost[i] = "its worker process died (killed by SIGKILL), also when run again alone"
+                continue
+            out.append(fn(item))
+            if on_result:
+                on_result(i, out[-1])
+        if lost:
+            raise TasksLostError(lost, out)
+        return out
+
+    def close(self) -> None:
+        pass
+
+    def abort(self) -> None:
+        self.aborted = True
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        pass
+
+
+def raise_days_failed(x: int) -> int:
+    """An executor task: ``x`` back, but 0 raises a :class:`DaysFailedError` (an error
+    whose constructor takes other arguments than its message)."""
+    import datetime as dt
+
+    from skyroute.jobs.deliver import DayFailed, DaysFailedError
+
+    if x == 0:
+        day = dt.date(2024, 1, 1)
+        raise DaysFailedError([], [DayFailed(day, f"{day}: the planner failed", True)], 2)
+    return x

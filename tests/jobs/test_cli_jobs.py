@@ -112,7 +112,8 @@ def test_deliver_on_dask_with_a_failing_day_and_a_dying_worker(monkeypatch, caps
 
 def test_fleet_sweep_says_a_worker_died_and_names_the_lost_run(monkeypatch, capsys):
     # a run whose worker process dies every time: the executor's warning came out bare
-    # (Python's last resort, no "skyroute:"), and the error named "task 1" of the map
+    # (Python's last resort, no "skyroute:"), and the error named "task 1" of the map;
+    # the row over the run that finished is printed (tests/jobs/test_sweep_lost.py)
     from functools import partial
 
     from tests.jobs.failing import fleet_dies_on_seed
@@ -125,9 +126,12 @@ def test_fleet_sweep_says_a_worker_died_and_names_the_lost_run(monkeypatch, caps
                          "seed", "--airspace", "shared")
     died = "(killed by SIGKILL, as the out-of-memory killer does)"
     lines = err.strip().splitlines()
-    assert code == 2 and out == "" and "Traceback" not in err, err
+    assert code == 2 and "Traceback" not in err, err
+    assert "│ seed      │ shared   │    1 │" in out, out  # the row over seed 0 alone
     assert any(x.startswith(f"skyroute: a worker process died {died}; the ")
                for x in lines), err
-    assert lines[-1] == ("skyroute: error: 1 of the 2 runs was lost: scheduler seed, "
-                         f"airspace shared, seed 1: its worker process died {died}, also "
-                         "when run again alone"), err
+    assert lines[-2:] == [
+        "skyroute: error: scheduler seed, airspace shared, seed 1: its worker process "
+        f"died {died}, also when run again alone",
+        "skyroute: error: 1 of the 2 runs was lost; the rows are over the other 1 (a "
+        "row's runs count them)"], err

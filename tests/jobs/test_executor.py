@@ -319,3 +319,18 @@ def test_ctrl_c_while_tasks_run_again_alone_ends_them(tmp_path):
             os.killpg(p.pid, signal.SIGKILL)
     assert (out, p.returncode) == ("interrupted\n", 0), err
     assert not list(tmp_path.glob("done-*"))
+
+
+def test_an_error_of_a_task_in_a_worker_is_raised_as_itself():
+    # a SkyrouteError whose constructor takes more than its message (DaysFailedError,
+    # InputFormatError, ...) raised in a pool worker did not unpickle in the caller: the
+    # pool broke ('terminated abruptly'), the task was run again alone and reported
+    # lost, "its worker process died (killed by SIGTERM)", its message gone
+    from skyroute.jobs.deliver import DaysFailedError
+    from tests.jobs.failing import raise_days_failed
+
+    with open_executor("local", workers=2) as ex, pytest.raises(DaysFailedError) as info:
+        ex.map(raise_days_failed, [1, 0, 2])
+    assert str(info.value) == "1 of the 2 days failed and was not stored (the other 1 " \
+        "is): 2024-01-01: the planner failed"
+    assert info.value.days == 2 and info.value.failed[0].expected

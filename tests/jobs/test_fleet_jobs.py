@@ -190,8 +190,9 @@ def test_a_run_whose_worker_dies_is_named_by_its_settings(monkeypatch, tmp_path)
     died = "its worker process died (killed by SIGKILL, as the out-of-memory killer does)"
     with open_executor("local", workers=2) as ex, pytest.raises(SkyrouteError) as err:
         sweep(preset("seed-3x3"), **{**SWEEP, "hours": 0.1}, executor=ex)
-    assert str(err.value) == (f"2 of the 4 runs were lost: scheduler seed, airspace "
-                              f"shared, seed 1: {died}, also when run again alone")
+    assert str(err.value) == (f"2 of the 4 runs were lost and left out of the rows: "
+                              f"scheduler seed, airspace shared, seed 1: {died}, also "
+                              "when run again alone; and 1 more")
 
     class KilledOnDask:  # what DaskExecutor.map raises for a KilledWorker
         def map(self, fn, items, *, on_result=None):

@@ -121,4 +121,69 @@ def test_the_json_report_keeps_every_option(monkeypatch, capsys, tmp_path):
     assert settings == {"load": ["plan", "flightpath"], "map": "den312d", "algorithm": "jps",
                         "db": "postgresql+psycopg://me:***@db:5432/lunch",
                         "date": "2024-01-03", "seed": 0, "requests": 10, "clients": 50,
-                        "workers": 1, "client_processes": 1, "client": "httpx"}
+                        "workers": 1, "client_processes": 1, "client": "httpx",
+                        "warm": True}
+
+
+def _never_answers(monkeypatch) -> list:
+    """Servers that start a process which never answers /health (nor exits); the list
+    gets each :class:`Server` made."""
+    import sys
+
+    from skyroute.bench.service import Server
+
+    made = []
+
+    def command(self, **_kw):
+        made.append(self)
+        return [sys.executable, "-c", "import time; time.sleep(600)"]
+
+    monkeypatch.setattr(Server, "_command", command)
+    return made
+
+
+def test_a_server_that_never_answers_is_one_line_naming_what_to_do(monkeypatch, capsys):
+    # serve warms every process before it answers: with numba's cache empty, several
+    # processes took 75 s on a loaded machine, and the fixed 120 s wait ended in "the
+    # server did not answer /health within 120 s", naming no way on
+    made = _never_answers(monkeypatch)
+    code, _, err = run(monkeypatch, capsys, "bench", "service", "--requests", "10",
+                         "--workers", "2", "--start-timeout", "0.3")
+    assert code == 2 and "Traceback" not in err, err
+    assert err.strip().splitlines()[-1] == (
+        "skyroute: error: the server did not answer /health within --start-timeout 0.3 s: "
+        "it warms each of its 2 processes before it serves, which compiles the planners' "
+        "kernels when numba's cache is empty (a minute or more on a busy machine); give a "
+        "longer --start-timeout, or --no-warm (each server process then loads the kernels "
+        "on its first requests)")
+    assert len(made) == 1 and made[0].proc.poll() is not None  # stopped, not left running
+
+
+def test_the_wait_for_a_server_grows_with_its_processes(monkeypatch):
+    from skyroute.bench.service import Server, default_start_timeout
+
+    _never_answers(monkeypatch)
+    waited = []
+    monkeypatch.setattr(Server, "_wait", lambda self, timeout: waited.append(timeout))
+    for workers in (1, 3):
+        Server(db="sqlite://", workers=workers).stop()
+    Server(db="sqlite://", workers=3, start_timeout=7.5).stop()
+    assert waited == [default_start_timeout(1), default_start_timeout(3), 7.5]
+    assert default_start_timeout(3) > default_start_timeout(1) >= 120
+
+
+def test_a_server_without_warming(monkeypatch):
+    from skyroute.bench.service import Server
+    from skyroute.errors import SkyrouteError
+
+    made = _never_answers(monkeypatch)
+    with pytest.raises(SkyrouteError) as err:
+        Server(db="sqlite://", warm=False, start_timeout=0.2)
+    assert str(err.value) == "the server did not answer /health within start_timeout=0.2 s; " \
+        "wait longer"
+    assert err.value.param == "start_timeout" and made[0].proc.poll() is not None
+    monkeypatch.undo()  # the real command: serve --no-warm
+    srv = object.__new__(Server)
+    srv.port, srv.workers, srv.warm = 8000, 2, False
+    assert srv._command(db="sqlite://", data=None, max_expansions=None)[-3:] == [
+        "--log-level", "warning", "--no-warm"]

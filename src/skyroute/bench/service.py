@@ -70,25 +70,52 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+START_TIMEOUT = 120.0  # seconds for a server of one process to answer /health
+START_PER_WORKER = 60.0  # and for each further process
+
+
+def default_start_timeout(workers: int) -> float:
+    """How long :class:`Server` waits for ``/health`` by default: :data:`START_TIMEOUT`
+    and :data:`START_PER_WORKER` for each process past the first. Each process warms the
+    planners before it serves (:mod:`skyroute.service.warm`): about a second from
+    numba's cache, but with the cache empty each compiles the kernels, all at once on
+    the same cores (75 s for several processes on a loaded 2-core machine)."""
+    return START_TIMEOUT + START_PER_WORKER * (workers - 1)
+
+
 class Server:
-    """``skyroute serve`` on a free port of 127.0.0.1, until ``stop()``."""
+    """``skyroute serve`` on a free port of 127.0.0.1, until ``stop()``.
+
+    ``warm``: the server warms its processes before it serves (``serve --no-warm`` when
+    False); ``start_timeout``: seconds to wait for ``/health`` (default
+    :func:`default_start_timeout`), after which the server is stopped and a
+    SkyrouteError with ``param="start_timeout"`` says what to do."""
 
     def __init__(self, *, db: str, workers: int = 1, data: Path | None = None,
-                 max_expansions: int | None = None) -> None:
+                 max_expansions: int | None = None, warm: bool = True,
+                 start_timeout: float | None = None) -> None:
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
+        self.workers, self.warm = workers, warm
+        cmd = self._command(db=db, data=data, max_expansions=max_expansions)
+        env = {**os.environ, "SKYROUTE_TOKEN": TOKEN}
+        self.proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
+                                     stderr=subprocess.PIPE, text=True)
+        self._wait(default_start_timeout(workers) if start_timeout is None
+                   else start_timeout)
+
+    def _command(self, *, db: str, data: Path | None, max_expansions: int | None) -> list:
         cmd = [sys.executable, "-m", "skyroute", "serve", "--port", str(self.port), "--db",
-               db, "--workers", str(workers), "--log-level", "warning"]
+               db, "--workers", str(self.workers), "--log-level", "warning"]
         if data is not None:
             cmd += ["--data", str(data)]
         if max_expansions is not None:
             cmd += ["--max-expansions", str(max_expansions)]
-        env = {**os.environ, "SKYROUTE_TOKEN": TOKEN}
-        self.proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
-                                     stderr=subprocess.PIPE, text=True)
-        self._wait()
+        if not self.warm:
+            cmd.append("--no-warm")
+        return cmd
 
-    def _wait(self, timeout: float = 120.0) -> None:
+    def _wait(self, timeout: float) -> None:
         import httpx
 
         end = time.monotonic() + timeout
@@ -103,7 +130,15 @@ class Server:
             except httpx.HTTPError:
                 time.sleep(0.2)
         self.stop()
-        raise SkyrouteError(f"the server did not answer /health within {timeout:g} s")
+        n = self.workers
+        why = ("" if not self.warm else
+               f": it warms {'its process' if n == 1 else f'each of its {n} processes'} "
+               "before it serves, which compiles the planners' kernels when numba's cache "
+               "is empty (a minute or more on a busy machine)")
+        raise SkyrouteError(f"the server did not answer /health within start_timeout="
+                            f"{timeout:g} s{why}; wait longer"
+                            + (", or start it without warming (warm=False)" if self.warm
+                               else ""), param="start_timeout")
 
     def stop(self) -> None:
         if self.proc.poll() is None:
@@ -311,9 +346,11 @@ def plan_queries(map_name: str, n: int, *, seed: int = 0,
 def bench_plan(*, map_name: str = "Paris_1_512", clients: int = 50, requests: int = 2000,
                warmup: int = 100, workers: int = 1, seed: int = 0, algorithm: str = "astar",
                db: str | None = None, client_processes: int = 1,
-               client: str = "httpx") -> dict:
+               client: str = "httpx", warm: bool = True,
+               start_timeout: float | None = None) -> dict:
     """POST /plan under load: the summary (server-side ``app``, ``wait``, ``plan`` and
-    client latency percentiles in ms, requests/s, errors)."""
+    client latency percentiles in ms, requests/s, errors). ``warm``, ``start_timeout``:
+    the :class:`Server`'s."""
     import tempfile
 
     check_load(clients=clients, requests=requests, workers=workers,
@@ -321,7 +358,8 @@ def bench_plan(*, map_name: str = "Paris_1_512", clients: int = 50, requests: in
     queries = plan_queries(map_name, warmup + requests, seed=seed, algorithm=algorithm)
     auth = {"Authorization": f"Bearer {TOKEN}"}
     with tempfile.TemporaryDirectory() as tmp, \
-            Server(db=db or f"sqlite:///{Path(tmp) / 'bench.db'}", workers=workers) as srv:
+            Server(db=db or f"sqlite:///{Path(tmp) / 'bench.db'}", workers=workers,
+                   warm=warm, start_timeout=start_timeout) as srv:
         asyncio.run(_load(srv.url, [("POST", "/plan", q) for q in queries[:warmup]],
                           min(clients, 8), auth))
         cpu0 = cpu_seconds(srv.proc.pid)
@@ -336,14 +374,15 @@ def bench_plan(*, map_name: str = "Paris_1_512", clients: int = 50, requests: in
 
 def bench_flightpath(*, db: str, date: str | None = None, clients: int = 50,
                      requests: int = 5000, warmup: int = 200, workers: int = 1,
-                     client_processes: int = 1, client: str = "httpx") -> dict:
+                     client_processes: int = 1, client: str = "httpx", warm: bool = True,
+                     start_timeout: float | None = None) -> dict:
     """GET /days/{date}/flightpath.geojson under load (the first stored day unless
     ``date``): the summary, as :func:`bench_plan`'s."""
     import httpx
 
     check_load(clients=clients, requests=requests, workers=workers,
                client_processes=client_processes)
-    with Server(db=db, workers=workers) as srv:
+    with Server(db=db, workers=workers, warm=warm, start_timeout=start_timeout) as srv:
         days = httpx.get(srv.url + "/days", timeout=30).json()
         if date is None:
             flown = [d["date"] for d in days if d["moves"]]

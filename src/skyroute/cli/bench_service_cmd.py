@@ -13,7 +13,7 @@ from rich.table import Table
 
 from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.tables import plain_console, print_table, wide_console
-from skyroute.errors import SEED_MAX, OptionError, check_choice
+from skyroute.errors import SEED_MAX, OptionError, SkyrouteError, check_choice, real
 from skyroute.files import check_writable, write_atomic
 
 LOADS = ("plan", "flightpath")
@@ -42,6 +42,13 @@ def bench_service(
                                                   "first stored day with moves).")] = None,
     seed: Annotated[int, typer.Option(
         min=0, max=SEED_MAX, help="Seed of the drawn scenario lines.")] = 0,
+    warm: Annotated[bool, typer.Option(
+        "--warm/--no-warm", help="The server warms each of its processes before it serves "
+        "('serve --warm'): about a second from numba's cache, a minute or more with the "
+        "cache empty.")] = True,
+    start_timeout: Annotated[float | None, typer.Option(
+        help="Seconds to wait for the server to answer /health (default 120, and 60 more "
+             "for each server process past the first).")] = None,
     json_out: Annotated[Path | None, typer.Option("--json", help="Write the rows here.")] =
         None,
 ) -> None:
@@ -64,6 +71,8 @@ def bench_service(
         raise OptionError("--load flightpath needs --db URL (a store with a flown day)")
     check_load(clients=clients, requests=requests, workers=workers,
                client_processes=client_processes, flags=True)
+    if start_timeout is not None:
+        real("start_timeout", start_timeout, low=0.0, strict=True)
     if "plan" in loads:
         check_plan_load(map_name, algorithm)
     if json_out:  # a bad path fails now, not after the runs
@@ -73,14 +82,22 @@ def bench_service(
     for x in loads:
         err.print(f"{x}: {requests:,} requests, {clients} {client} clients in {client_processes} "
                   f"process(es), {workers} server process(es) ...")
-        if x == "plan":
-            rows.append(bench_plan(map_name=map_name, clients=clients, requests=requests,
-                                   workers=workers, seed=seed, algorithm=algorithm,
-                                   client_processes=client_processes, client=client))
-        else:
-            rows.append(bench_flightpath(db=db, date=date, clients=clients,
-                                         requests=requests, workers=workers,
-                                         client_processes=client_processes, client=client))
+        server = {"warm": warm, "start_timeout": start_timeout}
+        try:
+            if x == "plan":
+                rows.append(bench_plan(map_name=map_name, clients=clients,
+                                       requests=requests, workers=workers, seed=seed,
+                                       algorithm=algorithm, client=client,
+                                       client_processes=client_processes, **server))
+            else:
+                rows.append(bench_flightpath(db=db, date=date, clients=clients,
+                                             requests=requests, workers=workers,
+                                             client_processes=client_processes,
+                                             client=client, **server))
+        except SkyrouteError as exc:
+            if exc.param != "start_timeout":
+                raise
+            raise SkyrouteError(_start_advice(str(exc), warm)) from None
     t = Table(title=f"service under load on 127.0.0.1 ({os.cpu_count()} cores, "
                     f"{platform.python_implementation()} {platform.python_version()})")
     for col in ("load", "req/s", "errors", "server p50 ms", "server p99 ms",
@@ -111,9 +128,19 @@ def bench_service(
                           "db": _shown_url(db), "date": date,
                           "seed": seed, "requests": requests, "clients": clients,
                           "workers": workers, "client_processes": client_processes,
-                          "client": client},
+                          "client": client, "warm": warm},
              "machine": machine(("fastapi", "uvicorn", "httpx", "sqlalchemy")), "rows": rows},
             indent=1))
+
+
+def _start_advice(message: str, warm: bool) -> str:
+    """The server's timeout in the flags' words: ``--start-timeout 240 s``, and what to
+    do (a longer ``--start-timeout``, or ``--no-warm``)."""
+    message = message.replace("start_timeout=", "--start-timeout ")
+    lead, _, _ = message.rpartition("; wait longer")
+    return lead + "; give a longer --start-timeout" + (
+        ", or --no-warm (each server process then loads the kernels on its first "
+        "requests)" if warm else "")
 
 
 def _shown_url(url: str | None) -> str | None:

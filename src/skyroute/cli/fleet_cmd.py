@@ -19,7 +19,7 @@ from skyroute.cli.executor_args import (
 )
 from skyroute.cli.parse import parse_items
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
-from skyroute.errors import SEED_MAX, OptionError, check_choice, real
+from skyroute.errors import SEED_MAX, OptionError, SkyrouteError, check_choice, real
 from skyroute.fleet.limits import MAX_DRONES, MAX_RATE, MAX_SEEDS, check_run, check_sweep
 from skyroute.fleet.scenario import PRESETS, Scenario, generate, load_scenario, preset, to_yaml
 
@@ -303,7 +303,7 @@ def sweep_command(
     """Run every scheduler x airspace x rate on every seed (the same package streams for
     each setting); one table of means with 95% confidence intervals."""
     from skyroute.fleet.simulate import check_levels
-    from skyroute.jobs.fleet import sweep
+    from skyroute.jobs.fleet import RunsLostError, sweep
 
     scheds = _choices(scheduler, "--scheduler", SCHEDULERS)
     spaces = _choices(airspace, "--airspace", AIRSPACES)
@@ -323,23 +323,42 @@ def sweep_command(
         check_run(drones=s.drones, hours=hours, rate_given=r is not None, rate_name="rates",
                   rate_per_hour=s.packages.rate_per_hour if r is None else r)
     err = plain_console(stderr=True)
+    lost: list[dict] = []  # runs whose worker died each time: said after the rows
     with progress_bar(err) as progress:
         task = progress.add_task("runs", total=runs)
         with open_from_flags(executor, dask, jobs, runs) as ex, \
                 executor_warnings(progress.console):  # e.g. a worker process died
-            rows = sweep(s, schedulers=scheds, airspaces=spaces, rates=rate_list,
-                         seeds=seed_list, hours=hours, executor=ex,
-                         on_result=lambda _i, _rep: progress.advance(task))
+            try:
+                rows = sweep(s, schedulers=scheds, airspaces=spaces, rates=rate_list,
+                             seeds=seed_list, hours=hours, executor=ex,
+                             on_result=lambda _i, _rep: progress.advance(task))
+            except RunsLostError as exc:
+                rows, lost = exc.rows, exc.lost
     if as_json:
         clean = [{k: None if isinstance(v, float) and math.isnan(v) else v
                   for k, v in r.items()} for r in rows]
-        typer.echo(json.dumps({"scenario": s.name, "hours": hours, "seeds": seed_list,
-                               "rows": clean}, allow_nan=False))
-    else:
+        doc = {"scenario": s.name, "hours": hours, "seeds": seed_list, "rows": clean}
+        typer.echo(json.dumps({**doc, "lost": lost} if lost else doc, allow_nan=False))
+    elif rows:
         print_table(wide_console(), _sweep_table(s, hours, seed_list, rows),
                     optional=_SWEEP_OPTIONAL)
+    if lost:
+        _say_lost(lost, runs)
     if any(r["conflicts"] or r["lost"] for r in rows):
         raise typer.Exit(1)
+
+
+def _say_lost(lost: list[dict], runs: int) -> None:
+    """The runs lost (their worker process died each time they were tried), after the
+    rows of the others: one line each on stderr, then how many, and exit 2 (as
+    ``deliver`` says its lost days)."""
+    for x in lost:
+        typer.echo(f"skyroute: error: {x['error']}", err=True)
+    n, rest = len(lost), runs - len(lost)
+    raise SkyrouteError(f"all {runs:,} runs were lost; there are no rows" if not rest else
+                        f"{n:,} of the {runs:,} runs {'was' if n == 1 else 'were'} lost; "
+                        f"the rows are over the other {rest:,} (a row's runs count "
+                        "them)")
 
 
 # Units under the names, so a header is no wider than its numbers; the last ones give way
@@ -352,7 +371,10 @@ _SWEEP_OPTIONAL = ("max wait\ns", "capacity\n/h", "loiters")
 def _sweep_table(s: Scenario, hours: float, seeds: list[int], rows: list[dict]) -> Table:
     t = Table(title=f"fleet sweep {s.name}: {s.drones} drones, {len(s.airports)} airports, "
                     f"{hours:g} h x {len(seeds)} seeds (mean ±95% CI)")
-    for col in _SWEEP_COLUMNS:
+    # a row over fewer runs than seeds (runs lost: their worker died) says so
+    short = any(r["runs"] < len(seeds) for r in rows)
+    columns = (*_SWEEP_COLUMNS[:2], "runs", *_SWEEP_COLUMNS[2:]) if short else _SWEEP_COLUMNS
+    for col in columns:
         # a cell wraps before its "±" on a narrow terminal (print_table keeps words whole)
         t.add_column(col, justify="left" if col in ("scheduler", "airspace") else "right")
 
@@ -364,7 +386,8 @@ def _sweep_table(s: Scenario, hours: float, seeds: list[int], rows: list[dict]) 
         return text if ci is None or math.isnan(ci) else f"{text} ±{ci * scale:{spec}}"
 
     for r in rows:
-        t.add_row(r["scheduler"], r["airspace"], _fmt(r["rate_per_hour"], ",.0f"),
+        runs = (f"{r['runs']:,}",) if short else ()
+        t.add_row(r["scheduler"], r["airspace"], *runs, _fmt(r["rate_per_hour"], ",.0f"),
                   pm(r, "delivered_per_hour", ",.1f"), pm(r, "served_share", ".1f", 100.0),
                   pm(r, "p95_delivery_s", ",.0f"), pm(r, "max_wait_s", ",.0f"),
                   pm(r, "loiters", ",.0f"), pm(r, "capacity_bound_per_hour", ",.1f"),

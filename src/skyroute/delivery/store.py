@@ -398,9 +398,6 @@ class DayKeptError(SkyrouteError):
                          "(nothing was written for the day)", param="replace")
         self.date, self.delivered, self.why = date, delivered, why
 
-    def __reduce__(self):  # raised in worker processes: rebuilt whole in the caller
-        return type(self), (self.date, self.delivered, self.why)
-
 
 def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[dict],
               moves: Iterable[dict], *, keep: str | None = None) -> None:

@@ -183,9 +183,14 @@ class LocalExecutor(_Executor):
                             raise
                         continue
                     pool_of[future] = self._pool
+                    # its processes as they are now: a broken pool's own table may have
+                    # lost the one that died by the time _how_ended reads it
+                    procs_of.setdefault(self._pool, {}).update(
+                        getattr(self._pool, "_processes", None) or {})
                     return future
 
         pool_of: dict = {}  # future -> its pool
+        procs_of: dict = {}  # pool -> {pid: process} of every worker it has had
         broke: list = []  # the pools that broke under our tasks
 
         def broken(i: int, future) -> None:
@@ -200,7 +205,8 @@ class LocalExecutor(_Executor):
             if not suspects:
                 return out
             log.warning("a worker process died (%s); the %d task(s) its pool held run "
-                        "again, one at a time, each alone", _how_ended(broke[0]),
+                        "again, one at a time, each alone",
+                        _how_ended(procs=list(procs_of.get(broke[0], {}).values())),
                         len(suspects))
             return self._again_alone(fn, items, sorted(suspects), out, on_result)
         except (CancelledError, RuntimeError):  # cancelled or refused by close

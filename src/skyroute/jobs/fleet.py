@@ -98,14 +98,18 @@ def sweep_specs(scenario: Scenario, *, schedulers, airspaces, rates, seeds,
     return configs, specs
 
 
-def sweep_rows(configs: list[tuple], n_seeds: int, reports: list[dict]) -> list[dict]:
+def sweep_rows(configs: list[tuple], n_seeds: int, reports: list[dict | None]) -> list[dict]:
     """One row per setting: runs, total conflicts and lost packages, and the mean and
-    ``_ci95`` half-width of each of :data:`SWEEP_METRICS` (NaN where undefined)."""
+    ``_ci95`` half-width of each of :data:`SWEEP_METRICS` (NaN where undefined). A
+    report None (a run lost: its worker died) is left out, so ``runs`` counts those
+    that finished; a setting none of whose runs finished has no row."""
     rows = []
     for k, (sc, sp, _) in enumerate(configs):
-        reps = reports[k * n_seeds:(k + 1) * n_seeds]
+        reps = [x for x in reports[k * n_seeds:(k + 1) * n_seeds] if x is not None]
+        if not reps:
+            continue
         row = {"scheduler": sc, "airspace": sp,
-               "rate_per_hour": reps[0]["settings"]["rate_per_hour"], "runs": n_seeds,
+               "rate_per_hour": reps[0]["settings"]["rate_per_hour"], "runs": len(reps),
                "conflicts": sum(x["conflicts"] for x in reps),
                "lost": sum(x["lost"] for x in reps)}
         for m in SWEEP_METRICS:
@@ -114,11 +118,46 @@ def sweep_rows(configs: list[tuple], n_seeds: int, reports: list[dict]) -> list[
     return rows
 
 
+class RunsLostError(SkyrouteError):
+    """Runs of a sweep whose worker process died under them every time they were tried
+    (:class:`~skyroute.jobs.executor.TasksLostError`); every other run finished.
+    ``rows``: :func:`sweep_rows` over the runs that finished (``runs`` counts them; a
+    setting without any has no row); ``lost``: one dict per lost run, in sweep order,
+    with its ``scheduler``, ``airspace``, ``rate_per_hour`` (as in the rows), ``seed``
+    and ``error`` (one line naming the run, :func:`lost_line`); ``runs``: how
+    many runs the sweep had. The message is one line: how many were lost, and the first."""
+
+    def __init__(self, rows: list[dict], lost: list[dict], runs: int) -> None:
+        self.rows, self.lost, self.runs = rows, lost, runs
+        n = len(lost)
+        super().__init__(f"{n:,} of the {runs:,} runs {'was' if n == 1 else 'were'} lost "
+                         f"and left out of the rows: {lost[0]['error']}"
+                         + (f"; and {n - 1:,} more" if n > 1 else ""))
+
+    def job_result(self) -> dict:
+        """What a failed sweep job keeps as its result: the rows that finished and the
+        lost runs."""
+        return {"rows": self.rows, "lost": self.lost}
+
+
+def lost_line(spec: RunSpec, why: str) -> str:
+    """A lost run named by its setting and seed: ``scheduler seed, airspace shared, rate
+    60/h, seed 3: its worker process died (...)`` (the rate only when the sweep gives
+    rates)."""
+    rate = "" if spec.rate_per_hour is None else f", rate {spec.rate_per_hour:g}/h"
+    return (f"scheduler {spec.scheduler}, airspace {spec.airspace}{rate}, "
+            f"seed {spec.seed}: {why}")
+
+
 def sweep(scenario: Scenario, *, schedulers=SCHEDULERS, airspaces=MODES,
           rates=(None,), seeds=range(10), hours: float, executor,
           on_result: Callable[[int, dict], None] | None = None) -> list[dict]:
     """Every scheduler x airspace x rate on every seed, one task per run on ``executor``
-    (``rates`` None: the scenario's); the rows of :func:`sweep_rows`."""
+    (``rates`` None: the scenario's); the rows of :func:`sweep_rows`.
+
+    A run whose worker died every time it was tried does not end the sweep: the others
+    run, then :class:`RunsLostError` is raised with the rows of those that finished
+    and the lost runs."""
     if scenario.packages.csv is not None:
         raise OptionError("a sweep runs Poisson streams; this scenario names a package CSV",
                           param="scenario")
@@ -129,21 +168,15 @@ def sweep(scenario: Scenario, *, schedulers=SCHEDULERS, airspaces=MODES,
                                  rates=rates, seeds=seeds, hours=hours)
     try:
         reports = executor.map(simulate_report, specs, on_result=on_result)
-    except TasksLostError as exc:  # named by the executor's task numbers ("task 5")
-        raise SkyrouteError(_lost_runs(exc, specs)) from None
+    except TasksLostError as exc:
+        lost = [{"scheduler": specs[i].scheduler, "airspace": specs[i].airspace,
+                 "rate_per_hour": (scenario.packages.rate_per_hour
+                                   if specs[i].rate_per_hour is None
+                                   else specs[i].rate_per_hour), "seed": specs[i].seed,
+                 "error": lost_line(specs[i], why)} for i, why in exc.lost.items()]
+        raise RunsLostError(sweep_rows(configs, len(seeds), exc.results), lost,
+                            len(specs)) from None
     return sweep_rows(configs, len(seeds), reports)
-
-
-def _lost_runs(exc: TasksLostError, specs: list[RunSpec]) -> str:
-    """The runs whose worker died every time they were tried, the first named by its
-    settings: "1 of the 12 runs was lost: scheduler optimal, airspace layers, seed 3:
-    its worker process died (...), also when run again alone"."""
-    n, total = len(exc.lost), len(specs)
-    i, why = next(iter(exc.lost.items()))
-    s = specs[i]
-    rate = "" if s.rate_per_hour is None else f", rate {s.rate_per_hour:g}/h"
-    return (f"{n:,} of the {total:,} runs {'was' if n == 1 else 'were'} lost: scheduler "
-            f"{s.scheduler}, airspace {s.airspace}{rate}, seed {s.seed}: {why}")
 
 
 @dataclass(frozen=True)
@@ -309,7 +342,9 @@ def fleet_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
 def sweep_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
               progress: Callable[[float], None]) -> dict:
     """A sweep (see :func:`check_sweep_params`), one task per run; ``{"rows": [...]}``
-    as :func:`sweep` gives them (NaN stored as null). Nothing per run is stored."""
+    as :func:`sweep` gives them (NaN stored as null). Nothing per run is stored. Runs
+    lost (:class:`RunsLostError`) fail the job once the others have run, keeping
+    ``{"rows", "lost"}`` as its result."""
     p = check_sweep_params(params)
     rates = p["rates"] or [None]
     total = len(p["schedulers"]) * len(p["airspaces"]) * len(rates) * len(p["seeds"])
@@ -320,7 +355,11 @@ def sweep_job(engine: sa.Engine, job_id: str, params: dict, *, executor,
         done += 1
         progress(done / total)
 
-    rows = sweep(_resolve(p), schedulers=p["schedulers"], airspaces=p["airspaces"],
-                 rates=rates, seeds=p["seeds"], hours=p["hours"], executor=executor,
-                 on_result=on_result)
+    try:
+        rows = sweep(_resolve(p), schedulers=p["schedulers"], airspaces=p["airspaces"],
+                     rates=rates, seeds=p["seeds"], hours=p["hours"], executor=executor,
+                     on_result=on_result)
+    except RunsLostError:  # every run has ended, finished or lost: the job fails with
+        progress(1.0)  # the rows that finished (RunsLostError.job_result)
+        raise
     return {"rows": rows}

@@ -18,7 +18,10 @@ Kinds (:data:`KINDS`) and their parameters:
   "report"}``; the run's files are in ``fleet_runs`` (:func:`skyroute.jobs.store.get_fleet_run`).
 - ``sweep``: ``preset`` or ``scenario``, ``schedulers``, ``airspaces``, ``rates``,
   ``seeds``, ``hours`` (:func:`skyroute.jobs.fleet.check_sweep_params`). Result:
-  ``{"rows": [...]}``.
+  ``{"rows": [...]}``. A sweep some of whose runs were lost (their worker process died
+  each time they were tried) ends ``failed`` naming them, with the result
+  ``{"rows": [...], "lost": [...]}``: the rows over the runs that finished and one entry
+  per lost run (:class:`~skyroute.jobs.fleet.RunsLostError`).
 
 Jobs run in two lanes per process, each a background thread running its jobs one at a
 time in the order submitted: deliveries in one, fleet runs and sweeps in the other
@@ -369,7 +372,9 @@ def _run(engine, job_id: str, kind: str, params: dict, executor) -> None:
             log.info("job %s (%s) failed: %s", job_id, kind, error_line(exc))
         else:
             log.error("job %s (%s) failed", job_id, kind, exc_info=True)
-        if not store.fail_job(engine, job_id, error_line(exc)):
+        kept = getattr(exc, "job_result", None)  # what it finished (a sweep's rows)
+        if not store.fail_job(engine, job_id, error_line(exc),
+                              result=kept() if callable(kept) else None):
             _ended(engine, job_id, "its error is discarded")
         return
     if not store.finish_job(engine, job_id, result):

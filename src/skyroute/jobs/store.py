@@ -186,12 +186,15 @@ def finish_job(engine: sa.Engine, job_id: str, result: dict | None) -> bool:
                  error=None)
 
 
-def fail_job(engine: sa.Engine, job_id: str, error: str) -> bool:
+def fail_job(engine: sa.Engine, job_id: str, error: str, *,
+             result: dict | None = None) -> bool:
     """Mark the job ``failed`` with ``error`` (made one line; no traceback belongs here)
     and delete its fleet runs; False (and nothing written) when it is no longer queued
-    or running."""
+    or running. ``result``: what the job did finish, kept as its JSON result (a sweep's
+    rows when some runs were lost)."""
     line = " ".join(str(error).split()) or "failed"
-    return _move(engine, job_id, state="failed", error=line)
+    extra = {} if result is None else {"result": json_safe(result)}
+    return _move(engine, job_id, state="failed", error=line, **extra)
 
 
 def _move(engine: sa.Engine, job_id: str, **values) -> bool:
