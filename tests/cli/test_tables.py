@@ -44,7 +44,7 @@ def sweep_rows() -> list[dict]:
     for sched, space, delivered, ci in (("seed", "layers", 35.185, 3.187),
                                         ("optimal", "shared", 45.9, 10.43)):
         row = {"scheduler": sched, "airspace": space, "rate_per_hour": 60.0,
-               "conflicts": 0, "lost": 0}
+               "conflicts": 0, "lost": 0, "runs": 3}  # sweep rows count their runs
         for m, v, c in (("delivered_per_hour", delivered, ci), ("served_share", 0.594, 0.128),
                         ("p95_delivery_s", 1625.6, 249.0), ("max_wait_s", 1838.1, 1053.4),
                         ("loiters", 3.33, 5.74), ("capacity_bound_per_hour", 37.12, 1.64)):

@@ -322,6 +322,20 @@ def _result(future):
             raise
 
 
+def _exit_code(proc, wait: float = 2.0) -> int | None:
+    """``proc``'s exit code, waiting up to ``wait`` s for it. The pool's own thread may
+    be reaping the process at the same moment: our ``waitpid`` then finds no child and
+    ``exitcode`` stays None for an instant after the process has ended, until that
+    thread records the code (a dead worker read as "exit status unknown", or only its
+    SIGTERMed neighbours seen: "killed by SIGTERM")."""
+    deadline = time.monotonic() + wait
+    while True:
+        proc.join(timeout=0.05)
+        if proc.exitcode is not None or time.monotonic() > deadline:
+            return proc.exitcode
+        time.sleep(0.01)
+
+
 def _how_ended(pool: ProcessPoolExecutor | None = None, *, procs=None) -> str:
     """How a broken pool's worker died: "killed by SIGKILL", "exit code 3", or
     "exit status unknown". The pool ends its other workers with SIGTERM, so another
@@ -332,8 +346,7 @@ def _how_ended(pool: ProcessPoolExecutor | None = None, *, procs=None) -> str:
     codes = []
     for proc in procs:
         try:
-            proc.join(timeout=1.0)  # reaped by now, or within a moment
-            codes.append(proc.exitcode)
+            codes.append(_exit_code(proc))
         except (ValueError, AssertionError, OSError):  # a closed Process object
             continue
     known = [c for c in codes if c is not None]
