@@ -245,6 +245,23 @@ def get_job(job_id: Annotated[str, Path(max_length=100)],
     job = runner.get(res.engine(), job_id)
     if job is None:
         raise Problem(404, f"no job {job_id!r}", kind="unknown-job")
+    if job.get("kind") == "deliver" and job["state"] == "done":
+        _forget_days(res, job.get("result") or {})
     return {"id": job_id, "kind": job.get("kind"), "state": job["state"],
             "progress": float(job.get("progress") or 0.0), "result": job.get("result"),
             "error": job.get("error")}
+
+
+def _forget_days(res, result: dict) -> None:
+    """Drop this process's copies of the flight files of the days a finished deliver job
+    stored: a file is served from memory for ``fresh_seconds``, and the viewer, loading
+    a day the moment its job is seen done, was shown the flight the job had replaced."""
+    import datetime as dt
+
+    try:
+        first = dt.date.fromisoformat(result["from"])
+        last = dt.date.fromisoformat(result["to"])
+    except (KeyError, TypeError, ValueError):
+        return
+    for k in range((last - first).days + 1):
+        res.cache.pop(f"flightpath:{first + dt.timedelta(days=k)}", None)
