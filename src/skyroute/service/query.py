@@ -50,8 +50,9 @@ def one_value_each(request: Request) -> None:
     once (a dependency of the app: it runs before each route's own parameters are
     read)."""
     route = request.scope.get("route")
-    if route is None or not hasattr(route, "dependant"):
-        return
+    if not request.scope.get("query_string") or route is None or \
+            not hasattr(route, "dependant"):
+        return  # most requests (POST /plan, the viewer's files) have no query at all
     query = request.query_params
     for name in single_valued(route):
         values = query.getlist(name)
