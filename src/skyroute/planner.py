@@ -87,8 +87,10 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
         from skyroute.world.world import World
 
         if not isinstance(grid, World):
+            hint = ("; wrap an array of blocked cells as skyroute.Grid(array)"
+                    if hasattr(grid, "shape") or isinstance(grid, list | tuple) else "")
             raise OptionError(f"grid must be a skyroute Grid or World, got "
-                              f"{type(grid).__name__}")
+                              f"{type(grid).__name__}{hint}")
         extra = {k: v for k, v in (("connectivity", connectivity), ("heuristic", heuristic),
                                    ("prune", prune), ("resolution", resolution))
                  if v is not None}

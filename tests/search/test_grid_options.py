@@ -153,3 +153,11 @@ def test_world_options_on_a_grid_are_refused(option):
     with pytest.raises(skyroute.OptionError, match=f"{name}=") as err:
         skyroute.plan(skyroute.load_map("den312d"), (50, 76), (60, 13), **option)
     assert err.value.param == name
+
+
+@pytest.mark.parametrize("grid", [np.zeros((4, 5), bool), [[0, 1], [0, 0]]])
+def test_an_array_is_refused_with_how_to_wrap_it(grid):
+    # a researcher's first try, plan(array, ...), said only "got ndarray"
+    with pytest.raises(skyroute.OptionError, match=r"skyroute\.Grid\(array\)"):
+        skyroute.plan(grid, (0, 0), (1, 1))
+    assert skyroute.plan(skyroute.Grid(np.asarray(grid, bool)), (0, 0), (1, 1)).found
