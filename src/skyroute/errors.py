@@ -77,6 +77,14 @@ class OptionError(SkyrouteError, ValueError):
     """An unknown or out-of-range option; the message lists the valid ones."""
 
 
+def check_instance(name: str, value: object, cls: type, what: str) -> None:
+    """Raise :class:`OptionError` unless ``value`` is a ``cls`` (``what`` names it for the
+    message): a wrong object passed where a Grid or World belongs is named, not met later
+    as an AttributeError deep inside a planner."""
+    if not isinstance(value, cls):
+        raise OptionError(f"{name} must be {what}, got {type(value).__name__}", param=name)
+
+
 def check_choice(name: str, value: object, choices: tuple) -> None:
     """Raise :class:`OptionError` unless ``value`` is one of ``choices`` (an array, which
     compares element by element, never is)."""

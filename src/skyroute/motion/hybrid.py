@@ -66,7 +66,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skyroute.errors import OptionError, QueryError, budget, check_seed, flag, real, whole
+from skyroute.errors import (
+    OptionError,
+    QueryError,
+    budget,
+    check_instance,
+    check_seed,
+    flag,
+    real,
+    whole,
+)
 from skyroute.motion import hybrid_search
 from skyroute.motion.arc_kernels import chain_free, edge_index
 from skyroute.motion.corner_distance import corner_graph
@@ -221,6 +230,7 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     OptionError
         an out-of-range option.
     """
+    check_instance("world", world, World, "a skyroute World")
     r, H, step, limit = _options(radius, heading_bins, step, reverse, max_expansions, seed,
                                  smooth)
     if max_expansions is None:

@@ -28,7 +28,7 @@ import numpy as np
 import shapely
 
 from skyroute.caches import register
-from skyroute.errors import OptionError, check_choice, flag, real, whole
+from skyroute.errors import OptionError, check_choice, check_instance, flag, real, whole
 from skyroute.result import Status
 from skyroute.world.world import World
 
@@ -224,6 +224,7 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
     goal). Points come in and the run's path goes out in the world's frame; distances
     (``step``, ``sensor_range``) are plane units. A run that does not reach the goal
     says why in :attr:`FieldRun.why`."""
+    check_instance("world", world, World, "a skyroute World")
     check_choice("mode", mode, MODES)
     step, sensor_range, tolerance = (real(name, value, low=0.0, strict=True, need="> 0")
                                      for name, value in (("step", step),

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from skyroute.caches import register
-from skyroute.errors import OptionError, QueryError, real, renamed, whole
+from skyroute.errors import OptionError, QueryError, check_instance, real, renamed, whole
 from skyroute.motion import move_search
 from skyroute.motion.zone_kernels import zone_arrays
 from skyroute.result import FOUND, STATUS_OF_CODE, Status
@@ -106,6 +106,7 @@ class Flight:
 
 
 def _check_world(world: World) -> None:
+    check_instance("world", world, World, "a skyroute World")
     if world.frame != "degrees":
         raise OptionError("the step drone flies in the 'degrees' frame (lon/lat as a plane); "
                           "load the world with frame='degrees'")

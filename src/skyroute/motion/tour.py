@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from skyroute.errors import QueryError, check_seed, real, whole
+from skyroute.errors import QueryError, check_instance, check_seed, real, whole
 from skyroute.motion import hybrid
 from skyroute.motion.dubins_kernel import TURNS, shortest_length, words
 from skyroute.motion.pieces import chain, check_samples, sample
@@ -135,6 +135,7 @@ def tour(start_pose, targets, radius: float, *, world: World | None = None,
         raise QueryError("targets must hold at least one (x, y) point")
     s = start.copy()
     if world is not None:
+        check_instance("world", world, World, "a skyroute World (or None: no obstacles)")
         s[:2] = world.check_point(start[:2], "start_pose")
         s[2] = float(world.heading_to_plane(start[2]))
         plane = np.array([world.check_point(p, f"targets[{i}]") for i, p in enumerate(pts)])

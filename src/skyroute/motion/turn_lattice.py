@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from skyroute.errors import OptionError, budget, check_choice, real
+from skyroute.errors import OptionError, budget, check_choice, check_instance, real
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH, STATUS_OF_CODE, Status
 from skyroute.roadmap.raster import entry_cell, world_raster
 from skyroute.search import heap
@@ -146,6 +146,7 @@ def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
     ``speed`` in cells per second, ``turn_rate`` in radians per second; ``start_heading``
     (radians, from the x axis towards +y) snaps to the nearest lattice heading, or any.
     """
+    check_instance("grid", grid, Grid, "a skyroute Grid")
     check_choice("headings", headings, (8, 16))
     speed, turn_rate = _rates(speed, turn_rate)
     start_heading = None if start_heading is None else real("start_heading", start_heading)
@@ -190,6 +191,7 @@ def plan_turns_world(world: World, start, goal, *, resolution: float | None = No
     in plane units. The route runs between the centres of the free cells nearest
     ``start`` and ``goal`` (reachable from them in a straight line), not the exact
     points: a leg joining them would take a turn the lattice does not price."""
+    check_instance("world", world, World, "a skyroute World")
     speed, _ = _rates(speed, turn_rate)  # named as given, before it is rescaled
     s = world.check_point(start, "start")
     t = world.check_point(goal, "goal")
