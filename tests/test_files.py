@@ -7,6 +7,8 @@ import stat
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from skyroute.files import write_atomic
 
@@ -153,3 +155,80 @@ def test_a_signal_while_a_set_is_renamed_into_place_leaves_it_whole(tmp_path, mo
         signal.signal(signum, before)
     assert renamed == names
     assert {p.name: p.read_text() for p in tmp_path.iterdir()} == dict.fromkeys(names, "new")
+
+
+@pytest.mark.parametrize("fail_at", [1, 2])
+def test_a_rename_failing_part_way_leaves_every_file_as_it_was(tmp_path, monkeypatch,
+                                                                fail_at):
+    """The k-th rename at the end of a written_together block fails (a full disk, a file
+    system error): the files renamed before it were left new and the later ones old (or
+    missing), a day half written. Now every file is as before the block (an earlier
+    version back in place, a new file gone), no temporary or backup file is left, and the
+    error is one line naming the file that failed."""
+    import skyroute.files as files
+    from skyroute.errors import SkyrouteError
+
+    (tmp_path / "b.txt").write_text("old b")  # an earlier run's; a.txt and c.txt are new
+    (tmp_path / "c.txt").write_text("old c")
+    real, renames = os.replace, []
+
+    def replace(src, dst):
+        if str(src).endswith(".tmp"):  # a staged file renamed into place
+            renames.append(dst)
+            if len(renames) == fail_at + 1:
+                raise OSError(28, "No space left on device")
+        return real(src, dst)
+
+    monkeypatch.setattr(files.os, "replace", replace)
+    names = ["a.txt", "b.txt", "c.txt", "sub/d.txt"]
+    with pytest.raises(SkyrouteError) as err, files.written_together():
+        for name in names:
+            files.write_atomic(tmp_path / name, f"new {name}")
+    failed = names[fail_at]
+    assert str(err.value) == f"{tmp_path / failed}: cannot write: No space left on device"
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == \
+        ["b.txt", "c.txt"]
+    assert (tmp_path / "b.txt").read_text() == "old b"
+    assert (tmp_path / "c.txt").read_text() == "old c"
+
+
+@given(st.lists(st.booleans(), min_size=1, max_size=5), st.integers(0, 6))
+@settings(max_examples=40, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+def test_written_together_is_all_or_none_whichever_rename_fails(tmp_path_factory, existed,
+                                                                 fail_at):
+    """Any number of files, some with an earlier version, the rename numbered ``fail_at``
+    failing (past the last: none fails): afterwards the folder holds either every new
+    version or exactly what it held before, and nothing else."""
+    import skyroute.files as files
+    from skyroute.errors import SkyrouteError
+
+    here = tmp_path_factory.mktemp("together")
+    before = {}
+    for k, old in enumerate(existed):
+        if old:
+            (here / f"f{k}").write_text(f"old {k}")
+            before[f"f{k}"] = f"old {k}"
+    real, renames = os.replace, []
+
+    def replace(src, dst):
+        if str(src).endswith(".tmp"):
+            renames.append(dst)
+            if len(renames) == fail_at + 1:
+                raise OSError(5, "Input/output error")
+        return real(src, dst)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(files.os, "replace", replace)
+        try:
+            with files.written_together():
+                for k in range(len(existed)):
+                    files.write_atomic(here / f"f{k}", f"new {k}")
+        except SkyrouteError as exc:
+            assert fail_at < len(existed) and "\n" not in str(exc)
+            assert str(exc).startswith(f"{here / f'f{fail_at}'}: cannot write: ")
+            expected = before
+        else:
+            assert fail_at >= len(existed)
+            expected = {f"f{k}": f"new {k}" for k in range(len(existed))}
+    assert {p.name: p.read_text() for p in here.iterdir()} == expected

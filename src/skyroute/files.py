@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import secrets
+import shutil
 import signal
 import threading
 from collections.abc import Iterator
@@ -108,7 +109,12 @@ def written_together() -> Iterator[None]:
     files were written left some of them new and the others missing, or an earlier
     run's. Each is written to a temporary file beside its place as the block goes, and
     they are renamed into place one after another when it ends (a rename each,
-    microseconds). A block inside another joins it.
+    microseconds). A rename that fails there (a full disk, a file system error) puts
+    back the files renamed before it: each file's earlier version is kept as a hard link
+    beside it until every rename has succeeded, so a failure leaves every file as it was
+    (a new one gone), and the error names the file whose rename failed. A reader sees
+    each file whole, old or new; one that reads several in the instant of the renames
+    may see some new and the others old. A block inside another joins it.
     """
     if _TOGETHER.get() is not None:
         yield
@@ -122,21 +128,70 @@ def written_together() -> Iterator[None]:
         _discard(staged)
         raise
     _TOGETHER.reset(token)
+    _rename_all(staged)
+
+
+def _rename_all(staged: list[tuple[str, Path, list[Path]]]) -> None:
+    """Rename every staged file into place, or (an OSError, a Ctrl-C before the signals
+    are held) none: the files renamed before a failure are put back as they were."""
+    backups: dict[Path, str] = {}  # place -> its earlier version, a hard link beside it
     done = 0  # the files renamed into place
+    failed = None  # the file being backed up or renamed when it failed
     try:
         # one step: a signal in the renames (a rename each, a round trip each on NFS)
         # left the first files new and the others removed, a mix of two runs
         with _signals_held():
             for tmp, path, _ in staged:
+                failed = path
+                if tmp and os.path.lexists(path):
+                    backups[path] = _backup(path)
+            for tmp, path, _ in staged:
+                failed = path
                 if tmp:
                     os.replace(tmp, path)
                 done += 1
     except BaseException as exc:
-        _discard(staged[done:])
+        if done == len(staged):  # a signal held through the renames, taken after them
+            raise
+        _put_back(staged[:done], backups)
+        _discard(staged)
         if isinstance(exc, OSError):
-            raise SkyrouteError(f"{staged[done][1]}: cannot write: {exc.strerror or exc}"
-                                ) from None
+            raise SkyrouteError(f"{failed}: cannot write: {exc.strerror or exc}") from None
         raise
+    finally:
+        for backup in backups.values():  # (those put back are no longer listed)
+            with suppress(OSError):
+                os.unlink(backup)
+
+
+def _backup(path: Path) -> str:
+    """A hard link to ``path`` beside it (a copy where the file system has no hard
+    links): its version before a written_together block's renames; the link's name."""
+    backup = str(path.parent / f".{path.name}.{secrets.token_hex(8)}.bak")
+    try:
+        os.link(path, backup, follow_symlinks=False)
+    except OSError:
+        try:
+            shutil.copy2(path, backup, follow_symlinks=False)
+        except BaseException:
+            with suppress(OSError):
+                os.unlink(backup)
+            raise
+    return backup
+
+
+def _put_back(renamed: list[tuple[str, Path, list[Path]]], backups: dict[Path, str]) -> None:
+    """Undo the renames of ``renamed``: each earlier version back in place (its backup
+    taken off ``backups``), a file that was new removed. A backup that cannot be put
+    back is left beside its file (the earlier version is not lost)."""
+    for tmp, path, _ in renamed:
+        if not tmp:
+            continue
+        with suppress(OSError):
+            if path in backups:
+                os.replace(backups.pop(path), path)
+            else:
+                os.unlink(path)
 
 
 @contextmanager

@@ -135,3 +135,40 @@ def test_fleet_sweep_says_a_worker_died_and_names_the_lost_run(monkeypatch, caps
         f"died {died}, also when run again alone",
         "skyroute: error: 1 of the 2 runs was lost; the rows are over the other 1 (a "
         "row's runs count them)"], err
+
+
+def test_fleet_sweep_on_dask_with_a_dying_worker_keeps_the_other_rows(monkeypatch, capsys):
+    # on an in-process Dask cluster the worker running seed 1 kills itself (SIGKILL) each
+    # time: the rows over the runs that finished are printed, the lost run is one line
+    # naming it, exit 2, as on the local executor (tests/jobs/test_sweep_lost.py).
+    # allowed-failures 0: the first death loses the run; worker-saturation 1.0 and 5 runs
+    # (more than twice the worker threads, so Dask queues them): a worker holds only the
+    # run it flies, so its death takes no other run with it.
+    import dask
+    import distributed  # noqa: F401  (its defaults loaded, so the block only overrides)
+
+    from skyroute.jobs.executor import DaskExecutor
+    from tests.jobs.failing import FailingDaskWorkers
+
+    real = DaskExecutor.__init__
+
+    def started(self, **kw):
+        real(self, **kw)
+        self.client.register_plugin(FailingDaskWorkers({"seed 1": "die"}))
+
+    monkeypatch.setattr(DaskExecutor, "__init__", started)
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0,
+                          "distributed.scheduler.worker-saturation": 1.0}):
+        code, out, err = run(monkeypatch, capsys, "fleet", "sweep", "--preset", "seed-3x3",
+                             "--scheduler", "seed", "--airspace", "shared", "--seeds", "0-4",
+                             "--hours", "0.1", "--json", "--executor", "dask", "--jobs", "2")
+    assert code == 2 and "Traceback" not in err, err
+    doc = json.loads(out)
+    assert [(r["airspace"], r["runs"]) for r in doc["rows"]] == [("shared", 4)]
+    why = ("scheduler seed, airspace shared, seed 1: its Dask worker died running it "
+           "(KilledWorker; see the workers' logs)")
+    assert [(x["seed"], x["error"]) for x in doc["lost"]] == [(1, why)]
+    assert err.strip().splitlines()[-2:] == [
+        f"skyroute: error: {why}",
+        "skyroute: error: 1 of the 5 runs was lost; the rows are over the other 4 (a "
+        "row's runs count them)"], err

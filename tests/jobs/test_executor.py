@@ -334,3 +334,74 @@ def test_an_error_of_a_task_in_a_worker_is_raised_as_itself():
     assert str(info.value) == "1 of the 2 days failed and was not stored (the other 1 " \
         "is): 2024-01-01: the planner failed"
     assert info.value.days == 2 and info.value.failed[0].expected
+
+
+
+class _BreakingSubmits:
+    """``executor._new_pool`` whose pools refuse some submits, as a pool does when one of
+    its workers died since the map looked at it: marked broken, BrokenProcessPool (or,
+    in the instant between the pool's thread marking it broken and shut down, 'cannot
+    schedule new futures after shutdown'). ``broken``: {workers: submit numbers}, counted
+    from 1 over every pool of that many workers (the map's pools have 2, those it runs a
+    task again alone in 1)."""
+
+    def __init__(self, broken: dict[int, set[int]], error: str) -> None:
+        self.broken, self.error = broken, error
+        self.submits = dict.fromkeys(broken, 0)
+        self.real = executor_mod._new_pool
+
+    def __call__(self, workers: int):
+        from concurrent.futures.process import BrokenProcessPool
+
+        pool = self.real(workers)
+        real = pool.submit
+
+        def submit(fn, *args, **kwargs):
+            self.submits[workers] += 1
+            if self.submits[workers] in self.broken[workers]:
+                pool._broken = "A child process terminated abruptly"
+                raise (BrokenProcessPool(pool._broken) if self.error == "BrokenProcessPool"
+                       else RuntimeError("cannot schedule new futures after shutdown"))
+            return real(fn, *args, **kwargs)
+
+        pool.submit = submit
+        return pool
+
+
+@pytest.mark.parametrize("error", ["BrokenProcessPool", "RuntimeError"])
+@pytest.mark.parametrize("broken", [
+    {2: {1, 2}, 1: set()},  # task 0 refused by the map's pool and by a fresh one
+    {2: {1, 2}, 1: {1}},  # and the pool it runs again alone in died idle
+])
+def test_a_pool_that_breaks_twice_before_a_submit_runs_the_task_again_alone(
+        monkeypatch, caplog, error, broken):
+    """Two workers dying in quick succession: the pool breaks between the map's look and
+    its submit, and the fresh pool the map opens breaks too; or the one-process pool a
+    task of a broken pool runs again in dies idle before its submit. The map ended in a
+    BrokenProcessPool (or RuntimeError) traceback; now the task is run again alone, and
+    every result comes back."""
+    breaking = _BreakingSubmits(broken, error)
+    monkeypatch.setattr(executor_mod, "_new_pool", breaking)
+    seen = []
+    with open_executor("local", workers=2) as ex, caplog.at_level("WARNING"):
+        assert ex.map(abs, [-1, -2, -3], on_result=lambda i, r: seen.append(i)) == [1, 2, 3]
+        assert ex.map(abs, [-4, -5]) == [4, 5]  # still usable afterwards
+    assert sorted(seen) == [0, 1, 2]
+    assert breaking.submits[1] == 1 + len(broken[1])  # task 0 alone: once more per refusal
+    assert any("a worker process died" in r.getMessage() for r in caplog.records)
+
+
+def test_a_task_every_pool_refuses_is_lost_in_one_line(monkeypatch):
+    """Every pool refuses task 0 (the map's and a fresh one; the one it would run alone
+    in and a fresh one): it is reported lost in one line, the others' results kept; no
+    BrokenProcessPool traceback."""
+    from skyroute.jobs.executor import TasksLostError
+
+    monkeypatch.setattr(executor_mod, "_new_pool",
+                        _BreakingSubmits({2: {1, 2}, 1: {1, 2}}, "BrokenProcessPool"))
+    with open_executor("local", workers=2) as ex, pytest.raises(TasksLostError) as info:
+        ex.map(abs, [-1, -2, -3])
+    assert info.value.results == [None, 2, 3] and list(info.value.lost) == [0]
+    assert info.value.lost[0] == ("its worker process died (exit status unknown), also "
+                                  "when run again alone")
+    assert str(info.value).startswith("1 of the 3 tasks was lost: task 0: its worker ")

@@ -404,3 +404,72 @@ def test_an_escape_raster_too_large_is_refused_before_the_first_move():
     assert err.value.param == "step"
     run = run_field(_open_c(), (5.0, 30.0), (1200.0, 1200.0), max_moves=10, escape=False)
     assert run.moves == 10 and not run.reached
+
+
+# -- the escape's raster made anew where the robot has left it -----------------------------
+
+def _open_wall() -> World:
+    """A wall 20 m long, no boundary: the escape's raster covers the wall, the start,
+    the robot and the goal, 8 cells round them."""
+    return World(np.array([shapely.box(20, 10, 21, 30)], dtype=object), np.full(1, -np.inf),
+                 np.full(1, np.inf), (), None, "enu")
+
+
+def _count_rasters(monkeypatch) -> list:
+    """(robot position, grid) of each escape raster made (the escape's _navigation)."""
+    from skyroute.motion import potential
+
+    made, real = [], potential._navigation
+
+    def navigation(world, goal, resolution, points):
+        out = real(world, goal, resolution, points)
+        made.append((points[-1].copy(), out[0]))
+        return out
+
+    monkeypatch.setattr(potential, "_navigation", navigation)
+    return made
+
+
+def test_the_escape_raster_is_made_anew_when_the_robot_has_left_it(monkeypatch):
+    """Arc mode, starting on a heading along the wall with a wide turn (0.02 rad a move)
+    and a 3-move stall window (its slow turning start counts as a stall): the escape
+    takes over at once, its turn-limited arcs carry the robot past the raster's top
+    edge (the wall's end, 30 m, plus 8 cells), and the next escape move makes the
+    raster anew round it. That rebuild never ran in 600 random runs; the run reaches the
+    goal, and its arcs never cross the wall (shapely, not the world's own check)."""
+    from skyroute.motion.potential import _holds
+
+    made = _count_rasters(monkeypatch)
+    world = _open_wall()
+    run = run_field(world, (10.0, 20.0), (30.0, 20.0), mode="arc", heading=math.pi / 2,
+                    max_turn=0.02, window=3)
+    assert len(made) >= 2, made
+    assert _holds(made[0][1], made[0][0]) and not _holds(made[0][1], made[1][0])
+    assert made[1][0][1] > 30  # past the wall's end, where the first raster stops
+    assert _holds(made[1][1], made[1][0])
+    assert run.reached and run.why == "" and run.escaped > 0, run
+    flown = shapely.LineString(run.trace)
+    assert not flown.intersects(shapely.box(20, 10, 21, 30))
+    assert math.dist(run.path[-1], (30.0, 20.0)) < 0.5
+
+
+def test_a_robot_too_far_for_a_new_escape_raster_stops_saying_why(monkeypatch):
+    """The robot, turning 0.01 rad a move, flies so far from the wall and the goal that a
+    raster holding it would pass ESCAPE_MAX_CELLS (here 4,000 cells): the run raised an
+    OptionError after its moves ("use a larger step", though the step was checked before
+    the first move). It now ends stuck with its path, saying where the robot flew."""
+    from skyroute.motion import potential
+
+    monkeypatch.setattr(potential, "ESCAPE_MAX_CELLS", 4000)
+    made = _count_rasters(monkeypatch)
+    world = _open_wall()
+    run = run_field(world, (10.0, 20.0), (30.0, 20.0), mode="arc", heading=math.pi,
+                    max_turn=0.01, window=3)
+    assert run.status.value == "stuck" and run.moves > 1 and len(made) >= 2, run
+    end = run.path[-1]
+    assert run.why.startswith(f"the robot flew to ({end[0]:.2f}, {end[1]:.2f}), "
+                              f"{math.dist(end, (30.0, 20.0)):.6g} from the goal, outside "
+                              "the escape's raster, and one holding it (cells of step=0.5 "
+                              "over "), run.why
+    assert run.why.endswith("would have more than 4,000 cells; a larger step makes fewer")
+    assert not shapely.LineString(run.trace).intersects(shapely.box(20, 10, 21, 30))

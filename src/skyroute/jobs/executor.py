@@ -33,7 +33,9 @@ died every time it was tried (see each kind) is raised at the end as
   which one killed it): the map goes on in a fresh pool, and runs the tasks the broken
   pool held again once the others are done, one at a time in a process of their own,
   so a task that kills its worker again is the one named (with the exit signal or code)
-  and takes no other task with it. A task is tried at most twice.
+  and takes no other task with it. A task is tried at most twice. A pool that refuses a
+  task as broken (a worker died since the map looked) is replaced by a fresh one; a task
+  the fresh one refuses too is one of those run again alone.
 - ``dask``: a ``distributed.Client`` on an existing scheduler (``address`` such as
   ``tcp://10.0.0.5:8786``) or on an in-process ``LocalCluster`` of ``workers`` worker
   processes, one thread each. Dask re-runs the tasks of a worker that dies on another
@@ -54,7 +56,7 @@ import signal
 import threading
 import time
 from collections.abc import Callable, Iterable
-from concurrent.futures import FIRST_COMPLETED, CancelledError, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, CancelledError, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
@@ -176,17 +178,22 @@ class LocalExecutor(_Executor):
                         self._pool = None
                     if self._pool is None:
                         self._pool = _new_pool(self.workers)
+                    pool = self._pool
                     try:
-                        future = self._pool.submit(fn, item)
-                    except BrokenProcessPool:  # it broke since the look above
-                        if tries == 2:
+                        future = pool.submit(fn, item)
+                    except (BrokenProcessPool, RuntimeError) as exc:
+                        if not _broke(pool, exc):
                             raise
-                        continue
-                    pool_of[future] = self._pool
+                        if tries == 1:  # it broke since the look above: a fresh one
+                            continue
+                        # the fresh one broke too (two workers dying in quick
+                        # succession): the item runs again alone, as its pool's others
+                        future = _failed(exc)
+                    pool_of[future] = pool
                     # its processes as they are now: a broken pool's own table may have
                     # lost the one that died by the time _how_ended reads it
-                    procs_of.setdefault(self._pool, {}).update(
-                        getattr(self._pool, "_processes", None) or {})
+                    procs_of.setdefault(pool, {}).update(
+                        getattr(pool, "_processes", None) or {})
                     return future
 
         pool_of: dict = {}  # future -> its pool
@@ -229,7 +236,22 @@ class LocalExecutor(_Executor):
                     if pool is None:
                         pool = _new_pool(1)
                         self._alone.add(pool)
-                    future = pool.submit(fn, items[i])
+                    try:
+                        future = pool.submit(fn, items[i])
+                    except (BrokenProcessPool, RuntimeError) as exc:
+                        # its process died idle after the task before (killed from
+                        # outside, or by what that task left running): a fresh one
+                        if not _broke(pool, exc):
+                            raise
+                        self._alone.discard(pool)
+                        pool = _new_pool(1)
+                        self._alone.add(pool)
+                        try:
+                            future = pool.submit(fn, items[i])
+                        except (BrokenProcessPool, RuntimeError) as exc:
+                            if not _broke(pool, exc):
+                                raise
+                            future = _failed(exc)  # lost below, as a death under it
                     procs = list((getattr(pool, "_processes", None) or {}).values())
                 try:
                     out[i] = _result(future)
@@ -307,6 +329,21 @@ def _end(pool: ProcessPoolExecutor) -> None:
 def _new_pool(workers: int) -> ProcessPoolExecutor:
     return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
                                initializer=_leave_sigint)
+
+
+def _broke(pool: ProcessPoolExecutor, exc: BaseException) -> bool:
+    """Whether ``exc``, raised by ``pool.submit``, says the pool broke: BrokenProcessPool,
+    or the "cannot schedule new futures after shutdown" RuntimeError of a submit that
+    looked before the pool's thread marked it broken and after it marked it shut down."""
+    return isinstance(exc, BrokenProcessPool) or bool(getattr(pool, "_broken", False))
+
+
+def _failed(exc: BaseException) -> Future:
+    """A future failed with BrokenProcessPool, for a task its pool refused as broken."""
+    future: Future = Future()
+    future.set_exception(exc if isinstance(exc, BrokenProcessPool)
+                         else BrokenProcessPool(str(exc)))
+    return future
 
 
 def _result(future):

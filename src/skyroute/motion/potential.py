@@ -141,11 +141,8 @@ def _edges(world: World):
 def _escape_box(world: World, goal: np.ndarray, r: float, points: np.ndarray) -> tuple:
     """The escape raster's bounds (see :func:`_navigation`); an OptionError naming
     ``step`` when it would pass :data:`ESCAPE_MAX_CELLS` cells of side ``r``."""
-    box = world.extent_with(np.vstack([points, goal]), margin=4 * r)
-    if world.boundary is None:
-        box = (box[0] - 4 * r, box[1] - 4 * r, box[2] + 4 * r, box[3] + 4 * r)
-    cells = (box[2] - box[0]) / r * ((box[3] - box[1]) / r)
-    if not math.isfinite(cells) or cells > ESCAPE_MAX_CELLS:
+    box = _raster_box(world, goal, r, points)
+    if not _fits(box, r):
         over = ("the boundary" if world.boundary is not None else
                 "the obstacles, the start, the robot and the goal")
         # its cells are a step wide: the caller has no resolution to change
@@ -154,6 +151,21 @@ def _escape_box(world: World, goal: np.ndarray, r: float, points: np.ndarray) ->
                           f"more than {ESCAPE_MAX_CELLS:,} cells; use a larger step, or "
                           "turn the escape off", param="step")
     return box
+
+
+def _raster_box(world: World, goal: np.ndarray, r: float, points: np.ndarray) -> tuple:
+    """The escape raster's bounds, unchecked (:func:`_escape_box`)."""
+    box = world.extent_with(np.vstack([points, goal]), margin=4 * r)
+    if world.boundary is None:
+        box = (box[0] - 4 * r, box[1] - 4 * r, box[2] + 4 * r, box[3] + 4 * r)
+    return box
+
+
+def _fits(box: tuple, r: float) -> bool:
+    """Whether a raster over ``box`` with cells of side ``r`` has at most
+    :data:`ESCAPE_MAX_CELLS` cells."""
+    cells = (box[2] - box[0]) / r * ((box[3] - box[1]) / r)
+    return math.isfinite(cells) and cells <= ESCAPE_MAX_CELLS
 
 
 def _navigation(world: World, goal: np.ndarray, resolution: float, points: np.ndarray):
@@ -259,7 +271,11 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
         stalled = len(path) > window and math.dist(path[-1], path[-window]) < 2 * step
         if escape and (stalled or on_nav > 0 or blocked):
             if nav is None or not _holds(nav[0], p):  # made anew where the robot is
-                nav = _navigation(world, t, step, np.array([path[0], p]))
+                seen = np.array([path[0], p])
+                if not _fits(box := _raster_box(world, t, step, seen), step):
+                    why = _too_far(world, p, t, step, box)  # (a run's end, not misuse)
+                    break
+                nav = _navigation(world, t, step, seen)
             q, why = _descend(world, nav, p, t, step)
             if q is None:
                 break
@@ -320,6 +336,17 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
                     world.from_plane(trace) if mode == "arc" else None,
                     float(np.hypot(*np.diff(flown, axis=0).T).sum()), _smoothness(path),
                     why)
+
+
+def _too_far(world: World, p: np.ndarray, t: np.ndarray, step: float, box: tuple) -> str:
+    """Why the escape cannot take over where the robot is now: a raster holding the
+    robot, the start and the goal (``box``) would pass :data:`ESCAPE_MAX_CELLS` cells.
+    (The check before the first move sees the start only; an OptionError here lost the
+    run's moves and told to use a larger step.)"""
+    return (f"the robot flew to {world._fmt(p)}, {math.dist(p, t):.6g} from the goal, "
+            f"outside the escape's raster, and one holding it (cells of step={step:g} "
+            f"over {box[2] - box[0]:.6g} x {box[3] - box[1]:.6g}) would have more than "
+            f"{ESCAPE_MAX_CELLS:,} cells; a larger step makes fewer")
 
 
 def _out_of_moves(path, t, max_moves, escaped, tolerance, window, step) -> str:
