@@ -85,6 +85,12 @@ def check_instance(name: str, value: object, cls: type, what: str) -> None:
         raise OptionError(f"{name} must be {what}, got {type(value).__name__}", param=name)
 
 
+class StoreBusyError(SkyrouteError):
+    """The store is locked by another writer for longer than its busy timeout (SQLite's
+    "database is locked"): nothing was written, and the same write may succeed later.
+    Not the caller's input: the service answers it 503 with ``Retry-After``."""
+
+
 def check_choice(name: str, value: object, choices: tuple) -> None:
     """Raise :class:`OptionError` unless ``value`` is one of ``choices`` (an array, which
     compares element by element, never is)."""

@@ -30,7 +30,7 @@ from typing import NamedTuple
 import sqlalchemy as sa
 
 from skyroute.caches import register
-from skyroute.errors import SkyrouteError
+from skyroute.errors import SkyrouteError, StoreBusyError
 
 DEFAULT_DB = "sqlite:///skyroute.db"
 # How long a SQLite store waits for another process's write to finish before it is an
@@ -141,6 +141,13 @@ def safe_url(url: str) -> str:
 _safe = safe_url
 
 
+def is_busy(exc: BaseException) -> bool:
+    """Whether ``exc`` is SQLite's "database is locked" (or "... table is locked"):
+    another connection held a lock past the busy timeout, a read's too (a writer whose
+    transaction outgrew its page cache holds the lock that keeps readers out)."""
+    return isinstance(exc, sa.exc.OperationalError) and "locked" in str(exc.orig)
+
+
 @contextmanager
 def writing(engine: sa.Engine) -> Iterator[sa.Connection]:
     """``engine.begin()`` for a transaction that reads, then writes what it read was
@@ -148,19 +155,19 @@ def writing(engine: sa.Engine) -> Iterator[sa.Connection]:
     importing the same orders, or making the schema of a new store, at once both read
     "not there" and the second's insert was an IntegrityError traceback ("table orders
     already exists" for the schema); now the second waits and reads the first's rows. A
-    lock held by another process past the busy timeout is a SkyrouteError, not a
-    "database is locked" traceback."""
+    lock held by another process past the busy timeout is a :class:`StoreBusyError`, not
+    a "database is locked" traceback."""
     try:
         with engine.begin() as conn:
             if conn.dialect.name == "sqlite":
                 conn.exec_driver_sql("BEGIN IMMEDIATE")
             yield conn
     except sa.exc.OperationalError as exc:
-        if "locked" not in str(exc.orig):
+        if not is_busy(exc):
             raise
-        raise SkyrouteError(f"{_safe(str(engine.url))}: the store is busy: another process "
-                            "kept it locked for too long (its busy timeout); try again when "
-                            "it is done") from None
+        raise StoreBusyError(f"{_safe(str(engine.url))}: the store is busy: another process "
+                             "kept it locked for too long (its busy timeout); try again when "
+                             "it is done") from None
 
 
 def init(engine: sa.Engine) -> str:

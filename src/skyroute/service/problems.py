@@ -13,9 +13,11 @@ from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import HTMLResponse, JSONResponse, Response
 from pydantic import BaseModel, Field
+from sqlalchemy.exc import OperationalError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from skyroute.errors import InputFormatError, SkyrouteError
+from skyroute.delivery.store import is_busy
+from skyroute.errors import InputFormatError, SkyrouteError, StoreBusyError
 
 MEDIA_TYPE = "application/problem+json"
 TYPE_BASE = "urn:skyroute:problem:"
@@ -256,6 +258,29 @@ async def _library(request: Request, exc: SkyrouteError) -> JSONResponse:
     return await _problem(request, from_skyrouteerror(exc))
 
 
+BUSY_RETRY_SECONDS = 5  # a busy store's Retry-After: its writer has held it past the timeout
+
+
+async def _busy(request: Request, exc: StoreBusyError) -> JSONResponse:
+    """The store locked by another process past its busy timeout: the server's condition,
+    and a passing one, not a fault of the request (a write was answered 422, a read
+    500); the store's URL in the library's message stays in the log."""
+    log.warning("%s %s: %s", request.method, request.url.path,
+                str(exc).splitlines()[0])
+    return problem_response(503, "the store is busy: another process has kept it locked "
+                            "past the busy timeout; nothing was changed; try again later",
+                            kind="store-busy",
+                            headers={"Retry-After": str(BUSY_RETRY_SECONDS)})
+
+
+async def _database(request: Request, exc: Exception) -> JSONResponse:
+    """A database error the store let through: a read of a locked SQLite store is
+    :func:`_busy`'s 503, anything else the 500 of :func:`_internal`."""
+    if is_busy(exc):
+        return await _busy(request, exc)
+    return await _internal(request, exc)
+
+
 async def _internal(request: Request, exc: Exception) -> JSONResponse:
     log.exception("unhandled error on %s %s", request.method, request.url.path)
     return problem_response(500, "the server could not answer this request; the error "
@@ -268,6 +293,8 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(Problem, _problem)
     app.add_exception_handler(StarletteHTTPException, _http)
     app.add_exception_handler(SkyrouteError, _library)
+    app.add_exception_handler(StoreBusyError, _busy)  # (a child: its own handler wins)
+    app.add_exception_handler(OperationalError, _database)
     app.add_exception_handler(Exception, _internal)
 
 

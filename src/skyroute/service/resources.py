@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 from fastapi import Depends, Request
 
-from skyroute.errors import SkyrouteError
+from skyroute.errors import SkyrouteError, StoreBusyError
 from skyroute.service.problems import Problem
 from skyroute.service.settings import Settings
 
@@ -53,6 +53,8 @@ class Resources:
                 if self._engine is None:
                     try:
                         self._engine = make_engine(self.settings.db_url)
+                    except StoreBusyError:
+                        raise  # a passing 503 with Retry-After (problems._busy)
                     except SkyrouteError as exc:
                         raise Problem(503, f"the store cannot be opened: {exc}",
                                       kind="store-unavailable") from None

@@ -18,7 +18,7 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from skyroute.delivery.limits import MAX_DAYS
-from skyroute.errors import SEED_MAX, SkyrouteError
+from skyroute.errors import SEED_MAX, SkyrouteError, StoreBusyError
 from skyroute.fleet.limits import (
     MAX_AIRPORTS,
     MAX_PACKAGES,
@@ -149,6 +149,8 @@ def _submit(res: Resources, kind: str, params: dict, *, once: bool = False
                 job_id, new = runner.submit_once(eng, kind, params, executor=res.executor())
             else:
                 job_id, new = runner.submit(eng, kind, params, executor=res.executor()), True
+        except StoreBusyError:
+            raise  # the server's condition, not the request's: 503 (problems._busy)
         except SkyrouteError as exc:
             raise Problem(422, str(exc), field=exc.param if isinstance(exc.param, str)
                           else None) from None
