@@ -1,5 +1,8 @@
 """The write endpoints' bearer token: missing is 401 (with ``WWW-Authenticate``), wrong
-is 403; compared in constant time (:func:`secrets.compare_digest`)."""
+is 403; compared in constant time (:func:`secrets.compare_digest`). A check the whole
+app runs before the route's own dependencies (:mod:`skyroute.service.query`) calls
+:func:`authenticate` first on a route that needs the token, so a caller without it
+learns nothing of the route's parameters."""
 
 from __future__ import annotations
 
@@ -25,3 +28,21 @@ async def require_token(
     expected = request.app.state.settings.token.encode()
     if not secrets.compare_digest(cred.credentials.encode(), expected):
         raise Problem(403, "the bearer token is not this server's")
+
+
+def needs_token(route) -> bool:
+    """Whether ``route`` (a FastAPI route) depends on :func:`require_token`, directly or
+    through its dependencies."""
+    todo = [route.dependant]
+    while todo:
+        dependant = todo.pop()
+        if dependant.call is require_token:
+            return True
+        todo += dependant.dependencies
+    return False
+
+
+async def authenticate(request: Request) -> None:
+    """:func:`require_token` for ``request``, called outside FastAPI's dependencies: by
+    an app-wide check that would otherwise answer before the route's token is read."""
+    await require_token(request, await _bearer(request))

@@ -5,7 +5,10 @@ the last of its repeats and drops the others without a word: ``GET
 /orders?date=2024-01-03&date=2024-01-04`` answered the orders of the 4th as if the 3rd
 had not been asked for. :func:`one_value_each`, a dependency of the whole app, answers
 such a request 422 naming the parameter, before the route runs; a parameter declared as
-a list (``list[str]``) still takes every repeat.
+a list (``list[str]``) still takes every repeat. On a route that needs the token the
+caller is authenticated first (401 or 403): as a dependency of the app the check runs
+before the route's own, and it answered a caller without the token 422 naming the
+route's parameter.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import typing
 
 from fastapi import Request
 
+from skyroute.service.auth import authenticate, needs_token
 from skyroute.service.problems import Problem
 
 _MANY = (list, tuple, set, frozenset, collections.abc.Sequence, collections.abc.Set)
@@ -45,10 +49,11 @@ def single_valued(route) -> tuple[str, ...]:
     return tuple(dict.fromkeys(names))
 
 
-def one_value_each(request: Request) -> None:
+async def one_value_each(request: Request) -> None:
     """A 422 problem naming the first single-valued query parameter given more than
     once (a dependency of the app: it runs before each route's own parameters are
-    read)."""
+    read), after the token on a route that needs one. (async: a sync dependency would
+    cost a trip through the thread pool)"""
     route = request.scope.get("route")
     if not request.scope.get("query_string") or route is None or \
             not hasattr(route, "dependant"):
@@ -57,6 +62,8 @@ def one_value_each(request: Request) -> None:
     for name in single_valued(route):
         values = query.getlist(name)
         if len(values) > 1:
+            if needs_token(route):
+                await authenticate(request)  # 401 or 403 first: the route's own order
             shown = ", ".join(repr(v) for v in values[:5]) + (", ..." if len(values) > 5
                                                               else "")
             raise Problem(422, f"{name}: given {len(values)} times ({shown}); give it once",
