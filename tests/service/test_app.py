@@ -44,7 +44,7 @@ def test_health_docs_and_static_page(client):
     assert "swagger" in client.get("/docs").text.lower()
     page = client.get("/")
     assert page.status_code == 200 and page.headers["content-type"].startswith("text/html")
-    assert 'href="/docs"' in page.text and "POST /plan" in page.text
+    assert 'href="docs"' in page.text and "POST /plan" in page.text
 
 
 @pytest.mark.parametrize("page", ["/docs", "/redoc"])

@@ -40,6 +40,10 @@ def serve_command(
         help="The delivery site over HTTP (as 'deliver').")] = None,
     host: Annotated[str, typer.Option(help="Address to listen on.")] = "127.0.0.1",
     port: Annotated[int, typer.Option(help="Port to listen on.")] = 8000,
+    root_path: Annotated[str, typer.Option(
+        help="The path a reverse proxy serves the server under (/skyroute for "
+             "https://host/skyroute/...; the proxy strips it): the links the service "
+             "hands out start with it. Default: none.")] = "",
     dask: Annotated[str | None, typer.Option(
         help="Run jobs on this Dask scheduler (tcp://HOST:8786); default: local "
              "processes.")] = None,
@@ -86,6 +90,7 @@ def serve_command(
         raise OptionError(f"--port {port} must be 1..65535")
     if workers < 1:
         raise OptionError(f"--workers {workers} must be at least 1")
+    root_path = check_root_path(root_path)
     check_listen(host, port)
     engine = make_engine(db)  # the store opens and is migrated before anyone asks
     orphans = _fail_orphans(engine)
@@ -107,6 +112,9 @@ def serve_command(
         raise OptionError(f"{flag}: {err['msg']}") from None
     url = f"http://{host}:{port}/"
     typer.echo(f"skyroute service on {url} (API docs {url}docs)", err=True)
+    if root_path:
+        typer.echo(f"served by a proxy under {root_path}/: the links it hands out start "
+                   "with it", err=True)
     if where == "generated":
         typer.echo(f"write token (give it as 'Authorization: Bearer TOKEN'; set "
                    f"{TOKEN_ENV} or --token-file to choose one):\n    {settings.token}")
@@ -116,13 +124,30 @@ def serve_command(
     # and then re-raises it, which run_cli's handler would report as "terminated", 143
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     # skyroute's loggers print as uvicorn's, at --log-level (each worker applies it)
-    logs = {"log_level": log_level, "log_config": log_config(log_level)}
+    logs = {"log_level": log_level, "log_config": log_config(log_level),
+            "root_path": root_path}
     if workers == 1:
         uvicorn.run(create_app(settings), host=host, port=port, **logs)
     else:
         os.environ[SETTINGS_ENV] = settings.model_dump_json()
         uvicorn.run("skyroute.service.app:app_from_env", factory=True, workers=workers,
                     host=host, port=port, **logs)
+
+
+def check_root_path(value: str) -> str:
+    """``--root-path`` as uvicorn takes it: empty, or ``/`` and path segments, without a
+    trailing ``/`` (``/skyroute/`` is ``/skyroute``; ``/`` is none)."""
+    path = value.strip().rstrip("/")
+    if path and (not path.startswith("/") or any(c in path for c in "?#\\ ")
+                 or "//" in path):
+        raise OptionError(f"--root-path {value!r} must be a path such as /skyroute (a "
+                          "leading /, no query, no spaces)")
+    try:
+        path.encode("ascii")  # uvicorn puts it in front of the raw path, as ASCII
+    except UnicodeEncodeError:
+        raise OptionError(f"--root-path {value!r} must be ASCII (percent-encode other "
+                          "characters)") from None
+    return path
 
 
 def check_listen(host: str, port: int) -> None:

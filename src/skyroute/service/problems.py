@@ -18,6 +18,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from skyroute.delivery.store import is_busy
 from skyroute.errors import InputFormatError, SkyrouteError, StoreBusyError
+from skyroute.service.paths import root_path, route_path
 
 MEDIA_TYPE = "application/problem+json"
 TYPE_BASE = "urn:skyroute:problem:"
@@ -194,7 +195,7 @@ def allowed(request: Request) -> str | None:
     and HEAD; it said "GET, HEAD" also for ``/days/{date}``, which a DELETE serves."""
     found: set[str] = set()
     for pattern, methods in getattr(request.app.state, "api_methods", ()):
-        if pattern.match(request.url.path):
+        if pattern.match(route_path(request)):
             found |= methods
     if "GET" in found:
         found.add("HEAD")
@@ -207,7 +208,7 @@ def api_path(request: Request) -> bool:
     heads = getattr(request.app.state, "api_heads", None)
     if heads is None:
         heads = api_heads(request.app.routes)
-    return request.url.path.split("/")[1] in heads
+    return route_path(request).split("/")[1] in heads
 
 
 NOT_FOUND_PAGE = """<!doctype html>
@@ -216,14 +217,14 @@ NOT_FOUND_PAGE = """<!doctype html>
 <meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">
 <title>Page not found - skyroute</title>
-<link rel="icon" href="/favicon.svg" type="image/svg+xml">
-<link rel="stylesheet" href="/viewer.css">
+<link rel="icon" href="{root}/favicon.svg" type="image/svg+xml">
+<link rel="stylesheet" href="{root}/viewer.css">
 </head>
 <body>
 <main id="main">
 <h1>Page not found</h1>
 <p>The page <code>{path}</code> does not exist.</p>
-<p><a href="/">Go to the skyroute start page</a></p>
+<p><a href="{root}/">Go to the skyroute start page</a></p>
 </main>
 </body>
 </html>
@@ -237,8 +238,9 @@ async def _http(request: Request, exc: StarletteHTTPException) -> Response:
         # a page of the viewer that is not there: a browser gets a page, API clients
         # the problem document; either may be cached only by the Accept it was asked with
         if prefers_html(request):
-            return HTMLResponse(NOT_FOUND_PAGE.format(path=html.escape(request.url.path)),
-                                status_code=404, headers={"Vary": "Accept"})
+            page = NOT_FOUND_PAGE.format(path=html.escape(request.url.path),
+                                         root=html.escape(root_path(request)))
+            return HTMLResponse(page, status_code=404, headers={"Vary": "Accept"})
         return problem_response(404, f"no such resource: {request.url.path}",
                                 headers={"Vary": "Accept"})
     if exc.status_code == 404 and detail == "Not Found":

@@ -15,12 +15,13 @@ import json
 import logging
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Path, Query, Response
+from fastapi import APIRouter, Path, Query, Request, Response
 from fastapi.responses import StreamingResponse
 from pydantic import BaseModel, Field
 
 from skyroute.service import cut
 from skyroute.service.middleware import is_head
+from skyroute.service.paths import url_path
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import Resources, ResourcesDep
 
@@ -114,13 +115,14 @@ def _scenario(run: dict) -> dict:
 RUNS_PAGE = 100  # runs in a page of GET /fleet/runs unless limit says otherwise
 MAX_RUNS_PAGE = 1000
 NEXT = {"Link": {"description": 'The next page, when there is one: `</fleet/runs?offset='
-                 'N&limit=M>; rel="next"`.', "schema": {"type": "string"}}}
+                 'N&limit=M>; rel="next"` (the path behind the server\'s root path, when it '
+                 'has one: `</prefix/fleet/runs?...>`).', "schema": {"type": "string"}}}
 
 
 @router.get("/fleet/runs", response_model=list[RunSummary],
             responses={200: {"headers": NEXT}, **responses(422, 503)},
             summary="Stored fleet runs, newest first, a page at a time")
-def list_runs(res: ResourcesDep, response: Response,
+def list_runs(res: ResourcesDep, request: Request, response: Response,
               offset: Annotated[int, Query(ge=0, le=2**62, description="Runs to skip, "
                                            "newest first.")] = 0,
               limit: Annotated[int, Query(ge=1, le=MAX_RUNS_PAGE, description="Runs in "
@@ -129,8 +131,8 @@ def list_runs(res: ResourcesDep, response: Response,
     rows = _store().list_fleet_runs(res.engine(), offset=offset, limit=limit + 1)
     if len(rows) > limit:
         del rows[limit:]
-        response.headers["Link"] = (f'</fleet/runs?offset={offset + limit}&limit={limit}>; '
-                                    'rel="next"')
+        nxt = url_path(request, f"/fleet/runs?offset={offset + limit}&limit={limit}")
+        response.headers["Link"] = f'<{nxt}>; rel="next"'
     out = []
     for r in rows:
         sc = r.get("scenario")
@@ -144,7 +146,7 @@ def list_runs(res: ResourcesDep, response: Response,
 @router.get("/fleet/runs/{run_id}", response_model=Run,
             responses=responses(404, 409, 422, 503),
             summary="A fleet run: report, scenario, a page of events")
-def get_run(run_id: RunId, res: ResourcesDep,
+def get_run(run_id: RunId, res: ResourcesDep, request: Request,
             offset: Annotated[int, Query(ge=0)] = 0,
             limit: Annotated[int, Query(ge=1, le=10_000)] = 1000) -> dict:
     store = _store()
@@ -161,7 +163,7 @@ def get_run(run_id: RunId, res: ResourcesDep,
     else:
         raise Problem(409, f"fleet run {run_id!r} was replaced again and again while it "
                       "was read; ask again", kind="run-changed")
-    base = f"/fleet/runs/{run_id}"
+    base = url_path(request, f"/fleet/runs/{run_id}")
     names = ["events.jsonl", "tracks.csv", "fleet.geojson"]
     if packages.size:  # a run stored without it: a 404 there
         names.append("packages.csv")

@@ -13,7 +13,7 @@ from __future__ import annotations
 import threading
 from typing import Annotated, Any, Literal
 
-from fastapi import APIRouter, Depends, Path
+from fastapi import APIRouter, Depends, Path, Request
 from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -30,6 +30,7 @@ from skyroute.fleet.limits import (
 from skyroute.service.alternatives import exactly_one
 from skyroute.service.auth import require_token
 from skyroute.service.dates import IsoDate
+from skyroute.service.paths import url_path
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import Resources, ResourcesDep
 
@@ -122,8 +123,8 @@ def _jobs():
     return runner
 
 
-def _submit(res: Resources, kind: str, params: dict, *, once: bool = False
-            ) -> JSONResponse:
+def _submit(res: Resources, request: Request, kind: str, params: dict, *,
+            once: bool = False) -> JSONResponse:
     """Queue the job: 202 ``{"id"}``. With ``once``, a job of ``kind`` with the same
     parameters already queued or running (this server's or another's on the store) is
     answered instead: 200 with its id, nothing queued, even when the queue is full."""
@@ -157,7 +158,7 @@ def _submit(res: Resources, kind: str, params: dict, *, once: bool = False
         if new:
             res.job_ids.append(job_id)
     return JSONResponse({"id": job_id}, status_code=202 if new else 200,
-                        headers={"Location": f"/jobs/{job_id}"})
+                        headers={"Location": url_path(request, f"/jobs/{job_id}")})
 
 
 @router.post("/jobs/deliver", status_code=202, response_model=JobId,
@@ -167,7 +168,7 @@ def _submit(res: Resources, kind: str, params: dict, *, once: bool = False
                               "its id; nothing new is queued"},
                         **responses(401, 403, 404, 413, 422, 429, 503)},
              summary="Fly a day or a range of days as a job")
-def post_deliver(body: DeliverJob, res: ResourcesDep):
+def post_deliver(body: DeliverJob, res: ResourcesDep, request: Request):
     """202 and the new job's id; 200 and the id of the job already doing it when the
     same days are queued or running with the same method and replace (a retried or
     double-clicked submission flies them once: follow that job)."""
@@ -178,14 +179,14 @@ def post_deliver(body: DeliverJob, res: ResourcesDep):
               "replace": body.replace,
               **({"data": str(s.data_dir)} if s.data_dir is not None else
                  {"source": s.source_url})}
-    return _submit(res, "deliver", params, once=True)
+    return _submit(res, request, "deliver", params, once=True)
 
 
 @router.post("/jobs/fleet", status_code=202, response_model=JobId,
              dependencies=[Depends(require_token)],
              responses=responses(401, 403, 413, 422, 429, 503),
              summary="Run a fleet simulation as a job")
-def post_fleet(body: FleetJob, res: ResourcesDep):
+def post_fleet(body: FleetJob, res: ResourcesDep, request: Request):
     from skyroute.fleet.airborne import check_flights
     from skyroute.fleet.scenario import Scenario, parse_scenario, preset
 
@@ -217,7 +218,7 @@ def post_fleet(body: FleetJob, res: ResourcesDep):
               "hours": body.hours, "seed": body.seed, "scheduler": body.scheduler,
               **({"airspace": body.airspace} if body.airspace else {}),
               **({"rate_per_hour": body.rate} if body.rate is not None else {})}
-    return _submit(res, "fleet", params)
+    return _submit(res, request, "fleet", params)
 
 
 def _check_work(scenario, body: FleetJob) -> None:

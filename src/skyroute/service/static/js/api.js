@@ -28,10 +28,17 @@ async function failure(response) {
   return new ApiError(response.status, detail, field);
 }
 
+/** The URL of the API's ``path`` (``/days``): under the folder of the page, the
+ * server's root, so the viewer works behind a proxy that serves it under a path
+ * (``skyroute serve --root-path``). A full URL (a ``Link`` the server gave) is kept. */
+export function apiURL(path) {
+  return path.startsWith("/") ? new URL(`.${path}`, document.baseURI).href : path;
+}
+
 async function send(path, init) {
   let response;
   try {
-    response = await fetch(path, init);
+    response = await fetch(apiURL(path), init);
   } catch {
     throw new ApiError(0, "the server did not answer (is skyroute serve still running?)");
   }
@@ -43,13 +50,14 @@ export async function getJSON(path) {
   return (await send(path, { headers: { Accept: "application/json" } })).json();
 }
 
-/** A page of a paged list: ``{items, next}``, ``next`` the path of the following page
- * (the answer's ``Link: <...>; rel="next"``) or null on the last page. */
+/** A page of a paged list: ``{items, next}``, ``next`` the URL of the following page
+ * (the answer's ``Link: <...>; rel="next"``, which has the server's root path in it:
+ * made full here, not put under the root again) or null on the last page. */
 export async function getPage(path) {
   const response = await send(path, { headers: { Accept: "application/json" } });
   const link = response.headers.get("Link") || "";
   const next = /<([^>]*)>\s*;\s*rel="?next"?/.exec(link);
-  return { items: await response.json(), next: next ? next[1] : null };
+  return { items: await response.json(), next: next ? new URL(next[1], response.url).href : null };
 }
 
 export async function getText(path) {

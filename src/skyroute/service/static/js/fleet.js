@@ -25,7 +25,7 @@ const TABLE_EVERY_MS = 150; // table refreshes while playing
 const MAX_PACKAGE_ROWS = 60;
 
 let runs = []; // the runs listed, newest first
-let nextRuns = null; // the path of the page of older runs (the Link rel="next"), or null
+let nextRuns = null; // the URL of the page of older runs (the Link rel="next"), or null
 let outOfPage = null; // a run the page's link names, older than the pages listed: last
 let listing = 0; // counts the listings: a page of older runs for an old listing is dropped
 let run = null; // {id, tracks, fold, ground, drones, horizon}
