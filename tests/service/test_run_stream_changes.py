@@ -211,3 +211,36 @@ def test_a_stored_file_follows_a_run_saved_again_while_it_is_compared(store_url,
                 list(parts)
     engine.dispose()
 
+
+
+def test_a_run_saved_again_in_the_same_microsecond_is_another_version(store_url,
+                                                                       monkeypatch):
+    """A stored file's version was its run's ``created`` alone, the saving process's
+    clock: a run saved again with other bytes at the same reading of the clock (a coarse
+    clock's tick, a clock stepped back, another host's clock) kept the version, and a
+    file being read went on in the new bytes: one file of two versions, no error. Each
+    save of a run now has a later ``created`` than the one it replaces."""
+    import datetime as dt
+
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    engine = make_engine(store_url)
+    stuck = dt.datetime(2024, 5, 1, 12, 0, 0, 123456)
+    monkeypatch.setattr(store, "_now", lambda: stuck)  # the clock does not move
+    old, new = b"a" * SIZE, b"b" * SIZE
+    store.save_fleet_run(engine, tracks_csv=old, **ARGS)
+    first = store.get_fleet_run(engine, "r", files=False)["created"]
+    parts = iter(store.open_fleet_file(engine, "r", "tracks_csv"))
+    assert next(parts) == old[:PART]
+    store.save_fleet_run(engine, tracks_csv=new, **ARGS)
+    with pytest.raises(store.RunChangedError):
+        rest = b"".join(parts)
+        raise AssertionError(f"read on into the new version: {rest[:8]!r}...")
+    second = store.get_fleet_run(engine, "r", files=False)["created"]
+    assert second > first  # one microsecond on: the clock said the same time
+    monkeypatch.setattr(store, "_now", lambda: stuck - dt.timedelta(hours=1))  # stepped back
+    store.save_fleet_run(engine, tracks_csv=old, **ARGS)
+    assert store.get_fleet_run(engine, "r", files=False)["created"] > second
+    assert b"".join(store.open_fleet_file(engine, "r", "tracks_csv")) == old
+    engine.dispose()

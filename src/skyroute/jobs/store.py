@@ -328,15 +328,29 @@ def save_fleet_run(engine: sa.Engine, *, scenario: str, params: dict, report: di
             if state == "failed":
                 raise JobEndedError(f"job {job_id} has failed; its fleet run is not stored")
         _drop_files(c, t, [run_id])
-        c.execute(runs.delete().where(runs.c.id == run_id))
+        replaced = c.execute(runs.delete().where(runs.c.id == run_id)
+                             .returning(runs.c.created)).scalar_one_or_none()
         c.execute(runs.insert().values(
             id=run_id, job_id=job_id, scenario=scenario, params=json_safe(params),
-            report=json_safe(report), created=_now()))
+            report=json_safe(report), created=_later(replaced)))
         for name in FILES:  # a part at a time: no second copy of the tracks in a list
             for k, (part, last) in enumerate(_parts(data.pop(name))):
                 c.execute(stored.insert().values(run_id=run_id, name=name, part=k,
                                                  data=part, lines=part_lines(part, last)))
     return run_id
+
+
+def _later(replaced: dt.datetime | None) -> dt.datetime:
+    """A saved run's ``created``: now, but at least a microsecond (what both databases
+    keep) after the version it replaces. ``created`` is the version a streamed file is
+    read by (:class:`StoredFile`), and the clock alone could give two saves the same one
+    (a coarse clock's tick, a clock stepped back, another host's clock): the file then
+    went on in the new bytes without a word. So a run's versions only grow while it is
+    stored (a run is deleted only with its failed job, whose runs are then refused)."""
+    now = _now()
+    if replaced is not None and now <= replaced:
+        return replaced + dt.timedelta(microseconds=1)
+    return now
 
 
 def _parts(data: bytes) -> Iterator[tuple[bytes, bool]]:
