@@ -4,6 +4,7 @@ and its flags."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -187,3 +188,79 @@ def test_a_server_without_warming(monkeypatch):
     srv.port, srv.workers, srv.warm = 8000, 2, False
     assert srv._command(db="sqlite://", data=None, max_expansions=None)[-3:] == [
         "--log-level", "warning", "--no-warm"]
+
+
+# a server whose /health answers at once (its first process is warm) while its second
+# process warms for a while longer: it writes the file ``late`` when that one is warm,
+# then marks both ready as skyroute.service.ready does (pid files), if it was asked to
+_SLOW_SECOND_PROCESS = """
+import http.server, os, sys, threading, time
+from pathlib import Path
+
+class Health(http.server.BaseHTTPRequestHandler):
+    def do_GET(self):
+        self.send_response(200); self.send_header("Content-Length", "0"); self.end_headers()
+    def log_message(self, *args):
+        pass
+
+port, late = int(sys.argv[1]), Path(sys.argv[2])
+server = http.server.HTTPServer(("127.0.0.1", port), Health)
+threading.Thread(target=server.serve_forever, daemon=True).start()
+ready = os.environ.get("SKYROUTE_READY_DIR")
+if ready:
+    Path(ready, "1").write_text("1")
+time.sleep(1.5)  # the second process warms
+late.write_text("warm")
+if ready:
+    Path(ready, "2").write_text("2")
+time.sleep(600)
+"""
+
+
+def test_the_bench_waits_until_every_server_process_is_warm(monkeypatch, tmp_path):
+    # /health answers once one process of 'serve --workers N' is warm: the bench started
+    # its load while the others still warmed (a second each from numba's cache, over a
+    # minute each without it) on the same cores
+    import sys
+
+    from skyroute.bench.service import Server
+
+    late = tmp_path / "late"
+
+    def command(self, **_kw):
+        return [sys.executable, "-c", _SLOW_SECOND_PROCESS, str(self.port), str(late)]
+
+    monkeypatch.setattr(Server, "_command", command)
+    with Server(db="sqlite://", workers=2, start_timeout=60):
+        assert late.exists(), "the bench began while a server process was still warming"
+
+
+@pytest.mark.slow
+def test_each_process_of_a_real_server_marks_itself_ready(tmp_path):
+    import os
+
+    from skyroute.bench.service import Server
+
+    with Server(db=f"sqlite:///{tmp_path / 'bench.db'}", workers=2, warm=False) as srv:
+        pids = sorted(int(p.read_text()) for p in Path(srv._ready.name).iterdir())
+        assert [p.name for p in Path(srv._ready.name).iterdir() if not p.name.isdigit()] == []
+        assert len(pids) == 2 and pids[0] != pids[1] and srv.proc.pid not in pids
+        for pid in pids:  # the server's worker processes, alive
+            os.kill(pid, 0)
+    assert not Path(srv._ready.name).exists()  # the folder goes with the server
+
+
+def test_a_process_marks_itself_ready_only_when_asked(monkeypatch, tmp_path):
+    import os
+
+    from skyroute.service.ready import READY_DIR_ENV, count_ready, mark_ready
+
+    monkeypatch.delenv(READY_DIR_ENV, raising=False)
+    assert mark_ready() is None
+    monkeypatch.setenv(READY_DIR_ENV, str(tmp_path))
+    path = mark_ready()
+    assert path == tmp_path / str(os.getpid()) and path.read_text() == f"{os.getpid()}\n"
+    assert [p.name for p in tmp_path.iterdir()] == [str(os.getpid())]  # no part left
+    assert count_ready(tmp_path) == 1 and count_ready(tmp_path / "gone") == 0
+    monkeypatch.setenv(READY_DIR_ENV, str(tmp_path / "gone"))
+    assert mark_ready() is None  # logged, never raised: a server does not stop for it

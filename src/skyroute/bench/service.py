@@ -30,12 +30,14 @@ import re
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
 from skyroute.errors import OptionError, SkyrouteError
+from skyroute.service.ready import READY_DIR_ENV, count_ready
 
 TOKEN = "bench-service-token"
 CLIENTS = ("httpx", "raw")
@@ -89,7 +91,13 @@ class Server:
     ``warm``: the server warms its processes before it serves (``serve --no-warm`` when
     False); ``start_timeout``: seconds to wait for ``/health`` (default
     :func:`default_start_timeout`), after which the server is stopped and a
-    SkyrouteError with ``param="start_timeout"`` says what to do."""
+    SkyrouteError with ``param="start_timeout"`` says what to do.
+
+    ``/health`` answers once one process is warm; the others may still be warming on the
+    same cores. So the wait also lasts until every process has written its pid to a
+    folder the server is given in ``$SKYROUTE_READY_DIR`` (:mod:`skyroute.service.ready`):
+    no measured request competes with a warm-up, whichever process the kernel hands the
+    connections to."""
 
     def __init__(self, *, db: str, workers: int = 1, data: Path | None = None,
                  max_expansions: int | None = None, warm: bool = True,
@@ -98,7 +106,9 @@ class Server:
         self.url = f"http://127.0.0.1:{self.port}"
         self.workers, self.warm = workers, warm
         cmd = self._command(db=db, data=data, max_expansions=max_expansions)
-        env = {**os.environ, "SKYROUTE_TOKEN": TOKEN}
+        # each server process writes its pid here once warm (skyroute.service.ready)
+        self._ready = tempfile.TemporaryDirectory(prefix="skyroute-ready-")
+        env = {**os.environ, "SKYROUTE_TOKEN": TOKEN, READY_DIR_ENV: self._ready.name}
         self.proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
                                      stderr=subprocess.PIPE, text=True)
         self._wait(default_start_timeout(workers) if start_timeout is None
@@ -125,10 +135,12 @@ class Server:
                                     + (self.proc.stderr.read().strip().splitlines() or
                                        ["(no message)"])[-1])
             try:
-                if httpx.get(self.url + "/health", timeout=1).status_code == 200:
+                if (httpx.get(self.url + "/health", timeout=1).status_code == 200
+                        and self.ready() >= self.workers):
                     return
             except httpx.HTTPError:
-                time.sleep(0.2)
+                pass
+            time.sleep(0.2)
         self.stop()
         n = self.workers
         why = ("" if not self.warm else
@@ -140,6 +152,10 @@ class Server:
                             + (", or start it without warming (warm=False)" if self.warm
                                else ""), param="start_timeout")
 
+    def ready(self) -> int:
+        """How many of the server's processes are warm (have marked themselves ready)."""
+        return count_ready(Path(self._ready.name))
+
     def stop(self) -> None:
         if self.proc.poll() is None:
             self.proc.terminate()
@@ -148,6 +164,7 @@ class Server:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
+        self._ready.cleanup()
 
     def __enter__(self) -> Server:
         return self
@@ -351,8 +368,6 @@ def bench_plan(*, map_name: str = "Paris_1_512", clients: int = 50, requests: in
     """POST /plan under load: the summary (server-side ``app``, ``wait``, ``plan`` and
     client latency percentiles in ms, requests/s, errors). ``warm``, ``start_timeout``:
     the :class:`Server`'s."""
-    import tempfile
-
     check_load(clients=clients, requests=requests, workers=workers,
                client_processes=client_processes)
     queries = plan_queries(map_name, warmup + requests, seed=seed, algorithm=algorithm)

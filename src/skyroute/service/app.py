@@ -5,7 +5,8 @@ error handlers, the body limit, the timing header, the API reference at ``/docs`
 Making the app opens nothing; the store, the site and the job executor open on first use
 (:mod:`skyroute.service.resources`) and close when the app shuts down. Starting it (the
 lifespan, before the server accepts a connection) warms the planners
-(:mod:`skyroute.service.warm`) unless ``Settings.warm`` is off.
+(:mod:`skyroute.service.warm`) unless ``Settings.warm`` is off, then marks the process
+ready for the bench that started it (:mod:`skyroute.service.ready`, only when asked).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from fastapi.staticfiles import StaticFiles
 from fastapi_offline import FastAPIOffline
 
 import skyroute
-from skyroute.service import cut, problems, query
+from skyroute.service import cut, problems, query, ready
 from skyroute.service.middleware import BodyLimit, HeadAsGet, ServerTiming
 from skyroute.service.resources import Resources
 from skyroute.service.routers import (
@@ -53,6 +54,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             from skyroute.service.warm import warm
 
             app.state.warmed = warm(app.state.resources)
+        ready.mark_ready()  # one file a process: the bench waits for all of them
         yield
         app.state.resources.close()
 
