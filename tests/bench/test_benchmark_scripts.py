@@ -37,7 +37,8 @@ def one_line_error(proc, name: str, words: str) -> None:
     assert proc.stderr.startswith(f"{name}: error: ") and words in proc.stderr, proc.stderr
 
 
-@pytest.mark.parametrize("name", ["plan_ab.py", "plan_overhead.py", "prepare_memory.py"])
+@pytest.mark.parametrize("name", ["plan_ab.py", "plan_overhead.py", "prepare_memory.py",
+                                  "prepare_time.py"])
 def test_each_script_has_a_help(name):
     proc = script(name, "--help")
     assert proc.returncode == 0 and proc.stdout.startswith(f"usage: {name}"), proc.stderr
@@ -178,3 +179,28 @@ def test_prepare_memory_reports_each_share(tmp_path):
 ])
 def test_prepare_memory_refuses_a_wrong_map(args, words):
     one_line_error(script("prepare_memory.py", *args), "prepare_memory.py", words)
+
+
+@pytest.mark.slow
+def test_prepare_time_times_each_tree_in_turn(tmp_path):
+    out = tmp_path / "time.json"
+    proc = script("prepare_time.py", str(SRC), str(SRC.parent), "--side", "48", "--builds",
+                  "2", "--rounds", "1", "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads(out.read_text())
+    assert [r["tree"] for r in doc["runs"]] == [str(SRC), str(SRC.parent)]
+    for r in doc["runs"]:
+        assert len(r["seconds"]) == 2 and all(positive(x) for x in r["seconds"])
+        assert all(k in ("table", "hierarchy", "landmarks", "jump") for k in r["accelerator"])
+        assert r["load"].startswith("load ")
+    assert [line.split(": ")[0] for line in proc.stdout.splitlines()] == [str(SRC), str(SRC.parent)]
+
+
+@pytest.mark.parametrize("args, words", [
+    (["src", "--side", "4"], "--side 4: expected 16 to 4096"),
+    (["src", "--share", "1.5"], "--share 1.5: expected 0 <= SHARE < 1"),
+    (["src", "--builds", "0"], "--builds 0: expected 1 to 100"),
+    (["no-such-tree-or-commit"], "neither a folder nor a commit"),
+])
+def test_prepare_time_refuses_wrong_input(args, words):
+    one_line_error(script("prepare_time.py", *args), "prepare_time.py", words)

@@ -64,7 +64,12 @@ HEAP_CAP = 1 << 14  # witness heap entries; a search that would need more gives 
 SHORTEN = shorten_table()
 EPS = 1e-9  # a witness this much longer still counts (lengths a + b sqrt2 differ by far more)
 WORKERS = 2  # priority estimates run on this many threads, each with its own scratch
-SERIAL = 2  # fewer nodes to estimate than this: one thread (a parallel launch costs more)
+# Fewer nodes to estimate than this: one thread. A parallel region needs both threads
+# scheduled at once; with the cores busy elsewhere each of the thousands of small regions
+# (one a contraction) waited for a time slice: random 512 at 30% built in 17-107 s
+# instead of 2 s. At 64 only the few large re-estimates are split (docs/benchmarks.md,
+# section 12, "Contraction under load").
+SERIAL = 64
 
 
 @njit(cache=True)
