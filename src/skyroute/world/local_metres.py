@@ -74,9 +74,9 @@ def local_metres(world: World, *, near=None) -> LocalMetres:
     scale = metres_per_degree(Home(*origin))
     if not (np.isfinite(scale).all() and scale.min() > 1e3):
         raise OptionError(f"world {world.name!r} lies at latitude {origin[1]:g}: at a pole "
-                          "a degree of longitude has no length, so distances in metres "
-                          "have no size in the degrees frame; load it in frame 'lonlat'",
-                          param="world")
+                          "(within half a degree) a degree of longitude is shorter than "
+                          "1 km, and distances in metres have no steady size in the "
+                          "degrees frame; load it in frame 'lonlat'", param="world")
 
     def move(p):
         return (p - origin) * scale
