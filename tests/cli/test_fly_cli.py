@@ -316,3 +316,27 @@ def test_dubins_out_writes_the_goal_once(monkeypatch, capsys, tmp_path):
     rows = np.array(list(csv.reader(out.open()))[1:], dtype=float)
     assert rows[-1, :2].tolist() == [-81.52, -27.41]
     assert (np.hypot(*np.diff(rows[:, :2], axis=0).T) > 1e-6).all()
+
+
+@pytest.mark.shared_data
+def test_field_defaults_fly_the_same_in_the_degrees_frame_as_in_lonlat(monkeypatch, capsys):
+    """`fly --vehicle field` on the ILP zones in --frame degrees, defaults: --step 1 and
+    --sensor-range 6 were degrees (the confinement area is 0.008 degrees across), so the
+    goal was "reached" at once, 0 moves, at the start. They are metres in every frame:
+    the run is the one in --frame lonlat (lengths on the ellipsoid within 1 %), and
+    --json's trajectory is in degrees, from the start as typed to the goal."""
+    from pyproj import Geod
+
+    geod, runs = Geod(ellps="WGS84"), {}
+    for frame in ("degrees", "lonlat"):
+        code, text, err = run(monkeypatch, capsys, "fly", ZONES, "--boundary", BOX,
+                              "--frame", frame, "--vehicle", "field",
+                              "--start=-3.1920,55.9460", "--goal=-3.1850,55.9430", "--json")
+        assert code == 0, err
+        runs[frame] = json.loads(text)
+    deg, ll = (np.array(runs[f]["trajectory"]) for f in ("degrees", "lonlat"))
+    assert runs["degrees"]["reached"] and runs["degrees"]["metrics"]["moves"] > 300
+    assert deg[0].tolist() == [-3.192, 55.946] and geod.inv(*deg[-1], -3.185, 55.943)[2] < 1
+    assert geod.line_length(*deg.T) == pytest.approx(geod.line_length(*ll.T), rel=0.01)
+    assert runs["degrees"]["metrics"]["length"] == pytest.approx(
+        float(np.hypot(*np.diff(deg, axis=0).T).sum()))  # plane units: degrees
