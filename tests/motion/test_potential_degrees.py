@@ -140,5 +140,5 @@ def test_a_degrees_world_at_a_pole_is_refused_naming_the_frame():
     infinite or zero moves."""
     world = World([shapely.box(10, 89.9, 10.5, 89.95)], [-np.inf], [np.inf], (),
                   shapely.box(0, 89.8, 20, 89.99), "degrees", Home(10, 89.995))
-    with pytest.raises(OptionError, match="at a pole .*frame 'lonlat'"):
+    with pytest.raises(OptionError, match=r"at a pole .*frame 'lonlat'"):
         run_field(world, (1, 89.85), (19, 89.85))
