@@ -16,6 +16,10 @@ robot a heading it cannot change by more than ``max_turn`` per move, drives a ci
 arc that turns towards the force, and makes fractional progress: the arc is ``step``
 long scaled by cos(heading error) (at least a quarter step), so the robot slows into
 sharp turns and speeds up when aligned, as a wheeled robot does.
+
+Distances (``step``, ``sensor_range``, ``tolerance``) are metres in every frame: a world
+in "degrees" is flown in metres round its home
+(:func:`~skyroute.world.local_metres.local_metres`) and its path returned in degrees.
 """
 
 from __future__ import annotations
