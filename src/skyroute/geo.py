@@ -85,17 +85,6 @@ def ned_to_lonlat(north, east, down, home: Home) -> np.ndarray:
     return enu_to_lonlat(east, north, -np.asarray(down, dtype=float), home)
 
 
-def metres_per_degree(home: Home) -> np.ndarray:
-    """(2,) metres per degree of longitude and of latitude at ``home``: the slopes of the
-    tangent plane there (east by longitude, north by latitude; the cross slopes vanish at
-    home), by central differences over 1e-3 degrees, exact to about 1e-10. The scale that
-    turns a distance in metres into the "degrees" frame's plane near home."""
-    d = 1e-3
-    enu = lonlat_to_enu(home.lon + np.array([-d, d, 0.0, 0.0]),
-                        home.lat + np.array([0.0, 0.0, -d, d]), home.alt, home)
-    return np.array([enu[1, 0] - enu[0, 0], enu[3, 1] - enu[2, 1]]) / (2 * d)
-
-
 def ned_heading_to_ilp(heading) -> np.ndarray:
     """NED heading (radians, 0 north, clockwise) -> ILP angle (degrees, 0 east, anticlockwise)."""
     return np.mod(90.0 - np.degrees(heading), 360.0)

@@ -116,13 +116,12 @@ def fly_command(
     resolution: Annotated[float | None, typer.Option(help=_for(
         "resolution", "cell size."))] = None,
     step: Annotated[float, typer.Option(help=_for(
-        "step", "sampling step (dubins; plane units, degrees in the degrees frame) or "
-                "move length and goal tolerance (field; metres in every frame)."))] = 1.0,
+        "step", "sampling step (dubins) or move length (field)."))] = 1.0,
     escape: Annotated[bool, typer.Option(help=_for(
         "escape", "follow a navigation function whenever the field cannot move on "
                   "(a local minimum, a blocked move)."))] = True,
     sensor_range: Annotated[float, typer.Option(help=_for(
-        "sensor_range", "sensor range, metres in every frame."))] = 6.0,
+        "sensor_range", "sensor range."))] = 6.0,
     sensor_rays: Annotated[int, typer.Option(help=_for(
         "sensor_rays", "sensor rays (density)."))] = 36,
     field_mode: Annotated[str, typer.Option(help=_for(

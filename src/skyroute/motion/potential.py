@@ -16,10 +16,6 @@ robot a heading it cannot change by more than ``max_turn`` per move, drives a ci
 arc that turns towards the force, and makes fractional progress: the arc is ``step``
 long scaled by cos(heading error) (at least a quarter step), so the robot slows into
 sharp turns and speeds up when aligned, as a wheeled robot does.
-
-Distances (``step``, ``sensor_range``, ``tolerance``) are metres in every frame: a world
-in "degrees" is flown in metres round its home
-(:func:`~skyroute.world.local_metres.local_metres`) and its path returned in degrees.
 """
 
 from __future__ import annotations
@@ -34,7 +30,6 @@ import shapely
 from skyroute.caches import register
 from skyroute.errors import OptionError, check_choice, check_instance, flag, real, whole
 from skyroute.result import Status
-from skyroute.world.local_metres import local_metres
 from skyroute.world.world import World
 
 COURSES = ("easy", "medium", "hard")
@@ -238,18 +233,9 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
     escape takes over again, it runs twice as long as the last time, so a trap
     the field keeps falling back into is left for good. In ``arc`` mode the robot starts
     on ``heading`` (radians in the world's frame's convention; default towards the
-    goal). Points come in and the run's path goes out in the world's frame.
-
-    Distances (``step``, ``sensor_range``, ``tolerance``) are metres in every frame: in
-    the metres frames they are the plane's units; a "degrees" world is flown in metres
-    around its home (:func:`~skyroute.world.local_metres.local_metres`, the lon/lat
-    plane scaled by the metres per degree of lon and of lat there), so the defaults
-    work there too and a value means the same distance as on the world in "lonlat"
-    (before, a 0.5 step was half a degree, 30 to 55 km, and a 0.5 tolerance "reached"
-    every goal of a city at once). :attr:`FieldRun.distance` and ``smoothness`` are
-    measured in the world's plane (degrees in "degrees", as other lengths there), and
-    the distances in :attr:`FieldRun.why` in the options' metres. A run that does not
-    reach the goal says why in :attr:`FieldRun.why`."""
+    goal). Points come in and the run's path goes out in the world's frame; distances
+    (``step``, ``sensor_range``) are plane units. A run that does not reach the goal
+    says why in :attr:`FieldRun.why`."""
     check_instance("world", world, World, "a skyroute World")
     check_choice("mode", mode, MODES)
     step, sensor_range, tolerance = (real(name, value, low=0.0, strict=True, need="> 0")
@@ -267,42 +253,10 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
     heading = None if heading is None else real("heading", heading)
     p = world.check_point(start, "start")
     t = world.check_point(goal, "goal")
-    theta = None if heading is None else float(world.heading_to_plane(heading))
-    plane = world  # the world's own plane, where the path is measured and returned
-    if world.plane == "degrees":  # flown in metres; the path comes back in degrees
-        local = local_metres(world, near=p)
-        given = (p, t)
-        p, t = local.to_metres([p, t])
-        theta = None if theta is None else local.heading_to_metres(theta)
-        world = local.world
-    if theta is None:  # towards the goal
-        theta = math.atan2(*(t - p)[::-1])
-    path, trace, status, escaped, why = _fly(
-        world, p, t, theta, step, attract, repulse, sensor_range, sensor_rays, tolerance,
-        max_moves, escape, window, mode, max_turn)
-    if plane is not world:
-        path, trace = (_back(local, xy, p, t, *given) for xy in (path, trace))
-    flown = trace if mode == "arc" else path
-    return FieldRun(plane.from_plane(path), status, escaped,
-                    plane.from_plane(trace) if mode == "arc" else None,
-                    float(np.hypot(*np.diff(flown, axis=0).T).sum()), _smoothness(path),
-                    why)
-
-
-def _back(local, xy: np.ndarray, p, t, start, goal) -> np.ndarray:
-    """Metres -> the "degrees" world's plane, the start and (where the run landed on
-    it) the goal as given, bit for bit."""
-    out = local.from_metres(xy)
-    out[np.all(xy == p, axis=1)] = start
-    out[np.all(xy == t, axis=1)] = goal
-    return out
-
-
-def _fly(world, p, t, theta, step, attract, repulse, sensor_range, sensor_rays, tolerance,
-         max_moves, escape, window, mode, max_turn):
-    """The run in a metres plane: (path, trace, status, escaped, why), plane arrays."""
     if escape:  # refused now, not after the moves flown before a first stall
         _escape_box(world, t, step, p[None, :])
+    theta = math.atan2(*(t - p)[::-1]) if heading is None else \
+        float(world.heading_to_plane(heading))
     path = [p.copy()]
     trace = [p.copy()]
     nav = None
@@ -376,7 +330,12 @@ def _fly(world, p, t, theta, step, attract, repulse, sensor_range, sensor_rays, 
     elif status is Status.BUDGET_EXHAUSTED:
         why = _out_of_moves(path, t, max_moves, escaped, tolerance, window,
                             step if mode == "arc" else None)
-    return np.array(path), np.array(trace), status, escaped, why
+    path, trace = np.array(path), np.array(trace)
+    flown = trace if mode == "arc" else path
+    return FieldRun(world.from_plane(path), status, escaped,
+                    world.from_plane(trace) if mode == "arc" else None,
+                    float(np.hypot(*np.diff(flown, axis=0).T).sum()), _smoothness(path),
+                    why)
 
 
 def _too_far(world: World, p: np.ndarray, t: np.ndarray, step: float, box: tuple) -> str:
