@@ -1,6 +1,8 @@
-"""The potential field on a world in the "degrees" frame: its distances are metres there
-too. Before, the defaults (step and tolerance 0.5) were half a degree, 30 to 55 km, and
-every goal of a city was "reached" at once, in 0 moves."""
+"""The potential field on a world in the "degrees" frame. Its distances are plane units
+there, degrees, as every distance of a World; its defaults, documented in metres, are
+taken into degrees (World.metres_in_plane). Before, the defaults (step and tolerance
+0.5) were half a degree, 55 km, and every goal of a city was "reached" at once, in 0
+moves."""
 
 import json
 import math
@@ -12,9 +14,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from pyproj import Geod
 
-from skyroute import OptionError, World, load_world
-from skyroute.geo import Home, enu_to_lonlat, lonlat_to_enu
-from skyroute.motion.potential import course, run_field
+from skyroute import World, load_world
+from skyroute.geo import Home, enu_to_lonlat, metres_per_degree_north
+from skyroute.motion.potential import DEFAULTS, course, run_field
 
 GEOD = Geod(ellps="WGS84")
 LON0, LAT0 = -3.188, 55.944  # Edinburgh, George Square
@@ -60,85 +62,107 @@ def _metres(lonlat: np.ndarray) -> float:
     return float(GEOD.line_length(lonlat[:, 0], lonlat[:, 1]))
 
 
+def _outside_the_zones(lonlat: np.ndarray) -> None:
+    """The polyline enters no zone's interior and stays inside the area: shapely on
+    the lon/lat path against the zones as written, not through the world."""
+    line = shapely.LineString(lonlat)
+    for zone in _zones():
+        assert not zone.relate_pattern(line, "T********"), zone  # interiors never meet
+    assert BOX.contains(line)
+
+
 @pytest.mark.parametrize("mode", ["step", "arc"])
 def test_the_default_run_on_a_degrees_world_reaches_the_goal_outside_the_zones(zones_file,
                                                                               mode):
     """Default options on a GeoJSON world loaded in "degrees": the goal is reached
-    (within the default tolerance of 0.5 m, measured on the ellipsoid) by a path that
-    enters no zone and stays inside the area, checked with shapely on the lon/lat path
-    against the zones as written, not through the world."""
+    (within the default tolerance, 0.5 m north and less east: at most 0.5 m on the
+    ellipsoid) in moves of about half a metre, by a path that enters no zone."""
     world = load_world(zones_file, frame="degrees")
     run = run_field(world, START, GOAL, mode=mode)
     lonlat = _flown(run)
     assert run.reached, run
     assert tuple(lonlat[0]) == START
-    _, _, off = GEOD.inv(*lonlat[-1], *GOAL)
-    assert off < 0.5
-    line = shapely.LineString(lonlat)
-    for zone in _zones():
-        assert not zone.relate_pattern(line, "T********"), zone  # interiors never meet
-    assert BOX.contains(line)
+    assert GEOD.inv(*lonlat[-1], *GOAL)[2] < 0.5
+    _outside_the_zones(lonlat)
     straight = GEOD.inv(*START, *GOAL)[2]
     assert straight < _metres(lonlat) < 2 * straight
-    assert run.moves > straight / 0.5 / 2  # moves of about the default 0.5 m
-    assert run.distance == pytest.approx(line.length)  # plane units: degrees
+    assert run.moves > straight / 0.5  # moves of at most the default 0.5 m
+    assert run.distance == pytest.approx(shapely.LineString(lonlat).length)  # degrees
 
 
 @pytest.mark.parametrize("mode", ["step", "arc"])
-@pytest.mark.parametrize("kw", [{}, {"step": 2.0, "tolerance": 1.0, "sensor_range": 10.0}])
-def test_the_same_world_in_degrees_and_in_lonlat_flies_the_same_run(zones_file, mode, kw):
-    """The GeoJSON world loaded in "degrees" and in "lonlat" (metres round its home), the
-    same options: the runs are the same on the ground (lengths on the ellipsoid within
-    1 %, moves within 3 %), the defaults and explicit values alike."""
-    runs = [run_field(load_world(zones_file, frame=frame), START, GOAL, mode=mode, **kw)
+def test_the_default_run_in_degrees_is_about_as_long_as_in_lonlat(zones_file, mode):
+    """The same GeoJSON world loaded in "degrees" and in "lonlat" (metres round its
+    home), default options: both reach the goal, and their lengths on the ellipsoid
+    agree within 10 % (measured: 7.5 % in step mode, 5 % in arc mode). Not closer: in
+    degrees the robot is isotropic on the lon/lat plane, so its step, sensor range and
+    tolerance east are cos(56 deg) = 0.56 of those north, where in lonlat they are
+    the same metres every way."""
+    runs = [run_field(load_world(zones_file, frame=frame), START, GOAL, mode=mode)
             for frame in ("degrees", "lonlat")]
     assert all(r.reached for r in runs), runs
     deg, ll = (_metres(_flown(r)) for r in runs)
-    assert deg == pytest.approx(ll, rel=0.01)
-    assert runs[0].moves == pytest.approx(runs[1].moves, rel=0.03)
+    assert deg == pytest.approx(ll, rel=0.1)
+
+
+def test_explicit_distances_are_plane_units_degrees():
+    """step=1e-5 on a "degrees" world is 1e-5 degrees a move, measured in the plane
+    (east as well as north), not 1e-5 metres; the tolerance left out is its default
+    0.5 m in degrees (4.5e-6), not half a degree (before: "reached" at the start, 0
+    moves). A free world, so every move is a full step along the field, but the last,
+    which lands on the goal from within a step of it."""
+    world = World([], [], [], (), BOX, "degrees", Home(LON0, LAT0))
+    run = run_field(world, START, GOAL, step=1e-5, escape=False)
+    assert run.reached, run
+    moves = np.hypot(*np.diff(run.path, axis=0).T)
+    np.testing.assert_allclose(moves[:-1], 1e-5, rtol=1e-9)
+    assert tuple(run.path[-1]) == GOAL and moves[-1] < 2e-5
+    straight = math.dist(START, GOAL)  # a straight line in degrees
+    assert run.moves == math.floor(straight / 1e-5)
+    assert run.distance == pytest.approx(straight)
+
+
+def test_the_defaults_are_their_metres_over_the_metres_per_degree_of_latitude():
+    """World.metres_in_plane: the identity in the metres frames; in "degrees", metres
+    over the metres per degree of latitude at the home (111,341 m at 55.944 N, by
+    pyproj's geodesic along the meridian)."""
+    deg = World([], [], [], (), BOX, "degrees", Home(LON0, LAT0))
+    per = GEOD.inv(LON0, LAT0 - 0.05, LON0, LAT0 + 0.05)[2] / 0.1
+    assert metres_per_degree_north(LAT0) == pytest.approx(per, rel=1e-6)
+    assert deg.metres_in_plane(0.5) == pytest.approx(0.5 / per, rel=1e-6)
+    assert World([], [], [], (), None, "degrees").metres_in_plane(2.0, near=(0, 90)) == \
+        pytest.approx(2.0 / 111_694.0, rel=1e-5)  # defined at a pole too
+    assert deg.in_frame("lonlat").metres_in_plane(0.5) == 0.5
+    assert DEFAULTS["step"] == 0.5 and DEFAULTS["tolerance"] == 0.5
 
 
 def _degrees_course(name: str, lon: float, lat: float):
     """A built-in course (enu metres) placed at (lon, lat) and carried to "degrees"
-    vertex by vertex through the tangent plane (World.in_frame)."""
+    vertex by vertex through the tangent plane (World.in_frame), with its start and
+    goal in lon/lat."""
     world, start, goal = course(name)
     centre = np.array([30.0, 30.0])
     move = lambda p: p - centre  # noqa: E731 -- home at the course's centre
     enu = World(shapely.transform(world.obstacles, move), world.floors, world.ceilings,
                 world.names, shapely.transform(world.boundary, move), "enu",
                 Home(lon, lat))
-    return enu, enu.in_frame("degrees"), start - centre, goal - centre
+    s, t = enu_to_lonlat(*np.array([start, goal]).T - centre[:, None], 0.0, enu.home)[:, :2]
+    return enu.in_frame("degrees"), s, t
 
 
-@settings(max_examples=8, deadline=None)
+@settings(max_examples=6, deadline=None)
 @given(lat=st.floats(-70, 70), lon=st.floats(-179, 179), mode=st.sampled_from(["step", "arc"]),
-       name=st.sampled_from(["medium", "hard"]), heading=st.floats(0, 2 * math.pi))
-def test_a_course_anywhere_on_earth_flies_the_same_in_degrees_as_in_metres(lat, lon, mode,
-                                                                           name, heading):
-    """A course carried to any latitude: in "degrees", with default options and the
-    same start heading (converted with pyproj alone), the run is the one flown in
-    metres: it reaches the goal, its path projected back to metres is as long within
-    1 %, and it ends within the tolerance of the goal."""
-    enu, deg, s, t = _degrees_course(name, lon, lat)
-    home = enu.home
-    ends = enu_to_lonlat(np.array([s[0], t[0], s[0] + math.cos(heading)]),
-                         np.array([s[1], t[1], s[1] + math.sin(heading)]), 0.0, home)[:, :2]
-    d = ends[2] - ends[0]
-    h_deg = math.atan2(d[1], d[0])  # the same direction on the flat lon/lat plane
-    metres = run_field(enu, s, t, mode=mode, heading=heading)
-    degrees = run_field(deg, ends[0], ends[1], mode=mode, heading=h_deg)
-    assert metres.reached and degrees.reached, (metres, degrees)
-    back = lonlat_to_enu(*_flown(degrees).T, 0.0, home)[:, :2]
-    assert np.hypot(*np.diff(back, axis=0).T).sum() == pytest.approx(metres.distance,
-                                                                      rel=0.01)
-    assert math.dist(back[-1], t) < 0.5 + 1e-6
-    assert deg.segments_free(_flown(degrees)[:-1], _flown(degrees)[1:]).all()
-
-
-def test_a_degrees_world_at_a_pole_is_refused_naming_the_frame():
-    """At a pole a degree of longitude has no length: one OptionError, not a run with
-    infinite or zero moves."""
-    world = World([shapely.box(10, 89.9, 10.5, 89.95)], [-np.inf], [np.inf], (),
-                  shapely.box(0, 89.8, 20, 89.99), "degrees", Home(10, 89.995))
-    with pytest.raises(OptionError, match=r"at a pole .*frame 'lonlat'"):
-        run_field(world, (1, 89.85), (19, 89.85))
+       name=st.sampled_from(["medium", "hard"]))
+def test_a_course_anywhere_on_earth_flies_with_the_defaults_in_degrees(lat, lon, mode, name):
+    """A course (47 m start to goal) carried to any latitude in "degrees": the default
+    run reaches the goal (within 0.5 m on the ellipsoid) along a free path at least as
+    long as the straight line, in moves no longer than 0.5 m."""
+    deg, s, t = _degrees_course(name, lon, lat)
+    run = run_field(deg, s, t, mode=mode)
+    assert run.reached, run
+    path = _flown(run)
+    assert deg.segments_free(path[:-1], path[1:]).all()
+    assert GEOD.inv(*path[-1], *t)[2] < 0.5 + 1e-6
+    straight = GEOD.inv(*s, *t)[2]
+    assert _metres(path) >= straight - 1e-6
+    assert run.moves >= straight / 0.5
