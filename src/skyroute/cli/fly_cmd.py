@@ -20,6 +20,7 @@ from skyroute.cli.tables import plain_console, print_table
 from skyroute.errors import OptionError, check_choice, real
 from skyroute.files import read_text, write_atomic, written_together
 from skyroute.io.geojson import dumps
+from skyroute.io.json_text import to_json
 from skyroute.planner import plan
 from skyroute.result import PlanResult, Status
 from skyroute.world.load import load_world
@@ -231,7 +232,7 @@ def fly_command(
                             obstacles=obstacles_label(altitude, safety, frame),
                             targets=visits if tour else None)
     if as_json:
-        typer.echo(json.dumps({k: v for k, v in doc.items() if k != "columns"}))
+        typer.echo(to_json({k: v for k, v in doc.items() if k != "columns"}))
     else:
         table = Table(title=f"{world.name}: {vehicle}", show_header=False)
         unit = "deg" if world.plane == "degrees" else "m"
@@ -506,7 +507,7 @@ def _not_reached(why: str) -> dict:
 def _render(path: Path, rows, columns, lonlat) -> str:
     suffix = path.suffix.lower()
     if suffix == ".json":
-        return json.dumps(rows)
+        return to_json(rows)
     if suffix == ".csv":
         buf = io.StringIO()
         w = csv.writer(buf)
