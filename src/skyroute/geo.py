@@ -85,6 +85,19 @@ def ned_to_lonlat(north, east, down, home: Home) -> np.ndarray:
     return enu_to_lonlat(east, north, -np.asarray(down, dtype=float), home)
 
 
+def metres_per_degree_north(lat: float) -> float:
+    """Metres per degree of latitude at latitude ``lat`` (degrees) on the WGS84 ellipsoid:
+    110,574 m at the equator, 111,694 m at the poles (pyproj's geodesic along the
+    meridian over a thousandth of a degree, one-sided at a pole). The scale that turns a
+    distance in metres into the "degrees" frame's plane units (see
+    :meth:`skyroute.world.world.World.metres_in_plane`)."""
+    from pyproj import Geod
+
+    lat = float(lat)
+    a, b = max(lat - 5e-4, -90.0), min(lat + 5e-4, 90.0)
+    return float(Geod(ellps="WGS84").inv(0.0, a, 0.0, b)[2] / (b - a))
+
+
 def ned_heading_to_ilp(heading) -> np.ndarray:
     """NED heading (radians, 0 north, clockwise) -> ILP angle (degrees, 0 east, anticlockwise)."""
     return np.mod(90.0 - np.degrees(heading), 360.0)

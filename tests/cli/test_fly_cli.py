@@ -316,3 +316,78 @@ def test_dubins_out_writes_the_goal_once(monkeypatch, capsys, tmp_path):
     rows = np.array(list(csv.reader(out.open()))[1:], dtype=float)
     assert rows[-1, :2].tolist() == [-81.52, -27.41]
     assert (np.hypot(*np.diff(rows[:, :2], axis=0).T) > 1e-6).all()
+
+
+def _strict(text: str) -> dict:
+    """JSON as RFC 8259 has it: Infinity and NaN refused (as jq and JSON.parse do)."""
+    def refuse(name):
+        raise ValueError(f"{name} is not JSON")
+    return json.loads(text, parse_constant=refuse)
+
+
+@pytest.mark.shared_data
+@pytest.mark.parametrize("mode", ["step", "arc"])
+def test_field_defaults_fly_in_the_degrees_frame(monkeypatch, capsys, mode):
+    """`fly --vehicle field --frame degrees` with the defaults on the ILP zones: --step 1
+    and --sensor-range 6 were degrees (the confinement area is 0.008 degrees across),
+    so the goal was "reached" at once, 0 moves. The defaults are metres taken into
+    degrees (1 m and 6 m north, less east): the run flies there in moves of at most a
+    metre, from the start as typed to within a metre of the goal, outside the zones;
+    its length is plane units, degrees."""
+    from pyproj import Geod
+
+    geod = Geod(ellps="WGS84")
+    code, text, err = run(monkeypatch, capsys, "fly", ZONES, "--boundary", BOX,
+                          "--frame", "degrees", "--vehicle", "field", "--field-mode", mode,
+                          "--start=-3.1920,55.9460", "--goal=-3.1850,55.9430", "--json")
+    assert code == 0, err
+    doc = _strict(text)
+    deg = np.array(doc["trajectory"])
+    straight = geod.inv(-3.192, 55.946, -3.185, 55.943)[2]
+    assert doc["reached"] and doc["metrics"]["moves"] > straight
+    assert deg[0].tolist() == [-3.192, 55.946] and geod.inv(*deg[-1], -3.185, 55.943)[2] < 1
+    assert straight < geod.line_length(*deg.T) < 1.5 * straight
+    world = skyroute.load_world(ZONES, boundary=BOX, frame="degrees")
+    assert world.segments_free(deg[:-1], deg[1:]).all()
+    assert doc["metrics"]["length"] == pytest.approx(
+        float(np.hypot(*np.diff(deg, axis=0).T).sum()))  # plane units: degrees
+
+
+@pytest.mark.shared_data
+def test_dubins_default_radius_in_the_degrees_frame_is_10_m(monkeypatch, capsys):
+    """`fly --vehicle dubins --frame degrees` without --radius: the default was 10
+    degrees (1,100 km round a city of 700 m: no_path); it is 10 m taken into degrees,
+    and its --step 1 m too. A given --radius stays plane units: 10 is still 10 degrees,
+    no path (its --json length null, not Infinity)."""
+    from pyproj import Geod
+
+    query = ["fly", ZONES, "--boundary", BOX, "--frame", "degrees", "--vehicle", "dubins",
+             "--start=-3.1920,55.9460", "--goal=-3.1850,55.9430", "--json"]
+    code, text, err = run(monkeypatch, capsys, *query)
+    assert code == 0, err
+    doc = _strict(text)
+    deg = np.array(doc["trajectory"])
+    assert doc["reached"] and doc["metrics"]["status"] == "found"
+    metres = Geod(ellps="WGS84").line_length(*deg[:, :2].T)
+    assert metres < 1.2 * Geod(ellps="WGS84").inv(-3.192, 55.946, -3.185, 55.943)[2]
+    steps = np.hypot(*np.diff(deg[:, :2], axis=0).T)
+    assert steps.max() <= 1.0 / 111_000  # samples of at most 1 m north
+    code, text, _ = run(monkeypatch, capsys, *query, "--radius", "10")
+    doc = _strict(text)  # its length is null, not Infinity
+    assert code == 1 and doc["metrics"]["status"] == "no_path"
+    assert doc["metrics"]["length"] is None
+
+
+
+
+@pytest.mark.shared_data
+def test_lattice_default_speed_in_the_degrees_frame_is_1_m_per_s(monkeypatch, capsys):
+    """`fly --vehicle lattice --frame degrees` without --speed: the default was 1 degree
+    per second (111 km/s: a 300 m route took 4 s, its turns 4 of them); it is 1 m/s
+    taken into degrees, so the route takes at least its length over 1 m/s north."""
+    code, text, err = run(monkeypatch, capsys, "fly", ZONES, "--boundary", BOX,
+                          "--frame", "degrees", "--vehicle", "lattice",
+                          "--start=-3.1920,55.9460", "--goal=-3.1890,55.9445", "--json")
+    assert code == 0, err
+    m = _strict(text)["metrics"]
+    assert m["time"] >= m["length"] * 111_000  # degrees over 1/111,341 degrees a second

@@ -75,6 +75,19 @@ def test_no_path_within_the_budget_exits_1_and_writes_nothing(monkeypatch, capsy
     assert json.loads(text)["metrics"]["status"] == "budget_exhausted"
 
 
+def test_json_of_a_flight_not_found_is_strict_json(monkeypatch, capsys):
+    """A search out of budget has no length: --json printed `"length": Infinity`, which
+    is no JSON (RFC 8259: jq and JSON.parse refuse it); it is null."""
+    def refuse(name):
+        raise ValueError(f"{name} is not JSON")
+
+    code, text, _ = run(monkeypatch, capsys, *BASE, "--start", "0,0,90", "--goal",
+                        "120,-180", "--max-expansions", "5", "--json")
+    doc = json.loads(text, parse_constant=refuse)
+    assert code == 1 and doc["metrics"]["status"] == "budget_exhausted"
+    assert doc["metrics"]["length"] is None
+
+
 def test_the_default_budget_says_which_flags_to_raise(monkeypatch, capsys):
     # without --max-expansions the search had no budget: a radius tiny beside the city
     # ran until the machine's memory was gone; now a default (lowered here) ends it

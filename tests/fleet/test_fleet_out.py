@@ -287,9 +287,16 @@ def test_a_bad_track_step_writes_nothing(sim, rep, tmp_path, step):
 
 def test_a_report_that_is_not_json_is_an_option_error(sim, tmp_path):
     with pytest.raises(OptionError, match="rep cannot be written") as err:
-        write_run(sim, {"served_share": math.nan}, tmp_path / "out")
+        write_run(sim, {"served_share": {1, 2}}, tmp_path / "out")
     assert err.value.param == "rep"
     assert not (tmp_path / "out").exists()
+
+
+def test_a_nan_in_the_report_is_written_null(sim, tmp_path):
+    """As every JSON skyroute writes (io/json_text.py): null, not NaN (no JSON); it
+    was refused as the report above is."""
+    write_run(sim, {"served_share": math.nan}, tmp_path / "out")
+    assert (tmp_path / "out" / "report.json").read_text() == '{\n  "served_share": null\n}\n'
 
 
 @pytest.mark.parametrize("blocker", ["tracks.csv", "fleet.geojson", "timeline.png"])

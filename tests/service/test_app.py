@@ -426,3 +426,14 @@ def test_a_repeated_query_parameter_is_checked_after_the_token(headers, status):
     # a route without the token: the 422 as before, and none without a repeat
     r = c.get("/orders?date=2024-01-03&date=2024-01-04")
     assert_problem(r, 422, field="date")
+
+
+def test_responses_write_infinities_and_nans_as_null():
+    """Starlette's JSONResponse refused them (a 500); the service's writes null, as
+    the routes with a response model do, and is every route's default."""
+    from skyroute.service.app import create_app
+    from skyroute.service.json_response import FiniteJSONResponse
+
+    body = FiniteJSONResponse({"length": float("inf"), "mean": [float("nan"), 1]}).body
+    assert body == b'{"length":null,"mean":[null,1]}'
+    assert create_app().router.default_response_class is FiniteJSONResponse

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated
 
@@ -27,6 +26,7 @@ from skyroute.cli.parse import parse_list
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import SEED_MAX, OptionError
 from skyroute.files import check_writable, write_atomic
+from skyroute.io.json_text import to_json
 from skyroute.world.load import bundled_maps
 
 bench_app = typer.Typer(help="Benchmarks against peer libraries.", no_args_is_help=True)
@@ -104,7 +104,7 @@ def bench_grid(
                             "seed": seed},
                "machine": machine([PEERS[p].module for p in have]),
                "maps": reports}
-        write_atomic(json_out, json.dumps(doc, indent=1))
+        write_atomic(json_out, to_json(doc, indent=1))
 
 
 def _random_specs(specs: list[str] | tuple, per_map: int) -> list[str]:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated
 
@@ -15,6 +14,7 @@ from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import SEED_MAX, OptionError, check_choice
 from skyroute.files import check_writable, write_atomic
+from skyroute.io.json_text import to_json
 
 
 @bench_app.command("fleet")
@@ -65,5 +65,5 @@ def bench_fleet(
         # the options, as every bench report keeps them (this one had none)
         settings = {"case": chosen, "scheduler": scheduler, "airspace": airspace,
                     "seed": seed}
-        write_atomic(json_out, json.dumps({"settings": settings, "machine": machine(),
+        write_atomic(json_out, to_json({"settings": settings, "machine": machine(),
                                            "rows": rows}, indent=1))

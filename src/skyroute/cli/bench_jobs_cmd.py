@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import datetime as dt
-import json
 from pathlib import Path
 from typing import Annotated
 
@@ -16,6 +15,7 @@ from skyroute.cli.parse import parse_date
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import OptionError
 from skyroute.files import check_writable, write_atomic
+from skyroute.io.json_text import to_json
 
 
 def _day(text: str, option: str) -> dt.date:
@@ -83,7 +83,7 @@ def bench_jobs_command(
                       f"{r['dask_speedup']:.2f}x" if dask else "-")
         print_table(out, s)
     if json_out:
-        write_atomic(json_out, json.dumps(
+        write_atomic(json_out, to_json(
             {"settings": {"data": str(data), "from": str(d0), "to": str(d1),
                           "method": method, "runs": runs, "simulate": counts},
              "machine": machine(("dask", "distributed")),

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 import platform
 from pathlib import Path
@@ -15,6 +14,7 @@ from skyroute.cli.bench_cmd import bench_app
 from skyroute.cli.tables import plain_console, print_table, wide_console
 from skyroute.errors import SEED_MAX, OptionError, SkyrouteError, check_choice, real
 from skyroute.files import check_writable, write_atomic
+from skyroute.io.json_text import to_json
 
 LOADS = ("plan", "flightpath")
 
@@ -122,7 +122,7 @@ def bench_service(
                                              "server CPU ms/req", "req/s per server core",
                                              "client CPU ms/req"))
     if json_out:
-        write_atomic(json_out, json.dumps(
+        write_atomic(json_out, to_json(
             {"settings": {"load": loads, "map": map_name if "plan" in loads else None,
                           "algorithm": algorithm if "plan" in loads else None,
                           "db": _shown_url(db), "date": date,

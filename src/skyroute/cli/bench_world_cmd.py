@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import sys
@@ -30,6 +29,7 @@ from skyroute.cli.parse import parse_items, parse_list
 from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_console
 from skyroute.errors import SEED_MAX, OptionError, SkyrouteError, check_choice
 from skyroute.files import check_writable, write_atomic
+from skyroute.io.json_text import to_json
 from skyroute.motion.step_drone import MERGE
 
 
@@ -161,7 +161,7 @@ def _bench_world(worlds, seed, city, altitude, safety, city_queries_n, no_path, 
         settings = {"worlds": worlds, "seed": seed, "seconds": seconds, "planners": chosen,
                     "city": city and str(city), "altitude": altitude, "safety": safety,
                     "city_queries": city_queries_n, "no_path": no_path}
-        write_atomic(json_out, json.dumps({**settings, "settings": settings,
+        write_atomic(json_out, to_json({**settings, "settings": settings,
                                            "machine": machine(("ompl",)), "worlds": reports,
                                            "city_queries": city_timing},
                                           indent=1, default=float))
@@ -219,7 +219,7 @@ def bench_motion(
     print_table(out, _dubins_table(d))
     if dubins:
         if json_out:
-            write_atomic(json_out, json.dumps({"machine": machine(("ompl",)), "dubins": d},
+            write_atomic(json_out, to_json({"machine": machine(("ompl",)), "dubins": d},
                                               indent=1))
         _exit_past_ompl()
         return
@@ -235,7 +235,7 @@ def bench_motion(
               f"median {r['median_ms']:,.1f} ms, p90 {r['p90_ms']:,.1f} ms, max "
               f"{r['max_ms']:,.1f} ms")
     if json_out:
-        write_atomic(json_out, json.dumps(
+        write_atomic(json_out, to_json(
             {"settings": {"data": str(data), "max_expansions": max_expansions, "merge": merge},
              "machine": machine(("ompl",)), "dubins": d, "step_drone": r}, indent=1))
     _exit_past_ompl()
@@ -323,6 +323,6 @@ def _bench_curvature(worlds, seed, secs, city, tours, json_out) -> None:
     if json_out:
         settings = {"worlds": worlds, "seed": seed, "budgets": list(secs),
                     "city": city and str(city), "tours": tours}
-        write_atomic(json_out, json.dumps({"settings": settings, "machine": machine(("ompl",)),
+        write_atomic(json_out, to_json({"settings": settings, "machine": machine(("ompl",)),
                                            "rows": rows, "summary": summ, "tours": t},
                                           indent=1, default=str))

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated
 
@@ -12,6 +11,7 @@ from skyroute.cli.parse import parse_date
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import plain_console
 from skyroute.errors import SEED_MAX
+from skyroute.io.json_text import to_json
 
 data_app = typer.Typer(help="Delivery data sets: synthesise one, serve one over HTTP.",
                        no_args_is_help=True)
@@ -40,7 +40,7 @@ def data_synth(
         with written_together():  # a Ctrl-C halfway leaves no part of a data set
             summary = synth(folder, days=days, orders_per_day=orders_per_day, seed=seed,
                             start=first, customers=customers)
-    typer.echo(json.dumps(summary))  # not through Rich: no markup, no wrapping
+    typer.echo(to_json(summary))  # not through Rich: no markup, no wrapping
 
 
 def _check_folder(folder: Path, replace: bool) -> None:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import datetime as dt
-import json
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -24,6 +23,7 @@ from skyroute.cli.tables import plain_console, print_table, progress_bar
 from skyroute.delivery.day import METHODS, DayResult
 from skyroute.delivery.store import DEFAULT_DB, safe_url
 from skyroute.errors import OptionError, SkyrouteError, check_choice
+from skyroute.io.json_text import to_json
 
 if TYPE_CHECKING:
     from skyroute.jobs.deliver import DayFailed
@@ -206,7 +206,7 @@ def _say_failed(failed: list[DayFailed], n: int) -> None:
 def _one_day(r: DayResult, files: list[Path], as_json: bool) -> None:
     rep = r.report()
     if as_json:
-        typer.echo(json.dumps(rep))
+        typer.echo(to_json(rep))
         return
     t = Table(title=f"delivery day {r.date}", show_header=False)
     t.add_column()
@@ -238,7 +238,7 @@ def _summary(results: list[DayResult], wall: float, jobs: int, workers: int, kin
              files=len(files), folders=sorted({str(f.parent) for f in files}),
              failed=[{"date": f.date.isoformat(), "error": f.error} for f in failed])
     if as_json:
-        typer.echo(json.dumps(s))
+        typer.echo(to_json(s))
         return
     if not s["days_with_orders"]:  # no table of money: _say_empty says why
         if files:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Annotated
@@ -22,6 +21,7 @@ from skyroute.cli.tables import plain_console, print_table, progress_bar, wide_c
 from skyroute.errors import SEED_MAX, OptionError, SkyrouteError, check_choice, real
 from skyroute.fleet.limits import MAX_DRONES, MAX_RATE, MAX_SEEDS, check_run, check_sweep
 from skyroute.fleet.scenario import PRESETS, Scenario, generate, load_scenario, preset, to_yaml
+from skyroute.io.json_text import to_json
 
 fleet_app = typer.Typer(help="Fixed-wing drones carry packages between airports: simulate, "
                              "write scenarios, sweep settings.", no_args_is_help=True)
@@ -159,7 +159,7 @@ def simulate_command(
                                                                   if plot else ""))
             files = write_run(sim, rep, out, track_step=track_step, plot=plot)
     if as_json:
-        typer.echo(json.dumps(rep))
+        typer.echo(to_json(rep))
     else:
         print_table(plain_console(), _report_table(rep, files))
     if rep["conflicts"] or rep["lost"]:
@@ -335,10 +335,8 @@ def sweep_command(
             except RunsLostError as exc:
                 rows, lost = exc.rows, exc.lost
     if as_json:
-        clean = [{k: None if isinstance(v, float) and math.isnan(v) else v
-                  for k, v in r.items()} for r in rows]
-        doc = {"scenario": s.name, "hours": hours, "seeds": seed_list, "rows": clean}
-        typer.echo(json.dumps({**doc, "lost": lost} if lost else doc, allow_nan=False))
+        doc = {"scenario": s.name, "hours": hours, "seeds": seed_list, "rows": rows}
+        typer.echo(to_json({**doc, "lost": lost} if lost else doc))  # NaN: null
     elif rows:
         print_table(wide_console(), _sweep_table(s, hours, seed_list, rows),
                     optional=_SWEEP_OPTIONAL)

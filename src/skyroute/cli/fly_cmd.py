@@ -20,6 +20,7 @@ from skyroute.cli.tables import plain_console, print_table
 from skyroute.errors import OptionError, check_choice, real
 from skyroute.files import read_text, write_atomic, written_together
 from skyroute.io.geojson import dumps
+from skyroute.io.json_text import to_json
 from skyroute.planner import plan
 from skyroute.result import PlanResult, Status
 from skyroute.world.load import load_world
@@ -61,10 +62,20 @@ UNUSED_IN_MODE = {
 MODE_FLAG = {"targets": "--targets", "waypoints": "--planner waypoints",
              "step": "--field-mode step"}
 EXIT_NOT_REACHED = 1
+# The distance options' defaults, in metres (speed in metres per second): a value given
+# is in the world's plane units (degrees in the degrees frame), a default is taken into
+# them (World.metres_in_plane), so the defaults fit a world in every frame.
+DEFAULT_METRES = {"radius": 10.0, "step": 1.0, "sensor_range": 6.0, "speed": 1.0}
 
 
 def _for(option: str, text: str) -> str:
-    """``option``'s help led by the vehicles that take it: ``"dubins: turning radius."``."""
+    """``option``'s help led by the vehicles that take it: ``"dubins: turning radius."``;
+    a distance option's (DEFAULT_METRES) followed by its units and default."""
+    if option in DEFAULT_METRES:
+        per, unit = (" per second", "m/s") if option == "speed" else ("", "m")
+        text += (f" Plane units{per} (degrees in the degrees frame); default "
+                 f"{DEFAULT_METRES[option]:g} {unit} (its equivalent in degrees in the "
+                 "degrees frame).")
     return f"{', '.join(TAKEN_BY[option])}: {text}"
 
 
@@ -87,7 +98,8 @@ def fly_command(
                    "Theta* path); for dubins, hybrid (Hybrid A* among the obstacles; the "
                    "default) or waypoints (Dubins curves through the exact route's "
                    "corners, which may cut them: reports free)."))] = None,
-    radius: Annotated[float, typer.Option(help=_for("radius", "turning radius."))] = 10.0,
+    radius: Annotated[float | None, typer.Option(help=_for(
+        "radius", "turning radius."))] = None,
     start_heading: Annotated[float | None, typer.Option(help=_for(
         "start_heading", "start heading, degrees in the frame's convention (clockwise from "
                          "north in lonlat and ned; anticlockwise from east in enu and "
@@ -109,19 +121,20 @@ def fly_command(
         "targets", "visit these targets (a .csv or .json of A,B points in --frame) in the "
                    "shortest order from START; GOAL is not used."))] = None,
     headings: Annotated[int, typer.Option(help=_for("headings", "8 or 16 headings."))] = 8,
-    speed: Annotated[float, typer.Option(help=_for(
-        "speed", "metres (plane units) per second."))] = 1.0,
+    speed: Annotated[float | None, typer.Option(help=_for(
+        "speed", "speed."))] = None,
     turn_rate: Annotated[float, typer.Option(help=_for(
         "turn_rate", "degrees per second."))] = 90.0,
     resolution: Annotated[float | None, typer.Option(help=_for(
         "resolution", "cell size."))] = None,
-    step: Annotated[float, typer.Option(help=_for(
-        "step", "sampling step (dubins) or move length (field)."))] = 1.0,
+    step: Annotated[float | None, typer.Option(help=_for(
+        "step", "sampling step (dubins), or move length, escape cell and goal tolerance "
+                "(field)."))] = None,
     escape: Annotated[bool, typer.Option(help=_for(
         "escape", "follow a navigation function whenever the field cannot move on "
                   "(a local minimum, a blocked move)."))] = True,
-    sensor_range: Annotated[float, typer.Option(help=_for(
-        "sensor_range", "sensor range."))] = 6.0,
+    sensor_range: Annotated[float | None, typer.Option(help=_for(
+        "sensor_range", "sensor range."))] = None,
     sensor_rays: Annotated[int, typer.Option(help=_for(
         "sensor_rays", "sensor rays (density)."))] = 36,
     field_mode: Annotated[str, typer.Option(help=_for(
@@ -153,7 +166,8 @@ def fly_command(
     if out is not None and out.suffix.lower() not in (".json", ".csv", ".geojson"):
         raise OptionError(f"--out {out}: the suffix must be .json, .csv or .geojson")
     check_outputs(out=out, plot=plot)
-    real("radius", radius, low=0.0, strict=True)
+    if radius is not None:  # checked before a long load; the others by the vehicles
+        real("radius", radius, low=0.0, strict=True)
     # degrees here; the library's check speaks radians
     real("max_turn", max_turn, low=0.0, strict=True, high=180.0, need="in (0, 180] degrees")
     if goal is None and targets is None:
@@ -173,6 +187,10 @@ def fly_command(
         world.check_point(a, "start")  # one error, in the user's frame, for every vehicle
         if targets is None:
             world.check_point(b, "goal")
+        radius, step, sensor_range, speed = (
+            world.metres_in_plane(DEFAULT_METRES[name], near=a) if value is None else value
+            for name, value in (("radius", radius), ("step", step),
+                                ("sensor_range", sensor_range), ("speed", speed)))
         if vehicle == "step":
             world, a, b = world.in_frame("degrees"), world.to_lonlat(a)[0], world.to_lonlat(b)[0]
             doc, rows, xy = _fly_step(world, a, b, planner)
@@ -214,7 +232,7 @@ def fly_command(
                             obstacles=obstacles_label(altitude, safety, frame),
                             targets=visits if tour else None)
     if as_json:
-        typer.echo(json.dumps({k: v for k, v in doc.items() if k != "columns"}))
+        typer.echo(to_json({k: v for k, v in doc.items() if k != "columns"}))
     else:
         table = Table(title=f"{world.name}: {vehicle}", show_header=False)
         unit = "deg" if world.plane == "degrees" else "m"
@@ -489,7 +507,7 @@ def _not_reached(why: str) -> dict:
 def _render(path: Path, rows, columns, lonlat) -> str:
     suffix = path.suffix.lower()
     if suffix == ".json":
-        return json.dumps(rows)
+        return to_json(rows)
     if suffix == ".csv":
         buf = io.StringIO()
         w = csv.writer(buf)

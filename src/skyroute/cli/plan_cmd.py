@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated
 
@@ -14,6 +13,7 @@ from skyroute.cli.tables import print_table, result_table
 from skyroute.errors import InputFormatError, OptionError
 from skyroute.files import check_writable, write_atomic, written_together
 from skyroute.io.geojson import dumps, grid_path_geojson
+from skyroute.io.json_text import to_json
 from skyroute.planner import plan
 from skyroute.search.grid_plan import GRID_ALGORITHMS, grid_options
 from skyroute.world.load import load_map
@@ -88,7 +88,7 @@ def plan_command(
 
                 plot_grid_path(grid, result, s, t, plot, prune=opts.prune, safety=safety)
     if as_json:
-        typer.echo(json.dumps(result.to_dict()))
+        typer.echo(to_json(result.to_dict()))
     else:
         from skyroute.cli.tables import plain_console
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated
 
@@ -17,6 +16,7 @@ from skyroute.cli.tables import plain_console, print_table, result_table
 from skyroute.errors import SEED_MAX, OptionError
 from skyroute.files import write_atomic, written_together
 from skyroute.io.geojson import dumps
+from skyroute.io.json_text import to_json
 from skyroute.io.world_out import (
     obstacles_label,
     path_north_east,
@@ -84,7 +84,7 @@ def plan_world_command(
     if result.found:
         with written_together():  # all the files or none (a Ctrl-C while plotting)
             if waypoints_out:
-                write_atomic(waypoints_out, json.dumps(waypoints(world, result.path, alt)))
+                write_atomic(waypoints_out, to_json(waypoints(world, result.path, alt)))
             if geojson:
                 write_atomic(geojson, dumps(world_path_geojson(world, result)))
             if plot:
@@ -94,7 +94,7 @@ def plan_world_command(
                                                        if k in given}),
                                 obstacles=obstacles_label(altitude, safety, world.frame))
     if as_json:
-        typer.echo(json.dumps(world_result_doc(world, result)))
+        typer.echo(to_json(world_result_doc(world, result)))
     else:
         files = (("waypoints file", waypoints_out), ("geojson", geojson), ("plot", plot)) \
             if result.found else ()

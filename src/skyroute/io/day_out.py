@@ -7,13 +7,13 @@ store_day`.)
 from __future__ import annotations
 
 import datetime as dt
-import json
 from pathlib import Path
 
 import numpy as np
 
 from skyroute.delivery.day import DayResult
 from skyroute.files import check_writable, write_atomic, written_together
+from skyroute.io.json_text import to_json
 
 
 def stem(date: dt.date) -> str:
@@ -24,7 +24,7 @@ def stem(date: dt.date) -> str:
 def geojson(result: DayResult, home) -> str:
     f = result.flight.flight
     pts = np.vstack([f.frm[:1], f.to]) if f.moves else np.array([home, home], dtype=float)
-    return json.dumps({"type": "FeatureCollection", "features": [{
+    return to_json({"type": "FeatureCollection", "features": [{
         "type": "Feature", "properties": {"date": result.date.isoformat(),
                                           "moves": f.moves},
         "geometry": {"type": "LineString", "coordinates": pts.tolist()}}]})
@@ -142,7 +142,7 @@ def write_outputs(site, result: DayResult, out: Path, *, plot: bool = True) -> l
     paths = output_paths(out, result.date, plot=plot)
     with written_together():  # a Ctrl-C halfway leaves none of the day's files
         write_atomic(paths[0], geojson(result, site.home))
-        write_atomic(paths[1], json.dumps(result.report(), indent=1))
+        write_atomic(paths[1], to_json(result.report(), indent=1))
         if plot:
             paths[2] = plot_day(site, result, paths[2])
     return paths

@@ -43,7 +43,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import math
 from pathlib import Path
 
@@ -57,6 +56,7 @@ from skyroute.fleet.simulate import TIME_DECIMALS, WARMUP_SHARE, Simulation
 from skyroute.fleet.trajectory import position
 from skyroute.geo import Home, ned_to_lonlat
 from skyroute.io.geojson import dumps
+from skyroute.io.json_text import to_json
 
 TRACK_PHASES = ("taxi", "takeoff", "climb", "cruise", "loiter", "approach", "landing",
                 "rollout")
@@ -83,7 +83,7 @@ def write_run(sim: Simulation, rep: dict, out: str | Path, *, track_step: float 
     out = Path(out)
     _check_step("track_step", track_step)
     try:
-        report_text = json.dumps(rep, indent=2, allow_nan=False) + "\n"
+        report_text = to_json(rep, indent=2) + "\n"  # a NaN or an infinity: null
     except (TypeError, ValueError) as exc:
         raise OptionError(f"rep cannot be written as JSON: {exc}", param="rep") from None
     paths = check_run_outputs(out, plot=plot)  # none written if one cannot be
@@ -117,7 +117,7 @@ def check_run_outputs(out: str | Path, *, plot: bool = False) -> list[Path]:
 
 def events_jsonl(sim: Simulation) -> str:
     """``sim.events`` as JSON lines: compact, keys in each event's order."""
-    return "".join(json.dumps(e, separators=(",", ":")) + "\n" for e in sim.events)
+    return "".join(to_json(e, separators=(",", ":")) + "\n" for e in sim.events)
 
 
 # -- tracks -------------------------------------------------------------------------

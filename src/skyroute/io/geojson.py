@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-import json
-
+from skyroute.io.json_text import to_json
 from skyroute.result import PlanResult
 from skyroute.world.grid import Grid
 
@@ -33,4 +32,4 @@ def grid_path_geojson(grid: Grid, result: PlanResult) -> dict:
 
 def dumps(obj: dict) -> str:
     """Compact, stable JSON text."""
-    return json.dumps(obj, separators=(",", ":")) + "\n"
+    return to_json(obj, separators=(",", ":")) + "\n"

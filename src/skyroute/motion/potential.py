@@ -16,6 +16,9 @@ robot a heading it cannot change by more than ``max_turn`` per move, drives a ci
 arc that turns towards the force, and makes fractional progress: the arc is ``step``
 long scaled by cos(heading error) (at least a quarter step), so the robot slows into
 sharp turns and speeds up when aligned, as a wheeled robot does.
+
+Distances are plane units (degrees in the "degrees" frame); the defaults are metres
+(:data:`DEFAULTS`) taken into them, so they fit a world in any frame.
 """
 
 from __future__ import annotations
@@ -34,6 +37,9 @@ from skyroute.world.world import World
 
 COURSES = ("easy", "medium", "hard")
 MODES = ("step", "arc")
+#: :func:`run_field`'s distance defaults in metres (``repulse`` in cubic metres), taken
+#: into a world's plane units when left out (degrees in the "degrees" frame)
+DEFAULTS = {"step": 0.5, "sensor_range": 6.0, "tolerance": 0.5, "repulse": 60.0}
 ARC_SAMPLES = 4  # points per arc, for collision checks and the drawn trace
 #: how far (cells) the escape looks for a cell of the navigation function when none of
 #: the robot's own neighbours has a way to the goal (the robot is in the clearance that
@@ -221,9 +227,10 @@ def _navigation(world: World, goal: np.ndarray, resolution: float, points: np.nd
     return grid, dist
 
 
-def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 1.0,
-              repulse: float = 60.0, sensor_range: float = 6.0, sensor_rays: int = 36,
-              tolerance: float = 0.5, max_moves: int = 2000, escape: bool = True,
+def run_field(world: World, start, goal, *, step: float | None = None,
+              attract: float = 1.0, repulse: float | None = None,
+              sensor_range: float | None = None, sensor_rays: int = 36,
+              tolerance: float | None = None, max_moves: int = 2000, escape: bool = True,
               window: int = 40, mode: str = "step", max_turn: float = math.pi / 4,
               heading: float | None = None) -> FieldRun:
     """Descend the field from ``start``; with ``escape``, follow the navigation function
@@ -233,11 +240,31 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
     escape takes over again, it runs twice as long as the last time, so a trap
     the field keeps falling back into is left for good. In ``arc`` mode the robot starts
     on ``heading`` (radians in the world's frame's convention; default towards the
-    goal). Points come in and the run's path goes out in the world's frame; distances
-    (``step``, ``sensor_range``) are plane units. A run that does not reach the goal
-    says why in :attr:`FieldRun.why`."""
+    goal). Points come in and the run's path goes out in the world's frame. A run that
+    does not reach the goal says why in :attr:`FieldRun.why`.
+
+    Distances (``step``, ``sensor_range``, ``tolerance``) are plane units, as every
+    distance of a World: metres, or degrees in the "degrees" frame, where the robot
+    flies the flat lon/lat plane as it is (a step is as many degrees east as north).
+    ``repulse`` multiplies ``(1/d - 1/sensor_range) / d**2`` against an attraction of
+    ``attract`` (no unit), so it is plane units cubed. Left out (None), each is its
+    default in metres (:data:`DEFAULTS`) taken into the plane's units
+    (:meth:`World.metres_in_plane`: in "degrees", over the metres per degree of
+    latitude at the world's home), ``repulse`` by the cube of that scale: the defaults
+    fit a world in any frame. Before, they were plane units in "degrees" too: a 0.5
+    step and tolerance were half a degree (55 km), and every goal of a city was
+    "reached" at the start, in 0 moves.
+    """
     check_instance("world", world, World, "a skyroute World")
     check_choice("mode", mode, MODES)
+    p = world.check_point(start, "start")
+    t = world.check_point(goal, "goal")
+    unit = world.metres_in_plane(1.0, near=p)  # one metre in plane units
+    step, sensor_range, tolerance = (DEFAULTS[name] * unit if value is None else value
+                                     for name, value in (("step", step),
+                                                         ("sensor_range", sensor_range),
+                                                         ("tolerance", tolerance)))
+    repulse = DEFAULTS["repulse"] * unit ** 3 if repulse is None else repulse
     step, sensor_range, tolerance = (real(name, value, low=0.0, strict=True, need="> 0")
                                      for name, value in (("step", step),
                                                          ("sensor_range", sensor_range),
@@ -251,8 +278,6 @@ def run_field(world: World, start, goal, *, step: float = 0.5, attract: float = 
     window = whole("window", window, low=1)
     escape = flag("escape", escape)
     heading = None if heading is None else real("heading", heading)
-    p = world.check_point(start, "start")
-    t = world.check_point(goal, "goal")
     if escape:  # refused now, not after the moves flown before a first stall
         _escape_box(world, t, step, p[None, :])
     theta = math.atan2(*(t - p)[::-1]) if heading is None else \

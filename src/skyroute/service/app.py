@@ -20,6 +20,7 @@ from fastapi_offline import FastAPIOffline
 
 import skyroute
 from skyroute.service import cut, problems, query, ready
+from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.middleware import BodyLimit, HeadAsGet, ServerTiming
 from skyroute.service.resources import Resources
 from skyroute.service.routers import (
@@ -62,6 +63,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     # in the field (no internet) still shows its API reference
     app = FastAPIOffline(title="skyroute", version=skyroute.__version__,
                          description=DESCRIPTION, lifespan=lifespan,
+                         # an infinity or a NaN is null, never a 500 (json_response)
+                         default_response_class=FiniteJSONResponse,
                          # every route: a repeated single-valued query parameter is a 422
                          dependencies=[Depends(query.one_value_each)])
     app.state.settings = settings

@@ -11,13 +11,14 @@ import logging
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
-from fastapi.responses import HTMLResponse, JSONResponse, Response
+from fastapi.responses import HTMLResponse, Response
 from pydantic import BaseModel, Field
 from sqlalchemy.exc import OperationalError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from skyroute.delivery.store import is_busy
 from skyroute.errors import InputFormatError, SkyrouteError, StoreBusyError
+from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.paths import root_path, route_path
 
 MEDIA_TYPE = "application/problem+json"
@@ -60,7 +61,7 @@ class Problem(Exception):  # noqa: N818  (an answer, not a failure of the server
 
 def problem_response(status: int, detail: str, *, field: str | None = None,
                      kind: str | None = None, errors: list[dict] | None = None,
-                     headers: dict[str, str] | None = None) -> JSONResponse:
+                     headers: dict[str, str] | None = None) -> FiniteJSONResponse:
     title = TITLES.get(status, "error")
     doc = {"type": TYPE_BASE + (kind or title.replace(" ", "-")), "title": title,
            "status": status, "detail": detail}
@@ -69,7 +70,7 @@ def problem_response(status: int, detail: str, *, field: str | None = None,
         # as a validation error reads: the message without the "field: " the detail has
         doc["errors"] = errors or [{"field": field,
                                     "message": detail.removeprefix(f"{field}: ")}]
-    return JSONResponse(doc, status_code=status, media_type=MEDIA_TYPE, headers=headers)
+    return FiniteJSONResponse(doc, status_code=status, media_type=MEDIA_TYPE, headers=headers)
 
 
 def from_skyrouteerror(exc: SkyrouteError, *, field: str | None = None) -> Problem:
@@ -121,7 +122,7 @@ def _not_json_media(request: Request) -> str | None:
     return f"Content-Type {media} is not JSON"
 
 
-async def _validation(request: Request, exc: RequestValidationError) -> JSONResponse:
+async def _validation(request: Request, exc: RequestValidationError) -> FiniteJSONResponse:
     bad = next((e for e in exc.errors() if e.get("type") == "json_invalid"), None)
     if bad is not None:  # its loc is a byte offset, not a field: a 400, as for non-UTF-8
         where = bad.get("loc", ())[-1:]
@@ -142,7 +143,7 @@ async def _validation(request: Request, exc: RequestValidationError) -> JSONResp
     return problem_response(422, detail, field=first["field"], errors=errors)
 
 
-async def _problem(request: Request, exc: Problem) -> JSONResponse:
+async def _problem(request: Request, exc: Problem) -> FiniteJSONResponse:
     return problem_response(exc.status, exc.detail, field=exc.field, kind=exc.kind,
                             headers=exc.headers)
 
@@ -256,14 +257,14 @@ async def _http(request: Request, exc: StarletteHTTPException) -> Response:
     return problem_response(exc.status_code, detail, headers=headers)
 
 
-async def _library(request: Request, exc: SkyrouteError) -> JSONResponse:
+async def _library(request: Request, exc: SkyrouteError) -> FiniteJSONResponse:
     return await _problem(request, from_skyrouteerror(exc))
 
 
 BUSY_RETRY_SECONDS = 5  # a busy store's Retry-After: its writer has held it past the timeout
 
 
-async def _busy(request: Request, exc: StoreBusyError) -> JSONResponse:
+async def _busy(request: Request, exc: StoreBusyError) -> FiniteJSONResponse:
     """The store locked by another process past its busy timeout: the server's condition,
     and a passing one, not a fault of the request (a write was answered 422, a read
     500); the store's URL in the library's message stays in the log."""
@@ -275,7 +276,7 @@ async def _busy(request: Request, exc: StoreBusyError) -> JSONResponse:
                             headers={"Retry-After": str(BUSY_RETRY_SECONDS)})
 
 
-async def _database(request: Request, exc: Exception) -> JSONResponse:
+async def _database(request: Request, exc: Exception) -> FiniteJSONResponse:
     """A database error the store let through: a read of a locked SQLite store is
     :func:`_busy`'s 503, anything else the 500 of :func:`_internal`."""
     if is_busy(exc):
@@ -283,7 +284,7 @@ async def _database(request: Request, exc: Exception) -> JSONResponse:
     return await _internal(request, exc)
 
 
-async def _internal(request: Request, exc: Exception) -> JSONResponse:
+async def _internal(request: Request, exc: Exception) -> FiniteJSONResponse:
     log.exception("unhandled error on %s %s", request.method, request.url.path)
     return problem_response(500, "the server could not answer this request; the error "
                             "is in its log")

@@ -31,6 +31,7 @@ from skyroute.geo import (
     heading_from_plane,
     heading_to_plane,
     lonlat_to_enu,
+    metres_per_degree_north,
 )
 from skyroute.world.grid import Grid, raster_shape
 from skyroute.world.points import (
@@ -131,6 +132,33 @@ class World:
     def has_lonlat(self) -> bool:
         """True when plane points can be given as lon/lat (a home, or the degrees frame)."""
         return self.frame == "degrees" or self.home is not None
+
+    def metres_in_plane(self, metres: float, *, near=None) -> float:
+        """A distance of ``metres`` in the plane's units: itself in the metres frames; in
+        "degrees", ``metres`` over the metres per degree of latitude
+        (:func:`~skyroute.geo.metres_per_degree_north`) at the world's home, else at the
+        centre of its extent, else at ``near`` (a plane point: a run's start).
+
+        What a vehicle's distance defaults, documented in metres, are in this world's
+        plane (a value the caller gives is plane units, as every distance of a World).
+        The degrees plane is flat and isotropic in degrees, so one scale serves every
+        direction; the north one is chosen because a degree of latitude is a degree
+        everywhere (110.6 to 111.7 km, pole included), so the default is never longer
+        on the ground than its metres: north it is as long, east cos(latitude) of it
+        (a geometric mean of the two scales would grow without bound near a pole)."""
+        metres = real("metres", metres)
+        if self.frame != "degrees":
+            return metres
+        if self.home is not None:
+            lat = self.home.lat
+        elif self.boundary is not None or len(self.obstacles):
+            lat = (self.bounds[1] + self.bounds[3]) / 2
+        elif near is not None:
+            lat = float(np.asarray(near, dtype=float).reshape(2)[1])
+        else:
+            raise OptionError(f"world {self.name!r} (frame 'degrees') has no home, extent "
+                              "or point to measure a metre at")
+        return metres / metres_per_degree_north(lat)
 
     def to_plane(self, points, what: str = "points") -> np.ndarray:
         """Points in the world's frame -> (N, 2) plane points; a malformed input is a

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import datetime as dt
 import hashlib
-import json
 import time
 from typing import Annotated
 
@@ -14,6 +13,7 @@ from fastapi import APIRouter, Depends, Path, Request, Response
 from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, Field
 
+from skyroute.io.json_text import to_json
 from skyroute.service.auth import require_token
 from skyroute.service.dates import IsoDate
 from skyroute.service.problems import Problem, responses
@@ -219,4 +219,4 @@ def _flightpath(eng, date: dt.date, res: Resources) -> bytes:
         "type": "Feature", "geometry": geometry,
         "properties": {"date": date.isoformat(), "moves": n, "angles": m["angle"].tolist(),
                        "orders": m["order_no"]}}]}
-    return json.dumps(doc, separators=(",", ":")).encode()
+    return to_json(doc, separators=(",", ":")).encode()

@@ -19,6 +19,7 @@ from fastapi import APIRouter, Path, Query, Request, Response
 from fastapi.responses import StreamingResponse
 from pydantic import BaseModel, Field
 
+from skyroute.io.json_text import to_json
 from skyroute.service import cut
 from skyroute.service.middleware import is_head
 from skyroute.service.paths import url_path
@@ -268,5 +269,5 @@ def get_geojson(run_id: RunId, res: ResourcesDep) -> Response:
 
     run = _run(res, run_id, "tracks_csv")
     scenario = parse_scenario(_scenario(run), "scenario")
-    text = json.dumps(fleet_geojson_from_tracks(scenario, _text(run, "tracks", "tracks_csv")))
+    text = to_json(fleet_geojson_from_tracks(scenario, _text(run, "tracks", "tracks_csv")))
     return _file(text, "application/geo+json", "fleet.geojson")

@@ -14,7 +14,6 @@ import threading
 from typing import Annotated, Any, Literal
 
 from fastapi import APIRouter, Depends, Path, Request
-from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from skyroute.delivery.limits import MAX_DAYS
@@ -30,6 +29,7 @@ from skyroute.fleet.limits import (
 from skyroute.service.alternatives import exactly_one
 from skyroute.service.auth import require_token
 from skyroute.service.dates import IsoDate
+from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.paths import url_path
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import Resources, ResourcesDep
@@ -124,7 +124,7 @@ def _jobs():
 
 
 def _submit(res: Resources, request: Request, kind: str, params: dict, *,
-            once: bool = False) -> JSONResponse:
+            once: bool = False) -> FiniteJSONResponse:
     """Queue the job: 202 ``{"id"}``. With ``once``, a job of ``kind`` with the same
     parameters already queued or running (this server's or another's on the store) is
     answered instead: 200 with its id, nothing queued, even when the queue is full."""
@@ -157,8 +157,8 @@ def _submit(res: Resources, request: Request, kind: str, params: dict, *,
                           else None) from None
         if new:
             res.job_ids.append(job_id)
-    return JSONResponse({"id": job_id}, status_code=202 if new else 200,
-                        headers={"Location": url_path(request, f"/jobs/{job_id}")})
+    return FiniteJSONResponse({"id": job_id}, status_code=202 if new else 200,
+                              headers={"Location": url_path(request, f"/jobs/{job_id}")})
 
 
 @router.post("/jobs/deliver", status_code=202, response_model=JobId,

@@ -16,12 +16,12 @@ from typing import Annotated, Literal
 
 from fastapi import APIRouter, Depends
 from fastapi.concurrency import run_in_threadpool
-from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, model_validator
 
 from skyroute.errors import SEED_MAX, InputFormatError, QueryError, SkyrouteError
 from skyroute.service.alternatives import exactly_one
 from skyroute.service.auth import require_token
+from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.problems import Problem, from_skyrouteerror, responses
 from skyroute.service.resources import Resources, ResourcesDep
 from skyroute.world.points import MAX_METRES
@@ -136,7 +136,7 @@ _SEARCH = threading.Lock()
 
 @router.post("/plan", response_model=PlanAnswer, dependencies=[Depends(require_token)],
              responses=responses(401, 403, 413, 422), summary="Plan one path")
-async def post_plan(body: PlanRequest, res: ResourcesDep) -> JSONResponse:
+async def post_plan(body: PlanRequest, res: ResourcesDep) -> FiniteJSONResponse:
     # A bundled map is read once and its search is bounded by the budget: when no other
     # search holds the slot it runs right here on the event loop (a thread hop and the
     # GIL hand-overs cost more than the search on most queries). The loop never waits
@@ -150,7 +150,7 @@ async def post_plan(body: PlanRequest, res: ResourcesDep) -> JSONResponse:
             _SEARCH.release()
     else:
         out, timing = await run_in_threadpool(_timed, body, res, t0)
-    return JSONResponse(out, headers={"Server-Timing": timing})
+    return FiniteJSONResponse(out, headers={"Server-Timing": timing})
 
 
 def _timed(body: PlanRequest, res: Resources, t0: float) -> tuple[dict, str]:

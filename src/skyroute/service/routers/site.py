@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Response
 
+from skyroute.io.json_text import to_json
 from skyroute.service.problems import responses
 from skyroute.service.resources import Resources, ResourcesDep
 
@@ -35,7 +36,6 @@ def get_site(res: ResourcesDep) -> Response:
 
 
 def _site_doc(site, res: Resources, dates: list) -> bytes:
-    import json
 
     import shapely
 
@@ -62,7 +62,7 @@ def _site_doc(site, res: Resources, dates: list) -> bytes:
             continue  # an order to an unknown place: GET /days/{date} gives its reason
         features.append(_point(p, kind="customer", words=w))
     doc = {"type": "FeatureCollection", "features": features}
-    return json.dumps(doc, separators=(",", ":")).encode()
+    return to_json(doc, separators=(",", ":")).encode()
 
 
 def _point(p, **props) -> dict:
