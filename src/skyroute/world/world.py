@@ -33,6 +33,7 @@ from skyroute.geo import (
     lonlat_to_enu,
 )
 from skyroute.world.grid import Grid, raster_shape
+from skyroute.world.nearest_free import nearest_free
 from skyroute.world.points import (
     MAX_REACH,
     as_points,
@@ -380,9 +381,9 @@ class World:
                              f"({self._extent_text()}){self._swapped_hint(given)}")
         j = int(self.blocking([p])[0])
         if j >= 0:
-            near = self.nearest_free(p, j)
-            raise QueryError(f"{what} {shown} lies inside obstacle "
-                             f"{self.names[j]!r}; nearest free point {self._fmt(near)}")
+            near = nearest_free(self, p, j, self._decimals)
+            hint = "" if near is None else f"; nearest free point {self._fmt(near)}"
+            raise QueryError(f"{what} {shown} lies inside obstacle {self.names[j]!r}{hint}")
         return p
 
     def _check_reach(self, p: np.ndarray, what: str, shown: str, given) -> None:
@@ -446,19 +447,6 @@ class World:
             return ""
         return f"; {self._fmt_frame(q)} is inside: points are (lon, lat)"
 
-    def nearest_free(self, p: np.ndarray, j: int) -> np.ndarray:
-        """A free point just outside obstacle j, nearest to p."""
-        ring = self.obstacles[j].exterior
-        q = np.array(shapely.line_interpolate_point(ring, ring.project(shapely.Point(p))).coords[0])
-        step = 1e-7 if self.frame == "degrees" else 1e-3
-        d = q - p
-        d = d / (np.linalg.norm(d) or 1.0)
-        for k in range(1, 20):
-            cand = q + d * step * k
-            if self.is_free([cand])[0]:
-                return cand
-        return q
-
     def _fmt(self, p) -> str:
         """A plane point as the caller wrote it: 7 decimals of a degree (about 1 cm) or cm."""
         return self._fmt_frame(self.from_plane([p])[0])
@@ -466,8 +454,12 @@ class World:
     def _fmt_frame(self, q) -> str:
         """A point in the world's frame, as :meth:`_fmt` shows it."""
         a, b = q
-        fmt = "{:.7f}" if self.frame in ("lonlat", "degrees") else "{:.2f}"
-        return f"({fmt.format(a)}, {fmt.format(b)})"
+        return f"({a:.{self._decimals}f}, {b:.{self._decimals}f})"
+
+    @property
+    def _decimals(self) -> int:
+        """Decimals a point is shown with: 7 of a degree (about 1 cm), or 2 of a metre."""
+        return 7 if self.frame in ("lonlat", "degrees") else 2
 
     def _extent_text(self) -> str:
         """'x in (a, b), y in (c, d)' for the map's extent, in the world's frame."""
