@@ -35,6 +35,7 @@ from skyroute.geo import (
 from skyroute.world.grid import Grid, raster_shape
 from skyroute.world.nearest_free import nearest_free
 from skyroute.world.points import (
+    MAX_METRES,
     MAX_REACH,
     as_points,
     check_metres,
@@ -378,7 +379,7 @@ class World:
         self._check_reach(p, what, shown, given)
         if not self.inside([p])[0]:
             raise QueryError(f"{what} {shown} lies outside the map "
-                             f"({self._extent_text()}){self._swapped_hint(given)}")
+                             f"({self._extent_text()}){self._hint(given)}")
         j = int(self.blocking([p])[0])
         if j >= 0:
             near = nearest_free(self, p, j, self._decimals)
@@ -410,7 +411,7 @@ class World:
         raise QueryError(f"{what} {shown} lies {far / 1000:,.0f} km from the world's home "
                          f"(lon {home.lon:g}, lat {home.lat:g}), more than the "
                          f"{MAX_REACH / 1000:,.0f} km a world with no boundary reaches"
-                         f"{self._swapped_hint(given)}")
+                         f"{self._hint(given)}")
 
     def _reach_home(self) -> Home | None:
         """Where :meth:`_check_reach` measures from: the home, else (a "degrees" world
@@ -428,6 +429,34 @@ class World:
             return None
         lon, lat = np.asarray(lonlat, dtype=float)
         return float(np.linalg.norm(lonlat_to_enu([lon], [lat], 0.0, home)))
+
+    def _hint(self, given) -> str:
+        """What a point refused as outside the map (or past its reach) was likely meant
+        as: its numbers swapped (:meth:`_swapped_hint`), else metres
+        (:meth:`_metres_hint`); '' when neither lies inside."""
+        return self._swapped_hint(given) or self._metres_hint(given)
+
+    def _metres_hint(self, given) -> str:
+        """'; ... 'ned' frame' when a point of the "lonlat" frame lies past the reach from
+        home as (lon, lat) but, read as (north, east) metres from home as FCND writes
+        points, would lie inside the map (with no boundary, within its reach); else ''.
+        ``--start 0,0`` (home, in metres) was refused as 5,965 km away, naming no way on;
+        a (lon, lat) near home but outside the map gets no such note."""
+        if given is None or self.frame != "lonlat" or self.home is None:
+            return ""
+        far = self._reach(given)
+        if far is None or far <= MAX_REACH:
+            return ""
+        north, east = np.asarray(given, dtype=float)
+        if not max(abs(north), abs(east)) <= MAX_METRES:
+            return ""
+        if self.boundary is None:
+            if np.hypot(north, east) > MAX_REACH:
+                return ""
+        elif not self.inside([(east, north)])[0]:
+            return ""
+        return ("; points are (lon, lat) here: (north, east) metres from home are the "
+                "'ned' frame")
 
     def _swapped_hint(self, given) -> str:
         """'; ... (lon, lat)' when a lon/lat point outside the map (or, with no boundary,
