@@ -33,7 +33,7 @@ def nearest_free(world, p: np.ndarray, j: int, decimals: int) -> np.ndarray | No
     if free.is_empty:
         return None
     q = np.array(shapely.shortest_line(pt, free).coords[-1])
-    return _stepped_out(world, p, q, decimals)
+    return _stepped_out(world, block, p, q, decimals)
 
 
 def _block(world, j: int):
@@ -51,9 +51,12 @@ def _block(world, j: int):
     return shapely.union_all(shapely.polygons(shapely.get_exterior_ring(parts)))
 
 
-def _stepped_out(world, p: np.ndarray, q: np.ndarray, decimals: int) -> np.ndarray | None:
+def _stepped_out(world, block, p: np.ndarray, q: np.ndarray,
+                 decimals: int) -> np.ndarray | None:
     """Of the points stepped out from ``q`` (on the block's edge) whose rounded form is
-    free, the one nearest ``p``, as typed back from its rounded form."""
+    free and outside the block, the one nearest ``p``, as typed back from its rounded
+    form. (The edge two touching obstacles share is free in the world, which tests each
+    obstacle alone, but inside the block, as the visibility graph merges them.)"""
     step = 10.0 ** -decimals / 10 if world.frame == "degrees" else 1e-3
     away = (q - p) / (np.hypot(*(q - p)) or 1.0)
     angles = np.linspace(0, 2 * np.pi, DIRECTIONS, endpoint=False)
@@ -61,7 +64,7 @@ def _stepped_out(world, p: np.ndarray, q: np.ndarray, decimals: int) -> np.ndarr
     k = np.arange(1, STEPS + 1)[:, None, None] * step
     cand = (q + k * dirs[None]).reshape(-1, 2)
     back = world.to_plane(np.round(world.from_plane(cand), decimals) + 0.0)  # no -0.00
-    ok = np.flatnonzero(world.is_free(back))
+    ok = np.flatnonzero(world.is_free(back) & ~shapely.within(shapely.points(back), block))
     if len(ok) == 0:
         return None
     return back[ok[np.argmin(np.hypot(*(back[ok] - p).T))]]
