@@ -46,6 +46,7 @@ def _example(cls: type) -> SkyrouteError:
     own = {
         "InputFormatError": lambda: cls("maps/a.map", "expected 'type octile'", line=1),
         "CityNotWallsError": lambda: cls("colliders.csv", "a city, not walls"),
+        "GridNotWorldError": lambda: cls("walls.csv", "wall segments, not a city", line=1),
         "DayKeptError": lambda: cls(DAY, 3, "every order is invalid"),
         "OrdersChangedError": lambda: cls([(DAY, 7, "customer", "Ann", "Bob")], [DAY]),
         "DaysFailedError": lambda: cls([], [DayFailed(DAY, f"{DAY}: gone", True)], 3),

@@ -69,6 +69,19 @@ class CityNotWallsError(InputFormatError):
     without importing shapely.)"""
 
 
+class GridNotWorldError(InputFormatError):
+    """A grid map (a MovingAI ``.map``, a ``.csv`` of wall segments, an image, a ``.npy``
+    array, a bundled map's name) read as a continuous world: plan on it as a grid
+    (:func:`skyroute.load_map`). It read "unknown world type '.map'", or "expected 'lat0
+    <deg>, lon0 <deg>', got 'x1,y1,x2,y2'", which named no way on, while a city given to
+    the grid loader is told where it belongs (:class:`CityNotWallsError`). ``what`` says
+    what the file is, for the CLI to name the command that plans on it."""
+
+    def __init__(self, path: object, what: str, *, line: int | None = None) -> None:
+        super().__init__(path, f"{what}: load it with skyroute.load_map", line=line)
+        self.what = what
+
+
 class QueryError(SkyrouteError, ValueError):
     """A start or goal that cannot be planned from: outside the map or on a blocked cell."""
 

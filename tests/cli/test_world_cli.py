@@ -178,3 +178,39 @@ def test_a_colliders_city_given_as_a_grid_map_points_to_plan_world(monkeypatch, 
         "...'), not wall segments x1,y1,x2,y2: plan in it with 'skyroute plan-world "
         "examples/city.csv --start LON,LAT --goal LON,LAT'")
     assert not (tmp_path / "city.idx").exists()
+
+
+GRID_MAPS = {  # a grid map given as WORLD: what the error calls it
+    "walls.csv": ("x1,y1,x2,y2\n0,0,10,0\n", ":1: wall segments x1,y1,x2,y2 (a grid map)"),
+    "commented.csv": ("# walls\n0,0,10,0\n", ":1: wall segments x1,y1,x2,y2 (a grid map)"),
+    "bare.csv": ("0,0,10,0\n", ":1: wall segments x1,y1,x2,y2 (a grid map)"),
+    "m.map": ("type octile\nheight 1\nwidth 1\nmap\n.\n", ": a grid map (.map), not a world"),
+    "m.npy": ("", ": a grid map (.npy), not a world"),
+    "m.png": ("", ": a grid map (.png), not a world"),
+}
+
+
+@pytest.mark.parametrize("command", [["plan-world"], ["fly", "--vehicle", "field"]])
+@pytest.mark.parametrize("name", [*GRID_MAPS, "den312d"])
+def test_a_grid_map_is_sent_to_skyroute_plan(monkeypatch, capsys, tmp_path, command, name):
+    # plan sends a colliders city to plan-world; plan-world and fly said "unknown world
+    # type '.map'" or "expected 'lat0 <deg>, lon0 <deg>', got 'x1,y1,x2,y2'"
+    monkeypatch.chdir(tmp_path)
+    text, words = GRID_MAPS.get(name, ("", ": no such file, but the name of a bundled grid map"))
+    if name in GRID_MAPS:
+        (tmp_path / name).write_text(text)
+    code, out, err = run(monkeypatch, capsys, *command[:1], name, *command[1:],
+                         "--start", "1,1", "--goal", "2,2")
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith(f"skyroute: error: {name}{words}"), err
+    assert err.endswith(f": plan on it with 'skyroute plan {name} --start X,Y --goal X,Y'\n")
+
+
+def test_load_world_names_load_map_for_a_grid_map(tmp_path):
+    import skyroute
+    from skyroute.errors import GridNotWorldError
+
+    (tmp_path / "w.csv").write_text("x1,y1,x2,y2\n0,0,10,0\n")
+    with pytest.raises(GridNotWorldError, match=r"w.csv:1: wall segments .*: load it with "
+                                                r"skyroute.load_map$"):
+        skyroute.load_world(tmp_path / "w.csv")

@@ -19,6 +19,9 @@ A, B = (-3.1890, 55.9456), (-3.1850, 55.9432)  # two streets of the city, (lon, 
 MADRID = (-3.7038, 40.4168)  # 1,700 km away; swapped, on the equator
 
 
+METRES_HINT = "; points are (lon, lat) here: (north, east) metres from home are the 'ned' frame"
+
+
 def _zones(tmp_path):
     ring = [[-3.19, 55.943], [-3.188, 55.943], [-3.188, 55.945], [-3.19, 55.945],
             [-3.19, 55.943]]
@@ -65,7 +68,9 @@ def test_a_point_plainly_far_is_refused_without_the_hint(tmp_path, point):
         text = str(err.value)
         assert text.startswith(f"start {world._fmt_frame(point)} lies "
                                f"{_km(world, point):,.0f} km from the world's home")
-        assert text.endswith("km a world with no boundary reaches"), text
+        # no swapped hint; in the lonlat frame the note on metres (true of any point)
+        metres = METRES_HINT if world.frame == "lonlat" else ""
+        assert text.endswith("km a world with no boundary reaches" + metres), text
 
 
 def test_a_point_just_inside_the_reach_is_still_planned(tmp_path):
@@ -121,3 +126,24 @@ def test_cli_refuses_it_in_one_line_exit_2_writing_nothing(monkeypatch, capsys, 
     assert code == 2 and text == "" and err.count("\n") == 1 and not out.exists(), err
     assert err.startswith("skyroute: error: start (55.9456000, -3.1890000) lies ")
     assert err.endswith("is within it: points are (lon, lat)\n")
+
+
+def test_a_point_typed_in_metres_is_refused_naming_the_ned_frame(monkeypatch, capsys):
+    # FCND writes points (north, east) metres from home: --start 0,0 (home) in the
+    # default lonlat frame was refused as 5,965 km away, naming no way on
+    code, text, err = run(monkeypatch, capsys, "plan-world", str(CITY), "--altitude", "10",
+                          "--start", "0,0", "--goal", "120,-180")
+    assert code == 2 and text == ""
+    assert err == ("skyroute: error: start (0.0000000, 0.0000000) lies 5,965 km from the "
+                   "world's home (lon -3.18687, lat 55.9445), more than the 1,000 km a world "
+                   f"with no boundary reaches{METRES_HINT}\n")
+    code, text, err = run(monkeypatch, capsys, "plan-world", str(CITY), "--altitude", "10",
+                          "--start", "0,0", "--goal", "120,-180", "--frame", "ned")
+    assert code == 0, err
+
+
+def test_a_point_in_metres_outside_a_boundary_names_the_ned_frame():
+    world = skyroute.load_world(CITY, altitude=10, boundary="-3.2,55.93,-3.17,55.96")
+    with pytest.raises(QueryError, match=r"^start \(20.0000000, 80.0000000\) lies outside "
+                                         r"the map .*'ned' frame$"):
+        skyroute.plan(world, (20, 80), B)

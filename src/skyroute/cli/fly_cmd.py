@@ -23,7 +23,6 @@ from skyroute.io.geojson import dumps
 from skyroute.io.json_text import to_json
 from skyroute.planner import plan
 from skyroute.result import PlanResult, Status
-from skyroute.world.load import load_world
 from skyroute.world.world import AXES
 
 VEHICLES = ("step", "dubins", "lattice", "field")
@@ -182,8 +181,8 @@ def fly_command(
     h0 = _one_heading(h0, start_heading, "start")
     h1 = _one_heading(h1, goal_heading, "goal")
     with delayed_status("planning"):  # a first Dubins flight compiles for 10-20 s
-        world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
-                           frame=frame)
+        world = wa.load_world_file(world_file, altitude=altitude, safety=safety,
+                                   boundary=boundary, frame=frame)
         world.check_point(a, "start")  # one error, in the user's frame, for every vehicle
         if targets is None:
             world.check_point(b, "goal")

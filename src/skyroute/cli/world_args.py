@@ -75,3 +75,16 @@ Safety = Annotated[float, typer.Option(
 Boundary = Annotated[str | None, typer.Option(
     "--boundary", help="A GeoJSON file or MINLON,MINLAT,MAXLON,MAXLAT to stay strictly "
                        "inside.")]
+
+
+def load_world_file(world_file: str, **options):
+    """:func:`skyroute.load_world`; a grid map given as WORLD says to plan on it with
+    ``skyroute plan`` (as ``plan`` sends a colliders city to ``plan-world``)."""
+    from skyroute.errors import GridNotWorldError, InputFormatError
+    from skyroute.world.load import load_world
+
+    try:
+        return load_world(world_file, **options)
+    except GridNotWorldError as exc:
+        raise InputFormatError(exc.path, f"{exc.what}: plan on it with 'skyroute plan "
+                               f"{world_file} --start X,Y --goal X,Y'", line=exc.line) from None

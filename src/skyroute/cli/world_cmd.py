@@ -26,7 +26,6 @@ from skyroute.io.world_out import (
 )
 from skyroute.planner import plan
 from skyroute.roadmap.world_plan import WORLD_ALGORITHMS, options_for, roadmap_edges
-from skyroute.world.load import load_world
 
 EXIT_NOT_FOUND = 1
 
@@ -77,8 +76,8 @@ def plan_world_command(
     b = wa.parse_pair(goal, "--goal", wa.point_names(frame))
     check_outputs(waypoints=waypoints_out, geojson=geojson, plot=plot)
     with delayed_status("planning"):  # a roadmap or raster, and a first run's compiles
-        world = load_world(world_file, altitude=altitude, safety=safety, boundary=boundary,
-                           frame=frame)
+        world = wa.load_world_file(world_file, altitude=altitude, safety=safety,
+                                   boundary=boundary, frame=frame)
         result = plan(world, a, b, algorithm=algorithm, **given)
     alt = 0.0 if altitude is None else altitude
     if result.found:

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import shapely
 
-from skyroute.errors import InputFormatError
+from skyroute.errors import GridNotWorldError, InputFormatError
 from skyroute.files import read_text, strip_bom
 from skyroute.geo import Home
 from skyroute.world.points import MAX_METRES
@@ -92,6 +92,25 @@ def _home(path: Path, line: str | None) -> tuple[float, float]:
             raise ValueError
         return float(m.group(1)), float(m.group(2))
     except ValueError:
+        if line is not None and _walls_line(line):
+            raise GridNotWorldError(path, "wall segments x1,y1,x2,y2 (a grid map), not a "
+                                    "colliders.csv city (line 1 'lat0 ..., lon0 ...')",
+                                    line=1) from None
         got = "an empty file" if line is None else repr(line[:60])
         raise InputFormatError(path, f"expected 'lat0 <deg>, lon0 <deg>', got {got}",
                                line=1) from None
+
+
+def _walls_line(line: str) -> bool:
+    """Whether line 1 is that of a walls file (:mod:`skyroute.world.segments`): a
+    comment, the header ``x1,y1,x2,y2`` or a wall of 4 numbers."""
+    cells = [c.strip() for c in line.split(",")]
+    if line.lstrip().startswith("#") or cells[0].lower() in ("x1", "x0", "x"):
+        return True
+    if len(cells) != 4:
+        return False
+    try:
+        [float(c) for c in cells]
+    except ValueError:
+        return False
+    return True

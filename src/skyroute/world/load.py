@@ -6,7 +6,14 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from skyroute.errors import InputFormatError, OptionError, check_choice, real, renamed
+from skyroute.errors import (
+    GridNotWorldError,
+    InputFormatError,
+    OptionError,
+    check_choice,
+    real,
+    renamed,
+)
 from skyroute.files import as_path
 from skyroute.world.grid import Grid
 
@@ -132,7 +139,14 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
                           f"({'degrees' if frame == 'degrees' else 'metres'})", param="safety")
     p = Path(path)
     if text is None and not p.exists():
+        key = p.name[:-4] if p.name.endswith(".map") else p.name
+        if str(path) == p.name and key in bundled_maps():
+            raise GridNotWorldError(p, "no such file, but the name of a bundled grid map, "
+                                    "not a world")
         raise InputFormatError(p, "no such file")
+    if p.suffix.lower() in (".map", ".npy", *IMAGE_SUFFIXES):
+        raise GridNotWorldError(p, f"a grid map ({p.suffix}), not a world (a colliders.csv "
+                                "city or GeoJSON zones)")
     if p.suffix.lower() == ".csv":
         if frame == "degrees":
             raise OptionError("frame='degrees': a colliders.csv city is in metres; use "

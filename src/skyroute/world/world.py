@@ -34,7 +34,9 @@ from skyroute.geo import (
     metres_per_degree_north,
 )
 from skyroute.world.grid import Grid, raster_shape
+from skyroute.world.nearest_free import nearest_free
 from skyroute.world.points import (
+    MAX_METRES,
     MAX_REACH,
     as_points,
     check_metres,
@@ -405,12 +407,12 @@ class World:
         self._check_reach(p, what, shown, given)
         if not self.inside([p])[0]:
             raise QueryError(f"{what} {shown} lies outside the map "
-                             f"({self._extent_text()}){self._swapped_hint(given)}")
+                             f"({self._extent_text()}){self._hint(given)}")
         j = int(self.blocking([p])[0])
         if j >= 0:
-            near = self.nearest_free(p, j)
-            raise QueryError(f"{what} {shown} lies inside obstacle "
-                             f"{self.names[j]!r}; nearest free point {self._fmt(near)}")
+            near = nearest_free(self, p, j, self._decimals)
+            hint = "" if near is None else f"; nearest free point {self._fmt(near)}"
+            raise QueryError(f"{what} {shown} lies inside obstacle {self.names[j]!r}{hint}")
         return p
 
     def _check_reach(self, p: np.ndarray, what: str, shown: str, given) -> None:
@@ -437,7 +439,7 @@ class World:
         raise QueryError(f"{what} {shown} lies {far / 1000:,.0f} km from the world's home "
                          f"(lon {home.lon:g}, lat {home.lat:g}), more than the "
                          f"{MAX_REACH / 1000:,.0f} km a world with no boundary reaches"
-                         f"{self._swapped_hint(given)}")
+                         f"{self._hint(given)}")
 
     def _reach_home(self) -> Home | None:
         """Where :meth:`_check_reach` measures from: the home, else (a "degrees" world
@@ -455,6 +457,34 @@ class World:
             return None
         lon, lat = np.asarray(lonlat, dtype=float)
         return float(np.linalg.norm(lonlat_to_enu([lon], [lat], 0.0, home)))
+
+    def _hint(self, given) -> str:
+        """What a point refused as outside the map (or past its reach) was likely meant
+        as: its numbers swapped (:meth:`_swapped_hint`), else metres
+        (:meth:`_metres_hint`); '' when neither lies inside."""
+        return self._swapped_hint(given) or self._metres_hint(given)
+
+    def _metres_hint(self, given) -> str:
+        """'; ... 'ned' frame' when a point of the "lonlat" frame lies past the reach from
+        home as (lon, lat) but, read as (north, east) metres from home as FCND writes
+        points, would lie inside the map (with no boundary, within its reach); else ''.
+        ``--start 0,0`` (home, in metres) was refused as 5,965 km away, naming no way on;
+        a (lon, lat) near home but outside the map gets no such note."""
+        if given is None or self.frame != "lonlat" or self.home is None:
+            return ""
+        far = self._reach(given)
+        if far is None or far <= MAX_REACH:
+            return ""
+        north, east = np.asarray(given, dtype=float)
+        if not max(abs(north), abs(east)) <= MAX_METRES:
+            return ""
+        if self.boundary is None:
+            if np.hypot(north, east) > MAX_REACH:
+                return ""
+        elif not self.inside([(east, north)])[0]:
+            return ""
+        return ("; points are (lon, lat) here: (north, east) metres from home are the "
+                "'ned' frame")
 
     def _swapped_hint(self, given) -> str:
         """'; ... (lon, lat)' when a lon/lat point outside the map (or, with no boundary,
@@ -474,19 +504,6 @@ class World:
             return ""
         return f"; {self._fmt_frame(q)} is inside: points are (lon, lat)"
 
-    def nearest_free(self, p: np.ndarray, j: int) -> np.ndarray:
-        """A free point just outside obstacle j, nearest to p."""
-        ring = self.obstacles[j].exterior
-        q = np.array(shapely.line_interpolate_point(ring, ring.project(shapely.Point(p))).coords[0])
-        step = 1e-7 if self.frame == "degrees" else 1e-3
-        d = q - p
-        d = d / (np.linalg.norm(d) or 1.0)
-        for k in range(1, 20):
-            cand = q + d * step * k
-            if self.is_free([cand])[0]:
-                return cand
-        return q
-
     def _fmt(self, p) -> str:
         """A plane point as the caller wrote it: 7 decimals of a degree (about 1 cm) or cm."""
         return self._fmt_frame(self.from_plane([p])[0])
@@ -494,8 +511,12 @@ class World:
     def _fmt_frame(self, q) -> str:
         """A point in the world's frame, as :meth:`_fmt` shows it."""
         a, b = q
-        fmt = "{:.7f}" if self.frame in ("lonlat", "degrees") else "{:.2f}"
-        return f"({fmt.format(a)}, {fmt.format(b)})"
+        return f"({a:.{self._decimals}f}, {b:.{self._decimals}f})"
+
+    @property
+    def _decimals(self) -> int:
+        """Decimals a point is shown with: 7 of a degree (about 1 cm), or 2 of a metre."""
+        return 7 if self.frame in ("lonlat", "degrees") else 2
 
     def _extent_text(self) -> str:
         """'x in (a, b), y in (c, d)' for the map's extent, in the world's frame."""
