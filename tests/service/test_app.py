@@ -131,6 +131,12 @@ def test_making_an_app_connects_to_nothing(tmp_path):
         assert "password" not in doc["detail"]
 
 
+def test_a_store_whose_folder_cannot_be_made_is_503(tmp_path):
+    (tmp_path / "taken").write_text("a file, not a folder\n")
+    with make_client(db_url=f"sqlite:///{tmp_path / 'taken' / 'sub' / 'x.db'}") as c:
+        assert_problem(c.get("/days"), 503, words="cannot make the store's folder")
+
+
 def test_settings_refuse_two_sites_and_bad_limits(tmp_path):
     from pydantic import ValidationError
 
