@@ -236,3 +236,11 @@ def test_an_output_that_cannot_be_written_is_refused_before_any_is(monkeypatch, 
     assert code == 2 and words.format(blocked=blocked) in err, err
     assert len(err.strip().splitlines()) == 1
     assert not written.exists() and not (tmp_path / bad[1]).exists()
+
+
+def test_a_store_folder_that_cannot_be_made_is_exit_2(monkeypatch, capsys, tmp_path):
+    (tmp_path / "taken").write_text("a file, not a folder\n")
+    code, out, err = run(monkeypatch, capsys, "db", "init", "--db",
+                         f"sqlite:///{tmp_path / 'taken' / 'sub' / 'x.db'}")
+    assert code == 2 and out == "" and "cannot make the store's folder" in err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1

@@ -139,6 +139,16 @@ def test_bad_urls_are_one_line_errors(tmp_path):
         store.orders_between(e, DAY, DAY)
 
 
+def test_a_store_folder_that_cannot_be_made_is_one_line(tmp_path):
+    # a file where the folder should be: the OSError of mkdir was a traceback (the CLI's
+    # exit 1, the service's 500)
+    (tmp_path / "taken").write_text("a file, not a folder\n")
+    with pytest.raises(SkyrouteError, match=r"cannot make the store's folder .*taken/sub"
+                       ) as err:
+        store.connect(f"sqlite:///{tmp_path / 'taken' / 'sub' / 'x.db'}")
+    assert err.value.param == "url" and "\n" not in str(err.value)
+
+
 def test_a_file_that_is_not_a_store_is_one_line(tmp_path):
     path = tmp_path / "not.db"
     path.write_text("garbage\n")

@@ -214,6 +214,12 @@ def _other_beside_first(d: dict) -> None:
      "no_fly_zones[0].points[1][1]: 1e+06 m from home is over the limit of 100,000 m"),
     (lambda d: d.update(airports=d["airports"] * 34),
      "airports: 102 airports is over the limit of 100"),
+    # counted before a zone is read: 125,000 zones fit in a 10 MB request to the service
+    (lambda d: d.update(no_fly_zones=[{"points": [[0, 0], [0, 9], [9, 0]]}] * 1001),
+     "no_fly_zones: 1,001 zones is over the limit of 1,000"),
+    (lambda d: d.update(no_fly_zones=[{"points": [[0, 0], [0, 9], [9, 0]] * 20_000},
+                                      {"points": [[0, 0], [0, 9], [9, 0]] * 20_000}]),
+     "no_fly_zones: 120,000 corners in all is over the limit of 100,000"),
     # a list of every level was made for each flight: a MemoryError traceback
     (lambda d: d["airspace"].update(shared_levels=10**9),
      "airspace.shared_levels: 1e+09 levels is over the limit of 1,000"),

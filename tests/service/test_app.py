@@ -47,6 +47,42 @@ def test_health_docs_and_static_page(client):
     assert 'href="docs"' in page.text and "POST /plan" in page.text
 
 
+VIEWER_FILES = ("/", "/index.html", "/day.html", "/planner.html", "/world.html",
+                "/fleet.html", "/js/day.js", "/viewer.css", "/favicon.svg")
+
+
+@pytest.mark.parametrize("path", VIEWER_FILES)
+def test_the_viewer_runs_only_its_own_scripts(client, path):
+    """Every viewer file carries a CSP that runs no inline script, no eval and nothing
+    from another origin, and lets no other site frame the page (a customer's or an
+    airport's name holding ``<script>``, were it ever set as HTML, would not run), and
+    nosniff."""
+    r = client.get(path)
+    assert r.status_code == 200
+    policy = dict(d.strip().split(" ", 1) for d in r.headers["content-security-policy"]
+                  .split(";"))
+    assert policy["script-src"] == "'self'" and policy["default-src"] == "'self'"
+    assert policy["frame-ancestors"] == "'none'" and policy["object-src"] == "'none'"
+    assert policy["connect-src"] == "'self'"
+    assert r.headers["x-content-type-options"] == "nosniff"
+    r = client.get(path, headers={"If-None-Match": r.headers["etag"]})
+    assert r.status_code == 304 and "content-security-policy" in r.headers
+
+
+@pytest.mark.parametrize("path", [p for p in VIEWER_FILES if p.endswith(".html")])
+def test_the_viewer_pages_need_no_inline_script(client, path):
+    """What the policy would block is not in the pages: every script is a file of this
+    server, and no element has an ``on...=`` handler."""
+    import re
+
+    html = client.get(path).text
+    scripts = re.findall(r"<script\b([^>]*)>(.*?)</script>", html, flags=re.S | re.I)
+    assert all(re.search(r'src="/?js/[^"]+"', a) and not body.strip()
+                           for a, body in scripts), scripts
+    assert not re.search(r"<[^>]+\son[a-z]+\s*=", html, flags=re.I)
+    assert "javascript:" not in html.lower()
+
+
 @pytest.mark.parametrize("page", ["/docs", "/redoc"])
 def test_api_reference_needs_no_internet(client, page):
     """Swagger UI and ReDoc load their scripts and styles from this server (FastAPI's
@@ -129,6 +165,12 @@ def test_making_an_app_connects_to_nothing(tmp_path):
         assert c.get("/maps").status_code == 200
         doc = assert_problem(c.get("/days"), 503, words="cannot connect")
         assert "password" not in doc["detail"]
+
+
+def test_a_store_whose_folder_cannot_be_made_is_503(tmp_path):
+    (tmp_path / "taken").write_text("a file, not a folder\n")
+    with make_client(db_url=f"sqlite:///{tmp_path / 'taken' / 'sub' / 'x.db'}") as c:
+        assert_problem(c.get("/days"), 503, words="cannot make the store's folder")
 
 
 def test_settings_refuse_two_sites_and_bad_limits(tmp_path):

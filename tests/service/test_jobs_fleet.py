@@ -264,6 +264,13 @@ RINGED = ringed()
      "1e+07 drones is over the limit of 1,000"),
     ("/jobs/fleet", {"scenario": {**SEED3, "airports": SEED3["airports"] * 34}},
      "scenario.airports", "102 airports is over the limit of 100"),
+    # refused before a zone is read: 1000 zones took about 10 s here, 125,000 minutes
+    ("/jobs/fleet", {"scenario": {**SEED3, "no_fly_zones": [
+        {"points": [[0, 0], [0, 9], [9, 0]]}] * 1001}},
+     "scenario.no_fly_zones", "1,001 zones is over the limit of 1,000"),
+    ("/jobs/fleet", {"scenario": {**SEED3, "no_fly_zones": [
+        {"points": [[0, 0], [0, 9], [9, 0]] * 33_334}]}},
+     "scenario.no_fly_zones", "100,002 corners in all is over the limit of 100,000"),
     ("/jobs/fleet", {"scenario": {**SEED3, "airports": [
         {**SEED3["airports"][0], "east": 1e12}, *SEED3["airports"][1:]]}},
      "scenario.airports[0].east", "1e+12 m from home is over the limit of 100,000 m"),

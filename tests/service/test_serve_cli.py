@@ -185,6 +185,33 @@ def test_bad_flags_are_one_line(monkeypatch, capsys, tmp_path, args, words):
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
 
 
+@pytest.mark.parametrize("given", ["env", "file"])
+def test_a_token_a_header_cannot_carry_is_one_line(monkeypatch, capsys, tmp_path, given):
+    """A non-ASCII token was taken, and every write was a 403: curl and httpx send it
+    as UTF-8, browsers as Latin-1, the server reads Latin-1. The message names the
+    character's place, never the token."""
+    from pydantic import ValidationError
+
+    from skyroute.service.settings import Settings
+
+    with pytest.raises(ValidationError, match="character 2 is not printable ASCII"):
+        Settings(token="s\u00e9cret")
+    assert Settings(token="two words~!").token == "two words~!"  # as before
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "token").write_text("s\u00e9cret\n", encoding="utf-8")
+    if given == "env":
+        monkeypatch.setenv("SKYROUTE_TOKEN", "s\u00e9cret")
+        args, where = [], "SKYROUTE_TOKEN: "
+    else:
+        monkeypatch.delenv("SKYROUTE_TOKEN", raising=False)
+        args, where = ["--token-file", str(tmp_path / "token")], f"--token-file {tmp_path}"
+    code, out, err = run(monkeypatch, capsys, "serve", "--db",
+                         f"sqlite:///{tmp_path / 's.db'}", *args)
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert where in err and "character 2 is not printable ASCII" in err
+    assert "\u00e9" not in err + out and "skyroute service on" not in err
+
+
 @pytest.mark.parametrize("host, words", [
     ("127.0.0.1", "the port is in use"),
     ("nosuch.invalid", "--host 'nosuch.invalid': not an address"),

@@ -108,8 +108,10 @@ def serve_command(
         err = exc.errors()[0]
         flag = {"max_body_bytes": "--max-body-mb", "job_queue": "--job-queue",
                 "max_expansions": "--max-expansions"}.get(str(err["loc"][0]) if err["loc"]
-                                                         else "", "--token-file")
-        raise OptionError(f"{flag}: {err['msg']}") from None
+                                                         else "",
+                                                         TOKEN_ENV if where == TOKEN_ENV
+                                                         else f"--token-file {where}")
+        raise OptionError(f"{flag}: {err['msg'].removeprefix('Value error, ')}") from None
     url = f"http://{host}:{port}/"
     typer.echo(f"skyroute service on {url} (API docs {url}docs)", err=True)
     if root_path:

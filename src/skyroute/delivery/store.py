@@ -75,7 +75,12 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
         parsed = sa.engine.make_url(url)
         sqlite = parsed.drivername.startswith("sqlite")
         if sqlite and parsed.database not in (None, "", ":memory:"):
-            Path(parsed.database).parent.mkdir(parents=True, exist_ok=True)
+            folder = Path(parsed.database).parent
+            try:
+                folder.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:  # a file in the way, no such place, no permission
+                raise SkyrouteError(f"url={_safe(url)}: cannot make the store's folder "
+                                    f"{folder}: {exc.strerror or exc}", param="url") from None
         busy = {"timeout": BUSY_SECONDS} if sqlite and "timeout" not in parsed.query else {}
         engine = sa.create_engine(url, connect_args=busy)
         with engine.connect():

@@ -32,6 +32,11 @@ MAX_SEEDS = 1000  # seeds in one sweep (the documented sweeps use 30)
 MAX_SWEEP_RUNS = 10_000  # runs in one sweep (the documented ones: 2x2x2 settings x 30 seeds)
 MAX_FLIGHT_HOURS = 12.0  # airborne time of one flight, its loiters included
 MAX_LEVELS = MAX_DRONES  # shared cruise levels: as many as the largest fleet has layers
+# no-fly zones: each zone costs about 1 ms of checks before a run (and more in its
+# cruises), each corner 0.05 ms; 125,000 zones fit in the service's 10 MB body and held
+# its POST /jobs/fleet for minutes (docs/fleet.md, Limits)
+MAX_ZONES = 1000
+MAX_ZONE_CORNERS = 100_000  # corners of all the zones together
 
 
 def expected_packages(rate_per_hour: float, hours: float) -> float:

@@ -38,6 +38,8 @@ from skyroute.fleet.limits import (
     MAX_DRONES,
     MAX_LEVELS,
     MAX_RATE,
+    MAX_ZONE_CORNERS,
+    MAX_ZONES,
 )
 from skyroute.fleet.vehicle import takeoff_phases
 
@@ -230,6 +232,20 @@ class Scenario(_Strict):
                              f"runway ({need:g} m)")
         return airports
 
+    @field_validator("no_fly_zones", mode="before")
+    @classmethod
+    def _zone_limits(cls, zones):
+        # counted on the input, before a zone is read: each zone's polygon is built and
+        # checked as it is read, and 125,000 zones fit in the service's 10 MB body
+        if isinstance(zones, list | tuple):
+            if len(zones) > MAX_ZONES:
+                raise ValueError(f"{len(zones):,} zones is over the limit of {MAX_ZONES:,}")
+            corners = sum(_corners(z) for z in zones)
+            if corners > MAX_ZONE_CORNERS:
+                raise ValueError(f"{corners:,} corners in all is over the limit of "
+                                 f"{MAX_ZONE_CORNERS:,}")
+        return zones
+
     @model_validator(mode="after")
     def _zones(self) -> Scenario:
         if self.no_fly_zones:
@@ -276,6 +292,13 @@ class Scenario(_Strict):
                 return a
         raise OptionError(f"no airport {airport_id!r}; airports: "
                           + ", ".join(a.id for a in self.airports))
+
+
+def _corners(zone) -> int:
+    """The corners a zone as given (a mapping or a NoFlyZone) lists; 0 for a zone that
+    is no zone (its own error comes when it is read)."""
+    points = zone.get("points") if isinstance(zone, dict) else getattr(zone, "points", None)
+    return len(points) if isinstance(points, list | tuple) else 0
 
 
 def takeoff_roll(drone: Drone, altitude: float) -> float | None:

@@ -15,7 +15,6 @@ from contextlib import asynccontextmanager
 from pathlib import Path
 
 from fastapi import APIRouter, Depends, FastAPI, Request
-from fastapi.staticfiles import StaticFiles
 from fastapi_offline import FastAPIOffline
 
 import skyroute
@@ -35,6 +34,7 @@ from skyroute.service.routers import (
     site,
 )
 from skyroute.service.settings import Settings
+from skyroute.service.viewer import ViewerFiles
 
 STATIC = Path(__file__).parent / "static"
 POST_ONLY = ("/plan", "/jobs/deliver", "/jobs/fleet")
@@ -78,7 +78,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(ServerTiming)  # inside the body limit: the body is in hand
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
     app.add_middleware(HeadAsGet)
-    app.mount("/", StaticFiles(directory=STATIC, html=True), name="static")
+    app.mount("/", ViewerFiles(directory=STATIC, html=True), name="static")
     # the API's first path segments: a browser asking for any other missing path gets
     # an HTML page, not the problem document (the routers' own routes are listed, as
     # the app keeps included routers unexpanded)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import secrets
 from pathlib import Path
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from skyroute.delivery.store import DEFAULT_DB
 
@@ -46,6 +46,18 @@ class Settings(BaseModel):
     warm: bool = Field(True, description="Load the planners' compiled kernels and "
                        "libraries when the app starts, before it takes a request "
                        "(skyroute.service.warm), not in its first POST /plan.")
+
+    @field_validator("token")
+    @classmethod
+    def _sendable(cls, token: str) -> str:
+        # the token travels in a header: a client sends a non-ASCII one as UTF-8 (curl,
+        # httpx) or Latin-1 (browsers), and no request matched it (every write a 403);
+        # the message names the character's place, not the character (a secret's part)
+        bad = next((i for i, ch in enumerate(token) if not " " <= ch <= "~"), None)
+        if bad is not None:
+            raise ValueError(f"the token's character {bad + 1} is not printable ASCII; "
+                             "it goes in an HTTP header, which carries only that")
+        return token
 
     @model_validator(mode="after")
     def _one_site(self) -> Settings:
