@@ -6,7 +6,14 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from skyroute.errors import InputFormatError, OptionError, check_choice, real, renamed
+from skyroute.errors import (
+    InputFormatError,
+    OptionError,
+    WorldNotGridError,
+    check_choice,
+    real,
+    renamed,
+)
 from skyroute.files import as_path
 from skyroute.world.grid import Grid
 
@@ -30,6 +37,9 @@ def resolve_map_path(path: str | Path) -> Path:
     bundled map of that name (a folder of the same name in the working folder does not
     hide it)."""
     p = as_path(path, "path")
+    if not str(path):  # Path("") is ".", read as "a folder, not a map file"
+        raise OptionError("path='' is empty: give a map file or a bundled map's name",
+                          param="path")
     try:
         if p.exists() and not p.is_dir():
             return p
@@ -87,6 +97,9 @@ def load_map(path: str | Path, *, resolution: float | None = None, safety: float
         from skyroute.world.image import read_npy
 
         grid = read_npy(p, resolution=resolution)
+    elif suffix in (".geojson", ".json"):  # load_world's GeoJSON
+        raise WorldNotGridError(p, f"GeoJSON zones ({suffix}), a world, not a grid map "
+                                "(.map, .csv walls, .npy, an image)")
     else:
         raise InputFormatError(p, f"unknown map type {suffix!r}; valid: .map, .csv, .npy, "
                                + ", ".join(IMAGE_SUFFIXES))
