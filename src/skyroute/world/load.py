@@ -6,14 +6,7 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from skyroute.errors import (
-    InputFormatError,
-    OptionError,
-    WorldNotGridError,
-    check_choice,
-    real,
-    renamed,
-)
+from skyroute.errors import InputFormatError, OptionError, check_choice, real, renamed
 from skyroute.files import as_path
 from skyroute.world.grid import Grid
 
@@ -98,6 +91,8 @@ def load_map(path: str | Path, *, resolution: float | None = None, safety: float
 
         grid = read_npy(p, resolution=resolution)
     elif suffix in (".geojson", ".json"):  # load_world's GeoJSON
+        from skyroute.errors import WorldNotGridError
+
         raise WorldNotGridError(p, f"GeoJSON zones ({suffix}), a world, not a grid map "
                                 "(.map, .csv walls, .npy, an image)")
     else:
