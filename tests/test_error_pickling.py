@@ -48,6 +48,7 @@ def _example(cls: type) -> SkyrouteError:
         "CityNotWallsError": lambda: cls("colliders.csv", "a city, not walls"),
         "GridNotWorldError": lambda: cls("walls.csv", "wall segments, not a city", line=1),
         "DayKeptError": lambda: cls(DAY, 3, "every order is invalid"),
+        "WorldNotGridError": lambda: cls("zones.geojson", "GeoJSON zones, not a grid map"),
         "OrdersChangedError": lambda: cls([(DAY, 7, "customer", "Ann", "Bob")], [DAY]),
         "DaysFailedError": lambda: cls([], [DayFailed(DAY, f"{DAY}: gone", True)], 3),
         "TasksLostError": lambda: cls({1: "its worker process died (exit code 3)"},

@@ -90,6 +90,17 @@ class OptionError(SkyrouteError, ValueError):
     """An unknown or out-of-range option; the message lists the valid ones."""
 
 
+class WorldNotGridError(InputFormatError):
+    """A continuous world's file (GeoJSON zones) read as a grid map: plan in it as a world
+    (:func:`skyroute.load_world`). It read "unknown map type '.geojson'", which named no
+    way on. ``what`` says what the file is, for the CLI to name the command that plans in
+    it (as :class:`CityNotWallsError` does for a colliders city)."""
+
+    def __init__(self, path: object, what: str, *, line: int | None = None) -> None:
+        super().__init__(path, f"{what}: load it with skyroute.load_world", line=line)
+        self.what = what
+
+
 def check_instance(name: str, value: object, cls: type, what: str) -> None:
     """Raise :class:`OptionError` unless ``value`` is a ``cls`` (``what`` names it for the
     message): a wrong object passed where a Grid or World belongs is named, not met later

@@ -76,9 +76,36 @@ def test_no_path_exits_1_and_writes_nothing(monkeypatch, capsys, tmp_path):
     assert not png.exists()
 
 
+ROOM = "x1,y1,x2,y2\n0,0,20,0\n20,0,20,10\n20,10,0,10\n0,10,0,0\n8,0,8,6\n"
+
+
+def test_a_walls_cell_is_the_same_place_with_any_safety(monkeypatch, capsys, tmp_path):
+    """--safety moved the raster's origin: cell (5, 5) at 0.5 m a cell started the path at
+    (2.25, 2.25) m, and with --safety 1 at (1.25, 1.25) m."""
+    import shapely
+
+    walls = tmp_path / "walls.csv"
+    walls.write_text(ROOM)
+    paths = {}
+    for safety in ("0", "1"):
+        gj = tmp_path / f"s{safety}.geojson"
+        code, _, err = run(monkeypatch, capsys, "plan", str(walls), "--start", "5,5",
+                             "--goal", "30,5", "--resolution", "0.5", "--safety", safety,
+                             "--geojson", str(gj))
+        assert code == 0, err
+        paths[safety] = json.loads(gj.read_text())["features"][0]["geometry"]["coordinates"]
+    assert paths["0"][0] == paths["1"][0] == [2.25, 2.25]
+    assert paths["0"][-1] == paths["1"][-1] == [14.75, 2.25]
+    # the margin holds in metres: no waypoint of the path comes within 1 m of a wall
+    segments = shapely.multilinestrings(
+        [[[(x1, y1), (x2, y2)] for x1, y1, x2, y2 in
+          (map(float, row.split(",")) for row in ROOM.splitlines()[1:])]])
+    assert shapely.distance(shapely.points(paths["1"]), segments).min() > 1.0
+    assert shapely.distance(shapely.points(paths["0"]), segments).min() < 1.0
+
+
 @pytest.mark.parametrize("far, option, words", [
     ("0,0,1e9,3", [], "walls.csv:3: the wall (0, 0) - (1e+09, 3) stretches the map to"),
-    ("1,1,2,2", ["--safety", "1e6"], "walls.csv: --safety 1e+06 around the walls makes"),
     ("1,1,2,2", ["--resolution", "0"], "error: --resolution 0.0 must be a positive number\n"),
 ])
 def test_a_walls_raster_too_large_names_the_line_or_the_flag(monkeypatch, capsys, tmp_path,
@@ -93,10 +120,46 @@ def test_a_walls_raster_too_large_names_the_line_or_the_flag(monkeypatch, capsys
     assert err.startswith("skyroute: error: ") and words in err
 
 
+@pytest.mark.parametrize("suffix", [".geojson", ".json"])
+def test_a_geojson_world_given_to_plan_points_to_plan_world(monkeypatch, capsys, tmp_path,
+                                                            suffix):
+    # it said "unknown map type '.geojson'; valid: .map, .csv, ...", naming no way on
+    zones = tmp_path / f"no-fly-zones{suffix}"
+    zones.write_text('{"type": "FeatureCollection", "features": []}')
+    code, out, err = run(monkeypatch, capsys, "plan", str(zones), "--start", "1,1", "--goal",
+                         "2,2")
+    assert code == 2 and out == "" and err == (
+        f"skyroute: error: {zones}: GeoJSON zones ({suffix}), a world, not a grid map (.map, "
+        f".csv walls, .npy, an image): plan in it with 'skyroute plan-world {zones} --start "
+        "LON,LAT --goal LON,LAT'\n")
+
+
+def test_a_walls_cell_within_the_margin_is_named_so(monkeypatch, capsys, tmp_path):
+    walls = tmp_path / "walls.csv"
+    walls.write_text(ROOM)
+    code, out, err = run(monkeypatch, capsys, "plan", str(walls), "--start", "5,5", "--goal",
+                         "15,5", "--resolution", "0.5", "--safety", "1")
+    assert code == 2 and out == "" and err == (
+        "skyroute: error: goal (15, 5) is free in walls.csv but within the --safety 1 m "
+        "margin of an obstacle; choose a cell farther from it or a smaller --safety\n")
+
+
 @pytest.mark.parametrize("args, words", [
     (["plan", "den312d", "--start", "0,0", "--goal", "60,13"], "start (0, 0) is on a blocked"),
     (["plan", "den312d", "--start", "50,76", "--goal", "99,9"], "goal (99, 9) lies outside"),
     (["plan", "nope.map", "--start", "0,0", "--goal", "1,1"], "nope.map: no such file"),
+    # a cell the map has free, blocked by the margin alone: it read "is on a blocked cell"
+    (["plan", *QUERY, "--safety", "3"], "error: start (50, 76) is free in den312d.map but "
+     "within the --safety 3 m margin of an obstacle; choose a cell farther from it or a "
+     "smaller --safety\n"),
+    (["plan", "den312d", "--start", "50,70", "--goal", "60,13", "--safety", "3"],
+     "error: goal (60, 13) is free in den312d.map but within the --safety 3 m margin"),
+    (["plan", "den312d", "--start", "0,0", "--goal", "60,13", "--safety", "3"],
+     "error: start (0, 0) is on a blocked cell\n"),
+    # an empty MAP read as the folder '.': ".: a folder, not a map file"
+    (["plan", "", "--start", "0,0", "--goal", "1,1"], "error: the MAP argument is empty: "
+     "give a map file or a bundled map's name (see 'skyroute maps')\n"),
+    (["prepare", "", "-o", "x.idx"], "error: the MAP argument is empty"),
     (["plan", *QUERY, "--algorithm", "foo"], "--algorithm 'foo' is not valid"),
     (["plan", "den312d", "--start", "5;x", "--goal", "1,1"], "--start '5;x' must be"),
     (["plan", *QUERY, "--bogus"], "No such option: --bogus"),

@@ -115,7 +115,61 @@ def test_field_reports_length_like_the_other_vehicles(monkeypatch, capsys, city)
                           "field", "--start", "0,0", "--goal", "60,-40", "--altitude", "10")
     assert code == 0, err
     rows = {line.split("│")[1].strip() for line in text.splitlines() if line.count("│") == 3}
-    assert {"length", "escape_moves"} <= rows and "distance" not in rows
+    assert {"length", "escape moves"} <= rows and "distance" not in rows
+
+
+def table_rows(text: str) -> dict:
+    return {line.split("│")[1].strip(): line.split("│")[2].strip()
+            for line in text.splitlines() if line.count("│") == 3}
+
+
+STEP = ["--frame", "local", "--altitude", "10", "--start", "0,0", "--goal", "30,-40"]
+
+
+@pytest.mark.parametrize("args, keys, labels", [
+    # the step drone's length is in degrees, which its value says: labelled as the others'
+    (["--vehicle", "step"], {"moves", "length_deg", "expanded", "seconds", "status"},
+     {"moves", "length", "expanded", "seconds", "status"}),
+    (["--vehicle", "field", "--step", "1"],
+     {"length", "moves", "smoothness", "status", "escape_moves"},
+     {"length", "moves", "smoothness", "status", "escape moves"}),
+    (["--vehicle", "lattice", "--resolution", "5"],
+     {"time", "length", "moves", "smoothness", "expanded", "status"}, None),
+    (["--vehicle", "dubins", "--planner", "waypoints", "--radius", "8"],
+     {"length", "moves", "smoothness", "free", "words"}, None),
+    (["--vehicle", "dubins", "--radius", "8"],
+     {"status", "length", "expanded", "seconds", "pieces", "moves", "smoothness"}, None),
+])
+def test_fly_tables_label_metrics_without_underscores(monkeypatch, capsys, city, args, keys,
+                                                      labels):
+    """The table showed "escape_moves" and "length_deg", unlike every other table's
+    labels ("max frontier"); --json keeps its keys."""
+    code, text, err = run(monkeypatch, capsys, "fly", city, *STEP, *args, "--json")
+    assert code == 0, err
+    doc = json.loads(text)
+    assert set(doc["metrics"]) == keys | {"reached"} if "reached" in doc["metrics"] else keys
+    code, text, err = run(monkeypatch, capsys, "fly", city, *STEP, *args)
+    assert code == 0, err
+    rows = table_rows(text)
+    assert set(rows) == (labels or keys) | {"reached"}
+    assert not any("_" in k for k in rows)
+    if "length_deg" in keys:
+        assert rows["length"] == f"{doc['metrics']['length_deg']:,.6f} deg"
+
+
+def test_the_tour_bounds_are_labelled_without_underscores():
+    from skyroute.cli.fly_cmd import metrics_table
+    from skyroute.cli.tables import plain_console
+
+    doc = {"reached": True, "metrics": {"status": "found", "length": 12.5, "method": "exact",
+                                        "order": "2 1", "greedy_bound": 14.0, "bound": 12.5,
+                                        "seconds": 0.25}}
+    console = plain_console(width=80)
+    with console.capture() as cap:
+        console.print(metrics_table("t", doc, "m"))
+    rows = table_rows(cap.get())
+    assert rows["greedy bound"] == "14.000000 m" and rows["bound"] == "12.500000 m"
+    assert not any("_" in k for k in rows)
 
 
 @pytest.mark.parametrize("args, words", [

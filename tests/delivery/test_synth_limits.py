@@ -63,14 +63,24 @@ def test_synth_refuses_a_negative_seed(monkeypatch, capsys, tmp_path):
     assert not (tmp_path / "x").exists() and not (tmp_path / "y").exists()
 
 
-def test_synth_prints_its_summary_as_plain_json(monkeypatch, capsys, tmp_path):
-    """stdout is one line of JSON, the folder as given: it went through Rich, which ate
-    '[bold]' as markup and broke a long line inside a string (invalid JSON)."""
+@pytest.mark.parametrize("as_json", [False, True])
+def test_synth_prints_its_summary_plainly(monkeypatch, capsys, tmp_path, as_json):
+    """stdout is one line, the folder as given: it went through Rich, which ate '[bold]'
+    as markup and broke a long line inside a string (invalid JSON). The line is a
+    sentence, as every other command's; the JSON object it printed by default is behind
+    --json."""
     out = tmp_path / ("a folder whose name is long enough to pass 80 columns " * 2) / "x[bold]y"
-    code, stdout, err = run(monkeypatch, capsys, "data", "synth", str(out), "--days", "1",
-                            "--orders-per-day", "1")
+    code, stdout, err = run(monkeypatch, capsys, "data", "synth", str(out), "--days", "2",
+                            "--orders-per-day", "3", *(["--json"] if as_json else []))
     assert code == 0, err
-    assert stdout.count("\n") == 1 and json.loads(stdout)["folder"] == str(out)
+    assert stdout.count("\n") == 1
+    if as_json:
+        assert json.loads(stdout) == {"folder": str(out), "days": 2, "first": "2024-01-01",
+                                      "last": "2024-01-02", "orders": 6, "shops": 5,
+                                      "customers": 7, "zones": 6}
+    else:
+        assert stdout == (f"wrote {out}: 6 orders over 2 days (2024-01-01 to 2024-01-02), "
+                          "5 shops, 7 customers' places, 6 no-fly zones\n")
     assert (out / "database" / "orders.csv").exists()
 
 
@@ -101,7 +111,7 @@ def test_synth_refuses_a_folder_that_is_not_empty_until_replace(monkeypatch, cap
     assert f"{out}: the folder is not empty (notes.txt); --replace writes the data set " \
         "into it, replacing files of the same names" in err
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
-    code, stdout, err = run(monkeypatch, capsys, *args, "--replace")
+    code, stdout, err = run(monkeypatch, capsys, *args, "--replace", "--json")
     assert code == 0, err
     assert json.loads(stdout)["orders"] == 1
     assert sorted(p.name for p in out.iterdir()) == ["database", "notes.txt", "website"]

@@ -69,9 +69,22 @@ def test_grid_picture_legend_beside_the_map_and_ends_named(figures, tmp_path):
     for end in ("start (0, 0)", "goal (7, 7)"):  # a corner start was half cut off
         assert not lines[end].get_clip_on()
         assert lines[end].get_zorder() > lines["path"].get_zorder()
-    assert ax.get_title() == f"bar: astar, cost {result.cost:.3f}, {result.expanded:,} expanded"
+    assert ax.get_title() == (f"bar: astar, cost {result.cost:.3f} cells, "
+                              f"{result.expanded:,} expanded")
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("x (column)", "y (row)")
     assert ax.get_aspect() == 1.0
+
+
+@pytest.mark.parametrize("resolution, cost", [(1.0, "cost 10.000 cells"),
+                                               (0.5, "cost 10.000 cells (5.000 m)")])
+def test_the_grid_title_gives_the_cost_s_unit(figures, tmp_path, resolution, cost):
+    """It read "cost 10.000" with 0.5 m cells: cells or metres? As plan's table: cells,
+    and metres where a cell is not 1 m."""
+    grid = Grid(np.zeros((4, 12), dtype=bool), resolution=resolution, name="row")
+    result = skyroute.plan(grid, (0, 1), (10, 1))
+    plot_grid_path(grid, result, (0, 1), (10, 1), tmp_path / "p.png")
+    assert figures[0].axes[0].get_title().replace("\n", ", ") == \
+        f"row: astar, {cost}, {result.expanded:,} expanded"
 
 
 def test_grid_picture_pixels_follow_the_map_size(tmp_path):
@@ -205,7 +218,7 @@ def test_pruned_grid_path_says_so_in_the_title(figures, tmp_path):
     fig = figures[0]
     lines = title_fits(fig, fig.axes[0])
     # balanced: it read "...cost 110.179, 1,587 expanded" over "pruned (los): 5 waypoints"
-    assert lines == [f"den312d.map: theta, cost {result.cost:.3f}",
+    assert lines == [f"den312d.map: theta, cost {result.cost:.3f} cells",
                      f"{result.expanded:,} expanded, pruned (los): {len(result.path)} waypoints"]
 
 
@@ -218,7 +231,7 @@ def test_a_long_title_on_a_narrow_map_takes_two_lines_within_the_figure(figures,
     lines = title_fits(fig, fig.axes[0])
     # no two lines fit over the map: three even ones, not the name over all the rest
     assert lines == ["a_rather_long_name_for_a_narrow_map.map: astar",
-                     f"cost {result.cost:.3f}, {result.expanded:,} expanded",
+                     f"cost {result.cost:.3f} cells, {result.expanded:,} expanded",
                      f"pruned (collinear): {len(result.path)} waypoints"]
 
 

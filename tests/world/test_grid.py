@@ -110,13 +110,15 @@ def test_segment_file_and_errors(tmp_path):
                 "walls.csv:1: a colliders.csv city (line 1 'lat0 ..., lon0 ...'), not wall "
                 "segments x1,y1,x2,y2: load it with skyroute.load_world")):
             load_map(p)
-    # The first file's grid: the walls' extent plus the clearance and one cell each side,
-    # so 7 x 7 cells of 0.5 m from (-0.75, -0.75); blocked are the cells the walls cross
-    # (y = 0 is row 1, x = 2 is column 5), no centre of another lying within 0.25 m.
-    expected = np.zeros((7, 7), bool)
-    expected[1, 1:6] = expected[1:6, 5] = True
+    # The first file's grid: the walls' extent on the 0.5 m lattice and one cell each
+    # side, whatever the safety (it was grown by the safety too, from (-0.75, -0.75)), so
+    # 6 x 6 cells from (-0.5, -0.5); blocked are the cells whose closed squares the walls
+    # touch (y = 0 is the edge of rows 0 and 1, x = 2 of columns 4 and 5), no centre of
+    # another lying within 0.25 m.
+    expected = np.zeros((6, 6), bool)
+    expected[0:2, :] = expected[:, 4:6] = True
     np.testing.assert_array_equal(g.blocked, expected)
-    assert tuple(g.origin) == (-0.75, -0.75)
+    assert tuple(g.origin) == (-0.5, -0.5)
 
 
 @pytest.mark.parametrize("header", ["x1,y1,x2,y2\r\n", ""])
@@ -238,10 +240,6 @@ WALLS = "x1,y1,x2,y2\n0,0,10,0\n0,5,10,5\n{far}\n2,2,4,4\n"
      r"^{p}:4: the wall \(0, 0\) - \(1e\+09, 3\) stretches the map to 1e\+09 x 7 m, "
      r"1e\+09 x 7 cells at 1 m a cell, above 67,108,864; is a coordinate wrong\?"),
     ("-4e8,2,3,2", {}, InputFormatError, r"^{p}:4: the wall \(-4e\+08, 2\) - \(3, 2\)"),
-    # a safety margin wider than any map: safety is named, with the file
-    ("1,1,2,2", {"safety": 1e6}, OptionError,
-     r"^{p}: safety=1e\+06 around the walls makes a raster of 2\.00001e\+06 x "
-     r"2\.00001e\+06 m, .*; use a smaller safety or a coarser resolution$"),
     # walls spread evenly at a resolution meant in kilometres: the resolution, with the file
     ("1,1,2,2", {"resolution": 1e-5}, OptionError,
      r"^{p}: resolution=1e-05 over a 10 x 5\.00002 extent .*; use a coarser resolution$"),
@@ -273,6 +271,20 @@ def test_a_folder_is_not_a_map_and_does_not_hide_a_bundled_one(tmp_path, monkeyp
     writer.start()
     assert load_map(fifo).width == 65
     writer.join()
+
+
+def test_an_empty_path_or_a_geojson_world_is_named_as_such(tmp_path):
+    # "" read as the folder ".": ".: a folder, not a map file"
+    with pytest.raises(OptionError, match=r"^path='' is empty: give a map file") as info:
+        load_map("")
+    assert info.value.param == "path"
+    # GeoJSON zones read "unknown map type '.geojson'", naming no way on
+    zones = tmp_path / "zones.geojson"
+    zones.write_text('{"type": "FeatureCollection", "features": []}')
+    with pytest.raises(skyroute.errors.WorldNotGridError, match=re.escape(
+            f"{zones}: GeoJSON zones (.geojson), a world, not a grid map (.map, .csv walls, "
+            ".npy, an image): load it with skyroute.load_world")):
+        load_map(zones)
 
 
 @pytest.mark.parametrize("copy_of", [copy.copy, copy.deepcopy,

@@ -29,6 +29,8 @@ def data_synth(
     replace: Annotated[bool, typer.Option(
         "--replace", help="Write into DIR even when it is not empty (files of the same "
                           "names are replaced).")] = False,
+    as_json: Annotated[bool, typer.Option(
+        "--json", help="Print the summary as one JSON object.")] = False,
 ) -> None:
     """Write a synthetic data set in the ILP layout (website/, database/) in another town."""
     first = parse_date(start, "--start")
@@ -40,7 +42,18 @@ def data_synth(
         with written_together():  # a Ctrl-C halfway leaves no part of a data set
             summary = synth(folder, days=days, orders_per_day=orders_per_day, seed=seed,
                             start=first, customers=customers)
-    typer.echo(to_json(summary))  # not through Rich: no markup, no wrapping
+    # not through Rich: no markup read in the folder's name, no wrapping
+    typer.echo(to_json(summary) if as_json else summary_line(summary))
+
+
+def summary_line(summary: dict) -> str:
+    """What ``data synth`` wrote, in one line, as ``synth-city`` says what it wrote (the
+    JSON object, which it printed by default, is behind ``--json``)."""
+    days = summary["days"]
+    span = summary["first"] if days == 1 else f"{summary['first']} to {summary['last']}"
+    return (f"wrote {summary['folder']}: {summary['orders']:,} orders over {days:,} "
+            f"day{'s' if days != 1 else ''} ({span}), {summary['shops']} shops, "
+            f"{summary['customers']:,} customers' places, {summary['zones']} no-fly zones")
 
 
 def _check_folder(folder: Path, replace: bool) -> None:

@@ -233,15 +233,33 @@ def fly_command(
     if as_json:
         typer.echo(to_json({k: v for k, v in doc.items() if k != "columns"}))
     else:
-        table = Table(title=f"{world.name}: {vehicle}", show_header=False)
         unit = "deg" if world.plane == "degrees" else "m"
-        for k, v in doc["metrics"].items():
-            if k != "reached":
-                table.add_row(k, _shown(k, v, unit))
-        table.add_row("reached", str(doc["reached"]))
-        print_table(plain_console(), table)
+        print_table(plain_console(), metrics_table(f"{world.name}: {vehicle}", doc, unit))
     if not doc["reached"]:
         raise typer.Exit(EXIT_NOT_REACHED)
+
+
+# A metric's label in the table where it is not its --json key with spaces for the
+# underscores ("escape_moves": "escape moves"): the step drone's length is in degrees,
+# which its value says ("0.004650 deg"), as the other vehicles' "length" says metres.
+LABELS = {"length_deg": "length"}
+
+
+def metric_label(name: str) -> str:
+    """A metric's label in the human table, as the other tables write theirs ("max
+    frontier", "search time"); ``--json`` keeps the key (``escape_moves``)."""
+    return LABELS.get(name, name.replace("_", " "))
+
+
+def metrics_table(title: str, doc: dict, plane_unit: str) -> Table:
+    """The table ``fly`` prints: each metric by its label (:func:`metric_label`) and
+    value (:func:`_shown`), then whether the goal was reached."""
+    table = Table(title=title, show_header=False)
+    for k, v in doc["metrics"].items():
+        if k != "reached":
+            table.add_row(metric_label(k), _shown(k, v, plane_unit))
+    table.add_row("reached", str(doc["reached"]))
+    return table
 
 
 # The unit of each metric in the table ("plane": metres, or degrees in the degrees frame

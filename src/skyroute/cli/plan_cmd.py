@@ -10,7 +10,7 @@ import typer
 from skyroute.cli.parse import check_outputs, parse_cell
 from skyroute.cli.status import delayed_status
 from skyroute.cli.tables import print_table, result_table
-from skyroute.errors import InputFormatError, OptionError
+from skyroute.errors import InputFormatError, OptionError, QueryError
 from skyroute.files import check_writable, write_atomic, written_together
 from skyroute.io.geojson import dumps, grid_path_geojson
 from skyroute.io.json_text import to_json
@@ -70,6 +70,8 @@ def plan_command(
                           "and --max-expansions at their defaults", param="index")
     with delayed_status("planning"):  # a first run compiles its kernels for seconds
         grid = _load_grid(map_file, resolution=resolution, safety=safety)
+        _check_margin(map_file, grid, {"start": s, "goal": t}, resolution=resolution,
+                      safety=safety)
         if index is not None:
             from skyroute.search.prepared import load_index
 
@@ -103,14 +105,38 @@ def plan_command(
 
 
 def _load_grid(map_file: str, *, resolution: float, safety: float):
-    """:func:`load_map`; a colliders city given as MAP says to plan in it with plan-world."""
-    from skyroute.errors import CITY, CityNotWallsError
+    """:func:`load_map`; a world given as MAP (a colliders city, GeoJSON zones) says to
+    plan in it with plan-world; an empty MAP says so (it read as the folder '.')."""
+    from skyroute.errors import CITY, CityNotWallsError, WorldNotGridError
 
+    if not map_file:
+        raise OptionError("the MAP argument is empty: give a map file or a bundled map's "
+                          "name (see 'skyroute maps')")
+    plan_world = f"plan in it with 'skyroute plan-world {map_file} --start LON,LAT --goal LON,LAT'"
     try:
         return load_map(map_file, resolution=resolution, safety=safety)
     except CityNotWallsError as exc:
-        raise InputFormatError(exc.path, f"{CITY}: plan in it with 'skyroute plan-world "
-                               f"{map_file} --start LON,LAT --goal LON,LAT'", line=1) from None
+        raise InputFormatError(exc.path, f"{CITY}: {plan_world}", line=1) from None
+    except WorldNotGridError as exc:
+        raise InputFormatError(exc.path, f"{exc.what}: {plan_world}", line=exc.line) from None
+
+
+def _check_margin(map_file: str, grid, cells: dict, *, resolution: float,
+                  safety: float) -> None:
+    """A start or goal blocked only by the ``--safety`` margin is named so (it read "is on
+    a blocked cell", as if the map had an obstacle there): the map is read again without
+    the margin, only then. Other faults are left to the planner's own errors, in its
+    order (start first; off the grid before blocked)."""
+    for what, (x, y) in cells.items():
+        if not (0 <= x < grid.width and 0 <= y < grid.height):
+            return
+        if grid.blocked[y, x]:
+            if safety > 0 and not _load_grid(map_file, resolution=resolution,
+                                              safety=0.0).blocked[y, x]:
+                raise QueryError(f"{what} ({x}, {y}) is free in {grid.name} but within the "
+                                 f"--safety {safety:g} m margin of an obstacle; choose a "
+                                 "cell farther from it or a smaller --safety")
+            return
 
 
 def prepare_command(

@@ -54,8 +54,8 @@ def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
         cell_pt = 72 * _cell_inches(grid.blocked.shape, area)
         draw_path(ax, result.path, lw=float(np.clip(cell_pt, 0.6, 1.6)))
     mark_ends(ax, start, goal, start_text=_cell(start), goal_text=_cell(goal))
-    cost = f"cost {result.cost:.3f}" if result.found else result.status.value
-    parts = [f"{grid.name}: {result.algorithm}", cost, f"{result.expanded:,} expanded"]
+    parts = [f"{grid.name}: {result.algorithm}", _grid_cost(grid, result),
+             f"{result.expanded:,} expanded"]
     if prune != "none" and result.found:
         parts.append(f"pruned ({prune}): {len(result.path)} waypoints")
     set_title(ax, parts)
@@ -81,6 +81,18 @@ def set_title(ax, parts: Sequence[str], *, fontsize: float = 10):
         return renderer.get_text_width_height_descent(text, font, ismath=False)[0]
 
     return ax.set_title("\n".join(title_lines(parts, room, width)), fontsize=fontsize)
+
+
+def _grid_cost(grid: Grid, result: PlanResult) -> str:
+    """The title's cost in cells (octile steps), as ``skyroute plan``'s table has it, and
+    in metres too where a cell is not 1 m ("cost 10.000 cells (5.000 m)"); it read
+    "cost 10.000", in no unit. The status when no path was found."""
+    if not result.found:
+        return result.status.value
+    cost = f"cost {result.cost:,.3f} cells"
+    if grid.resolution != 1:
+        cost += f" ({result.cost * grid.resolution:,.3f} m)"
+    return cost
 
 
 def title_lines(parts: Sequence[str], room: float,

@@ -37,6 +37,9 @@ def resolve_map_path(path: str | Path) -> Path:
     bundled map of that name (a folder of the same name in the working folder does not
     hide it)."""
     p = as_path(path, "path")
+    if not str(path):  # Path("") is ".", read as "a folder, not a map file"
+        raise OptionError("path='' is empty: give a map file or a bundled map's name",
+                          param="path")
     try:
         if p.exists() and not p.is_dir():
             return p
@@ -94,6 +97,11 @@ def load_map(path: str | Path, *, resolution: float | None = None, safety: float
         from skyroute.world.image import read_npy
 
         grid = read_npy(p, resolution=resolution)
+    elif suffix in (".geojson", ".json"):  # load_world's GeoJSON
+        from skyroute.errors import WorldNotGridError
+
+        raise WorldNotGridError(p, f"GeoJSON zones ({suffix}), a world, not a grid map "
+                                "(.map, .csv walls, .npy, an image)")
     else:
         raise InputFormatError(p, f"unknown map type {suffix!r}; valid: .map, .csv, .npy, "
                                + ", ".join(IMAGE_SUFFIXES))

@@ -2,6 +2,11 @@
 
 A cell is blocked when a wall passes through it (touching its closed square) or when its
 centre lies within ``safety`` of a wall, measured exactly to the segment.
+
+The raster's cells lie on the lattice of multiples of the resolution, and it covers the
+walls' bounding box and one cell more on every side, whatever the safety: a cell (x, y)
+names the same place with any margin. The margin blocks cells inside the raster and
+never grows it (outside the raster there is nowhere to plan anyway).
 """
 
 from __future__ import annotations
@@ -29,26 +34,38 @@ def read_segments(path: str | Path) -> np.ndarray:
 def load_segments(path: str | Path, *, resolution: float, safety: float = 0.0) -> Grid:
     """Read a walls file and rasterise it (:func:`rasterize_segments`). A raster above
     :data:`~skyroute.world.grid.MAX_CELLS` names what made it so: the line of the one
-    wall far from the others (a mistyped coordinate), else ``safety`` when the margin
-    alone is too wide, else ``resolution``; always with the file."""
+    wall far from the others (a mistyped coordinate), else ``resolution``; always with
+    the file (``safety`` never grows the raster)."""
     path = Path(path)
     seg, lines = _read(path)
     if not (math.isfinite(resolution) and resolution > 0 and math.isfinite(safety)
             and safety >= 0):  # rasterize_segments names the option
         return rasterize_segments(seg, resolution=resolution, safety=safety, name=path.name)
     try:
-        raster_shape(*_span(seg, resolution, safety), resolution)
+        raster_shape(*_span(seg, resolution), resolution)
     except OptionError as exc:
-        raise _too_large(path, seg, lines, resolution, safety, exc) from None
+        raise _too_large(path, seg, lines, resolution, exc) from None
     return rasterize_segments(seg, resolution=resolution, safety=safety, name=path.name)
 
 
-def _span(seg: np.ndarray, resolution: float, safety: float) -> tuple[float, float]:
-    """Width and height (metres) of the default raster: the walls' extent, ``safety``
-    and one cell on every side (as :func:`rasterize_segments` pads it)."""
-    pad = 2 * (safety + resolution)
+def _span(seg: np.ndarray, resolution: float) -> tuple[float, float]:
+    """Width and height (metres) of the default raster: the walls' extent and one cell
+    on every side (as :func:`rasterize_segments` pads it; the safety margin adds none)."""
+    pad = 2 * resolution
     xs, ys = seg[:, [0, 2]], seg[:, [1, 3]]
     return float(xs.max() - xs.min() + pad), float(ys.max() - ys.min() + pad)
+
+
+def wall_lattice(segments: np.ndarray, resolution: float) -> tuple[int, int, int, int]:
+    """The default raster's cells on the lattice of multiples of ``resolution``: (i0, j0,
+    i1, j1) with origin (i0, j0) * resolution and (i1 - i0) x (j1 - j0) cells, the
+    walls' bounding box floored and ceiled to the lattice and one cell more on every
+    side. It depends on the walls and the resolution only, never on the safety margin,
+    so a cell names the same place with any margin."""
+    xs, ys = segments[:, [0, 2]], segments[:, [1, 3]]
+    i0, j0 = math.floor(xs.min() / resolution) - 1, math.floor(ys.min() / resolution) - 1
+    i1, j1 = math.ceil(xs.max() / resolution) + 1, math.ceil(ys.max() / resolution) + 1
+    return i0, j0, i1, j1
 
 
 def _fits(span: tuple[float, float], resolution: float) -> bool:
@@ -60,23 +77,19 @@ def _fits(span: tuple[float, float], resolution: float) -> bool:
 
 
 def _too_large(path: Path, seg: np.ndarray, lines: list[int], resolution: float,
-               safety: float, exc: OptionError) -> InputFormatError | OptionError:
+               exc: OptionError) -> InputFormatError | OptionError:
     """The error for a walls raster above MAX_CELLS (``exc``: raster_shape's)."""
-    w, h = _span(seg, resolution, safety)
+    w, h = _span(seg, resolution)
     size = f"{w:.6g} x {h:.6g} m, {w / resolution:.3g} x {h / resolution:.3g} cells at " \
         f"{resolution:g} m a cell, above {MAX_CELLS:,}"
-    if not _fits(_span(seg[:1, [0, 1, 0, 1]], resolution, safety), resolution):
-        return OptionError(f"{path}: safety={safety:g} around the walls makes a raster "
-                           f"of {size}; use a smaller safety or a coarser resolution",
-                           param="safety")
     # the wall reaching farthest from the median of all the ends, in either axis; it is
     # the one to blame when the others fit and it makes the map 10 times as long
     ends = seg.reshape(-1, 2)
     reach = np.abs(ends - np.median(ends, axis=0)).max(axis=1).reshape(-1, 2).max(axis=1)
     k = int(np.argmax(reach))
     rest = np.delete(seg, k, axis=0)
-    if not len(rest) or (_fits(_span(rest, resolution, safety), resolution)
-                         and max(w, h) >= OUTLIER * max(_span(rest, resolution, safety))):
+    if not len(rest) or (_fits(_span(rest, resolution), resolution)
+                         and max(w, h) >= OUTLIER * max(_span(rest, resolution))):
         x1, y1, x2, y2 = seg[k]
         return InputFormatError(path, f"the wall ({x1:g}, {y1:g}) - ({x2:g}, {y2:g}) "
                                 f"stretches the map to {size}; is a coordinate wrong? "
@@ -120,8 +133,10 @@ def rasterize_segments(segments: np.ndarray, *, resolution: float, safety: float
                        name: str = "segments") -> Grid:
     """Rasterise (N, 4) segments at ``resolution`` metres per cell.
 
-    ``bounds`` = (xmin, ymin, xmax, ymax) defaults to the segments' extent plus the
-    safety margin and one cell on every side.
+    ``bounds`` = (xmin, ymin, xmax, ymax) defaults to the segments' extent on the
+    lattice of multiples of ``resolution`` and one cell more on every side
+    (:func:`wall_lattice`); the safety margin blocks cells in it but does not move or
+    grow it, so a cell names the same place with any ``safety``.
     """
     if not (math.isfinite(resolution) and resolution > 0):
         raise OptionError(f"resolution={resolution!r} must be a positive number",
@@ -130,11 +145,13 @@ def rasterize_segments(segments: np.ndarray, *, resolution: float, safety: float
         raise OptionError(f"safety={safety!r} must be a number >= 0", param="safety")
     seg = np.ascontiguousarray(segments, dtype=np.float64).reshape(-1, 4)
     if bounds is None:
-        pad = safety + resolution
-        xs, ys = seg[:, [0, 2]], seg[:, [1, 3]]
-        bounds = (xs.min() - pad, ys.min() - pad, xs.max() + pad, ys.max() + pad)
-    xmin, ymin, xmax, ymax = (float(b) for b in bounds)
-    width, height = raster_shape(xmax - xmin, ymax - ymin, resolution)
+        raster_shape(*_span(seg, resolution), resolution)  # refused before any allocation
+        i0, j0, i1, j1 = wall_lattice(seg, resolution)
+        # the shape counted in whole cells: (i1 - i0) * s / s can round up a cell
+        xmin, ymin, width, height = i0 * resolution, j0 * resolution, i1 - i0, j1 - j0
+    else:
+        xmin, ymin, xmax, ymax = (float(b) for b in bounds)
+        width, height = raster_shape(xmax - xmin, ymax - ymin, resolution)
     blocked = np.zeros((height, width), dtype=np.bool_)
     _rasterize(seg, xmin, ymin, resolution, safety, blocked)
     return Grid(blocked, resolution, (xmin, ymin), name=name)
