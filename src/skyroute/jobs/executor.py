@@ -221,6 +221,28 @@ class LocalExecutor(_Executor):
                 raise _closed(self) from None
             raise
 
+    def _submit_alone(self, pool, fn, item) -> tuple[ProcessPoolExecutor, Future]:
+        """``item`` submitted to ``pool``, a one-process pool of :attr:`_alone` (None: a
+        new one); a pool whose process died idle after the task before (killed from
+        outside, or by what that task left running) is replaced once. Returns the pool
+        and the future, a failed one when the fresh pool refuses too (the task is then
+        lost, as a death under it)."""
+        for tries in (1, 2):
+            if pool is None:
+                pool = _new_pool(1)
+                self._alone.add(pool)
+            try:
+                future = pool.submit(fn, item)
+            except (BrokenProcessPool, RuntimeError) as exc:
+                if not _broke(pool, exc):
+                    raise
+                future = _failed(exc)
+                if tries == 1:
+                    self._alone.discard(pool)
+                    pool = None
+                    continue
+            return pool, future
+
     def _again_alone(self, fn, items: list, again: list[int], out: list, on_result) -> list:
         """Run ``fn`` on the items at ``again`` (their pool broke under them) one at a
         time, each alone in a one-process pool (a fresh one after a death): fill ``out``
@@ -233,25 +255,7 @@ class LocalExecutor(_Executor):
                 with self._lock:
                     if self._closed:
                         raise _closed(self)
-                    if pool is None:
-                        pool = _new_pool(1)
-                        self._alone.add(pool)
-                    try:
-                        future = pool.submit(fn, items[i])
-                    except (BrokenProcessPool, RuntimeError) as exc:
-                        # its process died idle after the task before (killed from
-                        # outside, or by what that task left running): a fresh one
-                        if not _broke(pool, exc):
-                            raise
-                        self._alone.discard(pool)
-                        pool = _new_pool(1)
-                        self._alone.add(pool)
-                        try:
-                            future = pool.submit(fn, items[i])
-                        except (BrokenProcessPool, RuntimeError) as exc:
-                            if not _broke(pool, exc):
-                                raise
-                            future = _failed(exc)  # lost below, as a death under it
+                    pool, future = self._submit_alone(pool, fn, items[i])
                     procs = list((getattr(pool, "_processes", None) or {}).values())
                 try:
                     out[i] = _result(future)
