@@ -233,25 +233,24 @@ class LocalExecutor(_Executor):
                 with self._lock:
                     if self._closed:
                         raise _closed(self)
-                    if pool is None:
-                        pool = _new_pool(1)
-                        self._alone.add(pool)
-                    try:
-                        future = pool.submit(fn, items[i])
-                    except (BrokenProcessPool, RuntimeError) as exc:
-                        # its process died idle after the task before (killed from
-                        # outside, or by what that task left running): a fresh one
-                        if not _broke(pool, exc):
-                            raise
-                        self._alone.discard(pool)
-                        pool = _new_pool(1)
-                        self._alone.add(pool)
+                    for tries in (1, 2):
+                        if pool is None:
+                            pool = _new_pool(1)
+                            self._alone.add(pool)
                         try:
                             future = pool.submit(fn, items[i])
+                            break
                         except (BrokenProcessPool, RuntimeError) as exc:
+                            # its process died idle after the task before (killed from
+                            # outside, or by what that task left running): a fresh one;
+                            # the fresh one broken too: lost below, as a death under it
                             if not _broke(pool, exc):
                                 raise
-                            future = _failed(exc)  # lost below, as a death under it
+                            if tries == 2:
+                                future = _failed(exc)
+                            else:
+                                self._alone.discard(pool)
+                                pool = None
                     procs = list((getattr(pool, "_processes", None) or {}).values())
                 try:
                     out[i] = _result(future)
