@@ -86,6 +86,25 @@ def env_for(tree: Path) -> dict:
     return {**os.environ, "PYTHONPATH": str(tree)}
 
 
+def measure_in(tree: Path, argv: list[str], label: str) -> dict:
+    """Run ``python ARGV`` in a process that imports ``tree``'s skyroute and read the
+    JSON object on the last line it prints, whose ``skyroute`` names the package it
+    imported: a :class:`Fail` naming the tree (``label``) when the process fails or
+    imported another skyroute (an installed, non-editable one)."""
+    import json
+
+    proc = subprocess.run([sys.executable, *argv], capture_output=True, text=True,
+                          env=env_for(tree))
+    if proc.returncode != 0:
+        last = (proc.stderr.strip().splitlines() or ["(no message)"])[-1]
+        raise Fail(f"tree {label} ({tree}): the measuring process failed: {last}")
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    if not Path(out["skyroute"]).resolve().is_relative_to(tree):
+        raise Fail(f"tree {label}: the measuring process imported {out['skyroute']}, "
+                   f"not the skyroute of {tree} (is skyroute installed non-editable?)")
+    return out
+
+
 def parse_random(spec: str) -> tuple[int, float]:
     """``512:0.2`` -> (512, 0.2)."""
     side, _, share = spec.partition(":")

@@ -32,7 +32,6 @@ from __future__ import annotations
 import argparse
 import json
 import statistics
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -43,8 +42,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import (
     Fail,
     case_of,
-    env_for,
     load_average,
+    measure_in,
     resolve_tree,
     run_main,
 )
@@ -145,16 +144,7 @@ def main(argv=None) -> None:
 
 
 def _run(tree: Path, spec: Path, label: str) -> dict:
-    proc = subprocess.run([sys.executable, __file__, "A", "B", "--worker", str(spec)],
-                          capture_output=True, text=True, env=env_for(tree))
-    if proc.returncode != 0:
-        last = (proc.stderr.strip().splitlines() or ["no message"])[-1]
-        raise Fail(f"tree {label} ({tree}): the measuring process failed: {last}")
-    out = json.loads(proc.stdout.strip().splitlines()[-1])
-    if not Path(out["skyroute"]).resolve().is_relative_to(tree):
-        raise Fail(f"tree {label}: the measuring process imported {out['skyroute']}, "
-                   f"not the skyroute of {tree} (is skyroute installed non-editable?)")
-    return out
+    return measure_in(tree, [__file__, "A", "B", "--worker", str(spec)], label)
 
 
 def measure(job: dict) -> dict:

@@ -18,12 +18,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import Fail, env_for, load_average, resolve_tree, run_main
+from _common import Fail, load_average, measure_in, resolve_tree, run_main
 
 METHODS = ("auto", "subgoal", "jump")
 
@@ -78,15 +77,7 @@ def main(argv=None) -> None:
     for r in range(a.rounds):
         for spec, tree in trees:
             load = load_average()
-            out = subprocess.run([sys.executable, "-c", MEASURE, job], capture_output=True,
-                                 text=True, env=env_for(tree))
-            if out.returncode != 0:
-                last = (out.stderr.strip().splitlines() or ["(no message)"])[-1]
-                raise Fail(f"tree {spec!r}: the measuring process failed: {last}")
-            got = json.loads(out.stdout.strip().splitlines()[-1])
-            if not Path(got["skyroute"]).resolve().is_relative_to(tree):
-                raise Fail(f"tree {spec!r}: the process imported {got['skyroute']}, not "
-                           f"the skyroute of {tree} (is skyroute installed non-editable?)")
+            got = measure_in(tree, ["-c", MEASURE, job], repr(spec))
             runs.append({"tree": spec, "round": r + 1, "load": load, **got})
             secs = " ".join(f"{s:.2f}" for s in got["seconds"])
             print(f"{spec}: {secs} s ({', '.join(got['accelerator'])}; {load})",

@@ -160,6 +160,10 @@ def test_a_walls_cell_within_the_margin_is_named_so(monkeypatch, capsys, tmp_pat
     (["plan", "", "--start", "0,0", "--goal", "1,1"], "error: the MAP argument is empty: "
      "give a map file or a bundled map's name (see 'skyroute maps')\n"),
     (["prepare", "", "-o", "x.idx"], "error: the MAP argument is empty"),
+    # and an empty WORLD: ".: unknown world type ''"
+    (["plan-world", "", "--start", "0,0", "--goal", "1,1"], "error: the WORLD argument is "
+     "empty: give a colliders.csv city or a GeoJSON file of zones\n"),
+    (["fly", "", "--start", "0,0", "--goal", "1,1"], "error: the WORLD argument is empty"),
     (["plan", *QUERY, "--algorithm", "foo"], "--algorithm 'foo' is not valid"),
     (["plan", "den312d", "--start", "5;x", "--goal", "1,1"], "--start '5;x' must be"),
     (["plan", *QUERY, "--bogus"], "No such option: --bogus"),

@@ -116,6 +116,18 @@ def test_a_browser_on_a_missing_page_gets_a_page_linking_home(client, path):
     assert "<b>" not in r.text and "Accept" in r.headers["vary"]  # the path is escaped
 
 
+def test_the_missing_page_page_has_the_viewers_policy(client):
+    """The 'Page not found' page is a viewer page that shows the path asked for: it
+    carries the viewer's Content-Security-Policy and nosniff as the others do (it had
+    neither, the one viewer page a crafted link writes into)."""
+    from skyroute.service.viewer import HEADERS
+
+    r = client.get("/planer.html", headers={"Accept": BROWSER})
+    assert r.status_code == 404 and r.headers["content-type"].startswith("text/html")
+    for name, value in HEADERS.items():
+        assert r.headers[name] == value, name
+
+
 @pytest.mark.parametrize("accept", [None, "*/*", "application/json",
                                     "application/problem+json",
                                     "text/html;q=0.5, application/json",

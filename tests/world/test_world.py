@@ -235,3 +235,12 @@ def test_a_loaded_world_keeps_the_path_it_was_given_through_views_and_pickling(t
     assert w == w and w != again  # a World is equal only to itself, as before
     built = skyroute.World(w.obstacles, w.floors, w.ceilings, w.names, name="mine")
     assert built.source is None and built.where == "mine"
+
+
+def test_an_empty_world_path_is_named_as_such():
+    """``load_world("")`` read the folder "." (Path("")): ".: unknown world type ''", as
+    load_map's empty path said "a folder, not a map file" before it was named."""
+    with pytest.raises(OptionError, match=r"^path='' is empty: give a colliders\.csv "
+                       r"city or a GeoJSON file$") as info:
+        skyroute.load_world("")
+    assert info.value.param == "path"

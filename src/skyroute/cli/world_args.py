@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Annotated
 
 import numpy as np
@@ -62,7 +61,9 @@ FRAME_HELP = ("How points are typed and printed: lonlat (LON,LAT; the default, a
               "degrees (LON,LAT on a flat plane, the ILP rules; GeoJSON only).")
 
 
-WorldFile = Annotated[Path, typer.Argument(metavar="WORLD", help=(
+# str, not Path: Typer makes an empty argument Path("."), which load_world read as a
+# folder ("unknown world type ''"); load_world_file names it (as plan's MAP is a str)
+WorldFile = Annotated[str, typer.Argument(metavar="WORLD", help=(
     "A colliders.csv city (metres around lat0/lon0) or a GeoJSON file of zones."))]
 StartPoint = Annotated[str, typer.Option(
     "--start", help="A point in --frame: LON,LAT, NORTH,EAST or EAST,NORTH.")]
@@ -79,10 +80,14 @@ Boundary = Annotated[str | None, typer.Option(
 
 def load_world_file(world_file: str, **options):
     """:func:`skyroute.load_world`; a grid map given as WORLD says to plan on it with
-    ``skyroute plan`` (as ``plan`` sends a colliders city to ``plan-world``)."""
-    from skyroute.errors import GridNotWorldError, InputFormatError
+    ``skyroute plan`` (as ``plan`` sends a colliders city to ``plan-world``); an empty
+    WORLD says so, as ``plan`` says of an empty MAP (it read ".: unknown world type ''")."""
+    from skyroute.errors import GridNotWorldError, InputFormatError, OptionError
     from skyroute.world.load import load_world
 
+    if not str(world_file):
+        raise OptionError("the WORLD argument is empty: give a colliders.csv city or a "
+                          "GeoJSON file of zones")
     try:
         return load_world(world_file, **options)
     except GridNotWorldError as exc:

@@ -18,6 +18,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from skyroute.delivery.store import is_busy
 from skyroute.errors import InputFormatError, SkyrouteError, StoreBusyError
+from skyroute.service import viewer
 from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.paths import root_path, route_path
 
@@ -241,7 +242,9 @@ async def _http(request: Request, exc: StarletteHTTPException) -> Response:
         if prefers_html(request):
             page = NOT_FOUND_PAGE.format(path=html.escape(request.url.path),
                                          root=html.escape(root_path(request)))
-            return HTMLResponse(page, status_code=404, headers={"Vary": "Accept"})
+            # a page of the viewer's: its policy too (it shows the path asked for)
+            return HTMLResponse(page, status_code=404,
+                                headers={"Vary": "Accept", **viewer.HEADERS})
         return problem_response(404, f"no such resource: {request.url.path}",
                                 headers={"Vary": "Accept"})
     if exc.status_code == 404 and detail == "Not Found":

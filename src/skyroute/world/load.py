@@ -146,6 +146,9 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
         raise OptionError(f"safety={safety!r} must be at most {most:g} "
                           f"({'degrees' if frame == 'degrees' else 'metres'})", param="safety")
     p = Path(path)
+    if not str(path):  # Path("") is ".", a folder: "unknown world type ''"
+        raise OptionError("path='' is empty: give a colliders.csv city or a GeoJSON file",
+                          param="path")
     if text is None and not p.exists():
         key = p.name[:-4] if p.name.endswith(".map") else p.name
         if str(path) == p.name and key in bundled_maps():
