@@ -192,7 +192,7 @@ def test_a_server_without_warming(monkeypatch):
 
 # a server whose /health answers at once (its first process is warm) while its second
 # process warms for a while longer: it writes the file ``late`` when that one is warm,
-# then marks both ready as skyroute.service.ready does (pid files), if it was asked to
+# then marks both ready as skyroute.bench.ready does (pid files), if it was asked to
 _SLOW_SECOND_PROCESS = """
 import http.server, os, sys, threading, time
 from pathlib import Path
@@ -253,7 +253,7 @@ def test_each_process_of_a_real_server_marks_itself_ready(tmp_path):
 def test_a_process_marks_itself_ready_only_when_asked(monkeypatch, tmp_path):
     import os
 
-    from skyroute.service.ready import READY_DIR_ENV, count_ready, mark_ready
+    from skyroute.bench.ready import READY_DIR_ENV, count_ready, mark_ready
 
     monkeypatch.delenv(READY_DIR_ENV, raising=False)
     assert mark_ready() is None

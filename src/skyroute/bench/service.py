@@ -36,8 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from skyroute.bench.ready import READY_DIR_ENV, count_ready
 from skyroute.errors import OptionError, SkyrouteError
-from skyroute.service.ready import READY_DIR_ENV, count_ready
 
 TOKEN = "bench-service-token"
 CLIENTS = ("httpx", "raw")
@@ -95,7 +95,7 @@ class Server:
 
     ``/health`` answers once one process is warm; the others may still be warming on the
     same cores. So the wait also lasts until every process has written its pid to a
-    folder the server is given in ``$SKYROUTE_READY_DIR`` (:mod:`skyroute.service.ready`):
+    folder the server is given in ``$SKYROUTE_READY_DIR`` (:mod:`skyroute.bench.ready`):
     no measured request competes with a warm-up, whichever process the kernel hands the
     connections to."""
 
@@ -106,7 +106,7 @@ class Server:
         self.url = f"http://127.0.0.1:{self.port}"
         self.workers, self.warm = workers, warm
         cmd = self._command(db=db, data=data, max_expansions=max_expansions)
-        # each server process writes its pid here once warm (skyroute.service.ready)
+        # each server process writes its pid here once warm (skyroute.bench.ready)
         self._ready = tempfile.TemporaryDirectory(prefix="skyroute-ready-")
         env = {**os.environ, "SKYROUTE_TOKEN": TOKEN, READY_DIR_ENV: self._ready.name}
         self.proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,

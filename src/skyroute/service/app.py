@@ -6,7 +6,7 @@ Making the app opens nothing; the store, the site and the job executor open on f
 (:mod:`skyroute.service.resources`) and close when the app shuts down. Starting it (the
 lifespan, before the server accepts a connection) warms the planners
 (:mod:`skyroute.service.warm`) unless ``Settings.warm`` is off, then marks the process
-ready for the bench that started it (:mod:`skyroute.service.ready`, only when asked).
+ready for the bench that started it (:mod:`skyroute.bench.ready`, only when asked).
 """
 
 from __future__ import annotations
@@ -18,7 +18,8 @@ from fastapi import APIRouter, Depends, FastAPI, Request
 from fastapi_offline import FastAPIOffline
 
 import skyroute
-from skyroute.service import cut, problems, query, ready
+from skyroute.bench import ready
+from skyroute.service import cut, problems, query
 from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.middleware import BodyLimit, HeadAsGet, ServerTiming
 from skyroute.service.resources import Resources
