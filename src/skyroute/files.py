@@ -7,15 +7,17 @@ import os
 import secrets
 import shutil
 import signal
+import sys
 import threading
 from collections.abc import Iterator
-from contextlib import contextmanager, suppress
+from contextlib import AbstractContextManager, ExitStack, contextmanager, suppress
 from contextvars import ContextVar
 from pathlib import Path
-from typing import BinaryIO, TextIO
+from typing import BinaryIO, TextIO, TypeVar
 
 from skyroute.errors import InputFormatError, OptionError, SkyrouteError
 
+T = TypeVar("T")
 BOM = "\ufeff"  # a UTF-8 byte-order mark: Excel's "CSV UTF-8" and Notepad start with one
 
 
@@ -63,10 +65,25 @@ def _umask() -> int:
 _MODE = 0o666 & ~_umask()
 
 
-# the files of the innermost written_together block: (temporary file, its place, the
-# folders made for it)
-_TOGETHER: ContextVar[list[tuple[str, Path, list[Path]]] | None] = ContextVar(
-    "skyroute_together", default=None)
+class Together:
+    """What a :func:`written_together` block holds: its staged files (temporary file, its
+    place, the folders made for it) and the transactions it ends (:meth:`enter`)."""
+
+    def __init__(self) -> None:
+        self.staged: list[tuple[str, Path, list[Path]]] = []
+        self.ends = ExitStack()
+
+    def enter(self, transaction: AbstractContextManager[T]) -> T:
+        """Enter ``transaction`` (e.g. :func:`skyroute.delivery.store.writing`) now and
+        leave it when the block ends: without an error (committed) once every file is
+        renamed into place, before their earlier versions are dropped, so a commit that
+        fails puts the files back; with the error (rolled back) when the block raises
+        or a rename fails. What it returns (the connection)."""
+        return self.ends.enter_context(transaction)
+
+
+# the innermost written_together block of this thread
+_TOGETHER: ContextVar[Together | None] = ContextVar("skyroute_together", default=None)
 
 
 @contextmanager
@@ -79,7 +96,8 @@ def open_atomic(path: str | Path) -> Iterator[BinaryIO]:
     The block should only write the file: an OSError raised in it is reported as such.
     """
     path = Path(path)
-    staged = _TOGETHER.get()
+    together = _TOGETHER.get()
+    staged = None if together is None else together.staged
     made = _folders_for(path)
     # the temporary file's name is known before it exists: a Ctrl-C the moment it is
     # made (mkstemp's name not yet returned) left it behind
@@ -102,7 +120,7 @@ def open_atomic(path: str | Path) -> Iterator[BinaryIO]:
 
 
 @contextmanager
-def written_together() -> Iterator[None]:
+def written_together() -> Iterator[Together]:
     """Every file :func:`open_atomic` or :func:`write_atomic` writes in this block (in
     this thread) appears when the block ends, or none does if it raises (nor a folder
     made for one): a Ctrl-C or an error while a fleet run's folder or a delivery day's
@@ -115,31 +133,46 @@ def written_together() -> Iterator[None]:
     (a new one gone), and the error names the file whose rename failed. A reader sees
     each file whole, old or new; one that reads several in the instant of the renames
     may see some new and the others old. A block inside another joins it.
+
+    The block's :class:`Together` takes a database transaction that must change with
+    the files (:meth:`Together.enter`: a delivery day's rows): it is committed after
+    every rename, before the earlier versions are dropped, and a commit that fails puts
+    every file back; an error in the block or a failed rename rolls it back. The
+    renames and the commit are one step for SIGINT and SIGTERM (held until both are
+    done, or both undone). Only a crash of the process (SIGKILL, power) between the
+    last rename and the commit can leave the files new and the rows old.
     """
-    if _TOGETHER.get() is not None:
-        yield
+    outer = _TOGETHER.get()
+    if outer is not None:
+        yield outer
         return
-    staged: list[tuple[str, Path, list[Path]]] = []
-    token = _TOGETHER.set(staged)
+    together = Together()
+    token = _TOGETHER.set(together)
     try:
-        yield
+        yield together
     except BaseException:
         _TOGETHER.reset(token)
-        _discard(staged)
-        raise
+        _discard(together.staged)
+        if not together.ends.__exit__(*sys.exc_info()):  # the transactions rolled back
+            raise
+        return
     _TOGETHER.reset(token)
-    _rename_all(staged)
+    _rename_all(together)
 
 
-def _rename_all(staged: list[tuple[str, Path, list[Path]]]) -> None:
-    """Rename every staged file into place, or (an OSError, a Ctrl-C before the signals
-    are held) none: the files renamed before a failure are put back as they were."""
+def _rename_all(together: Together) -> None:
+    """Rename every staged file into place and commit the block's transactions, or (an
+    OSError, a failed commit, a Ctrl-C before the signals are held) neither: the files
+    renamed before a failure are put back as they were, the transactions rolled back."""
+    staged = together.staged
     backups: dict[Path, str] = {}  # place -> its earlier version, a hard link beside it
     done = 0  # the files renamed into place
     failed = None  # the file being backed up or renamed when it failed
+    committed = False
     try:
         # one step: a signal in the renames (a rename each, a round trip each on NFS)
-        # left the first files new and the others removed, a mix of two runs
+        # left the first files new and the others removed, a mix of two runs; nor may
+        # one come between the renames and the commit
         with _signals_held():
             for tmp, path, _ in staged:
                 failed = path
@@ -150,12 +183,17 @@ def _rename_all(staged: list[tuple[str, Path, list[Path]]]) -> None:
                 if tmp:
                     os.replace(tmp, path)
                 done += 1
+            failed = None
+            together.ends.close()  # commit (a failure rolls back what is left, and raises)
+            committed = True
     except BaseException as exc:
-        if done == len(staged):  # a signal held through the renames, taken after them
+        if committed:  # a signal held through the renames and the commit, taken after them
             raise
         _put_back(staged[:done], backups)
         _discard(staged)
-        if isinstance(exc, OSError):
+        # roll back (a commit that failed has ended its transactions already)
+        together.ends.__exit__(type(exc), exc, exc.__traceback__)
+        if isinstance(exc, OSError) and failed is not None:
             raise SkyrouteError(f"{failed}: cannot write: {exc.strerror or exc}") from None
         raise
     finally:

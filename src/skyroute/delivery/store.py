@@ -15,7 +15,8 @@ with their line counts from 0006).
 A SQLite file by default, PostgreSQL (or any SQLAlchemy URL) by ``--db``. The schema is
 made and upgraded by Alembic migrations shipped in the package (``db init`` runs them).
 A day's results go in one transaction: its old rows are deleted and the new ones
-inserted together, so a run killed midway leaves the previous state of that day.
+inserted together, so a run killed midway leaves the previous state of that day. The
+delivery runs commit it together with the day's files (:mod:`skyroute.jobs.deliver`).
 """
 
 from __future__ import annotations
@@ -411,18 +412,23 @@ class DayKeptError(SkyrouteError):
         self.date, self.delivered, self.why = date, delivered, why
 
 
-def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[dict],
-              moves: Iterable[dict], *, keep: str | None = None) -> None:
+def write_day(engine: sa.Engine | sa.Connection, date: dt.date, run: dict,
+              delivered: Iterable[dict], moves: Iterable[dict], *,
+              keep: str | None = None) -> None:
     """Replace one day's results in one transaction (``moves`` may be a generator). The
     run and delivery rows are checked to fit their columns first (:func:`check_fits`:
     money beyond a 32-bit INTEGER), so a failure leaves the day as it was. Two writers
     of one day at once: the later waits for the earlier's transaction, then replaces its
     rows (SQLite: its write lock; PostgreSQL: an advisory lock on the day).
 
+    ``engine``: an Engine (the day is committed here, in a transaction of its own), or
+    a Connection in a transaction of :func:`writing`: the day is written in it and its
+    owner commits it (with the day's files: :meth:`skyroute.files.Together.enter`).
+
     ``keep``: why this run must not replace a stored run of the day that delivered
     orders (None: it replaces any); such a stored run is kept, and
     :class:`DayKeptError` raised naming ``keep``, read in the same transaction."""
-    t_ = tables(engine)
+    t_ = tables(engine.engine)
     flightpath, deliveries, runs = t_["flightpath"], t_["deliveries"], t_["runs"]
     head = {**run, "delivery_date": date,
             "settings": json.dumps(run.get("settings", {}), sort_keys=True)}
@@ -430,7 +436,7 @@ def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[d
     check_fits(runs, head, f"{date}: ")
     for row in rows:
         check_fits(deliveries, row, f"{date}: order {row.get('order_no')!r}: ")
-    with writing(engine) as conn:
+    with _writing_in(engine) as conn:
         _lock_day(conn, date)
         if keep is not None:
             had = conn.scalar(sa.select(runs.c.orders_delivered)
@@ -450,6 +456,17 @@ def write_day(engine: sa.Engine, date: dt.date, run: dict, delivered: Iterable[d
                 batch = []
         if batch:
             conn.execute(flightpath.insert(), batch)
+
+
+@contextmanager
+def _writing_in(engine: sa.Engine | sa.Connection) -> Iterator[sa.Connection]:
+    """A Connection's own transaction as it is (its owner commits), or an Engine's new
+    one (:func:`writing`)."""
+    if isinstance(engine, sa.Connection):
+        yield engine
+    else:
+        with writing(engine) as conn:
+            yield conn
 
 
 def delete_unflown_day(engine: sa.Engine, date: dt.date) -> dict | None:
@@ -504,9 +521,10 @@ def day_rows(engine: sa.Engine, date: dt.date) -> dict[str, list[tuple]]:
                 .order_by(flightpath.c.seq))]}
 
 
-def store_day(engine, result, *, replace: bool = False) -> None:
+def store_day(engine: sa.Engine | sa.Connection, result, *, replace: bool = False) -> None:
     """Write a :class:`~skyroute.delivery.day.DayResult` (run, deliveries, moves) in
-    one transaction, replacing the day's stored results; but a day whose every order is
+    one transaction (``engine``'s own, or a Connection's, as :func:`write_day`),
+    replacing the day's stored results; but a day whose every order is
     invalid does not replace a stored run that delivered orders (:class:`DayKeptError`)
     unless ``replace``: flown with the wrong site's menus, every order is 'unknown
     item', and that silently replaced the day's real flight."""

@@ -1,7 +1,7 @@
 """What a delivery day leaves on disk: ``drone-DD-MM-YYYY.geojson`` (the flight as one
 LineString, SPEC.md 4.6), a PNG map of the day and a JSON report; each file is written
-whole or not at all. (Its rows in the store come first: :func:`skyroute.delivery.store.
-store_day`.)
+whole or not at all. (Its rows in the store, :func:`skyroute.delivery.store.store_day`,
+are committed with them: :func:`skyroute.jobs.deliver.run_days`.)
 """
 
 from __future__ import annotations

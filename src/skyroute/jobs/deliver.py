@@ -6,9 +6,10 @@ method. The worker flies the day and sends the :class:`DayResult` back; it write
 nothing. The caller stores each day as its result arrives (:func:`run_days`), in one
 transaction that first deletes whatever an earlier run stored for that date
 (:func:`skyroute.delivery.store.store_day`), together with the day's files when it
-writes any: they are written to temporary names first and renamed into place once the
-day is stored (:func:`skyroute.files.written_together`), so a day is stored with its
-files or, after an error or Ctrl-C, neither is. Workers that stored their days
+writes any: they are written to temporary names, the day's rows written, the files
+renamed into place, then the rows committed (:func:`skyroute.files.written_together`,
+:meth:`~skyroute.files.Together.enter`), so a day is stored with its files or, after an
+error, a failed rename or commit, or Ctrl-C, neither is. Workers that stored their days
 themselves stored days the caller then never wrote files for (a Ctrl-C, a full disk
 while a PNG was written, or another day's error in a range with ``--jobs``). A day run
 twice, or re-run on another worker after its worker died, is stored once (its first
@@ -171,10 +172,11 @@ def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executo
 
     ``files(result)``: writes the day's files through :func:`skyroute.files.open_atomic`
     (:func:`skyroute.io.day_out.write_outputs`); they are written to temporary names,
-    the day is stored, then they are renamed into place (one
-    :func:`~skyroute.files.written_together` block), so an error or Ctrl-C in either
-    leaves the day's rows and files as they were. ``on_day(result)`` is called once the
-    day is stored and its files are in place.
+    the day's rows written, the files renamed into place and the rows committed last
+    (one :func:`~skyroute.files.written_together` block), so an error or Ctrl-C in
+    either, a rename that fails or a commit that fails, leaves the day's rows and files
+    as they were. ``on_day(result)`` is called once the day is stored and its files are
+    in place.
 
     A day whose flight fails (:class:`DayFailed`, passed to ``on_failed`` as it
     arrives; also a day whose worker died under it every time it was tried, see
@@ -194,10 +196,15 @@ def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executo
             if on_failed is not None:
                 on_failed(result)
             return
-        with written_together():
+        # the rows are committed after the files are renamed into place, before their
+        # earlier versions are dropped: a failed rename rolls the rows back, a failed
+        # commit puts the files back (the rows were committed first: a failed rename
+        # left the new flight stored beside the earlier run's files)
+        with written_together() as together:
             if files is not None:
-                files(result)
-            store.store_day(engine, result, replace=replace)
+                files(result)  # staged first: the day's lock is not held while plotting
+            conn = together.enter(store.writing(engine))
+            store.store_day(conn, result, replace=replace)
         if on_day is not None:
             on_day(result)
 
