@@ -190,6 +190,31 @@ def test_a_server_without_warming(monkeypatch):
         "--log-level", "warning", "--no-warm"]
 
 
+@pytest.mark.parametrize("command", [
+    ["-c", "import sys; sys.exit('no store here')"],  # a server that dies at start
+    None,  # a server that cannot be started at all (no such program)
+])
+def test_a_server_that_dies_at_start_leaves_no_ready_folder(monkeypatch, tmp_path,
+                                                            command):
+    """The ready folder (``$SKYROUTE_READY_DIR``) was removed only by ``stop()``: a
+    server that exited at once, or could not be started, left a ``skyroute-ready-*``
+    folder in the temp dir for every such start."""
+    import sys
+    import tempfile
+
+    from skyroute.bench.service import Server
+    from skyroute.errors import SkyrouteError
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    program = [sys.executable, *command] if command else [str(tmp_path / "no-python")]
+    monkeypatch.setattr(Server, "_command", lambda self, **_kw: program)
+    with pytest.raises(SkyrouteError if command else FileNotFoundError) as err:
+        Server(db="sqlite://", warm=False, start_timeout=60)
+    if command:
+        assert str(err.value) == "the server did not start: no store here"
+    assert not list(tmp_path.glob("skyroute-ready-*"))  # while the error is still held
+
+
 # a server whose /health answers at once (its first process is warm) while its second
 # process warms for a while longer: it writes the file ``late`` when that one is warm,
 # then marks both ready as skyroute.bench.ready does (pid files), if it was asked to

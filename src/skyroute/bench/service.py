@@ -108,11 +108,16 @@ class Server:
         cmd = self._command(db=db, data=data, max_expansions=max_expansions)
         # each server process writes its pid here once warm (skyroute.bench.ready)
         self._ready = tempfile.TemporaryDirectory(prefix="skyroute-ready-")
+        self.proc: subprocess.Popen | None = None
         env = {**os.environ, "SKYROUTE_TOKEN": TOKEN, READY_DIR_ENV: self._ready.name}
-        self.proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
-                                     stderr=subprocess.PIPE, text=True)
-        self._wait(default_start_timeout(workers) if start_timeout is None
-                   else start_timeout)
+        try:
+            self.proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
+                                         stderr=subprocess.PIPE, text=True)
+            self._wait(default_start_timeout(workers) if start_timeout is None
+                       else start_timeout)
+        except BaseException:  # a server that died at start, or a Ctrl-C in the wait:
+            self.stop()  # no process left running, no ready folder left in the temp dir
+            raise
 
     def _command(self, *, db: str, data: Path | None, max_expansions: int | None) -> list:
         cmd = [sys.executable, "-m", "skyroute", "serve", "--port", str(self.port), "--db",
@@ -157,7 +162,8 @@ class Server:
         return count_ready(Path(self._ready.name))
 
     def stop(self) -> None:
-        if self.proc.poll() is None:
+        """Stop the server (if it runs) and remove its ready folder; again is harmless."""
+        if self.proc is not None and self.proc.poll() is None:
             self.proc.terminate()
             try:
                 self.proc.wait(20)
