@@ -120,7 +120,7 @@ def test_serve_passes_the_root_path_to_uvicorn(monkeypatch, capsys, tmp_path, gi
     served = []
     monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.append(kw))
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("SKYROUTE_TOKEN", "t0ken")
+    monkeypatch.setenv("SKYROUTE_TOKEN", "root-path-token-0001")
     code, _, err = run(monkeypatch, capsys, "serve", "--db",
                        f"sqlite:///{tmp_path / 's.db'}", "--root-path", given)
     assert code in (0, None) and len(served) == 1, err
@@ -133,7 +133,7 @@ def test_a_root_path_that_is_no_path_is_one_line(monkeypatch, capsys, tmp_path, 
     from tests.cli.test_cli import run
 
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("SKYROUTE_TOKEN", "t0ken")
+    monkeypatch.setenv("SKYROUTE_TOKEN", "root-path-token-0001")
     code, _, err = run(monkeypatch, capsys, "serve", "--root-path", given)
     assert code == 2 and len(err.strip().splitlines()) == 1, err
     assert f"--root-path {given!r} must be" in err, err

@@ -24,6 +24,7 @@ from skyroute.errors import OptionError
 from tests.cli.test_cli import run
 from tests.conftest import ROOT
 
+TOKEN = "serve-test-token-0001"
 WAIT = 60  # seconds: the longest a server may take to start, answer or stop
 
 
@@ -88,7 +89,7 @@ def test_serve_prints_a_generated_token_once(tmp_path):
 
 @pytest.mark.slow
 def test_serve_with_a_token_file_and_two_workers(tmp_path):
-    (tmp_path / "token").write_text("s3cret-token\n")
+    (tmp_path / "token").write_text("s3cret-token-0123456\n")
     proc, url = start(tmp_path, "--token-file", str(tmp_path / "token"), "--workers", "2",
                       "--data", str(ROOT / "examples" / "lunch"))
     try:
@@ -96,7 +97,7 @@ def test_serve_with_a_token_file_and_two_workers(tmp_path):
         # each on a connection of its own, as either worker may take it; httpx's default
         # timeout (5 s) is shorter than a cold worker's first /plan on a loaded machine
         ok = httpx.post(url + "/plan", json=body, timeout=WAIT,
-                        headers={"Authorization": "Bearer s3cret-token"})
+                        headers={"Authorization": "Bearer s3cret-token-0123456"})
         assert ok.status_code == 200 and ok.json()["status"] == "found"
         bad = httpx.post(url + "/plan", json=body, timeout=WAIT,
                          headers={"Authorization": "Bearer x"})
@@ -126,12 +127,12 @@ def test_skyroute_lines_are_logged_as_uvicorn_logs_its_own(monkeypatch, capsys, 
         for row in csv.DictReader(f):
             shutil.rmtree(other / "website" / "words" / row["deliverTo"].replace(".", "/"),
                           ignore_errors=True)
-    env = {"SKYROUTE_TOKEN": "t0ken"}
+    env = {"SKYROUTE_TOKEN": TOKEN}
     for level in ("info", "warning"):
         proc, url = start(tmp_path, "--data", str(other), env=env, log_level=level)
         try:
             job = httpx.post(url + "/jobs/deliver", json={"date": "2024-01-03"},
-                             headers={"Authorization": "Bearer t0ken"}, timeout=WAIT)
+                             headers={"Authorization": f"Bearer {TOKEN}"}, timeout=WAIT)
             assert job.status_code == 202, job.text
             deadline = time.monotonic() + WAIT
             while time.monotonic() < deadline:
@@ -160,7 +161,7 @@ def test_skyroute_lines_are_logged_as_uvicorn_logs_its_own(monkeypatch, capsys, 
 def test_a_log_level_not_uvicorns_is_one_line(monkeypatch, capsys, tmp_path):
     """A --log-level uvicorn does not know was its KeyError traceback, after the banner."""
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("SKYROUTE_TOKEN", "t")
+    monkeypatch.setenv("SKYROUTE_TOKEN", "serve-test-token-0001")
     code, out, err = run(monkeypatch, capsys, "serve", "--log-level", "loud", "--db",
                          f"sqlite:///{tmp_path / 's.db'}")
     assert code == 2 and len(err.strip().splitlines()) == 1, err
@@ -196,7 +197,7 @@ def test_a_token_a_header_cannot_carry_is_one_line(monkeypatch, capsys, tmp_path
 
     with pytest.raises(ValidationError, match="character 2 is not printable ASCII"):
         Settings(token="s\u00e9cret")
-    assert Settings(token="two words~!").token == "two words~!"  # as before
+    assert Settings(token="two words~! and more").token == "two words~! and more"  # as before
     monkeypatch.chdir(tmp_path)
     (tmp_path / "token").write_text("s\u00e9cret\n", encoding="utf-8")
     if given == "env":
@@ -212,6 +213,36 @@ def test_a_token_a_header_cannot_carry_is_one_line(monkeypatch, capsys, tmp_path
     assert "\u00e9" not in err + out and "skyroute service on" not in err
 
 
+@pytest.mark.parametrize("given", ["env", "file"])
+def test_a_short_token_is_refused_at_start(monkeypatch, capsys, tmp_path, given):
+    """A token of one character was taken: anyone who reached the server could guess
+    the writes' token by trying. Fewer than 16 characters is one line naming where the
+    token came from (never the token), exit 2, before the banner; a ``Settings`` check,
+    so ``create_app`` refuses it too."""
+    from pydantic import ValidationError
+
+    from skyroute.service.settings import Settings
+
+    with pytest.raises(ValidationError, match="shorter than 16 characters"):
+        Settings(token="x" * 15)
+    assert Settings(token="x" * 16).token == "x" * 16
+    monkeypatch.chdir(tmp_path)
+    short = "shorty-7"
+    (tmp_path / "token").write_text(short + "\n")
+    if given == "env":
+        monkeypatch.setenv("SKYROUTE_TOKEN", short)
+        args, where = [], "SKYROUTE_TOKEN: "
+    else:
+        monkeypatch.delenv("SKYROUTE_TOKEN", raising=False)
+        args, where = ["--token-file", str(tmp_path / "token")], f"--token-file {tmp_path}"
+    code, out, err = run(monkeypatch, capsys, "serve", "--db",
+                         f"sqlite:///{tmp_path / 's.db'}", *args)
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert err.startswith(f"skyroute: error: {where}") and "shorter than 16" in err, err
+    assert short not in err + out and "skyroute service on" not in err
+    assert not (tmp_path / "s.db").exists()  # refused before the store is made
+
+
 @pytest.mark.parametrize("host, words", [
     ("127.0.0.1", "the port is in use"),
     ("nosuch.invalid", "--host 'nosuch.invalid': not an address"),
@@ -222,7 +253,7 @@ def test_an_address_it_cannot_listen_on_is_one_line(monkeypatch, capsys, tmp_pat
     is one line naming the option, exit 2, before the banner and the store: uvicorn logged
     it after "skyroute service on ..." and exited 3."""
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("SKYROUTE_TOKEN", "t")
+    monkeypatch.setenv("SKYROUTE_TOKEN", "serve-test-token-0001")
     with socket.socket() as busy:
         busy.bind(("127.0.0.1", 0))
         busy.listen()
@@ -288,7 +319,7 @@ def test_serve_fails_the_jobs_a_stopped_server_left(monkeypatch, capsys, tmp_pat
     served = []
     monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.append(app))
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("SKYROUTE_TOKEN", "t0ken")
+    monkeypatch.setenv("SKYROUTE_TOKEN", "serve-test-token-0001")
     code, _, err = run(monkeypatch, capsys, "serve", "--db", db)
     assert code in (0, None) and len(served) == 1, err
     assert "2 job(s) left queued or running by a stopped server marked failed" in err

@@ -58,9 +58,10 @@ for text, fmt, s, g in [(city, "colliders", [-3.1890, 55.9456], [-3.1850, 55.943
     for a in ("visibility", "prm", "astar", "jps", "lazy_theta"):
         queries.append({"world_text": text, "world_format": fmt, "start": s, "goal": g,
                         "altitude": 10, "safety": 2, "algorithm": a})
-with TestClient(create_app(Settings(token="t", db_url="sqlite:///s.db"))) as client:
+token = "warm-test-token-0001"
+with TestClient(create_app(Settings(token=token, db_url="sqlite:///s.db"))) as client:
     started = loaded()
-    statuses = [client.post("/plan", json=q, headers={"Authorization": "Bearer t"})
+    statuses = [client.post("/plan", json=q, headers={"Authorization": f"Bearer {token}"})
                 .status_code for q in queries]
     after = loaded()
 print(json.dumps({"started": started, "after": after, "statuses": statuses}))
@@ -93,11 +94,11 @@ def test_warming_can_be_turned_off_and_never_stops_the_app(tmp_path, monkeypatch
     from skyroute.service.settings import Settings
 
     db = f"sqlite:///{tmp_path / 's.db'}"
-    with TestClient(create_app(Settings(token="t", db_url=db, warm=False))) as c:
+    with TestClient(create_app(Settings(token="warm-test-token-0001", db_url=db, warm=False))) as c:
         assert not hasattr(c.app.state, "warmed")
     broken = [*warm.queries(), {"map_text": "not a map", "start": [0, 0], "goal": [1, 1]}]
     monkeypatch.setattr(warm, "queries", lambda: broken)
-    with TestClient(create_app(Settings(token="t", db_url=db))) as c:
+    with TestClient(create_app(Settings(token="warm-test-token-0001", db_url=db))) as c:
         assert c.app.state.warmed["queries"] == len(broken)
         assert c.app.state.warmed["failed"] == 1
         assert c.get("/health").status_code == 200
@@ -114,7 +115,7 @@ def test_the_warm_up_queries_are_found_paths():
     from skyroute.service.settings import Settings
     from skyroute.service.warm import queries
 
-    res = Resources(Settings(token="t"))
+    res = Resources(Settings(token="warm-test-token-0001"))
     for body in queries():
         out = _plan(PlanRequest.model_validate(body), res)
         assert out["status"] == "found" and len(out["path"]) >= 2, body

@@ -92,19 +92,13 @@ def serve_command(
         raise OptionError(f"--workers {workers} must be at least 1")
     root_path = check_root_path(root_path)
     check_listen(host, port)
-    engine = make_engine(db)  # the store opens and is migrated before anyone asks
-    orphans = _fail_orphans(engine)
-    engine.dispose()
-    if orphans:
-        typer.echo(f"{len(orphans)} job(s) left queued or running by a stopped server "
-                   "marked failed", err=True)
     token, where = read_token(token_file)
     try:
         settings = Settings(db_url=db, data_dir=data, source_url=source, dask_address=dask,
                             max_body_bytes=int(max_body_mb * MB),
                             max_expansions=max_expansions, job_queue=job_queue, warm=warm,
                             **({"token": token} if token else {}))
-    except ValidationError as exc:  # a limit out of range
+    except ValidationError as exc:  # a limit out of range, or the token: before the store
         err = exc.errors()[0]
         flag = {"max_body_bytes": "--max-body-mb", "job_queue": "--job-queue",
                 "max_expansions": "--max-expansions"}.get(str(err["loc"][0]) if err["loc"]
@@ -112,6 +106,12 @@ def serve_command(
                                                          TOKEN_ENV if where == TOKEN_ENV
                                                          else f"--token-file {where}")
         raise OptionError(f"{flag}: {err['msg'].removeprefix('Value error, ')}") from None
+    engine = make_engine(db)  # the store opens and is migrated before anyone asks
+    orphans = _fail_orphans(engine)
+    engine.dispose()
+    if orphans:
+        typer.echo(f"{len(orphans)} job(s) left queued or running by a stopped server "
+                   "marked failed", err=True)
     url = f"http://{host}:{port}/"
     typer.echo(f"skyroute service on {url} (API docs {url}docs)", err=True)
     if root_path:

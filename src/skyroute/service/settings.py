@@ -15,6 +15,9 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 from skyroute.delivery.store import DEFAULT_DB
 
 MB = 1024 * 1024
+# a token's fewest characters: the write endpoints answer anyone who can reach the
+# server, so a short token is guessed by trying (the generated one has 43)
+MIN_TOKEN = 16
 
 
 class Settings(BaseModel):
@@ -27,8 +30,9 @@ class Settings(BaseModel):
                                   "ILP layout (as `deliver --data`).")
     source_url: str | None = Field(None, description="The delivery site over HTTP "
                                    "(as `deliver --source`).")
-    token: str = Field(default_factory=lambda: secrets.token_urlsafe(32), min_length=1,
-                       description="Bearer token the write endpoints require.")
+    token: str = Field(default_factory=lambda: secrets.token_urlsafe(32),
+                       description="Bearer token the write endpoints require (at least "
+                       f"{MIN_TOKEN} printable ASCII characters).")
     max_body_bytes: int = Field(10 * MB, gt=0, description="Largest request body (413 past it).")
     max_expansions: int = Field(2_000_000, gt=0, description="Search budget per POST /plan: "
                                 "a larger or missing max_expansions is capped to it.")
@@ -57,6 +61,10 @@ class Settings(BaseModel):
         if bad is not None:
             raise ValueError(f"the token's character {bad + 1} is not printable ASCII; "
                              "it goes in an HTTP header, which carries only that")
+        if len(token) < MIN_TOKEN:  # (the limit said, not the token's own length)
+            raise ValueError(f"the token is shorter than {MIN_TOKEN} characters, short "
+                             "enough to guess; choose a longer one (python -c 'import "
+                             "secrets; print(secrets.token_urlsafe(32))' makes one)")
         return token
 
     @model_validator(mode="after")
