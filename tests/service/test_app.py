@@ -169,20 +169,42 @@ def test_a_405_allows_the_methods_the_path_serves(client, method, path, allow):
     assert_problem(r, 405, words=f"{method} is not allowed on {path}")
 
 
-def test_making_an_app_connects_to_nothing(tmp_path):
+def test_making_an_app_connects_to_nothing(tmp_path, caplog):
     """A store that cannot be opened fails the requests that need it (503), not the
     app: create_app and /health never touch it."""
-    with make_client(db_url="postgresql+psycopg://nobody@127.0.0.1:1/none") as c:
+    with make_client(db_url="postgresql+psycopg://nobody:pw@127.0.0.1:1/none") as c:
         assert c.get("/health").status_code == 200
         assert c.get("/maps").status_code == 200
-        doc = assert_problem(c.get("/days"), 503, words="cannot connect")
-        assert "password" not in doc["detail"]
+        doc = assert_problem(c.get("/days"), 503, words="the store cannot be opened")
+        assert doc["type"] == "urn:skyroute:problem:store-unavailable"
+        assert "127.0.0.1" not in doc["detail"] and "nobody" not in doc["detail"]
+    logged = [r.getMessage() for r in caplog.records if r.name == "skyroute.service"]
+    assert any("nobody:***@127.0.0.1:1/none: cannot connect" in m for m in logged), logged
+    assert not any(":pw@" in m for m in logged)
 
 
-def test_a_store_whose_folder_cannot_be_made_is_503(tmp_path):
+def test_a_503_names_no_path_of_the_server(tmp_path, caplog):
+    """A store or delivery site that cannot be opened was a 503 whose detail named the
+    store's file (``url=sqlite:////srv/...``) or the site's folder: where the server
+    keeps its data, to anyone. The detail now says which is unavailable; the reason,
+    with the path, is in the server's log."""
     (tmp_path / "taken").write_text("a file, not a folder\n")
-    with make_client(db_url=f"sqlite:///{tmp_path / 'taken' / 'sub' / 'x.db'}") as c:
-        assert_problem(c.get("/days"), 503, words="cannot make the store's folder")
+    store = tmp_path / "taken" / "sub" / "x.db"
+    with make_client(db_url=f"sqlite:///{store}") as c:
+        doc = assert_problem(c.get("/days"), 503, words="the store cannot be opened; the "
+                             "server's log says why")
+        assert str(tmp_path) not in c.get("/days").text, doc
+    nosite = tmp_path / "not-a-site"
+    nosite.mkdir()
+    with make_client(db_url=f"sqlite:///{tmp_path / 's.db'}", data_dir=nosite) as c:
+        r = c.get("/site.geojson")
+        doc = assert_problem(r, 503, words="the delivery site cannot be read; the server's "
+                             "log says why")
+        assert doc["type"] == "urn:skyroute:problem:site-unavailable"
+        assert str(tmp_path) not in r.text
+    logged = [r.getMessage() for r in caplog.records if r.name == "skyroute.service"]
+    assert any(f"cannot make the store's folder {store.parent}" in m for m in logged), logged
+    assert any(str(nosite) in m for m in logged), logged
 
 
 def test_settings_refuse_two_sites_and_bad_limits(tmp_path):

@@ -1,6 +1,9 @@
 """What an app opens on first use and closes at shutdown: the store's engine (the engine
 factory), the delivery site, the bundled grids, and the jobs' executor. Nothing here runs
-at import or when the app is made, so ``create_app`` never touches a database.
+at import or when the app is made, so ``create_app`` never touches a database. A store
+or site that cannot be opened is a 503 that says so, and the reason (which names the
+store's URL or path, the site's folder or URL) goes to the server's log, not to the
+caller.
 
 Routers reach these through the dependencies at the bottom (``Depends(engine)``, ...).
 """
@@ -8,6 +11,7 @@ Routers reach these through the dependencies at the bottom (``Depends(engine)``,
 from __future__ import annotations
 
 import contextlib
+import logging
 import threading
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -16,6 +20,8 @@ from fastapi import Depends, Request
 from skyroute.errors import SkyrouteError, StoreBusyError
 from skyroute.service.problems import Problem
 from skyroute.service.settings import Settings
+
+log = logging.getLogger("skyroute.service")
 
 if TYPE_CHECKING:
     import sqlalchemy as sa
@@ -55,9 +61,10 @@ class Resources:
                         self._engine = make_engine(self.settings.db_url)
                     except StoreBusyError:
                         raise  # a passing 503 with Retry-After (problems._busy)
-                    except SkyrouteError as exc:
-                        raise Problem(503, f"the store cannot be opened: {exc}",
-                                      kind="store-unavailable") from None
+                    except SkyrouteError as exc:  # its URL or path stays in the log
+                        log.warning("the store cannot be opened: %s", exc)
+                        raise Problem(503, "the store cannot be opened; the server's log "
+                                      "says why", kind="store-unavailable") from None
         return self._engine
 
     def site(self) -> Site:
@@ -75,9 +82,11 @@ class Resources:
                     try:
                         self._site = load_site(open_source(self.settings.data_dir,
                                                            self.settings.source_url))
-                    except SkyrouteError as exc:
-                        raise Problem(503, f"the delivery site cannot be read: {exc}",
-                                      kind="site-unavailable") from None
+                    except SkyrouteError as exc:  # its folder or URL stays in the log
+                        log.warning("the delivery site cannot be read: %s", exc)
+                        raise Problem(503, "the delivery site cannot be read; the "
+                                      "server's log says why", kind="site-unavailable"
+                                      ) from None
         return self._site
 
     def grid(self, name: str) -> Grid | None:
