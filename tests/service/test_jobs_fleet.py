@@ -150,6 +150,32 @@ def test_deliver_job_is_202_with_an_id(site_client, fake):
                    "progress": 0.0, "result": None, "error": None}
 
 
+def test_a_failed_jobs_error_is_shown_in_full_only_with_the_token(site_client, fake,
+                                                                  tmp_path):
+    """``GET /jobs/{id}`` is open, and a failed job's error may name the server's data
+    folder or store (a site without its menus, another site's orders ``stored for ...
+    in sqlite:////srv/...``): it was shown to anyone who had a job's id. Without the
+    token (or with a wrong one) the error now says only that the job failed."""
+    where = f"{tmp_path}/site/website/menus/menus.json: no such file"
+    fake.jobs["j-failed"] = {"id": "j-failed", "kind": "deliver", "state": "failed",
+                             "progress": 0.0, "result": None, "error": where}
+    fake.jobs["j-done"] = {"id": "j-done", "kind": "fleet", "state": "done",
+                           "progress": 1.0, "result": {"fleet_run": "r"}, "error": None}
+    for headers in ({}, {"Authorization": "Bearer wrong-token-0123456789"},
+                    {"Authorization": AUTH["Authorization"].replace("Bearer", "Basic")}):
+        job = site_client.get("/jobs/j-failed", headers=headers)
+        assert job.status_code == 200, job.text
+        assert job.json()["state"] == "failed" and job.json()["error"] == (
+            "the job failed; its error is shown with the server's token (Authorization: "
+            "Bearer TOKEN)")
+        assert str(tmp_path) not in job.text
+    assert site_client.get("/jobs/j-failed", headers=AUTH).json()["error"] == where
+    for headers in ({}, AUTH):  # a job that did not fail: as it was, either way
+        assert site_client.get("/jobs/j-done", headers=headers).json() == {
+            "id": "j-done", "kind": "fleet", "state": "done", "progress": 1.0,
+            "result": {"fleet_run": "r"}, "error": None}
+
+
 def test_a_deliver_job_can_replace_a_kept_flight(site_client, fake):
     # a day whose every order is invalid keeps its stored flight and fails the job; the
     # job had no way to store it anyway, as the CLI's --replace does

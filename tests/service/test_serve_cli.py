@@ -136,7 +136,8 @@ def test_skyroute_lines_are_logged_as_uvicorn_logs_its_own(monkeypatch, capsys, 
             assert job.status_code == 202, job.text
             deadline = time.monotonic() + WAIT
             while time.monotonic() < deadline:
-                state = httpx.get(f"{url}/jobs/{job.json()['id']}", timeout=WAIT).json()
+                state = httpx.get(f"{url}/jobs/{job.json()['id']}", timeout=WAIT,
+                                  headers={"Authorization": f"Bearer {TOKEN}"}).json()
                 if state["state"] in ("done", "failed"):
                     break
                 time.sleep(0.2)

@@ -612,10 +612,17 @@ def _job_routes(p, job: dict, kind: str = "fleet", posts: list | None = None) ->
     def poll(r):
         if job["state"] == "unreachable":
             r.abort()
-        else:
-            r.fulfill(json={"id": "job-1", "kind": kind, "result": None, "error": None, **job})
+            return
+        doc = {"id": "job-1", "kind": kind, "result": None, "error": None, **job}
+        if doc["error"] and r.request.headers.get("authorization") != f"Bearer {TOKEN}":
+            doc["error"] = HIDDEN_ERROR  # as the server: the error in full with the token
+        r.fulfill(json=doc)
 
     p.route("**/jobs/job-1", poll)
+
+
+HIDDEN_ERROR = ("the job failed; its error is shown with the server's token "
+                "(Authorization: Bearer TOKEN)")
 
 
 def _start_fleet_job(open_page, server, job: dict):
@@ -660,6 +667,24 @@ def test_fleet_job_shows_it_runs_and_survives_a_reload(open_page, server):
     p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
     assert p.inner_text("#job-status") == "" and not p.is_disabled("#start")
     pg.done("fleet-job")
+
+
+def test_a_failed_job_shows_its_error_read_with_the_token(open_page, server):
+    """GET /jobs/{id} shows a failed job's error in full only with the token (it may
+    name the server's files); the page polls with the token it submitted the job with,
+    so it says why the job failed, not only that it did."""
+    job = {"state": "running", "progress": 0.0}
+    pg = _start_fleet_job(open_page, server, job)
+    p = pg.page
+    p.wait_for_function("document.querySelector('#job-status').textContent"
+                        ".startsWith('Job running')")
+    job.update(state="failed", error="scenario.airports: too few (see the docs)")
+    p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'error'",
+                        timeout=15_000)
+    assert p.inner_text("#job-status").startswith(
+        "The job failed: scenario.airports: too few (see the docs)"), \
+        p.inner_text("#job-status")
+    assert not pg.errors, pg.errors
 
 
 def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):

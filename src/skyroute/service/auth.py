@@ -11,6 +11,7 @@ from typing import Annotated
 
 from fastapi import Depends, Request
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
+from fastapi.security.utils import get_authorization_scheme_param
 
 from skyroute.service.problems import Problem
 
@@ -46,3 +47,11 @@ async def authenticate(request: Request) -> None:
     """:func:`require_token` for ``request``, called outside FastAPI's dependencies: by
     an app-wide check that would otherwise answer before the route's token is read."""
     await require_token(request, await _bearer(request))
+
+
+def has_token(request: Request) -> bool:
+    """Whether ``request`` carries ``Authorization: Bearer <the token>``; never an error:
+    for an open read that shows its holder more (a failed job's full error)."""
+    scheme, given = get_authorization_scheme_param(request.headers.get("Authorization"))
+    expected = request.app.state.settings.token.encode()
+    return scheme.lower() == "bearer" and secrets.compare_digest(given.encode(), expected)

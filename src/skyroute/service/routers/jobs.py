@@ -1,7 +1,8 @@
 """Long work as jobs: ``POST /jobs/deliver`` (a day or a range of stored orders),
 ``POST /jobs/fleet`` (a fleet run) -> 202 ``{"id"}`` (a delivery job the same as one
 queued or running -> 200 and that job's id); ``GET /jobs/{id}`` -> its state, progress,
-result or error.
+result or error (open to all, as every read; a failed job's error in full only with the
+token, as it may name the server's data folder or store).
 
 The jobs themselves (tables, Dask or local processes) live in :mod:`skyroute.jobs`,
 imported on first use; without it these endpoints answer 503. A server holds at most
@@ -27,7 +28,7 @@ from skyroute.fleet.limits import (
     track_rows,
 )
 from skyroute.service.alternatives import exactly_one
-from skyroute.service.auth import require_token
+from skyroute.service.auth import has_token, require_token
 from skyroute.service.dates import IsoDate
 from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.paths import url_path
@@ -105,13 +106,21 @@ class JobId(BaseModel):
     id: str
 
 
+# a failed job's error to a reader without the token: the error itself may name the
+# server's data folder, its store's file or URL (a bad site, another site's orders)
+HIDDEN_ERROR = ("the job failed; its error is shown with the server's token "
+                "(Authorization: Bearer TOKEN)")
+
+
 class JobState(BaseModel):
     id: str
     kind: str | None = None
     state: Literal["queued", "running", "done", "failed"]
     progress: float = Field(ge=0, le=1)
     result: Any = None
-    error: str | None = None
+    error: str | None = Field(None, description="A failed job's error, one line; without "
+                              "the token (`Authorization: Bearer TOKEN`) only that it "
+                              "failed, as the error may name the server's files.")
 
 
 def _jobs():
@@ -243,16 +252,21 @@ def _check_work(scenario, body: FleetJob) -> None:
 @router.get("/jobs/{job_id}", response_model=JobState, responses=responses(404, 503),
             summary="A job's state, progress and result")
 def get_job(job_id: Annotated[str, Path(max_length=100)],
-            res: ResourcesDep) -> dict:
+            res: ResourcesDep, request: Request) -> dict:
+    """Open to all; a failed job's ``error`` in full only with the token (it may name
+    the server's data folder or store), else a line saying it failed."""
     runner = _jobs()
     job = runner.get(res.engine(), job_id)
     if job is None:
         raise Problem(404, f"no job {job_id!r}", kind="unknown-job")
     if job.get("kind") == "deliver" and job["state"] == "done":
         _forget_days(res, job.get("result") or {})
+    error = job.get("error")
+    if error is not None and not has_token(request):
+        error = HIDDEN_ERROR
     return {"id": job_id, "kind": job.get("kind"), "state": job["state"],
             "progress": float(job.get("progress") or 0.0), "result": job.get("result"),
-            "error": job.get("error")}
+            "error": error}
 
 
 def _forget_days(res, result: dict) -> None:

@@ -46,8 +46,11 @@ async function send(path, init) {
   return response;
 }
 
-export async function getJSON(path) {
-  return (await send(path, { headers: { Accept: "application/json" } })).json();
+/** GET ``path``'s JSON; with ``token``, the bearer token too (GET /jobs/{id} shows a
+ * failed job's error in full only to the token's holder). */
+export async function getJSON(path, { token = false } = {}) {
+  const headers = { Accept: "application/json" };
+  return (await send(path, { headers: token ? authorised(headers) : headers })).json();
 }
 
 /** A page of a paged list: ``{items, next}``, ``next`` the URL of the following page

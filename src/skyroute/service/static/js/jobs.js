@@ -61,7 +61,8 @@ export class JobFollower {
       for (;;) {
         let job;
         try {
-          job = await getJSON(`/jobs/${encodeURIComponent(id)}`);
+          // with the token that submitted it: a failed job's error is shown in full
+          job = await getJSON(`/jobs/${encodeURIComponent(id)}`, { token: true });
         } catch (err) {
           if (err.status === 0 || err.status >= 500) {
             say(line, `${explain(err, following)} Asking again every ${RETRY_MS / 1000} s…`, "error");
