@@ -165,10 +165,13 @@ def test_without_a_site(lunch):
         assert empty["geometry"] is None and empty["properties"]["moves"] == 0
 
 
-def test_a_broken_site_is_503(tmp_path, lunch):
+def test_a_broken_site_is_503(tmp_path, lunch, caplog):
     (tmp_path / "website").mkdir()
     with make_client(db_url=lunch[0], data_dir=tmp_path) as c:
-        assert_problem(c.get("/site.geojson"), 503, words="menus.json")
+        r = c.get("/site.geojson")
+        assert_problem(r, 503, words="the delivery site cannot be read; the server's log")
+        assert str(tmp_path) not in r.text  # the folder's path is for the log alone
+    assert any("menus.json" in r.getMessage() for r in caplog.records), caplog.records
 
 
 
