@@ -110,6 +110,47 @@ def test_a_day_stored_again_is_served_fresh(tmp_path, lunch):
         assert b[0] == pytest.approx(a[0] + 1)
 
 
+def test_two_flights_of_a_day_stored_at_one_clock_tick_have_two_etags(tmp_path):
+    """The flight file's ETag (and the server's cached copy) was keyed by the run's
+    finish time and move count: a day flown again with the same number of moves and the
+    same finish time (a coarse or frozen clock, a clock stepped back, a worker on another
+    host) kept the first flight's ETag, so the server went on serving the first flight
+    and a client's ``If-None-Match`` kept it too. The version is now a digest of the
+    stored moves: another flight, another ETag; the same flight, the same one."""
+    import datetime as dt
+
+    from skyroute.delivery.store import write_day
+    from skyroute.service.resources import make_engine
+
+    db = f"sqlite:///{tmp_path / 'tick.db'}"
+    eng = make_engine(db)
+    date, frozen = dt.date(2024, 1, 5), dt.datetime(2024, 1, 5, 12, 0, 0)
+
+    def store(lon: float) -> None:  # three moves, the same clock reading every time
+        moves = [{"seq": k, "order_no": "1AFFE082", "from_lon": lon + k * 1.5e-4,
+                  "from_lat": 55.944, "angle": 0, "to_lon": lon + (k + 1) * 1.5e-4,
+                  "to_lat": 55.944} for k in range(3)]
+        write_day(eng, date, {"started": frozen, "finished": frozen, "moves": 3,
+                              "orders_placed": 1, "orders_delivered": 0,
+                              "orders_invalid": 0, "money_delivered": 0,
+                              "money_placed": 100, "settings": {}}, [], moves)
+
+    url = f"/days/{date}/flightpath.geojson"
+    with make_client(db_url=db, fresh_seconds=0) as c:  # the store asked every time
+        store(-3.1870)
+        first = c.get(url)
+        store(-3.1900)  # another flight, at the same tick with as many moves
+        second = c.get(url)
+        assert second.status_code == 200
+        assert second.json()["features"][0]["geometry"]["coordinates"][0][0] == -3.19
+        assert second.headers["etag"] != first.headers["etag"]
+        cached = c.get(url, headers={"If-None-Match": first.headers["etag"]})
+        assert cached.status_code == 200 and cached.content == second.content
+        store(-3.1900)  # the same flight stored again: the same ETag
+        assert c.get(url).headers["etag"] == second.headers["etag"]
+    eng.dispose()
+
+
 @pytest.mark.parametrize("path", ["/days/2023-06-01", "/days/2023-06-01/flightpath.geojson"])
 def test_unknown_date_is_404(day_client, path):
     assert_problem(day_client.get(path), 404, words="2023-06-01 is not stored")

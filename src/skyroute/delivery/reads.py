@@ -8,6 +8,7 @@ Reads only; a day's rows are written in one transaction by
 from __future__ import annotations
 
 import datetime as dt
+import hashlib
 import json
 
 import numpy as np
@@ -52,16 +53,6 @@ def day_report(engine: sa.Engine, date: dt.date) -> dict | None:
             "settings": json.loads(r.settings or "{}")}
 
 
-def day_version(engine: sa.Engine, date: dt.date) -> str | None:
-    """What changes whenever the day is stored again (its run's finish time and moves),
-    or None when the day was never flown: a key for caching what is made from its rows."""
-    runs = tables(engine)["runs"]
-    with engine.connect() as conn:
-        r = conn.execute(sa.select(runs.c.finished, runs.c.moves)
-                         .where(runs.c.delivery_date == date)).first()
-    return None if r is None else f"{date}:{r.finished.isoformat()}:{r.moves}"
-
-
 def day_deliveries(engine: sa.Engine, date: dt.date) -> list[dict]:
     """The day's delivered orders, in the order the flight delivered them."""
     t = tables(engine)
@@ -81,11 +72,35 @@ def day_deliveries(engine: sa.Engine, date: dt.date) -> list[dict]:
 def day_moves(engine: sa.Engine, date: dt.date) -> dict[str, np.ndarray]:
     """The day's moves as columns in flying order: ``frm`` and ``to`` (N, 2) lon/lat,
     ``angle`` (ILP degrees, -999 hover), ``order_no``."""
-    fp = tables(engine)["flightpath"]
+    with engine.connect() as conn:
+        return _moves(conn, tables(engine)["flightpath"], date)
+
+
+def day_flight(engine: sa.Engine, date: dt.date) -> tuple[str, dict] | None:
+    """(version, moves) of a stored day, read in one transaction, or None when the day
+    was never flown. ``moves`` as :func:`day_moves`; ``version`` changes whenever they
+    do: the day and a SHA-256 of its moves (every value the flight file is made of), a
+    key for caching that file and its ETag. It was the run's finish time and move count,
+    which two flights of the day can share (a coarse or stepped-back clock, a worker on
+    another host): the second was then served as the first. The same moves stored again
+    keep their version."""
+    t = tables(engine)
+    runs = t["runs"]
+    with engine.connect() as conn:
+        if conn.scalar(sa.select(runs.c.moves).where(runs.c.delivery_date == date)) is None:
+            return None
+        m = _moves(conn, t["flightpath"], date)
+    digest = hashlib.sha256()
+    for part in (m["frm"], m["to"], m["angle"]):
+        digest.update(np.ascontiguousarray(part, dtype="<f8").tobytes())
+    digest.update("\0".join(m["order_no"]).encode())
+    return f"{date}:{len(m['angle'])}:{digest.hexdigest()}", m
+
+
+def _moves(conn: sa.Connection, fp: sa.Table, date: dt.date) -> dict:
     q = sa.select(fp.c.from_lon, fp.c.from_lat, fp.c.angle, fp.c.to_lon, fp.c.to_lat,
                   fp.c.order_no).where(fp.c.delivery_date == date).order_by(fp.c.seq)
-    with engine.connect() as conn:
-        rows = conn.execute(q).all()
+    rows = conn.execute(q).all()
     a = np.array([r[:5] for r in rows], dtype=float).reshape(-1, 5)
     return {"frm": a[:, 0:2], "angle": a[:, 2].astype(int), "to": a[:, 3:5],
             "order_no": [r[5] for r in rows]}

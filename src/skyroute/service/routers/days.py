@@ -101,9 +101,13 @@ def _report(eng, date: dt.date) -> dict:
 
     rep = day_report(eng, date)
     if rep is None:
-        raise Problem(404, f"day {date} is not stored; GET /days lists the stored days",
-                      kind="unknown-date")
+        raise _not_stored(date)
     return rep
+
+
+def _not_stored(date: dt.date) -> Problem:
+    return Problem(404, f"day {date} is not stored; GET /days lists the stored days",
+                   kind="unknown-date")
 
 
 @router.get("/days/{date}", response_model=Day, responses=responses(404, 422, 503),
@@ -187,25 +191,25 @@ async def get_flightpath(date: DayDate, request: Request, res: ResourcesDep) -> 
 
 def _flightpath_entry(date: dt.date, res: Resources, old: tuple | None) -> tuple:
     """(checked at, version, ETag, body) of the day's file, made again only when the
-    day's version in the store changed."""
-    from skyroute.delivery.reads import day_version
+    day's version (a digest of its stored moves) changed; the version and the body come
+    from one read, so an ETag never names another flight's body."""
+    from skyroute.delivery.reads import day_flight
 
     eng = res.engine()
-    version = day_version(eng, date)
-    if version is None:
-        _report(eng, date)  # the 404
+    got = day_flight(eng, date)
+    if got is None:
+        raise _not_stored(date)
+    version, moves = got
     if old is not None and old[1] == version:
         return (time.monotonic(), *old[1:])
     etag = '"' + hashlib.sha1(version.encode()).hexdigest()[:20] + '"'
-    return time.monotonic(), version, etag, _flightpath(eng, date, res)
+    return time.monotonic(), version, etag, _flightpath(moves, date, res)
 
 
-def _flightpath(eng, date: dt.date, res: Resources) -> bytes:
+def _flightpath(m: dict, date: dt.date, res: Resources) -> bytes:
+    """The file of the day's moves ``m`` (:func:`~skyroute.delivery.reads.day_moves`)."""
     import numpy as np
 
-    from skyroute.delivery.reads import day_moves
-
-    m = day_moves(eng, date)
     n = len(m["angle"])
     if n:
         geometry = {"type": "LineString",
