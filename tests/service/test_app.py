@@ -207,6 +207,29 @@ def test_a_503_names_no_path_of_the_server(tmp_path, caplog):
     assert any(str(nosite) in m for m in logged), logged
 
 
+def test_a_host_not_allowed_is_a_400_problem_before_the_body_is_read(tmp_path):
+    """``Settings.allowed_hosts`` (``serve --allowed-hosts``): Starlette's Host check,
+    its refusal a problem document like every other error (Starlette says "Invalid host
+    header" as text), before the body limit reads a byte; HEAD as GET, without a body.
+    The app factory's default takes any Host (``*``), as TestClient's ``testserver``."""
+    from skyroute.service.settings import Settings
+
+    assert Settings().allowed_hosts == ("*",)
+    with make_client(db_url=f"sqlite:///{tmp_path / 'h.db'}",
+                     allowed_hosts=("localhost", "::1")) as c:
+        doc = assert_problem(c.get("/health"), 400, words="the Host 'testserver' is not "
+                             "one of this server's names (skyroute serve --allowed-hosts)")
+        assert doc["type"] == "urn:skyroute:problem:untrusted-host"
+        for host in ("localhost:8000", "[::1]:8000", "LocalHost"):
+            assert c.get("/health", headers={"Host": host}).status_code == 200, host
+        big = c.post("/plan", content=b"x" * (11 * 1024 * 1024), headers=AUTH)
+        assert_problem(big, 400, words="not one of this server's names")  # not a 413
+        head = c.head("/health")
+        assert head.status_code == 400 and head.content == b""
+        assert c.get("/health", headers={"Host": "localhost.attacker.example"}
+                     ).status_code == 400
+
+
 def test_settings_refuse_two_sites_and_bad_limits(tmp_path):
     from pydantic import ValidationError
 

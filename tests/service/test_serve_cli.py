@@ -324,7 +324,8 @@ def test_serve_fails_the_jobs_a_stopped_server_left(monkeypatch, capsys, tmp_pat
     code, _, err = run(monkeypatch, capsys, "serve", "--db", db)
     assert code in (0, None) and len(served) == 1, err
     assert "2 job(s) left queued or running by a stopped server marked failed" in err
-    with TestClient(served[0]) as c:
+    with TestClient(served[0], base_url="http://127.0.0.1:8000",  # one of its names
+                    headers={"Authorization": f"Bearer {TOKEN}"}) as c:  # errors in full
         for job_id in (queued, running):
             job = c.get(f"/jobs/{job_id}").json()
             assert job["state"] == "failed" and job["error"] == ORPHANED, job
@@ -348,3 +349,85 @@ def test_a_token_file_saved_with_a_byte_order_mark_gives_the_token(tmp_path, mon
     f.write_bytes(b"\xff\xfes\x00")  # UTF-16: one line naming the option and the file
     with pytest.raises(OptionError, match=r"^--token-file .*token\.txt: cannot read: not UTF-8"):
         read_token(f)
+
+
+def _served(monkeypatch, capsys, tmp_path, *args) -> tuple[object, str]:
+    """(the app ``skyroute serve *args`` would run, its stderr), uvicorn not started."""
+    import uvicorn
+
+    served = []
+    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.append(app))
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SKYROUTE_TOKEN", TOKEN)
+    code, _, err = run(monkeypatch, capsys, "serve", "--db",
+                       f"sqlite:///{tmp_path / 's.db'}", "--no-warm", "--port",
+                       str(free_port()), *args)
+    assert code in (0, None) and len(served) == 1, err
+    return served[0], err
+
+
+def _status(app, host: str) -> int:
+    from fastapi.testclient import TestClient
+
+    with TestClient(app, base_url=f"http://{host}") as c:
+        return c.get("/health").status_code
+
+
+def test_a_loopback_server_answers_only_to_its_names(monkeypatch, capsys, tmp_path):
+    """DNS rebinding: a page of another site points a DNS name of its own at 127.0.0.1,
+    and the browser lets it read what the server there answers, as it sends that name
+    as the Host; no Host was refused. ``serve`` on a loopback address now answers to
+    localhost, 127.0.0.1, [::1] and its --host alone: another Host is a 400 problem."""
+    app, err = _served(monkeypatch, capsys, tmp_path)
+    for host in ("127.0.0.1:8000", "localhost:8000", "[::1]:8000", "LOCALHOST"):
+        assert _status(app, host) == 200, host
+    for host in ("rebind.attacker.example:8000", "testserver", "127.0.0.2:8000"):
+        assert _status(app, host) == 400, host
+    assert "warning" not in err, err
+    app, _ = _served(monkeypatch, capsys, tmp_path, "--host", "127.0.0.2")  # its --host
+    assert _status(app, "127.0.0.2:8000") == 200
+    assert _status(app, "rebind.attacker.example") == 400
+
+
+def test_allowed_hosts_names_the_servers_names(monkeypatch, capsys, tmp_path):
+    app, err = _served(monkeypatch, capsys, tmp_path, "--allowed-hosts",
+                       "sky.example, *.fleet.example,::1")
+    for host in ("sky.example", "a.fleet.example:443", "[::1]:8000"):
+        assert _status(app, host) == 200, host
+    for host in ("127.0.0.1:8000", "localhost", "fleet.example", "other.example"):
+        assert _status(app, host) == 400, host
+    app, err = _served(monkeypatch, capsys, tmp_path, "--allowed-hosts", "*")
+    assert _status(app, "any.example") == 200 and "warning" not in err
+
+
+def test_a_server_on_all_addresses_takes_any_host_and_says_so(monkeypatch, capsys,
+                                                              tmp_path):
+    """Bound to 0.0.0.0 the names other machines reach it by are not known: any Host is
+    taken by default, with one warning naming --allowed-hosts."""
+    app, err = _served(monkeypatch, capsys, tmp_path, "--host", "0.0.0.0")
+    assert _status(app, "any.example") == 200
+    warned = [ln for ln in err.splitlines() if ln.startswith("warning:")]
+    assert len(warned) == 1 and "any Host header is taken" in warned[0] and \
+        "--allowed-hosts" in warned[0], err
+    app, err = _served(monkeypatch, capsys, tmp_path, "--host", "0.0.0.0",
+                       "--allowed-hosts", "sky.example")
+    assert _status(app, "sky.example") == 200 and _status(app, "any.example") == 400
+    assert "warning" not in err
+
+
+@pytest.mark.parametrize("given, words", [
+    ("sky.example:8000", "--allowed-hosts: host 'sky.example:8000': give the name or "
+                         "address alone (no port, scheme or path)"),
+    ("http://sky.example", "no port, scheme or path"),
+    ("sky.*.example", "--allowed-hosts: host 'sky.*.example': give a name, an address, "
+                      "*.domain or *"),
+    (",", "--allowed-hosts: give at least one host (or * for any)"),
+])
+def test_bad_allowed_hosts_are_one_line(monkeypatch, capsys, tmp_path, given, words):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SKYROUTE_TOKEN", TOKEN)
+    code, out, err = run(monkeypatch, capsys, "serve", "--db",
+                         f"sqlite:///{tmp_path / 's.db'}", "--allowed-hosts", given)
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+    assert "skyroute service on" not in err + out and not (tmp_path / "s.db").exists()
+

@@ -39,6 +39,13 @@ def serve_command(
     source: Annotated[str | None, typer.Option(
         help="The delivery site over HTTP (as 'deliver').")] = None,
     host: Annotated[str, typer.Option(help="Address to listen on.")] = "127.0.0.1",
+    allowed_hosts: Annotated[str | None, typer.Option(
+        help="The names clients reach the server by, comma-separated (host names, "
+             "addresses, *.example.com; '*' for any): a request whose Host header names "
+             "another is a 400, so a page of another site cannot reach the server through "
+             "a DNS name of its own (DNS rebinding). Default: on a loopback --host, "
+             "localhost, 127.0.0.1, ::1 and the --host; on any other, any (with a "
+             "warning).")] = None,
     port: Annotated[int, typer.Option(help="Port to listen on.")] = 8000,
     root_path: Annotated[str, typer.Option(
         help="The path a reverse proxy serves the server under (/skyroute for "
@@ -93,18 +100,19 @@ def serve_command(
     root_path = check_root_path(root_path)
     check_listen(host, port)
     token, where = read_token(token_file)
+    hosts = (default_hosts(host) if allowed_hosts is None
+             else [h for h in allowed_hosts.split(",") if h.strip()])
     try:
         settings = Settings(db_url=db, data_dir=data, source_url=source, dask_address=dask,
                             max_body_bytes=int(max_body_mb * MB),
                             max_expansions=max_expansions, job_queue=job_queue, warm=warm,
-                            **({"token": token} if token else {}))
+                            allowed_hosts=hosts, **({"token": token} if token else {}))
     except ValidationError as exc:  # a limit out of range, or the token: before the store
         err = exc.errors()[0]
+        field = str(err["loc"][0]) if err["loc"] else ""
         flag = {"max_body_bytes": "--max-body-mb", "job_queue": "--job-queue",
-                "max_expansions": "--max-expansions"}.get(str(err["loc"][0]) if err["loc"]
-                                                         else "",
-                                                         TOKEN_ENV if where == TOKEN_ENV
-                                                         else f"--token-file {where}")
+                "max_expansions": "--max-expansions", "allowed_hosts": "--allowed-hosts"
+                }.get(field, TOKEN_ENV if where == TOKEN_ENV else f"--token-file {where}")
         raise OptionError(f"{flag}: {err['msg'].removeprefix('Value error, ')}") from None
     engine = make_engine(db)  # the store opens and is migrated before anyone asks
     orphans = _fail_orphans(engine)
@@ -117,6 +125,10 @@ def serve_command(
     if root_path:
         typer.echo(f"served by a proxy under {root_path}/: the links it hands out start "
                    "with it", err=True)
+    if allowed_hosts is None and "*" in settings.allowed_hosts:
+        typer.echo(f"warning: on --host {host} any Host header is taken, so a page of "
+                   "another site may reach this server through a DNS name it points here; "
+                   "give the names clients use with --allowed-hosts", err=True)
     if where == "generated":
         typer.echo(f"write token (give it as 'Authorization: Bearer TOKEN'; set "
                    f"{TOKEN_ENV} or --token-file to choose one):\n    {settings.token}")
@@ -134,6 +146,28 @@ def serve_command(
         os.environ[SETTINGS_ENV] = settings.model_dump_json()
         uvicorn.run("skyroute.service.app:app_from_env", factory=True, workers=workers,
                     host=host, port=port, **logs)
+
+
+LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "::1")
+
+
+def default_hosts(host: str) -> list[str]:
+    """``--allowed-hosts``'s default for ``--host``: on a loopback address (every address
+    ``host`` resolves to is one: 127.0.0.1, ::1, localhost) the names of this machine's
+    loopback and ``host`` itself, the names a local client's Host header gives; on any
+    other (0.0.0.0, a name of the machine's network) any, ``*``: the names other
+    machines reach it by are not known here."""
+    import ipaddress
+    import socket
+
+    try:
+        found = socket.getaddrinfo(host, None, type=socket.SOCK_STREAM)
+    except (socket.gaierror, UnicodeError):
+        return ["*"]
+    addresses = {ipaddress.ip_address(a[4][0].split("%")[0]) for a in found}
+    if addresses and all(a.is_loopback for a in addresses):
+        return [*LOOPBACK_HOSTS, host]
+    return ["*"]
 
 
 def check_root_path(value: str) -> str:

@@ -21,7 +21,7 @@ import skyroute
 from skyroute.bench import ready
 from skyroute.service import cut, problems, query
 from skyroute.service.json_response import FiniteJSONResponse
-from skyroute.service.middleware import BodyLimit, HeadAsGet, ServerTiming
+from skyroute.service.middleware import BodyLimit, HeadAsGet, ServerTiming, TrustedHosts
 from skyroute.service.resources import Resources
 from skyroute.service.routers import (
     days,
@@ -78,6 +78,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         app.include_router(module.router)
     app.add_middleware(ServerTiming)  # inside the body limit: the body is in hand
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
+    if "*" not in settings.allowed_hosts:  # before the body is read; HEAD as GET, too
+        app.add_middleware(TrustedHosts, allowed_hosts=settings.allowed_hosts)
     app.add_middleware(HeadAsGet)
     app.mount("/", ViewerFiles(directory=STATIC, html=True), name="static")
     # the API's first path segments: a browser asking for any other missing path gets

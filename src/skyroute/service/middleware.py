@@ -1,7 +1,7 @@
-"""Three plain ASGI middlewares: the request body limit (413 past it, before any handler
+"""Four plain ASGI middlewares: the request body limit (413 past it, before any handler
 reads a byte too many), the server-side timing header every response carries
-(``Server-Timing: app;dur=MS``, which the load benchmark reads), and HEAD answered as
-GET without its body.
+(``Server-Timing: app;dur=MS``, which the load benchmark reads), HEAD answered as GET
+without its body, and the check of the ``Host`` header against the server's names.
 
 The body limit runs first and hands the app the whole body, so ``app;dur`` is the time
 from the complete request to the response headers: the server's work on the request,
@@ -10,6 +10,9 @@ not the wait for a client's bytes to arrive."""
 from __future__ import annotations
 
 import time
+
+from starlette.datastructures import Headers
+from starlette.middleware.trustedhost import TrustedHostMiddleware
 
 from skyroute.service.problems import problem_response
 
@@ -133,3 +136,42 @@ class HeadAsGet:
             await send(message)
 
         await self.app({**scope, "method": "GET", HEAD_KEY: True}, receive, no_body)
+
+
+class TrustedHosts:
+    """Starlette's :class:`~starlette.middleware.trustedhost.TrustedHostMiddleware` over
+    ``allowed_hosts`` (names, addresses, ``*.example.com``), its refusal a 400 problem
+    document like the app's other errors (Starlette's is the text "Invalid host
+    header"). Without it a page of another site reaches a server on 127.0.0.1 through a
+    DNS name of its own that it points there (DNS rebinding), and reads what the server
+    serves: the browser sends that name as the ``Host``."""
+
+    def __init__(self, app, allowed_hosts) -> None:
+        self.app = app
+        self.check = TrustedHostMiddleware(self._through, allowed_hosts=list(allowed_hosts),
+                                           www_redirect=False)
+
+    async def _through(self, scope, receive, refusal: _Refusal) -> None:
+        await self.app(scope, receive, refusal.send)  # a trusted host: the real send
+
+    async def __call__(self, scope, receive, send) -> None:
+        refusal = _Refusal(send)
+        await self.check(scope, receive, refusal)
+        if refusal.refused:
+            host = Headers(scope=scope).get("host")
+            said = "no Host header" if host is None else f"the Host {host[:100]!r}"
+            response = problem_response(
+                400, f"{said} is not one of this server's names (skyroute serve "
+                "--allowed-hosts)", kind="untrusted-host")
+            await response(scope, receive, send)
+
+
+class _Refusal:
+    """The ``send`` handed to Starlette's check: its own refusal is dropped (a problem
+    is sent instead); a request it lets through is sent on with ``send`` itself."""
+
+    def __init__(self, send) -> None:
+        self.send, self.refused = send, False
+
+    async def __call__(self, message) -> None:
+        self.refused = True

@@ -7,6 +7,7 @@ ask for, and the job queue length.
 
 from __future__ import annotations
 
+import ipaddress
 import secrets
 from pathlib import Path
 
@@ -47,6 +48,11 @@ class Settings(BaseModel):
     dask_address: str | None = Field(None, description="Run jobs on this Dask scheduler "
                                      "(tcp://HOST:8786) instead of local processes.")
     job_workers: int | None = Field(None, ge=1, description="Local worker processes for jobs.")
+    allowed_hosts: tuple[str, ...] = Field(("*",), description="The names a request's "
+                                           "Host header may give (a 400 for any other): "
+                                           "host names, addresses, *.example.com; '*' "
+                                           "takes any (the app factory's default; `serve` "
+                                           "on a loopback address names its own).")
     warm: bool = Field(True, description="Load the planners' compiled kernels and "
                        "libraries when the app starts, before it takes a request "
                        "(skyroute.service.warm), not in its first POST /plan.")
@@ -67,6 +73,13 @@ class Settings(BaseModel):
                              "secrets; print(secrets.token_urlsafe(32))' makes one)")
         return token
 
+    @field_validator("allowed_hosts")
+    @classmethod
+    def _hosts(cls, hosts: tuple[str, ...]) -> tuple[str, ...]:
+        if not hosts:
+            raise ValueError("give at least one host (or * for any)")
+        return tuple(dict.fromkeys(host_pattern(h) for h in hosts))
+
     @model_validator(mode="after")
     def _one_site(self) -> Settings:
         if self.data_dir is not None and self.source_url is not None:
@@ -76,3 +89,24 @@ class Settings(BaseModel):
     @property
     def has_site(self) -> bool:
         return self.data_dir is not None or self.source_url is not None
+
+
+def host_pattern(text: str) -> str:
+    """``text`` as a Host header names it, for the Host check (Starlette's
+    ``TrustedHostMiddleware``): lower case, an IPv6 address in brackets (``::1`` ->
+    ``[::1]``); ``*`` (any host), or ``*.`` and a domain (its subdomains). A ValueError
+    naming it for a port, an empty name or a ``*`` elsewhere."""
+    host = text.strip().lower()
+    bare = host.removeprefix("[").removesuffix("]")
+    try:
+        if ipaddress.ip_address(bare).version == 6:
+            return f"[{bare}]"
+    except ValueError:
+        pass
+    if not host or host == "*." or "*" in host[1:] or (host[0] == "*" and host != "*"
+                                                      and not host.startswith("*.")):
+        raise ValueError(f"host {text!r}: give a name, an address, *.domain or *")
+    if ":" in host or "/" in host:
+        raise ValueError(f"host {text!r}: give the name or address alone (no port, "
+                         "scheme or path)")
+    return host
