@@ -118,9 +118,11 @@ def test_a_day_whose_rename_or_commit_fails_keeps_its_rows_and_files(
             code, err = deliver(monkeypatch, capsys, db, out, DAY)
             assert code == 2 and len(err.strip().splitlines()) == 1, err
             assert "report-03-01-2024.json: cannot write: No space left on device" in err
-        else:  # not skyroute's error: the traceback of an uncaught one, exit 1
-            with pytest.raises(sa.exc.OperationalError, match="disk I/O error"):
-                deliver(monkeypatch, capsys, db, out, DAY)
+        else:  # the driver's error: one line, exit 2 (it was a traceback)
+            code, err = deliver(monkeypatch, capsys, db, out, DAY)
+            assert code == 2 and len(err.strip().splitlines()) == 1, err
+            assert err.startswith("skyroute: error: the store's database failed: disk I/O "
+                                  "error"), err
     # the store's day and the files as they were: the earlier flight, or none
     assert stored(db, DAY) == rows
     assert on_disk(out) == files

@@ -114,6 +114,21 @@ def _interrupt(exc: BaseException) -> BaseException | None:
     return None
 
 
+def database_failure(exc: BaseException) -> str | None:
+    """One line for an error the store's database driver raised through SQLAlchemy (its
+    ``orig``: a full disk, a disk I/O error, a server gone mid-run), else None. Such an
+    error is no bug of skyroute and no input of the user's to fix, but it was printed as
+    a traceback; the transaction it ended was rolled back (and a day's files put back).
+    SQLAlchemy is not imported for the test: a plan never loads it."""
+    if not type(exc).__module__.startswith("sqlalchemy"):
+        return None
+    orig = getattr(exc, "orig", None)
+    if orig is None:
+        return None
+    text = (str(orig).strip().splitlines() or [type(orig).__name__])[0]
+    return f"the store's database failed: {text} (nothing of the step it ended was stored)"
+
+
 def run_cli(app: typer.Typer) -> None:
     """Run a Typer app; expected errors print ``skyroute: error: ...`` and exit 2;
     SIGINT prints ``skyroute: interrupted`` and exits 130, SIGTERM ``skyroute:
@@ -173,6 +188,10 @@ def _run(app: typer.Typer, signals: _Signals | None) -> None:
             _signal_exit(signals.seen)
         if isinstance(exc, SkyrouteError):
             print(f"skyroute: error: {in_flags(exc)}", file=sys.stderr)
+            sys.exit(EXIT_BAD_INPUT)
+        line = database_failure(exc)
+        if line is not None:
+            print(f"skyroute: error: {line}", file=sys.stderr)
             sys.exit(EXIT_BAD_INPUT)
         raise
     if code == EXIT_INTERRUPTED:  # Typer turns Ctrl-C into exit code 130, silently
