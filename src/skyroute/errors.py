@@ -115,6 +115,13 @@ class StoreBusyError(SkyrouteError):
     Not the caller's input: the service answers it 503 with ``Retry-After``."""
 
 
+class StoreSchemaError(SkyrouteError):
+    """The store lacks skyroute's tables (never initialised, an older schema, or its
+    tables dropped or its file replaced under a running server); the message names the
+    store's URL (password hidden) and says to run ``skyroute db init``. Not the caller's
+    input: the service answers it 503, the URL kept in its log."""
+
+
 def check_choice(name: str, value: object, choices: tuple) -> None:
     """Raise :class:`OptionError` unless ``value`` is one of ``choices`` (an array, which
     compares element by element, never is)."""

@@ -31,7 +31,7 @@ from typing import NamedTuple
 import sqlalchemy as sa
 
 from skyroute.caches import register
-from skyroute.errors import SkyrouteError, StoreBusyError
+from skyroute.errors import SkyrouteError, StoreBusyError, StoreSchemaError
 
 DEFAULT_DB = "sqlite:///skyroute.db"
 # How long a SQLite store waits for another process's write to finish before it is an
@@ -53,17 +53,18 @@ register(_REFLECTED.clear)
 def tables(engine: sa.Engine, names: tuple[str, ...] = TABLES) -> dict[str, sa.Table]:
     """The tables ``names`` (default the delivery tables) as the migrations made them,
     reflected once per database: the migrations are the one definition of the schema.
-    Other packages' tables (``jobs``, ``fleet_runs``) live in the same store."""
+    Other packages' tables (``jobs``, ``fleet_runs``) live in the same store. A store
+    without them is a :class:`~skyroute.errors.StoreSchemaError` naming its URL."""
     key = (str(engine.url), names)
     if key not in _REFLECTED:
         have = set(sa.inspect(engine).get_table_names())
         if "runs" not in have:
-            raise SkyrouteError(f"{_safe(key[0])}: no skyroute tables; run 'skyroute db "
-                                "init' first")
+            raise StoreSchemaError(f"{_safe(key[0])}: no skyroute tables; run 'skyroute "
+                                   "db init' first")
         missing = [n for n in names if n not in have]
         if missing:
-            raise SkyrouteError(f"{_safe(key[0])}: no table {', '.join(missing)} (an older "
-                                "schema); run 'skyroute db init' to upgrade it")
+            raise StoreSchemaError(f"{_safe(key[0])}: no table {', '.join(missing)} (an "
+                                   "older schema); run 'skyroute db init' to upgrade it")
         md = sa.MetaData()
         md.reflect(engine, only=names)
         _REFLECTED[key] = dict(md.tables)

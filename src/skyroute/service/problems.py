@@ -17,7 +17,7 @@ from sqlalchemy.exc import OperationalError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from skyroute.delivery.store import is_busy
-from skyroute.errors import InputFormatError, SkyrouteError, StoreBusyError
+from skyroute.errors import InputFormatError, SkyrouteError, StoreBusyError, StoreSchemaError
 from skyroute.service import viewer
 from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.paths import root_path, route_path
@@ -279,6 +279,18 @@ async def _busy(request: Request, exc: StoreBusyError) -> FiniteJSONResponse:
                             headers={"Retry-After": str(BUSY_RETRY_SECONDS)})
 
 
+async def _schema(request: Request, exc: StoreSchemaError) -> FiniteJSONResponse:
+    """The store without skyroute's tables (dropped, or its file replaced, under the
+    running server, which made them when it opened the store): the server's condition,
+    answered as a store that cannot be opened is (``Resources.engine``). The library's
+    message names the store's URL or file: it was the body of a 422, to anyone; it now
+    stays in the log."""
+    log.warning("%s %s: the store cannot be read: %s", request.method, request.url.path,
+                str(exc).splitlines()[0])
+    return problem_response(503, "the store cannot be read: its tables are missing; the "
+                            "server's log says why", kind="store-unavailable")
+
+
 async def _database(request: Request, exc: Exception) -> FiniteJSONResponse:
     """A database error the store let through: a read of a locked SQLite store is
     :func:`_busy`'s 503, anything else the 500 of :func:`_internal`."""
@@ -300,6 +312,7 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(StarletteHTTPException, _http)
     app.add_exception_handler(SkyrouteError, _library)
     app.add_exception_handler(StoreBusyError, _busy)  # (a child: its own handler wins)
+    app.add_exception_handler(StoreSchemaError, _schema)  # (likewise)
     app.add_exception_handler(OperationalError, _database)
     app.add_exception_handler(Exception, _internal)
 

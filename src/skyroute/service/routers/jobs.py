@@ -18,7 +18,7 @@ from fastapi import APIRouter, Depends, Path, Request
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from skyroute.delivery.limits import MAX_DAYS
-from skyroute.errors import SEED_MAX, SkyrouteError, StoreBusyError
+from skyroute.errors import SEED_MAX, SkyrouteError, StoreBusyError, StoreSchemaError
 from skyroute.fleet.limits import (
     MAX_AIRPORTS,
     MAX_PACKAGES,
@@ -159,8 +159,10 @@ def _submit(res: Resources, request: Request, kind: str, params: dict, *,
                 job_id, new = runner.submit_once(eng, kind, params, executor=res.executor())
             else:
                 job_id, new = runner.submit(eng, kind, params, executor=res.executor()), True
-        except StoreBusyError:
-            raise  # the server's condition, not the request's: 503 (problems._busy)
+        except (StoreBusyError, StoreSchemaError):
+            # the server's condition, not the request's: a 503 naming no URL
+            # (problems._busy, _schema); the 422 of str(exc) named the store's file
+            raise
         except SkyrouteError as exc:
             raise Problem(422, str(exc), field=exc.param if isinstance(exc.param, str)
                           else None) from None
