@@ -703,9 +703,9 @@ def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):
 
 
 @contextlib.contextmanager
-def _copied_run(server):
-    """A second fleet run in the store, the module's run stored again (same settings);
-    its id. Deleted at the end."""
+def _copied_run(server, **changes):
+    """A second fleet run in the store, the module's run stored again (same settings,
+    but for ``changes``); its id. Deleted at the end."""
     import sqlalchemy as sa
 
     from skyroute.jobs import store
@@ -714,13 +714,32 @@ def _copied_run(server):
     run = store.get_fleet_run(eng, server[1])
     copy = store.save_fleet_run(eng, **{k: run[k] for k in (
         "scenario", "params", "report", "events_jsonl", "tracks_csv", "packages_csv",
-        "fleet_geojson")})
+        "fleet_geojson")} | changes)
     try:
         yield copy
     finally:
         with eng.begin() as c:
             c.execute(sa.text("DELETE FROM fleet_runs WHERE id = :id"), {"id": copy})
         eng.dispose()
+
+
+def test_a_run_stored_without_packages_csv_opens_without_a_console_error(open_page, server):
+    """A run stored without packages.csv (its ``files`` do not name it: a run stored
+    before it was kept) opened with a 404 for it, which the browser logs as a console
+    error; the page now asks for it only where the run has it, and learns the packages'
+    routes from the landing events."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    with _copied_run(server, packages_csv="") as copy:
+        assert "packages.csv" not in httpx.get(f"{server[0]}/fleet/runs/{copy}").json()["files"]
+        pg = open_page(f"/fleet.html#run={copy}", "desktop")
+        p = pg.page
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        assert p.input_value("#run") == copy
+        set_slider(p, "#time", p.eval_on_selector("#time", "e => e.max"))
+        p.wait_for_function("document.querySelector('#packages tbody tr')")
+        assert "delivered" in p.inner_text("#packages-caption")
+        pg.done("fleet-run-without-packages")
 
 
 def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):

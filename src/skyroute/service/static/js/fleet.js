@@ -174,10 +174,14 @@ async function load(id) {
   say(status, `Loading run ${runLabel(entry, { when: false })}…`, "busy");
   let detail, tracksText, eventsText, geo, routesText;
   try {
+    const asked = getJSON(`${base}?limit=1`);
     [detail, tracksText, eventsText, geo, routesText] = await Promise.all([
-      getJSON(`${base}?limit=1`), getText(`${base}/tracks.csv`), getText(`${base}/events.jsonl`),
+      asked, getText(`${base}/tracks.csv`), getText(`${base}/events.jsonl`),
       getJSON(`${base}/fleet.geojson`),
-      getText(`${base}/packages.csv`).catch(() => null), // routes known from the start (else from events)
+      // routes known from the start (else from events); asked for only where the run's
+      // files name it: a run stored without it is a 404, a console error in the browser
+      asked.then((d) => ((d.files || {})["packages.csv"] ? getText(`${base}/packages.csv`) : null))
+        .catch(() => null),
     ]);
   } catch (err) {
     if (mine === loading) say(status, explain(err, "Reading the run"), "error");
