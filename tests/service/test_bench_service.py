@@ -273,6 +273,7 @@ def test_each_process_of_a_real_server_marks_itself_ready(tmp_path):
         for pid in pids:  # the server's worker processes, alive
             os.kill(pid, 0)
     assert not Path(srv._ready.name).exists()  # the folder goes with the server
+    assert srv.proc.stderr.closed  # its pipe too (left to the collector: a ResourceWarning)
 
 
 def test_a_process_marks_itself_ready_only_when_asked(monkeypatch, tmp_path):

@@ -170,6 +170,8 @@ class Server:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
+        if self.proc is not None and self.proc.stderr is not None:
+            self.proc.stderr.close()  # (a ResourceWarning when left to the collector)
         self._ready.cleanup()
 
     def __enter__(self) -> Server:
