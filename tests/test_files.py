@@ -11,6 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from skyroute.files import write_atomic
+from tests.rename_failures import earlier_versions, failing_rename
 
 
 def test_written_files_get_the_umask_mode_not_mkstemps_private_one(tmp_path):
@@ -170,16 +171,7 @@ def test_a_rename_failing_part_way_leaves_every_file_as_it_was(tmp_path, monkeyp
 
     (tmp_path / "b.txt").write_text("old b")  # an earlier run's; a.txt and c.txt are new
     (tmp_path / "c.txt").write_text("old c")
-    real, renames = os.replace, []
-
-    def replace(src, dst):
-        if str(src).endswith(".tmp"):  # a staged file renamed into place
-            renames.append(dst)
-            if len(renames) == fail_at + 1:
-                raise OSError(28, "No space left on device")
-        return real(src, dst)
-
-    monkeypatch.setattr(files.os, "replace", replace)
+    failing_rename(monkeypatch, fail_at + 1)
     names = ["a.txt", "b.txt", "c.txt", "sub/d.txt"]
     with pytest.raises(SkyrouteError) as err, files.written_together():
         for name in names:
@@ -204,22 +196,9 @@ def test_written_together_is_all_or_none_whichever_rename_fails(tmp_path_factory
     from skyroute.errors import SkyrouteError
 
     here = tmp_path_factory.mktemp("together")
-    before = {}
-    for k, old in enumerate(existed):
-        if old:
-            (here / f"f{k}").write_text(f"old {k}")
-            before[f"f{k}"] = f"old {k}"
-    real, renames = os.replace, []
-
-    def replace(src, dst):
-        if str(src).endswith(".tmp"):
-            renames.append(dst)
-            if len(renames) == fail_at + 1:
-                raise OSError(5, "Input/output error")
-        return real(src, dst)
-
+    before = earlier_versions(here, existed)
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(files.os, "replace", replace)
+        failing_rename(mp, fail_at + 1, errno=5, message="Input/output error")
         try:
             with files.written_together():
                 for k in range(len(existed)):

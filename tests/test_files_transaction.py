@@ -3,7 +3,6 @@ change together or not at all, whichever of a rename, the commit or the block fa
 
 from __future__ import annotations
 
-import os
 import signal
 from contextlib import contextmanager
 from pathlib import Path
@@ -14,6 +13,7 @@ from hypothesis import strategies as st
 
 import skyroute.files as files
 from skyroute.errors import SkyrouteError
+from tests.rename_failures import earlier_versions, failing_rename
 
 
 class CommitError(Exception):
@@ -46,20 +46,6 @@ class Transaction:
 
 def folder(here: Path) -> dict[str, str]:
     return {p.name: p.read_text() for p in sorted(here.iterdir()) if p.is_file()}
-
-
-def failing_rename(monkeypatch, at: int) -> None:
-    """The ``at``-th rename of a staged file into place (from 1) fails: a full disk."""
-    real, renames = os.replace, []
-
-    def replace(src, dst):
-        if str(src).endswith(".tmp"):
-            renames.append(dst)
-            if len(renames) == at:
-                raise OSError(28, "No space left on device")
-        return real(src, dst)
-
-    monkeypatch.setattr(files.os, "replace", replace)
 
 
 def test_the_commit_comes_after_every_rename_and_before_the_backups_go(tmp_path):
@@ -170,11 +156,7 @@ def test_files_and_transaction_change_together_or_not_at_all(tmp_path_factory, e
     afterwards either every file is new and the transaction committed, or the folder
     holds exactly what it held before and the transaction was rolled back."""
     here = tmp_path_factory.mktemp("together")
-    before = {}
-    for k, old in enumerate(existed):
-        if old:
-            (here / f"f{k}").write_text(f"old {k}")
-            before[f"f{k}"] = f"old {k}"
+    before = earlier_versions(here, existed)
     tx = Transaction(here, fails=commit_fails)
     with pytest.MonkeyPatch.context() as mp:
         failing_rename(mp, fail_at + 1)

@@ -9,7 +9,6 @@ are dropped: a failed rename rolls the rows back, a failed commit puts the files
 from __future__ import annotations
 
 import json
-import os
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -18,6 +17,7 @@ import sqlalchemy as sa
 
 from tests.cli.test_cli import run
 from tests.conftest import ROOT
+from tests.rename_failures import failing_rename
 
 EXAMPLE = str(ROOT / "examples" / "lunch")
 DAY = "2024-01-03"
@@ -65,16 +65,6 @@ def failing(how: str, at: int = 2):
     """In the block, the ``at``-th rename of a staged file into place (from 1) fails (a
     full disk), or (``how`` "commit") the commit of a transaction that wrote flight path
     rows does (the server gone, a disk error: as SQLAlchemy reports a driver's error)."""
-    import skyroute.files as files
-
-    real, renames = os.replace, []
-
-    def replace(src, dst):
-        if str(src).endswith(".tmp"):
-            renames.append(dst)
-            if len(renames) == at:
-                raise OSError(28, "No space left on device")
-        return real(src, dst)
 
     def wrote(conn, _cursor, statement, *_args):
         if statement.lstrip().upper().startswith("INSERT INTO FLIGHTPATH"):
@@ -86,7 +76,7 @@ def failing(how: str, at: int = 2):
 
     if how == "rename":
         with pytest.MonkeyPatch.context() as mp:
-            mp.setattr(files.os, "replace", replace)
+            failing_rename(mp, at)
             yield
         return
     events = [("before_cursor_execute", wrote), ("commit", commit)]

@@ -187,6 +187,23 @@ def test_bad_flags_are_one_line(monkeypatch, capsys, tmp_path, args, words):
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
 
 
+def _serve_with_token(monkeypatch, capsys, tmp_path, given: str, token: str):
+    """``serve`` started with ``token`` from $SKYROUTE_TOKEN (``given`` "env") or from a
+    ``--token-file`` ("file"): (exit code, stdout, stderr, how the error names that
+    source)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "token").write_text(token + "\n", encoding="utf-8")
+    if given == "env":
+        monkeypatch.setenv("SKYROUTE_TOKEN", token)
+        args, where = [], "SKYROUTE_TOKEN: "
+    else:
+        monkeypatch.delenv("SKYROUTE_TOKEN", raising=False)
+        args, where = ["--token-file", str(tmp_path / "token")], f"--token-file {tmp_path}"
+    code, out, err = run(monkeypatch, capsys, "serve", "--db",
+                         f"sqlite:///{tmp_path / 's.db'}", *args)
+    return code, out, err, where
+
+
 @pytest.mark.parametrize("given", ["env", "file"])
 def test_a_token_a_header_cannot_carry_is_one_line(monkeypatch, capsys, tmp_path, given):
     """A non-ASCII token was taken, and every write was a 403: curl and httpx send it
@@ -199,16 +216,8 @@ def test_a_token_a_header_cannot_carry_is_one_line(monkeypatch, capsys, tmp_path
     with pytest.raises(ValidationError, match="character 2 is not printable ASCII"):
         Settings(token="s\u00e9cret")
     assert Settings(token="two words~! and more").token == "two words~! and more"  # as before
-    monkeypatch.chdir(tmp_path)
-    (tmp_path / "token").write_text("s\u00e9cret\n", encoding="utf-8")
-    if given == "env":
-        monkeypatch.setenv("SKYROUTE_TOKEN", "s\u00e9cret")
-        args, where = [], "SKYROUTE_TOKEN: "
-    else:
-        monkeypatch.delenv("SKYROUTE_TOKEN", raising=False)
-        args, where = ["--token-file", str(tmp_path / "token")], f"--token-file {tmp_path}"
-    code, out, err = run(monkeypatch, capsys, "serve", "--db",
-                         f"sqlite:///{tmp_path / 's.db'}", *args)
+    code, out, err, where = _serve_with_token(monkeypatch, capsys, tmp_path, given,
+                                              "s\u00e9cret")
     assert code == 2 and len(err.strip().splitlines()) == 1, err
     assert where in err and "character 2 is not printable ASCII" in err
     assert "\u00e9" not in err + out and "skyroute service on" not in err
@@ -227,17 +236,8 @@ def test_a_short_token_is_refused_at_start(monkeypatch, capsys, tmp_path, given)
     with pytest.raises(ValidationError, match="shorter than 16 characters"):
         Settings(token="x" * 15)
     assert Settings(token="x" * 16).token == "x" * 16
-    monkeypatch.chdir(tmp_path)
     short = "shorty-7"
-    (tmp_path / "token").write_text(short + "\n")
-    if given == "env":
-        monkeypatch.setenv("SKYROUTE_TOKEN", short)
-        args, where = [], "SKYROUTE_TOKEN: "
-    else:
-        monkeypatch.delenv("SKYROUTE_TOKEN", raising=False)
-        args, where = ["--token-file", str(tmp_path / "token")], f"--token-file {tmp_path}"
-    code, out, err = run(monkeypatch, capsys, "serve", "--db",
-                         f"sqlite:///{tmp_path / 's.db'}", *args)
+    code, out, err, where = _serve_with_token(monkeypatch, capsys, tmp_path, given, short)
     assert code == 2 and len(err.strip().splitlines()) == 1, err
     assert err.startswith(f"skyroute: error: {where}") and "shorter than 16" in err, err
     assert short not in err + out and "skyroute service on" not in err
