@@ -127,8 +127,12 @@ def test_budget_exhausted(algorithm):
 def test_bad_queries_raise(algorithm, start, goal, words):
     b = np.zeros((5, 5), bool)
     b[1, 1] = True
-    with pytest.raises(QueryError, match=words.replace("(", r"\(").replace(")", r"\)")):
+    with pytest.raises(QueryError, match=words.replace("(", r"\(").replace(")", r"\)")) \
+            as err:
         skyroute.plan(skyroute.Grid(b), start, goal, algorithm=algorithm)
+    # param names the argument the message starts with, as an OptionError's does (None)
+    assert err.value.param == str(err.value).split()[0]
+    assert err.value.param in ("start", "goal")
 
 
 # keys, members or bytes that are free in-range ints: each passed as a cell
@@ -272,3 +276,24 @@ def test_setup_is_timed_apart_from_the_search(algorithm, monkeypatch):
     assert first.extra["setup_seconds"] == 100.0 and first.seconds == 1.0
     assert "setup_seconds" not in again.extra and again.seconds == 1.0  # set up once
     assert first.cost == again.cost and first.expanded == again.expanded
+
+
+@pytest.mark.parametrize("start, goal, param", [
+    ((-158.75, -163.19), (-160.0, -160.0), "goal"),  # inside a building
+    ((np.nan, 0.0), (0.3, -0.7), "start"), ((1.0, 2.0, 3.0), (0.3, -0.7), "start"),
+    ((0.3, -0.7), "ab", "goal"), ((0.3, -0.7), [(0.3, -0.7)] * 2, "goal"),
+])
+def test_a_bad_world_point_names_its_argument(start, goal, param):
+    with pytest.raises(QueryError) as err:
+        skyroute.plan(_city("ned"), start, goal)
+    assert err.value.param == param and str(err.value).startswith(param)
+
+
+def test_a_prepared_grid_names_its_bad_argument():
+    index = skyroute.prepare(skyroute.Grid(np.eye(4, dtype=bool)))
+    with pytest.raises(QueryError) as err:
+        index.plan((1, 0), (1, 1))
+    assert err.value.param == "goal"
+    with pytest.raises(OptionError, match=r"ask the index itself: index\.plan") as err:
+        skyroute.plan(index, (1, 0), (0, 1))  # it said only "got PreparedGrid"
+    assert err.value.param == "grid"

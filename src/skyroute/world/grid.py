@@ -199,12 +199,12 @@ def cell_xy(cell: object, what: str) -> tuple[int, int]:
     (b"\\x01\\x02" unpacks to two ints)."""
     if isinstance(cell, Mapping | Set | bytes | bytearray):
         raise QueryError(f"{what} {cell!r} must be two integers (x, y), not a "
-                         f"{type(cell).__name__}")
+                         f"{type(cell).__name__}", param=what)
     try:
         x, y = cell  # type: ignore[misc]
         return operator.index(x), operator.index(y)
     except (TypeError, ValueError):
-        raise QueryError(f"{what} {cell!r} must be two integers (x, y)") from None
+        raise QueryError(f"{what} {cell!r} must be two integers (x, y)", param=what) from None
 
 
 def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
@@ -213,9 +213,9 @@ def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
     x, y = cell_xy(cell, what)
     if not (0 <= x < grid.width and 0 <= y < grid.height):
         raise QueryError(f"{what} ({x}, {y}) lies outside the {grid.width}x{grid.height} grid "
-                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})")
+                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})", param=what)
     if grid.blocked[y, x]:
-        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell")
+        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell", param=what)
     return x, y
 
 
