@@ -297,3 +297,20 @@ def test_a_prepared_grid_names_its_bad_argument():
     with pytest.raises(OptionError, match=r"ask the index itself: index\.plan") as err:
         skyroute.plan(index, (1, 0), (0, 1))  # it said only "got PreparedGrid"
     assert err.value.param == "grid"
+
+
+@pytest.mark.parametrize("algorithm", WORLD_ALGORITHMS)
+def test_a_world_result_has_one_shape_found_or_not(algorithm):
+    # PRM's no_path lacked extra's k, raw_cost and build_seconds: a KeyError for a
+    # notebook tabling its runs
+    import shapely
+
+    ring = shapely.box(0, 0, 10, 10).difference(shapely.box(3, 3, 7, 7))
+    world = skyroute.World([ring], [0], [50], ("ring",))
+    found = skyroute.plan(world, (-2, 5), (12, 5), algorithm=algorithm)
+    walled = skyroute.plan(world, (-2, 5), (5, 5), algorithm=algorithm)  # inside the ring
+    assert found.status is Status.FOUND and walled.status is Status.NO_PATH
+    assert sorted(found.extra) == sorted(walled.extra)
+    assert walled.path.shape == (0, 2) and walled.path.dtype == found.path.dtype
+    assert walled.cost == np.inf and found.algorithm == walled.algorithm == algorithm
+    assert walled.path_lonlat is found.path_lonlat is None  # a plane world, no home
