@@ -41,6 +41,7 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
     corner_cutting : bool
         False (MovingAI's rule): a diagonal step needs both side cells free. True: one
         free side suffices; squeezing between two diagonal blocked cells is never legal.
+        8-connected only (not ``jps``).
     heuristic : {"octile", "euclidean", "manhattan", "zero"}, optional
         Default octile (8-connected), Manhattan (4-connected), Euclidean (any-angle).
         Manhattan is admissible only 4-connected: with diagonal or any-angle steps

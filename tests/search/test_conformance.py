@@ -187,6 +187,10 @@ def test_cells_as_numpy_ints_or_lists_plan_as_tuples(algorithm):
     ({"algorithm": "bfs", "connectivity": 8}, "bfs' is 4-connected"),
     ({"algorithm": "jps", "corner_cutting": True}, "jps' needs"),
     ({"algorithm": "dijkstra", "heuristic": "octile"}, "takes no heuristic"),
+    # corner cutting with 4-connected moves was read by nothing and ignored
+    ({"connectivity": 4, "corner_cutting": True}, "connectivity=4 has no diagonal steps"),
+    ({"algorithm": "theta", "connectivity": 4, "corner_cutting": True}, "no corners to cut"),
+    ({"algorithm": "bfs", "corner_cutting": True}, "bfs' is 4-connected, so it has no"),
 ])
 def test_bad_options_raise_listing_valid_ones(options, words):
     with pytest.raises(OptionError, match=words.replace("(", r"\(")):
