@@ -318,3 +318,11 @@ def test_a_world_result_has_one_shape_found_or_not(algorithm):
     assert walled.path.shape == (0, 2) and walled.path.dtype == found.path.dtype
     assert walled.cost == np.inf and found.algorithm == walled.algorithm == algorithm
     assert walled.path_lonlat is found.path_lonlat is None  # a plane world, no home
+
+
+@pytest.mark.parametrize("cell", [np.array([[0], [1]]), np.array([[0, 1], [1, 0]])])
+def test_a_cell_given_as_a_2d_array_is_refused_in_one_line(cell):
+    with pytest.raises(QueryError) as err:
+        skyroute.plan(open_grid(3, 3), (0, 0), cell)
+    assert "\n" not in str(err.value)  # the array's repr ran over two lines
+    assert str(err.value).startswith("goal array([[0") and err.value.param == "goal"

@@ -204,7 +204,8 @@ def cell_xy(cell: object, what: str) -> tuple[int, int]:
         x, y = cell  # type: ignore[misc]
         return operator.index(x), operator.index(y)
     except (TypeError, ValueError):
-        raise QueryError(f"{what} {cell!r} must be two integers (x, y)", param=what) from None
+        shown = " ".join(repr(cell).split())  # one line: a 2-D array's repr has several
+        raise QueryError(f"{what} {shown} must be two integers (x, y)", param=what) from None
 
 
 def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
