@@ -41,8 +41,11 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
     corner_cutting : bool
         False (MovingAI's rule): a diagonal step needs both side cells free. True: one
         free side suffices; squeezing between two diagonal blocked cells is never legal.
+        8-connected only (not ``jps``).
     heuristic : {"octile", "euclidean", "manhattan", "zero"}, optional
         Default octile (8-connected), Manhattan (4-connected), Euclidean (any-angle).
+        Manhattan is admissible only 4-connected: with diagonal or any-angle steps
+        the path may be longer than the optimum.
     weight : float, optional
         >= 1 (default 1); weighted A* returns a cost at most ``weight`` x the optimum.
     prune : {"none", "collinear", "los"}, optional
@@ -69,7 +72,7 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
         inside an obstacle), or not two numbers (two integers on a Grid).
     OptionError
         an unknown, out-of-range or inapplicable option (the message lists the valid
-        ones).
+        ones), or ``grid`` not a Grid or World.
 
     Examples
     --------
@@ -87,10 +90,8 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
         from skyroute.world.world import World
 
         if not isinstance(grid, World):
-            hint = ("; wrap an array of blocked cells as skyroute.Grid(array)"
-                    if hasattr(grid, "shape") or isinstance(grid, list | tuple) else "")
             raise OptionError(f"grid must be a skyroute Grid or World, got "
-                              f"{type(grid).__name__}{hint}")
+                              f"{type(grid).__name__}{_hint(grid)}", param="grid")
         extra = {k: v for k, v in (("connectivity", connectivity), ("heuristic", heuristic),
                                    ("prune", prune), ("resolution", resolution))
                  if v is not None}
@@ -118,3 +119,13 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
                             corner_cutting=corner_cutting, heuristic=heuristic,
                             weight=weight, prune=prune, max_expansions=max_expansions)
     return plan_grid(grid, start, goal, opts)
+
+
+def _hint(grid: object) -> str:
+    """What to do instead, for a ``grid`` that is no Grid or World: wrap an array, or ask
+    a prepared index itself."""
+    if hasattr(grid, "shape") or isinstance(grid, list | tuple):
+        return "; wrap an array of blocked cells as skyroute.Grid(array)"
+    if type(grid).__name__ == "PreparedGrid":  # not imported: the grid path stays light
+        return "; ask the index itself: index.plan(start, goal)"
+    return ""

@@ -111,13 +111,14 @@ def two_indices(draw, n: int) -> tuple[int, int]:
     return i, (i + draw(st.integers(1, n - 1))) % n
 
 
-def grid_optimum(blocked: np.ndarray, s, t, *, connectivity=8) -> float:
+def grid_optimum(blocked: np.ndarray, s, t, *, connectivity=8, corner_cutting=False) -> float:
     """The optimal cost from cell ``s`` to cell ``t`` ((x, y)): scipy's Dijkstra on the
     free cells' graph built here (straight moves 1, diagonal moves sqrt 2 between two free
-    side cells: no corner cutting); inf when ``t`` is out of reach."""
+    side cells, or with ``corner_cutting`` beside at least one); inf when ``t`` is out of
+    reach."""
     blocked = np.ascontiguousarray(blocked, dtype=bool)
     w = blocked.shape[1]
-    key = (blocked.tobytes(), blocked.shape, connectivity)
+    key = (blocked.tobytes(), blocked.shape, connectivity, corner_cutting)
     return float(_distances(key, int(s[1]) * w + int(s[0]))[int(t[1]) * w + int(t[0])])
 
 
@@ -128,7 +129,7 @@ def _distances(key, source: int) -> np.ndarray:
 
 @functools.lru_cache(maxsize=16)
 def _grid_graph(key):
-    raw, (h, w), connectivity = key
+    raw, (h, w), connectivity, corner_cutting = key
     blocked = np.frombuffer(raw, dtype=bool).reshape(h, w)
     moves = [(1, 0), (0, 1)] + ([(1, 1), (1, -1)] if connectivity == 8 else [])
     rows, cols, wts = [], [], []
@@ -137,7 +138,8 @@ def _grid_graph(key):
             u, v = x + dx, y + dy
             if not (0 <= u < w and 0 <= v < h) or blocked[v, u]:
                 continue
-            if dx and dy and (blocked[y, u] or blocked[v, x]):
+            sides = blocked[y, u], blocked[v, x]
+            if dx and dy and (all(sides) if corner_cutting else any(sides)):
                 continue
             rows.append(y * w + x)
             cols.append(v * w + u)

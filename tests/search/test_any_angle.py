@@ -147,12 +147,14 @@ def test_line_of_sight_is_shapely_s(q):
 
 
 @settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(rule_queries(), st.sampled_from(ANY_ANGLE), st.sampled_from([4, 8]), st.booleans(),
+@given(rule_queries(), st.sampled_from(ANY_ANGLE),
+       st.sampled_from([(4, False), (8, False), (8, True)]),  # 4-connected: no corners
        st.sampled_from(["none", "collinear", "los"]))
-def test_any_angle_on_every_move_rule(q, algorithm, connectivity, corner_cutting, prune):
+def test_any_angle_on_every_move_rule(q, algorithm, rule, prune):
     # the existing properties ran the default rule only: 4-connected moves and corner
     # cutting too, against networkx's optimum for that rule; every segment seen by shapely
     blocked, s, t = q
+    connectivity, corner_cutting = rule
     r = skyroute.plan(skyroute.Grid(blocked), s, t, algorithm=algorithm, prune=prune,
                       connectivity=connectivity, corner_cutting=corner_cutting)
     optimum = move_rule_optimum(blocked, s, t, connectivity, corner_cutting)

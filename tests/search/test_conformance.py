@@ -127,8 +127,12 @@ def test_budget_exhausted(algorithm):
 def test_bad_queries_raise(algorithm, start, goal, words):
     b = np.zeros((5, 5), bool)
     b[1, 1] = True
-    with pytest.raises(QueryError, match=words.replace("(", r"\(").replace(")", r"\)")):
+    with pytest.raises(QueryError, match=words.replace("(", r"\(").replace(")", r"\)")) \
+            as err:
         skyroute.plan(skyroute.Grid(b), start, goal, algorithm=algorithm)
+    # param names the argument the message starts with, as an OptionError's does (None)
+    assert err.value.param == str(err.value).split()[0]
+    assert err.value.param in ("start", "goal")
 
 
 # keys, members or bytes that are free in-range ints: each passed as a cell
@@ -183,6 +187,10 @@ def test_cells_as_numpy_ints_or_lists_plan_as_tuples(algorithm):
     ({"algorithm": "bfs", "connectivity": 8}, "bfs' is 4-connected"),
     ({"algorithm": "jps", "corner_cutting": True}, "jps' needs"),
     ({"algorithm": "dijkstra", "heuristic": "octile"}, "takes no heuristic"),
+    # corner cutting with 4-connected moves was read by nothing and ignored
+    ({"connectivity": 4, "corner_cutting": True}, "connectivity=4 has no diagonal steps"),
+    ({"algorithm": "theta", "connectivity": 4, "corner_cutting": True}, "no corners to cut"),
+    ({"algorithm": "bfs", "corner_cutting": True}, "bfs' is 4-connected, so it has no"),
 ])
 def test_bad_options_raise_listing_valid_ones(options, words):
     with pytest.raises(OptionError, match=words.replace("(", r"\(")):
@@ -272,3 +280,49 @@ def test_setup_is_timed_apart_from_the_search(algorithm, monkeypatch):
     assert first.extra["setup_seconds"] == 100.0 and first.seconds == 1.0
     assert "setup_seconds" not in again.extra and again.seconds == 1.0  # set up once
     assert first.cost == again.cost and first.expanded == again.expanded
+
+
+@pytest.mark.parametrize("start, goal, param", [
+    ((-158.75, -163.19), (-160.0, -160.0), "goal"),  # inside a building
+    ((np.nan, 0.0), (0.3, -0.7), "start"), ((1.0, 2.0, 3.0), (0.3, -0.7), "start"),
+    ((0.3, -0.7), "ab", "goal"), ((0.3, -0.7), [(0.3, -0.7)] * 2, "goal"),
+])
+def test_a_bad_world_point_names_its_argument(start, goal, param):
+    with pytest.raises(QueryError) as err:
+        skyroute.plan(_city("ned"), start, goal)
+    assert err.value.param == param and str(err.value).startswith(param)
+
+
+def test_a_prepared_grid_names_its_bad_argument():
+    index = skyroute.prepare(skyroute.Grid(np.eye(4, dtype=bool)))
+    with pytest.raises(QueryError) as err:
+        index.plan((1, 0), (1, 1))
+    assert err.value.param == "goal"
+    with pytest.raises(OptionError, match=r"ask the index itself: index\.plan") as err:
+        skyroute.plan(index, (1, 0), (0, 1))  # it said only "got PreparedGrid"
+    assert err.value.param == "grid"
+
+
+@pytest.mark.parametrize("algorithm", WORLD_ALGORITHMS)
+def test_a_world_result_has_one_shape_found_or_not(algorithm):
+    # PRM's no_path lacked extra's k, raw_cost and build_seconds: a KeyError for a
+    # notebook tabling its runs
+    import shapely
+
+    ring = shapely.box(0, 0, 10, 10).difference(shapely.box(3, 3, 7, 7))
+    world = skyroute.World([ring], [0], [50], ("ring",))
+    found = skyroute.plan(world, (-2, 5), (12, 5), algorithm=algorithm)
+    walled = skyroute.plan(world, (-2, 5), (5, 5), algorithm=algorithm)  # inside the ring
+    assert found.status is Status.FOUND and walled.status is Status.NO_PATH
+    assert sorted(found.extra) == sorted(walled.extra)
+    assert walled.path.shape == (0, 2) and walled.path.dtype == found.path.dtype
+    assert walled.cost == np.inf and found.algorithm == walled.algorithm == algorithm
+    assert walled.path_lonlat is found.path_lonlat is None  # a plane world, no home
+
+
+@pytest.mark.parametrize("cell", [np.array([[0], [1]]), np.array([[0, 1], [1, 0]])])
+def test_a_cell_given_as_a_2d_array_is_refused_in_one_line(cell):
+    with pytest.raises(QueryError) as err:
+        skyroute.plan(open_grid(3, 3), (0, 0), cell)
+    assert "\n" not in str(err.value)  # the array's repr ran over two lines
+    assert str(err.value).startswith("goal array([[0") and err.value.param == "goal"

@@ -122,6 +122,8 @@ def test_results_compare_by_identity_and_hash():
     ({"algorithm": "jps", "connectivity": 4}, "connectivity"),
     ({"algorithm": "jps", "corner_cutting": True}, "corner_cutting"),
     ({"algorithm": "astar", "max_expansions": -1}, "max_expansions"),
+    ({"algorithm": "astar", "connectivity": 4, "corner_cutting": True}, "corner_cutting"),
+    ({"algorithm": "bfs", "corner_cutting": True}, "corner_cutting"),
 ])
 def test_an_option_conflict_names_the_option(options, param):
     with pytest.raises(skyroute.OptionError) as info:

@@ -375,3 +375,42 @@ def test_grid_cell_tests_refuse_what_is_not_two_integers(cell):
         with pytest.raises(skyroute.QueryError, match="two integers"):
             test(cell)
     assert grid.is_free((np.int64(1), np.int64(2))) and not grid.in_bounds((8, 0))
+
+
+@pytest.mark.parametrize("make, param", [(Grid, "blocked"), (from_array, "array")])
+@pytest.mark.parametrize("bad, words", [
+    # text was read by its truth value: "0" and "." are non-empty, so blocked
+    (np.array([["0", "1"], ["0", "0"]]), "got dtype <U1: convert text first"),
+    ([[".", "@"], [".", "."]], "got dtype <U1: convert text first"),
+    (np.array([[b"0", b"1"]]), "got dtype |S1: convert text first"),
+    ([[0, None], [0, 0]], "got None"),  # None read as free
+    ([[0, "x"], [1, 0]], "got dtype <U21"),
+    (np.zeros((2, 2), complex), "got dtype complex128"),
+    ([[0, 1], [0]], "its rows of equal length"),  # numpy's own ValueError
+])
+def test_an_array_of_text_or_ragged_rows_is_refused_naming_it(make, param, bad, words):
+    with pytest.raises(OptionError) as err:
+        make(bad)
+    assert err.value.param == param
+    assert str(err.value).startswith(f"{param} must ") and words in str(err.value)
+
+
+@pytest.mark.parametrize("values", [
+    np.array([[0, 1], [0, 0]], dtype=object),  # numbers as objects: read as numbers
+    [[False, np.True_], [0, 0.0]],
+    np.asfortranarray([[0, 7], [0, 0]], dtype=np.int8),
+    np.array([[0, 0, 1, 0], [0, 0, 0, 0]], np.uint8)[:, ::2],  # a strided view
+])
+def test_arrays_of_numbers_in_any_type_or_layout_read_alike(values):
+    assert Grid(values).blocked.tolist() == [[False, True], [False, False]]
+
+
+def test_a_grid_or_a_bad_shape_given_as_blocked_is_named():
+    g = Grid(np.zeros((2, 2)))
+    with pytest.raises(OptionError, match=r"^blocked must be an array, got a Grid") as err:
+        Grid(g)  # it read "must be a non-empty 2-D array, got shape ()"
+    assert err.value.param == "blocked"
+    for bad in (np.zeros(3), np.zeros((0, 2)), None):
+        with pytest.raises(OptionError) as err:
+            Grid(bad)
+        assert err.value.param == "blocked"

@@ -135,7 +135,7 @@ def _check_margin(map_file: str, grid, cells: dict, *, resolution: float,
                                               safety=0.0).blocked[y, x]:
                 raise QueryError(f"{what} ({x}, {y}) is free in {grid.name} but within the "
                                  f"--safety {safety:g} m margin of an obstacle; choose a "
-                                 "cell farther from it or a smaller --safety")
+                                 "cell farther from it or a smaller --safety", param=what)
             return
 
 

@@ -116,10 +116,12 @@ class PRM:
         graph = coo_matrix((lengths + 1e-300, (r, c)), shape=(n + 2, n + 2)).tocsr()
         dist, pred = dijkstra(graph, directed=False, indices=n, return_predecessors=True)
         settled = int(np.count_nonzero(np.isfinite(dist) & (dist <= dist[n + 1])))
+        # the same keys whatever the status: a caller tabling runs reads every one
+        extra = {"samples": n, "edges": len(self.edges), "k": self.k,
+                 "raw_cost": float(dist[n + 1]), "build_seconds": self.build_seconds}
         if not np.isfinite(dist[n + 1]):
             return PlanResult(Status.NO_PATH, np.empty((0, 2)), math.inf, settled, 0, checks,
-                              time.perf_counter() - t0, "prm",
-                              {"samples": n, "edges": len(self.edges)})
+                              time.perf_counter() - t0, "prm", extra)
         path = [n + 1]
         while path[-1] != n:
             path.append(int(pred[path[-1]]))
@@ -130,10 +132,7 @@ class PRM:
         tests += more + again
         cost = float(np.hypot(*np.diff(short, axis=0).T).sum())
         return PlanResult(Status.FOUND, short, cost, settled, 0, checks + tests,
-                          time.perf_counter() - t0, "prm",
-                          {"samples": n, "edges": len(self.edges), "k": self.k,
-                           "raw_cost": float(dist[n + 1]),
-                           "build_seconds": self.build_seconds})
+                          time.perf_counter() - t0, "prm", extra)
 
     def _query_rng(self, s: np.ndarray, t: np.ndarray) -> np.random.Generator:
         """The shortcuts' generator for one query: from the seed and the query's bits."""

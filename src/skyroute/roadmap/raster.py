@@ -129,4 +129,5 @@ def entry_cell(world: World, grid: Grid, p: np.ndarray, what: str) -> tuple[int,
             if free.any():
                 return tuple(int(v) for v in cells[order][np.argmax(free)])
     raise QueryError(f"{what} {world._fmt(p)} is too close to an obstacle for a "
-                     f"{grid.resolution:.3g} grid; use a finer resolution or the visibility graph")
+                     f"{grid.resolution:.3g} grid; use a finer resolution or the visibility graph",
+                     param=what)

@@ -67,6 +67,13 @@ def _grid_options(algorithm, connectivity, corner_cutting, heuristic, weight, pr
         raise OptionError("algorithm='bfs' is 4-connected; use connectivity=4 or "
                           "algorithm='dijkstra' for 8-connected unit costs",
                           param=("connectivity", "algorithm"))
+    if connectivity == 4 and corner_cutting:  # read by no search: refused, not ignored
+        if algorithm == "bfs":
+            raise OptionError("algorithm='bfs' is 4-connected, so it has no corners to cut; "
+                              "drop corner cutting", param=("corner_cutting", "algorithm"))
+        raise OptionError("connectivity=4 has no diagonal steps, so no corners to cut; "
+                          "drop corner cutting or use connectivity=8",
+                          param=("corner_cutting", "connectivity"))
     if algorithm == "jps" and (connectivity != 8 or corner_cutting):
         # the parameters named in the message too: the CLI speaks of them as its flags
         raise OptionError("algorithm='jps' needs connectivity=8 and no corner cutting",

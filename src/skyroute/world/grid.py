@@ -9,6 +9,7 @@ cell (x, y) covers ``[ox + x*s, ox + (x+1)*s) x [oy + y*s, oy + (y+1)*s)`` for o
 from __future__ import annotations
 
 import math
+import numbers
 import operator
 import warnings
 from collections.abc import Mapping, Set
@@ -21,6 +22,32 @@ from skyroute.errors import InputFormatError, OptionError, QueryError, real, ren
 from skyroute.world.points import plane_points
 
 NAN_HINT = "use 0 for free and non-zero for blocked"
+
+
+def occupancy_values(array: object, name: str) -> np.ndarray:
+    """``array`` as a numpy array of numbers or booleans (non-zero / True = blocked), else
+    an :class:`OptionError` naming ``name``: the readers of arrays (:class:`Grid`,
+    ``from_array``) take what a ``.npy`` file may hold. Text was read by its truth value,
+    so ``[["0", "1"]]`` or a map's ``"."`` and ``"@"`` characters were all blocked, and
+    ``None`` in a list was free; rows of unequal length were numpy's own ValueError.
+    NaN is refused by :func:`nan_cell`, its caller's next test."""
+    try:
+        values = np.asarray(array)
+    except (TypeError, ValueError):  # ragged rows ("an inhomogeneous shape")
+        raise OptionError(f"{name} must be a 2-D array of numbers or booleans, its rows "
+                          f"of equal length", param=name) from None
+    if values.dtype.kind == "O":  # a list mixing numbers and other objects
+        for v in values.flat:
+            if not isinstance(v, numbers.Real | np.bool_):
+                raise OptionError(f"{name} must hold numbers or booleans (non-zero "
+                                  f"blocked), got {v!r}", param=name)
+        return values.astype(np.float64)
+    if values.dtype.kind not in "biuf":
+        text = ": convert text first, e.g. (array == '@')" if values.dtype.kind in "US" \
+            else ""
+        raise OptionError(f"{name} must hold numbers or booleans (non-zero blocked), got "
+                          f"dtype {values.dtype}{text}", param=name)
+    return values
 
 
 def nan_cell(values: np.ndarray) -> tuple[int, int] | None:
@@ -40,7 +67,10 @@ class Grid:
     """Boolean occupancy (True = blocked) with a resolution (cell size) and origin in
     metres.
 
-    The array is copied and made read-only, so a Grid never changes after creation.
+    ``blocked`` is a 2-D array (or nested lists) of booleans or numbers indexed
+    ``[row, column]``, non-zero blocked, any memory layout; NaN, text and other objects
+    are an OptionError naming ``blocked``. It is copied and made read-only, so a Grid
+    never changes after creation.
     ``cell_size`` is the old name of ``resolution`` (deprecated).
 
     Examples
@@ -62,13 +92,17 @@ class Grid:
                  cell_size: float | None = None) -> None:
         resolution = renamed("resolution", resolution, "cell_size", cell_size)
         resolution = 1.0 if resolution is None else resolution
-        values = np.asarray(blocked)
+        if isinstance(blocked, Grid):  # np.asarray of one is a 0-d object array
+            raise OptionError("blocked must be an array, got a Grid: use it as it is, or "
+                              "its .blocked", param="blocked")
+        values = occupancy_values(blocked, "blocked")
         if (cell := nan_cell(values)) is not None:
             raise OptionError(f"blocked has NaN at cell {cell} (x, y); {NAN_HINT}",
                               param="blocked")
         arr = np.array(values, dtype=bool, copy=True)
         if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
-            raise OptionError(f"blocked must be a non-empty 2-D array, got shape {arr.shape}")
+            raise OptionError(f"blocked must be a non-empty 2-D array, got shape {arr.shape}",
+                              param="blocked")
         if real("resolution", resolution) <= 0:
             raise OptionError(f"resolution={resolution!r} must be a positive number",
                               param="resolution")
@@ -165,12 +199,13 @@ def cell_xy(cell: object, what: str) -> tuple[int, int]:
     (b"\\x01\\x02" unpacks to two ints)."""
     if isinstance(cell, Mapping | Set | bytes | bytearray):
         raise QueryError(f"{what} {cell!r} must be two integers (x, y), not a "
-                         f"{type(cell).__name__}")
+                         f"{type(cell).__name__}", param=what)
     try:
         x, y = cell  # type: ignore[misc]
         return operator.index(x), operator.index(y)
     except (TypeError, ValueError):
-        raise QueryError(f"{what} {cell!r} must be two integers (x, y)") from None
+        shown = " ".join(repr(cell).split())  # one line: a 2-D array's repr has several
+        raise QueryError(f"{what} {shown} must be two integers (x, y)", param=what) from None
 
 
 def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
@@ -179,9 +214,9 @@ def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
     x, y = cell_xy(cell, what)
     if not (0 <= x < grid.width and 0 <= y < grid.height):
         raise QueryError(f"{what} ({x}, {y}) lies outside the {grid.width}x{grid.height} grid "
-                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})")
+                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})", param=what)
     if grid.blocked[y, x]:
-        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell")
+        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell", param=what)
     return x, y
 
 

@@ -7,7 +7,14 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError
-from skyroute.world.grid import MAX_CELLS, NAN_HINT, Grid, check_file_cells, nan_cell
+from skyroute.world.grid import (
+    MAX_CELLS,
+    NAN_HINT,
+    Grid,
+    check_file_cells,
+    nan_cell,
+    occupancy_values,
+)
 
 NPY_MAGIC = b"\x93NUMPY"
 
@@ -16,7 +23,7 @@ def from_array(array: np.ndarray, *, resolution: float = 1.0,
                origin: tuple[float, float] = (0.0, 0.0), name: str = "array") -> Grid:
     """A Grid from a 2-D array indexed [row, column]; non-zero / True means blocked. NaN,
     which says neither, is an OptionError naming its cell (``bool(nan)`` is True)."""
-    a = np.asarray(array)
+    a = occupancy_values(array, "array")
     if (cell := nan_cell(a)) is not None:
         raise OptionError(f"array has NaN at cell {cell} (x, y); {NAN_HINT}", param="array")
     return Grid(a != 0, resolution, origin, name=name)

@@ -24,7 +24,7 @@ def _floats(points, what: str) -> np.ndarray:
     try:
         return np.asarray(points, dtype=float)
     except (TypeError, ValueError):
-        raise QueryError(f"{what} must be numbers, got {points!r}") from None
+        raise QueryError(f"{what} must be numbers, got {points!r}", param=what) from None
 
 
 def as_points(points, what: str, *, dims: int = 2) -> np.ndarray:
@@ -43,9 +43,9 @@ def as_points(points, what: str, *, dims: int = 2) -> np.ndarray:
     if p.ndim != 2 or p.shape[1] != dims:
         names = "(a, b)" if dims == 2 else f"{dims}"
         raise QueryError(f"{what} must be {names} numbers or an (N, {dims}) array, "
-                         f"got shape {np.shape(points)}")
+                         f"got shape {np.shape(points)}", param=what)
     if not np.all(np.isfinite(p)):
-        raise QueryError(f"{what} must be finite numbers, got {p.tolist()}")
+        raise QueryError(f"{what} must be finite numbers, got {p.tolist()}", param=what)
     return p
 
 
@@ -66,7 +66,8 @@ def plane_points(points, what: str = "points") -> np.ndarray:
         return p[None, :]
     if p.size == 0:
         return p.reshape(0, 2)
-    raise QueryError(f"{what} must be (a, b) numbers or an (N, 2) array, got shape {p.shape}")
+    raise QueryError(f"{what} must be (a, b) numbers or an (N, 2) array, got shape {p.shape}",
+                     param=what)
 
 
 def check_places(p: np.ndarray, what: str) -> np.ndarray:
@@ -75,7 +76,7 @@ def check_places(p: np.ndarray, what: str) -> np.ndarray:
     if bad.any():
         q = p[np.argmax(bad)]
         raise QueryError(f"{what} ({q[0]:.7g}, {q[1]:.7g}) is not a place: expected "
-                         "(lon, lat) degrees, lon in [-180, 180], lat in [-90, 90]")
+                         "(lon, lat) degrees, lon in [-180, 180], lat in [-90, 90]", param=what)
     return p
 
 
@@ -86,5 +87,5 @@ def check_metres(p: np.ndarray, what: str) -> np.ndarray:
     if bad.any():
         q = p[np.argmax(bad)]
         raise QueryError(f"{what} ({q[0]:.7g}, {q[1]:.7g}) lies more than {MAX_METRES:.0e} m "
-                         "from home: not a point of this world's local plane")
+                         "from home: not a point of this world's local plane", param=what)
     return p

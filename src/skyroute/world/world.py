@@ -396,7 +396,8 @@ class World:
         given (not as it comes back from the plane: far from home a lon/lat does not)."""
         p = self.to_plane(point, what)
         if len(p) != 1:
-            raise QueryError(f"{what} must be one point (a, b), got {len(p)} points")
+            raise QueryError(f"{what} must be one point (a, b), got {len(p)} points",
+                             param=what)
         return self.check_plane_point(p[0], what, given=as_points(point, what)[0])
 
     def check_plane_point(self, p: np.ndarray, what: str, *, given=None) -> np.ndarray:
@@ -407,12 +408,14 @@ class World:
         self._check_reach(p, what, shown, given)
         if not self.inside([p])[0]:
             raise QueryError(f"{what} {shown} lies outside the map "
-                             f"({self._extent_text()}){self._hint(given)}")
+                             f"({self._extent_text()}){self._hint(given)}",
+                             param=what)
         j = int(self.blocking([p])[0])
         if j >= 0:
             near = nearest_free(self, p, j, self._decimals)
             hint = "" if near is None else f"; nearest free point {self._fmt(near)}"
-            raise QueryError(f"{what} {shown} lies inside obstacle {self.names[j]!r}{hint}")
+            raise QueryError(f"{what} {shown} lies inside obstacle {self.names[j]!r}{hint}",
+                             param=what)
         return p
 
     def _check_reach(self, p: np.ndarray, what: str, shown: str, given) -> None:
@@ -439,7 +442,7 @@ class World:
         raise QueryError(f"{what} {shown} lies {far / 1000:,.0f} km from the world's home "
                          f"(lon {home.lon:g}, lat {home.lat:g}), more than the "
                          f"{MAX_REACH / 1000:,.0f} km a world with no boundary reaches"
-                         f"{self._hint(given)}")
+                         f"{self._hint(given)}", param=what)
 
     def _reach_home(self) -> Home | None:
         """Where :meth:`_check_reach` measures from: the home, else (a "degrees" world
