@@ -18,6 +18,7 @@ import sqlalchemy as sa
 from skyroute.delivery import store
 from skyroute.delivery.orders import Order
 from skyroute.errors import SkyrouteError
+from tests.conftest import PG, new_pg_database
 
 DAY = dt.date(2024, 1, 1)
 COLUMNS = {
@@ -137,6 +138,28 @@ def test_bad_urls_are_one_line_errors(tmp_path):
     e = store.connect(f"sqlite:///{tmp_path / 'empty.db'}")
     with pytest.raises(SkyrouteError, match="skyroute db init"):
         store.orders_between(e, DAY, DAY)
+
+
+@pytest.mark.parametrize("url, words", [
+    # SQLAlchemy reads the port with int(): a ValueError traceback
+    ("postgresql+psycopg://u:sekret@127.0.0.1:54x2/db", "not a database URL: its port is "
+     "not a number"),
+    ("postgresql+psycopg://u:sekret@[::1:5432/db", "not a database URL: its port is not a "
+     "number"),
+    # the driver's own refusals of an option: a ValueError traceback (SQLite) and "the
+    # store's database failed" (psycopg's ProgrammingError), which named no URL
+    ("sqlite:///{tmp}/x.db?timeout=soon", "cannot connect: a bad option value in the URL "
+     "(could not convert string to float: 'soon')"),
+    ("postgresql+psycopg://u:sekret@127.0.0.1:1/db?nosuch=1", "cannot connect: invalid "
+     'connection option "nosuch"'),
+])
+def test_a_url_with_a_bad_port_or_option_is_one_line(tmp_path, url, words):
+    with pytest.raises(SkyrouteError) as err:
+        store.connect(url.format(tmp=tmp_path))
+    msg = str(err.value)
+    assert words in msg and err.value.param == "url", msg
+    assert "sekret" not in msg and "\n" not in msg
+    assert not (tmp_path / "x.db").exists()
 
 
 def test_a_store_folder_that_cannot_be_made_is_one_line(tmp_path):
@@ -308,6 +331,57 @@ def test_a_new_postgresql_store_made_by_two_runs_at_once(fresh_pg):
                               cwd=str(Path(__file__).parents[2])) for _ in range(4)]
     done = [(p.communicate(timeout=60), p.returncode) for p in procs]
     assert [(out, rc) for (out, _), rc in done] == [("0006\n", 0)] * 4, done
+
+
+@pytest.mark.parametrize("encoding", ["SQL_ASCII", "LATIN1"])
+def test_a_postgresql_database_not_in_utf8_is_refused_in_one_line(encoding):
+    # SQL_ASCII: a TypeError traceback on connecting (the driver read text as bytes);
+    # LATIN1: connected, then an order of 'Zoë😀' was a UnicodeEncodeError traceback
+    with new_pg_database("skyroute_enc", encoding=encoding) as url:
+        with pytest.raises(SkyrouteError) as err:
+            store.connect(url)
+        name = sa.engine.make_url(url).database
+        assert str(err.value) == (
+            f"url={url}: the database's encoding is {encoding}; skyroute stores text of any "
+            "language, as SQLite does: make the database in UTF8 (createdb -E UTF8 -T "
+            f"template0 {name}, or CREATE DATABASE {name} ENCODING 'UTF8' TEMPLATE "
+            "template0)")
+        assert err.value.param == "url"
+
+
+def test_postgresql_stores_any_text_as_sqlite_does(fresh_pg, engine):
+    given = [Order("ü1234567", DAY, "Zoë😀ß", "ŵ.日本.ø", ("Crème brûlée 🍮" + "x" * 85,))]
+    pg = store.connect(fresh_pg)
+    store.init(pg)
+    for e in (engine, pg):
+        assert store.import_orders(e, given) == (1, 0, ())
+        assert store.orders_between(e, DAY, DAY) == {DAY: given}
+    pg.dispose()
+
+
+def test_a_connection_the_server_ended_is_replaced_not_an_error(fresh_pg):
+    # the pool handed out a connection the server had ended (a restart, a proxy's idle
+    # timeout): the read failed ('terminating connection due to administrator command',
+    # the service's 500) until every pooled connection had failed once
+    e = store.connect(fresh_pg)
+    store.init(e)
+    with e.connect() as c:  # the one connection of the pool
+        pid = c.exec_driver_sql("select pg_backend_pid()").scalar()
+    admin = sa.create_engine(PG, isolation_level="AUTOCOMMIT")
+    with admin.connect() as c:
+        assert c.execute(sa.text("select pg_terminate_backend(:p)"), {"p": pid}).scalar()
+        for _ in range(600):  # until it has gone
+            if not c.execute(sa.text("select count(*) from pg_stat_activity where pid = :p"),
+                             {"p": pid}).scalar():
+                break
+            time.sleep(0.05)
+        else:
+            pytest.fail("the server never ended the connection")
+    admin.dispose()
+    assert store.order_dates(e) == []
+    with e.connect() as c:
+        assert c.exec_driver_sql("select pg_backend_pid()").scalar() != pid
+    e.dispose()
 
 
 @pytest.mark.parametrize("stored_before", [False, True])
