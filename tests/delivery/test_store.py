@@ -162,6 +162,32 @@ def test_a_url_with_a_bad_port_or_option_is_one_line(tmp_path, url, words):
     assert not (tmp_path / "x.db").exists()
 
 
+def test_a_server_that_never_answers_is_one_line_not_a_hang():
+    # a server (or a proxy before it) that took the connection and said nothing: libpq
+    # waited for ever, so 'db init' hung and so did each request of the service
+    import socket
+
+    with socket.socket() as silent:
+        silent.bind(("127.0.0.1", 0))
+        silent.listen(8)
+        url = f"postgresql+psycopg://u@127.0.0.1:{silent.getsockname()[1]}/db"
+        script = textwrap.dedent(f"""
+            from skyroute.delivery import store
+            from skyroute.errors import SkyrouteError
+            store.CONNECT_SECONDS = 2
+            try:
+                store.connect({url!r})
+            except SkyrouteError as exc:
+                print(exc)
+        """)
+        try:
+            out = subprocess.run([sys.executable, "-c", script], capture_output=True,
+                                 text=True, timeout=60, cwd=str(Path(__file__).parents[2]))
+        except subprocess.TimeoutExpired:
+            pytest.fail("connecting to a silent server never gave up")
+    assert out.stdout == f"url={url}: cannot connect: connection timeout expired\n", out
+
+
 def test_a_store_folder_that_cannot_be_made_is_one_line(tmp_path):
     # a file where the folder should be: the OSError of mkdir was a traceback (the CLI's
     # exit 1, the service's 500)

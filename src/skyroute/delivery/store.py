@@ -38,6 +38,10 @@ DEFAULT_DB = "sqlite:///skyroute.db"
 # error (Python's sqlite3 waits 5 s): a cron job's import or a day being stored by another
 # 'skyroute deliver'. A URL's own '?timeout=SECONDS' wins.
 BUSY_SECONDS = 30.0
+# How long connecting to a database server may take before it is an error (libpq waits
+# for ever: a server or proxy that took the connection and never answered held 'db init'
+# and every request of the service). A URL's own '?connect_timeout=SECONDS' wins.
+CONNECT_SECONDS = 10
 SQL_INT = (-2**31, 2**31 - 1)  # an INTEGER column: 32 bits on PostgreSQL, 64 on SQLite
 TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
 # The PostgreSQL advisory lock that :func:`init` holds while it makes or upgrades the
@@ -72,8 +76,9 @@ def tables(engine: sa.Engine, names: tuple[str, ...] = TABLES) -> dict[str, sa.T
 
 
 def connect(url: str = DEFAULT_DB) -> sa.Engine:
-    """An engine for ``url``; a bad URL, an unreachable server or a PostgreSQL database
-    that cannot hold every text SQLite does (:func:`_check_encoding`) is one clear error.
+    """An engine for ``url``; a bad URL, an unreachable server (one that does not answer
+    within :data:`CONNECT_SECONDS`) or a PostgreSQL database that cannot hold every
+    text SQLite does (:func:`_encoding`) is one clear error.
 
     On a server, a pooled connection is tested before each use (``pool_pre_ping``): one
     the server has ended (a restart, an idle timeout of a proxy or firewall) was handed
@@ -92,11 +97,14 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
         args: dict = {}
         if sqlite and "timeout" not in parsed.query:
             args["timeout"] = BUSY_SECONDS
-        if parsed.drivername in LIBPQ and "client_encoding" not in parsed.query:
-            # text as UTF-8 whatever the database's encoding, so that a SQL_ASCII one is
-            # read as str (the driver gave bytes: a TypeError traceback on connecting)
-            # and judged by _check_encoding
-            args["client_encoding"] = "utf8"
+        if parsed.drivername in LIBPQ:
+            if "client_encoding" not in parsed.query:
+                # text as UTF-8 whatever the database's encoding, so that a SQL_ASCII one
+                # is read as str (the driver gave bytes: a TypeError traceback on
+                # connecting) and judged by _encoding
+                args["client_encoding"] = "utf8"
+            if "connect_timeout" not in parsed.query:
+                args["connect_timeout"] = CONNECT_SECONDS
         engine = sa.create_engine(url, connect_args=args, pool_pre_ping=not sqlite)
         with engine.connect() as conn:
             encoding = _encoding(conn)
