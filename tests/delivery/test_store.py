@@ -457,6 +457,41 @@ def test_two_runs_of_one_day_at_once_on_postgresql(fresh_pg, stored_before):
     e.dispose()
 
 
+def test_a_lock_held_past_the_busy_timeout_is_busy_on_postgresql(fresh_pg, monkeypatch):
+    # a session that kept a lock the day needs (a psql session left in a transaction
+    # that touched runs, a stalled writer): the day waited for ever on PostgreSQL, where
+    # SQLite's busy timeout made it StoreBusyError
+    from skyroute.errors import StoreBusyError
+
+    monkeypatch.setattr(store, "BUSY_SECONDS", 1.0)
+    e = store.connect(fresh_pg)
+    store.init(e)
+    outcome: list = []
+
+    def write():
+        try:
+            store.write_day(e, DAY, run_row(2), [], moves(2))
+            outcome.append("written")
+        except Exception as exc:  # the test reports what it was
+            outcome.append(exc)
+
+    holder = sa.create_engine(fresh_pg)
+    with holder.connect() as h:
+        h.execute(sa.text("lock table runs in exclusive mode"))  # held to its rollback
+        writer = threading.Thread(target=write, daemon=True)
+        writer.start()
+        writer.join(60)
+        if writer.is_alive():
+            h.rollback()
+            writer.join(60)
+            pytest.fail(f"the day waited for the lock past the busy timeout ({outcome})")
+    holder.dispose()
+    assert len(outcome) == 1 and isinstance(outcome[0], StoreBusyError), outcome
+    assert "the store is busy" in str(outcome[0])
+    assert store.day_rows(e, DAY) == {"deliveries": [], "flightpath": []}
+    e.dispose()
+
+
 NEXT = DAY + dt.timedelta(1)
 DAYS = [*TWO, Order("0000000c", NEXT, "s2400003", "a.b.e", ("y",))]
 

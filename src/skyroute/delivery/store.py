@@ -34,9 +34,12 @@ from skyroute.caches import register
 from skyroute.errors import SkyrouteError, StoreBusyError, StoreSchemaError
 
 DEFAULT_DB = "sqlite:///skyroute.db"
-# How long a SQLite store waits for another process's write to finish before it is an
-# error (Python's sqlite3 waits 5 s): a cron job's import or a day being stored by another
-# 'skyroute deliver'. A URL's own '?timeout=SECONDS' wins.
+# How long a store waits for another process's write to finish before it is an error
+# (StoreBusyError): a cron job's import or a day being stored by another 'skyroute
+# deliver'. SQLite: its busy timeout (Python's sqlite3 waits 5 s), a URL's own
+# '?timeout=SECONDS' wins. PostgreSQL: the session's lock_timeout (it waited for ever,
+# e.g. behind a psql session left in a transaction), a URL's own
+# '?options=-c lock_timeout=MS' wins.
 BUSY_SECONDS = 30.0
 # How long connecting to a database server may take before it is an error (libpq waits
 # for ever: a server or proxy that took the connection and never answered held 'db init'
@@ -105,6 +108,10 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
                 args["client_encoding"] = "utf8"
             if "connect_timeout" not in parsed.query:
                 args["connect_timeout"] = CONNECT_SECONDS
+            options = str(parsed.query.get("options", ""))
+            if "lock_timeout" not in options:  # added to the URL's (connect_args win)
+                args["options"] = (f"{options} -c lock_timeout="
+                                   f"{round(BUSY_SECONDS * 1000)}").strip()
         engine = sa.create_engine(url, connect_args=args, pool_pre_ping=not sqlite)
         with engine.connect() as conn:
             encoding = _encoding(conn)
@@ -213,8 +220,14 @@ _safe = safe_url
 def is_busy(exc: BaseException) -> bool:
     """Whether ``exc`` is SQLite's "database is locked" (or "... table is locked"):
     another connection held a lock past the busy timeout, a read's too (a writer whose
-    transaction outgrew its page cache holds the lock that keeps readers out)."""
-    return isinstance(exc, sa.exc.OperationalError) and "locked" in str(exc.orig)
+    transaction outgrew its page cache holds the lock that keeps readers out); or
+    PostgreSQL's lock timeout (SQLSTATE 55P03, lock_not_available: :data:`BUSY_SECONDS`
+    waited for a lock another session held)."""
+    if not isinstance(exc, sa.exc.OperationalError):
+        return False
+    orig = exc.orig
+    code = getattr(orig, "sqlstate", None) or getattr(orig, "pgcode", None)
+    return code == "55P03" or (code is None and "locked" in str(orig))
 
 
 @contextmanager
