@@ -146,15 +146,18 @@ PG = os.environ.get("SKYROUTE_TEST_PG", "postgresql+psycopg://postgres@127.0.0.1
 
 
 @contextlib.contextmanager
-def new_pg_database(prefix: str):
+def new_pg_database(prefix: str, *, encoding: str | None = None):
     """The URL of a new, empty PostgreSQL database named ``prefix`` and a random suffix,
-    dropped on leaving (a skip when no server answers, unless $CI is set)."""
+    dropped on leaving (a skip when no server answers, unless $CI is set); ``encoding``:
+    made in that encoding (from template0, C locale) instead of the server's default."""
     base = sa.engine.make_url(PG)
     name = f"{prefix}_{uuid.uuid4().hex[:12]}"
+    made_in = (f" encoding '{encoding}' template template0 lc_collate 'C' lc_ctype 'C'"
+               if encoding else "")
     try:
         admin = sa.create_engine(base, isolation_level="AUTOCOMMIT")
         with admin.connect() as c:
-            c.execute(sa.text(f"create database {name}"))
+            c.execute(sa.text(f"create database {name}{made_in}"))
     except sa.exc.OperationalError:
         if os.environ.get("CI"):
             raise

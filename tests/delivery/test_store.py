@@ -18,6 +18,7 @@ import sqlalchemy as sa
 from skyroute.delivery import store
 from skyroute.delivery.orders import Order
 from skyroute.errors import SkyrouteError
+from tests.conftest import PG, new_pg_database
 
 DAY = dt.date(2024, 1, 1)
 COLUMNS = {
@@ -137,6 +138,54 @@ def test_bad_urls_are_one_line_errors(tmp_path):
     e = store.connect(f"sqlite:///{tmp_path / 'empty.db'}")
     with pytest.raises(SkyrouteError, match="skyroute db init"):
         store.orders_between(e, DAY, DAY)
+
+
+@pytest.mark.parametrize("url, words", [
+    # SQLAlchemy reads the port with int(): a ValueError traceback
+    ("postgresql+psycopg://u:sekret@127.0.0.1:54x2/db", "not a database URL: its port is "
+     "not a number"),
+    ("postgresql+psycopg://u:sekret@[::1:5432/db", "not a database URL: its port is not a "
+     "number"),
+    # the driver's own refusals of an option: a ValueError traceback (SQLite) and "the
+    # store's database failed" (psycopg's ProgrammingError), which named no URL
+    ("sqlite:///{tmp}/x.db?timeout=soon", "cannot connect: a bad option value in the URL "
+     "(could not convert string to float: 'soon')"),
+    ("postgresql+psycopg://u:sekret@127.0.0.1:1/db?nosuch=1", "cannot connect: invalid "
+     'connection option "nosuch"'),
+])
+def test_a_url_with_a_bad_port_or_option_is_one_line(tmp_path, url, words):
+    with pytest.raises(SkyrouteError) as err:
+        store.connect(url.format(tmp=tmp_path))
+    msg = str(err.value)
+    assert words in msg and err.value.param == "url", msg
+    assert "sekret" not in msg and "\n" not in msg
+    assert not (tmp_path / "x.db").exists()
+
+
+def test_a_server_that_never_answers_is_one_line_not_a_hang():
+    # a server (or a proxy before it) that took the connection and said nothing: libpq
+    # waited for ever, so 'db init' hung and so did each request of the service
+    import socket
+
+    with socket.socket() as silent:
+        silent.bind(("127.0.0.1", 0))
+        silent.listen(8)
+        url = f"postgresql+psycopg://u@127.0.0.1:{silent.getsockname()[1]}/db"
+        script = textwrap.dedent(f"""
+            from skyroute.delivery import store
+            from skyroute.errors import SkyrouteError
+            store.CONNECT_SECONDS = 2
+            try:
+                store.connect({url!r})
+            except SkyrouteError as exc:
+                print(exc)
+        """)
+        try:
+            out = subprocess.run([sys.executable, "-c", script], capture_output=True,
+                                 text=True, timeout=60, cwd=str(Path(__file__).parents[2]))
+        except subprocess.TimeoutExpired:
+            pytest.fail("connecting to a silent server never gave up")
+    assert out.stdout == f"url={url}: cannot connect: connection timeout expired\n", out
 
 
 def test_a_store_folder_that_cannot_be_made_is_one_line(tmp_path):
@@ -310,6 +359,57 @@ def test_a_new_postgresql_store_made_by_two_runs_at_once(fresh_pg):
     assert [(out, rc) for (out, _), rc in done] == [("0006\n", 0)] * 4, done
 
 
+@pytest.mark.parametrize("encoding", ["SQL_ASCII", "LATIN1"])
+def test_a_postgresql_database_not_in_utf8_is_refused_in_one_line(encoding):
+    # SQL_ASCII: a TypeError traceback on connecting (the driver read text as bytes);
+    # LATIN1: connected, then an order of 'Zoë😀' was a UnicodeEncodeError traceback
+    with new_pg_database("skyroute_enc", encoding=encoding) as url:
+        with pytest.raises(SkyrouteError) as err:
+            store.connect(url)
+        name = sa.engine.make_url(url).database
+        assert str(err.value) == (
+            f"url={url}: the database's encoding is {encoding}; skyroute stores text of any "
+            "language, as SQLite does: make the database in UTF8 (createdb -E UTF8 -T "
+            f"template0 {name}, or CREATE DATABASE {name} ENCODING 'UTF8' TEMPLATE "
+            "template0)")
+        assert err.value.param == "url"
+
+
+def test_postgresql_stores_any_text_as_sqlite_does(fresh_pg, engine):
+    given = [Order("ü1234567", DAY, "Zoë😀ß", "ŵ.日本.ø", ("Crème brûlée 🍮" + "x" * 85,))]
+    pg = store.connect(fresh_pg)
+    store.init(pg)
+    for e in (engine, pg):
+        assert store.import_orders(e, given) == (1, 0, ())
+        assert store.orders_between(e, DAY, DAY) == {DAY: given}
+    pg.dispose()
+
+
+def test_a_connection_the_server_ended_is_replaced_not_an_error(fresh_pg):
+    # the pool handed out a connection the server had ended (a restart, a proxy's idle
+    # timeout): the read failed ('terminating connection due to administrator command',
+    # the service's 500) until every pooled connection had failed once
+    e = store.connect(fresh_pg)
+    store.init(e)
+    with e.connect() as c:  # the one connection of the pool
+        pid = c.exec_driver_sql("select pg_backend_pid()").scalar()
+    admin = sa.create_engine(PG, isolation_level="AUTOCOMMIT")
+    with admin.connect() as c:
+        assert c.execute(sa.text("select pg_terminate_backend(:p)"), {"p": pid}).scalar()
+        for _ in range(600):  # until it has gone
+            if not c.execute(sa.text("select count(*) from pg_stat_activity where pid = :p"),
+                             {"p": pid}).scalar():
+                break
+            time.sleep(0.05)
+        else:
+            pytest.fail("the server never ended the connection")
+    admin.dispose()
+    assert store.order_dates(e) == []
+    with e.connect() as c:
+        assert c.exec_driver_sql("select pg_backend_pid()").scalar() != pid
+    e.dispose()
+
+
 @pytest.mark.parametrize("stored_before", [False, True])
 def test_two_runs_of_one_day_at_once_on_postgresql(fresh_pg, stored_before):
     # the later writer's insert of the run was an IntegrityError ('duplicate key value
@@ -354,6 +454,41 @@ def test_two_runs_of_one_day_at_once_on_postgresql(fresh_pg, stored_before):
         assert c.execute(sa.text("select moves from runs")).all() == [(4,)]
     assert {r[2] for r in store.day_rows(e, DAY)["flightpath"]} == {"second00"}
     assert len(store.day_rows(e, DAY)["flightpath"]) == 4
+    e.dispose()
+
+
+def test_a_lock_held_past_the_busy_timeout_is_busy_on_postgresql(fresh_pg, monkeypatch):
+    # a session that kept a lock the day needs (a psql session left in a transaction
+    # that touched runs, a stalled writer): the day waited for ever on PostgreSQL, where
+    # SQLite's busy timeout made it StoreBusyError
+    from skyroute.errors import StoreBusyError
+
+    monkeypatch.setattr(store, "BUSY_SECONDS", 1.0)
+    e = store.connect(fresh_pg)
+    store.init(e)
+    outcome: list = []
+
+    def write():
+        try:
+            store.write_day(e, DAY, run_row(2), [], moves(2))
+            outcome.append("written")
+        except Exception as exc:  # the test reports what it was
+            outcome.append(exc)
+
+    holder = sa.create_engine(fresh_pg)
+    with holder.connect() as h:
+        h.execute(sa.text("lock table runs in exclusive mode"))  # held to its rollback
+        writer = threading.Thread(target=write, daemon=True)
+        writer.start()
+        writer.join(60)
+        if writer.is_alive():
+            h.rollback()
+            writer.join(60)
+            pytest.fail(f"the day waited for the lock past the busy timeout ({outcome})")
+    holder.dispose()
+    assert len(outcome) == 1 and isinstance(outcome[0], StoreBusyError), outcome
+    assert "the store is busy" in str(outcome[0])
+    assert store.day_rows(e, DAY) == {"deliveries": [], "flightpath": []}
     e.dispose()
 
 

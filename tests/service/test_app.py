@@ -183,6 +183,33 @@ def test_making_an_app_connects_to_nothing(tmp_path, caplog):
     assert not any(":pw@" in m for m in logged)
 
 
+def test_a_store_lost_after_it_was_opened_is_a_503(fresh_pg, caplog):
+    """The store's database gone under the running server (its server down or
+    restarting, the database dropped) was a 500 'internal error' and a traceback in the
+    log at every request; it is the 503 the docs promise ("the store ... cannot be
+    reached"), with Retry-After, and one line in the log."""
+    import sqlalchemy as sa
+
+    from tests.conftest import PG
+
+    with make_client(db_url=fresh_pg) as c:
+        assert c.get("/days").status_code == 200  # the store opened, a connection pooled
+        admin = sa.create_engine(PG, isolation_level="AUTOCOMMIT")
+        name = sa.engine.make_url(fresh_pg).database
+        with admin.connect() as a:
+            a.execute(sa.text(f"drop database {name} with (force)"))
+        admin.dispose()
+        caplog.clear()
+        for _ in range(2):  # the pooled connection, then a new one: both refused
+            r = c.get("/days")
+            doc = assert_problem(r, 503, words="the store cannot be reached")
+            assert doc["type"] == "urn:skyroute:problem:store-unavailable"
+            assert r.headers["retry-after"] == "10" and name not in r.text
+    logged = [r for r in caplog.records if r.name == "skyroute.service"]
+    assert logged and all(r.exc_info is None for r in logged), logged
+    assert f'database "{name}" does not exist' in logged[-1].getMessage()
+
+
 def test_a_503_names_no_path_of_the_server(tmp_path, caplog):
     """A store or delivery site that cannot be opened was a 503 whose detail named the
     store's file (``url=sqlite:////srv/...``) or the site's folder: where the server

@@ -316,6 +316,12 @@ RINGED = ringed()
      "no cruise can join airports C and A: zones 'west', 'east' close a ring round C"),
     ("/jobs/fleet", {"scenario": {"packages": [1]}}, "scenario.packages",
      "expected a mapping"),
+    # ran on SQLite; on PostgreSQL the run was flown, then not stored: a raw SQL error
+    ("/jobs/fleet", {"scenario": {**SEED3, "name": "Zoë\x00"}}, "scenario.name",
+     "'Zoë\\x00' holds a NUL character, which a PostgreSQL store cannot keep"),
+    ("/jobs/fleet", {"scenario": {**SEED3, "airports": [
+        {**SEED3["airports"][0], "id": "A\x00"}, *SEED3["airports"][1:]]}},
+     "scenario.airports[0].id", "holds a NUL character"),
 ])
 def test_bad_job_input_is_422(site_client, fake, path, body, field, words):
     assert_problem(site_client.post(path, json=body, headers=AUTH), 422, field, words)

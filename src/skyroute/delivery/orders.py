@@ -89,6 +89,11 @@ def _rows(path: Path, header: list[str]):
             raise InputFormatError(path, f"expected {len(header)} non-empty fields "
                                    f"({', '.join(header)}), found {row!r}",
                                    line=reader.line_num)
+        for name, v in zip(header, row, strict=True):
+            if "\0" in v:  # SQLite stored it, PostgreSQL refused the whole import
+                raise InputFormatError(path, f"{name} {v.strip()!r} holds a NUL character, "
+                                       "which a PostgreSQL store cannot keep",
+                                       line=reader.line_num)
         yield reader.line_num, [v.strip() for v in row]
 
 

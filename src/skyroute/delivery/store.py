@@ -34,10 +34,17 @@ from skyroute.caches import register
 from skyroute.errors import SkyrouteError, StoreBusyError, StoreSchemaError
 
 DEFAULT_DB = "sqlite:///skyroute.db"
-# How long a SQLite store waits for another process's write to finish before it is an
-# error (Python's sqlite3 waits 5 s): a cron job's import or a day being stored by another
-# 'skyroute deliver'. A URL's own '?timeout=SECONDS' wins.
+# How long a store waits for another process's write to finish before it is an error
+# (StoreBusyError): a cron job's import or a day being stored by another 'skyroute
+# deliver'. SQLite: its busy timeout (Python's sqlite3 waits 5 s), a URL's own
+# '?timeout=SECONDS' wins. PostgreSQL: the session's lock_timeout (it waited for ever,
+# e.g. behind a psql session left in a transaction), a URL's own
+# '?options=-c lock_timeout=MS' wins.
 BUSY_SECONDS = 30.0
+# How long connecting to a database server may take before it is an error (libpq waits
+# for ever: a server or proxy that took the connection and never answered held 'db init'
+# and every request of the service). A URL's own '?connect_timeout=SECONDS' wins.
+CONNECT_SECONDS = 10
 SQL_INT = (-2**31, 2**31 - 1)  # an INTEGER column: 32 bits on PostgreSQL, 64 on SQLite
 TABLES = ("orders", "order_details", "deliveries", "flightpath", "runs")
 # The PostgreSQL advisory lock that :func:`init` holds while it makes or upgrades the
@@ -72,9 +79,16 @@ def tables(engine: sa.Engine, names: tuple[str, ...] = TABLES) -> dict[str, sa.T
 
 
 def connect(url: str = DEFAULT_DB) -> sa.Engine:
-    """An engine for ``url``; a bad URL or an unreachable server is one clear error."""
+    """An engine for ``url``; a bad URL, an unreachable server (one that does not answer
+    within :data:`CONNECT_SECONDS`) or a PostgreSQL database that cannot hold every
+    text SQLite does (:func:`_encoding`) is one clear error.
+
+    On a server, a pooled connection is tested before each use (``pool_pre_ping``): one
+    the server has ended (a restart, an idle timeout of a proxy or firewall) was handed
+    out as it was, and the read or day on it failed ("terminating connection due to
+    administrator command": the service's 500) until the pool had dropped each."""
+    parsed = _parse(url)
     try:
-        parsed = sa.engine.make_url(url)
         sqlite = parsed.drivername.startswith("sqlite")
         if sqlite and parsed.database not in (None, "", ":memory:"):
             folder = Path(parsed.database).parent
@@ -83,25 +97,80 @@ def connect(url: str = DEFAULT_DB) -> sa.Engine:
             except OSError as exc:  # a file in the way, no such place, no permission
                 raise SkyrouteError(f"url={_safe(url)}: cannot make the store's folder "
                                     f"{folder}: {exc.strerror or exc}", param="url") from None
-        busy = {"timeout": BUSY_SECONDS} if sqlite and "timeout" not in parsed.query else {}
-        engine = sa.create_engine(url, connect_args=busy)
-        with engine.connect():
-            pass
+        args: dict = {}
+        if sqlite and "timeout" not in parsed.query:
+            args["timeout"] = BUSY_SECONDS
+        if parsed.drivername in LIBPQ:
+            if "client_encoding" not in parsed.query:
+                # text as UTF-8 whatever the database's encoding, so that a SQL_ASCII one
+                # is read as str (the driver gave bytes: a TypeError traceback on
+                # connecting) and judged by _encoding
+                args["client_encoding"] = "utf8"
+            if "connect_timeout" not in parsed.query:
+                args["connect_timeout"] = CONNECT_SECONDS
+            options = str(parsed.query.get("options", ""))
+            if "lock_timeout" not in options:  # added to the URL's (connect_args win)
+                args["options"] = (f"{options} -c lock_timeout="
+                                   f"{round(BUSY_SECONDS * 1000)}").strip()
+        engine = sa.create_engine(url, connect_args=args, pool_pre_ping=not sqlite)
+        with engine.connect() as conn:
+            encoding = _encoding(conn)
     except sa.exc.NoSuchModuleError:  # a URL, of a kind or a driver SQLAlchemy does not know
-        raise SkyrouteError(f"url={_safe(url)!r}: {_unknown_kind(url)} (e.g. "
-                            "sqlite:///skyroute.db or postgresql+psycopg://user@"
-                            "127.0.0.1:5432/test)", param="url") from None
-    except sa.exc.ArgumentError:
-        raise SkyrouteError(f"url={_safe(url)!r}: not a database URL (e.g. "
-                            "sqlite:///skyroute.db or postgresql+psycopg://user@127.0.0.1:5432/"
-                            "test)", param="url") from None
-    except (sa.exc.OperationalError, sa.exc.InterfaceError) as exc:
+        raise SkyrouteError(f"url={_safe(url)!r}: {_unknown_kind(url)} ({EXAMPLE_URLS})",
+                            param="url") from None
+    except sa.exc.ArgumentError:  # one the dialect refuses: sqlite://user@/x.db
+        raise SkyrouteError(f"url={_safe(url)!r}: not a database URL ({EXAMPLE_URLS})",
+                            param="url") from None
+    except sa.exc.DBAPIError as exc:  # refused, no such database or role, a bad option
         raise SkyrouteError(f"url={_safe(url)}: cannot connect: "
                             f"{str(exc.orig).strip().splitlines()[0]}", param="url") from None
+    except ValueError as exc:  # an option's value the driver cannot read: ?timeout=abc
+        raise SkyrouteError(f"url={_safe(url)}: cannot connect: a bad option value in the "
+                            f"URL ({exc})", param="url") from None
     except ModuleNotFoundError as exc:
         raise SkyrouteError(f"url={_safe(url)}: driver {exc.name!r} is not installed",
                             param="url") from None
+    if encoding not in (None, "UTF8"):
+        engine.dispose()
+        raise SkyrouteError(f"url={_safe(url)}: the database's encoding is {encoding}; "
+                            "skyroute stores text of any language, as SQLite does: make "
+                            f"the database in UTF8 (createdb -E UTF8 -T template0 "
+                            f"{parsed.database}, or CREATE DATABASE {parsed.database} "
+                            "ENCODING 'UTF8' TEMPLATE template0)", param="url")
     return engine
+
+
+EXAMPLE_URLS = "e.g. sqlite:///skyroute.db or postgresql+psycopg://user@127.0.0.1:5432/test"
+
+
+def _parse(url: str) -> sa.engine.URL:
+    """``url`` parsed, or a SkyrouteError: not a URL, or a port that is not a number
+    (SQLAlchemy reads it with int(): a ValueError traceback for ':5432x', '[::1:5432')."""
+    try:
+        return sa.engine.make_url(url)
+    except ValueError:
+        why = "its port is not a number"
+    except sa.exc.ArgumentError:
+        why = None
+    raise SkyrouteError(f"url={_safe(url)!r}: not a database URL" +
+                        (f": {why}" if why else "") + f" ({EXAMPLE_URLS})", param="url")
+
+
+# SQLAlchemy's PostgreSQL drivers over libpq, which take libpq's client_encoding
+LIBPQ = ("postgresql", "postgresql+psycopg", "postgresql+psycopg2",
+         "postgresql+psycopg2cffi")
+
+
+def _encoding(conn: sa.Connection) -> str | None:
+    """A PostgreSQL database's encoding (``UTF8``, ``LATIN1``, ...; None on another
+    kind of store). :func:`connect` refuses any but UTF8: SQLite holds any text, and a
+    store on a server must hold what it does. A LATIN1 database refused an order whose
+    text it has no letter for ('Zoë😀': a UnicodeEncodeError traceback), and SQL_ASCII
+    counted a ``String(8)`` in bytes ('Zoë😀ß' is 5 letters and 9 bytes: refused) and
+    could not be connected to without the client encoding :func:`connect` sets."""
+    if conn.dialect.name != "postgresql":
+        return None
+    return str(conn.exec_driver_sql("show server_encoding").scalar()).upper()
 
 
 def exists(url: str) -> bool:
@@ -111,7 +180,7 @@ def exists(url: str) -> bool:
     of :func:`connect`."""
     try:
         parsed = sa.engine.make_url(url)
-    except sa.exc.ArgumentError:
+    except (sa.exc.ArgumentError, ValueError):  # connect() says what is wrong
         parsed = None
     if parsed is not None and parsed.drivername.startswith("sqlite"):
         db = parsed.database
@@ -139,7 +208,7 @@ def safe_url(url: str) -> str:
     SQLAlchemy cannot parse, whose ``user:password@`` is masked as text)."""
     try:
         return sa.engine.make_url(url).render_as_string(hide_password=True)
-    except sa.exc.ArgumentError:
+    except (sa.exc.ArgumentError, ValueError):  # ValueError: a port that is no number
         import re
 
         return re.sub(r"(://[^:/@]*:)[^@/]*@", r"\1***@", str(url))
@@ -151,8 +220,14 @@ _safe = safe_url
 def is_busy(exc: BaseException) -> bool:
     """Whether ``exc`` is SQLite's "database is locked" (or "... table is locked"):
     another connection held a lock past the busy timeout, a read's too (a writer whose
-    transaction outgrew its page cache holds the lock that keeps readers out)."""
-    return isinstance(exc, sa.exc.OperationalError) and "locked" in str(exc.orig)
+    transaction outgrew its page cache holds the lock that keeps readers out); or
+    PostgreSQL's lock timeout (SQLSTATE 55P03, lock_not_available: :data:`BUSY_SECONDS`
+    waited for a lock another session held)."""
+    if not isinstance(exc, sa.exc.OperationalError):
+        return False
+    orig = exc.orig
+    code = getattr(orig, "sqlstate", None) or getattr(orig, "pgcode", None)
+    return code == "55P03" or (code is None and "locked" in str(orig))
 
 
 @contextmanager

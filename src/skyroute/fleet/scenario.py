@@ -80,6 +80,17 @@ class _Strict(BaseModel):
                              "off, true and false as booleans)")
         return v
 
+    @field_validator("*", mode="after")
+    @classmethod
+    def _no_nul(cls, v):
+        # a name with a NUL character ran on SQLite; on PostgreSQL the service's job flew
+        # the whole run and then failed to store it ('PostgreSQL text fields cannot
+        # contain NUL (0x00) bytes'), a raw SQL error as the job's error
+        if isinstance(v, str) and "\0" in v:
+            raise ValueError(f"{v!r} holds a NUL character, which a PostgreSQL store "
+                             "cannot keep")
+        return v
+
 
 def _first_bool(v) -> bool | None:
     """The first boolean in ``v`` or in its (nested) lists, or None."""

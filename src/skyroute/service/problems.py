@@ -291,12 +291,32 @@ async def _schema(request: Request, exc: StoreSchemaError) -> FiniteJSONResponse
                             "server's log says why", kind="store-unavailable")
 
 
-async def _database(request: Request, exc: Exception) -> FiniteJSONResponse:
+UNREACHABLE_RETRY_SECONDS = 10  # a lost server's Retry-After: a restart takes seconds
+
+
+async def _database(request: Request, exc: OperationalError) -> FiniteJSONResponse:
     """A database error the store let through: a read of a locked SQLite store is
-    :func:`_busy`'s 503, anything else the 500 of :func:`_internal`."""
+    :func:`_busy`'s 503; the store's server lost (:func:`lost`) a 503
+    ``store-unavailable`` with ``Retry-After``, the driver's reason in the log in one
+    line; anything else the 500 of :func:`_internal`."""
     if is_busy(exc):
         return await _busy(request, exc)
+    if lost(exc):
+        log.warning("%s %s: the store cannot be reached: %s", request.method,
+                    request.url.path, (str(exc.orig).strip().splitlines() or ["?"])[0])
+        return problem_response(503, "the store cannot be reached; the server's log says "
+                                "why; try again later", kind="store-unavailable",
+                                headers={"Retry-After": str(UNREACHABLE_RETRY_SECONDS)})
     return await _internal(request, exc)
+
+
+def lost(exc: OperationalError) -> bool:
+    """Whether ``exc`` is a store that cannot be reached after the server opened it: no
+    connection could be made (no statement: the database server down or restarting,
+    the database dropped), or one was lost in a statement (SQLAlchemy marks it
+    invalidated). The server's condition, and often a passing one; it was a 500 whose
+    traceback filled the log at every request."""
+    return exc.connection_invalidated or exc.statement is None
 
 
 async def _internal(request: Request, exc: Exception) -> FiniteJSONResponse:
