@@ -52,9 +52,20 @@ def _indexed(zones: tuple[tuple[str, tuple[tuple[float, float], ...]], ...]):
     return [n for n, _ in zones], polys, shapely.STRtree(polys)
 
 
+_LAST: tuple = (None, None)  # (a scenario's list of zones, its index)
+
+
 def _zone_index(scenario):
-    return _indexed(tuple((z.name, tuple(map(tuple, z.points)))
-                          for z in scenario.no_fly_zones))
+    """:func:`_indexed` of the scenario's zones; the last list's is kept by identity, as
+    the cache's key (every corner) took a millisecond to build for 1000 zones, each
+    check."""
+    global _LAST
+    zones = scenario.no_fly_zones
+    last, index = _LAST  # one read: another thread may replace it
+    if last is not zones:
+        index = _indexed(tuple((z.name, tuple(map(tuple, z.points))) for z in zones))
+        _LAST = (zones, index)  # holding the list keeps its id from being reused
+    return index
 
 
 def crossed(scenario, geometry) -> str | None:
