@@ -211,3 +211,32 @@ def test_written_together_is_all_or_none_whichever_rename_fails(tmp_path_factory
             assert fail_at >= len(existed)
             expected = {f"f{k}": f"new {k}" for k in range(len(existed))}
     assert {p.name: p.read_text() for p in here.iterdir()} == expected
+
+
+def test_remove_atomic_goes_with_the_renames_or_not_at_all(tmp_path, monkeypatch):
+    import skyroute.files as files
+    from skyroute.errors import SkyrouteError
+
+    (tmp_path / "old.png").write_text("an earlier run's")
+    with monkeypatch.context() as m:  # the second rename fails: nothing changes
+        failing_rename(m, 2)
+        with pytest.raises(SkyrouteError), files.written_together():
+            files.write_atomic(tmp_path / "a.txt", "new a")
+            files.remove_atomic(tmp_path / "old.png")
+            files.write_atomic(tmp_path / "b.txt", "new b")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["old.png"]
+    assert (tmp_path / "old.png").read_text() == "an earlier run's"
+    with pytest.raises(KeyboardInterrupt), files.written_together():  # an error in it
+        files.remove_atomic(tmp_path / "old.png")
+        raise KeyboardInterrupt
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["old.png"]
+    with files.written_together():
+        files.write_atomic(tmp_path / "a.txt", "new a")
+        files.remove_atomic(tmp_path / "old.png")
+        files.remove_atomic(tmp_path / "never.png")  # not there: nothing to do
+        files.write_atomic(tmp_path / "c.txt", "written, then removed")
+        files.remove_atomic(tmp_path / "c.txt")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt"]
+    files.write_atomic(tmp_path / "d.txt", "d")
+    files.remove_atomic(tmp_path / "d.txt")  # outside a block: now
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt"]

@@ -70,7 +70,8 @@ class Together:
     place, the folders made for it) and the transactions it ends (:meth:`enter`)."""
 
     def __init__(self) -> None:
-        self.staged: list[tuple[str, Path, list[Path]]] = []
+        # tmp "" a write that failed, None a file to remove (remove_atomic)
+        self.staged: list[tuple[str | None, Path, list[Path]]] = []
         self.ends = ExitStack()
 
     def enter(self, transaction: AbstractContextManager[T]) -> T:
@@ -176,12 +177,14 @@ def _rename_all(together: Together) -> None:
         with _signals_held():
             for tmp, path, _ in staged:
                 failed = path
-                if tmp and os.path.lexists(path):
+                if (tmp or tmp is None) and os.path.lexists(path):
                     backups[path] = _backup(path)
             for tmp, path, _ in staged:
                 failed = path
                 if tmp:
                     os.replace(tmp, path)
+                elif tmp is None and path in backups:  # removed (its backup kept)
+                    os.unlink(path)
                 done += 1
             failed = None
             together.ends.close()  # commit (a failure rolls back what is left, and raises)
@@ -223,8 +226,8 @@ def _put_back(renamed: list[tuple[str, Path, list[Path]]], backups: dict[Path, s
     taken off ``backups``), a file that was new removed. A backup that cannot be put
     back is left beside its file (the earlier version is not lost)."""
     for tmp, path, _ in renamed:
-        if not tmp:
-            continue
+        if not tmp and not (tmp is None and path in backups):
+            continue  # a failed write, or a removal of a file that was not there
         with suppress(OSError):
             if path in backups:
                 os.replace(backups.pop(path), path)
@@ -255,7 +258,7 @@ def _signals_held() -> Iterator[None]:
             signal.raise_signal(sig)
 
 
-def _stage(staged: list, tmp: str, path: Path, made: list[Path]) -> None:
+def _stage(staged: list, tmp: str | None, path: Path, made: list[Path]) -> None:
     """Add ``tmp`` to be renamed to ``path``; a file staged for ``path`` before (written
     twice in one block) is dropped: the later one wins, as it would have."""
     for k, (old, place, _) in enumerate(staged):
@@ -285,6 +288,19 @@ def _discard(staged: list) -> None:
                          key=lambda f: len(f.parts), reverse=True):
         with suppress(OSError):  # not empty (another writer's file), or gone
             folder.rmdir()
+
+
+def remove_atomic(path: str | Path) -> None:
+    """Remove the file ``path`` when the :func:`written_together` block ends, with its
+    renames, or not at all (kept when the block fails); outside a block, now. A file
+    an earlier run left beside the ones a block writes (a fleet run's maps, not drawn
+    this time) would otherwise be read as this run's."""
+    path = Path(path)
+    together = _TOGETHER.get()
+    if together is None:
+        path.unlink(missing_ok=True)
+        return
+    _stage(together.staged, None, path, [])
 
 
 def write_atomic(path: str | Path, data: bytes | str) -> Path:

@@ -162,11 +162,11 @@ def _scenario_file(tmp_path, edit) -> str:
 
 
 @pytest.mark.parametrize("args, words", [
-    # a scenario file past a limit: named by file and field
-    (["{drones}"], "big.yaml: drones: 1e+09 drones is over the limit of 1,000"),
-    (["{rate}"], "big.yaml: packages.rate_per_hour: 1e+12 packages per hour is over the "
+    # a scenario file past a limit: named by file, line and field
+    (["{drones}"], "big.yaml:38: drones: 1e+09 drones is over the limit of 1,000"),
+    (["{rate}"], "big.yaml:51: packages.rate_per_hour: 1e+12 packages per hour is over the "
                  "limit of 100,000"),
-    (["{far}"], "big.yaml: airports[2].north: 1e+12 m from home is over the limit of "
+    (["{far}"], "big.yaml:28: airports[2].north: 1e+12 m from home is over the limit of "
                 "100,000 m"),
     # options past a limit
     (["--preset", "seed-3x3", "--hours", "1e9"], "--hours 1e+09 is over the limit of 168"),

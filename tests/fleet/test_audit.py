@@ -99,6 +99,73 @@ def test_small_fleets_keep_every_rule_the_audit_checks(tmp_path_factory, case):
     assert rep["lost"] == numbers["lost"] == 0
 
 
+@st.composite
+def rules(draw):
+    """A generated layout with other airspace and airport rules than the defaults:
+    separation minima, layers closer than the vertical minimum (each layer is then no
+    slice of its own and only the reservations keep drones apart), several shared
+    levels, no hand-over time (a drone leaves by the other gate the instant it
+    arrived), an airport's gates placed farther apart, and small no-fly zones. (Gates
+    placed on a take-off runway's line are left out: ground movements are not
+    deconflicted beyond the bookings, docs/fleet.md says, and the audit flags a drone
+    taxiing from such a gate while another uses the runway.)"""
+    airports = draw(st.integers(2, 4))
+    s = generate(airports, draw(st.integers(1, 6)), area_km=draw(st.floats(2.5, 5.0)),
+                 seed=draw(st.integers(0, 10_000)))
+    data = yaml.safe_load(to_yaml(s))
+    data["airspace"].update(
+        sep_horizontal=draw(st.sampled_from([20.0, 50.0, 120.0, 300.0])),
+        sep_vertical=draw(st.sampled_from([5.0, 10.0, 15.0, 30.0])),
+        layer_step=draw(st.sampled_from([3.0, 7.5, 10.0, 20.0])),
+        shared_levels=draw(st.integers(1, 6)))
+    data["handover_seconds"] = draw(st.sampled_from([0.0, 15.0, 60.0]))
+    if draw(st.booleans()):  # farther apart than gate_width, off the take-off runway
+        a = data["airports"][0]
+        h, gap = math.radians(a["takeoff"]["heading_deg"]), draw(st.floats(30.0, 120.0))
+        a["gates"] = [[a["north"] - k * gap / 2 * math.sin(h), a["east"] + k * gap / 2 *
+                       math.cos(h)] for k in (-1, 1)]
+    zones = []
+    for k in range(draw(st.integers(0, 2))):
+        n, e = draw(st.floats(-2500, 2500)), draw(st.floats(-2500, 2500))
+        h, w = draw(st.floats(20, 300)), draw(st.floats(20, 300))
+        zones.append({"name": f"z{k}", "points": [[n, e], [n + h, e], [n + h, e + w],
+                                                   [n, e + w]]})
+    data["no_fly_zones"] = zones
+    return (data, draw(st.sampled_from([30.0, 90.0, 200.0])), draw(st.integers(0, 1000)),
+            draw(st.sampled_from(["seed", "optimal"])),
+            draw(st.sampled_from(["layers", "shared"])))
+
+
+@settings(max_examples=25, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture,
+                                 HealthCheck.too_slow])
+@given(case=rules())
+def test_fleets_under_other_rules_keep_every_rule_the_audit_checks(tmp_path_factory, case):
+    from skyroute.errors import SkyrouteError
+    from skyroute.fleet.report import report
+    from skyroute.fleet.scenario import parse_scenario
+    from skyroute.fleet.simulate import run
+    from skyroute.io.fleet_out import write_run
+
+    data, rate, seed, scheduler, airspace = case
+    try:
+        s = parse_scenario(data)
+        sim = run(s, hours=0.3, seed=seed, scheduler=scheduler, airspace=airspace,
+                  rate_per_hour=rate)
+    except SkyrouteError:  # gates too close, a zone over a runway or in a final's way
+        s = parse_scenario({**data, "no_fly_zones": [], "airports": [
+            {**a, "gates": None} for a in data["airports"]]})
+        sim = run(s, hours=0.3, seed=seed, scheduler=scheduler, airspace=airspace,
+                  rate_per_hour=rate)
+    rep = report(sim)
+    d = tmp_path_factory.mktemp("rules")
+    write_run(sim, rep, d)
+    problems, numbers = audit(d, s)
+    assert problems == []
+    assert rep["conflicts"] == 0 and rep["lost"] == numbers["lost"] == 0
+    assert numbers["delivered"] == rep["delivered"]
+
+
 # ------------------------------------------------------------- the audit can fail
 
 @pytest.fixture(scope="module")

@@ -350,3 +350,23 @@ def test_durations_read_in_their_unit():
 
     assert [_duration(s) for s in (30, 240, 720, 8640, 86400)] == [
         "30 s", "4 min", "12 min", "2.4 h", "24 h"]
+
+
+def test_a_run_without_plots_removes_an_earlier_runs_maps(sim, rep, tmp_path, monkeypatch):
+    # a folder written with --plot, then again without: map.png and timeline.png of the
+    # first run stayed beside the second run's files, read as its maps
+    from tests.rename_failures import failing_rename
+
+    write_run(sim, rep, tmp_path, track_step=5.0, plot=True)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    # a rename that fails (a full disk) leaves the folder as it was, maps included
+    with monkeypatch.context() as m:
+        failing_rename(m, 3)
+        with pytest.raises(SkyrouteError, match="No space left on device"):
+            write_run(sim, {**rep, "offered": -1}, tmp_path, track_step=5.0)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    write_run(sim, rep, tmp_path, track_step=5.0)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(FILES)
+    (tmp_path / "map.png").mkdir()  # not a file a run wrote: left alone
+    write_run(sim, rep, tmp_path, track_step=5.0)
+    assert (tmp_path / "map.png").is_dir()

@@ -286,3 +286,85 @@ def test_a_cruise_search_out_of_budget_says_so_not_that_none_exists(monkeypatch)
         "2000 E) ran out of its budget (10 expansions): it found none, nor showed that "
         "none exists")
     assert err.value.param == "no_fly_zones"
+
+
+def _masts_at(name: str, airport: int, altitude: float):
+    """Preset ``name`` with two small zones at the far side of both loiter circles of
+    ``airport`` at ``altitude`` only (a lower level's circles, 95 m nearer the runway
+    per 10 m, stay clear of them), and the data of that scenario."""
+    import yaml
+
+    from skyroute.fleet.scenario import runway_ends, to_yaml
+
+    s = preset(name)
+    a = s.airports[airport]
+    thr, _ = runway_ends(a, a.landing)
+    psi = math.radians(a.landing.heading_deg)
+    u = np.array([math.cos(psi), math.sin(psi)])
+    gate = thr - altitude / math.tan(math.radians(s.drone.glide_angle_deg)) * u
+    r = s.drone.turn_radius
+    zones = []
+    for k, side in enumerate((1, -1)):
+        n, e = (float(x) for x in gate + side * r * np.array([-u[1], u[0]]) - (r + 5) * u)
+        zones.append({"name": f"mast{k}", "points": [[n - 10, e - 10], [n + 10, e - 10],
+                                                      [n + 10, e + 10], [n - 10, e + 10]]})
+    data = yaml.safe_load(to_yaml(s))
+    data["no_fly_zones"] = zones
+    return parse_scenario(data), data
+
+
+def test_a_level_whose_loiter_circles_the_zones_block_is_refused_before_a_run():
+    # seed-9x9's drone 8 cruises at 130 m in layers; both its loiter circles at E enter
+    # a zone. E is not of the farthest pair the airborne check plans, so the run failed
+    # when drone 8 was first sent to E (after 1.1 simulated hours with seed 1) with a
+    # line naming neither the file, the zones nor the drone
+    from skyroute.errors import OptionError
+    from skyroute.fleet.simulate import check_levels
+
+    s, _ = _masts_at("seed-9x9", 4, 130.0)
+    with pytest.raises(OptionError) as err:
+        check_levels(s, "layers", where="masts.yaml")
+    assert str(err.value) == (
+        "masts.yaml: no_fly_zones: airport E: both loiter circles at 130 m cross no-fly "
+        "zones 'mast1' and 'mast0', drone 8's level in layers; fly shared, fewer drones "
+        "or move the zone")
+    with pytest.raises(OptionError, match=r"^no_fly_zones: airport E: both loiter "):
+        run(s, hours=0.1, seed=1)  # the library refuses it before the first event too
+    check_levels(s, "shared")  # its four levels, 50 to 80 m, are clear
+    check_levels(s.model_copy(update={"drones": 8}), "layers")  # up to 120 m
+
+
+def test_a_climb_out_or_final_the_zones_block_at_a_shared_level_is_refused_before_a_run():
+    from skyroute.errors import OptionError
+    from skyroute.fleet.simulate import check_levels
+
+    # the final approach to E from 80 m (the fourth shared level) starts 761 m out, at
+    # 1939 m east; from 70 m 666 m out
+    s = _two_airports([[-1, 1950], [-1, 2000], [1, 2000], [1, 1950]])
+    with pytest.raises(OptionError) as err:
+        check_levels(s, "shared", where="two.yaml")
+    assert str(err.value) == (
+        "two.yaml: no_fly_zones: airport E's final approach from 80 m crosses no-fly zone "
+        "'wall', one of the 4 shared levels; fewer shared_levels, a smaller layer_step "
+        "or move the zone")
+    check_levels(s.model_copy(update={"airspace": s.airspace.model_copy(
+        update={"shared_levels": 3})}), "shared")
+
+
+def test_the_cli_refuses_a_blocked_level_in_one_line_and_writes_nothing(monkeypatch, capsys,
+                                                                       tmp_path):
+    import yaml
+
+    from tests.cli.test_cli import run as cli
+
+    _, data = _masts_at("seed-9x9", 4, 130.0)
+    path = tmp_path / "masts.yaml"
+    path.write_text(yaml.safe_dump(data))
+    code, out, err = cli(monkeypatch, capsys, "fleet", "simulate", str(path), "--hours",
+                         "24", "--seed", "1", "--out", str(tmp_path / "out"))
+    assert code == 2 and out == ""
+    assert err.splitlines() == [
+        f"skyroute: error: {path}: no_fly_zones: airport E: both loiter circles at 130 m "
+        "cross no-fly zones 'mast1' and 'mast0', drone 8's level in layers; fly shared, "
+        "fewer drones or move the zone"]
+    assert not (tmp_path / "out").exists()

@@ -120,6 +120,11 @@ def test_a_scenario_reads_its_csv_beside_it_up_to_the_horizon(tmp_path, nine):
     (HEADER + "nan,A,0,B,1\n", 2, "t: 'nan' must be a number"),
     (HEADER + "10,C,0,C,1\n", 2, "to_airport: 'C' is the origin"),
     (HEADER + "10,A,0,B\n", 2, "expected 5 fields, got 4"),
+    # a quoted field holding a line break (a spreadsheet's cell with one) ends its record
+    # a line later: the next records' lines were one short, this one named line 3
+    (HEADER + '10,A,0,B,1\n20,A,0,B,"1\n"\n30,A,9,B,1\n', 5, "from_gate: '9' must be"),
+    (HEADER + '10,A,"x\ny",B,1\n20,A,0,B,2\n', 2, "from_gate: 'x\\ny' must be"),
+    (HEADER + '10,A,"0\n",B,1\n20,A,0,B,2\n', 4, "to_gate: '2' must be"),
 ])
 def test_csv_errors_name_the_file_the_line_and_the_field(tmp_path, nine, text, line, words):
     p = write(tmp_path, text)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import pytest
 
@@ -151,7 +152,7 @@ def test_a_misspelt_required_key_is_named_not_reported_missing(tmp_path, typo, w
     p.write_text(sc.to_yaml(sc.preset("seed-3x3")).replace("airports:", f"{typo}:", 1))
     with pytest.raises(InputFormatError) as err:
         sc.load_scenario(p)
-    assert str(err.value).startswith(f"{p}: {words}")
+    assert re.match(rf"{re.escape(str(p))}:\d+: {re.escape(words)}", str(err.value))
 
 
 def test_airports_closer_than_a_runway_are_refused():
@@ -226,7 +227,7 @@ def _other_beside_first(d: dict) -> None:
 ])
 def test_bad_scenario_files_give_one_line_naming_the_field(tmp_path, edit, words):
     p, msg = _refused(tmp_path, edit)
-    assert msg.startswith(f"{p}: ") and words in msg and "\n" not in msg
+    assert re.match(rf"{re.escape(str(p))}:\d+: ", msg) and words in msg and "\n" not in msg
 
 
 def _refused(tmp_path, edit) -> tuple:
@@ -268,7 +269,8 @@ def test_the_command_line_prints_one_line_and_exits_2(tmp_path, monkeypatch, cap
         main()
     out, err = capsys.readouterr()
     assert info.value.code == 2 and out == ""
-    assert err.count("\n") == 1 and f"{p}: " in err and words in err
+    assert err.count("\n") == 1 and re.search(rf"{re.escape(str(p))}:\d+: ", err)
+    assert words in err
 
 
 def test_a_gate_just_within_500_m_is_allowed():
@@ -369,7 +371,7 @@ def _roll(h: float) -> float:
 ])
 def test_runways_must_hold_the_ground_rolls(tmp_path, edit, words):
     p, msg = _refused(tmp_path, edit)
-    assert msg == f"{p}: {words}"
+    assert re.fullmatch(rf"{re.escape(str(p))}:\d+: {re.escape(words)}", msg)
 
 
 def test_runways_just_long_enough_are_allowed():
@@ -400,3 +402,63 @@ def test_generate_takes_numpy_numbers():
 
     a = sc.generate(np.int64(3), np.int64(3), area_km=np.float32(4.0), seed=np.int64(2))
     assert a == sc.generate(3, 3, area_km=4.0, seed=2)
+
+
+SCENARIO_WITH_LINES = """\
+name: hand-written
+airports:
+  - id: A
+    north: 0
+    east: 0
+    landing: {heading_deg: 0}
+    takeoff: {heading_deg: 90}
+  - id: B
+    north: 0
+    east: 3000
+    landing:
+      heading_deg: 90
+      length: 600
+    takeoff:
+      heading_deg: 0
+      length: 600
+drones: 2
+drone:
+  cruise_speed: 50
+airspace:
+  mode: layers
+"""
+
+
+@pytest.mark.parametrize("old, new, line, words", [
+    ("drones: 2", "drones: 0", 17, "drones: Input should be greater than or equal to 1"),
+    ("      heading_deg: 90\n", "      heading_deg: 360\n", 12,
+     "airports[1].landing.heading_deg: Input should be less than 360"),
+    ("  cruise_speed: 50", "  cruise_sped: 50", 19, "drone.cruise_sped: unknown key; did "
+     "you mean cruise_speed?"),
+    ("  mode: layers", "  mode: stacked", 21, "airspace.mode: Input should be 'layers' or"),
+    # a check of several fields names its field first; the line is that field's
+    ("      length: 600\n    takeoff", "      length: 100\n    takeoff", 13,
+     "airports[1].landing.length: 100 m is shorter than the roll-out"),
+    # a field left out: the line of the mapping it is missing from
+    ("    takeoff: {heading_deg: 90}\n", "", 3, "airports[0].takeoff: Field required"),
+    ("    east: 3000", "    east: 300", 2, "airports: A and B are 300 m apart"),
+])
+def test_a_yaml_scenarios_errors_name_the_line_of_the_field(tmp_path, old, new, line, words):
+    # a hand-written scenario's errors named the field but not the line, though its YAML
+    # syntax errors did
+    p = tmp_path / "mine.yaml"
+    assert SCENARIO_WITH_LINES.count(old) == 1
+    p.write_text(SCENARIO_WITH_LINES.replace(old, new))
+    with pytest.raises(InputFormatError) as err:
+        sc.load_scenario(p)
+    assert str(err.value).startswith(f"{p}:{line}: {words}")
+    assert err.value.line == line
+    sc.parse_scenario(__import__("yaml").safe_load(SCENARIO_WITH_LINES))  # itself valid
+
+
+def test_a_toml_scenarios_errors_name_the_field_without_a_line(tmp_path):
+    p = tmp_path / "mine.toml"
+    p.write_text('drones = 0\n[[airports]]\nid = "A"\n')
+    with pytest.raises(InputFormatError) as err:
+        sc.load_scenario(p)
+    assert str(err.value).startswith(f"{p}: ") and err.value.line is None

@@ -313,7 +313,7 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
 
     # climb: one straight piece from the lift-off point to the climb-out point
     top = lift_off + climb * u_up
-    nofly.check_line(scenario, lift_off, top, f"airport {origin}'s climb-out to {h:g} m")
+    check_climb_out(scenario, a, h)
     tr = Trajectory(drone, t_lift, (*lift_off, 0.0))
     tr.line_to(add("climb", climb_s), (*top, h))
 
@@ -324,8 +324,7 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
     final = h / math.tan(math.radians(d.glide_angle_deg))
     gate = land_thr - final * u_down
     r, v = d.turn_radius, d.cruise_speed
-    nofly.check_line(scenario, gate, land_thr, f"airport {destination}'s final approach "
-                     f"from {h:g} m")
+    side = check_arrival(scenario, b, h, loiter_side)  # the final, the loiter's side
     plane_start = (top[1], top[0], float(heading_to_plane(psi_up, "ned")))
     plane_goal = (gate[1], gate[0], float(heading_to_plane(psi_down, "ned")))
     path = shortest_path(plane_start, plane_goal, r)
@@ -349,18 +348,8 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
     phases.append(Phase("cruise", phases[-1].end, clock))
     t_ask = clock
 
-    # the loiter circle through the approach gate, tangent to the approach course (on
-    # the other side when a no-fly zone is in the way)
-    side = -1.0 if loiter_side == "left" else 1.0
-    for s_try in (side, -side):
-        loiter_centre = (float(gate[0] - s_try * r * math.sin(psi_down)),
-                         float(gate[1] + s_try * r * math.cos(psi_down)))
-        if nofly.circle_clear(scenario, loiter_centre, r):
-            side = s_try
-            break
-    else:
-        raise QueryError(f"airport {destination}: both loiter circles at {h:g} m cross a "
-                         "no-fly zone", param="no_fly_zones")
+    # the loiter circle through the approach gate, tangent to the approach course
+    loiter_centre = _loiter_centre(gate, psi_down, r, side)
 
     # approach: one straight glide from the approach gate to the threshold
     slope = math.hypot(final, h)
@@ -391,6 +380,58 @@ def plan_flight(scenario: Scenario, drone: int, origin: str, destination: str, *
         taxi_out_route=route_out, taxi_in_route=route_in,
         takeoff_roll=rolls[0], rollout_roll=rolls[1], aircraft=d,
         gate_widths=(a.gate_width, b.gate_width))
+
+
+def check_climb_out(scenario: Scenario, airport: Airport, altitude: float) -> None:
+    """A QueryError naming the airport and the zone when the straight climb from
+    ``airport``'s lift-off point to ``altitude`` (along its take-off heading) enters a
+    no-fly zone; a drone cannot bend it."""
+    if not scenario.no_fly_zones:
+        return
+    d = scenario.drone
+    thr, _ = runway_ends(airport, airport.takeoff)
+    psi = math.radians(airport.takeoff.heading_deg)
+    u = np.array([math.cos(psi), math.sin(psi)])
+    roll, _, climb, _ = takeoff_phases(altitude, d.climb_angle_deg, d.landing_speed,
+                                       d.cruise_speed)
+    lift_off = thr + roll * u
+    nofly.check_line(scenario, lift_off, lift_off + climb * u,
+                     f"airport {airport.id}'s climb-out to {altitude:g} m")
+
+
+def check_arrival(scenario: Scenario, airport: Airport, altitude: float,
+                  loiter_side: str = "left") -> float:
+    """The side of the loiter circle at ``airport`` for a cruise at ``altitude``: -1.0
+    (left-hand) or 1.0, ``loiter_side`` unless its circle enters a no-fly zone and the
+    other's does not. A QueryError naming the airport and the zones when the final
+    approach (a straight glide) enters a zone, or both circles do."""
+    side = -1.0 if loiter_side == "left" else 1.0
+    if not scenario.no_fly_zones:
+        return side
+    land_thr, _ = runway_ends(airport, airport.landing)
+    psi = math.radians(airport.landing.heading_deg)
+    u = np.array([math.cos(psi), math.sin(psi)])
+    gate = land_thr - altitude / math.tan(math.radians(scenario.drone.glide_angle_deg)) * u
+    nofly.check_line(scenario, gate, land_thr, f"airport {airport.id}'s final approach "
+                     f"from {altitude:g} m")
+    r = scenario.drone.turn_radius
+    names = []
+    for s_try in (side, -side):
+        name = nofly.circle_crossed(scenario, _loiter_centre(gate, psi, r, s_try), r)
+        if name is None:
+            return s_try
+        names.append(name)
+    zones = (f"no-fly zone {names[0]!r}" if names[0] == names[1] else
+             f"no-fly zones {names[0]!r} and {names[1]!r}")
+    raise QueryError(f"airport {airport.id}: both loiter circles at {altitude:g} m cross "
+                     f"{zones}", param="no_fly_zones")
+
+
+def _loiter_centre(gate, psi_down: float, r: float, side: float) -> tuple[float, float]:
+    """Centre (north, east) of the loiter circle through the approach ``gate``, tangent
+    to the approach course ``psi_down`` (compass radians), on ``side`` (-1.0 left-hand)."""
+    return (float(gate[0] - side * r * math.sin(psi_down)),
+            float(gate[1] + side * r * math.cos(psi_down)))
 
 
 def takeoff_overrun(scenario: Scenario, airport: Airport, altitude: float) -> str | None:

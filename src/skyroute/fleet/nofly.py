@@ -43,13 +43,40 @@ def zone_world(scenario) -> World | None:
     return _world(tuple((z.name, tuple(map(tuple, z.points))) for z in scenario.no_fly_zones))
 
 
+@functools.lru_cache(maxsize=8)
+def _indexed(zones: tuple[tuple[str, tuple[tuple[float, float], ...]], ...]):
+    """(names, polygons in the (east, north) plane, their STRtree), built once per set
+    of zones: a check before a run tests every airport at every level."""
+    polys = np.array([shapely.Polygon([(e, n) for n, e in pts]) for _, pts in zones],
+                     dtype=object)
+    return [n for n, _ in zones], polys, shapely.STRtree(polys)
+
+
+_LAST: tuple = (None, None)  # (a scenario's list of zones, its index)
+
+
+def _zone_index(scenario):
+    """:func:`_indexed` of the scenario's zones; the last list's is kept by identity, as
+    the cache's key (every corner) took a millisecond to build for 1000 zones, each
+    check."""
+    global _LAST
+    zones = scenario.no_fly_zones
+    last, index = _LAST  # one read: another thread may replace it
+    if last is not zones:
+        index = _indexed(tuple((z.name, tuple(map(tuple, z.points))) for z in zones))
+        _LAST = (zones, index)  # holding the list keeps its id from being reused
+    return index
+
+
 def crossed(scenario, geometry) -> str | None:
     """The name of the first zone whose interior ``geometry`` (in the (east, north)
     plane) meets, or None."""
-    for z in scenario.no_fly_zones:
-        poly = shapely.Polygon([(e, n) for n, e in z.points])
-        if geometry.intersects(poly) and not geometry.touches(poly):
-            return z.name
+    if not scenario.no_fly_zones:
+        return None
+    names, polys, tree = _zone_index(scenario)
+    for k in sorted(tree.query(geometry).tolist()):  # those whose boxes meet it
+        if geometry.intersects(polys[k]) and not geometry.touches(polys[k]):
+            return names[k]
     return None
 
 
@@ -64,10 +91,21 @@ def check_line(scenario, p0, p1, what: str) -> None:
         raise QueryError(f"{what} crosses no-fly zone {name!r}", param="no_fly_zones")
 
 
+def circle_crossed(scenario, centre, radius: float) -> str | None:
+    """The name of the first zone the circle (centre (north, east), ``radius``) enters,
+    or None."""
+    if not scenario.no_fly_zones:
+        return None
+    n, e = centre
+    if not len(_zone_index(scenario)[2].query(shapely.box(e - radius, n - radius,
+                                                           e + radius, n + radius))):
+        return None  # no zone near: the ring is not built
+    return crossed(scenario, shapely.Point(e, n).buffer(radius, quad_segs=64).exterior)
+
+
 def circle_clear(scenario, centre, radius: float) -> bool:
     """True when the circle (centre (north, east), ``radius``) enters no zone."""
-    ring = shapely.Point(centre[1], centre[0]).buffer(radius, quad_segs=64).exterior
-    return crossed(scenario, ring) is None
+    return circle_crossed(scenario, centre, radius) is None
 
 
 def cruise(scenario, start, goal, radius: float, path: DubinsPath, *,

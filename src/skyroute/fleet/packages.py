@@ -119,7 +119,9 @@ def read_csv(path: str | Path, scenario: Scenario) -> Stream:
             header = next(reader, None)
             if header is None or tuple(h.strip() for h in header) != CSV_HEADER:
                 raise InputFormatError(p, "header must be " + ",".join(CSV_HEADER), line=1)
-            for line, rec in enumerate(reader, start=2):
+            end = reader.line_num  # the physical line each record ends on: a quoted
+            for rec in reader:  # field may hold a line break, so records are not lines
+                line, end = end + 1, reader.line_num
                 if not rec or all(not x.strip() for x in rec):
                     continue
                 if len(rows) >= MAX_PACKAGES:

@@ -12,6 +12,7 @@ it, ``gate_width`` apart, or where its ``gates`` field puts them.
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from pathlib import Path
 from typing import Annotated, Literal
@@ -352,7 +353,40 @@ def load_scenario(path: str | Path) -> Scenario:
     else:
         raise InputFormatError(p, f"unknown scenario type {p.suffix!r}; valid: .yaml, .yml, "
                                ".toml")
-    return parse_scenario(data, p)
+    locate = None if p.suffix.lower() == ".toml" else lambda loc: _yaml_line(text, loc)
+    return _parse(data, p, locate)
+
+
+def _yaml_line(text: str, loc: tuple) -> int | None:
+    """The line (from 1) of the YAML ``text`` where the field at ``loc`` (a validation
+    error's path: keys and list indices) is given, or of the nearest enclosing one that
+    is (a missing field: its mapping's; a key from a ``<<`` merge: the mapping's)."""
+    import yaml
+
+    node, line = yaml.compose(text, Loader=_unique_keys_loader()), None
+    for part in loc:
+        if isinstance(node, yaml.MappingNode):
+            found = next(((k, v) for k, v in node.value if isinstance(k, yaml.ScalarNode)
+                          and k.value == str(part)), None)
+            if found is None:
+                break
+            line, node = found[0].start_mark.line + 1, found[1]
+        elif (isinstance(node, yaml.SequenceNode) and isinstance(part, int)
+              and 0 <= part < len(node.value)):
+            node = node.value[part]
+            line = node.start_mark.line + 1
+        else:
+            break
+    return line
+
+
+# "airports[1].takeoff.length: ...": the field a check of several fields names first
+_FIELD = re.compile(r"([A-Za-z_]\w*(?:\[\d+\]|\.[A-Za-z_]\w*)*): ")
+
+
+def _loc(field: str) -> tuple:
+    """``airports[1].takeoff.length`` -> ``("airports", 1, "takeoff", "length")``."""
+    return tuple(int(x) if x.isdigit() else x for x in re.findall(r"\w+", field))
 
 
 def _unique_keys_loader():
@@ -386,6 +420,12 @@ def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
     long its flights stay airborne is checked by those that plan them
     (:func:`skyroute.fleet.airborne.check_flights`, which plans with this module's
     types: it sits above it)."""
+    return _parse(data, where)
+
+
+def _parse(data, where, locate=None) -> Scenario:
+    """:func:`parse_scenario`; ``locate(loc)`` gives the line of the file where the field
+    at ``loc`` is, for the error to name (``my.yaml:17: airports[1]...``)."""
     if not isinstance(data, dict):
         raise InputFormatError(where, "expected a mapping of scenario fields")
     try:
@@ -400,7 +440,12 @@ def parse_scenario(data, where: str | Path = "scenario") -> Scenario:
         if err["type"] == "extra_forbidden":  # a typo: say what the section takes
             msg = _unknown_key(err["loc"])
         # a check of several fields (at the model level) names its own field first
-        raise InputFormatError(where, f"{field.lstrip('.')}: {msg}" if field else msg) from None
+        text = f"{field.lstrip('.')}: {msg}" if field else msg
+        line = None
+        if locate is not None:
+            named = _FIELD.match(text)
+            line = locate(_loc(named.group(1)) if named else ())
+        raise InputFormatError(where, text, line=line) from None
     return s
 
 

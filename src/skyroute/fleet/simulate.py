@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skyroute.errors import OptionError, SkyrouteError, check_choice, check_seed
+from skyroute.errors import OptionError, QueryError, SkyrouteError, check_choice, check_seed
 from skyroute.fleet import dispatch, packages
 from skyroute.fleet.airborne import MAX_LOITERS, too_long
 from skyroute.fleet.airspace import (
@@ -45,7 +45,13 @@ from skyroute.fleet.airspace import (
     level_choices,
     samples,
 )
-from skyroute.fleet.flightplan import FlightPlan, plan_flight, takeoff_overrun
+from skyroute.fleet.flightplan import (
+    FlightPlan,
+    check_arrival,
+    check_climb_out,
+    plan_flight,
+    takeoff_overrun,
+)
 from skyroute.fleet.nofly import check_joined
 from skyroute.fleet.packages import TIME_DECIMALS, Stream, horizon_seconds
 from skyroute.fleet.scenario import Scenario
@@ -185,6 +191,25 @@ def check_levels(scenario: Scenario, airspace: str | None = None, *,
         if why is not None:
             raise OptionError(("" if where is None else f"{where}: ")
                               + f"{why}, {which}; {advice}", param="airspace")
+    _check_fixed_legs(scenario, levels, where, advice.replace("or a longer runway",
+                                                              "or move the zone"))
+
+
+def _check_fixed_legs(scenario: Scenario, levels, where, advice: str) -> None:
+    """Refuse, before a run, a level at which some airport's climb-out, final approach
+    or both loiter circles enter a no-fly zone: any flight may use any airport at any
+    level of its airspace, and one that did failed the run when it was first planned,
+    hours into it, naming neither the file nor the level's drone."""
+    if not scenario.no_fly_zones:
+        return
+    for alt, which in levels:  # the lowest first: the level most flights use
+        for a in scenario.airports:
+            try:
+                check_climb_out(scenario, a, alt)
+                check_arrival(scenario, a, alt)
+            except QueryError as exc:
+                raise OptionError(("" if where is None else f"{where}: ") + "no_fly_zones: "
+                                  f"{exc}, {which}; {advice}", param="scenario") from None
 
 
 def _check_scenario(scenario) -> None:

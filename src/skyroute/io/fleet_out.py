@@ -49,7 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import OptionError, SkyrouteError
-from skyroute.files import check_writable, write_atomic, written_together
+from skyroute.files import check_writable, remove_atomic, write_atomic, written_together
 from skyroute.fleet.flightplan import FlightPlan, gate_position, ground_position
 from skyroute.fleet.scenario import runway_ends
 from skyroute.fleet.simulate import TIME_DECIMALS, WARMUP_SHARE, Simulation
@@ -79,7 +79,8 @@ def write_run(sim: Simulation, rep: dict, out: str | Path, *, track_step: float 
               plot: bool = False) -> list[Path]:
     """Write the files of the module docstring for run ``sim`` with report ``rep`` into
     folder ``out`` (created when missing); tracks every ``track_step`` seconds; the two
-    PNGs only with ``plot``. Returns the paths written, in that order."""
+    PNGs only with ``plot`` (without it, those of an earlier run in ``out`` are removed
+    with the others' renames). Returns the paths written, in that order."""
     out = Path(out)
     _check_step("track_step", track_step)
     try:
@@ -96,6 +97,10 @@ def write_run(sim: Simulation, rep: dict, out: str | Path, *, track_step: float 
         if plot:
             plot_map(sim, paths[5])
             plot_timeline(sim, paths[6])
+        else:  # an earlier run's maps would be read as this one's
+            for stale in run_outputs(out, plot=True)[len(RUN_FILES):]:
+                if stale.is_file() or stale.is_symlink():
+                    remove_atomic(stale)
     return paths
 
 
