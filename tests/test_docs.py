@@ -203,6 +203,51 @@ def test_cli_md_options_are_the_commands_options():
     assert [(c, f) for c, f in pairs if f not in known[c]] == []
 
 
+def cli_md_defaults(text: str, names: list[str]) -> list[tuple[str, str, str]]:
+    """(command, option, value) for every ``[--option VALUE]`` of a docs/cli.md synopsis
+    (code blocks and inline spans, as :func:`cli_md_options` reads them) whose VALUE is
+    written as the default (``[--clients 50]``, ``[--seeds 0-9]``), not as a placeholder
+    (``[--safety C]``, ``[--db URL]``) or an example (``[--plot out.png]``)."""
+    import re
+
+    blocks = re.findall(r"^```[^\n]*\n(.*?)^```", text, re.M | re.S)
+    prose = re.sub(r"^```[^\n]*\n.*?^```", "", text, flags=re.M | re.S)
+    chunks = [c for b in blocks for c in re.split(r"\n(?=skyroute )", b)]
+    chunks += prose.split("`")[1::2]
+    out = []
+    for chunk in chunks:
+        words = chunk.split()
+        found = [n for n in names if words[:1] == ["skyroute"]
+                 and words[1:1 + len(n.split())] == n.split()]
+        if found:
+            out += [(max(found, key=len), flag, value) for flag, value in
+                    re.findall(r"\[(--[\w-]+)\s+([^\]\s|]+)\]", chunk)]
+    return out
+
+
+def test_cli_md_synopsis_defaults_are_the_commands_defaults():
+    """A value docs/cli.md's synopses give an option (``[--requests 2000]``,
+    ``[--method milp]``) is the default its --help shows: a default changed in the code
+    alone fails here. A value in capitals is a placeholder, one the option does not
+    default to (None) or one with '...' an example; each is left out."""
+    commands = dict(_cli_commands())
+    triples = cli_md_defaults((ROOT / "docs" / "cli.md").read_text(), list(commands))
+    checked, bad = 0, []
+    for name, flag, value in triples:
+        (param,) = [p for p in commands[name].params if flag in p.opts + p.secondary_opts]
+        if value.isupper() or "..." in value or param.default in (None, ""):
+            continue
+        if isinstance(param.default, str) or not isinstance(param.default, (int, float)):
+            same = value == str(param.default)
+        else:
+            same = float(value) == float(param.default)
+        checked += 1
+        if not same:
+            bad.append((name, flag, value, param.default))
+    assert checked >= 40  # the synopses were read
+    assert bad == []
+
+
 def doc_command_lines() -> list[tuple[str, str]]:
     """(file, command line) for each ``skyroute`` command in a code block of README.md
     and docs/*.md, after any environment settings or ``time`` in front, up to a ``>``

@@ -90,6 +90,64 @@ def test_a_scheduler_that_does_not_answer_is_an_error_within_the_timeout(monkeyp
     assert not isinstance(err.value, OptionError)
 
 
+@contextlib.contextmanager
+def _not_a_scheduler(answer: bytes | None):
+    """A TCP server on a free port of 127.0.0.1 that is no Dask scheduler: it says
+    ``answer`` to each connection (an HTTP server's reply, as on the dashboard's port
+    8787), or nothing at all (``None``), and keeps the connection open."""
+    import socket
+    import threading
+
+    server = socket.create_server(("127.0.0.1", 0))
+    held = []
+
+    def serve():
+        with contextlib.suppress(OSError):
+            while True:
+                conn, _ = server.accept()
+                held.append(conn)
+                if answer is not None:
+                    conn.sendall(answer)
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        yield f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    finally:
+        server.close()
+        for conn in held:
+            conn.close()
+
+
+@pytest.mark.parametrize("answer", [None, b"HTTP/1.1 400 Bad Request\r\n\r\n"],
+                         ids=["silent", "http"])
+def test_a_server_that_is_no_scheduler_is_an_error_within_the_timeout(monkeypatch, answer):
+    """``--dask`` at a port where another server listens: distributed bounds the TCP
+    connection but not the handshake after it, so a silent server kept the command
+    waiting for ever, and an HTTP answer was read as a frame of 3 EiB (a MemoryError
+    traceback). Both are the one-line error, within the timeout."""
+    import threading
+
+    monkeypatch.setattr(executor_mod, "CONNECT_TIMEOUT", "1s")
+    raised = []
+
+    def connect(address):
+        try:
+            open_executor("dask", address=address).close()
+        except BaseException as exc:
+            raised.append(exc)
+
+    with _not_a_scheduler(answer) as address:
+        # in a thread: the old code never returned from the silent server
+        attempt = threading.Thread(target=connect, args=(address,), daemon=True)
+        attempt.start()
+        attempt.join(8)
+        assert not attempt.is_alive(), "still waiting for the handshake"
+    (err,) = raised
+    assert isinstance(err, SkyrouteError), repr(err)
+    assert str(err).startswith(f"address={address!r}: no Dask scheduler there (")
+    assert "\n" not in str(err) and err.param == "address"
+
+
 def test_an_existing_scheduler_runs_the_tasks(dask_executor):
     address = dask_executor.client.scheduler.address
     with open_executor("dask", address=address, workers=5) as ex:  # workers: unused

@@ -452,6 +452,39 @@ def _gather(submit: Callable, items: list, window: int, on_result,
     return out
 
 
+def _handshake(address: str) -> None:
+    """Connect to ``address`` and read a Dask handshake within ``CONNECT_TIMEOUT``, else
+    raise OSError. distributed bounds the TCP connection but not the handshake read
+    after it: another server on the port (the dashboard's 8787, any HTTP server) kept
+    ``Client`` waiting for ever when silent, and its answer, read as a frame length,
+    was a MemoryError of exabytes. Run on a thread of its own, with its own event loop,
+    as a server calls this from inside one."""
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from dask.utils import parse_timedelta
+    from distributed.comm import connect
+
+    timeout = parse_timedelta(CONNECT_TIMEOUT, default="seconds")
+    bound = timeout + 2  # connect() ends an unanswered connection at timeout, its way
+
+    async def shake():
+        try:
+            comm = await asyncio.wait_for(connect(address, timeout=timeout), bound)
+        except TimeoutError:
+            raise OSError(f"something at {address} took the connection but did not "
+                          f"answer as a Dask scheduler within {bound:g} s") from None
+        except (OSError, ValueError, TypeError):  # refused, timed out, malformed
+            raise
+        except Exception as exc:
+            raise OSError(f"something at {address} answered, but not in Dask's "
+                          f"protocol ({type(exc).__name__} reading it)") from None
+        await comm.close()
+
+    with ThreadPoolExecutor(1, thread_name_prefix="skyroute-dask-handshake") as pool:
+        pool.submit(asyncio.run, shake()).result()
+
+
 class DaskExecutor(_Executor):
     """Tasks on a Dask cluster: an existing scheduler, or an in-process ``LocalCluster``.
 
@@ -485,6 +518,7 @@ class DaskExecutor(_Executor):
                 raise OptionError(f"address={address!r} must be a scheduler address like "
                                   "tcp://HOST:8786", param="address")
             try:
+                _handshake(address)
                 self.client = Client(address, timeout=CONNECT_TIMEOUT)
             except (OSError, ValueError, TypeError) as exc:
                 reason = " ".join(str(exc).split()) or type(exc).__name__
