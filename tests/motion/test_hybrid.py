@@ -569,3 +569,19 @@ def test_a_result_has_no_sliver_piece_and_samples_no_pose_twice(start, goal):
     assert (np.hypot(*np.diff(poses[:, :2], axis=0).T) > 1e-6).all()
     assert poses[0, :2].tolist() == list(start[:2]) and poses[-1, :2].tolist() == list(goal)
     assert path_free(world, res.segments)
+
+
+def test_a_radius_far_larger_than_the_world_is_planned_at_once():
+    """A turning radius of 1,000 km round a 100 m block without a boundary: the way past
+    the block is a loop of about 2 pi r. Each primitive (r pi / 9 long) was tested chunk
+    by chunk at the edge buckets' size (1.6 m) also far outside the world: radius 1e6
+    took 95 s, and this one (1e9) would take about a day; the chunks that cannot reach
+    the world are skipped, so it takes well under a second."""
+    world = make_world([(40, 40, 60, 60)], boundary=None)
+    r = 1e9
+    res = plan(world, (0, 0), (100, 100), r, max_expansions=20_000)
+    assert res.found and res.length == pytest.approx(2 * math.pi * r, rel=1e-3)
+    assert all(p.radius == r for p in res.segments)
+    assert path_free(world, res.segments)
+    line = shapely.LineString(res.sample(r / 1e4)[:, :2])
+    assert not line.intersects(world.obstacles[0])
