@@ -396,9 +396,11 @@ def test_a_boxed_in_goal_ends_at_once():
     world = make_world([(40, 40, 60, 60)])
     res = plan(world, (10, 10, 0.0), (99, 50, math.pi), R)
     assert res.status is Status.NO_PATH and res.expanded < 20
+    assert res.extra["closed"] == "goal" and res.extra["closed_after"] == res.expanded
     # the start faces the boundary: the forward search ends at once too
     res = plan(world, (1, 50, math.pi), (90, 90, 0.0), R)
     assert res.status is Status.NO_PATH and res.expanded < 600
+    assert res.extra["closed"] == "start" and res.extra["closed_after"] < 100
 
 
 def test_result_pieces_describe_arcs():

@@ -119,7 +119,11 @@ class HybridResult:
     of the planning. :meth:`sample` gives poses in the world's frame. ``extra``:
     ``raw_length`` before shortcutting, analytic ``tries``, ``shortcut_tries``; on
     ``budget_exhausted``, the ``budget`` spent, ``radii_across`` (the search region's
-    longer side in turning radii) and a one-line ``hint``.
+    longer side in turning radii) and a one-line ``hint``; on ``no_path``, which end's
+    states ran out (``closed``: "goal", no lattice state outside a few around the goal
+    reaches it, or "start", every state the start reaches was expanded) and after how
+    many expansions of that search (``closed_after``: a few hundred or less means that
+    end is boxed in, as a pose facing a wall).
     """
 
     status: Status
@@ -275,14 +279,18 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         back = lattice.search(gxy, _turned(gth), sxy, _turned(sth), first)
     if back.code == NO_PATH or (back.code == FOUND and back.expanded < first):
         res, expanded = back.reversed(reverse), back.expanded
+        closed = ("goal", back.expanded)
     else:
         res = lattice.search(sxy, sth, gxy, gth, limit - back.expanded)
         expanded = back.expanded + res.expanded
+        closed = ("start", res.expanded)
     status = STATUS_OF_CODE[res.code]
     start_pose = (float(sxy[0]), float(sxy[1]), math.nan if sth is None else float(sth))
     goal_pose = (float(gxy[0]), float(gxy[1]), math.nan if gth is None else float(gth))
     if status is not Status.FOUND:
         extra = {"tries": back.tries + res.tries}
+        if status is Status.NO_PATH:
+            extra.update(closed=closed[0], closed_after=int(closed[1]))
         if status is Status.BUDGET_EXHAUSTED:
             extra.update(budget=limit, radii_across=_across(region) / r,
                          hint=_hint(limit, max_expansions is None, _across(region) / r, r))
