@@ -220,9 +220,9 @@ def test_load_world_names_load_map_for_a_grid_map(tmp_path):
                                      ["fly", "--vehicle", "field"]])
 @pytest.mark.parametrize("point, words", [
     ("38,50", "start (38.00, 50.00) lies outside obstacle 'box at line 3' but within its "
-              "--safety 5 m margin; nearest free point (35.00, 50.00)"),
+              "--safety 5 m margin; nearest free point (34.99, 50.00)"),
     ("45,50", "start (45.00, 50.00) lies inside obstacle 'box at line 3'; nearest free "
-              "point (35.00, 50.00)"),
+              "point (34.99, 50.00)"),
 ])
 def test_a_point_blocked_only_by_the_safety_margin_says_so(monkeypatch, capsys, tmp_path,
                                                            command, point, words):
@@ -252,4 +252,4 @@ def test_a_target_blocked_only_by_the_safety_margin_says_so(monkeypatch, capsys,
     assert code == 2 and out == ""
     assert err == ("skyroute: error: targets.csv: target 2 (50.00, 62.00) lies outside "
                    "obstacle 'box at line 3' but within its --safety 5 m margin; nearest "
-                   "free point (50.00, 65.00)\n")
+                   "free point (50.00, 65.01)\n")
