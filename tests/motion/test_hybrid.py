@@ -30,6 +30,18 @@ def make_world(boxes, boundary=(0, 0, 100, 100)) -> World:
                  boundary=shapely.box(*boundary) if boundary else None)
 
 
+def on_an_edge(world: World, points) -> bool:
+    """Whether a point lies on (within 1e-6 of) an obstacle's or the boundary's edge,
+    which Hybrid A* refuses."""
+    outlines = [shapely.boundary(g) for g in world.obstacles]
+    if world.boundary is not None:
+        outlines.append(world.boundary.exterior)
+    if not outlines:
+        return False
+    d = shapely.distance(shapely.union_all(outlines), shapely.points(np.asarray(points, float)))
+    return bool((d <= 1e-6).any())
+
+
 def wrap(a):
     return (np.asarray(a) + math.pi) % (2 * math.pi) - math.pi
 
@@ -250,6 +262,7 @@ def test_property_paths_are_free_curvature_bounded_and_not_too_short(
         start, goal = (min(start[0], x / 2), mid, start[2]), (max(goal[0], 99 - (99 - x - w) / 2),
                                                             mid, goal[2])
     assume(world.is_free([start[:2], goal[:2]]).all())
+    assume(not on_an_edge(world, [start[:2], goal[:2]]))  # refused: a QueryError
     s = start if start_heading else start[:2]
     g = goal if goal_heading else goal[:2]
     res = plan(world, s, g, radius, max_expansions=20_000, reverse=reverse)
@@ -587,3 +600,23 @@ def test_a_radius_far_larger_than_the_world_is_planned_at_once():
     assert path_free(world, res.segments)
     line = shapely.LineString(res.sample(r / 1e4)[:, :2])
     assert not line.intersects(world.obstacles[0])
+
+
+def test_a_start_or_goal_on_an_edge_is_refused_naming_it():
+    """A point on an obstacle's edge is free in the world, but every piece from it meets
+    the edge: the search ended in no_path after 572 expansions. And two boxes touching
+    along x = 50 are one block whose outline alone the pieces were tested against: from
+    a start to a goal on the face they share the path ran 16 m through the block
+    (found, length 16). Both are refused, naming the point."""
+    block = make_world([(40, 40, 50, 60), (50, 40, 60, 60)])
+    with pytest.raises(QueryError, match=r"^start \(50.00, 42.00\) lies on the edge of "
+                       r"obstacle 'obstacle 0'; a turning vehicle's path keeps clear of "
+                       r"every edge: move it off the edge$"):
+        plan(block, (50, 42, math.pi / 2), (50, 58, math.pi / 2), R)
+    with pytest.raises(QueryError, match=r"^goal \(50.00, 58.00\) lies on the edge"):
+        plan(block, (20, 20), (50, 58), R)
+    with pytest.raises(QueryError, match=r"^start \(60.00, 50.00\) lies on the edge"):
+        plan(block, (60, 50, 0.0), (90, 90), R)  # facing away from the east face
+    # a hair off it, the way out is found (and the same flight a hair further off)
+    res = plan(block, (60.01, 50, 0.0), (90, 90), R)
+    check_path(block, res, (60.01, 50, 0.0), (90, 90), R)
