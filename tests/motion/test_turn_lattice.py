@@ -183,9 +183,9 @@ def test_property_a_world_route_is_free_and_drives_along_its_headings(
     obs = np.array([shapely.box(x, y, x + w, y + h) for x, y, w, h in boxes], dtype=object)
     world = World(obs, np.full(len(obs), -np.inf), np.full(len(obs), np.inf), (),
                   boundary=shapely.box(0, 0, 100, 100), frame=frame)
+    assume(world.is_free([start, goal]).all())  # plane points
     flip = (lambda p: p[::-1]) if frame == "ned" else (lambda p: p)
-    s, g = flip(start), flip(goal)
-    assume(world.is_free([s, g]).all())
+    s, g = flip(start), flip(goal)  # as the frame reads them
     try:
         res = plan_turns_world(world, s, g, headings=headings, resolution=resolution,
                                start_heading=math.radians(start_heading))
