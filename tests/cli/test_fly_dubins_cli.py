@@ -145,6 +145,44 @@ def test_tour_visits_every_target(monkeypatch, capsys, tmp_path, head):
     assert m["bound"] <= m["length"] + 1e-9
 
 
+def test_a_tour_to_a_walled_off_target_is_no_path(monkeypatch, capsys, tmp_path):
+    """A target inside a closed ring of buildings: `fly --targets` said `found`, `reached
+    True`, order `0 0` (the last target flown to twice), and wrote a trajectory that
+    never came near the walled one. It is `no_path`, exit 1, and writes nothing."""
+    city = tmp_path / "ring.csv"
+    city.write_text("lat0 37.792480, lon0 -122.397450\n"
+                    "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n"
+                    "100,80,20,30,5,20\n100,120,20,30,5,20\n"
+                    "75,100,20,5,25,20\n125,100,20,5,25,20\n", encoding="utf-8")
+    targets, out = tmp_path / "targets.csv", tmp_path / "tour.csv"
+    targets.write_text("100,100\n0,50\n", encoding="utf-8")
+    code, text, err = run(monkeypatch, capsys, "fly", str(city), "--frame", "ned",
+                          "--vehicle", "dubins", "--start", "0,0", "--targets", str(targets),
+                          "--json", "--out", str(out))
+    assert code == 1, err
+    m = json.loads(text)["metrics"]
+    assert m["status"] == "no_path" and m["length"] is None and m["order"] == ""
+    assert not out.exists()
+
+
+def test_a_flight_along_a_face_two_buildings_share_is_refused(monkeypatch, capsys,
+                                                             tmp_path):
+    """Two buildings touching along east 50: a start and a goal on that face are free
+    points, and the flight between them ran 16 m through the block (found, exit 0).
+    It is one line naming the start, exit 2, and no file."""
+    city, out = tmp_path / "two.csv", tmp_path / "t.csv"
+    city.write_text("lat0 37.792480, lon0 -122.397450\n"
+                    "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n"
+                    "50,45,20,10,5,20\n50,55,20,10,5,20\n", encoding="utf-8")
+    code, text, err = run(monkeypatch, capsys, "fly", str(city), "--frame", "ned",
+                          "--vehicle", "dubins", "--start", "42,50,0", "--goal", "58,50,0",
+                          "--out", str(out))
+    assert code == 2 and text == "" and not out.exists()
+    assert err == ("skyroute: error: start (42.00, 50.00) lies on the edge of obstacle 'box "
+                   "at line 3'; a turning vehicle's path keeps clear of every edge: move it "
+                   "off the edge\n")
+
+
 @pytest.mark.parametrize("args, words", [
     (["--start", "15,-30", "--goal", "120,-180"], "lies inside obstacle"),
     (["--start", "0,0,north", "--goal", "120,-180"], "--start '0,0,north' must be"),

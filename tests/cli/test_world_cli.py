@@ -214,3 +214,42 @@ def test_load_world_names_load_map_for_a_grid_map(tmp_path):
     with pytest.raises(GridNotWorldError, match=r"w.csv:1: wall segments .*: load it with "
                                                 r"skyroute.load_map$"):
         skyroute.load_world(tmp_path / "w.csv")
+
+
+@pytest.mark.parametrize("command", [["plan-world"], ["fly", "--vehicle", "dubins"],
+                                     ["fly", "--vehicle", "field"]])
+@pytest.mark.parametrize("point, words", [
+    ("38,50", "start (38.00, 50.00) lies outside obstacle 'box at line 3' but within its "
+              "--safety 5 m margin; nearest free point (34.99, 50.00)"),
+    ("45,50", "start (45.00, 50.00) lies inside obstacle 'box at line 3'; nearest free "
+              "point (34.99, 50.00)"),
+])
+def test_a_point_blocked_only_by_the_safety_margin_says_so(monkeypatch, capsys, tmp_path,
+                                                           command, point, words):
+    """A start 2 m south of a building (N 40-60, E 40-60) with --safety 5 read "lies
+    inside obstacle 'box at line 3'", as if the building stood there; inside the
+    building itself the words stay."""
+    city = tmp_path / "city.csv"
+    city.write_text("lat0 37.792480, lon0 -122.397450\n"
+                    "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n50,50,20,10,10,20\n",
+                    encoding="utf-8")
+    code, out, err = run(monkeypatch, capsys, *command[:1], str(city), *command[1:],
+                         "--frame", "ned", "--safety", "5", "--start", point,
+                         "--goal", "100,100")
+    assert code == 2 and out == ""
+    assert err == f"skyroute: error: {words}\n"
+
+
+def test_a_target_blocked_only_by_the_safety_margin_says_so(monkeypatch, capsys, tmp_path):
+    city, targets = tmp_path / "city.csv", tmp_path / "targets.csv"
+    city.write_text("lat0 37.792480, lon0 -122.397450\n"
+                    "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n50,50,20,10,10,20\n",
+                    encoding="utf-8")
+    targets.write_text("0,50\n50,62\n", encoding="utf-8")
+    code, out, err = run(monkeypatch, capsys, "fly", str(city), "--vehicle", "dubins",
+                         "--frame", "ned", "--safety", "5", "--start", "0,0",
+                         "--targets", str(targets))
+    assert code == 2 and out == ""
+    assert err == ("skyroute: error: targets.csv: target 2 (50.00, 62.00) lies outside "
+                   "obstacle 'box at line 3' but within its --safety 5 m margin; nearest "
+                   "free point (50.00, 65.01)\n")

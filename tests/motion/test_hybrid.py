@@ -30,6 +30,18 @@ def make_world(boxes, boundary=(0, 0, 100, 100)) -> World:
                  boundary=shapely.box(*boundary) if boundary else None)
 
 
+def on_an_edge(world: World, points) -> bool:
+    """Whether a point lies on (within 1e-6 of) an obstacle's or the boundary's edge,
+    which Hybrid A* refuses."""
+    outlines = [shapely.boundary(g) for g in world.obstacles]
+    if world.boundary is not None:
+        outlines.append(world.boundary.exterior)
+    if not outlines:
+        return False
+    d = shapely.distance(shapely.union_all(outlines), shapely.points(np.asarray(points, float)))
+    return bool((d <= 1e-6).any())
+
+
 def wrap(a):
     return (np.asarray(a) + math.pi) % (2 * math.pi) - math.pi
 
@@ -250,6 +262,7 @@ def test_property_paths_are_free_curvature_bounded_and_not_too_short(
         start, goal = (min(start[0], x / 2), mid, start[2]), (max(goal[0], 99 - (99 - x - w) / 2),
                                                             mid, goal[2])
     assume(world.is_free([start[:2], goal[:2]]).all())
+    assume(not on_an_edge(world, [start[:2], goal[:2]]))  # refused: a QueryError
     s = start if start_heading else start[:2]
     g = goal if goal_heading else goal[:2]
     res = plan(world, s, g, radius, max_expansions=20_000, reverse=reverse)
@@ -396,9 +409,11 @@ def test_a_boxed_in_goal_ends_at_once():
     world = make_world([(40, 40, 60, 60)])
     res = plan(world, (10, 10, 0.0), (99, 50, math.pi), R)
     assert res.status is Status.NO_PATH and res.expanded < 20
+    assert res.extra["closed"] == "goal" and res.extra["closed_after"] == res.expanded
     # the start faces the boundary: the forward search ends at once too
     res = plan(world, (1, 50, math.pi), (90, 90, 0.0), R)
     assert res.status is Status.NO_PATH and res.expanded < 600
+    assert res.extra["closed"] == "start" and res.extra["closed_after"] < 100
 
 
 def test_result_pieces_describe_arcs():
@@ -569,3 +584,39 @@ def test_a_result_has_no_sliver_piece_and_samples_no_pose_twice(start, goal):
     assert (np.hypot(*np.diff(poses[:, :2], axis=0).T) > 1e-6).all()
     assert poses[0, :2].tolist() == list(start[:2]) and poses[-1, :2].tolist() == list(goal)
     assert path_free(world, res.segments)
+
+
+def test_a_radius_far_larger_than_the_world_is_planned_at_once():
+    """A turning radius of 1,000 km round a 100 m block without a boundary: the way past
+    the block is a loop of about 2 pi r. Each primitive (r pi / 9 long) was tested chunk
+    by chunk at the edge buckets' size (1.6 m) also far outside the world: radius 1e6
+    took 95 s, and this one (1e9) would take about a day; the chunks that cannot reach
+    the world are skipped, so it takes well under a second."""
+    world = make_world([(40, 40, 60, 60)], boundary=None)
+    r = 1e9
+    res = plan(world, (0, 0), (100, 100), r, max_expansions=20_000)
+    assert res.found and res.length == pytest.approx(2 * math.pi * r, rel=1e-3)
+    assert all(p.radius == r for p in res.segments)
+    assert path_free(world, res.segments)
+    line = shapely.LineString(res.sample(r / 1e4)[:, :2])
+    assert not line.intersects(world.obstacles[0])
+
+
+def test_a_start_or_goal_on_an_edge_is_refused_naming_it():
+    """A point on an obstacle's edge is free in the world, but every piece from it meets
+    the edge: the search ended in no_path after 572 expansions. And two boxes touching
+    along x = 50 are one block whose outline alone the pieces were tested against: from
+    a start to a goal on the face they share the path ran 16 m through the block
+    (found, length 16). Both are refused, naming the point."""
+    block = make_world([(40, 40, 50, 60), (50, 40, 60, 60)])
+    with pytest.raises(QueryError, match=r"^start \(50.00, 42.00\) lies on the edge of "
+                       r"obstacle 'obstacle 0'; a turning vehicle's path keeps clear of "
+                       r"every edge: move it off the edge$"):
+        plan(block, (50, 42, math.pi / 2), (50, 58, math.pi / 2), R)
+    with pytest.raises(QueryError, match=r"^goal \(50.00, 58.00\) lies on the edge"):
+        plan(block, (20, 20), (50, 58), R)
+    with pytest.raises(QueryError, match=r"^start \(60.00, 50.00\) lies on the edge"):
+        plan(block, (60, 50, 0.0), (90, 90), R)  # facing away from the east face
+    # a hair off it, the way out is found (and the same flight a hair further off)
+    res = plan(block, (60.01, 50, 0.0), (90, 90), R)
+    check_path(block, res, (60.01, 50, 0.0), (90, 90), R)

@@ -473,3 +473,40 @@ def test_a_robot_too_far_for_a_new_escape_raster_stops_saying_why(monkeypatch):
                               "over "), run.why
     assert run.why.endswith("would have more than 4,000 cells; a larger step makes fewer")
     assert not shapely.LineString(run.trace).intersects(shapely.box(20, 10, 21, 30))
+
+
+def test_the_sensor_reads_the_outlines_in_range_and_sees_what_the_union_shows(monkeypatch):
+    """Each sense intersected its rays with the union of every outline in the world:
+    50 ms a move in the FCND city (a 300 m run took 22 s). It now takes the outlines the
+    obstacles' index finds within range, and the hits are those of the union."""
+    import skyroute
+    from skyroute.motion import potential
+    from tests.conftest import ROOT
+
+    world = skyroute.load_world(str(ROOT / "examples" / "city.csv"), frame="ned",
+                                altitude=10, safety=2)
+    union = shapely.unary_union([shapely.boundary(g) for g in world.obstacles])
+    total = int(shapely.get_num_coordinates(union))
+    rng = np.random.default_rng(4)
+    pts = rng.uniform(*np.array(world.bounds).reshape(2, 2), size=(200, 2))
+    for p in pts[world.is_free(pts)][:60]:
+        got = potential._sense(world, p, 6.0, 36)
+        ang = np.arange(36) * 2 * math.pi / 36
+        ends = p + 6.0 * np.c_[np.cos(ang), np.sin(ang)]
+        hit = shapely.intersection(shapely.linestrings(
+            np.stack([np.broadcast_to(p, ends.shape), ends], axis=1)), union)
+        d = shapely.distance(shapely.Point(p), hit)
+        ok = ~shapely.is_empty(hit)
+        want = p + (d[ok] / 6.0)[:, None] * (ends[ok] - p)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
+    sizes = []
+    intersection = shapely.intersection
+
+    def spy(a, b, **kw):
+        sizes.append(int(shapely.get_num_coordinates(b).sum()))
+        return intersection(a, b, **kw)
+
+    monkeypatch.setattr(shapely, "intersection", spy)
+    run = run_field(world, (0.0, 0.0), (-60.0, 60.0), step=1.0, tolerance=1.0)
+    assert run.reached and sizes
+    assert max(sizes) < total / 4, (max(sizes), total)

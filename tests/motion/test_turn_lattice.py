@@ -4,7 +4,8 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, example, given, settings
+import shapely
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
@@ -161,3 +162,53 @@ def test_lattice_options_are_checked():
     r = plan_turns(grid, (50, 76), (60, 13), speed=np.float32(2), start_heading=np.array(1.0),
                    max_expansions=np.int64(10**6))
     assert r.found
+
+
+_box = st.tuples(st.floats(5, 80), st.floats(5, 80), st.floats(2, 20), st.floats(2, 20))
+_pt = st.tuples(st.floats(1, 99), st.floats(1, 99))
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(_box, max_size=5), _pt, _pt, st.sampled_from(["enu", "ned"]),
+       st.sampled_from([8, 16]), st.floats(-360, 360), st.sampled_from([2.0, 5.0]))
+def test_property_a_world_route_is_free_and_drives_along_its_headings(
+        boxes, start, goal, frame, headings, start_heading, resolution):
+    """On a World (a 100 m square, random boxes, read in enu or ned): every leg of the
+    route meets no obstacle's interior and stays inside the boundary (shapely), a move
+    drives along the heading it has (in the frame's convention), a turn in place is to a
+    neighbouring lattice heading, and the distance is the legs' length."""
+    from skyroute.motion.turn_lattice import _DIRS, plan_turns_world
+    from skyroute.world.world import World
+
+    obs = np.array([shapely.box(x, y, x + w, y + h) for x, y, w, h in boxes], dtype=object)
+    world = World(obs, np.full(len(obs), -np.inf), np.full(len(obs), np.inf), (),
+                  boundary=shapely.box(0, 0, 100, 100), frame=frame)
+    assume(world.is_free([start, goal]).all())  # plane points
+    flip = (lambda p: p[::-1]) if frame == "ned" else (lambda p: p)
+    s, g = flip(start), flip(goal)  # as the frame reads them
+    try:
+        res = plan_turns_world(world, s, g, headings=headings, resolution=resolution,
+                               start_heading=math.radians(start_heading))
+    except skyroute.QueryError as exc:  # no free cell in sight of a point (a narrow gap)
+        assert "is too close to an obstacle" in str(exc)
+        return
+    if not res.found:
+        assert res.status is skyroute.Status.NO_PATH
+        return
+    plane = world.to_plane(res.path)
+    line = shapely.LineString(plane) if len(plane) > 1 else shapely.Point(plane[0])
+    union = shapely.unary_union(obs)
+    assert not union.relate_pattern(line, "T********")  # no interior point shared
+    assert shapely.box(0, 0, 100, 100).contains(line)
+    th = np.asarray(world.heading_to_plane(res.headings))
+    d = np.diff(plane, axis=0)
+    moves = np.hypot(*d.T) > 1e-9
+    along = np.arctan2(d[:, 1], d[:, 0])
+    gap = lambda a, b: np.abs((a - b + math.pi) % (2 * math.pi) - math.pi)  # noqa: E731
+    assert (gap(along, th[1:])[moves] < 1e-9).all()  # drives the heading it has
+    assert (gap(th[1:], th[:-1])[moves] < 1e-9).all()  # and turns only in place
+    turns = gap(th[1:], th[:-1])[~moves]  # to a neighbouring lattice heading
+    ang = np.arctan2(*np.array(_DIRS[headings])[:, ::-1].T)
+    steps = gap(np.roll(ang, -1), ang)
+    assert all(np.isclose(steps, t, rtol=0, atol=1e-9).any() for t in turns)
+    assert res.distance == pytest.approx(float(np.hypot(*d.T).sum()), abs=1e-9)

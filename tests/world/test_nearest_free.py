@@ -36,14 +36,14 @@ def test_not_inside_an_overlapping_neighbour():
     world = rect_world([(0, 0, 2, 2), (1.5, 0, 4, 1.8)])
     p = suggested(world, (1.9, 1.7))
     assert world.is_free([p])[0]
-    assert p == (2.0, 1.8)  # the corner where the two edges meet; not (2.00, 1.70)
+    assert p == (2.01, 1.81)  # by the corner where the two edges meet; not (2.00, 1.70)
 
 
 def test_not_in_a_pocket_closed_in_by_the_block():
     # four boxes round a 1 m courtyard; the start is in the west box by the courtyard
     world = rect_world([(0, 0, 1, 3), (2, 0, 3, 3), (0, 0, 3, 1), (0, 2, 3, 3)])
     p = suggested(world, (0.9, 1.5))
-    assert p == (0.0, 1.5)  # not (1.0, 1.5), in the courtyard
+    assert p == (-0.01, 1.5)  # not (1.0, 1.5), in the courtyard
     assert skyroute.plan(world, p, (50, 50)).found
 
 
@@ -59,7 +59,7 @@ def test_inside_the_boundary():
     boundary = shapely.box(-0.5, -10, 10, 10)
     world = rect_world([(-1, -1, 1, 1)], boundary=boundary)
     p = suggested(world, (-0.4, 0.0), goal=(5, 5))
-    assert p in [(-0.4, 1.0), (-0.4, -1.0)]  # not (-1.00, 0.00), outside the boundary
+    assert p in [(-0.4, 1.01), (-0.4, -1.01)]  # not (-1.00, 0.00), outside the boundary
     assert world.is_free([p])[0]
 
 
@@ -98,3 +98,18 @@ def test_fcnd_block_of_touching_boxes():
     p = suggested(city, (300, 200), goal=(0, 0))
     assert city.is_free([p])[0]
     assert skyroute.plan(city, (0, 0), p).found
+
+
+def test_a_turning_vehicle_can_start_from_the_suggestion():
+    """The suggestion lay on the obstacle's edge, (50.00, 60.00): free, but Hybrid A*'s
+    pieces keep clear of every edge, so `fly --vehicle dubins` from it found no path
+    (after 572 expansions). It is now a step of the printed resolution off the edge,
+    on no edge."""
+    from skyroute.motion.hybrid import plan as hybrid_plan
+
+    world = rect_world([(40, 40, 60, 60)])
+    for start in ((50.0, 45.0), (45.0, 50.0), (58.0, 59.0)):
+        p = suggested(world, start, goal=(100.0, 100.0))
+        assert hybrid_plan(world, p, (100.0, 100.0), 10.0).found
+        assert world.is_free([p])[0]
+        assert shapely.distance(world.obstacles[0], shapely.Point(p)) > 0

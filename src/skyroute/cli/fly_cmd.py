@@ -181,11 +181,11 @@ def fly_command(
     h0 = _one_heading(h0, start_heading, "start")
     h1 = _one_heading(h1, goal_heading, "goal")
     with delayed_status("planning"):  # a first Dubins flight compiles for 10-20 s
-        world = wa.load_world_file(world_file, altitude=altitude, safety=safety,
-                                   boundary=boundary, frame=frame)
-        world.check_point(a, "start")  # one error, in the user's frame, for every vehicle
-        if targets is None:
-            world.check_point(b, "goal")
+        loaded = {"altitude": altitude, "safety": safety, "boundary": boundary, "frame": frame}
+        world = wa.load_world_file(world_file, **loaded)
+        # one error, in the user's frame, for every vehicle
+        wa.check_points(world_file, world, {"start": a} if targets is not None else
+                        {"start": a, "goal": b}, **loaded)
         radius, step, sensor_range, speed = (
             world.metres_in_plane(DEFAULT_METRES[name], near=a) if value is None else value
             for name, value in (("radius", radius), ("step", step),
@@ -194,7 +194,9 @@ def fly_command(
             world, a, b = world.in_frame("degrees"), world.to_lonlat(a)[0], world.to_lonlat(b)[0]
             doc, rows, xy = _fly_step(world, a, b, planner)
         elif vehicle == "dubins" and targets is not None:
-            visits = _read_targets(targets, world)
+            visits = _read_targets(targets)
+            wa.check_points(world_file, world, {f"{targets.name}: target {i + 1}": p
+                                                for i, p in enumerate(visits)}, **loaded)
             doc, rows, xy = _fly_tour(world, a, h0, visits, radius, step, max_expansions)
         elif vehicle == "dubins" and planner == "hybrid":
             doc, rows, xy = _fly_hybrid(world, a, b, h0, h1, radius, step, reverse,
@@ -343,7 +345,7 @@ def _one_heading(typed: float | None, option: float | None, what: str) -> float 
     return None if deg is None else math.radians(deg)
 
 
-def _read_targets(path: Path, world) -> np.ndarray:
+def _read_targets(path: Path) -> np.ndarray:
     """(N, 2) target points from a .csv (A,B per line, an optional header) or a .json
     list of [A, B]; errors name the file and line."""
     from skyroute.errors import InputFormatError
@@ -369,8 +371,6 @@ def _read_targets(path: Path, world) -> np.ndarray:
         pts = np.array(rows).reshape(-1, 2)
     if len(pts) == 0:
         raise InputFormatError(path, "no targets")
-    for i, p in enumerate(pts):
-        world.check_point(p, f"{path.name}: target {i + 1}")
     return pts
 
 

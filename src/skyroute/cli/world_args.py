@@ -93,3 +93,32 @@ def load_world_file(world_file: str, **options):
     except GridNotWorldError as exc:
         raise InputFormatError(exc.path, f"{exc.what}: plan on it with 'skyroute plan "
                                f"{world_file} --start X,Y --goal X,Y'", line=exc.line) from None
+
+
+def check_points(world_file: str, world, points: dict, **options) -> None:
+    """Each ``{what: point}`` (in the world's frame) free in ``world``, else its
+    QueryError; a point blocked only by the ``--safety`` margin is named so. It read
+    "lies inside obstacle 'box at line 3'" for a point 2 m outside the building, as if
+    the map had the building there; the world is read again without the margin, only
+    then (``options``: those ``world`` was loaded with)."""
+    from skyroute.errors import QueryError
+
+    safety = options.get("safety") or 0.0
+    for what, point in points.items():
+        try:
+            world.check_point(point, what)
+        except QueryError as exc:
+            if safety <= 0:
+                raise
+            p = world.to_plane(point, what)
+            j = int(world.blocking(p)[0])
+            phrase = f"lies inside obstacle {world.names[j]!r}" if j >= 0 else None
+            if phrase is None or phrase not in str(exc):
+                raise
+            bare = load_world_file(world_file, **{**options, "safety": 0.0})
+            if not bare.is_free(p)[0]:
+                raise
+            unit = "degrees" if world.plane == "degrees" else "m"
+            raise QueryError(str(exc).replace(
+                phrase, f"lies outside obstacle {world.names[j]!r} but within its --safety "
+                        f"{safety:g} {unit} margin")) from None

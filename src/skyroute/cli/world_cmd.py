@@ -76,8 +76,9 @@ def plan_world_command(
     b = wa.parse_pair(goal, "--goal", wa.point_names(frame))
     check_outputs(waypoints=waypoints_out, geojson=geojson, plot=plot)
     with delayed_status("planning"):  # a roadmap or raster, and a first run's compiles
-        world = wa.load_world_file(world_file, altitude=altitude, safety=safety,
-                                   boundary=boundary, frame=frame)
+        loaded = {"altitude": altitude, "safety": safety, "boundary": boundary, "frame": frame}
+        world = wa.load_world_file(world_file, **loaded)
+        wa.check_points(world_file, world, {"start": a, "goal": b}, **loaded)
         result = plan(world, a, b, algorithm=algorithm, **given)
     alt = 0.0 if altitude is None else altitude
     if result.found:

@@ -195,8 +195,19 @@ def piece_free(x, y, th, k, u, r, edges, start, items, x0, y0, cell, nx, ny, eps
     cx = cy = a0 = sweep = sag = 0.0
     res = cell / SUB
     slack = 0.7072 * res + abs(du) + eps  # half a sub-cell's diagonal, the chunk, eps
-    for j in range(n):
+    gx1, gy1 = x0 + nx * cell, y0 + ny * cell
+    j = -1
+    while j < n - 1:
+        j += 1
         px, py, pth = advance(x, y, th, k, du * j, r)
+        # outside the buckets' grid (whose edges lie a bucket inside it), the next m
+        # chunks stay within m |du| of here: skip those that cannot reach the grid, so a
+        # piece far longer than the world (a radius of kilometres round a city block)
+        # costs its chunks near the edges, not length / bucket of them
+        out = math.hypot(max(x0 - px, px - gx1, 0.0), max(y0 - py, py - gy1, 0.0))
+        if out > abs(du):
+            j += int(min(out / abs(du), n)) - 1
+            continue
         # a chunk lies within |du| of its start: far enough from every edge, it is free
         ci = math.floor((px - x0) / res)
         cj = math.floor((py - y0) / res)

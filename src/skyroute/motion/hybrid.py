@@ -65,6 +65,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+import shapely
 
 from skyroute.errors import (
     OptionError,
@@ -119,7 +120,11 @@ class HybridResult:
     of the planning. :meth:`sample` gives poses in the world's frame. ``extra``:
     ``raw_length`` before shortcutting, analytic ``tries``, ``shortcut_tries``; on
     ``budget_exhausted``, the ``budget`` spent, ``radii_across`` (the search region's
-    longer side in turning radii) and a one-line ``hint``.
+    longer side in turning radii) and a one-line ``hint``; on ``no_path``, which end's
+    states ran out (``closed``: "goal", no lattice state outside a few around the goal
+    reaches it, or "start", every state the start reaches was expanded) and after how
+    many expansions of that search (``closed_after``: a few hundred or less means that
+    end is boxed in, as a pose facing a wall).
     """
 
     status: Status
@@ -226,7 +231,9 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     Raises
     ------
     QueryError
-        a malformed pose, or a start or goal inside an obstacle or outside the boundary.
+        a malformed pose, or a start or goal inside an obstacle, outside the boundary,
+        or on an obstacle's edge (a face two touching obstacles share too) or within
+        1e-9 of the extent of an edge, where every piece would meet it.
     OptionError
         an out-of-range option.
     """
@@ -255,6 +262,8 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     world.check_plane_point(gxy, "goal", given=g_typed if approach is None else None)
     t0 = time.perf_counter()
     index = edge_index(world, _bucket(world))
+    _off_edges(world, index, sxy, "start", s_typed)
+    _off_edges(world, index, gxy, "goal", g_typed if approach is None else None)
     if final is not None:
         ok = _free(index, [Piece("S", final.start, final.length, r)])
         if not ok:
@@ -275,14 +284,18 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         back = lattice.search(gxy, _turned(gth), sxy, _turned(sth), first)
     if back.code == NO_PATH or (back.code == FOUND and back.expanded < first):
         res, expanded = back.reversed(reverse), back.expanded
+        closed = ("goal", back.expanded)
     else:
         res = lattice.search(sxy, sth, gxy, gth, limit - back.expanded)
         expanded = back.expanded + res.expanded
+        closed = ("start", res.expanded)
     status = STATUS_OF_CODE[res.code]
     start_pose = (float(sxy[0]), float(sxy[1]), math.nan if sth is None else float(sth))
     goal_pose = (float(gxy[0]), float(gxy[1]), math.nan if gth is None else float(gth))
     if status is not Status.FOUND:
         extra = {"tries": back.tries + res.tries}
+        if status is Status.NO_PATH:
+            extra.update(closed=closed[0], closed_after=int(closed[1]))
         if status is Status.BUDGET_EXHAUSTED:
             extra.update(budget=limit, radii_across=_across(region) / r,
                          hint=_hint(limit, max_expansions is None, _across(region) / r, r))
@@ -423,6 +436,34 @@ def _free(index, pieces: list[Piece]) -> bool:
         if not chain_free(*p.start, turns, lens, r, *index.args(), stamp, tick):
             return False
     return True
+
+
+def _off_edges(world: World, index, p: np.ndarray, what: str, given) -> None:
+    """A QueryError when the plane point ``p`` lies on an obstacle's edge, or within
+    ``index.eps`` of an obstacle's or the boundary's edge. Such a point is free in the
+    world, but every piece from or to it meets that edge: the search ended in no_path
+    after hundreds of expansions; and a face two touching obstacles share lies inside
+    their block (whose outline alone the pieces are tested against), so between two
+    points on such faces a path ran through the building."""
+    shown = world._fmt(p) if given is None else world._fmt_frame(given)
+    fix = "a turning vehicle's path keeps clear of every edge: move it off the edge"
+    if len(world.obstacles):
+        touch = world.tree.query(shapely.Point(p), predicate="intersects")
+        if len(touch):
+            raise QueryError(f"{what} {shown} lies on the edge of obstacle "
+                             f"{world.names[int(touch.min())]!r}; {fix}")
+    e = index.edges
+    if len(e) and _gap(e, p) <= index.eps:
+        raise QueryError(f"{what} {shown} lies within {index.eps:.1g} of an obstacle's or "
+                         f"the boundary's edge; {fix}")
+
+
+def _gap(edges: np.ndarray, p: np.ndarray) -> float:
+    """The distance from point ``p`` to the nearest of the (E, 4) segments."""
+    a, d = edges[:, :2], edges[:, 2:] - edges[:, :2]
+    L2 = np.einsum("ij,ij->i", d, d)
+    t = np.clip(np.einsum("ij,ij->i", p - a, d) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
+    return float(np.hypot(*(a + t[:, None] * d - p).T).min())
 
 
 def _bucket(world: World) -> float:

@@ -120,11 +120,34 @@ def _sense(world: World, p: np.ndarray, sensor_range: float, rays: int) -> np.nd
     ang = np.arange(rays) * 2 * math.pi / rays
     ends = p + sensor_range * np.c_[np.cos(ang), np.sin(ang)]
     lines = shapely.linestrings(np.stack([np.broadcast_to(p, ends.shape), ends], axis=1))
-    edges = _edges(world)
-    hit = shapely.intersection(lines, edges)
+    near = _near_edges(world, p, sensor_range)
+    if len(near) == 0:
+        return np.empty((0, 2))
+    # each ray against each outline in range, the nearest hit kept: the same points as
+    # against the union of every outline, which cost 50 ms a sense in the FCND city
+    hit = shapely.intersection(lines[:, None], near[None, :])
     d = shapely.distance(shapely.Point(p), hit)
-    ok = ~shapely.is_empty(hit) & np.isfinite(d)
+    d = np.where(shapely.is_empty(hit) | ~np.isfinite(d), np.inf, d).min(axis=1)
+    ok = np.isfinite(d)
     return p + (d[ok] / sensor_range)[:, None] * (ends[ok] - p)
+
+
+_OUTLINE_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+register(_OUTLINE_CACHE.clear)
+
+
+def _near_edges(world: World, p: np.ndarray, reach: float) -> np.ndarray:
+    """The outlines (obstacles' boundaries and the boundary's exterior) whose boxes come
+    within ``reach`` of ``p`` (the obstacles' STRtree; outlines cached per world)."""
+    if world not in _OUTLINE_CACHE:
+        rings = shapely.boundary(world.obstacles) if len(world.obstacles) else \
+            np.empty(0, dtype=object)
+        outer = None if world.boundary is None else shapely.Polygon(world.boundary).exterior
+        _OUTLINE_CACHE[world] = (np.asarray(rings, dtype=object), outer)
+    rings, outer = _OUTLINE_CACHE[world]
+    near = rings[world.tree.query(shapely.box(*(p - reach), *(p + reach)))] if len(rings) \
+        else rings
+    return near if outer is None else np.append(near, outer)
 
 
 _EDGE_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

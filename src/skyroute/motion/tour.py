@@ -122,7 +122,11 @@ def tour(start_pose, targets, radius: float, *, world: World | None = None,
     radians in its convention (clockwise from north in "lonlat" and "ned", anticlockwise
     from +x in "enu" and "degrees"), and each leg is flown by
     :func:`skyroute.motion.hybrid.plan` (``max_expansions``, ``seed``) to the chosen
-    arrival heading; a leg it cannot fly makes the tour's status.
+    arrival heading. A leg it finds no path for (a target reached heading into a wall
+    is a dead end, which the table's lower bounds do not see) takes its arcs out of the
+    table and the tour is solved again (``extra["repairs"]`` counts these); a leg out of
+    budget makes the tour's status. ``no_path`` with no legs: no order has a finite cost
+    (a target walled off).
     """
     t0 = time.perf_counter()
     radius = real("radius", radius, low=0.0, strict=True)  # numpy numbers too
@@ -149,20 +153,55 @@ def tour(start_pose, targets, radius: float, *, world: World | None = None,
     dist0 = np.hypot(*(plane - s[:2]).T)
     D = np.hypot(*(plane[:, None] - plane[None]).transpose(2, 0, 1))
     greedy_bound, greedy = nearest_first(c0, C, dist0, D, n, H)
-    if n <= exact_limit:
-        bound, places = held_karp(c0, C, n, H)
-        method = "exact"
-    else:
-        bound, places = improve(greedy // H, c0, C, H, 50)
-        method = "local search"
+    method = "exact" if n <= exact_limit else "local search"
+    flown: dict = {}  # (place before or -1 for the start, place) -> HybridResult
+    repairs = 0
+    while True:
+        if n <= exact_limit:
+            bound, places = held_karp(c0, C, n, H)
+        else:
+            bound, places = improve(greedy // H, c0, C, H, 50)
+        if not math.isfinite(bound):  # no order in the table: a target walled off in
+            # 2D (Held-Karp's places are then no tour), or every way cut below
+            return TourResult(Status.NO_PATH, (), np.empty(0), (), math.inf, method,
+                              math.inf, float(greedy_bound), time.perf_counter() - t0,
+                              {"headings": H, "targets": n, "repairs": repairs})
+        legs, status, length, failed = _fly(world, s, plane, places, cand, float(radius),
+                                            max_expansions, seed, flown)
+        if status is not Status.NO_PATH or not _cut(c0, C, places, failed, legs[-1]):
+            break
+        repairs += 1
     order = tuple(int(p // H) for p in places)
     heads = cand[places % H]
-    legs, status, length = _fly(world, s, plane, order, heads, float(radius),
-                                max_expansions, seed)
     out_heads = heads if world is None else world.heading_from_plane(heads)
     return TourResult(status, order, np.asarray(out_heads, dtype=float), tuple(legs), length,
                       method, float(bound), float(greedy_bound), time.perf_counter() - t0,
-                      {"headings": H, "targets": n})
+                      {"headings": H, "targets": n, "repairs": repairs})
+
+
+def _cut(c0, C, places, failed: int, leg) -> bool:
+    """Take out of the leg table (in place) the arcs that made leg ``failed`` of the tour
+    ``places`` a ``no_path``, so the next order avoids them; False when the tour cannot
+    be flown at all (the start pose is boxed in).
+
+    A target reached on one heading may be a dead end (facing a wall a metre away, no
+    turn gets out) or reachable from nowhere (a wall behind it), which the table's lower
+    bounds do not see. Hybrid A* says which end ran out of states
+    (``extra["closed"]``): a start boxed in (its search ran out within the few hundred
+    expansions of the reversed one) loses every arc out of its place, which may still end
+    the tour; otherwise the goal's place loses every arc into it. Each cut removes arcs
+    the tour used, so the repairs end, after at most two per place."""
+    a = places[failed - 1] if failed else -1
+    b = places[failed]
+    if leg.extra.get("closed") == "start" and \
+            leg.extra.get("closed_after", math.inf) <= hybrid._REVERSE_BUDGET:
+        if a < 0:
+            return False
+        C[a, :] = math.inf
+    else:
+        c0[b] = math.inf
+        C[:, b] = math.inf
+    return True
 
 
 def _with_obstacles(world, s, plane, H, c0, C):
@@ -182,11 +221,15 @@ def _with_obstacles(world, s, plane, H, c0, C):
     return c0, C
 
 
-def _fly(world, s, plane, order, heads, r, max_expansions, seed):
-    """The legs in visiting order: Dubins pieces, or Hybrid A* among obstacles."""
-    legs, length, pose = [], 0.0, tuple(float(v) for v in s)
-    for k, h in zip(order, heads, strict=True):
-        goal = (float(plane[k, 0]), float(plane[k, 1]), float(h))
+def _fly(world, s, plane, places, cand, r, max_expansions, seed, flown):
+    """The legs in visiting order (Dubins pieces, or Hybrid A* among obstacles), the
+    status, the length and the index of the leg that failed (len(places) when none).
+    ``flown`` keeps the Hybrid A* legs by (place before, place) for a repaired order."""
+    legs, length, pose, prev = [], 0.0, tuple(float(v) for v in s), -1
+    H = len(cand)
+    for i, p in enumerate(places):
+        p = int(p)
+        goal = (float(plane[p // H, 0]), float(plane[p // H, 1]), float(cand[p % H]))
         if world is None:
             lens, total = words(*pose, *goal, r)
             w = int(np.argmin(total))
@@ -194,15 +237,15 @@ def _fly(world, s, plane, order, heads, r, max_expansions, seed):
             legs.append(leg)
             length += float(total[w])
         else:
-            a = (*world.from_plane([pose[:2]])[0], float(world.heading_from_plane(pose[2])))
-            b = (*world.from_plane([goal[:2]])[0], float(world.heading_from_plane(goal[2])))
-            leg = hybrid.plan(world, a, b, r, max_expansions=max_expansions, seed=seed)
+            if (prev, p) not in flown:
+                a = (*world.from_plane([pose[:2]])[0], float(world.heading_from_plane(pose[2])))
+                b = (*world.from_plane([goal[:2]])[0], float(world.heading_from_plane(goal[2])))
+                flown[prev, p] = hybrid.plan(world, a, b, r, max_expansions=max_expansions,
+                                             seed=seed)
+            leg = flown[prev, p]
             legs.append(leg)
             if not leg.found:
-                return legs, leg.status, math.inf
+                return legs, leg.status, math.inf, i
             length += leg.length
-        pose = goal
-    return legs, Status.FOUND, length
-
-
-
+        pose, prev = goal, p
+    return legs, Status.FOUND, length, len(places)

@@ -6,7 +6,8 @@ colliders city overlap (the FCND city is built of touching 10 m boxes, and ``saf
 grows them into each other), so the edge of one box is often inside its neighbour, and a
 gap between boxes inside a block is free but closed in. And it must be free as printed,
 since the caller types it back: a point 1 mm outside an edge, shown to the cm, can round
-back inside.
+back inside. And it must be off the edge, not on it: a point on an edge is free, but a
+turning vehicle cannot leave it (Hybrid A*'s pieces keep clear of every edge).
 """
 
 from __future__ import annotations
@@ -54,8 +55,8 @@ def _block(world, j: int):
 def _stepped_out(world, block, p: np.ndarray, q: np.ndarray,
                  decimals: int) -> np.ndarray | None:
     """Of the points stepped out from ``q`` (on the block's edge) whose rounded form is
-    free and outside the block, the one nearest ``p``, as typed back from its rounded
-    form. (The edge two touching obstacles share is free in the world, which tests each
+    free and off every obstacle (on no edge), the one nearest ``p``, as typed back from
+    its rounded form. (The edge two touching obstacles share is free in the world, which tests each
     obstacle alone, but inside the block, as the visibility graph merges them.)"""
     step = 10.0 ** -decimals / 10 if world.frame == "degrees" else 1e-3
     away = (q - p) / (np.hypot(*(q - p)) or 1.0)
@@ -64,7 +65,20 @@ def _stepped_out(world, block, p: np.ndarray, q: np.ndarray,
     k = np.arange(1, STEPS + 1)[:, None, None] * step
     cand = (q + k * dirs[None]).reshape(-1, 2)
     back = world.to_plane(np.round(world.from_plane(cand), decimals) + 0.0)  # no -0.00
-    ok = np.flatnonzero(world.is_free(back) & ~shapely.within(shapely.points(back), block))
+    # off the block's edge, not on it: a point on an edge is free, but no turning
+    # vehicle can leave it (Hybrid A*'s pieces keep clear of every edge: no_path)
+    pts = shapely.points(back)
+    ok = np.flatnonzero(world.is_free(back) & shapely.disjoint(pts, block)
+                        & ~world_touches(world, pts))
     if len(ok) == 0:
         return None
     return back[ok[np.argmin(np.hypot(*(back[ok] - p).T))]]
+
+
+def world_touches(world, pts) -> np.ndarray:
+    """True for each point on an obstacle's edge (free, but on it)."""
+    out = np.zeros(len(pts), bool)
+    if len(world.obstacles):
+        ip, _ = world.tree.query(pts, predicate="intersects")
+        out[ip] = True
+    return out
