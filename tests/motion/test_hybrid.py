@@ -84,14 +84,22 @@ def check_path(world: World, res, start, goal, radius, *, ds=0.05, reverse=False
     assert np.all(2 * radius * np.sin(turn / 2) <= chord * (1 + 1e-6) + 1e-6)
     moving = chord > 1e-6  # shorter chords: their direction is rounding noise
     mid = poses[:-1, 2] + wrap(np.diff(poses[:, 2])) / 2
+    # the first and last rows are pinned to the poses given, and a piece starts within
+    # rounding of where the one before it ends: a chord of c beside such a gap g turns
+    # by up to about 2 g / c (a 0.1 mm path of 17 um chords: 1.1e-6 rad)
+    first = res.segments[0].start if res.segments else res.start
+    gap = max([math.dist(first[:2], poses[0, :2]), math.dist(end[:2], poses[-1, :2])]
+              + [math.dist(a.end[:2], b.start[:2])
+                 for a, b in zip(res.segments[:-1], res.segments[1:], strict=True)])
+    tol = (1e-6 + 2 * gap / np.maximum(chord, 1e-300))[moving]
     off = np.abs(wrap(np.arctan2(d[:, 1], d[:, 0]) - mid))[moving]
     backwards = any(p.reverse for p in res.segments)
     if backwards:  # each chord along the nose or straight behind it
-        assert np.all((off < 1e-6) | (off > math.pi - 1e-6))
+        assert np.all((off < tol) | (off > math.pi - tol))
         if any(p.reverse and p.length > 2 * ds for p in res.segments):
             assert np.any(off > 3)
     else:
-        assert np.all(off < 1e-6)
+        assert np.all(off < tol)
     # at least the lower bound
     if len(start) == 3 and len(goal) == 3:
         lb_dubins = max(math.dist(start[:2], goal[:2]),
