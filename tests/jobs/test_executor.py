@@ -148,6 +148,36 @@ def test_a_server_that_is_no_scheduler_is_an_error_within_the_timeout(monkeypatc
     assert "\n" not in str(err) and err.param == "address"
 
 
+def test_a_tls_scheduler_of_the_dask_configuration_is_reached(tmp_path):
+    """A ``tls://`` scheduler whose certificates are in Dask's configuration, as
+    ``Client`` reads them: the handshake check connected without them and refused it
+    ("TLS expects a `ssl_context` argument")."""
+    import shutil
+    import subprocess
+
+    import dask
+    from distributed import LocalCluster
+    from distributed.security import Security
+
+    if shutil.which("openssl") is None:
+        pytest.skip("no openssl to make a certificate")
+    cert, key = str(tmp_path / "cert.pem"), str(tmp_path / "key.pem")
+    subprocess.run(["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout",
+                    key, "-out", cert, "-days", "1", "-subj", "/CN=localhost", "-addext",
+                    "subjectAltName=IP:127.0.0.1"], check=True, capture_output=True)
+    roles = {f"tls_{r}_{k}": v for r in ("client", "scheduler", "worker")
+             for k, v in (("cert", cert), ("key", key))}
+    security = Security(tls_ca_file=cert, require_encryption=True, **roles)
+    config = {"distributed.comm.require-encryption": True,
+              "distributed.comm.tls.ca-file": cert, "distributed.comm.tls.client.cert": cert,
+              "distributed.comm.tls.client.key": key}
+    cluster = LocalCluster(n_workers=0, processes=False, protocol="tls", security=security,
+                           host="127.0.0.1", dashboard_address=None)
+    with cluster, dask.config.set(config), \
+            open_executor("dask", address=cluster.scheduler_address) as ex:
+        assert ex.client.scheduler.address == cluster.scheduler_address
+
+
 def test_an_existing_scheduler_runs_the_tasks(dask_executor):
     address = dask_executor.client.scheduler.address
     with open_executor("dask", address=address, workers=5) as ex:  # workers: unused

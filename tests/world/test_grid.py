@@ -395,6 +395,26 @@ def test_an_array_of_text_or_ragged_rows_is_refused_naming_it(make, param, bad, 
     assert str(err.value).startswith(f"{param} must ") and words in str(err.value)
 
 
+def _holding_an_array():
+    a = np.zeros((1, 2), dtype=object)
+    a[0, 1] = np.eye(3)
+    return a
+
+
+@pytest.mark.parametrize("make, param", [(Grid, "blocked"), (from_array, "array")])
+@pytest.mark.parametrize("bad, words", [
+    # numpy reads a sparse matrix as one object: its repr ran over two lines
+    (lambda: __import__("scipy.sparse").sparse.csr_matrix(np.eye(3)), "got csr_matrix"),
+    (_holding_an_array, "got array([[1., 0., 0.], [0., 1., 0.], [0., 0., 1.]])"),
+    (lambda: None, "got None"),
+])
+def test_an_object_that_is_no_number_is_named_in_one_line(make, param, bad, words):
+    with pytest.raises(OptionError) as err:
+        make(bad())
+    assert err.value.param == param and "\n" not in str(err.value)
+    assert str(err.value).startswith(f"{param} must ") and str(err.value).endswith(words)
+
+
 @pytest.mark.parametrize("values", [
     np.array([[0, 1], [0, 0]], dtype=object),  # numbers as objects: read as numbers
     [[False, np.True_], [0, 0.0]],

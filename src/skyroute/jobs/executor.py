@@ -458,19 +458,23 @@ def _handshake(address: str) -> None:
     after it: another server on the port (the dashboard's 8787, any HTTP server) kept
     ``Client`` waiting for ever when silent, and its answer, read as a frame length,
     was a MemoryError of exabytes. Run on a thread of its own, with its own event loop,
-    as a server calls this from inside one."""
+    as a server calls this from inside one. It connects as ``Client`` does, with the
+    connection arguments of Dask's configuration (a ``tls://`` scheduler's certificates).
+    """
     import asyncio
     from concurrent.futures import ThreadPoolExecutor
 
     from dask.utils import parse_timedelta
     from distributed.comm import connect
+    from distributed.security import Security
 
     timeout = parse_timedelta(CONNECT_TIMEOUT, default="seconds")
     bound = timeout + 2  # connect() ends an unanswered connection at timeout, its way
+    args = Security().get_connection_args("client")  # Client's own, from the config
 
     async def shake():
         try:
-            comm = await asyncio.wait_for(connect(address, timeout=timeout), bound)
+            comm = await asyncio.wait_for(connect(address, timeout=timeout, **args), bound)
         except TimeoutError:
             raise OSError(f"something at {address} took the connection but did not "
                           f"answer as a Dask scheduler within {bound:g} s") from None

@@ -37,10 +37,15 @@ def occupancy_values(array: object, name: str) -> np.ndarray:
         raise OptionError(f"{name} must be a 2-D array of numbers or booleans, its rows "
                           f"of equal length", param=name) from None
     if values.dtype.kind == "O":  # a list mixing numbers and other objects
+        if values.ndim == 0:  # no array at all (a scipy sparse matrix: use .toarray())
+            got = "None" if array is None else type(array).__name__
+            raise OptionError(f"{name} must be a 2-D array of numbers or booleans, got "
+                              f"{got}", param=name)
         for v in values.flat:
             if not isinstance(v, numbers.Real | np.bool_):
+                shown = " ".join(repr(v).split())  # one line: an array's repr has several
                 raise OptionError(f"{name} must hold numbers or booleans (non-zero "
-                                  f"blocked), got {v!r}", param=name)
+                                  f"blocked), got {shown}", param=name)
         return values.astype(np.float64)
     if values.dtype.kind not in "biuf":
         text = ": convert text first, e.g. (array == '@')" if values.dtype.kind in "US" \
