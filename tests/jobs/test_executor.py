@@ -90,6 +90,69 @@ def test_a_scheduler_that_does_not_answer_is_an_error_within_the_timeout(monkeyp
     assert not isinstance(err.value, OptionError)
 
 
+@contextlib.contextmanager
+def _not_a_scheduler(answer: bytes | None):
+    """A TCP server on a free local port that takes every connection and sends
+    ``answer`` (None: nothing, as a web server waiting for a whole request does); its
+    address."""
+    import socket
+    import threading
+
+    server = socket.create_server(("127.0.0.1", 0))
+    taken: list[socket.socket] = []
+
+    def serve() -> None:
+        while True:
+            try:
+                conn, _ = server.accept()
+            except OSError:  # closed
+                return
+            taken.append(conn)
+            if answer is not None:
+                conn.sendall(answer)
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        yield f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    finally:
+        server.close()
+        for conn in taken:
+            conn.close()
+
+
+@pytest.mark.parametrize("answer, words", [
+    (None, "it took the connection but did not answer as a Dask scheduler within 1.5 s"),
+    (b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n",
+     "it answered, but not as a Dask scheduler"),
+])
+def test_a_server_that_is_not_a_scheduler_is_one_line_within_the_timeout(monkeypatch,
+                                                                           answer, words):
+    """--dask naming the dashboard's port (or any server that is not Dask): distributed
+    waited for its handshake forever, or read a web server's answer as the length of a
+    message (a MemoryError traceback)."""
+    import threading
+
+    monkeypatch.setattr(executor_mod, "CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr(executor_mod, "HANDSHAKE_TIMEOUT", 0.5, raising=False)
+    got: list[BaseException] = []
+
+    def attempt() -> None:
+        try:
+            open_executor("dask", address=address).close()
+        except BaseException as exc:  # noqa: BLE001 - looked at below
+            got.append(exc)
+
+    with _not_a_scheduler(answer) as address:
+        thread = threading.Thread(target=attempt, daemon=True)
+        thread.start()
+        thread.join(timeout=30)
+        assert not thread.is_alive(), f"{address}: still connecting after 30 s"
+    assert len(got) == 1 and isinstance(got[0], SkyrouteError), got
+    text = str(got[0])
+    assert text.startswith(f"address={address!r}: no Dask scheduler there (")
+    assert words in text and "\n" not in text and got[0].param == "address"
+
+
 def test_an_existing_scheduler_runs_the_tasks(dask_executor):
     address = dask_executor.client.scheduler.address
     with open_executor("dask", address=address, workers=5) as ex:  # workers: unused

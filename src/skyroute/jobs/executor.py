@@ -452,6 +452,60 @@ def _gather(submit: Callable, items: list, window: int, on_result,
     return out
 
 
+HANDSHAKE_TIMEOUT = 5.0  # seconds more for a server that took the connection to answer
+
+
+class NotDaskError(OSError):
+    """A server at the address took the connection but did not answer as a Dask
+    scheduler (said as the reason of "no Dask scheduler there")."""
+
+
+def _handshake(address: str) -> None:
+    """Connect to the scheduler at ``address`` and read its handshake, as the Client is
+    about to, but within :data:`CONNECT_TIMEOUT` plus :data:`HANDSHAKE_TIMEOUT` in all.
+
+    distributed waits for the handshake without a limit once the TCP connection is
+    made: ``--dask`` naming a server that takes connections but is not a scheduler (the
+    scheduler's dashboard port 8787, a database) held the command forever, and one
+    that answered other bytes (an error page) raised a MemoryError traceback, reading
+    them as the length of a message. Run in a thread of its own: the caller may be in
+    an event loop (a server's)."""
+    import asyncio
+
+    from dask.utils import parse_timedelta
+    from distributed.comm import connect
+
+    seconds = parse_timedelta(CONNECT_TIMEOUT)
+    limit = seconds + HANDSHAKE_TIMEOUT
+    outcome: list[BaseException | None] = []
+
+    async def shake() -> None:
+        # connect's own timeout bounds the connecting (an OSError "Timed out trying to
+        # connect ..."), so the outer limit, later, is met only while waiting to be answered
+        comm = await connect(address, timeout=seconds)
+        await comm.close()
+
+    def run() -> None:
+        try:
+            asyncio.run(asyncio.wait_for(shake(), limit))
+            outcome.append(None)
+        except (OSError, ValueError, TypeError) as exc:
+            outcome.append(NotDaskError(
+                "it took the connection but did not answer as a Dask scheduler within "
+                f"{limit:g} s; a dashboard's port (8787)?")
+                if isinstance(exc, TimeoutError) and not str(exc) else exc)
+        except Exception as exc:  # what it answered is not Dask's protocol
+            outcome.append(NotDaskError(
+                f"it answered, but not as a Dask scheduler ({type(exc).__name__}); "
+                "a dashboard's port (8787)?"))
+
+    thread = threading.Thread(target=run, name="skyroute-dask-handshake", daemon=True)
+    thread.start()
+    thread.join()
+    if outcome and outcome[0] is not None:
+        raise outcome[0]
+
+
 class DaskExecutor(_Executor):
     """Tasks on a Dask cluster: an existing scheduler, or an in-process ``LocalCluster``.
 
@@ -485,6 +539,7 @@ class DaskExecutor(_Executor):
                 raise OptionError(f"address={address!r} must be a scheduler address like "
                                   "tcp://HOST:8786", param="address")
             try:
+                _handshake(address)
                 self.client = Client(address, timeout=CONNECT_TIMEOUT)
             except (OSError, ValueError, TypeError) as exc:
                 reason = " ".join(str(exc).split()) or type(exc).__name__
