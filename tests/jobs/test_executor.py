@@ -153,6 +153,35 @@ def test_a_server_that_is_not_a_scheduler_is_one_line_within_the_timeout(monkeyp
     assert words in text and "\n" not in text and got[0].param == "address"
 
 
+def _in_memory(dask_scheduler, prefix: str) -> int:
+    """On the scheduler: how many tasks whose key starts with ``prefix`` hold a result."""
+    return sum(1 for k, ts in dask_scheduler.tasks.items()
+               if str(k).startswith(prefix) and ts.state == "memory")
+
+
+def test_dask_lets_go_of_each_result_once_it_has_it(dask_executor):
+    """A result taken is released on the cluster while the map runs: kept to the map's
+    end, every result stayed in its worker's memory, and a worker that died late in a
+    range had every task it had finished run again."""
+    client = dask_executor.client
+    quick: list[int] = []  # the quick tasks come back long before the slow one
+    held: list[int] = []  # tasks in memory on the cluster once all three came back
+
+    def on_result(i: int, _r) -> None:
+        if i == 3:
+            return
+        quick.append(i)
+        if len(quick) == 3:  # wait (up to 3 s) until the scheduler has let go of them
+            end = time.monotonic() + 3
+            while not held or held[-1] and time.monotonic() < end:
+                held.append(client.run_on_scheduler(_in_memory, prefix="sleep-"))
+                time.sleep(0.05)
+
+    out = dask_executor.map(time.sleep, [0.0, 0.0, 0.0, 5.0], on_result=on_result)
+    assert out == [None] * 4 and sorted(quick) == [0, 1, 2]
+    assert held[-1] == 0, f"{held[-1]} finished tasks still held on the cluster"
+
+
 def test_an_existing_scheduler_runs_the_tasks(dask_executor):
     address = dask_executor.client.scheduler.address
     with open_executor("dask", address=address, workers=5) as ex:  # workers: unused

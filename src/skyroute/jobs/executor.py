@@ -47,6 +47,7 @@ died every time it was tried (see each kind) is raised at the end as
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import itertools
 import logging
@@ -598,6 +599,11 @@ class DaskExecutor(_Executor):
         try:
             for f in as_completed(futures):
                 i = index[f.key]
+                # let go of each task once its result is here: held to the map's end,
+                # every result stayed in its worker's memory, and a worker that died
+                # had all the tasks it had finished run again (a long range of days
+                # flown twice over, while the map waited for its last ones)
+                futures[i] = None
                 try:
                     out[i] = f.result()
                 except KilledWorker as exc:  # the others run on
@@ -606,12 +612,15 @@ class DaskExecutor(_Executor):
                                f"its Dask worker died running it, on each of the {tries} "
                                "workers that tried it") + " (KilledWorker; see the workers' logs)"
                     continue
+                finally:
+                    with contextlib.suppress(RuntimeError):  # a client closed meanwhile
+                        f.release()
                 if on_result:
                     on_result(i, out[i])
         except Exception as exc:
             if self._closed:  # the client closed under this map: nothing left to cancel
                 raise _closed(self) from None
-            self.client.cancel(futures)
+            self.client.cancel([f for f in futures if f is not None])
             if not isinstance(exc, RuntimeError) or "deserializ" not in str(exc):
                 raise
             raise SkyrouteError(f"the Dask scheduler at {self.client.scheduler.address} "
@@ -619,7 +628,7 @@ class DaskExecutor(_Executor):
                                 "the scheduler and every worker") from None
         except BaseException:
             if not self._closed:
-                self.client.cancel(futures)
+                self.client.cancel([f for f in futures if f is not None])
             raise
         finally:
             del futures
