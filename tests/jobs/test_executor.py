@@ -182,6 +182,24 @@ def test_dask_lets_go_of_each_result_once_it_has_it(dask_executor):
     assert held[-1] == 0, f"{held[-1]} finished tasks still held on the cluster"
 
 
+def test_ctrl_c_in_the_terminal_leaves_the_local_clusters_workers_to_the_command():
+    """Ctrl-C reaches every process of the terminal's group: each worker of the
+    in-process cluster printed a KeyboardInterrupt traceback over the command's
+    "skyroute: interrupted", and its nanny started it again. They ignore it; the
+    command closes the cluster."""
+    import os
+    import signal
+
+    with open_executor("dask", workers=1) as ex:
+        client = ex.client
+        (pid,) = client.run(os.getpid).values()
+        os.kill(pid, signal.SIGINT)
+        time.sleep(1.0)  # a worker that took it ends, and its nanny starts another
+        client.wait_for_workers(1, timeout=10)
+        assert list(client.run(os.getpid).values()) == [pid]
+        assert ex.map(math.sqrt, [4.0]) == [2.0]
+
+
 def test_an_existing_scheduler_runs_the_tasks(dask_executor):
     address = dask_executor.client.scheduler.address
     with open_executor("dask", address=address, workers=5) as ex:  # workers: unused

@@ -533,7 +533,8 @@ class DaskExecutor(_Executor):
             self._cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
                                          threads_per_worker=1, processes=True,
                                          dashboard_address=None,
-                                         silence_logs=logging.ERROR)
+                                         silence_logs=logging.ERROR,
+                                         preload=["skyroute.jobs.local_worker"])
             self.client = Client(self._cluster)
         else:
             if not isinstance(address, str):
