@@ -139,7 +139,7 @@ def test_a_server_that_is_not_a_scheduler_is_one_line_within_the_timeout(monkeyp
     def attempt() -> None:
         try:
             open_executor("dask", address=address).close()
-        except BaseException as exc:  # noqa: BLE001 - looked at below
+        except BaseException as exc:
             got.append(exc)
 
     with _not_a_scheduler(answer) as address:
@@ -173,7 +173,7 @@ def test_dask_lets_go_of_each_result_once_it_has_it(dask_executor):
         quick.append(i)
         if len(quick) == 3:  # wait (up to 3 s) until the scheduler has let go of them
             end = time.monotonic() + 3
-            while not held or held[-1] and time.monotonic() < end:
+            while not held or (held[-1] and time.monotonic() < end):
                 held.append(client.run_on_scheduler(_in_memory, prefix="sleep-"))
                 time.sleep(0.05)
 
