@@ -220,6 +220,22 @@ def test_another_skyroute_on_the_cluster_is_refused(dask_executor, monkeypatch):
                               "skyroute on the scheduler and every worker")
 
 
+def test_a_worker_that_cannot_import_the_tasks_is_refused(dask_executor, monkeypatch):
+    """A worker whose skyroute is installed (the versions agree) but does not import (a
+    dependency missing on its machine; here a module of the tasks that is not there)
+    closed itself on its first task, and with no other worker the run waited forever."""
+    monkeypatch.setattr(executor_mod, "TASK_IMPORTS", "import skyroute.jobs.no_such_module",
+                        raising=False)
+    address = dask_executor.client.scheduler.address
+    with pytest.raises(SkyrouteError) as err:
+        open_executor("dask", address=address)
+    text = str(err.value)
+    assert text.startswith(f"address={address!r}: worker tcp://") and "\n" not in text
+    assert ("cannot import skyroute's tasks (ModuleNotFoundError: No module named "
+            "'skyroute.jobs.no_such_module'); install the same skyroute") in text
+    assert dask_executor.map(math.sqrt, [4.0]) == [2.0]  # the workers are still there
+
+
 @pytest.mark.parametrize("kind, workers", [("local", 2), ("local", 1), ("dask", 1)])
 def test_closing_cuts_off_another_threads_map_with_a_clear_error(kind, workers):
     """A server shutting down closes its executor while a lane's map runs: that map ends
@@ -515,3 +531,32 @@ def test_a_task_every_pool_refuses_is_lost_in_one_line(monkeypatch):
     assert info.value.lost[0] == ("its worker process died (exit status unknown), also "
                                   "when run again alone")
     assert str(info.value).startswith("1 of the 3 tasks was lost: task 0: its worker ")
+
+
+def test_a_scheduler_without_workers_says_so_and_its_tasks_wait_for_one(caplog):
+    """A scheduler whose workers have not joined (or have all left): the tasks wait for
+    one without a word from Dask, and the command looked hung. It says so once."""
+    import logging
+    import threading
+
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=0, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, \
+            caplog.at_level(logging.WARNING, logger="skyroute.jobs"), \
+            open_executor("dask", address=cluster.scheduler_address) as ex:
+        out: list = []
+        thread = threading.Thread(target=lambda: out.append(ex.map(math.sqrt, [9.0])))
+        thread.start()
+
+        def said() -> list[str]:
+            return [r.getMessage() for r in caplog.records if r.name == "skyroute.jobs"]
+
+        end = time.monotonic() + 30
+        while not said() and time.monotonic() < end:
+            time.sleep(0.05)
+        assert said() == [f"the Dask scheduler at {cluster.scheduler_address} has no "
+                          "workers; the tasks wait until one joins"]
+        cluster.scale(1)
+        thread.join(timeout=60)
+        assert out == [[3.0]]

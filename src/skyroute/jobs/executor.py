@@ -453,6 +453,9 @@ def _gather(submit: Callable, items: list, window: int, on_result,
     return out
 
 
+# what a worker runs to import the modules skyroute's tasks name (run by ``exec``, a
+# builtin: a function of skyroute's own could not be sent to a worker that lacks it)
+TASK_IMPORTS = "import skyroute.jobs.deliver, skyroute.jobs.fleet"
 HANDSHAKE_TIMEOUT = 5.0  # seconds more for a server that took the connection to answer
 
 
@@ -550,6 +553,7 @@ class DaskExecutor(_Executor):
                                     param="address") from None
             try:
                 self._check_versions()
+                self._check_imports()
             except BaseException:
                 self.client.close()
                 raise
@@ -574,6 +578,20 @@ class DaskExecutor(_Executor):
                     f"{theirs or '(not installed)'}, this machine {mine}; install the same "
                     "skyroute on the scheduler and every worker", param="address")
 
+    def _check_imports(self) -> None:
+        """Every worker must import skyroute's tasks. One whose skyroute is installed
+        (the versions agree) but does not import (a dependency missing or broken on its
+        machine) closes itself on its first task, reading it; with no other worker the
+        run waited forever. Importing them now also spares the first tasks the time."""
+        got = self.client.run(exec, TASK_IMPORTS, on_error="return")
+        for worker, r in sorted(got.items()):
+            if isinstance(r, BaseException):
+                why = " ".join(str(r).split()) or "no message"
+                raise SkyrouteError(
+                    f"address={self.address!r}: worker {worker} cannot import skyroute's "
+                    f"tasks ({type(r).__name__}: {why}); install the same skyroute, with "
+                    "its dependencies, on the scheduler and every worker", param="address")
+
     def __repr__(self) -> str:
         where = self.address or "LocalCluster"
         return f"DaskExecutor({where}, workers={self.workers})"
@@ -591,6 +609,11 @@ class DaskExecutor(_Executor):
             raise _closed(self)
         if not items:
             return []
+        if self.address is not None and not self.workers:
+            # (a scheduler started before its workers, or whose workers all left): the
+            # tasks wait for one, which Dask does without a word: the run looked hung
+            log.warning("the Dask scheduler at %s has no workers; the tasks wait until "
+                        "one joins", self.address)
         # pure=False: a task is run each time it is asked for, never served from an
         # earlier identical call (the tasks write to the store)
         futures = self.client.map(fn, items, pure=False)
