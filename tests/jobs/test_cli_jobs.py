@@ -52,6 +52,7 @@ def test_sweep_on_dask_prints_the_local_rows(monkeypatch, capsys):
     (["--executor", "local", "--dask", "tcp://127.0.0.1:8786"],
      "--dask ADDRESS runs on a Dask cluster; drop --executor local"),
     (["--dask", "nonsense"], "--dask 'nonsense': no Dask scheduler there"),
+    (["--dask", ""], "--dask '': expected a scheduler address like tcp://HOST:8786"),
     (["--executor", "dask", "--jobs", "0"], "--jobs 0 must be at least 1"),
 ])
 @pytest.mark.parametrize("command", [

@@ -4,6 +4,7 @@ give the same reports; each day is stored once, by the caller, as its result arr
 from __future__ import annotations
 
 import datetime as dt
+from pathlib import Path
 
 import pytest
 
@@ -54,6 +55,32 @@ def test_local_and_dask_store_the_same_rows(tmp_path, dask_executor):
     assert stored(a, dates) == stored(b, dates)
     assert all(len(stored(a, dates)[d]["flightpath"]) == r.flight.moves > 500
                for d, r in zip(dates, ra, strict=True))
+
+
+def test_a_relative_data_folder_is_read_by_workers_in_another_folder(
+        tmp_path, dask_executor, monkeypatch):
+    """``--data syn`` with workers started in another folder (``dask worker`` on the
+    scheduler's machine, or a shared folder on another): each worker read ``syn``
+    against its own working folder, and every day failed "no such file"."""
+    import os
+
+    engine = lunch_store(f"sqlite:///{tmp_path / 'rel.db'}", DATES)
+    by_date = days_between(engine, dt.date(2024, 1, 1), dt.date(2024, 1, 2))
+    prepare_legs(load_site(DirSource(EXAMPLE)), [o for v in by_date.values() for o in v])
+    elsewhere = tmp_path / "workers"
+    elsewhere.mkdir()
+    monkeypatch.chdir(EXAMPLE.parent)
+    client = dask_executor.client
+    before = client.run(os.getcwd)
+    client.run(os.chdir, str(elsewhere))
+    try:
+        results = run_days(engine, DirSource(Path(EXAMPLE.name)), by_date,
+                           executor=dask_executor)
+    finally:
+        for worker, folder in before.items():
+            client.run(os.chdir, folder, workers=[worker])
+    assert [r.date for r in results] == [dt.date(2024, 1, 1), dt.date(2024, 1, 2)]
+    assert all(r.orders for r in results)
 
 
 def test_a_day_run_again_replaces_itself(tmp_path, dask_executor):

@@ -178,6 +178,53 @@ def test_a_tls_scheduler_of_the_dask_configuration_is_reached(tmp_path):
         assert ex.client.scheduler.address == cluster.scheduler_address
 
 
+def _in_memory(dask_scheduler, prefix: str) -> int:
+    """On the scheduler: how many tasks whose key starts with ``prefix`` hold a result."""
+    return sum(1 for k, ts in dask_scheduler.tasks.items()
+               if str(k).startswith(prefix) and ts.state == "memory")
+
+
+def test_dask_lets_go_of_each_result_once_it_has_it(dask_executor):
+    """A result taken is released on the cluster while the map runs: kept to the map's
+    end, every result stayed in its worker's memory, and a worker that died late in a
+    range had every task it had finished run again."""
+    client = dask_executor.client
+    quick: list[int] = []  # the quick tasks come back long before the slow one
+    held: list[int] = []  # tasks in memory on the cluster once all three came back
+
+    def on_result(i: int, _r) -> None:
+        if i == 3:
+            return
+        quick.append(i)
+        if len(quick) == 3:  # wait (up to 3 s) until the scheduler has let go of them
+            end = time.monotonic() + 3
+            while not held or (held[-1] and time.monotonic() < end):
+                held.append(client.run_on_scheduler(_in_memory, prefix="sleep-"))
+                time.sleep(0.05)
+
+    out = dask_executor.map(time.sleep, [0.0, 0.0, 0.0, 5.0], on_result=on_result)
+    assert out == [None] * 4 and sorted(quick) == [0, 1, 2]
+    assert held[-1] == 0, f"{held[-1]} finished tasks still held on the cluster"
+
+
+def test_ctrl_c_in_the_terminal_leaves_the_local_clusters_workers_to_the_command():
+    """Ctrl-C reaches every process of the terminal's group: each worker of the
+    in-process cluster printed a KeyboardInterrupt traceback over the command's
+    "skyroute: interrupted", and its nanny started it again. They ignore it; the
+    command closes the cluster."""
+    import os
+    import signal
+
+    with open_executor("dask", workers=1) as ex:
+        client = ex.client
+        (pid,) = client.run(os.getpid).values()
+        os.kill(pid, signal.SIGINT)
+        time.sleep(1.0)  # a worker that took it ends, and its nanny starts another
+        client.wait_for_workers(1, timeout=10)
+        assert list(client.run(os.getpid).values()) == [pid]
+        assert ex.map(math.sqrt, [4.0]) == [2.0]
+
+
 def test_an_existing_scheduler_runs_the_tasks(dask_executor):
     address = dask_executor.client.scheduler.address
     with open_executor("dask", address=address, workers=5) as ex:  # workers: unused
@@ -196,6 +243,22 @@ def test_another_skyroute_on_the_cluster_is_refused(dask_executor, monkeypatch):
     assert str(err.value) == (f"address={address!r}: the scheduler has skyroute "
                               f"{real('skyroute')}, this machine 9.9; install the same "
                               "skyroute on the scheduler and every worker")
+
+
+def test_a_worker_that_cannot_import_the_tasks_is_refused(dask_executor, monkeypatch):
+    """A worker whose skyroute is installed (the versions agree) but does not import (a
+    dependency missing on its machine; here a module of the tasks that is not there)
+    closed itself on its first task, and with no other worker the run waited forever."""
+    monkeypatch.setattr(executor_mod, "TASK_IMPORTS", "import skyroute.jobs.no_such_module",
+                        raising=False)
+    address = dask_executor.client.scheduler.address
+    with pytest.raises(SkyrouteError) as err:
+        open_executor("dask", address=address)
+    text = str(err.value)
+    assert text.startswith(f"address={address!r}: worker tcp://") and "\n" not in text
+    assert ("cannot import skyroute's tasks (ModuleNotFoundError: No module named "
+            "'skyroute.jobs.no_such_module'); install the same skyroute") in text
+    assert dask_executor.map(math.sqrt, [4.0]) == [2.0]  # the workers are still there
 
 
 @pytest.mark.parametrize("kind, workers", [("local", 2), ("local", 1), ("dask", 1)])
@@ -493,3 +556,32 @@ def test_a_task_every_pool_refuses_is_lost_in_one_line(monkeypatch):
     assert info.value.lost[0] == ("its worker process died (exit status unknown), also "
                                   "when run again alone")
     assert str(info.value).startswith("1 of the 3 tasks was lost: task 0: its worker ")
+
+
+def test_a_scheduler_without_workers_says_so_and_its_tasks_wait_for_one(caplog):
+    """A scheduler whose workers have not joined (or have all left): the tasks wait for
+    one without a word from Dask, and the command looked hung. It says so once."""
+    import logging
+    import threading
+
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=0, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, \
+            caplog.at_level(logging.WARNING, logger="skyroute.jobs"), \
+            open_executor("dask", address=cluster.scheduler_address) as ex:
+        out: list = []
+        thread = threading.Thread(target=lambda: out.append(ex.map(math.sqrt, [9.0])))
+        thread.start()
+
+        def said() -> list[str]:
+            return [r.getMessage() for r in caplog.records if r.name == "skyroute.jobs"]
+
+        end = time.monotonic() + 30
+        while not said() and time.monotonic() < end:
+            time.sleep(0.05)
+        assert said() == [f"the Dask scheduler at {cluster.scheduler_address} has no "
+                          "workers; the tasks wait until one joins"]
+        cluster.scale(1)
+        thread.join(timeout=60)
+        assert out == [[3.0]]

@@ -205,3 +205,19 @@ def test_a_run_whose_worker_dies_is_named_by_its_settings(monkeypatch, tmp_path)
                   executor=KilledOnDask(), progress=lambda _p: None)
     assert str(err.value) == ("the fleet run was lost: its Dask worker died running it "
                               "(KilledWorker; see the workers' logs)")
+
+
+def test_a_fleet_task_on_a_machine_without_the_sqlite_store_makes_nothing(tmp_path):
+    """A Dask worker on another machine, given the server's SQLite store: it made an
+    empty file and its folders at that path, then failed "no skyroute tables; run
+    'skyroute db init' first" of a store that has them."""
+    from skyroute.jobs.fleet import FleetTask, RunSpec, fly_fleet
+
+    elsewhere = tmp_path / "server" / "data" / "skyroute.db"  # not on this "machine"
+    spec = RunSpec(preset("seed-3x3").model_dump(), 0.05)
+    with pytest.raises(SkyrouteError) as err:
+        fly_fleet(FleetTask(f"sqlite:///{elsewhere}", "run-1", "job-1", spec))
+    text = str(err.value)
+    assert text.startswith(f"the SQLite store {elsewhere} is not on this worker's machine")
+    assert "PostgreSQL" in text and "\n" not in text
+    assert not (tmp_path / "server").exists()

@@ -26,7 +26,11 @@ DaskAddress = Annotated[str | None, typer.Option(
 
 def executor_kind(executor: str | None, dask: str | None, jobs: int) -> str:
     """The executor's kind the flags ask for (checked before any work starts)."""
-    kind = executor or ("dask" if dask else "local")
+    if dask is not None and not dask.strip():  # (read as no address: "drop --executor
+        # local", which was not given)
+        raise OptionError(f"--dask {dask!r}: expected a scheduler address like "
+                          "tcp://HOST:8786")
+    kind = executor or ("dask" if dask is not None else "local")
     check_choice("executor", kind, KINDS)
     if kind == "local" and dask is not None:
         raise OptionError("--dask ADDRESS runs on a Dask cluster; drop --executor local")

@@ -114,6 +114,11 @@ def serve_command(
                 "max_expansions": "--max-expansions", "allowed_hosts": "--allowed-hosts"
                 }.get(field, TOKEN_ENV if where == TOKEN_ENV else f"--token-file {where}")
         raise OptionError(f"{flag}: {err['msg'].removeprefix('Value error, ')}") from None
+    if dask is not None:  # a wrong address (or skyroute on the cluster): one line now;
+        # it was found by the first job, a 422 naming the address to its caller
+        from skyroute.jobs.executor import open_executor
+
+        open_executor("dask", address=dask).close()
     engine = make_engine(db)  # the store opens and is migrated before anyone asks
     orphans = _fail_orphans(engine)
     engine.dispose()

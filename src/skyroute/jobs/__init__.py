@@ -5,7 +5,9 @@
 - :mod:`~skyroute.jobs.store`: the ``jobs``, ``fleet_runs`` and ``servers`` tables (in
   the delivery store, migrations 0002 and 0003).
 - :mod:`~skyroute.jobs.deliver`: a range of delivery days, one task per day, each stored
-  by its worker in one transaction.
+  by the caller in one transaction as it arrives.
+- :mod:`~skyroute.jobs.local_worker`: the start of each worker of the in-process Dask
+  cluster (it leaves Ctrl-C to the command).
 - :mod:`~skyroute.jobs.fleet`: fleet runs (stored in ``fleet_runs``) and sweeps.
 - :mod:`~skyroute.jobs.runner`: ``submit`` / ``get``: jobs in a background thread with
   their state and progress in the store (what the service calls).

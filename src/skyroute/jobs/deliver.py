@@ -117,6 +117,17 @@ def _interrupted(exc: BaseException) -> bool:
     return False
 
 
+def for_workers(source: DirSource | HttpSource) -> DirSource | HttpSource:
+    """``source`` as the workers read it: a folder by its absolute path. A relative
+    ``--data`` was read by each Dask worker against its own working folder (a worker
+    started elsewhere failed every day with "syn/website/menus/menus.json: no such
+    file"). Absolute, not resolved: a shared folder is mounted at the same path on
+    every machine, while its symbolic links may lead elsewhere on this one."""
+    if isinstance(source, DirSource) and not source.root.is_absolute():
+        return DirSource(source.root.absolute())
+    return source
+
+
 def fly_day(task: DayTask) -> DayResult | DayFailed:
     """The worker's task: fly the day and return it (the caller stores it), or the
     :class:`DayFailed` saying why it could not be flown."""
@@ -187,6 +198,7 @@ def run_days(engine: sa.Engine, source, by_date: dict[dt.date, list], *, executo
     day, writing its files, a day kept, the executor's own) or a Ctrl-C stops the run:
     it has stored the days that arrived before it, each with its files, and no other."""
     check_choice("method", method, METHODS)
+    source = for_workers(source)
     tasks = [DayTask(source, d, tuple(orders), method) for d, orders in sorted(by_date.items())]
     failed: list[DayFailed] = []
 

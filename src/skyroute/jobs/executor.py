@@ -47,6 +47,7 @@ died every time it was tried (see each kind) is raised at the end as
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import itertools
 import logging
@@ -452,6 +453,11 @@ def _gather(submit: Callable, items: list, window: int, on_result,
     return out
 
 
+# what a worker runs to import the modules skyroute's tasks name (run by ``exec``, a
+# builtin: a function of skyroute's own could not be sent to a worker that lacks it)
+TASK_IMPORTS = "import skyroute.jobs.deliver, skyroute.jobs.fleet"
+
+
 def _handshake(address: str) -> None:
     """Connect to ``address`` and read a Dask handshake within ``CONNECT_TIMEOUT``, else
     raise OSError. distributed bounds the TCP connection but not the handshake read
@@ -515,7 +521,8 @@ class DaskExecutor(_Executor):
             self._cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
                                          threads_per_worker=1, processes=True,
                                          dashboard_address=None,
-                                         silence_logs=logging.ERROR)
+                                         silence_logs=logging.ERROR,
+                                         preload=["skyroute.jobs.local_worker"])
             self.client = Client(self._cluster)
         else:
             if not isinstance(address, str):
@@ -531,6 +538,7 @@ class DaskExecutor(_Executor):
                                     param="address") from None
             try:
                 self._check_versions()
+                self._check_imports()
             except BaseException:
                 self.client.close()
                 raise
@@ -555,6 +563,20 @@ class DaskExecutor(_Executor):
                     f"{theirs or '(not installed)'}, this machine {mine}; install the same "
                     "skyroute on the scheduler and every worker", param="address")
 
+    def _check_imports(self) -> None:
+        """Every worker must import skyroute's tasks. One whose skyroute is installed
+        (the versions agree) but does not import (a dependency missing or broken on its
+        machine) closes itself on its first task, reading it; with no other worker the
+        run waited forever. Importing them now also spares the first tasks the time."""
+        got = self.client.run(exec, TASK_IMPORTS, on_error="return")
+        for worker, r in sorted(got.items()):
+            if isinstance(r, BaseException):
+                why = " ".join(str(r).split()) or "no message"
+                raise SkyrouteError(
+                    f"address={self.address!r}: worker {worker} cannot import skyroute's "
+                    f"tasks ({type(r).__name__}: {why}); install the same skyroute, with "
+                    "its dependencies, on the scheduler and every worker", param="address")
+
     def __repr__(self) -> str:
         where = self.address or "LocalCluster"
         return f"DaskExecutor({where}, workers={self.workers})"
@@ -572,6 +594,11 @@ class DaskExecutor(_Executor):
             raise _closed(self)
         if not items:
             return []
+        if self.address is not None and not self.workers:
+            # (a scheduler started before its workers, or whose workers all left): the
+            # tasks wait for one, which Dask does without a word: the run looked hung
+            log.warning("the Dask scheduler at %s has no workers; the tasks wait until "
+                        "one joins", self.address)
         # pure=False: a task is run each time it is asked for, never served from an
         # earlier identical call (the tasks write to the store)
         futures = self.client.map(fn, items, pure=False)
@@ -581,6 +608,11 @@ class DaskExecutor(_Executor):
         try:
             for f in as_completed(futures):
                 i = index[f.key]
+                # let go of each task once its result is here: held to the map's end,
+                # every result stayed in its worker's memory, and a worker that died
+                # had all the tasks it had finished run again (a long range of days
+                # flown twice over, while the map waited for its last ones)
+                futures[i] = None
                 try:
                     out[i] = f.result()
                 except KilledWorker as exc:  # the others run on
@@ -589,12 +621,15 @@ class DaskExecutor(_Executor):
                                f"its Dask worker died running it, on each of the {tries} "
                                "workers that tried it") + " (KilledWorker; see the workers' logs)"
                     continue
+                finally:
+                    with contextlib.suppress(RuntimeError):  # a client closed meanwhile
+                        f.release()
                 if on_result:
                     on_result(i, out[i])
         except Exception as exc:
             if self._closed:  # the client closed under this map: nothing left to cancel
                 raise _closed(self) from None
-            self.client.cancel(futures)
+            self.client.cancel([f for f in futures if f is not None])
             if not isinstance(exc, RuntimeError) or "deserializ" not in str(exc):
                 raise
             raise SkyrouteError(f"the Dask scheduler at {self.client.scheduler.address} "
@@ -602,7 +637,7 @@ class DaskExecutor(_Executor):
                                 "the scheduler and every worker") from None
         except BaseException:
             if not self._closed:
-                self.client.cancel(futures)
+                self.client.cancel([f for f in futures if f is not None])
             raise
         finally:
             del futures

@@ -86,8 +86,24 @@ def worker_url(engine: sa.Engine) -> str:
 
 
 def engine_for(url: str) -> sa.Engine:
-    """One engine per URL in this process (a worker keeps its own across tasks)."""
+    """One engine per URL in this process (a worker keeps its own across tasks).
+
+    A SQLite store (:func:`worker_url`: an absolute path on the server's machine) that
+    is not there is refused, and nothing is made: a Dask worker on another machine made
+    an empty file (and its folders) at that path and failed the fleet job with "no
+    skyroute tables; run 'skyroute db init' first", of a store that has them."""
     if url not in _ENGINES:
+        parsed = sa.engine.make_url(url)
+        db = parsed.database
+        if (parsed.drivername.startswith("sqlite") and db not in (None, "", ":memory:")
+                and not Path(db).is_file()):
+            import socket
+
+            raise SkyrouteError(
+                f"the SQLite store {db} is not on this worker's machine "
+                f"({socket.gethostname()}); a fleet job's worker stores its run, so on a "
+                "cluster of several machines the store must be a database every worker "
+                "reaches (PostgreSQL)", param="url")
         _ENGINES[url] = connect(url)
     return _ENGINES[url]
 

@@ -11,6 +11,7 @@ imported on first use; without it these endpoints answer 503. A server holds at 
 
 from __future__ import annotations
 
+import logging
 import threading
 from typing import Annotated, Any, Literal
 
@@ -34,6 +35,8 @@ from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.paths import url_path
 from skyroute.service.problems import Problem, responses
 from skyroute.service.resources import Resources, ResourcesDep
+
+log = logging.getLogger("skyroute.service")
 
 router = APIRouter(tags=["jobs"])
 MAX_HOURS = 24.0  # this server's own limit: a job holds a worker (fleet.limits allows more)
@@ -132,6 +135,24 @@ def _jobs():
     return runner
 
 
+EXECUTOR_RETRY_SECONDS = 30  # an unreachable Dask scheduler's Retry-After
+
+
+def _executor(res: Resources):
+    """The jobs' executor, or a 503 when it cannot be opened (``serve --dask`` naming a
+    scheduler that has gone, or never answered): the server's condition, not the
+    request's. It was a 422 "invalid input" with ``field: address``, a field no request
+    has, naming the scheduler's address to the caller; the reason goes to the log."""
+    try:
+        return res.executor()
+    except SkyrouteError as exc:
+        log.warning("jobs: the executor cannot be opened: %s", str(exc).splitlines()[0])
+        raise Problem(503, "jobs cannot start: the server cannot reach its Dask cluster; "
+                      "the server's log says why; try again later",
+                      kind="executor-unavailable",
+                      headers={"Retry-After": str(EXECUTOR_RETRY_SECONDS)}) from None
+
+
 def _submit(res: Resources, request: Request, kind: str, params: dict, *,
             once: bool = False) -> FiniteJSONResponse:
     """Queue the job: 202 ``{"id"}``. With ``once``, a job of ``kind`` with the same
@@ -156,9 +177,9 @@ def _submit(res: Resources, request: Request, kind: str, params: dict, *,
                                   headers={"Retry-After": "10"})
                 new = False
             elif once:
-                job_id, new = runner.submit_once(eng, kind, params, executor=res.executor())
+                job_id, new = runner.submit_once(eng, kind, params, executor=_executor(res))
             else:
-                job_id, new = runner.submit(eng, kind, params, executor=res.executor()), True
+                job_id, new = runner.submit(eng, kind, params, executor=_executor(res)), True
         except (StoreBusyError, StoreSchemaError):
             # the server's condition, not the request's: a 503 naming no URL
             # (problems._busy, _schema); the 422 of str(exc) named the store's file
