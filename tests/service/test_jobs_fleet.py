@@ -719,6 +719,31 @@ def test_a_head_of_a_runs_file_reads_no_part(tmp_path, request, db):
 
 @needs_jobs
 @pytest.mark.parametrize("db", ["sqlite", "postgresql"])
+def test_an_id_with_a_nul_character_is_an_unknown_job_or_run(tmp_path, request, db):
+    """A job or run id holding NUL (``%00`` in the path) is a 404 on either store: no id
+    holds one, and PostgreSQL refuses the character in any text value, which was a 500
+    of every job and run route (found by schemathesis' CLI beside a PostgreSQL store)."""
+    url = (f"sqlite:///{tmp_path / 'runs.db'}" if db == "sqlite"
+           else request.getfixturevalue("fresh_pg"))
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    eng = make_engine(url)
+    run = store.save_fleet_run(eng, scenario="seed-3x3", params={}, report={},
+                               events_jsonl="", tracks_csv=b"", packages_csv="id\n0\n",
+                               fleet_geojson="{}")
+    eng.dispose()
+    with make_client(db_url=url) as c:
+        assert c.get(f"/fleet/runs/{run}/packages.csv").status_code == 200
+        assert_problem(c.get("/jobs/a%00b"), 404, words="no job")
+        for suffix in ("", "/events.jsonl", "/tracks.csv", "/fleet.geojson",
+                       "/packages.csv"):
+            assert_problem(c.get(f"/fleet/runs/{run}%00{suffix}"), 404,
+                           words="no fleet run")
+
+
+@needs_jobs
+@pytest.mark.parametrize("db", ["sqlite", "postgresql"])
 def test_a_page_of_events_reads_the_parts_it_lies_in(tmp_path, request, db):
     """GET /fleet/runs/{id} pages events.jsonl from its stored parts: a page from the
     start reads the first part alone, a page across a part boundary the two parts, a
