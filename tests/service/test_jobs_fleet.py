@@ -327,6 +327,22 @@ def test_bad_job_input_is_422(site_client, fake, path, body, field, words):
     assert_problem(site_client.post(path, json=body, headers=AUTH), 422, field, words)
 
 
+@pytest.mark.parametrize("scenario, field, words", [
+    # accepted, flown, then not stored (SQLite and PostgreSQL alike): the job failed with
+    # a raw UnicodeEncodeError after the whole run
+    ({**SEED3, "name": "x\ud800"}, "scenario.name",
+     "scenario.name: 'x\\ud800' holds U+D800, half of a UTF-16 surrogate pair"),
+    # a key that is no text: the whole message was the field
+    ({**SEED3, "\ud800": 1}, "scenario", "scenario: Input should be a valid string"),
+])
+def test_a_lone_surrogate_in_a_scenario_is_422(site_client, fake, scenario, field, words):
+    body = json.dumps({"scenario": scenario, "hours": 0.5}).encode()  # the escape kept
+    r = site_client.post("/jobs/fleet", content=body,
+                         headers={**AUTH, "Content-Type": "application/json"})
+    assert_problem(r, 422, field, words)
+    assert fake.submitted == []
+
+
 def test_unknown_job_is_404(site_client, fake):
     assert_problem(site_client.get("/jobs/nope"), 404, words="no job 'nope'")
 
