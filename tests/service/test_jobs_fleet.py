@@ -738,7 +738,7 @@ def test_a_head_of_a_runs_file_reads_no_part(tmp_path, request, db):
 def test_an_id_with_a_nul_character_is_an_unknown_job_or_run(tmp_path, request, db):
     """A job or run id holding NUL (``%00`` in the path) is a 404 on either store: no id
     holds one, and PostgreSQL refuses the character in any text value, which was a 500
-    of every job and run route (found by schemathesis' CLI beside a PostgreSQL store)."""
+    of every job and run route (schemathesis puts no NUL in a path)."""
     url = (f"sqlite:///{tmp_path / 'runs.db'}" if db == "sqlite"
            else request.getfixturevalue("fresh_pg"))
     from skyroute.jobs import store

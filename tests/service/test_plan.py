@@ -302,7 +302,7 @@ ZONES_TEXT = json.dumps({"type": "FeatureCollection", "features": [ZONE]})
 def test_a_lone_surrogate_in_an_upload_is_422(client, extra, field, words):
     """A lone surrogate (``"\\ud800"``, no character) in a map or a zone's name was a
     500: the map's text could not be encoded, the visibility graph's cache key neither
-    (found by fuzzing the running server)."""
+    (found probing a running server beside schemathesis, which sends no surrogates)."""
     body = {"start": [0, 0], "goal": [1, 1], **extra}
     if "world_text" in extra:
         body.update(start=[0.0, 0.0], goal=[0.003, 0.0])
