@@ -47,6 +47,17 @@ def open_text(path: str | Path) -> TextIO:
     return Path(path).open(encoding="utf-8-sig", newline="")
 
 
+def lone_surrogate(text: str) -> int | None:
+    """The index of the first lone surrogate in ``text`` (U+D800..U+DFFF: half of a
+    UTF-16 pair, no character; JSON's ``"\\ud800"`` and YAML's read as one), or None.
+    Such text cannot be written as UTF-8: not to a file, a terminal or a store."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        return exc.start
+    return None
+
+
 def strip_bom(data: str | bytes) -> str | bytes:
     """``data`` without a leading byte-order mark: text already in hand (an upload, an
     HTTP answer) or bytes."""

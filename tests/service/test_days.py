@@ -83,6 +83,26 @@ def test_flightpath_is_the_clis_file(day_client, lunch):
                                            .read_text())["features"][0]["geometry"]
 
 
+def test_if_none_match_is_compared_as_http_says_and_the_304_is_documented(day_client):
+    """If-None-Match names the flight's ETag also weakly (``W/"x"``: what a proxy that
+    compresses the file hands out and the client sends back), in a list, or as ``*``;
+    only the exact ETag was a 304. The 304 and the ETag are in the OpenAPI: the answer
+    was a status the schema did not list (schemathesis never sends If-None-Match)."""
+    url = f"/days/{DAY}/flightpath.geojson"
+    etag = day_client.get(url).headers["etag"]
+    for held in (etag, f"W/{etag}", f'"0123", {etag}', f'W/"0123", W/{etag}', "*"):
+        r = day_client.get(url, headers={"If-None-Match": held})
+        assert r.status_code == 304 and not r.content and r.headers["etag"] == etag, held
+    for held in ('"0123"', f'"{etag}"', 'W/"0123"', ""):
+        assert day_client.get(url, headers={"If-None-Match": held}).status_code == 200, held
+    op = day_client.get("/openapi.json").json()["paths"][
+        "/days/{date}/flightpath.geojson"]["get"]
+    assert {"200", "304"} <= set(op["responses"])
+    assert "ETag" in op["responses"]["304"]["headers"]
+    assert "ETag" in op["responses"]["200"]["headers"]
+    assert [p["name"] for p in op["parameters"] if p["in"] == "header"] == ["if-none-match"]
+
+
 def test_a_day_stored_again_is_served_fresh(tmp_path, lunch):
     """The flight path is cached by the day's run: storing the day again changes it."""
     import shutil

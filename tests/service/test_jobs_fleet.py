@@ -327,6 +327,22 @@ def test_bad_job_input_is_422(site_client, fake, path, body, field, words):
     assert_problem(site_client.post(path, json=body, headers=AUTH), 422, field, words)
 
 
+@pytest.mark.parametrize("scenario, field, words", [
+    # accepted, flown, then not stored (SQLite and PostgreSQL alike): the job failed with
+    # a raw UnicodeEncodeError after the whole run
+    ({**SEED3, "name": "x\ud800"}, "scenario.name",
+     "scenario.name: 'x\\ud800' holds U+D800, half of a UTF-16 surrogate pair"),
+    # a key that is no text: the whole message was the field
+    ({**SEED3, "\ud800": 1}, "scenario", "scenario: Input should be a valid string"),
+])
+def test_a_lone_surrogate_in_a_scenario_is_422(site_client, fake, scenario, field, words):
+    body = json.dumps({"scenario": scenario, "hours": 0.5}).encode()  # the escape kept
+    r = site_client.post("/jobs/fleet", content=body,
+                         headers={**AUTH, "Content-Type": "application/json"})
+    assert_problem(r, 422, field, words)
+    assert fake.submitted == []
+
+
 def test_unknown_job_is_404(site_client, fake):
     assert_problem(site_client.get("/jobs/nope"), 404, words="no job 'nope'")
 
@@ -715,6 +731,31 @@ def test_a_head_of_a_runs_file_reads_no_part(tmp_path, request, db):
         nope = c.head(f"/fleet/runs/nope/{name}")
         assert nope.status_code == 404 and nope.content == b""
         assert nope.headers["content-type"] == "application/problem+json"
+
+
+@needs_jobs
+@pytest.mark.parametrize("db", ["sqlite", "postgresql"])
+def test_an_id_with_a_nul_character_is_an_unknown_job_or_run(tmp_path, request, db):
+    """A job or run id holding NUL (``%00`` in the path) is a 404 on either store: no id
+    holds one, and PostgreSQL refuses the character in any text value, which was a 500
+    of every job and run route (schemathesis puts no NUL in a path)."""
+    url = (f"sqlite:///{tmp_path / 'runs.db'}" if db == "sqlite"
+           else request.getfixturevalue("fresh_pg"))
+    from skyroute.jobs import store
+    from skyroute.service.resources import make_engine
+
+    eng = make_engine(url)
+    run = store.save_fleet_run(eng, scenario="seed-3x3", params={}, report={},
+                               events_jsonl="", tracks_csv=b"", packages_csv="id\n0\n",
+                               fleet_geojson="{}")
+    eng.dispose()
+    with make_client(db_url=url) as c:
+        assert c.get(f"/fleet/runs/{run}/packages.csv").status_code == 200
+        assert_problem(c.get("/jobs/a%00b"), 404, words="no job")
+        for suffix in ("", "/events.jsonl", "/tracks.csv", "/fleet.geojson",
+                       "/packages.csv"):
+            assert_problem(c.get(f"/fleet/runs/{run}%00{suffix}"), 404,
+                           words="no fleet run")
 
 
 @needs_jobs

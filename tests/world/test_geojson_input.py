@@ -201,6 +201,21 @@ def test_a_world_built_from_polygons_with_heights_plans_as_without():
     assert round(b.cost, 6) == 4.828427 and b.path.tolist() == a.path.tolist()
 
 
+def test_a_name_with_a_lone_surrogate_is_refused_naming_the_feature(monkeypatch, capsys,
+                                                                    tmp_path):
+    # JSON's "\ud800" is half a surrogate pair, no character: plan-world's visibility
+    # graph could not hash the name (a UnicodeEncodeError traceback)
+    path = tmp_path / "z.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [
+        ZONE, polygon(square(-3.185, 55.943), name="\ud800"), AREA]}))
+    assert "\\ud800" in path.read_text()
+    code, out, err = run(monkeypatch, capsys, "plan-world", str(path),
+                         "--start=-3.194,55.941", "--goal=-3.186,55.949")
+    assert code == 2 and out == "" and err == (
+        f"skyroute: error: {path}: feature 1: its name holds U+D800, half of a UTF-16 "
+        "surrogate pair and no character\n")
+
+
 @pytest.mark.parametrize("value", ["NaN", "Infinity", "-Infinity", "1e999"])
 def test_a_coordinate_that_is_no_json_number_names_the_feature(tmp_path, value):
     # Python's json reads NaN and Infinity; GEOS then said "ParseException: Error parsing

@@ -31,7 +31,7 @@ from pydantic import (
 )
 
 from skyroute.errors import InputFormatError, OptionError, check_seed, real, whole
-from skyroute.files import read_text
+from skyroute.files import lone_surrogate, read_text
 from skyroute.fleet.limits import (
     MAX_AIRPORTS,
     MAX_AREA_KM,
@@ -90,6 +90,11 @@ class _Strict(BaseModel):
         if isinstance(v, str) and "\0" in v:
             raise ValueError(f"{v!r} holds a NUL character, which a PostgreSQL store "
                              "cannot keep")
+        # a lone surrogate ("\\ud800" in JSON or YAML) ran the whole simulation, then
+        # failed to be written: the CLI's report (a traceback), the service's store
+        if isinstance(v, str) and (at := lone_surrogate(v)) is not None:
+            raise ValueError(f"{v!r} holds U+{ord(v[at]):04X}, half of a UTF-16 surrogate "
+                             "pair and no character")
         return v
 
 

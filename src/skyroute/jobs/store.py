@@ -304,9 +304,18 @@ def fail_orphans(engine: sa.Engine, error: str, *, dead_after: float,
     return ids
 
 
+def _no_such_id(key: str) -> bool:
+    """Whether no row can have the id ``key``: one holding a NUL character. Ids are made
+    here (UUIDs); PostgreSQL refuses the character in any text value (a DataError, a 500
+    of the service's, where SQLite found no row), so such an id is unknown on both."""
+    return "\0" in str(key)
+
+
 def get_job(engine: sa.Engine, job_id: str) -> dict | None:
     """``{"id", "kind", "params", "state", "progress", "result", "error", "created",
     "updated", "owner"}`` (times ISO 8601 UTC), or None for an unknown id."""
+    if _no_such_id(job_id):
+        return None
     jobs = _t(engine)["jobs"]
     with engine.connect() as c:
         r = c.execute(sa.select(jobs).where(jobs.c.id == str(job_id))).mappings().first()
@@ -418,6 +427,8 @@ def get_fleet_run(engine: sa.Engine, run_id: str, *,
         wanted = tuple(files)
         for k in wanted:
             check_choice("files", k, FILES)
+    if _no_such_id(run_id):
+        return None
     t = _t(engine)
     runs, stored = t["fleet_runs"], t["fleet_run_files"]
     if not wanted:  # the run's head alone
@@ -597,6 +608,8 @@ def open_fleet_file(engine: sa.Engine, run_id: str, name: str) -> StoredFile | N
     parts, read now in one statement, its bytes as it is iterated (:class:`StoredFile`);
     a file the run lacks is empty; None for an unknown run."""
     check_choice("name", name, FILES)
+    if _no_such_id(run_id):
+        return None
     t = _t(engine)
     runs, stored = t["fleet_runs"], t["fleet_run_files"]
     q = (sa.select(runs.c.created, sa.func.count(stored.c.part),

@@ -23,7 +23,7 @@ import numpy as np
 import shapely
 
 from skyroute.errors import InputFormatError, OptionError, QueryError, check_choice
-from skyroute.files import read_text, strip_bom
+from skyroute.files import lone_surrogate, read_text, strip_bom
 from skyroute.geo import FRAME_ALIASES, FRAMES, Home, lonlat_to_enu
 from skyroute.world.points import MAX_REACH, check_places
 from skyroute.world.world import World
@@ -63,6 +63,9 @@ def _polygon(path: Path, i: int, feature: dict) -> tuple[shapely.Geometry, str]:
         raise InputFormatError(path, f"feature {i} is {type(feature).__name__} "
                                f"{json.dumps(feature)[:40]}, not a GeoJSON Feature object")
     name = str(_properties(feature).get("name", f"feature {i}"))
+    if (at := lone_surrogate(name)) is not None:  # the escape "\\ud800": no character
+        raise InputFormatError(path, f"feature {i}: its name holds U+{ord(name[at]):04X}, "
+                               "half of a UTF-16 surrogate pair and no character")
     geom = feature.get("geometry")
     kind = geom.get("type") if isinstance(geom, dict) else None
     if kind not in ("Polygon", "MultiPolygon"):

@@ -70,7 +70,10 @@ def read_map(path: str | Path, *, text: str | bytes | None = None) -> Grid:
     bad header, a row of the wrong width, an unknown character or a wrong number of rows.
     """
     path = Path(path)
-    lines = _lines(path, text.encode("utf-8") if isinstance(text, str) else text)
+    # (a lone surrogate, "\\ud800" in an upload's JSON, goes through as bytes that are
+    # not ASCII: refused with its line as any other character, not a UnicodeEncodeError)
+    lines = _lines(path, text.encode("utf-8", "surrogatepass") if isinstance(text, str)
+                   else text)
     if not lines or lines[0].split() != ["type", "octile"]:
         got = lines[0].strip() if lines else "an empty file"
         raise InputFormatError(path, f"expected 'type octile', got {got!r}", line=1)

@@ -6,10 +6,11 @@ from __future__ import annotations
 
 import datetime as dt
 import hashlib
+import re
 import time
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, Path, Request, Response
+from fastapi import APIRouter, Depends, Header, Path, Response
 from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, Field
 
@@ -165,14 +166,24 @@ def delete_day(date: DayDate, res: ResourcesDep) -> Response:
     return Response(status_code=204)
 
 
+ETAG = {"ETag": {"description": "The flight's version (a digest of its stored moves): "
+                 "it changes whenever the flight does.", "schema": {"type": "string"}}}
+
+
 @router.get("/days/{date}/flightpath.geojson", response_class=Response,
             responses={200: {"content": {GEOJSON: {"schema": {"type": "object"}}},
                              "description": "The flight as one LineString in lon/lat "
                              "(the file `deliver` writes), with each move's ILP angle and "
-                             "order number in its properties."},
+                             "order number in its properties.", "headers": ETAG},
+                       304: {"description": "Not modified: `If-None-Match` names the "
+                             "flight's ETag; no body.", "headers": ETAG},
                        **responses(404, 422, 503)},
             summary="A stored day's flight as GeoJSON")
-async def get_flightpath(date: DayDate, request: Request, res: ResourcesDep) -> Response:
+async def get_flightpath(date: DayDate, res: ResourcesDep,
+                         if_none_match: Annotated[str | None, Header(
+                             description="ETags held (`\"...\"`, `W/\"...\"`, a list, "
+                             "or `*`): 304 when one is the flight's.")] = None
+                         ) -> Response:
     # The file is made once per stored version of the day and served from memory; the
     # store is asked again whether the day changed once fresh_seconds have passed (on
     # the thread pool, so the event loop never waits for the database).
@@ -184,9 +195,19 @@ async def get_flightpath(date: DayDate, request: Request, res: ResourcesDep) -> 
         entry = await run_in_threadpool(_flightpath_entry, date, res, entry)
         res.cache[key] = entry
     _, _, etag, body = entry
-    if request.headers.get("if-none-match") == etag:
+    if if_none_match is not None and _names(if_none_match, etag):
         return Response(status_code=304, headers={"ETag": etag})
     return Response(body, media_type=GEOJSON, headers={"ETag": etag})
+
+
+def _names(if_none_match: str, etag: str) -> bool:
+    """Whether an ``If-None-Match`` value names ``etag`` (RFC 9110 13.1.2): ``*``, or a
+    list of ETags compared weakly (``W/"x"`` is ``"x"``). A proxy that compresses the
+    file (nginx's gzip) hands the client ``W/"x"``, which the client sends back; only
+    the exact ``"x"`` was a 304, so such a client always fetched the whole flight."""
+    if if_none_match.strip() == "*":
+        return True
+    return etag in re.findall(r'"[^"]*"', if_none_match)
 
 
 def _flightpath_entry(date: dt.date, res: Resources, old: tuple | None) -> tuple:

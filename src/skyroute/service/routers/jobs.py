@@ -240,8 +240,11 @@ def post_fleet(body: FleetJob, res: ResourcesDep, request: Request):
             check_flights(scenario, "scenario")
         except SkyrouteError as exc:
             text = str(exc).removeprefix("scenario: ")
-            raise Problem(422, f"scenario.{text}", field="scenario." + text.split(":")[0]
-                          ) from None
+            # "drone.rollout: ..." names its field; a message naming none is the
+            # scenario's (a key that is no text: the whole message was the field)
+            head, named, _ = text.partition(": ")
+            raise Problem(422, f"scenario.{text}" if named else f"scenario: {text}",
+                          field=f"scenario.{head}" if named else "scenario") from None
     else:
         scenario = preset(body.preset)
     _check_work(scenario, body)
