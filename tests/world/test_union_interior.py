@@ -124,7 +124,7 @@ def boxes_and_segments(draw):
         boxes.append((x, y, x + draw(st.integers(1, 4)), y + draw(st.integers(1, 4))))
     if draw(st.booleans()):  # a neighbour sharing the first box's right face
         _, y0, x1, y1 = boxes[0]
-        boxes.append((x1, y0 + draw(st.integers(-1, 1)), x1 + 2, y1))
+        boxes.append((x1, y0 + draw(st.integers(-1, y1 - y0 - 1)), x1 + 2, y1))
     end = st.one_of(st.tuples(lattice, lattice),
                     st.tuples(lattice, lattice).map(lambda p: (p[0] + 0.5, p[1] + 0.5)),
                     st.tuples(st.floats(-1, 13), st.floats(-1, 13)))

@@ -77,7 +77,7 @@ def crossed(scenario, geometry) -> str | None:
     if not scenario.no_fly_zones:
         return None
     names, polys, tree = _zone_index(scenario)
-    k = entered_one(polys, tree, geometry)
+    k = entered_one(polys, tree, geometry, lowest=True)
     return None if k < 0 else names[k]
 
 

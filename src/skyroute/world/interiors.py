@@ -54,15 +54,20 @@ def entered(polygons: np.ndarray, tree: shapely.STRtree, geoms) -> np.ndarray:
     return out
 
 
-def entered_one(polygons: np.ndarray, tree: shapely.STRtree, geom) -> int:
-    """:func:`entered` for one geometry (a leaner path for one segment at a time)."""
+def entered_one(polygons: np.ndarray, tree: shapely.STRtree, geom, *,
+                lowest: bool = False) -> int:
+    """:func:`entered` for one geometry (a leaner path for one segment at a time): the
+    index of an obstacle it enters (with ``lowest``, the lowest, as :func:`entered`
+    names it; without, the first found, which saves a sort), or -1."""
     if len(polygons) == 0:
         return -1
-    hits = np.sort(tree.query(geom, predicate="intersects"))
+    hits = tree.query(geom, predicate="intersects")
+    if lowest:
+        hits = np.sort(hits)
     for j in hits:
         if not polygons[j].touches(geom):
             return int(j)
-    return _joined(polygons, hits, geom) if len(hits) >= 2 else -1
+    return _joined(polygons, np.sort(hits), geom) if len(hits) >= 2 else -1
 
 
 def _joined(polygons: np.ndarray, members: np.ndarray, geom) -> int:

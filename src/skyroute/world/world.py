@@ -360,7 +360,7 @@ class World:
         line = shapely.LineString([a, b])
         if self.boundary is not None and not self._prepared_boundary.contains_properly(line):
             return False
-        return entered_one(self.obstacles, self.tree, line) < 0
+        return not len(self.obstacles) or entered_one(self.obstacles, self.tree, line) < 0
 
     def clearance(self, points) -> np.ndarray:
         """Distance from each point to the nearest obstacle (0 inside one); inf if none."""
