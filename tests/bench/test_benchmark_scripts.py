@@ -38,7 +38,7 @@ def one_line_error(proc, name: str, words: str) -> None:
 
 
 @pytest.mark.parametrize("name", ["plan_ab.py", "plan_overhead.py", "prepare_memory.py",
-                                  "prepare_time.py"])
+                                  "prepare_time.py", "world_queries.py"])
 def test_each_script_has_a_help(name):
     proc = script(name, "--help")
     assert proc.returncode == 0 and proc.stdout.startswith(f"usage: {name}"), proc.stderr
@@ -204,3 +204,27 @@ def test_prepare_time_times_each_tree_in_turn(tmp_path):
 ])
 def test_prepare_time_refuses_wrong_input(args, words):
     one_line_error(script("prepare_time.py", *args), "prepare_time.py", words)
+
+
+def test_world_queries_counts_segments_through_shared_faces(tmp_path):
+    # two boxes sharing the face north = 5 (and a lone one): the segment along it, run
+    # past both ends, passes through the building; this tree calls none of them free
+    city, out = tmp_path / "two.csv", tmp_path / "wq.json"
+    city.write_text("lat0 37.792480, lon0 -122.397450\n"
+                    "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n"
+                    "0,0,10,5,10,10\n10,0,10,5,10,10\n60,60,10,5,5,10\n")
+    proc = script("world_queries.py", str(SRC), "--city", str(city), "--safety", "0",
+                  "--rounds", "1", "--repeats", "1", "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    (run,) = json.loads(out.read_text())["runs"]
+    assert run["shared_faces"] == 1 and run["through"] == 1
+    assert run["through_called_free"] == 0
+    assert positive(run["load_ms"]) and all(positive(v) for v in run["ms"].values())
+
+
+@pytest.mark.parametrize("args, words", [
+    (["src", "--city", "no-such.csv"], "--city no-such.csv: no such file"),
+    (["src", "--city", __file__, "--rounds", "0"], "--rounds 0: expected 1 to 100"),
+])
+def test_world_queries_refuses_wrong_input(args, words):
+    one_line_error(script("world_queries.py", *args), "world_queries.py", words)

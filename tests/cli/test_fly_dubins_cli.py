@@ -167,9 +167,9 @@ def test_a_tour_to_a_walled_off_target_is_no_path(monkeypatch, capsys, tmp_path)
 
 def test_a_flight_along_a_face_two_buildings_share_is_refused(monkeypatch, capsys,
                                                              tmp_path):
-    """Two buildings touching along east 50: a start and a goal on that face are free
+    """Two buildings touching along east 50: a start and a goal on that face were free
     points, and the flight between them ran 16 m through the block (found, exit 0).
-    It is one line naming the start, exit 2, and no file."""
+    It is one line naming the start, inside the block, exit 2, and no file."""
     city, out = tmp_path / "two.csv", tmp_path / "t.csv"
     city.write_text("lat0 37.792480, lon0 -122.397450\n"
                     "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n"
@@ -178,9 +178,8 @@ def test_a_flight_along_a_face_two_buildings_share_is_refused(monkeypatch, capsy
                           "--vehicle", "dubins", "--start", "42,50,0", "--goal", "58,50,0",
                           "--out", str(out))
     assert code == 2 and text == "" and not out.exists()
-    assert err == ("skyroute: error: start (42.00, 50.00) lies on the edge of obstacle 'box "
-                   "at line 3'; a turning vehicle's path keeps clear of every edge: move it "
-                   "off the edge\n")
+    assert err == ("skyroute: error: start (42.00, 50.00) lies inside obstacle 'box at line "
+                   "3'; nearest free point (39.99, 50.00)\n")
 
 
 @pytest.mark.parametrize("args, words", [

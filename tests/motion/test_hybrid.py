@@ -615,13 +615,13 @@ def test_a_start_or_goal_on_an_edge_is_refused_naming_it():
     the edge: the search ended in no_path after 572 expansions. And two boxes touching
     along x = 50 are one block whose outline alone the pieces were tested against: from
     a start to a goal on the face they share the path ran 16 m through the block
-    (found, length 16). Both are refused, naming the point."""
+    (found, length 16). Both are refused, naming the point: the shared face is inside
+    the block's union (as the world now tests it), an outer edge is on the edge."""
     block = make_world([(40, 40, 50, 60), (50, 40, 60, 60)])
-    with pytest.raises(QueryError, match=r"^start \(50.00, 42.00\) lies on the edge of "
-                       r"obstacle 'obstacle 0'; a turning vehicle's path keeps clear of "
-                       r"every edge: move it off the edge$"):
+    with pytest.raises(QueryError, match=r"^start \(50.00, 42.00\) lies inside obstacle "
+                       r"'obstacle 0'; nearest free point \(50.00, 39.99\)$"):
         plan(block, (50, 42, math.pi / 2), (50, 58, math.pi / 2), R)
-    with pytest.raises(QueryError, match=r"^goal \(50.00, 58.00\) lies on the edge"):
+    with pytest.raises(QueryError, match=r"^goal \(50.00, 58.00\) lies inside obstacle"):
         plan(block, (20, 20), (50, 58), R)
     with pytest.raises(QueryError, match=r"^start \(60.00, 50.00\) lies on the edge"):
         plan(block, (60, 50, 0.0), (90, 90), R)  # facing away from the east face

@@ -25,6 +25,7 @@ from skyroute.motion import hybrid
 from skyroute.motion.dubins import DubinsPath
 from skyroute.motion.pieces import KINDS, chain
 from skyroute.result import Status
+from skyroute.world.interiors import entered_one
 from skyroute.world.world import World
 
 
@@ -49,6 +50,7 @@ def _indexed(zones: tuple[tuple[str, tuple[tuple[float, float], ...]], ...]):
     of zones: a check before a run tests every airport at every level."""
     polys = np.array([shapely.Polygon([(e, n) for n, e in pts]) for _, pts in zones],
                      dtype=object)
+    shapely.prepare(polys)
     return [n for n, _ in zones], polys, shapely.STRtree(polys)
 
 
@@ -70,14 +72,13 @@ def _zone_index(scenario):
 
 def crossed(scenario, geometry) -> str | None:
     """The name of the first zone whose interior ``geometry`` (in the (east, north)
-    plane) meets, or None."""
+    plane) meets, or None. Zones that touch count as one: a line along the edge two
+    zones share runs inside them (:func:`~skyroute.world.interiors.entered_one`)."""
     if not scenario.no_fly_zones:
         return None
     names, polys, tree = _zone_index(scenario)
-    for k in sorted(tree.query(geometry).tolist()):  # those whose boxes meet it
-        if geometry.intersects(polys[k]) and not geometry.touches(polys[k]):
-            return names[k]
-    return None
+    k = entered_one(polys, tree, geometry, lowest=True)
+    return None if k < 0 else names[k]
 
 
 def check_line(scenario, p0, p1, what: str) -> None:

@@ -231,9 +231,10 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     Raises
     ------
     QueryError
-        a malformed pose, or a start or goal inside an obstacle, outside the boundary,
-        or on an obstacle's edge (a face two touching obstacles share too) or within
-        1e-9 of the extent of an edge, where every piece would meet it.
+        a malformed pose, or a start or goal inside an obstacle (or on a face two
+        touching obstacles share: inside their union), outside the boundary, or on an
+        obstacle's edge or within 1e-9 of the extent of an edge, where every piece
+        would meet it.
     OptionError
         an out-of-range option.
     """
@@ -442,9 +443,8 @@ def _off_edges(world: World, index, p: np.ndarray, what: str, given) -> None:
     """A QueryError when the plane point ``p`` lies on an obstacle's edge, or within
     ``index.eps`` of an obstacle's or the boundary's edge. Such a point is free in the
     world, but every piece from or to it meets that edge: the search ended in no_path
-    after hundreds of expansions; and a face two touching obstacles share lies inside
-    their block (whose outline alone the pieces are tested against), so between two
-    points on such faces a path ran through the building."""
+    after hundreds of expansions. (A point on a face two touching obstacles share lies
+    inside their union: :meth:`World.check_point` refuses it first.)"""
     shown = world._fmt(p) if given is None else world._fmt_frame(given)
     fix = "a turning vehicle's path keeps clear of every edge: move it off the edge"
     if len(world.obstacles):

@@ -56,8 +56,7 @@ def _stepped_out(world, block, p: np.ndarray, q: np.ndarray,
                  decimals: int) -> np.ndarray | None:
     """Of the points stepped out from ``q`` (on the block's edge) whose rounded form is
     free and off every obstacle (on no edge), the one nearest ``p``, as typed back from
-    its rounded form. (The edge two touching obstacles share is free in the world, which tests each
-    obstacle alone, but inside the block, as the visibility graph merges them.)"""
+    its rounded form."""
     step = 10.0 ** -decimals / 10 if world.frame == "degrees" else 1e-3
     away = (q - p) / (np.hypot(*(q - p)) or 1.0)
     angles = np.linspace(0, 2 * np.pi, DIRECTIONS, endpoint=False)

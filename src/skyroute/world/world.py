@@ -8,8 +8,9 @@ that frame and planners return paths in it; :meth:`World.to_plane` and
 table of frames). Obstacles are shapely polygons with a floor and a ceiling;
 ``at(altitude)`` keeps those that count at an altitude. Queries are exact and vectorised
 (shapely 2 and an STRtree): a point is free when it lies in no obstacle's interior and
-strictly inside the boundary; a segment is free when it meets no obstacle's interior and
-lies strictly inside the boundary (touching an obstacle's edge or corner is allowed).
+strictly inside the boundary; a segment is free when it meets no interior of the
+obstacles' union and lies strictly inside the boundary (touching an obstacle's edge or
+corner is allowed; a face two touching obstacles share lies inside their union).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from skyroute.geo import (
     metres_per_degree_north,
 )
 from skyroute.world.grid import Grid, raster_shape
+from skyroute.world.interiors import entered, entered_one
 from skyroute.world.nearest_free import nearest_free
 from skyroute.world.points import (
     MAX_METRES,
@@ -301,23 +303,24 @@ class World:
         return shapely.contains_properly(self._prepared_boundary, pts)
 
     def blocking(self, points) -> np.ndarray:
-        """Index of an obstacle whose interior holds each point, or -1."""
+        """Index of an obstacle whose interior holds each point, or -1. A point on the
+        face two touching obstacles share lies inside their union, so it is blocked
+        too (by the lowest-numbered of them); one on an outer edge is free."""
         p = plane_points(points)
-        out = np.full(len(p), -1, np.int64)
         if len(self.obstacles) == 0:
-            return out
-        # "within" is strict for a point: one on an obstacle's edge is free
-        ip, io = self.tree.query(shapely.points(p), predicate="within")
-        out[ip] = io
-        return out
+            return np.full(len(p), -1, np.int64)
+        return entered(self.obstacles, self.tree, shapely.points(p))
 
     def is_free(self, points) -> np.ndarray:
-        """True where a point is in no obstacle's interior and strictly inside the boundary."""
+        """True where a point is in no interior of the obstacles' union (:meth:`blocking`)
+        and strictly inside the boundary."""
         return (self.blocking(points) < 0) & self.inside(points)
 
     def segments_free(self, a, b) -> np.ndarray:
-        """True for each segment a[i] -> b[i] that meets no obstacle interior and lies
-        strictly inside the boundary. a, b: (N, 2)."""
+        """True for each segment a[i] -> b[i] that meets no interior of the obstacles'
+        union and lies strictly inside the boundary. a, b: (N, 2). Touching an edge or a
+        corner is allowed; running along (or through) a face two touching obstacles
+        share is not (:mod:`skyroute.world.interiors`)."""
         a, b = _segment_ends(a, b)
         n = len(a)
         ok = np.ones(n, bool)
@@ -328,12 +331,7 @@ class World:
         lines = shapely.linestrings(coords[~same])
         idx = np.flatnonzero(~same)
         if len(self.obstacles) and len(lines):
-            il, io = self.tree.query(lines, predicate="intersects")
-            if len(il):
-                # interiors meet <=> they intersect and do not merely touch (both
-                # predicates are fast on the prepared obstacles)
-                hit = ~shapely.touches(self.obstacles[io], lines[il])
-                ok[idx[np.unique(il[hit])]] = False
+            ok[idx] = entered(self.obstacles, self.tree, lines) < 0
         if same.any():
             ok[same] = self.is_free(a[same])
         if self.boundary is not None and len(lines):
@@ -362,11 +360,7 @@ class World:
         line = shapely.LineString([a, b])
         if self.boundary is not None and not self._prepared_boundary.contains_properly(line):
             return False
-        if len(self.obstacles):
-            for j in self.tree.query(line, predicate="intersects"):
-                if not self.obstacles[j].touches(line):
-                    return False
-        return True
+        return not len(self.obstacles) or entered_one(self.obstacles, self.tree, line) < 0
 
     def clearance(self, points) -> np.ndarray:
         """Distance from each point to the nearest obstacle (0 inside one); inf if none."""
