@@ -22,6 +22,14 @@ class Fail(Exception):  # noqa: N818 (the scripts raise it as `raise Fail(...)`)
     """Bad input: the script prints ``NAME: error: MESSAGE`` and exits 2."""
 
 
+def check_counts(args, names: tuple[str, ...], low: int = 1, high: int = 100) -> None:
+    """A :class:`Fail` naming the first of the options ``names`` (attributes of the
+    parsed ``args``) whose value lies outside ``low`` to ``high``."""
+    for name in names:
+        if not low <= getattr(args, name) <= high:
+            raise Fail(f"--{name} {getattr(args, name)}: expected {low} to {high}")
+
+
 def run_main(main) -> None:
     """Run ``main()``; a :class:`Fail` or a skyroute input error is one line, exit 2."""
     name = Path(sys.argv[0]).name

@@ -22,7 +22,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import Fail, load_average, measure_in, resolve_tree, run_main
+from _common import Fail, check_counts, load_average, measure_in, resolve_tree, run_main
 
 METHODS = ("auto", "subgoal", "jump")
 
@@ -62,9 +62,7 @@ def parse(argv=None) -> argparse.Namespace:
         raise Fail(f"--side {a.side}: expected 16 to 4096 cells")
     if not 0.0 <= a.share < 1.0:
         raise Fail(f"--share {a.share}: expected 0 <= SHARE < 1")
-    for name in ("builds", "rounds"):
-        if not 1 <= getattr(a, name) <= 100:
-            raise Fail(f"--{name} {getattr(a, name)}: expected 1 to 100")
+    check_counts(a, ("builds", "rounds"))
     return a
 
 

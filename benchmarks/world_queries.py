@@ -25,7 +25,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import Fail, load_average, measure_in, resolve_tree, run_main
+from _common import Fail, check_counts, load_average, measure_in, resolve_tree, run_main
 
 MEASURE = """
 import json, sys, time
@@ -105,9 +105,7 @@ def parse(argv=None) -> argparse.Namespace:
         raise Fail(f"--city {a.city}: no such file")
     if not all(0.0 <= s < 1e4 for s in a.safety) or not 0.0 <= a.altitude < 1e4:
         raise Fail("--altitude and --safety: expected 0 to 10,000 m")
-    for name in ("repeats", "rounds"):
-        if not 1 <= getattr(a, name) <= 100:
-            raise Fail(f"--{name} {getattr(a, name)}: expected 1 to 100")
+    check_counts(a, ("repeats", "rounds"))
     return a
 
 
