@@ -46,12 +46,11 @@ def zone_world(scenario) -> World | None:
 
 @functools.lru_cache(maxsize=8)
 def _indexed(zones: tuple[tuple[str, tuple[tuple[float, float], ...]], ...]):
-    """(names, polygons in the (east, north) plane, their STRtree), built once per set
-    of zones: a check before a run tests every airport at every level."""
-    polys = np.array([shapely.Polygon([(e, n) for n, e in pts]) for _, pts in zones],
-                     dtype=object)
-    shapely.prepare(polys)
-    return [n for n, _ in zones], polys, shapely.STRtree(polys)
+    """(names, polygons in the (east, north) plane, their STRtree, which prepares
+    them): those of :func:`_world`'s World, held per set of zones, as a check before a
+    run tests every airport at every level."""
+    world = _world(zones)
+    return list(world.names), world.obstacles, world.tree
 
 
 _LAST: tuple = (None, None)  # (a scenario's list of zones, its index)
