@@ -1472,3 +1472,102 @@ def test_fleet_replay_ends_where_the_run_ends(open_page, server):
         with eng.begin() as c:
             c.execute(sa.text("DELETE FROM fleet_runs WHERE id = :id"), {"id": run_id})
         eng.dispose()
+
+
+@pytest.mark.parametrize("page", ["day", "fleet"])
+def test_an_empty_store_says_so_and_how_to_fill_it(open_page, page):
+    """A fresh store (``skyroute db init``): the fleet page's run list was an empty box
+    (its "no stored runs" replaced by the runs, none); the day page said to fly a day
+    below, which on a store without orders stores an empty day. The list says there is
+    nothing, and the day page says the orders come first."""
+    pg = open_page(f"/{page}.html", "desktop")
+    p = pg.page
+    if page == "day":
+        p.route("**/days", lambda r: r.fulfill(json=[]))
+        p.reload()
+        p.wait_for_function("document.querySelector('#status').textContent"
+                            ".includes('no delivery day')")
+        assert "skyroute db import DIR --db URL" in p.inner_text("#status")
+        key, words = "#date", "no stored days"
+    else:
+        p.route(re.compile(r"/fleet/runs\?limit="), lambda r: r.fulfill(json=[]))
+        p.reload()
+        p.wait_for_function("document.querySelector('#status').textContent"
+                            ".startsWith('No fleet run')")
+        key, words = "#run", "no stored runs"
+    assert p.locator(f"{key} option").all_inner_texts() == [words]
+    assert p.is_disabled(key)
+    pg.done(f"{page}-empty-store")
+
+
+def test_a_day_flown_without_stored_orders_says_nothing_was_flown(open_page):
+    """A day flown from the page when the store holds none of its orders (a fresh store,
+    or a date typed wrong) is stored as a day of no orders; the job line said "The day
+    is flown and stored." in green. It says nothing was flown, and why."""
+    if server_has_no_jobs():
+        pytest.skip("skyroute.jobs is not in this tree: no jobs")
+    date = "2024-02-01"  # a stored day of no orders
+    pg = open_page(f"/day.html#date={DAY}", "desktop")
+    p = pg.page
+    _job_routes(p, {"state": "done", "progress": 1.0, "result": {
+        "from": date, "to": date, "days": 1, "days_with_orders": 0}}, kind="deliver")
+    p.wait_for_function("document.querySelector('#time').max > 0")
+    p.fill("#job-date", date)
+    p.fill("#token", TOKEN)
+    p.click("#start")
+    p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{date}:')"
+                        " && !document.querySelector('#start').ariaDisabled")
+    text = p.inner_text("#job-status")
+    assert text.startswith(f"Nothing was flown: the store holds no orders of {date}."), text
+    assert "skyroute db import" in text
+    assert p.evaluate("document.querySelector('#job-status').dataset.kind") == "error"
+    assert p.is_visible("#delete")  # the way to take the empty day off
+    pg.done("day-job-no-orders")
+
+
+@pytest.mark.parametrize("page", ["day", "fleet", "planner"])
+def test_a_failed_choice_leaves_the_list_on_what_is_shown(open_page, server, page):
+    """A day or map chosen while the server did not answer, or a run deleted since the
+    list was read: the status line said so, but the list stayed on the failed choice
+    while the page showed the one before, and choosing that one again asked nothing (no
+    change). The list goes back to what is shown; a deleted run goes from it."""
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    with contextlib.ExitStack() as stack:
+        if page == "day":
+            key, shown, other = "#date", DAY, "2024-02-01"
+            pg = open_page(f"/day.html#date={shown}", "desktop")
+            pg.page.wait_for_function("document.querySelector('#time').max > 0")
+            gone = f"**/days/{other}*"
+        elif page == "planner":
+            key, shown, other = "#map-name", "Berlin_1_256", "den312d"
+            pg = open_page("/planner.html", "desktop")
+            _open_map(pg, shown)
+            gone = f"**/maps/{other}"
+        else:
+            import sqlalchemy as sa
+
+            key, shown, other = "#run", server[1], stack.enter_context(_copied_run(server))
+            pg = open_page(f"/fleet.html#run={shown}", "desktop")
+            pg.page.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+            eng = sa.create_engine(server[2])
+            with eng.begin() as c:  # deleted after the page listed it
+                for table, column in (("fleet_run_files", "run_id"), ("fleet_runs", "id")):
+                    c.execute(sa.text(f"DELETE FROM {table} WHERE {column} = :id"), {"id": other})
+            eng.dispose()
+        p = pg.page
+        if page != "fleet":
+            p.route(gone, lambda r: r.abort())  # the server does not answer
+        p.select_option(key, other)
+        p.wait_for_function("document.querySelector('#status').dataset.kind === 'error'")
+        said = p.inner_text("#status")
+        assert ("did not answer" if page != "fleet" else "(404)") in said, said
+        assert p.input_value(key) == shown
+        if page == "fleet":
+            assert other not in _options(p) and shown in _options(p)
+            return
+        p.unroute(gone)  # the server is back: the same choice again is read
+        p.select_option(key, other)
+        p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{other}')",
+                            timeout=15_000)
+        assert p.input_value(key) == other

@@ -78,8 +78,9 @@ async function listDays(wanted = null) {
     select.replaceChildren(h("option", {}, "no stored days"));
     select.disabled = true;
     showNoDay();
-    say(status, "The store holds no delivery day yet: fly one below (or with `skyroute deliver DATE " +
-      "--data DIR --db URL`).", "info");
+    // a day is flown from the store's orders: a fresh store has none to fly
+    say(status, "The store holds no delivery day yet. Import a day's orders (skyroute db import " +
+      "DIR --db URL) and fly it below, or fly it with skyroute deliver DATE --data DIR --db URL.", "info");
     return false;
   }
   select.replaceChildren(...days.map((d) => h("option", { value: d.date },
@@ -128,6 +129,12 @@ const jobs = new JobFollower({
   hint: (error) => (/replace=true/.test(error || "") ? "To store the day as flown now, " +
     "over its stored flight, tick “Replace a kept flight” and fly it again." : ""),
   onDone: async (r) => {
+    if (r.days_with_orders === 0) {
+      // the job stores the day even so (a day of no orders): not "flown", and what to do
+      say(jobStatus, `Nothing was flown: the store holds no orders of ${r.from}. Import them ` +
+        "(skyroute db import DIR --db URL) and fly the day again; the day stored without a " +
+        "flight can be deleted above.", "error");
+    }
     if (!(await listDays(r.from))) return;
     await loadSite();
     await load(select.value);
@@ -181,7 +188,12 @@ async function load(date, note = "") {
       getJSON(`/days/${encodeURIComponent(date)}/flightpath.geojson`),
     ]);
   } catch (err) {
-    if (mine === loading) say(status, explain(err, `Reading ${date}`), "error");
+    if (mine !== loading) return;
+    say(status, explain(err, `Reading ${date}`), "error");
+    // a day deleted since the list was read goes from it; the list shows the day shown
+    // again (left on the failed one, choosing that one again asked nothing)
+    if (err instanceof ApiError && err.status === 404) [...select.options].find((o) => o.value === date)?.remove();
+    if (day) select.value = day.date;
     return;
   }
   if (mine !== loading) return; // another day was chosen while this one was read

@@ -112,9 +112,9 @@ async function listRuns(select = null) {
   nextRuns = page.next;
   outOfPage = null;
   if (!runs.length) {
+    showRuns(); // (an empty list) before the line that says so, which it replaced
     runSelect.replaceChildren(h("option", {}, "no stored runs"));
     runSelect.disabled = true;
-    showRuns();
     say(status, "No fleet run is stored yet: start one below.", "info");
     return false;
   }
@@ -184,7 +184,15 @@ async function load(id) {
         .catch(() => null),
     ]);
   } catch (err) {
-    if (mine === loading) say(status, explain(err, "Reading the run"), "error");
+    if (mine !== loading) return;
+    say(status, explain(err, "Reading the run"), "error");
+    // a run deleted since the list was read goes from it; the list shows the run shown
+    // again (left on the failed one, choosing that one again asked nothing)
+    if (err instanceof ApiError && err.status === 404) {
+      runs = runs.filter((r) => String(r.id) !== String(id));
+      showRuns();
+    }
+    if (run) runSelect.value = run.id;
     return;
   }
   if (mine !== loading) return; // another run was chosen while this one was read

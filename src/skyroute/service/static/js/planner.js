@@ -39,7 +39,9 @@ async function loadMap(name) {
   try {
     doc = await getJSON(`/maps/${encodeURIComponent(name)}`);
   } catch (err) {
-    if (mine === loading) say(status, explain(err, `Reading map ${name}`), "error");
+    if (mine !== loading) return;
+    say(status, explain(err, `Reading map ${name}`), "error");
+    if (grid) mapSelect.value = grid.name; // the map shown: choosing the failed one asks again
     return;
   }
   if (mine !== loading) return; // another map was chosen while this one was read
