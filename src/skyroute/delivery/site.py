@@ -87,17 +87,24 @@ def _read_menus(source) -> tuple[tuple[tuple[str, str], ...], dict[str, tuple[in
             name, loc, items = shop["name"], shop["location"], shop["menu"]
             if not (isinstance(name, str) and isinstance(loc, str)):
                 raise ValueError("name and location must be strings")
+            loc = loc.strip()  # as the order CSVs' deliverTo is read
             for it in items:
                 item, pence = it["item"], it["pence"]
                 if not isinstance(item, str):
                     raise ValueError(f"item {item!r}: an item's name must be a string")
+                # spaces round a name read past, as in orderDetails.csv: a menu's 'Ham
+                # roll ' was never 'Ham roll', and its orders were invalid ('unknown item')
+                item = item.strip()
+                if not item:
+                    raise ValueError(f"item {it['item']!r}: an item's name is empty")
                 # bool is an int to Python: true would be 1p; 2**63 and more overflow SQL
                 if isinstance(pence, bool) or not isinstance(pence, int) \
                         or not 0 <= pence < 2**63:
                     raise ValueError(f"item {item!r}: pence must be a whole number >= 0 "
                                      "(below 2**63)")
-                if item in menu:
-                    raise ValueError(f"item {item!r} is also on shop "
+                if item in menu:  # twice on this shop's menu, or on an earlier one's
+                    raise ValueError(f"item {item!r} is twice on its menu" if menu[item][1]
+                                     == k else f"item {item!r} is also on shop "
                                      f"{shops[menu[item][1]][0]!r}'s menu")
                 menu[item] = (pence, k)
         except (KeyError, TypeError) as exc:
