@@ -584,6 +584,36 @@ def test_a_day_whose_files_fail_is_not_stored(monkeypatch, capsys, tmp_path, fly
     assert not (tmp_path / "out").exists()  # nor a file, nor the folder made for them
 
 
+def test_a_range_stopped_by_a_full_disk_says_which_days_are_stored(monkeypatch, capsys,
+                                                                  tmp_path, fly_once):
+    # the disk fills while the second day's PNG is written: the range stops, keeping the
+    # first day with its files; the one line said only "...png: cannot write: No space
+    # left on device", not whether 2024-01-01 was kept or 2024-01-03 flown
+    calls = []
+
+    def save(fig, path, **kw):
+        calls.append(path)
+        if len(calls) == 2:
+            return _full_disk_png(fig, path)
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        Path(path).write_bytes(b"png")
+
+    monkeypatch.setattr("skyroute.io.plot.save_figure", save)
+    db, out = tmp_path / "r.db", tmp_path / "out"
+    code, _, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
+                       "2024-01-03", "--data", EXAMPLE, "--db", f"sqlite:///{db}", "--out",
+                       str(out), "--plot")
+    assert code == 2 and err.count("error") == 1, err  # after the "imported" line
+    assert err.strip().endswith(
+        "drone-02-01-2024.png: cannot write: No space left on device; the range stopped "
+        "there: 1 of its 3 days is stored with its files (2024-01-01), the other 2 not"), err
+    assert _stored_day(db, "2024-01-01")[0] and not _stored_day(db, "2024-01-02")[0]
+    assert _files_of(out) == ["drone-01-01-2024.geojson", "drone-01-01-2024.png",
+                              "report-01-01-2024.json"]
+
+
 def _files_of(out: Path) -> list[str]:
     return sorted(p.name for p in out.iterdir())
 
