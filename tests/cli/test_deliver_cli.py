@@ -247,10 +247,11 @@ def test_an_order_number_too_long_for_the_store_is_one_line(monkeypatch, capsys,
     code, _, err = run(monkeypatch, capsys, "deliver", "2024-01-01", "--data", str(data),
                        "--db", f"sqlite:///{tmp_path / 'o.db'}", "--out", str(tmp_path / "o"))
     assert code == 2 and len(err.strip().splitlines()) == 1, err
-    assert "order '123456789': order_no '123456789' is 9 characters, orders.order_no " \
-           "holds at most 8" in err
-    assert not any(_stored_rows(tmp_path / "o.db").values())
-    assert not (tmp_path / "o").exists()
+    # named by file and line as it is read, before a store is made (a new store, its
+    # tables empty, was left behind)
+    assert "orders.csv:110: orderNo '123456789' is 9 characters; the store keeps at " \
+           "most 8" in err
+    assert not (tmp_path / "o.db").exists() and not (tmp_path / "o").exists()
 
 
 def test_each_invalid_order_is_one_line_on_a_narrow_stderr(monkeypatch, capsys, tmp_path):
@@ -583,6 +584,36 @@ def test_a_day_whose_files_fail_is_not_stored(monkeypatch, capsys, tmp_path, fly
     assert not (tmp_path / "out").exists()  # nor a file, nor the folder made for them
 
 
+def test_a_range_stopped_by_a_full_disk_says_which_days_are_stored(monkeypatch, capsys,
+                                                                  tmp_path, fly_once):
+    # the disk fills while the second day's PNG is written: the range stops, keeping the
+    # first day with its files; the one line said only "...png: cannot write: No space
+    # left on device", not whether 2024-01-01 was kept or 2024-01-03 flown
+    calls = []
+
+    def save(fig, path, **kw):
+        calls.append(path)
+        if len(calls) == 2:
+            return _full_disk_png(fig, path)
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        Path(path).write_bytes(b"png")
+
+    monkeypatch.setattr("skyroute.io.plot.save_figure", save)
+    db, out = tmp_path / "r.db", tmp_path / "out"
+    code, _, err = run(monkeypatch, capsys, "deliver", "--from", "2024-01-01", "--to",
+                       "2024-01-03", "--data", EXAMPLE, "--db", f"sqlite:///{db}", "--out",
+                       str(out), "--plot")
+    assert code == 2 and err.count("error") == 1, err  # after the "imported" line
+    assert err.strip().endswith(
+        "drone-02-01-2024.png: cannot write: No space left on device; the range stopped "
+        "there: 1 of its 3 days is stored with its files (2024-01-01), the other 2 not"), err
+    assert _stored_day(db, "2024-01-01")[0] and not _stored_day(db, "2024-01-02")[0]
+    assert _files_of(out) == ["drone-01-01-2024.geojson", "drone-01-01-2024.png",
+                              "report-01-01-2024.json"]
+
+
 def _files_of(out: Path) -> list[str]:
     return sorted(p.name for p in out.iterdir())
 
@@ -800,6 +831,14 @@ def _lunch_with(tmp_path, name: str, edit) -> Path:
      "orderNo,deliveryDate,customer,deliverTo"),
     ("orderDetails.csv", lambda t: t + "zzzz,Club sandwich (Small)\n",
      "is not in orders.csv"),
+    # a value too long for its store column: one line naming the store's column, no
+    # file or line, after the new store was made
+    ("orders.csv", lambda t: t.replace(",s2433825,", ",cust-00012,", 1),
+     "orders.csv:2: customer 'cust-00012' is 10 characters; the store keeps at most 8"),
+    ("orders.csv", lambda t: t.replace(",brook.boat.brick", "," + "a" * 65, 1),
+     f"orders.csv:2: deliverTo '{'a' * 65}' is 65 characters; the store keeps at most 64"),
+    ("orderDetails.csv", lambda t: t.replace("Club sandwich (Small)", "C" * 101, 1),
+     "is 101 characters; the store keeps at most 100"),
 ])
 def test_malformed_order_files_leave_no_new_store_behind(monkeypatch, capsys, tmp_path,
                                                          command, name, edit, words):

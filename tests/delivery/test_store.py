@@ -60,6 +60,16 @@ def test_init_makes_the_issues_tables_and_is_repeatable(engine):
     assert store.init(engine) == "0006"  # again: nothing to do
 
 
+def test_the_csv_readers_widths_are_the_stores_columns(engine):
+    # the reader refuses a value too long for its column before any store is opened
+    from skyroute.delivery.orders import WIDTHS
+
+    t = store.tables(engine)
+    columns = {"orderNo": t["orders"].c.order_no, "customer": t["orders"].c.customer,
+               "deliverTo": t["orders"].c.deliver_to, "item": t["order_details"].c.item}
+    assert {k: c.type.length for k, c in columns.items()} == WIDTHS
+
+
 def test_import_is_idempotent(engine):
     orders = [Order("0000000a", DAY, "s2400001", "a.b.c", ("x", "y", "x")),
               Order("0000000b", DAY, "s2400002", "a.b.d", ("z",))]

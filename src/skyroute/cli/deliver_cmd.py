@@ -131,8 +131,11 @@ def deliver_command(
             def files(r: DayResult) -> None:  # staged; in place once the day is stored
                 write_outputs(site, r, out, plot=draw)
 
+            stored: list[dt.date] = []  # the days stored, with their files, so far
+
             def finished(r: DayResult) -> None:
                 written.extend(output_paths(out, r.date, plot=draw))
+                stored.append(r.date)
                 progress.advance(days)
 
             failed: list[DayFailed] = []  # said once the other days are stored
@@ -141,11 +144,16 @@ def deliver_command(
                     results = run_days(engine, src, by_date, executor=ex, method=method,
                                        replace=replace, files=files, on_day=finished,
                                        on_failed=lambda _f: progress.advance(days))
-            except DayKeptError as exc:
-                raise SkyrouteError(f"{exc}; --replace stores the day as flown now"
-                                    ) from None
             except DaysFailedError as exc:
                 results, failed = exc.stored, exc.failed
+            except SkyrouteError as exc:  # storing a day or writing its files: it stops
+                kept = isinstance(exc, DayKeptError)
+                if one_day and not kept:
+                    raise
+                text = str(exc) + ("; --replace stores the day as flown now" if kept else "")
+                if not one_day:
+                    text += f"; {_stopped(sorted(stored), len(by_date))}"
+                raise SkyrouteError(text) from None
             wall = time.perf_counter() - t0
         workers = ex.workers
     if day is not None:
@@ -156,6 +164,18 @@ def deliver_command(
     _say_empty(results, list(by_date))
     if failed:
         _say_failed(failed, len(by_date))
+
+
+def _stopped(stored: list[dt.date], n: int) -> str:
+    """What a range stopped by an error (a full disk, a day kept) left: the days stored
+    before it, each with its files, and that no other is (the error alone did not say
+    whether the days before it were kept, nor that the later ones were not flown)."""
+    if not stored:
+        return f"the range stopped there and none of its {n:,} days is stored"
+    k = len(stored)
+    return (f"the range stopped there: {k:,} of its {n:,} days "
+            f"{'is' if k == 1 else 'are'} stored with {'its' if k == 1 else 'their'} "
+            f"files ({some_days(stored)}), the other {n - k:,} not")
 
 
 def _say_empty(results: list[DayResult], dates: list[dt.date]) -> None:

@@ -12,13 +12,16 @@ which is how a synthetic set in another town names its own.
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
 
+import numpy as np
 import shapely
 
 from skyroute.delivery.source import DirSource, HttpSource
-from skyroute.errors import InputFormatError
+from skyroute.errors import InputFormatError, QueryError
 from skyroute.world.geojson_world import read_geojson_world
+from skyroute.world.points import check_places
 from skyroute.world.world import World
 
 ILP_HOME = "nests.takes.print"  # Appleton Tower
@@ -87,17 +90,24 @@ def _read_menus(source) -> tuple[tuple[tuple[str, str], ...], dict[str, tuple[in
             name, loc, items = shop["name"], shop["location"], shop["menu"]
             if not (isinstance(name, str) and isinstance(loc, str)):
                 raise ValueError("name and location must be strings")
+            loc = loc.strip()  # as the order CSVs' deliverTo is read
             for it in items:
                 item, pence = it["item"], it["pence"]
                 if not isinstance(item, str):
                     raise ValueError(f"item {item!r}: an item's name must be a string")
+                # spaces round a name read past, as in orderDetails.csv: a menu's 'Ham
+                # roll ' was never 'Ham roll', and its orders were invalid ('unknown item')
+                item = item.strip()
+                if not item:
+                    raise ValueError(f"item {it['item']!r}: an item's name is empty")
                 # bool is an int to Python: true would be 1p; 2**63 and more overflow SQL
                 if isinstance(pence, bool) or not isinstance(pence, int) \
                         or not 0 <= pence < 2**63:
                     raise ValueError(f"item {item!r}: pence must be a whole number >= 0 "
                                      "(below 2**63)")
-                if item in menu:
-                    raise ValueError(f"item {item!r} is also on shop "
+                if item in menu:  # twice on this shop's menu, or on an earlier one's
+                    raise ValueError(f"item {item!r} is twice on its menu" if menu[item][1]
+                                     == k else f"item {item!r} is also on shop "
                                      f"{shops[menu[item][1]][0]!r}'s menu")
                 menu[item] = (pence, k)
         except (KeyError, TypeError) as exc:
@@ -122,12 +132,14 @@ def load_site(source: DirSource | HttpSource) -> Site:
         try:
             home_words = str(area["home"])
             box = tuple(float(v) for v in area["confinement"])
-            if len(box) != 4 or not (box[0] < box[2] and box[1] < box[3]):
+            if len(box) != 4 or not (box[0] < box[2] and box[1] < box[3]) \
+                    or not all(map(math.isfinite, box)):
                 raise ValueError
         except (KeyError, TypeError, ValueError):
             raise InputFormatError(source.where("area.json"), "expected {\"home\": WORDS, "
                                    "\"confinement\": [min_lon, min_lat, max_lon, max_lat]}"
                                    ) from None
+        _check_area(source, home_words, box)
     zones = "buildings/no-fly-zones.geojson"
     world = read_geojson_world(source.where(zones), boundary=shapely.box(*box),
                                frame="degrees", text=source.text(zones))
@@ -138,6 +150,24 @@ def load_site(source: DirSource | HttpSource) -> Site:
             [(f"shop {s.name!r}", s.words, s.lonlat) for s in site.shops]:
         check_place(site, label, words, p)
     return site
+
+
+def _check_area(source, home_words: str, box: tuple[float, ...]) -> None:
+    """``area.json``'s confinement on its own: on the Earth, small enough for a world, and
+    around home. A box too big, or written (lat, lon), was named as a fault of the zones
+    file (the world is read from it with the box as its boundary)."""
+    where = source.where("area.json")
+    try:
+        check_places(np.array([box[:2], box[2:]]), "a corner of the confinement")
+    except QueryError as exc:
+        raise InputFormatError(where, str(exc)) from None
+    read_geojson_world(where, boundary=shapely.box(*box), frame="degrees",
+                       text='{"type": "FeatureCollection", "features": []}')
+    x, y = _read_words(source, home_words)
+    if not (box[0] < x < box[2] and box[1] < y < box[3]):
+        raise InputFormatError(where, f"home {home_words!r} at ({x}, {y}) is not inside the "
+                               f"confinement {list(box)} (min_lon, min_lat, max_lon, "
+                               "max_lat)")
 
 
 def check_place(site: Site, label: str, words: str, p: tuple[float, float]) -> None:

@@ -2,11 +2,13 @@
 
 Independent of how the flight was made: it recomputes every move from its angle, tests
 each segment against the zones and the area, and checks that every delivered order has
-its hovers at each shop and then at its customer, and that the day ends home.
+its hovers at each shop and then at its customer, one order after another, and that the
+day ends home.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -59,4 +61,12 @@ def check_flight(world, home, frm, angle, to, labels, deliveries) -> list[str]:
                 k += 1
         if k < len(stops):
             bad.append(f"order {order_no}: missing its hover at stop {k + 1} of {len(stops)}")
+    # one order at a time (SPEC.md 4.2): the delivered orders' hovers come order by
+    # order; a flight that picked up two orders before delivering either passed
+    claimed = {order_no for order_no, _ in deliveries}
+    runs = [no for no, _ in itertools.groupby(labels[h] for h in hovers if labels[h] in claimed)]
+    twice = next((no for k, no in enumerate(runs) if no in runs[:k]), None)
+    if twice is not None:
+        bad.append(f"order {twice}: its stops are split by another order's (the drone "
+                   "carries one order at a time)")
     return bad
