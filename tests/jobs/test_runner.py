@@ -83,6 +83,39 @@ def test_an_unexpected_error_is_its_type_and_message(tmp_path, monkeypatch):
     assert job["error"] == "ZeroDivisionError: division by zero second line"
 
 
+def test_a_database_error_is_stored_without_its_statement(tmp_path, caplog):
+    """The store refusing a day's row (a full disk, a constraint): the job's error was
+    SQLAlchemy's text, the INSERT with every value of the row in it; it is one line
+    naming the kind of statement and the database's reason, the SQL in the log."""
+    engine = lunch_store(f"sqlite:///{tmp_path / 'd.db'}", ())
+    with engine.begin() as c:
+        c.exec_driver_sql("CREATE TRIGGER full BEFORE INSERT ON runs BEGIN "
+                          "SELECT RAISE(ABORT, 'database or disk is full'); END")
+    with open_executor("local", workers=1) as ex, caplog.at_level("ERROR", "skyroute.jobs"):
+        job = runner.wait(engine, runner.submit(engine, "deliver", {
+            "date": "2024-01-05", "data": str(EXAMPLE)}, executor=ex), timeout=60)
+    assert job["state"] == "failed"
+    assert job["error"] == ("IntegrityError: the store could not run an INSERT: database "
+                            "or disk is full"), job["error"]
+    assert "INSERT INTO runs" in caplog.text  # the detail stays in the server's log
+
+
+def test_an_error_stored_with_its_statement_is_read_without_it(tmp_path):
+    """A job failed by an older skyroute kept SQLAlchemy's whole text: it is read up to
+    the row (PostgreSQL's DETAIL) and the SQL."""
+    from skyroute.jobs import store
+
+    engine = lunch_store(f"sqlite:///{tmp_path / 'o.db'}", ())
+    job_id = store.create_job(engine, "deliver", {"date": "2024-01-05"})
+    store.fail_job(engine, job_id, 'IntegrityError: (psycopg.errors.UniqueViolation) '
+                   'duplicate key value violates unique constraint "t_pkey"\nDETAIL:  Key '
+                   "(a)=(x) already exists.\n[SQL: INSERT INTO t VALUES (%(a)s)]\n"
+                   "[parameters: {'a': 'x'}]")
+    assert runner.get(engine, job_id)["error"] == (
+        'IntegrityError: (psycopg.errors.UniqueViolation) duplicate key value violates '
+        'unique constraint "t_pkey"')
+
+
 @pytest.mark.parametrize("kind, params, words", [
     ("plan", {}, "kind='plan' is not valid; choose one of 'deliver', 'fleet', 'sweep'"),
     ("deliver", {"date": "tomorrow", "data": str(EXAMPLE)}, "date='tomorrow'"),

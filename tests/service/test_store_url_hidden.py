@@ -10,7 +10,7 @@ import sqlite3
 
 import pytest
 
-from tests.service.conftest import AUTH, make_client
+from tests.service.conftest import AUTH, EXAMPLE, make_client
 
 
 @pytest.mark.parametrize("dropped, method, path, body", [
@@ -36,3 +36,27 @@ def test_a_store_without_its_tables_names_no_path(tmp_path, caplog, dropped, met
     assert doc["detail"].startswith("the store cannot be read"), doc
     logged = [x.getMessage() for x in caplog.records if x.name == "skyroute.service"]
     assert any(str(db) in m and "skyroute db init" in m for m in logged), logged
+
+
+
+def test_a_job_failed_by_the_store_shows_no_sql(tmp_path):
+    """A deliver job whose day the store refused to write (here a trigger; a full disk,
+    a constraint): ``GET /jobs/{id}`` gave SQLAlchemy's text, the INSERT with the row's
+    values and a link to SQLAlchemy's site; it gives one line saying what failed."""
+    from skyroute.jobs import runner
+
+    db = tmp_path / "store.db"
+    with make_client(db_url=f"sqlite:///{db}", data_dir=EXAMPLE, job_workers=1) as c:
+        res = c.app.state.resources
+        with res.engine().begin() as conn:
+            conn.exec_driver_sql("CREATE TRIGGER full BEFORE INSERT ON runs BEGIN "
+                                 "SELECT RAISE(ABORT, 'database or disk is full'); END")
+        # as POST /jobs/deliver submits it (without its check of the site, a second)
+        job_id = runner.submit(res.engine(), "deliver", {"date": "2024-01-05",
+                                                         "data": str(EXAMPLE)},
+                               executor=res.executor())
+        runner.wait(res.engine(), job_id, timeout=60)
+        job = c.get(f"/jobs/{job_id}", headers=AUTH).json()
+    assert job["state"] == "failed", job
+    assert job["error"] == ("IntegrityError: the store could not run an INSERT: database "
+                            "or disk is full"), job["error"]

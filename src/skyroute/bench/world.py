@@ -20,7 +20,7 @@ import numpy as np
 import shapely
 
 from skyroute.errors import OptionError, SkyrouteError, real
-from skyroute.world.load import ALTITUDE
+from skyroute.world.load import ALTITUDE, MIN_ALTITUDE
 from skyroute.world.world import World
 
 OMPL_PLANNERS = ("PRM", "PRMstar", "RRTstar", "RRTConnect", "InformedRRTstar")
@@ -40,7 +40,7 @@ def random_rect_world(seed: int, *, count: int = 20, size: float = 100.0) -> Wor
 def check_altitude(altitude: float) -> None:
     """An OptionError unless ``altitude`` is a finite number >= 0 (metres above ground),
     worded as :func:`skyroute.world.load.load_world` words it."""
-    real("altitude", altitude, low=0, need=ALTITUDE)
+    real("altitude", altitude, low=MIN_ALTITUDE, need=ALTITUDE)
 
 
 def load_city(path, *, altitude: float, safety: float) -> World:

@@ -69,6 +69,7 @@ import logging
 import math
 import os
 import queue
+import re
 import socket
 import threading
 import time
@@ -274,8 +275,11 @@ def get(engine: sa.Engine, job_id: str) -> dict | None:
     """The job as :func:`skyroute.jobs.store.get_job` gives it; None for an unknown id.
     Another owner's unfinished job is first checked for orphans (:func:`fail_orphans`,
     at most once per :data:`HEARTBEAT_EVERY` seconds per store), so a job whose server
-    died is seen failed even where no server has jobs left to beat for."""
+    died is seen failed even where no server has jobs left to beat for. An error stored
+    by an older skyroute, which quoted the SQL of a database error, is cut before it."""
     job = store.get_job(engine, job_id)
+    if job is not None and job["error"]:
+        job["error"] = SQL_QUOTES.split(job["error"])[0]  # stored before database_error
     if job is None or job["state"] not in ("queued", "running") or job["owner"] == owner():
         return job
     url, now = str(engine.url), time.monotonic()
@@ -308,9 +312,44 @@ def wait(engine: sa.Engine, job_id: str, *, timeout: float | None = None,
 
 
 def error_line(exc: BaseException) -> str:
-    """One line for the store: a SkyrouteError's message, else type and message."""
-    text = str(exc) if isinstance(exc, SkyrouteError) else f"{type(exc).__name__}: {exc}"
+    """One line for the store: a SkyrouteError's message, a database error's
+    (:func:`database_error`), else type and message."""
+    if isinstance(exc, SkyrouteError):
+        text = str(exc)
+    elif isinstance(exc, sa.exc.StatementError):
+        text = database_error(exc)
+    else:
+        text = f"{type(exc).__name__}: {exc}"
     return " ".join(text.split()) or type(exc).__name__
+
+
+SQL_VERBS = ("SELECT", "INSERT", "UPDATE", "DELETE")
+# where SQLAlchemy's text of an error, made one line, goes on to quote the row
+# (PostgreSQL's DETAIL) and the SQL with its parameters
+SQL_QUOTES = re.compile(r" (?:DETAIL: |\[SQL: )")
+
+
+def database_error(exc: sa.exc.StatementError) -> str:
+    """What failed in the store, without the statement: SQLAlchemy's text of the error
+    holds the SQL and its parameters (the rows being written: order numbers,
+    customers' places; a run's scenario), which the job's stored error showed to every
+    holder of the token; the traceback in the log keeps them. The kind of statement and
+    the first line of the database's own reason (PostgreSQL's further lines, DETAIL,
+    quote the row).
+
+    >>> exc = sa.exc.IntegrityError("INSERT INTO t (a) VALUES (?)", ("x",),
+    ...                             Exception("UNIQUE constraint failed: t.a"))
+    >>> database_error(exc)
+    'IntegrityError: the store could not run an INSERT: UNIQUE constraint failed: t.a'
+    """
+    reason = exc.orig if exc.orig is not None else exc
+    lines = str(reason).strip().splitlines()
+    words = (exc.statement or "").split(maxsplit=1)
+    verb = words[0].upper() if words and words[0].upper() in SQL_VERBS else None
+    what = f"{'an' if verb in ('INSERT', 'UPDATE') else 'a'} {verb}" if verb else \
+        "a statement"
+    return (f"{type(exc).__name__}: the store could not run {what}: "
+            f"{lines[0] if lines else type(reason).__name__}")
 
 
 def _work(jobs: queue.Queue) -> None:

@@ -32,6 +32,7 @@ from scipy.spatial import cKDTree
 
 from skyroute.errors import OptionError, check_seed, flag, whole
 from skyroute.result import PlanResult, Status
+from skyroute.roadmap.limits import MAX_SAMPLES, MIN_SAMPLES
 from skyroute.roadmap.simplify import shortcut, smooth
 from skyroute.world.world import World
 
@@ -145,13 +146,12 @@ class PRM:
 
 
 MARGIN = 0.1  # of the obstacles' extent: sampled round them in a world with no boundary
-MAX_SAMPLES = 10**7  # 160 MB of points and far more of edges: past it, a MemoryError
 
 
 def prm_options(samples, neighbours, prm_star, seed) -> tuple[int, int, bool, int]:
     """The options checked and as plain Python values (numpy integers are integers), or
     an OptionError naming the first bad one."""
-    return (whole("samples", samples, low=2, high=MAX_SAMPLES),
+    return (whole("samples", samples, low=MIN_SAMPLES, high=MAX_SAMPLES),
             whole("neighbours", neighbours, low=1), flag("prm_star", prm_star),
             check_seed(seed))
 

@@ -108,7 +108,9 @@ def load_map(path: str | Path, *, resolution: float | None = None, safety: float
     return grid.inflate(safety)
 
 
-ALTITUDE = "a finite number >= 0"  # what an altitude must be: metres above the ground
+MIN_ALTITUDE = 0.0  # metres above the ground: below it no building counts
+ALTITUDE = f"a finite number >= {MIN_ALTITUDE:g}"  # what an altitude must be
+MAX_SAFETY_DEGREES = 180.0  # a safety margin in the degrees frame; in metres, MAX_METRES
 
 
 def load_world(path: str | Path, *, altitude: float | None = None, safety: float = 0.0,
@@ -140,8 +142,8 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
     # metres above the ground, as bench.world.check_altitude has it: -5 kept no building
     # of a city (all stand on the ground) and planned straight through them
     if altitude is not None:
-        altitude = real("altitude", altitude, low=0, need=ALTITUDE)
-    most = 180.0 if frame == "degrees" else MAX_METRES
+        altitude = real("altitude", altitude, low=MIN_ALTITUDE, need=ALTITUDE)
+    most = MAX_SAFETY_DEGREES if frame == "degrees" else MAX_METRES
     if safety > most:
         raise OptionError(f"safety={safety!r} must be at most {most:g} "
                           f"({'degrees' if frame == 'degrees' else 'metres'})", param="safety")

@@ -17,6 +17,9 @@ MAX_METRES = 1e7
 # has no boundary. A (lat, lon) written for (lon, lat) lands thousands of km away; and the
 # tangent plane at home is off by 0.1 % at 500 km, 0.4 % at 1,000.
 MAX_REACH = 1_000_000
+# A place on Earth: (lon, lat) degrees within these, either side of 0.
+MAX_LON = 180.0
+MAX_LAT = 90.0
 
 
 def _floats(points, what: str) -> np.ndarray:
@@ -72,11 +75,12 @@ def plane_points(points, what: str = "points") -> np.ndarray:
 
 def check_places(p: np.ndarray, what: str) -> np.ndarray:
     """``p`` when every row is a (lon, lat) on Earth, else a QueryError naming ``what``."""
-    bad = (np.abs(p[:, 0]) > 180) | (np.abs(p[:, 1]) > 90)
+    bad = (np.abs(p[:, 0]) > MAX_LON) | (np.abs(p[:, 1]) > MAX_LAT)
     if bad.any():
         q = p[np.argmax(bad)]
         raise QueryError(f"{what} ({q[0]:.7g}, {q[1]:.7g}) is not a place: expected "
-                         "(lon, lat) degrees, lon in [-180, 180], lat in [-90, 90]", param=what)
+                         f"(lon, lat) degrees, lon in [-{MAX_LON:g}, {MAX_LON:g}], lat in "
+                         f"[-{MAX_LAT:g}, {MAX_LAT:g}]", param=what)
     return p
 
 

@@ -19,12 +19,14 @@ from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, model_validator
 
 from skyroute.errors import SEED_MAX, InputFormatError, QueryError, SkyrouteError
+from skyroute.roadmap.limits import MAX_SAMPLES, MIN_SAMPLES
 from skyroute.service.alternatives import exactly_one
 from skyroute.service.auth import require_token
 from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.problems import Problem, from_skyrouteerror, responses
 from skyroute.service.resources import Resources, ResourcesDep
-from skyroute.world.points import MAX_METRES
+from skyroute.world.load import MAX_SAFETY_DEGREES, MIN_ALTITUDE, bundled_maps
+from skyroute.world.points import MAX_LAT, MAX_LON, MAX_METRES
 
 router = APIRouter(tags=["plan"])
 
@@ -36,6 +38,16 @@ Algorithm = Literal["astar", "dijkstra", "bfs", "jps", "theta", "lazy_theta", "v
 # `connectivity` is a choice, not a count: 8.0 is taken as 8, as skyroute.plan takes it.
 Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]
 Point = tuple[Number, Number]
+# The schema states every bound the server holds a value to (a client or a form made
+# from /openapi.json refuses what the server would), from the library's own constants.
+Lon = Annotated[Number, Field(ge=-MAX_LON, le=MAX_LON)]
+Lat = Annotated[Number, Field(ge=-MAX_LAT, le=MAX_LAT)]
+MapName = Literal[tuple(bundled_maps())]  # the bundled maps, as GET /maps lists them
+# a margin in the degrees frame is at most MAX_SAFETY_DEGREES (load_world refuses more,
+# a 422 naming safety): a bound that depends on frame, stated as JSON Schema's if/then
+DEGREES_SAFETY = {"if": {"properties": {"frame": {"const": "degrees"}},
+                         "required": ["frame"]},
+                  "then": {"properties": {"safety": {"maximum": MAX_SAFETY_DEGREES}}}}
 Pair = Annotated[list[float], Field(min_length=2, max_length=2)]
 SOURCES = ("map", "map_text", "world_text")  # exactly one of them
 
@@ -53,10 +65,10 @@ class PlanRequest(BaseModel):
         "examples": [{"map": "den312d", "start": [50, 76], "goal": [60, 13],
                       "algorithm": "astar"}],
         **exactly_one("map", "map_text", ("world_text", "world_format"),
-                      among=SOURCES)})
+                      among=SOURCES), **DEGREES_SAFETY})
 
-    map: str | None = Field(None, max_length=200, description="A bundled map's name "
-                            "(GET /maps). Exactly one of map, map_text and world_text.")
+    map: MapName | None = Field(None, description="A bundled map's name (GET /maps). "
+                                "Exactly one of map, map_text and world_text.")
     map_text: str | None = Field(None, description="A MovingAI .map file's text. Exactly "
                                  "one of map, map_text and world_text.")
     world_text: str | None = Field(None, description="A world file's text, read as "
@@ -67,11 +79,15 @@ class PlanRequest(BaseModel):
         "geojson (zones). Required with world_text.")
     frame: Literal["lonlat", "ned", "local", "enu", "degrees"] = Field(
         "lonlat", description="Worlds: the frame of start, goal and the path.")
-    altitude: Number | None = Field(None, description="Worlds: keep obstacles that count "
-                                    "at this altitude.")
-    safety: Number = Field(0.0, ge=0, description="Grow obstacles by this margin.")
-    boundary: tuple[Number, Number, Number, Number] | None = Field(
-        None, description="Worlds: [min_lon, min_lat, max_lon, max_lat].")
+    altitude: Number | None = Field(None, ge=MIN_ALTITUDE, description="Worlds: keep "
+                                    "obstacles that count at this altitude (metres above "
+                                    "the ground).")
+    safety: Number = Field(0.0, ge=0, le=MAX_METRES, description="Grow obstacles by this "
+                           "margin: metres, or degrees in the degrees frame (there at "
+                           f"most {MAX_SAFETY_DEGREES:g}).")
+    boundary: tuple[Lon, Lat, Lon, Lat] | None = Field(
+        None, description="Worlds: [min_lon, min_lat, max_lon, max_lat], each min below "
+        "its max.")
     start: Point
     goal: Point
     algorithm: Algorithm | None = Field(None, description="Default astar on maps, "
@@ -88,7 +104,9 @@ class PlanRequest(BaseModel):
                                       "grid algorithms: cell size in world units (at most "
                                       "a local plane's 1e7 m; the raster, 8 cells round "
                                       "the obstacles and points, must lie within it).")
-    samples: int = Field(1000, strict=True, ge=1, le=10**9, description="PRM samples.")
+    samples: int = Field(1000, strict=True, ge=MIN_SAMPLES, le=MAX_SAMPLES,
+                         description="PRM samples (the server may hold them to a lower "
+                         "limit: a 422 naming its limit).")
     neighbours: int = Field(10, strict=True, ge=1, le=1000, description="PRM neighbours.")
     prm_star: StrictBool = False
     seed: int = Field(0, strict=True, ge=0, le=SEED_MAX, description="PRM seed.")
@@ -242,12 +260,7 @@ def _grid(body: PlanRequest, res: Resources):
         raise Problem(422, f"{stray}={getattr(body, stray)!r} applies to a world "
                       "(world_text); a map is searched as it is", field=stray)
     if body.map is not None:
-        grid = res.grid(body.map)
-        if grid is None:
-            from skyroute.world.load import bundled_maps
-
-            raise Problem(422, f"map {body.map!r} is not a bundled map; choose one of "
-                          + ", ".join(repr(m) for m in bundled_maps()), field="map")
+        grid = res.grid(body.map)  # one of the bundled maps: the schema's enum (MapName)
     else:
         from skyroute.world.movingai import read_map
 
