@@ -185,3 +185,102 @@ def test_ctrl_c_while_a_fleet_run_is_written_leaves_the_earlier_run(tmp_path):
     assert (p.returncode, err) == (130, "skyroute: interrupted\n")
     assert sorted(out.iterdir()) == before  # no temporary file left either
     assert all((out / n).read_text() == f"earlier {n}\n" for n in RUN_FILES)
+
+
+# A command whose clean-up after a Ctrl-C takes a while (workers ending, a transaction
+# rolled back, temporary files removed): a second Ctrl-C comes during it.
+SLOW_CLEANUP = """
+import sys, time
+from pathlib import Path
+import typer
+from skyroute.cli.errors import run_cli
+
+app = typer.Typer(add_completion=False)
+
+@app.command()
+def work(marker: str) -> None:
+    try:
+        print("ready", flush=True)
+        time.sleep(30)
+    finally:
+        print("cleaning up", flush=True)
+        time.sleep(0.5)
+        Path(marker).write_text("done")  # the clean-up's last step
+
+run_cli(app)
+"""
+
+
+@pytest.mark.parametrize("second", [signal.SIGINT, signal.SIGTERM])
+def test_a_second_signal_does_not_cut_the_clean_up_short(tmp_path, second):
+    # a second Ctrl-C (or SIGTERM) while the first one's clean-up ran raised in that
+    # clean-up: its last steps were skipped (a temporary file left, workers not ended)
+    marker = tmp_path / "cleaned"
+    p = _start(["-c", SLOW_CLEANUP, str(marker)])
+    try:
+        assert p.stdout.readline() == "ready\n"
+        p.send_signal(signal.SIGINT)
+        assert p.stdout.readline() == "cleaning up\n"
+        p.send_signal(second)
+        _, err = p.communicate(timeout=20)
+    finally:
+        p.kill()
+    assert (p.returncode, err) == (130, "skyroute: interrupted\n")
+    assert marker.read_text() == "done"
+
+
+class _Stderr:
+    """stderr on which a second Ctrl-C arrives while the one line is written."""
+
+    def __init__(self) -> None:
+        self.text = ""
+
+    def write(self, text: str) -> int:
+        if not self.text:
+            signal.raise_signal(signal.SIGINT)
+        self.text += text
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+
+def test_a_second_ctrl_c_while_the_line_is_printed(monkeypatch):
+    # 'skyroute prepare' pressed Ctrl-C twice: a KeyboardInterrupt traceback under
+    # "skyroute: interrupted", and the process died by the signal (exit status -2)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # run_cli's then
+    monkeypatch.setattr(sys, "argv", ["skyroute"])
+    err = _Stderr()
+    monkeypatch.setattr(sys, "stderr", err)
+    try:
+        with pytest.raises(SystemExit) as done:
+            run_cli(_raises(KeyboardInterrupt()))
+    except KeyboardInterrupt:  # (not out of the test: it would end the test session)
+        pytest.fail("the second Ctrl-C came out of run_cli as a KeyboardInterrupt")
+    assert done.value.code == 130
+    assert err.text == "skyroute: interrupted\n"
+
+
+# A Ctrl-C in Python's teardown, after the command has done its work (an atexit hook of
+# numba, Dask or multiprocessing runs then: the hook here stands for them).
+TEARDOWN = """
+import atexit, os, signal, sys
+from skyroute.cli.app import console
+
+atexit.register(lambda: os.kill(os.getpid(), signal.SIGINT))
+sys.argv = ["skyroute", "--version"]
+console()
+"""
+
+
+def test_ctrl_c_in_the_teardown_after_the_work_changes_nothing():
+    # it printed "Exception ignored in atexit callback" and a KeyboardInterrupt
+    # traceback under the command's output (later in the teardown the process was
+    # killed by the signal instead: exit status -2 for a command that had done its work)
+    p = _start(["-c", TEARDOWN])
+    try:
+        stdout, err = p.communicate(timeout=20)
+    finally:
+        p.kill()
+    assert (p.returncode, err) == (0, "")
+    assert stdout == f"skyroute {skyroute.__version__}\n"

@@ -585,3 +585,24 @@ def test_a_scheduler_without_workers_says_so_and_its_tasks_wait_for_one(caplog):
         cluster.scale(1)
         thread.join(timeout=60)
         assert out == [[3.0]]
+
+
+def _sigint_blocked_here(_):
+    """In a pool worker: whether SIGINT is blocked in it (its mask from its start)."""
+    import signal
+
+    return signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+
+
+def test_local_workers_start_deaf_to_ctrl_c():
+    """A Ctrl-C to the terminal's group in the second or so a spawned worker takes to
+    start Python and reach the pool's initializer (which ignores SIGINT) printed a
+    KeyboardInterrupt traceback from multiprocessing's spawn_main, one per worker.
+    Workers are started with SIGINT blocked, from their first instruction; the caller's
+    mask is as it was."""
+    import signal
+
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, [])
+    with open_executor("local", workers=2) as ex:
+        assert ex.map(_sigint_blocked_here, [0, 1]) == [True, True]
+    assert signal.pthread_sigmask(signal.SIG_BLOCK, []) == before

@@ -51,14 +51,31 @@ class _Signals:
     object-cache hook); ctypes prints the KeyboardInterrupt as "Exception ignored on
     calling ctypes callback function" with its traceback, and numba then failed with
     RuntimeError ('no compiled object yet'): a traceback and exit code 1 for a Ctrl-C.
+
+    A second signal while the first one's exception unwinds the work, or once the
+    command is ending by it (``ending``), raises nothing: it cut the clean-up short (a
+    temporary file not removed, workers not ended) or, in the last line, printed a
+    KeyboardInterrupt traceback under ``skyroute: interrupted`` and died by the signal.
+    One that comes after the first was swallowed (handled and done with) raises again.
     """
 
     def __init__(self, main_pid: int) -> None:
         self.main_pid = main_pid
         self.seen: int | None = None  # the last signal (signal.SIGINT / SIGTERM)
         self.active = True  # our handlers are in place
+        self.ending = False  # the command is ending by a signal: its line is due
+
+    def unwinding(self) -> bool:
+        """Whether a signal's exception is being handled (an ``except`` or ``finally``
+        block, a context manager's exit, or what they call), or the command is ending:
+        by a signal, or with its exit code on the way out (SystemExit)."""
+        handled = sys.exc_info()[1]
+        return self.ending or isinstance(handled, SystemExit) or \
+            _interrupt(handled) is not None
 
     def on_sigint(self, signum, frame):
+        if self.unwinding():
+            return
         self.seen = signal.SIGINT
         raise KeyboardInterrupt
 
@@ -66,6 +83,8 @@ class _Signals:
         if os.getpid() != self.main_pid:  # a forked worker: die as it would have
             signal.signal(signal.SIGTERM, signal.SIG_DFL)
             os.kill(os.getpid(), signal.SIGTERM)
+            return
+        if self.unwinding():
             return
         self.seen = signal.SIGTERM
         raise Terminated
@@ -155,7 +174,9 @@ def run_cli(app: typer.Typer) -> None:
             signal.signal(sig, handler)
 
 
-def _signal_exit(signum) -> None:
+def _signal_exit(signum, signals: _Signals | None) -> None:
+    if signals is not None:
+        signals.ending = True  # a second Ctrl-C must not cut the line short
     term = signum == signal.SIGTERM
     print(f"skyroute: {'terminated' if term else 'interrupted'}", file=sys.stderr)
     sys.exit(EXIT_TERMINATED if term else EXIT_INTERRUPTED)
@@ -174,18 +195,19 @@ def _run(app: typer.Typer, signals: _Signals | None) -> None:
         print(f"skyroute: error: {exc.format_message()}{hint}", file=sys.stderr)
         sys.exit(getattr(exc, "exit_code", EXIT_BAD_INPUT) or EXIT_BAD_INPUT)
     except (typer.Abort, KeyboardInterrupt):
-        _signal_exit(signal.SIGINT)
+        _signal_exit(signal.SIGINT, signals)
     except Terminated:
-        _signal_exit(signal.SIGTERM)
+        _signal_exit(signal.SIGTERM, signals)
     except Exception as exc:
         # the signal's own exception lost on the way (see _Signals), or wrapped: a
         # SystemError from a numba call ('CPUDispatcher(...) returned a result with an
         # exception set') caused by it; an error after a signal is the signal's doing
         found = _interrupt(exc)
         if found is not None:
-            _signal_exit(signal.SIGTERM if isinstance(found, Terminated) else signal.SIGINT)
+            _signal_exit(signal.SIGTERM if isinstance(found, Terminated) else signal.SIGINT,
+                         signals)
         if signals is not None and signals.seen is not None:
-            _signal_exit(signals.seen)
+            _signal_exit(signals.seen, signals)
         if isinstance(exc, SkyrouteError):
             print(f"skyroute: error: {in_flags(exc)}", file=sys.stderr)
             sys.exit(EXIT_BAD_INPUT)
@@ -195,5 +217,5 @@ def _run(app: typer.Typer, signals: _Signals | None) -> None:
             sys.exit(EXIT_BAD_INPUT)
         raise
     if code == EXIT_INTERRUPTED:  # Typer turns Ctrl-C into exit code 130, silently
-        print("skyroute: interrupted", file=sys.stderr)
+        _signal_exit(signal.SIGINT, signals)
     sys.exit(code if isinstance(code, int) else 0)

@@ -181,7 +181,8 @@ class LocalExecutor(_Executor):
                         self._pool = _new_pool(self.workers)
                     pool = self._pool
                     try:
-                        future = pool.submit(fn, item)
+                        with _sigint_blocked():  # (it may start a worker)
+                            future = pool.submit(fn, item)
                     except (BrokenProcessPool, RuntimeError) as exc:
                         if not _broke(pool, exc):
                             raise
@@ -233,7 +234,8 @@ class LocalExecutor(_Executor):
                 pool = _new_pool(1)
                 self._alone.add(pool)
             try:
-                future = pool.submit(fn, item)
+                with _sigint_blocked():
+                    future = pool.submit(fn, item)
             except (BrokenProcessPool, RuntimeError) as exc:
                 if not _broke(pool, exc):
                     raise
@@ -403,6 +405,22 @@ def _how_ended(pool: ProcessPoolExecutor | None = None, *, procs=None) -> str:
         return f"killed by {name}" + (", as the out-of-memory killer does"
                                       if code == -signal.SIGKILL else "")
     return f"exit code {code}"
+
+
+@contextlib.contextmanager
+def _sigint_blocked():
+    """SIGINT blocked in this thread while the block runs: a pool's ``submit`` starts
+    its worker processes, which inherit the mask, so a worker is deaf to Ctrl-C from
+    its first instruction (and then ignores it, :func:`_leave_sigint`). A Ctrl-C in the
+    second or so a spawned worker took to start Python and reach that initializer
+    printed a KeyboardInterrupt traceback from multiprocessing's ``spawn_main`` (each
+    worker one) over ``skyroute: interrupted``. This process still gets the signal:
+    another thread takes it for the main one, or this thread once it is unblocked."""
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _leave_sigint() -> None:
