@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import math
 import time
+import warnings
 
 import pytest
 
@@ -606,3 +607,19 @@ def test_local_workers_start_deaf_to_ctrl_c():
     with open_executor("local", workers=2) as ex:
         assert ex.map(_sigint_blocked_here, [0, 1]) == [True, True]
     assert signal.pthread_sigmask(signal.SIG_BLOCK, []) == before
+
+
+# A local Dask cluster takes no fixed port: two at once (two commands, or a command beside
+# a notebook's cluster) printed distributed's "Port 8787 is already in use" warning to the
+# second one's user.
+def test_a_second_local_cluster_warns_of_no_busy_port(dask_executor):
+    assert dask_executor.map(abs, [-1]) == [1]  # the module's cluster is up
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        second = open_executor("dask", workers=1)
+        try:
+            assert second.map(abs, [-2]) == [2]
+        finally:
+            second.close()
+    assert not [w for w in seen if "already in use" in str(w.message)], \
+        [str(w.message) for w in seen]

@@ -539,6 +539,12 @@ class DaskExecutor(_Executor):
             self._cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
                                          threads_per_worker=1, processes=True,
                                          dashboard_address=None,
+                                         # its HTTP routes (no dashboard) on a free
+                                         # port: at distributed's default (8787), a
+                                         # second cluster or any server there made a
+                                         # "Port 8787 is already in use" warning
+                                         scheduler_kwargs={
+                                             "dashboard_address": "127.0.0.1:0"},
                                          silence_logs=logging.ERROR,
                                          preload=["skyroute.jobs.local_worker"])
             self.client = Client(self._cluster)
