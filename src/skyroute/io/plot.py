@@ -97,8 +97,8 @@ def draw_grid_path(ax, grid: Grid, result: PlanResult | None = None,
     >>> grid = skyroute.load_map("den312d")
     >>> r = skyroute.plan(grid, (50, 76), (60, 13))
     >>> ax = draw_grid_path(Figure().subplots(), grid, r, (50, 76), (60, 13))
-    >>> ax.get_title(), ax.get_xlabel()
-    ('den312d.map: astar\ncost 112.556 cells, 1,497 expanded', 'x (column)')
+    >>> ax.get_title().splitlines(), ax.get_xlabel()  # the title fits the axes' width
+    (['den312d.map: astar', 'cost 112.556 cells, 1,497 expanded'], 'x (column)')
     """
     from matplotlib import colormaps
 
