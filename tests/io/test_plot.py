@@ -20,6 +20,7 @@ import skyroute
 from skyroute.io import world_out
 from skyroute.io.plot import (
     PALETTE_COLOURS,
+    draw_grid_path,
     draw_path,
     grid_dpi,
     place_labels,
@@ -369,3 +370,68 @@ def test_fly_tour_plot_numbers_the_targets_and_draws_no_goal(monkeypatch, capsys
     world = skyroute.load_world(CITY, altitude=10, safety=2, frame="ned")
     np.testing.assert_allclose(marks.get_xydata(),
                                world.to_plane(np.array([[60, 30], [-60, 60], [0, -120]])))
+
+
+def test_writing_a_picture_keeps_the_callers_backend_and_figures(tmp_path):
+    """Each picture writer called ``matplotlib.use("Agg")``: from a notebook (its inline
+    backend) or a script on another backend, writing a --plot picture from Python
+    switched the caller's backend to Agg, and its later figures no longer showed.
+    (Every writer makes its figure by ``new_figure``; the grid's stands for them.)"""
+    old = matplotlib.get_backend()
+    plt.switch_backend("svg")  # stands for a notebook's or a desktop's backend
+    try:
+        mine = plt.figure()
+        figures = plt.get_fignums()
+        grid = Grid(np.zeros((4, 4), dtype=bool), name="open")
+        plot_grid_path(grid, skyroute.plan(grid, (0, 0), (3, 3)), (0, 0), (3, 3),
+                       tmp_path / "grid.png")
+        assert matplotlib.get_backend() == "svg"
+        assert plt.get_fignums() == figures  # skyroute's figure never joined pyplot's
+    finally:
+        plt.close(mine)
+        plt.switch_backend(old)
+    assert min(png_size(tmp_path / "grid.png")) > 100
+
+
+def test_a_grid_and_its_path_drawn_on_the_callers_axes():
+    """What ``plan --plot`` draws, onto an Axes of the caller's (one panel of several,
+    on a backend with no renderer of its own), the figure's size left alone."""
+    from matplotlib.backends.backend_svg import FigureCanvasSVG
+    from matplotlib.figure import Figure
+
+    blocked = np.zeros((6, 9), dtype=bool)
+    blocked[1:5, 4] = True
+    grid = Grid(blocked, name="wall")
+    r = skyroute.plan(grid, (1, 3), (7, 3))
+    fig = Figure(figsize=(8, 3))
+    FigureCanvasSVG(fig)
+    left, right = fig.subplots(1, 2)
+    assert draw_grid_path(right, grid, r, (1, 3), (7, 3)) is right
+    assert tuple(fig.get_size_inches()) == (8, 3) and not left.has_data()
+    np.testing.assert_array_equal(right.images[0].get_array(), blocked)  # [row, column]
+    lines = {ln.get_label(): ln for ln in right.get_lines()}
+    np.testing.assert_array_equal(np.c_[lines["path"].get_data()], r.path)  # (x, y) cells
+    assert {"start (1, 3)", "goal (7, 3)", "blocked"} <= set(lines)
+    assert right.get_title().replace("\n", ", ") == \
+        f"wall: astar, cost {r.cost:.3f} cells, {r.expanded:,} expanded"
+    assert right.get_ylim() == (5.5, -0.5)  # y (row) down, as MovingAI counts
+    bare = draw_grid_path(left, grid)  # the map alone
+    assert bare.get_title() == "wall" and [ln.get_label() for ln in bare.get_lines()] == \
+        ["blocked"]
+
+
+def test_a_world_path_drawn_on_the_callers_axes_is_in_its_plane():
+    """A "ned" world's (north, east) path is drawn as (east, north) metres, true
+    proportions, start and goal named as typed."""
+    from matplotlib.figure import Figure
+
+    world = load_world(str(ROOT / "examples" / "city.csv"), altitude=10, safety=2,
+                       frame="ned")
+    r = skyroute.plan(world, (0, 0), (120, -180))
+    ax = world_out.draw_world_path(Figure().subplots(), world, r, (0, 0), (120, -180))
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    np.testing.assert_allclose(np.c_[lines["path"].get_data()], r.path[:, ::-1])
+    assert "goal (north 120 m, east -180 m)" in lines
+    assert (ax.get_xlabel(), ax.get_ylabel(), ax.get_aspect()) == ("east (m)", "north (m)",
+                                                                   1.0)
+    assert ax.get_legend() is None  # the caller's to place

@@ -434,3 +434,23 @@ def test_a_grid_or_a_bad_shape_given_as_blocked_is_named():
         with pytest.raises(OptionError) as err:
             Grid(bad)
         assert err.value.param == "blocked"
+
+
+def test_a_grids_cells_cannot_be_made_writeable_again():
+    """numpy lets an array that owns its memory be made writeable again: with
+    ``g.blocked.flags.writeable = True`` a wall drawn into a grid already searched was
+    walked through, as the search reused the workspace cached for the old cells."""
+    g = Grid(np.zeros((5, 5), dtype=bool))
+    assert skyroute.plan(g, (0, 0), (4, 4)).cost == pytest.approx(4 * np.sqrt(2))
+    with pytest.raises(ValueError):
+        g.blocked.flags.writeable = True
+    with pytest.raises(ValueError):
+        g.blocked.setflags(write=True)
+    assert g.blocked.flags.c_contiguous and not g.blocked.flags.writeable
+    for copied in (copy.deepcopy(g), pickle.loads(pickle.dumps(g)), g.inflate(1)):
+        with pytest.raises(ValueError):
+            copied.blocked.setflags(write=True)
+    # the way to change cells: a new Grid from a copy
+    b = g.blocked.copy()
+    b[:4, 2] = True
+    assert skyroute.plan(Grid(b), (0, 0), (4, 4)).cost == pytest.approx(6 + np.sqrt(2))

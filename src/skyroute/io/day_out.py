@@ -34,15 +34,10 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
     """Zones, area, the flight, shops, customer places (:func:`customer_places`: served,
     partly served or not served, each kind in the legend only when the day has one,
     with its count), home."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from skyroute.io.plot import place_labels, save_figure, set_title
+    from skyroute.io.plot import new_figure, place_labels, save_figure, set_title
     from skyroute.io.world_out import draw_world, finish_axes
 
-    fig, ax = plt.subplots(figsize=(10, 6))
+    fig, ax = new_figure((10, 6))
     draw_world(ax, site.world, label="no-fly zone")
     f = result.flight.flight
     if f.moves:

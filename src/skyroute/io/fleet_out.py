@@ -479,21 +479,26 @@ def plot_map(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
     """``map.png``: runways (landing dark, take-off light), gates, airports, no-fly zones
     (hatched, named), and the airborne tracks coloured by drone (a legend up to 10
     drones, else a colour bar); metres north and east of the home, true proportions."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     import shapely
+    from matplotlib import colormaps
+    from matplotlib.cm import ScalarMappable
     from matplotlib.collections import LineCollection
+    from matplotlib.colors import Normalize
     from matplotlib.patches import Polygon
 
     from skyroute.fleet.report import flights_flown
-    from skyroute.io.plot import legend_outside, place_labels, save_figure, set_title
+    from skyroute.io.plot import (
+        legend_outside,
+        new_figure,
+        place_labels,
+        save_figure,
+        set_title,
+    )
 
     s = sim.scenario
-    fig, ax = plt.subplots(figsize=(9, 8))
+    fig, ax = new_figure((9, 8))
     n = s.drones
-    cmap = plt.get_cmap("tab10" if n <= 10 else "viridis")
+    cmap = colormaps["tab10" if n <= 10 else "viridis"]
     colour = (lambda d: cmap(d % 10)) if n <= 10 else (lambda d: cmap(d / max(n - 1, 1)))
     lines: dict[int, list[np.ndarray]] = {}
     for f in sim.flights:
@@ -527,7 +532,7 @@ def plot_map(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
     # the flights the report counts (a run also holds flights planned past its end)
     set_title(ax, [*_settings(sim), f"{len(flights_flown(sim))} flights"])
     if n > 10:
-        sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(0, n - 1))
+        sm = ScalarMappable(cmap=cmap, norm=Normalize(0, n - 1))
         fig.colorbar(sm, ax=ax, label="drone", orientation="horizontal", shrink=0.6,
                      pad=0.08, aspect=40)
     legend_outside(ax)
@@ -542,13 +547,8 @@ def plot_timeline(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
     """``timeline.png``: packages waiting (spawned, not picked up), in flight (picked
     up, not handed over) and delivered (cumulative) over time; below, each loiter circle
     (a landing refused) by airport; the warm-up window shaded on both."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from skyroute.fleet.report import window_counts
-    from skyroute.io.plot import save_figure, set_title
+    from skyroute.io.plot import new_figure, save_figure, set_title
 
     H = sim.horizon
     st = sim.stream
@@ -562,8 +562,8 @@ def plot_timeline(sim: Simulation, path: str | Path, *, dpi: int = 150) -> Path:
 
     spawned = count(st.t[st.t < H])
     picked, delivered = count(sim.pickup), count(sim.delivered)
-    fig, (top, low) = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True,
-                                   gridspec_kw={"height_ratios": [3, 1.3]})
+    fig, (top, low) = new_figure((10, 6.5), 2, 1, sharex=True,
+                                 gridspec_kw={"height_ratios": [3, 1.3]})
     x = t / scale
     top.step(x, spawned - picked, where="post", color="tab:orange", label="waiting")
     top.step(x, picked - delivered, where="post", color="tab:blue", label="in flight")

@@ -1,6 +1,13 @@
 """PNG pictures of maps and paths (matplotlib, imported only when a plot is asked for),
 and the conventions every map picture shares: start and goal drawn on top and never cut
-by the frame, the legend outside the map, labels that keep out of each other's way."""
+by the frame, the legend outside the map, labels that keep out of each other's way.
+
+From Python, :func:`draw_grid_path` draws a grid and a path onto a matplotlib Axes of
+the caller's (``skyroute.io.world_out.draw_world_path`` a World's); the ``plot_*``
+functions write the pictures the CLI's ``--plot`` writes. Figures are made without
+pyplot (:func:`new_figure`): a picture written from a notebook or a script neither
+switches its backend nor joins its pyplot figures.
+"""
 
 from __future__ import annotations
 
@@ -22,47 +29,99 @@ CELL_PIXELS = 4  # a grid picture gives each cell at least this many pixels, up 
 DOTS_UP_TO = 60  # a path's points are marked when it has at most this many
 PALETTE_COLOURS = 256  # every picture is written as an 8-bit palette PNG
 SNAP = 8  # a common colour replaces the palette entry within this many levels of it
+BLOCKED_GREY = 1 / 1.4  # blocked cells' shade on the "Greys" map (vmax 1.4: not black)
+
+
+def new_figure(figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, **kw):
+    """``(figure, axes)`` for a picture written to a file: a matplotlib ``Figure`` with
+    an Agg canvas of its own, made without pyplot. Each writer called
+    ``matplotlib.use("Agg")`` and ``pyplot.subplots``, which switched a notebook's or a
+    script's backend to Agg under it (its later figures no longer showed) and was
+    pyplot's global state in threads; ``kw`` goes to ``Figure.subplots``."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(nrows, ncols, **kw)
+
+
+def renderer_of(fig):
+    """A renderer to measure text with: the figure's canvas's (Agg and the interactive
+    backends built on it), else a detached Agg renderer of the figure's size and dpi
+    (a caller's figure on the svg or pdf backend has none)."""
+    get = getattr(fig.canvas, "get_renderer", None)
+    if get is not None:
+        return get()
+    from matplotlib.backends.backend_agg import RendererAgg
+
+    return RendererAgg(int(fig.bbox.width), int(fig.bbox.height), fig.dpi)
 
 
 def plot_grid_path(grid: Grid, result: PlanResult, start: tuple[int, int],
                    goal: tuple[int, int], path: str | Path, *, dpi: int | None = None,
                    prune: str = "none", safety: float = 0.0) -> Path:
-    """Draw the grid (blocked cells dark), the path, start (green) and goal (red).
-
-    Axes are cell coordinates (x to the right, y down, as MovingAI counts them). ``dpi``
-    defaults to :func:`grid_dpi`: large maps get the pixels their cells need. ``prune``
-    and ``safety`` are what the grid and the path were made with: the title says how a
-    path was pruned ("pruned (los): 5 waypoints"), the legend that the blocked cells
-    include the safety margin ("blocked, grown by 1.5 m").
-    """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """Write the PNG ``skyroute plan --plot`` writes: :func:`draw_grid_path` on a figure
+    sized to the map, the legend beside it. ``dpi`` defaults to :func:`grid_dpi`: large
+    maps get the pixels their cells need."""
     h, w = grid.blocked.shape
     size = 7.0
     area = (size * min(1.6, max(0.6, w / h)), size)  # the map's, inches
     dpi = grid_dpi(grid.blocked.shape, area) if dpi is None else dpi
-    fig, ax = plt.subplots(figsize=area)
+    fig, ax = new_figure(area)
+    # A line no wider than a cell (in points), so a corridor of a maze stays visible.
+    cell_pt = 72 * _cell_inches(grid.blocked.shape, area)
+    draw_grid_path(ax, grid, result, start, goal, prune=prune, safety=safety,
+                   lw=float(np.clip(cell_pt, 0.6, 1.6)))
+    legend_outside(ax)
+    return save_figure(fig, path, dpi=dpi)
+
+
+def draw_grid_path(ax, grid: Grid, result: PlanResult | None = None,
+                   start: tuple[int, int] | None = None, goal: tuple[int, int] | None = None,
+                   *, prune: str = "none", safety: float = 0.0, lw: float = 1.6):
+    """Draw a grid (blocked cells dark), and a result's path with its start (green dot)
+    and goal (red star) when given, onto a matplotlib Axes: what ``skyroute plan
+    --plot`` draws. Returns ``ax``.
+
+    Axes are cell coordinates: x to the right (column), y down (row), as MovingAI counts
+    them and ``plan`` takes them; a cell's centre is at its (x, y) (multiply by
+    ``grid.resolution`` and add ``grid.origin`` for metres, :meth:`Grid.to_world`).
+    The title says the map, algorithm, cost and expansions; the artists are labelled
+    for ``ax.legend()``. ``prune`` and ``safety`` are what the path and the grid were
+    made with: the title says how a path was pruned ("pruned (los): 5 waypoints"), the
+    legend that the blocked cells include the margin ("blocked, grown by 1.5 m").
+
+    >>> import skyroute
+    >>> from matplotlib.figure import Figure
+    >>> grid = skyroute.load_map("den312d")
+    >>> r = skyroute.plan(grid, (50, 76), (60, 13))
+    >>> ax = draw_grid_path(Figure().subplots(), grid, r, (50, 76), (60, 13))
+    >>> ax.get_title().splitlines(), ax.get_xlabel()  # the title fits the axes' width
+    (['den312d.map: astar', 'cost 112.556 cells, 1,497 expanded'], 'x (column)')
+    """
+    from matplotlib import colormaps
+
+    h, w = grid.blocked.shape
     ax.imshow(grid.blocked, cmap="Greys", vmin=0, vmax=1.4, interpolation="nearest",
               extent=(-0.5, w - 0.5, h - 0.5, -0.5))
-    ax.plot([], [], "s", color=plt.get_cmap("Greys")(1 / 1.4), ms=7,
+    ax.plot([], [], "s", color=colormaps["Greys"](BLOCKED_GREY), ms=7,
             label="blocked" + (f", grown by {safety:g} m" if safety > 0 else ""))
-    if result.found:
-        # A line no wider than a cell (in points), so a corridor of a maze stays visible.
-        cell_pt = 72 * _cell_inches(grid.blocked.shape, area)
-        draw_path(ax, result.path, lw=float(np.clip(cell_pt, 0.6, 1.6)))
-    mark_ends(ax, start, goal, start_text=_cell(start), goal_text=_cell(goal))
-    parts = [f"{grid.name}: {result.algorithm}", _grid_cost(grid, result),
-             f"{result.expanded:,} expanded"]
-    if prune != "none" and result.found:
-        parts.append(f"pruned ({prune}): {len(result.path)} waypoints")
+    if result is not None and result.found:
+        draw_path(ax, result.path, lw=lw)
+    if start is not None:
+        mark_ends(ax, start, goal, start_text=_cell(start),
+                  goal_text="" if goal is None else _cell(goal))
+    parts = [grid.name]
+    if result is not None:
+        parts = [f"{grid.name}: {result.algorithm}", _grid_cost(grid, result),
+                 f"{result.expanded:,} expanded"]
+        if prune != "none" and result.found:
+            parts.append(f"pruned ({prune}): {len(result.path)} waypoints")
     set_title(ax, parts)
     ax.set_xlabel("x (column)")
     ax.set_ylabel("y (row)")
-    legend_outside(ax)
-    return save_figure(fig, path, dpi=dpi)
+    return ax
 
 
 def set_title(ax, parts: Sequence[str], *, fontsize: float = 10):
@@ -73,7 +132,7 @@ def set_title(ax, parts: Sequence[str], *, fontsize: float = 10):
     from matplotlib.font_manager import FontProperties
 
     fig = ax.figure
-    renderer = fig.canvas.get_renderer()
+    renderer = renderer_of(fig)
     font = FontProperties(size=fontsize)
     room = ax.get_position().width * fig.bbox.width  # pixels
 
@@ -167,7 +226,7 @@ def legend_outside(ax, **kw):
     fig = ax.figure
     legend = ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8,
                        borderaxespad=0, **kw)
-    width = legend.get_window_extent(fig.canvas.get_renderer()).width / fig.dpi
+    width = legend.get_window_extent(renderer_of(fig)).width / fig.dpi
     w, h = fig.get_size_inches()
     fig.set_size_inches(w + width + 0.1, h)
     return legend
@@ -190,7 +249,7 @@ def place_labels(ax, points, texts, *, avoid=(), fontsize: float = 8,
     fig = ax.figure
     fig.tight_layout()
     ax.apply_aspect()
-    renderer = fig.canvas.get_renderer()
+    renderer = renderer_of(fig)
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     others = np.asarray(avoid, dtype=float).reshape(-1, 2)
     r = marker_pt * fig.dpi / 72.0  # a marker's half width in pixels
@@ -253,16 +312,13 @@ def _overlap(a, b) -> float:
 
 def save_figure(fig, path: str | Path, *, dpi: int = DPI) -> Path:
     """Render a matplotlib figure to PNG (cropped to everything drawn, legends beside the
-    axes included), close it, and write the file whole, as a palette image
-    (:func:`palette_png`)."""
-    import matplotlib.pyplot as plt
-
+    axes included) and write the file whole, as a palette image (:func:`palette_png`).
+    The figure is :func:`new_figure`'s, in no pyplot list: nothing to close."""
     buf = io.BytesIO()
     fig.tight_layout()
     # "tight" takes in what tight_layout leaves out: a legend placed beside the axes
     # (fleet map.png, the day's map) was clipped at the image's right edge.
     fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
-    plt.close(fig)
     return write_atomic(path, palette_png(buf.getvalue()))
 
 

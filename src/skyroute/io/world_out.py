@@ -1,7 +1,8 @@
 """A path planned on a World as FCND waypoints, lon/lat GeoJSON, and a PNG map.
 
 Paths and points come in the world's frame (as :func:`skyroute.plan` returns them);
-pictures are drawn in its plane (east/north metres, or lon/lat in degrees)."""
+pictures are drawn in its plane (east/north metres, or lon/lat in degrees), onto a
+caller's matplotlib Axes by :func:`draw_world_path`."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from skyroute.io.plot import (
     draw_path,
     legend_outside,
     mark_ends,
+    new_figure,
     place_labels,
     save_figure,
     set_title,
@@ -86,45 +88,73 @@ def world_path_geojson(world: World, result: PlanResult) -> dict:
 def plot_world_path(world: World, result: PlanResult, start, goal, path: str | Path, *,
                     edges: np.ndarray | None = None, dpi: int = 150,
                     obstacles: str = "obstacles", targets: np.ndarray | None = None) -> Path:
+    """Write the PNG ``skyroute plan-world --plot`` and ``fly --plot`` write:
+    :func:`draw_world_path` on an 8 x 8 inch figure, the legend beside the map."""
+    fig, ax = new_figure((8, 8))
+    draw_world_path(ax, world, result, start, goal, edges=edges, obstacles=obstacles,
+                    targets=targets, legend=True)
+    return save_figure(fig, path, dpi=dpi)
+
+
+def draw_world_path(ax, world: World, result: PlanResult | None = None, start=None,
+                    goal=None, *, edges: np.ndarray | None = None,
+                    obstacles: str = "obstacles", targets: np.ndarray | None = None,
+                    legend: bool = False):
     """Draw obstacles (grey), the boundary (dashed), roadmap edges (thin, plane
-    segments), the path; ``result.path``, ``start`` and ``goal`` in the world's frame
-    (the legend names start and goal as they were given, also where a vehicle stopped
-    short of the goal). ``obstacles`` is the grey shapes' legend entry:
-    :func:`obstacles_label` says at which altitude and grown by what margin the world
-    was loaded, which the world itself does not record. ``targets`` (a tour's, in the
-    world's frame; ``goal`` None) are drawn numbered as given."""
-    import matplotlib
+    segments), the path, start (green dot) and goal (red star) onto a matplotlib Axes:
+    what ``skyroute plan-world --plot`` draws. Returns ``ax``.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    ``result.path``, ``start``, ``goal`` and ``targets`` are in the world's frame (as
+    :func:`skyroute.plan` takes and returns them); the axes are its plane: east and north
+    metres (x east, true proportions), or lon/lat in the degrees frame, so a "ned"
+    world's (north, east) points are drawn turned into (east, north); draw anything else
+    through :meth:`World.to_plane`. The legend names start and goal as given.
+    ``obstacles`` is the grey shapes' legend entry (:func:`obstacles_label` says at
+    which altitude and grown by what margin the world was loaded, which the world itself
+    does not record). ``targets`` (a tour's; ``goal`` None) are drawn numbered as given.
+    The artists are labelled for ``ax.legend()``; ``legend=True`` puts it beside the map
+    and widens the figure for it, as the pictures written to files have it.
 
-    fig, ax = plt.subplots(figsize=(8, 8))
+    >>> import shapely, skyroute
+    >>> from matplotlib.figure import Figure
+    >>> w = skyroute.World([shapely.box(1, 1, 3, 3)], [0], [50], ("tower",))
+    >>> r = skyroute.plan(w, (0, 2), (4, 2))
+    >>> ax = draw_world_path(Figure().subplots(), w, r, (0, 2), (4, 2))
+    >>> ax.get_title(), ax.get_xlabel()
+    ('world: visibility, 4.82843 m', 'east (m)')
+    """
     draw_world(ax, world, label=obstacles)
     if edges is not None and len(edges):
         from matplotlib.collections import LineCollection
 
+        name = result.algorithm if result is not None else "roadmap"
         ax.add_collection(LineCollection(edges, colors="tab:cyan", linewidths=0.3, alpha=0.5,
-                                         label=f"{result.algorithm} graph "
-                                               f"({len(edges):,} edges)"))
-    if result.found:
+                                         label=f"{name} graph ({len(edges):,} edges)"))
+    if result is not None and result.found:
         draw_path(ax, world.to_plane(result.path, "path"), lw=1.8)
-    mark_ends(ax, world.to_plane(start, "start")[0],
-              None if goal is None else world.to_plane(goal, "goal")[0],
-              start_text=_point(world, start),
-              goal_text="" if goal is None else _point(world, goal))
+    if start is not None:
+        mark_ends(ax, world.to_plane(start, "start")[0],
+                  None if goal is None else world.to_plane(goal, "goal")[0],
+                  start_text=_point(world, start),
+                  goal_text="" if goal is None else _point(world, goal))
     if targets is not None:
         pts = world.to_plane(np.asarray(targets, dtype=float).reshape(-1, 2), "targets")
         ax.plot(*pts.T, "D", color="tab:red", ms=7, markeredgecolor="white",
                 markeredgewidth=0.8, clip_on=False, zorder=6, linestyle="none",
                 label=f"targets ({len(pts)}), numbered as given")
-    unit = "deg" if world.plane == "degrees" else "m"
-    cost = f"{result.cost:.6g} {unit}" if result.found else result.status.value
-    set_title(ax, [f"{world.name}: {result.algorithm}", cost])
-    finish_axes(ax, world)
+    if result is not None:
+        unit = "deg" if world.plane == "degrees" else "m"
+        cost = f"{result.cost:.6g} {unit}" if result.found else result.status.value
+        set_title(ax, [f"{world.name}: {result.algorithm}", cost])
+    else:
+        set_title(ax, [world.name])
+    frame_axes(ax, world)
+    if legend:
+        legend_outside(ax)
     if targets is not None:
         place_labels(ax, pts, [str(k + 1) for k in range(len(pts))],
-                     avoid=world.to_plane(start, "start"))
-    return save_figure(fig, path, dpi=dpi)
+                     avoid=() if start is None else world.to_plane(start, "start"))
+    return ax
 
 
 def obstacles_label(altitude: float | None, safety: float, frame: str) -> str:
@@ -172,12 +202,17 @@ def draw_world(ax, world: World, *, label: str = "obstacles") -> None:
 
 
 def finish_axes(ax, world: World) -> None:
+    """:func:`frame_axes`, and the legend beside the map."""
+    frame_axes(ax, world)
+    legend_outside(ax)
+
+
+def frame_axes(ax, world: World) -> None:
     """Axis names with units, true proportions (degrees squeezed by cos latitude), plain
-    tick numbers (no "+5.594e1" offset on latitudes), the legend beside the map."""
+    tick numbers (no "+5.594e1" offset on latitudes)."""
     degrees = world.plane == "degrees"
     ax.set_xlabel("longitude (°)" if degrees else "east (m)")
     ax.set_ylabel("latitude (°)" if degrees else "north (m)")
     ax.set_aspect("equal" if world.plane == "metres" else
                   1 / np.cos(np.radians(np.mean(ax.get_ylim()))))
     ax.ticklabel_format(useOffset=False, style="plain")
-    legend_outside(ax)

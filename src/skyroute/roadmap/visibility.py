@@ -40,6 +40,7 @@ from skyroute.roadmap import sight_kernels as sk
 from skyroute.roadmap.corner_search import corner_astar
 from skyroute.roadmap.visibility_cache import graph_key, load_graph, save_graph
 from skyroute.world.geometry import boundary_corners, convex_corners
+from skyroute.world.prepared_lock import LOCK
 from skyroute.world.world import World
 
 MAX_CORNERS = 10_000  # about 12 million pairs tested: 1 GB and 8 s (see above)
@@ -180,7 +181,9 @@ def fewest_corners(world: World) -> int:
     n = len(world.obstacles)
     if world.boundary is not None or n == 0:
         return 0
-    i, j = world.tree.query(world.obstacles, predicate="intersects")
+    tree = world.tree
+    with LOCK:  # the obstacles are prepared, and tested through that form
+        i, j = tree.query(world.obstacles, predicate="intersects")
     touching = csr_matrix((np.ones(len(i)), (i, j)), shape=(n, n))
     return 3 * connected_components(touching, directed=False)[0]
 

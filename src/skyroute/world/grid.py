@@ -74,8 +74,10 @@ class Grid:
 
     ``blocked`` is a 2-D array (or nested lists) of booleans or numbers indexed
     ``[row, column]``, non-zero blocked, any memory layout; NaN, text and other objects
-    are an OptionError naming ``blocked``. It is copied and made read-only, so a Grid
-    never changes after creation.
+    are an OptionError naming ``blocked``. It is copied into memory that cannot be made
+    writeable again (``blocked.setflags(write=True)`` is a ValueError), so a Grid never
+    changes after creation: searches cache per Grid. To change cells, make a new Grid
+    from a copy (``b = grid.blocked.copy(); b[y, x] = True; Grid(b, ...)``).
     ``cell_size`` is the old name of ``resolution`` (deprecated).
 
     Examples
@@ -104,7 +106,7 @@ class Grid:
         if (cell := nan_cell(values)) is not None:
             raise OptionError(f"blocked has NaN at cell {cell} (x, y); {NAN_HINT}",
                               param="blocked")
-        arr = np.array(values, dtype=bool, copy=True)
+        arr = np.asarray(values, dtype=bool)  # copied by _frozen
         if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
             raise OptionError(f"blocked must be a non-empty 2-D array, got shape {arr.shape}",
                               param="blocked")
@@ -116,8 +118,7 @@ class Grid:
         except (TypeError, ValueError):
             raise OptionError(f"origin={origin!r} must be two numbers (x, y)",
                               param="origin") from None
-        arr.setflags(write=False)
-        object.__setattr__(self, "blocked", arr)
+        object.__setattr__(self, "blocked", _frozen(arr))
         object.__setattr__(self, "resolution", float(resolution))
         object.__setattr__(self, "origin", (real("origin", ox), real("origin", oy)))
         object.__setattr__(self, "name", name)
@@ -196,6 +197,15 @@ class Grid:
     def free_fraction(self) -> float:
         """Share of free cells, for reports."""
         return float(1.0 - self.blocked.mean())
+
+
+def _frozen(arr: np.ndarray) -> np.ndarray:
+    """``arr`` copied (C order) into an immutable bytes object and viewed as an array.
+    ``setflags(write=False)`` alone could be undone: an array that owns its memory may be
+    made writeable again (``grid.blocked.flags.writeable = True``, the usual answer to
+    numpy's "assignment destination is read-only"), and a search then reused the
+    workspace cached for the grid's old cells: a path through the new walls."""
+    return np.frombuffer(arr.tobytes(), dtype=bool).reshape(arr.shape)
 
 
 def cell_xy(cell: object, what: str) -> tuple[int, int]:

@@ -21,6 +21,8 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from skyroute.world.prepared_lock import LOCK
+
 _NONE = np.iinfo(np.int64).max
 
 
@@ -29,7 +31,13 @@ def entered(polygons: np.ndarray, tree: shapely.STRtree, geoms) -> np.ndarray:
     obstacle of ``polygons`` (indexed by ``tree``) it enters, or -1 where it meets no
     interior of their union (touching edges and corners is allowed). The index is the
     lowest of the obstacles whose interior it meets, else the lowest of the touching
-    obstacles whose union's interior it meets (for error messages)."""
+    obstacles whose union's interior it meets (for error messages). The obstacles are
+    tested through their prepared forms, holding :data:`~skyroute.world.prepared_lock.LOCK`."""
+    with LOCK:
+        return _entered(polygons, tree, geoms)
+
+
+def _entered(polygons: np.ndarray, tree: shapely.STRtree, geoms) -> np.ndarray:
     geoms = np.asarray(geoms, dtype=object).ravel()
     out = np.full(len(geoms), -1, np.int64)
     if len(polygons) == 0 or len(geoms) == 0:
@@ -61,6 +69,11 @@ def entered_one(polygons: np.ndarray, tree: shapely.STRtree, geom, *,
     names it; without, the first found, which saves a sort), or -1."""
     if len(polygons) == 0:
         return -1
+    with LOCK:
+        return _entered_one(polygons, tree, geom, lowest)
+
+
+def _entered_one(polygons: np.ndarray, tree: shapely.STRtree, geom, lowest: bool) -> int:
     hits = tree.query(geom, predicate="intersects")
     if lowest:
         hits = np.sort(hits)

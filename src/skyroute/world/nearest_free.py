@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from skyroute.world.prepared_lock import LOCK
+
 # Candidates are stepped out from the block's edge in these many directions (and straight
 # away from the point), up to STEPS steps of a tenth of the printed resolution.
 DIRECTIONS = 16
@@ -43,7 +45,8 @@ def _block(world, j: int):
     members = {j}
     frontier = np.array([j])
     while len(frontier):
-        _, found = world.tree.query(world.obstacles[frontier], predicate="intersects")
+        with LOCK:  # the obstacles are prepared, and tested through that form
+            _, found = world.tree.query(world.obstacles[frontier], predicate="intersects")
         new = set(found.tolist()) - members
         members |= new
         frontier = np.array(sorted(new), dtype=np.int64)

@@ -45,6 +45,7 @@ from skyroute.world.points import (
     check_places,
     plane_points,
 )
+from skyroute.world.prepared_lock import LOCK
 
 AXES = {"lonlat": ("lon", "lat"), "degrees": ("lon", "lat"), "ned": ("north", "east"),
         "enu": ("x", "y")}
@@ -251,9 +252,11 @@ class World:
 
     @cached_property
     def tree(self) -> STRtree:
-        """Spatial index over the obstacles (which are prepared for fast predicates)."""
-        shapely.prepare(self.obstacles)
-        return STRtree(self.obstacles)
+        """Spatial index over the obstacles (which are prepared for fast predicates, under
+        :data:`~skyroute.world.prepared_lock.LOCK`, as every test through them runs)."""
+        with LOCK:
+            shapely.prepare(self.obstacles)
+            return STRtree(self.obstacles)
 
     def merged(self) -> World:
         """The same free space with overlapping or touching obstacles fused into one
@@ -278,7 +281,7 @@ class World:
     def _prepared_boundary(self):
         if self.boundary is None:
             return None
-        b = shapely.Polygon(self.boundary)
+        b = shapely.Polygon(self.boundary)  # a copy of its own: prepared, held by LOCK
         shapely.prepare(b)
         return b
 
@@ -300,7 +303,8 @@ class World:
         if self.boundary is None:
             return np.ones(len(p), bool)
         pts = shapely.points(p)
-        return shapely.contains_properly(self._prepared_boundary, pts)
+        with LOCK:
+            return shapely.contains_properly(self._prepared_boundary, pts)
 
     def blocking(self, points) -> np.ndarray:
         """Index of an obstacle whose interior holds each point, or -1. A point on the
@@ -335,7 +339,8 @@ class World:
         if same.any():
             ok[same] = self.is_free(a[same])
         if self.boundary is not None and len(lines):
-            ok[idx] &= shapely.contains_properly(self._prepared_boundary, lines)
+            with LOCK:
+                ok[idx] &= shapely.contains_properly(self._prepared_boundary, lines)
         return ok
 
     def segments_clear(self, a, b) -> np.ndarray:
@@ -348,7 +353,8 @@ class World:
             il, _ = self.tree.query(lines, predicate="intersects")
             ok[il] = False
         if self.boundary is not None:
-            ok &= shapely.contains_properly(self._prepared_boundary, lines)
+            with LOCK:
+                ok &= shapely.contains_properly(self._prepared_boundary, lines)
         return ok
 
     def segment_free(self, a, b) -> bool:
@@ -358,8 +364,10 @@ class World:
         if np.array_equal(a, b):
             return bool(self.is_free([a])[0])
         line = shapely.LineString([a, b])
-        if self.boundary is not None and not self._prepared_boundary.contains_properly(line):
-            return False
+        if self.boundary is not None:
+            with LOCK:
+                if not self._prepared_boundary.contains_properly(line):
+                    return False
         return not len(self.obstacles) or entered_one(self.obstacles, self.tree, line) < 0
 
     def clearance(self, points) -> np.ndarray:
@@ -572,7 +580,8 @@ class World:
             if c1 <= c0 or r1 <= r0:
                 continue
             gx, gy = np.meshgrid(xs[c0:c1], ys[r0:r1])
-            blocked[r0:r1, c0:c1] |= shapely.intersects_xy(poly, gx, gy)
+            with LOCK:  # an obstacle itself (no margin) may be prepared
+                blocked[r0:r1, c0:c1] |= shapely.intersects_xy(poly, gx, gy)
         if w.boundary is not None:
             inner = shapely.Polygon(w.boundary)
             if safety > 0:
