@@ -1,1 +1,5 @@
 """The ``skyroute`` command line (Typer + Rich)."""
+
+from skyroute.lazy import exports as _exports
+
+__getattr__, __dir__ = _exports(__name__)  # its modules, imported when first asked for

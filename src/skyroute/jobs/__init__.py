@@ -14,3 +14,7 @@
 
 See docs/scaling.md for running on a cluster.
 """
+
+from skyroute.lazy import exports as _exports
+
+__getattr__, __dir__ = _exports(__name__)  # its modules, imported when first asked for

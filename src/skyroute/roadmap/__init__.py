@@ -1,1 +1,5 @@
 """Roadmaps over continuous worlds: built once, queried many times."""
+
+from skyroute.lazy import exports as _exports
+
+__getattr__, __dir__ = _exports(__name__)  # its modules, imported when first asked for
