@@ -478,6 +478,39 @@ def test_shutdown_ends_the_jobs_worker_processes(tmp_path):
     assert ours() == []
 
 
+def test_a_cancelled_lifespan_still_closes_the_resources(monkeypatch):
+    """A second Ctrl-C to 'skyroute serve' is uvicorn's forced exit: no shutdown is
+    sent, the lifespan is cancelled as the loop ends. The resources were not closed (the
+    jobs' workers ran on, the exit waited for their tasks, and the running job failed
+    with "cannot schedule new futures after shutdown", not as an orphan) and starlette
+    logged the cancellation as a failed shutdown, a KeyboardInterrupt traceback."""
+    import asyncio
+
+    from skyroute.service.app import create_app
+    from skyroute.service.settings import Settings
+
+    app = create_app(Settings(token=TOKEN, warm=False, db_url="sqlite://"))
+    closed: list[bool] = []
+    monkeypatch.setattr(app.state.resources, "close", lambda: closed.append(True))
+
+    async def serve() -> None:
+        running = asyncio.Event()
+
+        async def lifespan() -> None:  # as starlette's router holds it while serving
+            async with app.router.lifespan_context(app):
+                running.set()
+                await asyncio.Event().wait()  # starlette's wait for the shutdown message
+
+        task = asyncio.create_task(lifespan())
+        await running.wait()
+        task.cancel()  # the loop's end cancels what still runs
+        await asyncio.wait({task})
+        assert not task.cancelled() and task.exception() is None  # no failed shutdown
+
+    asyncio.run(serve())
+    assert closed == [True]
+
+
 def _query_routes(client) -> list[tuple[str, dict]]:
     """(path, {name: a valid value}) of every GET route of the API with query
     parameters, from its OpenAPI document (a route added later is covered too)."""

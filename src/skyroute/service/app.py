@@ -11,6 +11,8 @@ ready for the bench that started it (:mod:`skyroute.bench.ready`, only when aske
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
 from contextlib import asynccontextmanager
 from pathlib import Path
 
@@ -57,7 +59,13 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
             app.state.warmed = warm(app.state.resources)
         ready.mark_ready()  # one file a process: the bench waits for all of them
-        yield
+        # a second Ctrl-C (uvicorn's forced exit) sends no shutdown: the lifespan is
+        # cancelled as the loop ends, which starlette logged as a failed shutdown (a
+        # KeyboardInterrupt and CancelledError traceback); the jobs' workers ran on,
+        # the exit waited for their tasks, and the running job failed with "cannot
+        # schedule new futures after shutdown", not as an orphan
+        with contextlib.suppress(asyncio.CancelledError):
+            yield
         app.state.resources.close()
 
     # /docs and /redoc from files in the fastapi-offline package, not a CDN: a server
