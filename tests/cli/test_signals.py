@@ -284,3 +284,30 @@ def test_ctrl_c_in_the_teardown_after_the_work_changes_nothing():
         p.kill()
     assert (p.returncode, err) == (0, "")
     assert stdout == f"skyroute {skyroute.__version__}\n"
+
+
+HUNG_TEARDOWN = """
+import atexit, os, signal, sys, time
+from skyroute.cli.app import console
+
+def hang():  # a teardown that does not end (a thread or a pool not let go)
+    os.kill(os.getpid(), signal.SIGINT)
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(120)
+
+atexit.register(hang)
+sys.argv = ["skyroute", "--version"]
+console()
+"""
+
+
+def test_a_second_ctrl_c_leaves_a_hung_teardown_with_the_commands_exit_code():
+    # the signals were ignored for the whole teardown: one that hung could not be left
+    # with Ctrl-C or SIGTERM, only SIGKILL
+    p = _start(["-c", HUNG_TEARDOWN])
+    try:
+        stdout, err = p.communicate(timeout=60)
+    finally:
+        p.kill()
+    assert (p.returncode, err) == (0, "")
+    assert stdout == f"skyroute {skyroute.__version__}\n"

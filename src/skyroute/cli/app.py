@@ -8,6 +8,7 @@ scipy.linalg or shapely (tests/cli/test_startup.py).
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import os
 import signal
@@ -169,14 +170,15 @@ def console() -> None:
     its files written (or removed), and what is left is Python's teardown (0.3 s and
     more with numba, matplotlib or Dask loaded), in which a Ctrl-C printed a
     KeyboardInterrupt traceback from whatever ran (an atexit hook) or, later, killed the
-    process by the signal: a command that had done its work reported as interrupted."""
+    process by the signal: a command that had done its work reported as interrupted. A
+    second one ends the process at once with the command's exit code, so a teardown that
+    hangs (a thread or pool not let go) can still be left."""
     if len(sys.argv) >= 2 and sys.argv[1] in QUICK_EXIT:
         gc.disable()
     try:
         main()
     except SystemExit as done:
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(sig, signal.SIG_IGN)
+        _teardown_signals(done.code)
         if len(sys.argv) < 2 or sys.argv[1] not in QUICK_EXIT:
             raise
         code = done.code
@@ -189,3 +191,23 @@ def console() -> None:
         except (OSError, ValueError):  # a closed pipe: nothing left to say
             code = code or 1
         os._exit(code or 0)
+
+
+def _teardown_signals(code) -> None:
+    """SIGINT and SIGTERM once the command has ended: the first is ignored (its files
+    are written, and the teardown's own clean-up, an atexit hook, a temporary folder,
+    runs), the second leaves at once with the command's exit code."""
+    status = code if isinstance(code, int) else (0 if code is None else 1)
+    seen: list[int] = []
+
+    def handler(signum, frame) -> None:
+        seen.append(signum)
+        if len(seen) >= 2:
+            for stream in (sys.stdout, sys.stderr):
+                # closed, or a write under way (a reentrant call)
+                with contextlib.suppress(Exception):
+                    stream.flush()
+            os._exit(status)
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, handler)
