@@ -22,8 +22,9 @@ def website(root: Path) -> dict:
         return d["coordinates"]["lng"], d["coordinates"]["lat"]
 
     menus = json.loads((site / "menus" / "menus.json").read_text())
-    items = {it["item"]: (it["pence"], s["name"]) for s in menus for it in s["menu"]}
-    shops = {s["name"]: place(s["location"]) for s in menus}
+    # spaces round a name or a place are read past, as skyroute and the CSVs read them
+    items = {it["item"].strip(): (it["pence"], s["name"]) for s in menus for it in s["menu"]}
+    shops = {s["name"]: place(s["location"].strip()) for s in menus}
     zones = [shapely.geometry.shape(f["geometry"]) for f in json.loads(
         (site / "buildings" / "no-fly-zones.geojson").read_text())["features"]]
     area_file = site / "area.json"

@@ -131,11 +131,11 @@ def deliver_command(
             def files(r: DayResult) -> None:  # staged; in place once the day is stored
                 write_outputs(site, r, out, plot=draw)
 
-            stored: list[dt.date] = []  # the days stored, with their files, so far
+            done: list[dt.date] = []  # the days stored, with their files, so far
 
             def finished(r: DayResult) -> None:
                 written.extend(output_paths(out, r.date, plot=draw))
-                stored.append(r.date)
+                done.append(r.date)
                 progress.advance(days)
 
             failed: list[DayFailed] = []  # said once the other days are stored
@@ -152,7 +152,7 @@ def deliver_command(
                     raise
                 text = str(exc) + ("; --replace stores the day as flown now" if kept else "")
                 if not one_day:
-                    text += f"; {_stopped(sorted(stored), len(by_date))}"
+                    text += f"; {_stopped(sorted(done), len(by_date))}"
                 raise SkyrouteError(text) from None
             wall = time.perf_counter() - t0
         workers = ex.workers
