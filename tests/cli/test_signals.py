@@ -261,50 +261,31 @@ def test_a_second_ctrl_c_while_the_line_is_printed(monkeypatch):
     assert err.text == "skyroute: interrupted\n"
 
 
-# A Ctrl-C in Python's teardown, after the command has done its work (an atexit hook of
-# numba, Dask or multiprocessing runs then: the hook here stands for them).
+# Signals in Python's teardown, after the command has done its work (an atexit hook of
+# numba, Dask or multiprocessing runs then: the hook here stands for them). One Ctrl-C
+# printed "Exception ignored in atexit callback" and a KeyboardInterrupt traceback under
+# the command's output (later in the teardown the process was killed by the signal
+# instead: exit status -2 for a command that had done its work); ignoring them all left
+# a teardown that hangs (a thread or a pool not let go) to SIGKILL.
 TEARDOWN = """
-import atexit, os, signal, sys
-from skyroute.cli.app import console
-
-atexit.register(lambda: os.kill(os.getpid(), signal.SIGINT))
-sys.argv = ["skyroute", "--version"]
-console()
-"""
-
-
-def test_ctrl_c_in_the_teardown_after_the_work_changes_nothing():
-    # it printed "Exception ignored in atexit callback" and a KeyboardInterrupt
-    # traceback under the command's output (later in the teardown the process was
-    # killed by the signal instead: exit status -2 for a command that had done its work)
-    p = _start(["-c", TEARDOWN])
-    try:
-        stdout, err = p.communicate(timeout=20)
-    finally:
-        p.kill()
-    assert (p.returncode, err) == (0, "")
-    assert stdout == f"skyroute {skyroute.__version__}\n"
-
-
-HUNG_TEARDOWN = """
 import atexit, os, signal, sys, time
 from skyroute.cli.app import console
 
-def hang():  # a teardown that does not end (a thread or a pool not let go)
-    os.kill(os.getpid(), signal.SIGINT)
-    os.kill(os.getpid(), signal.SIGINT)
-    time.sleep(120)
+def hook():
+    for _ in range({signals}):
+        os.kill(os.getpid(), signal.SIGINT)
+    time.sleep({hang})
 
-atexit.register(hang)
+atexit.register(hook)
 sys.argv = ["skyroute", "--version"]
 console()
 """
 
 
-def test_a_second_ctrl_c_leaves_a_hung_teardown_with_the_commands_exit_code():
-    # the signals were ignored for the whole teardown: one that hung could not be left
-    # with Ctrl-C or SIGTERM, only SIGKILL
-    p = _start(["-c", HUNG_TEARDOWN])
+@pytest.mark.parametrize("signals, hang", [(1, 0), (2, 120)],
+                         ids=["one-changes-nothing", "a-second-leaves-a-hung-teardown"])
+def test_signals_in_the_teardown_keep_the_commands_exit_code(signals, hang):
+    p = _start(["-c", TEARDOWN.format(signals=signals, hang=hang)])
     try:
         stdout, err = p.communicate(timeout=60)
     finally:
