@@ -10,15 +10,15 @@ errors do), ``file`` (an InputFormatError naming a file: its pickle does not loa
 a pool handed it back as a worker 'terminated abruptly'), ``bug`` (a ZeroDivisionError),
 ``die`` (the worker kills its own process with SIGKILL, as the out-of-memory killer
 does), ``die-once`` (the same, on the first try of that date only: a file in ``marks``
-remembers it across processes).
+remembers it across processes). Dask workers: tests/jobs/failing_dask.py. This module
+does not import ``distributed``: each spawned pool worker imports it, to unpickle its
+initializer (a second a worker, four workers a test whose worker dies).
 
 The same kinds apply to a fleet sweep's runs (``skyroute.jobs.fleet._simulate``): a key
 ``seed N`` matches every run of seed N, ``SCHEDULER AIRSPACE seed N`` one setting's.
 """
 
 from __future__ import annotations
-
-from distributed import WorkerPlugin
 
 
 def fail_in_workers(kinds: dict[str, str], marks: str | None = None) -> None:
@@ -74,23 +74,6 @@ def failing_workers(monkeypatch, kinds: dict[str, str], marks=None) -> None:
     monkeypatch.setattr("skyroute.jobs.executor._leave_sigint",
                         partial(fail_in_workers, kinds,
                                 None if marks is None else str(marks)))
-
-
-class FailingDaskWorkers(WorkerPlugin):
-    """A Dask worker plugin doing what :func:`fail_in_workers` does in each worker of a
-    cluster, also in one its nanny starts again after a death (register it with
-    ``client.register_plugin``)."""
-
-    name = "skyroute-failing-days"
-
-    def __init__(self, kinds: dict[str, str], marks: str | None = None) -> None:
-        self.kinds, self.marks = kinds, marks
-
-    def setup(self, worker) -> None:
-        fail_in_workers(self.kinds, self.marks)
-
-    def teardown(self, worker) -> None:
-        pass
 
 
 def die_below_zero(x: int) -> int:

@@ -82,7 +82,7 @@ def test_deliver_on_dask_with_a_failing_day_and_a_dying_worker(monkeypatch, caps
 
     from skyroute.jobs.executor import DaskExecutor
     from tests.cli.test_deliver_cli import _stored_day
-    from tests.jobs.failing import FailingDaskWorkers
+    from tests.jobs.failing_dask import FailingDaskWorkers
 
     real = DaskExecutor.__init__
 
@@ -149,7 +149,7 @@ def test_fleet_sweep_on_dask_with_a_dying_worker_keeps_the_other_rows(monkeypatc
     import distributed  # noqa: F401  (its defaults loaded, so the block only overrides)
 
     from skyroute.jobs.executor import DaskExecutor
-    from tests.jobs.failing import FailingDaskWorkers
+    from tests.jobs.failing_dask import FailingDaskWorkers
 
     real = DaskExecutor.__init__
 

@@ -137,8 +137,9 @@ def test_empty_world_free_headings():
     res = plan(world, (10, 10), (70, 50), R)  # no headings: the straight line
     assert res.length == pytest.approx(math.dist((10, 10), (70, 50)), abs=1e-9)
     res = plan(world, (10, 10, math.pi), (70, 50), R)  # turn, then the tangent
+    # (floats, as the planner calls it: whole numbers compile another signature)
     assert res.found and res.length == pytest.approx(
-        free_heading_bound(10, 10, math.pi, 70, 50, R), abs=1e-9)
+        free_heading_bound(10.0, 10.0, math.pi, 70.0, 50.0, R), abs=1e-9)
     check_path(world, res, (10, 10, math.pi), (70, 50), R)
     res = plan(world, (10, 10), (70, 50, 0.5), R)
     assert res.found and res.length < dubins.shortest_path((10, 10, 0), (70, 50, 0.5),
@@ -389,8 +390,12 @@ def test_arc_and_segment_distances_match_shapely():
 
 def test_path_free_is_exact_at_a_corner():
     world = make_world([(40, 40, 60, 60)])
+    from numba import types
+
+    from skyroute.motion.arc_kernels import chain_free
     from skyroute.motion.pieces import Piece
 
+    before = set(chain_free.signatures)
     # a straight that passes 1 mm above the box, and one that clips its corner by 1 mm
     assert path_free(world, [Piece("S", (10, 60.001, 0.0), 80, R)])
     assert not path_free(world, [Piece("S", (10, 59.999, 0.0), 80, R)])
@@ -399,6 +404,11 @@ def test_path_free_is_exact_at_a_corner():
         rad = 10 + dr
         p = Piece("L", (50 - rad, 70, -math.pi / 2), rad * math.pi, rad)
         assert path_free(world, [p]) is ok
+    # pieces of whole numbers are checked by the planner's own (float) kernel: an int
+    # start or length was a signature of its own, compiled afresh (15 s cold)
+    added = set(chain_free.signatures) - before
+    assert not any(t in (types.int64, types.Array(types.int64, 1, "C"))
+                   for sig in added for t in (*sig[:3], sig[4], sig[5])), added
 
 
 # -- smaller contracts --------------------------------------------------------------------

@@ -53,6 +53,7 @@ SIZES = (("Small", 0), ("Regular", 45), ("Large", 90))
 # buildings kept apart, so most seeds paint themselves into a corner (seed 0 fits its
 # sixth after about 100,000 draws, seed 1 after 26,000; the bound keeps both as they were).
 ZONE_DRAWS = 120_000
+ZONE_BATCH = 4_000  # draws made and screened at once (see _zones)
 # Places give up after this many draws in a row without finding a free point.
 PLACE_DRAWS = 20_000
 
@@ -93,28 +94,73 @@ def _zones(rng, box: shapely.Polygon) -> list[shapely.Polygon]:
     """Buildings in the middle of the box: rotated blocks and L shapes, kept apart.
 
     Drawn at random until six fit; after ``ZONE_DRAWS`` draws, one building in each cell
-    of a 3 x 2 grid instead (which always fits).
+    of a 3 x 2 grid instead (which always fits). The draws are made ``ZONE_BATCH`` at a
+    time (the same numbers, in the same order, as one draw after another) and most are
+    set aside by :func:`_surely_not`, without shapely; the others are decided as before.
     """
     x0, y0, x1, y1 = box.bounds
     w, h = x1 - x0, y1 - y0
     inner = box.buffer(-4 * STEP)
     bounds = inner.bounds
     zones: list[shapely.Polygon] = []
-    for _ in range(ZONE_DRAWS):
-        cx = x0 + w * rng.uniform(0.25, 0.75)
-        cy = y0 + h * rng.uniform(0.2, 0.8)
-        a, b = w * rng.uniform(0.04, 0.1), h * rng.uniform(0.08, 0.22)
-        el = bool(rng.random() < 0.5)
-        angle = rng.uniform(-35, 35)
-        if not _may_fit(cx, cy, a, b, el, angle, bounds):
-            continue
-        z = _building(cx, cy, a, b, el, angle)
-        if z.is_valid and all(z.distance(o) > 3 * STEP for o in zones) and \
-                inner.contains(z):
-            zones.append(z)
-            if len(zones) == 6:
-                return zones
+    # each draw: cx, cy, a, b in the box's shares below, an L when < 0.5, an angle
+    low = np.array([0.25, 0.2, 0.04, 0.08, 0.0, -35.0])
+    high = np.array([0.75, 0.8, 0.1, 0.22, 1.0, 35.0])
+    for first in range(0, ZONE_DRAWS, ZONE_BATCH):
+        n = min(ZONE_BATCH, ZONE_DRAWS - first)
+        state = rng.bit_generator.state
+        u = rng.random((n, 6))  # as rng.uniform(low, high) and rng.random() draw them
+        v = low + (high - low) * u
+        v[:, 4] = u[:, 4]
+        cx, cy = x0 + w * v[:, 0], y0 + h * v[:, 1]
+        a, b = w * v[:, 2], h * v[:, 3]
+        el, angle = v[:, 4] < 0.5, v[:, 5]
+        skip = _surely_not(cx, cy, a, b, el, angle, bounds, zones)
+        for i in np.flatnonzero(~skip):
+            args = (float(cx[i]), float(cy[i]), float(a[i]), float(b[i]), bool(el[i]),
+                    float(angle[i]))
+            if not _may_fit(*args, bounds):
+                continue
+            z = _building(*args)
+            if z.is_valid and all(z.distance(o) > 3 * STEP for o in zones) and \
+                    inner.contains(z):
+                zones.append(z)
+                if len(zones) == 6:
+                    rng.bit_generator.state = state  # the draws up to this one, no more
+                    rng.random((i + 1) * 6)
+                    return zones
+                skip[i + 1:] |= _surely_not(cx[i + 1:], cy[i + 1:], a[i + 1:], b[i + 1:],
+                                            el[i + 1:], angle[i + 1:], bounds, zones[-1:])
     return _zones_in_cells(rng, inner)
+
+
+def _surely_not(cx, cy, a, b, el, angle, bounds, zones) -> np.ndarray:
+    """For arrays of draws: True where the building surely does not fit, so the loop of
+    :func:`_zones` need not look (never where it would be kept): a corner more than
+    ``_may_fit``'s slack (and a margin for numpy's sine beside math's) outside
+    ``bounds``, or one within 3 steps less 2e-6 of a zone placed (the building's own
+    corners are these, moved by less than 1e-6 by the rounding to 6 decimals)."""
+    ox = np.where(el, cx - a / 6, cx)  # the centroid
+    oy = np.where(el, cy - b / 6, cy)
+    # the outline's corners (a block's four, its first one repeated for the L's six)
+    px = np.stack([cx - a, cx + a, cx + a, np.where(el, cx, cx - a), np.where(el, cx, cx - a),
+                   cx - a], axis=1)
+    py = np.stack([cy - b, cy - b, np.where(el, cy, cy + b), np.where(el, cy, cy + b),
+                   cy + b, np.where(el, cy + b, cy - b)], axis=1)
+    t = np.radians(angle)[:, None]
+    c, s = np.cos(t), np.sin(t)
+    qx = ox[:, None] + c * (px - ox[:, None]) - s * (py - oy[:, None])
+    qy = oy[:, None] + s * (px - ox[:, None]) + c * (py - oy[:, None])
+    slack = 1e-6 + 1e-9
+    out = ((qx < bounds[0] - slack) | (qx > bounds[2] + slack) | (qy < bounds[1] - slack)
+           | (qy > bounds[3] + slack)).any(axis=1)
+    look = np.flatnonzero(~out)
+    if zones and len(look):
+        placed = shapely.union_all(zones)
+        shapely.prepare(placed)
+        near = shapely.dwithin(placed, shapely.points(qx[look], qy[look]), 3 * STEP - 2e-6)
+        out[look] = near.any(axis=1)
+    return out
 
 
 def _zones_in_cells(rng, inner: shapely.Polygon) -> list[shapely.Polygon]:

@@ -431,10 +431,13 @@ def _free(index, pieces: list[Piece]) -> bool:
     stamp = np.zeros(len(index.edges), np.int64)
     tick = np.zeros(1, np.int64)
     for p in pieces:
+        # floats, whatever the piece holds: a piece of whole numbers ((10, 60, 0), 80)
+        # was another signature, compiled afresh (15 s) beside the planner's own
+        x, y, th = (float(v) for v in p.start)
         turns = np.array([p.k], np.int64)
-        lens = np.array([p.signed_length])
-        r = p.radius if p.k != 0 else 1.0
-        if not chain_free(*p.start, turns, lens, r, *index.args(), stamp, tick):
+        lens = np.array([p.signed_length], np.float64)
+        r = float(p.radius) if p.k != 0 else 1.0
+        if not chain_free(x, y, th, turns, lens, r, *index.args(), stamp, tick):
             return False
     return True
 
