@@ -108,3 +108,32 @@ def test_boxes_are_named_by_their_own_line_after_blank_lines(tmp_path):
     assert city.names == ("box at line 3", "box at line 6")
     with pytest.raises(skyroute.QueryError, match="inside obstacle 'box at line 6'"):
         skyroute.plan(city.at(10), (-20, 20), (40, 40))
+
+
+def test_the_first_fcnd_layout_with_the_home_on_two_lines_reads_as_the_later_one(tmp_path):
+    # FCND-Motion-Planning's first colliders.csv (2018; students' forks keep it) has line
+    # 1 'lat0,lon0', line 2 the values, the header on line 3: "expected 'lat0 <deg>, lon0
+    # <deg>', got 'lat0,lon0'"
+    plain, first = tmp_path / "plain.csv", tmp_path / "first.csv"
+    plain.write_text(f"{HOME}\n{HEADER}\n{BOXES}")
+    first.write_text(f"lat0,lon0\n37.792480,-122.397450\n{HEADER}\n{BOXES}")
+    a, b = read_colliders(plain, frame="ned"), read_colliders(first, frame="ned")
+    assert (b.home.lat, b.home.lon) == (a.home.lat, a.home.lon) == (37.79248, -122.39745)
+    assert list(b.obstacles) == list(a.obstacles)
+    assert b.names == ("box at line 4", "box at line 5")
+
+
+@pytest.mark.parametrize("text, line, words", [
+    ("lat0,lon0\n", 2, "expected '<lat0>,<lon0>' under line 1's 'lat0,lon0', got the end"),
+    ("lat0,lon0\n37.79;-122.39\n", 2, "got '37.79;-122.39'"),
+    ("lat0,lon0\n97.79,-122.39\n", 2, "home lat0 97.79, lon0 -122.39 is not a place"),
+    (f"lat0,lon0\n37.79,-122.39\n{BOXES}", 3, "expected the header"),
+    (f"lat0,lon0\n37.79,-122.39\n{HEADER}\n", 4, "no boxes after the header"),
+    (f"lat0,lon0\n37.79,-122.39\n{HEADER}\n1,1,1,1,1,1\n1,1,1\n", 5, "expected 6 numbers"),
+])
+def test_the_first_fcnd_layout_names_its_own_lines(tmp_path, text, line, words):
+    path = tmp_path / "c.csv"
+    path.write_text(text)
+    with pytest.raises(InputFormatError) as err:
+        read_colliders(path)
+    assert err.value.line == line and words in str(err.value)

@@ -339,6 +339,30 @@ def test_a_16_bit_image_reads_as_its_8_bit_twin(tmp_path, suffix):
     assert sixteen.blocked.tolist() == eight.blocked.tolist()
 
 
+def test_an_image_is_read_in_bands_of_rows_not_as_float_copies_of_the_whole(tmp_path):
+    # the whole image went to RGBA and then to float32 grey: 20 bytes a pixel, 1.4 GB
+    # for a PNG at the 8192 x 8192 limit; numpy's and Python's allocations only here
+    # (tracemalloc does not see Pillow's own image memory)
+    import tracemalloc
+
+    grey = np.full((2048, 1024), 255, np.uint8)
+    grey[100:1900, 500] = 0
+    rgba = np.dstack([grey] * 3 + [np.full_like(grey, 255)])
+    rgba[:5, :5, 3] = 0  # transparent: free whatever its colour
+    rgba[:5, :5, :3] = 0
+    Image.fromarray(grey).save(tmp_path / "g.png")
+    Image.fromarray(rgba).save(tmp_path / "a.png")
+    for name in ("g.png", "a.png"):
+        tracemalloc.start()
+        try:
+            grid = load_map(tmp_path / name)
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        np.testing.assert_array_equal(grid.blocked, grey < 128)
+        assert peak < 8 * grey.size, f"{name}: {peak / grey.size:.1f} bytes a pixel"
+
+
 def test_a_floating_point_image_is_refused(tmp_path):
     Image.fromarray(np.zeros((2, 2), np.float32)).save(tmp_path / "f.tiff")
     with pytest.raises(InputFormatError, match="floating-point image"):

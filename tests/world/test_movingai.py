@@ -126,3 +126,56 @@ def test_bundled_maps_are_the_reference_bytes():
     for path in maps.values():
         assert path.read_bytes() == (MOVINGAI / path.name).read_bytes()
     assert load_map("den312d").blocked.shape == (81, 65)
+
+
+def test_a_tab_or_space_after_the_last_scen_column_is_no_column(tmp_path):
+    # "expected 9 tab-separated columns, got 10 (its columns are separated by spaces)":
+    # a trailing tab was a tenth column, and the hint blamed spaces there were none of
+    plain = read_scen(write(tmp_path, SCEN, "m.map.scen"))
+    for end in ("\t", " ", "\t\t"):
+        sc = read_scen(write(tmp_path, SCEN.replace("\n0", f"{end}\n0").replace(
+            "2.41421\n", f"2.41421{end}\n"), "t.map.scen"))
+        np.testing.assert_array_equal(sc.starts, plain.starts)
+        np.testing.assert_array_equal(sc.optimal, plain.optimal)
+        np.testing.assert_array_equal(sc.tolerance, plain.tolerance)
+
+
+def test_every_scen_line_must_name_the_same_map(tmp_path):
+    # only the first line's map column was checked against the map: a line for another
+    # map of the same size ran on this one
+    p = write(tmp_path, SCEN.replace("1\tm.map", "1\tother.map"), "m.map.scen")
+    with pytest.raises(InputFormatError) as err:
+        read_scen(p)
+    assert err.value.line == 3 and "map 'other.map' differs from the first line's 'm.map'" \
+        in str(err.value)
+
+
+@pytest.mark.parametrize("version", ["", "version 0\n", "version 0.0\r\n"])
+def test_a_version_0_scen_reads_as_hog2_reads_it(tmp_path, version):
+    # HOG2's loader reads a file with no version line (or 'version 0') as 7 columns, no
+    # map size: "expected 'version 1', got '0\tm.map\t0\t0\t3\t0\t3.00000000'"
+    v0 = "0\tm.map\t0\t0\t3\t0\t3.00000000\n1\tm.map\t0\t2\t2\t1\t2.41421\n"
+    sc = read_scen(write(tmp_path, version + v0, "m.map.scen"))
+    v1 = read_scen(write(tmp_path, SCEN, "v1.map.scen"))
+    assert (sc.width, sc.height, sc.map_name) == (None, None, "m.map")
+    for name in ("starts", "goals", "optimal", "tolerance", "buckets"):
+        np.testing.assert_array_equal(getattr(sc, name), getattr(v1, name))
+
+
+def test_a_version_0_scen_is_checked_against_its_map(tmp_path):
+    from skyroute.bench.grid import load_case
+
+    m = write(tmp_path, "type octile\nheight 3\nwidth 4\nmap\n....\n.@..\n....\n", "m.map")
+    s = write(tmp_path, "0\tm.map\t0\t0\t3\t0\t3\n\n0\tm.map\t0\t0\t4\t0\t4\n", "m.map.scen")
+    with pytest.raises(InputFormatError) as err:
+        load_case(m, s, per_map=0)
+    assert str(err.value) == f"{s}:3: goal (4, 0) lies outside m.map (4x3)"
+
+
+def test_nine_columns_with_no_version_line_say_what_is_missing(tmp_path):
+    p = write(tmp_path, SCEN.partition("\n")[2], "m.map.scen")
+    with pytest.raises(InputFormatError) as err:
+        read_scen(p)
+    assert err.value.line == 1 and str(err.value).endswith(
+        "expected 7 tab-separated columns, got 9 (a file of 9 columns starts with the line "
+        "'version 1')")

@@ -218,12 +218,13 @@ def check_random_per_map(per_map: int, side: int | None = None) -> None:
 def check_scenario(grid: Grid, scen: Scenario, map_name: str) -> None:
     """Raise InputFormatError naming the .scen file and line unless the scenario names
     the map (its second column's file name; a folder before it is ignored), is for the
-    grid's size and every line's start and goal lie on free cells of it."""
+    grid's size (a version-0 file gives none) and every line's start and goal lie on
+    free cells of it."""
     named = scen.map_name.replace("\\", "/").rsplit("/", 1)[-1]
     if named != map_name:
         raise InputFormatError(scen.path, f"scenario is for {named} (its map column), not "
                                f"{map_name}", line=query_line(scen.path, 0))
-    if (scen.width, scen.height) != (grid.width, grid.height):
+    if scen.width is not None and (scen.width, scen.height) != (grid.width, grid.height):
         raise InputFormatError(scen.path, f"scenario is for a {scen.width}x{scen.height} map, "
                                f"{map_name} is {grid.width}x{grid.height}",
                                line=query_line(scen.path, 0))

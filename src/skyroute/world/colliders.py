@@ -2,7 +2,10 @@
 
 Line 1 is ``lat0 <deg>, lon0 <deg>``; line 2 the header
 ``posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ``; then one box per row: centre north,
-east and height above ground, and half extents along north, east and up (metres). Each
+east and height above ground, and half extents along north, east and up (metres). The
+course's first file (Udacity's FCND-Motion-Planning, 2018, still in many students' forks)
+gives the home on two lines, ``lat0,lon0`` over ``37.792480,-122.397450``, the header on
+line 3 and boxes from line 4; it is read as well. Each
 box grows by ``safety`` on every side and at its top; it counts at an altitude below
 its top + safety.
 
@@ -44,17 +47,23 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
         text = read_text(path, max_bytes=MAX_BYTES,
                          kind=f"a colliders file (at most {MAX_BOXES:,} boxes)")
     lines = strip_bom(text).splitlines()
-    boxes = sum(1 for line in lines[2:] if line.strip())
+    # the header's index: 2 in the first FCND layout, whose home takes two lines
+    head = 2 if lines and "".join(lines[0].split()).lower() == "lat0,lon0" else 1
+    boxes = sum(1 for line in lines[head + 1:] if line.strip())
     if boxes > MAX_BOXES:
         raise InputFormatError(path, f"{boxes:,} boxes, over the limit of {MAX_BOXES:,} in a "
                                "colliders file")
-    lat0, lon0 = _home(path, lines[0] if lines else None)
+    if head == 2:
+        lat0, lon0 = _home_values(path, lines[1] if len(lines) > 1 else None)
+    else:
+        lat0, lon0 = _home(path, lines[0] if lines else None)
     if not (-90 <= lat0 <= 90 and -180 <= lon0 <= 180):
-        raise InputFormatError(path, f"home lat0 {lat0}, lon0 {lon0} is not a place", line=1)
-    if len(lines) < 2 or "".join(lines[1].split()).lower() != HEADER.lower():
-        raise InputFormatError(path, f"expected the header {HEADER!r}", line=2)
+        raise InputFormatError(path, f"home lat0 {lat0}, lon0 {lon0} is not a place",
+                               line=head)
+    if len(lines) <= head or "".join(lines[head].split()).lower() != HEADER.lower():
+        raise InputFormatError(path, f"expected the header {HEADER!r}", line=head + 1)
     rows, numbers = [], []
-    for n, line in enumerate(lines[2:], start=3):
+    for n, line in enumerate(lines[head + 1:], start=head + 2):
         if not line.strip():
             continue
         parts = line.split(",")
@@ -73,7 +82,7 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
         rows.append(vals)
         numbers.append(n)
     if not rows:
-        raise InputFormatError(path, "no boxes after the header", line=3)
+        raise InputFormatError(path, "no boxes after the header", line=head + 2)
     b = np.array(rows)
     north, east, up, hn, he, hu = b.T
     s = float(safety)
@@ -99,6 +108,20 @@ def _home(path: Path, line: str | None) -> tuple[float, float]:
         got = "an empty file" if line is None else repr(line[:60])
         raise InputFormatError(path, f"expected 'lat0 <deg>, lon0 <deg>', got {got}",
                                line=1) from None
+
+
+def _home_values(path: Path, line: str | None) -> tuple[float, float]:
+    """(lat0, lon0) from line 2 of the first FCND layout, ``<lat>,<lon>`` under a line 1
+    of ``lat0,lon0`` (None: the file ends after line 1)."""
+    parts = line.split(",") if line is not None else []
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        return float(parts[0]), float(parts[1])
+    except ValueError:
+        got = "the end of the file" if line is None else repr(line[:60])
+        raise InputFormatError(path, f"expected '<lat0>,<lon0>' under line 1's 'lat0,lon0', "
+                               f"got {got}", line=2) from None
 
 
 def _walls_line(line: str) -> bool:

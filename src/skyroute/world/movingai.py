@@ -113,15 +113,16 @@ def read_map(path: str | Path, *, text: str | bytes | None = None) -> Grid:
 class Scenario:
     """The queries of one ``.scen`` file, as parallel arrays (one row per line).
 
-    ``starts`` and ``goals`` are (N, 2) int arrays of (x, y) cells; ``optimal`` the
+    ``width`` and ``height`` are the map's size, None for a version-0 file, which gives
+    none. ``starts`` and ``goals`` are (N, 2) int arrays of (x, y) cells; ``optimal`` the
     octile lengths; ``tolerance`` the rounding of each printed length (half a unit of
     its last decimal), so a cost matches when ``|cost - optimal| <= tolerance``.
     """
 
     path: Path
     map_name: str
-    width: int
-    height: int
+    width: int | None
+    height: int | None
     buckets: np.ndarray
     starts: np.ndarray
     goals: np.ndarray
@@ -147,28 +148,45 @@ def query_line(path: str | Path, index: int) -> int | None:
         lines = _lines(Path(path), kind="a scenario file")
     except InputFormatError:
         return None
-    numbers = [n for n, line in enumerate(lines[1:], start=2) if line.strip()]
+    first = 1 if _version_line(lines) else 0
+    numbers = [n for n, line in enumerate(lines[first:], start=first + 1) if line.strip()]
     return numbers[index] if index < len(numbers) else None
 
 
+def _version_line(lines: list[str]) -> bool:
+    """Whether line 1 is a version line (a file of version 0 may have none)."""
+    return bool(lines) and lines[0].split()[:1] == ["version"]
+
+
 def read_scen(path: str | Path) -> Scenario:
-    """Read a MovingAI ``.scen`` file (``version 1``, 9 tab-separated columns)."""
+    """Read a MovingAI ``.scen`` file: ``version 1`` and 9 tab-separated columns, or the
+    older version 0 (a ``version 0`` line or none, as HOG2's loader reads it) of 7
+    columns, ``bucket map start_x start_y goal_x goal_y length``, which give no map size
+    (``width`` and ``height`` are then None). Every line must name the same map."""
     path = Path(path)
     lines = _lines(path, kind="a scenario file")
-    if not lines or lines[0].strip() not in ("version 1", "version 1.0"):
-        got = lines[0].strip() if lines else "an empty file"
-        raise InputFormatError(path, f"expected 'version 1', got {got!r}", line=1)
+    version = lines[0].split()[1:] if _version_line(lines) else ["0"]
+    if len(version) != 1 or version[0] not in ("1", "1.0", "0", "0.0"):
+        raise InputFormatError(path, f"expected 'version 1' (or 'version 0'), got "
+                               f"{lines[0].strip()!r}", line=1)
+    ncols = 9 if version[0].startswith("1") else 7
+    first = 1 if _version_line(lines) else 0
     buckets, coords, optimal, tol = [], [], [], []
     map_name, size = None, None
-    for n, line in enumerate(lines[1:], start=2):
+    for n, line in enumerate(lines[first:], start=first + 1):
         if not line.strip():
             continue
-        cols = line.split("\t")
-        if len(cols) != 9:
-            spaced = " (its columns are separated by spaces)" if len(line.split()) == 9 \
-                else ""
-            raise InputFormatError(path, f"expected 9 tab-separated columns, got "
-                                   f"{len(cols)}{spaced}", line=n)
+        # a tab or space after the last column (an editor's, a script's) is no column
+        cols = line.strip().split("\t")
+        if len(cols) != ncols:
+            spaced = " (its columns are separated by spaces)" \
+                if len(line.split()) == ncols and " " in line.strip() else ""
+            hint = "" if first or len(cols) != 9 else \
+                " (a file of 9 columns starts with the line 'version 1')"
+            raise InputFormatError(path, f"expected {ncols} tab-separated columns, got "
+                                   f"{len(cols)}{spaced}{hint}", line=n)
+        if ncols == 7:  # version 0: no map size
+            cols = [cols[0], cols[1], "0", "0", *cols[2:]]
         try:
             nums = [int(c) for c in (cols[0], *cols[2:8])]
             length = float(cols[8])
@@ -176,12 +194,15 @@ def read_scen(path: str | Path) -> Scenario:
             raise InputFormatError(path, "bucket, width, height, start_x, start_y, goal_x, "
                                    "goal_y must be integers and length a number", line=n) from None
         bucket, w, h, sx, sy, gx, gy = nums
-        if size is None:
+        if map_name is None:
             map_name, size = cols[1].strip(), (w, h)
+        elif cols[1].strip() != map_name:
+            raise InputFormatError(path, f"map {cols[1].strip()!r} differs from the first "
+                                   f"line's {map_name!r}", line=n)
         elif (w, h) != size:
             raise InputFormatError(path, f"map size {w}x{h} differs from the first line's "
                                    f"{size[0]}x{size[1]}", line=n)
-        if not (0 <= sx < w and 0 <= gx < w and 0 <= sy < h and 0 <= gy < h):
+        if ncols == 9 and not (0 <= sx < w and 0 <= gx < w and 0 <= sy < h and 0 <= gy < h):
             raise InputFormatError(path, f"start ({sx}, {sy}) or goal ({gx}, {gy}) lies "
                                    f"outside the {w}x{h} map", line=n)
         if not np.isfinite(length) or length < 0:
@@ -192,7 +213,9 @@ def read_scen(path: str | Path) -> Scenario:
         optimal.append(length)
         tol.append(0.5 * 10.0 ** -decimals + 1e-9)
     if size is None:
-        raise InputFormatError(path, "no scenario lines after the version line", line=2)
+        raise InputFormatError(path, "no scenario lines" + (" after the version line"
+                                                            if first else ""), line=first + 1)
+    width, height = size if ncols == 9 else (None, None)
     c = np.array(coords, dtype=np.int64).reshape(-1, 4)
-    return Scenario(path, map_name or "", size[0], size[1], np.array(buckets, dtype=np.int64),
+    return Scenario(path, map_name or "", width, height, np.array(buckets, dtype=np.int64),
                     c[:, :2].copy(), c[:, 2:].copy(), np.array(optimal), np.array(tol))
