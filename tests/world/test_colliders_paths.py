@@ -9,6 +9,7 @@ waypoints start at the start, end at the goal and head along each leg
 (atan2(east, north), FCND's optional heading step).
 """
 
+import itertools
 import math
 
 import numpy as np
@@ -85,15 +86,14 @@ def test_every_planner_keeps_out_of_the_boxes_at_the_altitude(case):
         assert exact.found, name
         path = np.asarray(r.path)
         assert path[0].tolist() == list(start) and path[-1].tolist() == list(goal)
-        assert not any(enters(union, a, b) for a, b in zip(path[:-1], path[1:],
-                                                           strict=True)), name
+        assert not any(enters(union, a, b) for a, b in itertools.pairwise(path)), name
         length = float(np.hypot(*np.diff(path, axis=0).T).sum())
         assert r.cost == pytest.approx(length, rel=1e-9, abs=1e-9)
         assert exact.cost <= r.cost + 1e-9, name
         rows_out = waypoints(world, r.path, altitude)
         np.testing.assert_allclose(np.array(rows_out)[:, :3],
                                    np.c_[path, np.full(len(path), altitude)], atol=1e-9)
-        for w0, w1 in zip(rows_out[:-1], rows_out[1:], strict=True):
+        for w0, w1 in itertools.pairwise(rows_out):
             dn, de = w1[0] - w0[0], w1[1] - w0[1]
             if math.hypot(dn, de) > 1e-6:
                 turn = (w1[3] - math.atan2(de, dn) + math.pi) % (2 * math.pi) - math.pi
