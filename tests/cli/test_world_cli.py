@@ -262,7 +262,7 @@ ROOM = ("lat0 37.792480, lon0 -122.397450\nposX,posY,posZ,halfSizeX,halfSizeY,ha
 
 def test_a_prm_that_misses_a_path_says_one_may_still_exist(monkeypatch, capsys, tmp_path):
     # the table said only "no_path" (exit 1) where the visibility graph finds 44.4 m:
-    # 1,000 samples missed 6 of 45 random pairs of the FCND city so
+    # 1,000 samples missed 5 of 44 random pairs of the FCND city so
     room = tmp_path / "room.csv"
     room.write_text(ROOM)
     common = [str(room), "--frame", "ned", "--start=5,-5", "--goal=-20,30", "--altitude", "5"]
