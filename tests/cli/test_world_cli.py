@@ -253,3 +253,25 @@ def test_a_target_blocked_only_by_the_safety_margin_says_so(monkeypatch, capsys,
     assert err == ("skyroute: error: targets.csv: target 2 (50.00, 62.00) lies outside "
                    "obstacle 'box at line 3' but within its --safety 5 m margin; nearest "
                    "free point (50.00, 65.01)\n")
+
+
+ROOM = ("lat0 37.792480, lon0 -122.397450\nposX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n"
+        "-11,0,10,1,12,10\n11,0,10,1,12,10\n0,-11,10,10,1,10\n"
+        "-5.25,11,10,4.75,1,10\n5.25,11,10,4.75,1,10\n")  # a room, a 1 m door east
+
+
+def test_a_prm_that_misses_a_path_says_one_may_still_exist(monkeypatch, capsys, tmp_path):
+    # the table said only "no_path" (exit 1) where the visibility graph finds 44.4 m:
+    # 1,000 samples missed 5 of 44 random pairs of the FCND city so
+    room = tmp_path / "room.csv"
+    room.write_text(ROOM)
+    common = [str(room), "--frame", "ned", "--start=5,-5", "--goal=-20,30", "--altitude", "5"]
+    code, out, _ = run(monkeypatch, capsys, "plan-world", *common, "--algorithm", "prm",
+                       "--samples", "20")
+    assert code == 1 and "no_path" in out
+    words = " ".join(out.replace("│", " ").split())  # the table's folded cell, one line
+    assert ("why the roadmap of 20 samples (seed 0) joins no path from start to goal; one "
+            "may still exist: more --samples, another --seed, or --algorithm visibility "
+            "(exact) may find it") in words, out
+    code, out, _ = run(monkeypatch, capsys, "plan-world", *common)
+    assert code == 0 and "44.405277 m" in out and "why" not in out

@@ -147,3 +147,46 @@ def test_a_point_in_metres_outside_a_boundary_names_the_ned_frame():
     with pytest.raises(QueryError, match=r"^start \(20.0000000, 80.0000000\) lies outside "
                                          r"the map .*'ned' frame$"):
         skyroute.plan(world, (20, 80), B)
+
+
+# -- at the FCND city's latitude the same slips are no place at all -------------------
+
+SF = "lat0 37.792480, lon0 -122.397450\nposX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n" \
+     "50,50,10,5,5,10\n-50,-50,10,5,5,10\n"
+SF_HOME, SF_GOAL = (-122.397450, 37.792480), (-122.396428, 37.795232)
+NOT_A_PLACE = ("is not a place: expected (lon, lat) degrees, lon in [-180, 180], lat in "
+               "[-90, 90]")
+
+
+@pytest.mark.parametrize("boundary, swapped", [
+    (None, "is one, within the 1,000 km a world with no boundary reaches"),
+    ("-122.41,37.78,-122.38,37.80", "is one, inside the map")])
+def test_a_point_that_is_no_place_says_what_it_likely_was(tmp_path, boundary, swapped):
+    # (lat, lon) from the colliders' "lat0, lon0" line, or FCND's (north, east) metres:
+    # at 37.8 N both are no place (lat -122.4, lat -180), and the error gave no hint
+    city = tmp_path / "sf.csv"
+    city.write_text(SF)
+    world = skyroute.load_world(city, altitude=5, safety=5, boundary=boundary)
+    with pytest.raises(QueryError) as err:
+        skyroute.plan(world, SF_HOME, SF_GOAL[::-1])
+    assert str(err.value) == (f"goal (37.79523, -122.3964) {NOT_A_PLACE}; (-122.3964280, "
+                              f"37.7952320) {swapped}: points are (lon, lat)")
+    with pytest.raises(QueryError) as err:
+        skyroute.plan(world, (120, -180), SF_GOAL)
+    assert str(err.value) == f"start (120, -180) {NOT_A_PLACE}{METRES_HINT}"
+    with pytest.raises(QueryError) as err:  # plainly nothing near: no hint
+        skyroute.plan(world, SF_HOME, (5e7, 5e7))
+    assert str(err.value) == f"goal (5e+07, 5e+07) {NOT_A_PLACE}"
+
+
+def test_cli_with_a_safety_margin_keeps_the_hint(monkeypatch, capsys, tmp_path):
+    # with --safety, the CLI converted a refused point again to see whether only the
+    # margin blocked it: "not a place" came back from that, without the hint
+    city = tmp_path / "sf.csv"
+    city.write_text(SF)
+    code, text, err = run(monkeypatch, capsys, "plan-world", str(city), "--altitude", "5",
+                          "--safety", "5", "--start=-122.397450,37.792480",
+                          "--goal=37.795232,-122.396428")
+    assert code == 2 and text == "" and err.count("\n") == 1
+    assert err.endswith("; (-122.3964280, 37.7952320) is one, within the 1,000 km a world "
+                        "with no boundary reaches: points are (lon, lat)\n"), err

@@ -396,7 +396,13 @@ class World:
         """One point in the world's frame -> its (2,) plane point when it is free, else a
         QueryError naming ``what`` that speaks in the world's frame and shows the point as
         given (not as it comes back from the plane: far from home a lon/lat does not)."""
-        p = self.to_plane(point, what)
+        try:
+            p = self.to_plane(point, what)
+        except QueryError as exc:  # "not a place": say what it likely was
+            hint = self._not_a_place_hint(point, what)
+            if not hint:
+                raise
+            raise QueryError(f"{exc}{hint}", param=what) from None
         if len(p) != 1:
             raise QueryError(f"{what} must be one point (a, b), got {len(p)} points",
                              param=what)
@@ -469,16 +475,17 @@ class World:
         (:meth:`_metres_hint`); '' when neither lies inside."""
         return self._swapped_hint(given) or self._metres_hint(given)
 
-    def _metres_hint(self, given) -> str:
+    def _metres_hint(self, given, *, far: bool = False) -> str:
         """'; ... 'ned' frame' when a point of the "lonlat" frame lies past the reach from
-        home as (lon, lat) but, read as (north, east) metres from home as FCND writes
-        points, would lie inside the map (with no boundary, within its reach); else ''.
-        ``--start 0,0`` (home, in metres) was refused as 5,965 km away, naming no way on;
-        a (lon, lat) near home but outside the map gets no such note."""
+        home as (lon, lat) (``far``: it is known to be no (lon, lat) at all) but, read as
+        (north, east) metres from home as FCND writes points, would lie inside the map
+        (with no boundary, within its reach); else ''. ``--start 0,0`` (home, in metres)
+        was refused as 5,965 km away, naming no way on; a (lon, lat) near home but
+        outside the map gets no such note."""
         if given is None or self.frame != "lonlat" or self.home is None:
             return ""
-        far = self._reach(given)
-        if far is None or far <= MAX_REACH:
+        reach = None if far else self._reach(given)
+        if not far and (reach is None or reach <= MAX_REACH):
             return ""
         north, east = np.asarray(given, dtype=float)
         if not max(abs(north), abs(east)) <= MAX_METRES:
@@ -491,10 +498,30 @@ class World:
         return ("; points are (lon, lat) here: (north, east) metres from home are the "
                 "'ned' frame")
 
-    def _swapped_hint(self, given) -> str:
+    def _not_a_place_hint(self, point, what: str) -> str:
+        """What a point of a lon/lat frame that is no place (|lat| > 90) was likely
+        meant as: its numbers swapped, (lat, lon) (:meth:`_swapped_hint`), else (north,
+        east) metres (:meth:`_metres_hint`); '' when neither lies in the map, or the
+        point is not one pair of numbers. A FCND student's likely slips, typed (lat, lon)
+        from the colliders' ``lat0, lon0`` line or (north, east) metres, are no place at
+        the FCND city's latitude (lat -122.4, or east beyond 90 m), and got no hint,
+        where the same slips near a higher latitude (Edinburgh) did."""
+        if self.frame not in ("lonlat", "degrees"):
+            return ""
+        try:
+            given = as_points(point, what)
+        except QueryError:
+            return ""
+        if len(given) != 1:
+            return ""
+        return self._swapped_hint(given[0], reach_text=True) or \
+            self._metres_hint(given[0], far=True)
+
+    def _swapped_hint(self, given, *, reach_text: bool = False) -> str:
         """'; ... (lon, lat)' when a lon/lat point outside the map (or, with no boundary,
         past its reach) would lie inside it (within it) with its two numbers swapped,
-        else ''."""
+        else ''. ``reach_text``: the point is no place at all, so the note says what
+        "it" is (the map, or the reach of a world with no boundary)."""
         if given is None or self.frame not in ("lonlat", "degrees"):
             return ""
         q = np.asarray(given, dtype=float)[::-1]
@@ -504,10 +531,13 @@ class World:
             far = self._reach(q)
             if far is None or far > MAX_REACH:
                 return ""
-            return f"; {self._fmt_frame(q)} is within it: points are (lon, lat)"
+            within = f"one, within the {MAX_REACH / 1000:,.0f} km a world with no " \
+                "boundary reaches" if reach_text else "within it"
+            return f"; {self._fmt_frame(q)} is {within}: points are (lon, lat)"
         if not self.inside(self.to_plane(q))[0]:
             return ""
-        return f"; {self._fmt_frame(q)} is inside: points are (lon, lat)"
+        inside = "one, inside the map" if reach_text else "inside"
+        return f"; {self._fmt_frame(q)} is {inside}: points are (lon, lat)"
 
     def _fmt(self, p) -> str:
         """A plane point as the caller wrote it: 7 decimals of a degree (about 1 cm) or cm."""
