@@ -310,3 +310,45 @@ def test_a_goal_within_a_step_is_no_moves_ending_at_the_start(offset):
         assert flight.then(plan_moves(w, s, (-3.1870, 55.9442))).end.tolist() != list(s)
     with pytest.raises(skyroute.QueryError, match="at="):
         Flight(np.empty((0, 2)), np.empty(0, int), np.empty((0, 2))).hover()
+
+
+def _grid_city(k: int) -> skyroute.World:
+    """k x k boxes of 1e-4 degrees, 3e-4 apart: 4 k^2 corners, more pairs than the step
+    drone tests one by one."""
+    from skyroute.world.world import World
+
+    boxes = [shapely.box(AT[0] + 3e-4 * a, AT[1] + 3e-4 * b, AT[0] + 3e-4 * a + 1e-4,
+                         AT[1] + 3e-4 * b + 1e-4) for a in range(k) for b in range(k)]
+    n = len(boxes)
+    return World(np.array(boxes, dtype=object), np.full(n, -np.inf), np.full(n, np.inf),
+                 tuple(f"box {i}" for i in range(n)), None, "degrees")
+
+
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")
+def test_a_city_of_corners_plans_from_the_visibility_graphs_table(monkeypatch):
+    # The corner table tested every pair of corners with shapely: the FCND city's 3,534
+    # corners (6.2 million pairs) ran 45 minutes and took 3 GB before the first move.
+    import skyroute.motion.step_drone as sd
+    from skyroute.world.world import World
+
+    start, goal = (AT[0] - 2e-4, AT[1] - 2e-4), (AT[0] + 2.8e-3, AT[1] + 2.6e-3)
+    tested = []
+    real_free = World.segments_free
+
+    def counting(self, a, b):
+        tested.append(len(np.atleast_2d(a)))
+        return real_free(self, a, b)
+
+    monkeypatch.setattr(World, "segments_free", counting)
+    city = _grid_city(9)
+    corners = 4 * 81
+    assert corners * (corners - 1) // 2 > sd.MAX_PAIRS
+    flight = plan_moves(city, start, goal)
+    assert flight.status is skyroute.Status.FOUND
+    assert sum(tested) < corners * (corners - 1) // 20  # no pair-by-pair table
+    monkeypatch.setattr(sd, "MAX_PAIRS", 10**9)  # the pair-by-pair table, as before
+    exact = plan_moves(_grid_city(9), start, goal)
+    assert flight.moves == exact.moves
+    lines = shapely.linestrings(np.stack([flight.frm, flight.to], axis=1))
+    boxes = city.obstacles[None, :]
+    assert (shapely.length(shapely.intersection(lines[:, None], boxes)) < 1e-12).all()

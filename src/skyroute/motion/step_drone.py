@@ -37,6 +37,7 @@ from skyroute.world.world import World
 STEP = 0.00015
 HOVER = -999
 ANGLES = np.arange(0, 360, 10)
+MAX_PAIRS = 50_000  # corner pairs tested one by one; more: the visibility graph's table
 MERGE = 5e-6  # positions in one lattice cell this wide (1/30 step) are one state
 _CORNER_GRAPHS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _ZONES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -140,12 +141,13 @@ class DistanceBound:
         self.world = world
         self.target = np.asarray(target, dtype=float)
         if world not in _CORNER_GRAPHS:
-            corners = convex_corners(world.merged())[0]
-            n = len(corners)
-            i, j = np.triu_indices(n, 1)
-            ok = world.segments_free(corners[i], corners[j]) if n else np.zeros(0, bool)
-            _CORNER_GRAPHS[world] = (corners, i[ok], j[ok])
-        self.corners, i, j = _CORNER_GRAPHS[world]
+            _CORNER_GRAPHS[world] = _corner_pairs(world)
+        table = _CORNER_GRAPHS[world]
+        if not isinstance(table, tuple):  # a city's: the visibility graph's corner table
+            self.corners = table.corners
+            self.dist = table.to(self.target) if len(self.corners) else np.zeros(0)
+            return
+        self.corners, i, j = table
         n = len(self.corners)
         sees = world.segments_free(np.broadcast_to(self.target, (n, 2)), self.corners) \
             if n else np.zeros(0, bool)
@@ -155,6 +157,27 @@ class DistanceBound:
                        np.vstack([self.corners, self.target])[cols]).T) + 1e-300
         graph = coo_matrix((w, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
         self.dist = dijkstra(graph, directed=False, indices=n)[:n] if n else np.zeros(0)
+
+
+def _corner_pairs(world: World):
+    """The convex corners and the free pairs among them, each pair tested by shapely: up
+    to :data:`MAX_PAIRS` pairs (the ILP map's zones have a few dozen corners). A city's
+    corners are too many for that (the FCND city: 3,534 corners, 6.2 million pairs at
+    about 0.4 ms each, 45 minutes and 3 GB before the first move): there the corner
+    table of :mod:`skyroute.motion.corner_distance` (the visibility graph's, compiled,
+    kept on disk) serves, and beyond its size no corners, the straight-line bound
+    (still a lower bound: A* stays exact, with more expansions)."""
+    from skyroute.motion.corner_distance import MAX_CORNERS, CornerGraph, corner_graph
+
+    corners = convex_corners(world.merged())[0]
+    n = len(corners)
+    if n * (n - 1) // 2 > MAX_PAIRS:
+        if n > MAX_CORNERS:
+            return CornerGraph(np.zeros((0, 2)), np.zeros((0, 0)), np.zeros((0, 4)))
+        return corner_graph(world)
+    i, j = np.triu_indices(n, 1)
+    ok = world.segments_free(corners[i], corners[j]) if n else np.zeros(0, bool)
+    return corners, i[ok], j[ok]
 
 
 def _bound(world: World, t: np.ndarray) -> DistanceBound:
