@@ -45,4 +45,3 @@ def exports(package: str, home: dict[str, str] | None = None) -> tuple[Callable,
         return sorted({*public, *modules(), *dunders})
 
     return __getattr__, __dir__
-

@@ -25,6 +25,7 @@ import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
+import shapely
 
 from skyroute.caches import register
 from skyroute.errors import OptionError, QueryError, check_instance, real, renamed, whole
@@ -37,7 +38,7 @@ from skyroute.world.world import World
 STEP = 0.00015
 HOVER = -999
 ANGLES = np.arange(0, 360, 10)
-MAX_PAIRS = 50_000  # corner pairs tested one by one; more: the visibility graph's table
+MAX_PAIRS = 50_000  # vertex pairs up to which corners are tested pair by pair
 MERGE = 5e-6  # positions in one lattice cell this wide (1/30 step) are one state
 _CORNER_GRAPHS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _ZONES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -160,21 +161,24 @@ class DistanceBound:
 
 
 def _corner_pairs(world: World):
-    """The convex corners and the free pairs among them, each pair tested by shapely: up
-    to :data:`MAX_PAIRS` pairs (the ILP map's zones have a few dozen corners). A city's
-    corners are too many for that (the FCND city: 3,534 corners, 6.2 million pairs at
-    about 0.4 ms each, 45 minutes and 3 GB before the first move): there the corner
-    table of :mod:`skyroute.motion.corner_distance` (the visibility graph's, compiled,
-    kept on disk) serves, and beyond its size no corners, the straight-line bound
-    (still a lower bound: A* stays exact, with more expansions)."""
-    from skyroute.motion.corner_distance import MAX_CORNERS, CornerGraph, corner_graph
+    """The convex corners and the free pairs among them, each pair tested by shapely,
+    where the obstacles' vertices make at most :data:`MAX_PAIRS` pairs (the ILP map's
+    zones have a few dozen corners). A city's corners are too many for that (the FCND
+    city: 3,534 corners, 6.2 million pairs at about 0.4 ms each, 45 minutes and 3 GB
+    before the first move): there the corner table of
+    :mod:`skyroute.motion.corner_distance` (the visibility graph's, compiled, kept on
+    disk) serves, and where that table refuses the world's size no corners, the
+    straight-line bound (still a lower bound: A* stays exact, with more expansions)."""
+    from skyroute.motion.corner_distance import CornerGraph, corner_graph
 
+    v = int(shapely.get_num_coordinates(world.obstacles).sum())  # >= the corners
+    if v * (v - 1) // 2 > MAX_PAIRS:
+        try:
+            return corner_graph(world)
+        except OptionError:  # more corners than its table holds
+            return CornerGraph(np.zeros((0, 2)), np.zeros((0, 0)), np.zeros((0, 4)))
     corners = convex_corners(world.merged())[0]
     n = len(corners)
-    if n * (n - 1) // 2 > MAX_PAIRS:
-        if n > MAX_CORNERS:
-            return CornerGraph(np.zeros((0, 2)), np.zeros((0, 0)), np.zeros((0, 4)))
-        return corner_graph(world)
     i, j = np.triu_indices(n, 1)
     ok = world.segments_free(corners[i], corners[j]) if n else np.zeros(0, bool)
     return corners, i[ok], j[ok]
