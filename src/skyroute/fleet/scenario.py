@@ -398,8 +398,8 @@ def _unique_keys_loader():
     """PyYAML's SafeLoader, refusing a key given twice in one mapping: it kept the last
     silently, so a second ``drones: 9`` further down overrode the first unseen. On
     LibYAML's parser where PyYAML has it (CSafeLoader: the same documents and marks;
-    the pure-Python parser took 4 s for a zone of 60,000 corners, and an error's line
-    is found by parsing the text again)."""
+    with the pure-Python parser a scenario of 120,000 corners took 9.5 s to be refused,
+    as an error's line is found by parsing the text again; 0.5 s so)."""
     import yaml
 
     class UniqueKeys(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
