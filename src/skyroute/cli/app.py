@@ -166,7 +166,7 @@ def console() -> None:
     objects, and the collector's 240 passes over them took 0.08-0.11 s of a cold plan,
     to free nothing the short-lived process needs back.
 
-    Once the command has ended, SIGINT and SIGTERM are ignored: its output is printed and
+    Once the command has ended, a first SIGINT or SIGTERM is ignored: its output is printed and
     its files written (or removed), and what is left is Python's teardown (0.3 s and
     more with numba, matplotlib or Dask loaded), in which a Ctrl-C printed a
     KeyboardInterrupt traceback from whatever ran (an atexit hook) or, later, killed the
