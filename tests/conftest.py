@@ -52,16 +52,26 @@ def _early_processes(request, tmp_path_factory, leg_cache):
     waits for its own through the ``early_process`` fixture. Their environment is
     ``os.environ`` as Python holds it: a library loaded in this process sets COLUMNS=80
     and LINES=24 in the C environment (not in ``os.environ``), which a child inherits
-    by default and which the CLI's tables honour."""
+    by default and which the CLI's tables honour. Under pytest-xdist a worker does not
+    know which tests it will be sent, so there each process starts when its test asks
+    for it (the other worker is the second core then)."""
     started = {}
-    for item in request.session.items:
+    xdist_worker = hasattr(request.config, "workerinput")
+    for item in () if xdist_worker else request.session.items:
         mark = item.get_closest_marker("early_process")
         if mark is not None and item.get_closest_marker("skip") is None:
             cwd = tmp_path_factory.mktemp("process")
-            started[item.nodeid] = cwd, subprocess.Popen(
-                [sys.executable, *mark.args], cwd=cwd, stdout=subprocess.PIPE,
-                stderr=subprocess.PIPE, text=True, env=dict(os.environ))
+            started[item.nodeid] = cwd, _start(mark.args, cwd)
     yield started
+    _stop(started)
+
+
+def _start(args, cwd: Path) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, *args], cwd=cwd, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=dict(os.environ))
+
+
+def _stop(started: dict) -> None:
     for _, proc in started.values():  # a test that never ran (-x, Ctrl-C): stop its process
         if proc.poll() is None:
             proc.kill()
@@ -69,8 +79,12 @@ def _early_processes(request, tmp_path_factory, leg_cache):
 
 
 @pytest.fixture
-def early_process(request, _early_processes):
+def early_process(request, _early_processes, tmp_path_factory):
     """(exit code, stdout, stderr, folder) of this test's ``early_process``, once it ends."""
+    if request.node.nodeid not in _early_processes:  # an xdist worker: start it now
+        cwd = tmp_path_factory.mktemp("process")
+        mark = request.node.get_closest_marker("early_process")
+        _early_processes[request.node.nodeid] = cwd, _start(mark.args, cwd)
     cwd, proc = _early_processes[request.node.nodeid]
     out, err = proc.communicate(timeout=300)
     return proc.returncode, out, err, cwd
