@@ -29,7 +29,7 @@ import shapely
 
 from skyroute.caches import register
 from skyroute.errors import OptionError, QueryError, check_instance, real, renamed, whole
-from skyroute.motion import move_search
+from skyroute.motion import edge_grid, move_search
 from skyroute.motion.zone_kernels import zone_arrays
 from skyroute.result import FOUND, STATUS_OF_CODE, Status
 from skyroute.world.geometry import convex_corners
@@ -196,11 +196,12 @@ def _bound(world: World, t: np.ndarray) -> DistanceBound:
 
 
 def _zones(world: World) -> tuple:
-    """The compiled kernels' view of the zones (cached per world)."""
+    """The compiled kernels' view of the zones (cached per world): edges, owner, zone
+    count, boundary edges, and the edges' bucket grid (meta, start, ids)."""
     z = _ZONES.get(world)
     if z is None:
         edges, owner, bedges = zone_arrays(world)
-        z = _ZONES[world] = (edges, owner, len(world.obstacles), bedges)
+        z = _ZONES[world] = (edges, owner, len(world.obstacles), bedges, *edge_grid.build(edges))
     return z
 
 
