@@ -23,9 +23,11 @@ from numba import njit
 SLACK = 1e-6  # of a cell: the padding that absorbs rounding in the bucket arithmetic
 
 
-def build(edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(meta, start, ids) for ``edges`` (E, 4): about one bucket per edge, square buckets
-    no smaller than the edges' mean length over four (so an edge spans a few buckets)."""
+def build(edges: np.ndarray, cell: float | None = None
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(meta, start, ids) for ``edges`` (E, 4): by default about one bucket per edge,
+    square buckets no smaller than the edges' mean length over four (so an edge spans a
+    few buckets), at most 4,096 across; or buckets ``cell`` wide."""
     e = np.ascontiguousarray(edges, dtype=float).reshape(-1, 4)
     if len(e) == 0:
         return np.array([0.0, 0.0, 1.0, 1.0, 1.0]), np.zeros(2, np.int64), np.zeros(0, np.int64)
@@ -33,7 +35,9 @@ def build(edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     hi = np.maximum(e[:, :2], e[:, 2:]).max(axis=0)
     w, h = hi - lo
     mean = float(np.hypot(e[:, 2] - e[:, 0], e[:, 3] - e[:, 1]).mean())
-    cell = max(math.sqrt(max(w * h, 1e-300) / len(e)), mean / 4, max(w, h) / 4096, 1e-300)
+    if cell is None:
+        cell = max(math.sqrt(max(w * h, 1e-300) / len(e)), mean / 4, max(w, h) / 4096,
+                   1e-300)
     cell = float(cell)
     x0, y0 = lo[0] - cell / 2, lo[1] - cell / 2
     nx = math.floor((w + cell) / cell) + 1
