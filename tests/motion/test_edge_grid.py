@@ -60,6 +60,6 @@ def test_points_and_segments_off_the_grid_meet_no_edge():
 def test_an_edge_is_listed_only_in_the_buckets_it_passes():
     # a diagonal across a 10 x 10 grid: about 2 * 10 buckets, not the 100 of its box
     edges = np.array([[0.0, 0.0, 10.0, 10.0], [0.0, 10.0, 0.5, 10.0]])
-    meta, start, ids = edge_grid.build(edges, 1.0)
+    meta, _, ids = edge_grid.build(edges, 1.0)
     assert int(meta[3]) * int(meta[4]) >= 100
     assert np.count_nonzero(ids == 0) <= 40

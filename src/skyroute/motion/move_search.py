@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, types
+from numba import njit, objmode, types
 from numba.typed import Dict
 
 from skyroute.motion.zone_kernels import crosses, expand, sight
@@ -22,6 +22,12 @@ from skyroute.search import heap
 
 _TIE = (1 << 20) - 1
 _HALF = 1 << 31
+_POLL = 4096  # expansions between two returns to the interpreter (for Ctrl-C)
+
+
+def _poll() -> None:
+    """Called from the compiled search now and then: the interpreter runs a pending
+    signal's handler here (Ctrl-C raises KeyboardInterrupt out of the search)."""
 
 
 @njit(cache=True)
@@ -154,6 +160,9 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, meta, st
                 size += 1
                 continue
         closed[i] = True
+        if expanded % _POLL == _POLL - 1:
+            with objmode():
+                _poll()
         if expanded >= max_expansions:
             return BUDGET_EXHAUSTED, -1, expanded, x[:n], y[:n], parent[:n], move[:n]
         expanded += 1
