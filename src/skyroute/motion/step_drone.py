@@ -218,7 +218,7 @@ def default_budget(world: World, merge: float = MERGE) -> int:
     state its search can hold (the ``merge``-wide lattice cells of the boundary's box:
     a state is expanded once, so the search ends found or no_path), at most
     :data:`MAX_BUDGET`; without a boundary :data:`UNBOUNDED_BUDGET`. The ILP area at the
-    default merge: 1,181,568 (1,632 x 724 cells)."""
+    default merge: 1,183,200 (1,632 x 725 cells)."""
     if world.boundary is None:
         return UNBOUNDED_BUDGET
     x0, y0, x1, y1 = shapely.Polygon(world.boundary).bounds
