@@ -3,6 +3,7 @@
 import functools
 import json
 import math
+import os
 from collections import deque
 
 import numpy as np
@@ -179,8 +180,9 @@ def test_heuristic_never_exceeds_the_moves_left(world, places, u, v, k):
     t = np.array(list(places.values())[k])
     table = DistanceBound(world, t)
     sees = bool(world.segments_free([q], [t])[0])
+    z = _zones(world)
     h = move_search.bound(q[0], q[1], sees, t[0], t[1], table.corners, table.dist,
-                          _zones(world)[0], STEP)
+                          z[0], *z[4:], STEP)
     d = shortest_distance(q, t)
     assert h <= max(0, math.ceil(d / STEP - 1 + 1e-9))
 
@@ -210,6 +212,62 @@ def test_every_move_between_random_points_is_legal(world, u0, v0, u1, v1, behind
     assert_legal(flight.hover(), start)
     assert math.dist(flight.end, goal) < STEP
     assert flight.moves * STEP > shortest_distance(start, goal) - STEP - 1e-12
+
+
+HARD = (_area_point(0.75, 0.75), _area_point(0.1875, 0.5))
+
+
+def test_a_pair_past_200000_expansions_is_found_within_the_default_budget(world):
+    # The way west between the buildings is 31.35 steps long but no flight of steps
+    # passes it; the fewest moves go round (36), and A* must expand every state with
+    # f < 36 first: 215,220 expansions. The default budget was 200,000
+    # (budget_exhausted); it is now every state of the area's merge lattice.
+    start, goal = HARD
+    flight = plan_moves(world, start, goal)
+    assert flight.status is skyroute.Status.FOUND
+    assert flight.expanded > 200_000
+    assert_legal(flight.hover(), start)
+    assert math.dist(flight.end, goal) < STEP
+    assert flight.moves * STEP > shortest_distance(start, goal) - STEP - 1e-12
+
+
+def test_default_budget_is_every_state_of_a_bounded_world(world):
+    from skyroute.motion.step_drone import MERGE, UNBOUNDED_BUDGET, default_budget
+
+    assert default_budget(world) >= (AREA[2] - AREA[0]) / MERGE * (AREA[3] - AREA[1]) / MERGE
+    assert default_budget(_grid_city(2)) == UNBOUNDED_BUDGET  # no boundary: no such count
+    tiny = plan_moves(world, AT, (-3.1913, 55.9455), max_expansions=None)
+    assert tiny.found
+
+
+def test_ctrl_c_stops_a_long_search_inside_the_compiled_loop(world):
+    import signal
+    import threading
+    import traceback
+
+    class SigintError(Exception):
+        pass
+
+    armed = [True]
+
+    def handler(signum, frame):
+        if armed[0]:
+            raise SigintError
+
+    plan_moves(world, AT, (-3.1913, 55.9455))  # compiled and the corner table built
+    old = signal.signal(signal.SIGINT, handler)
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    try:
+        timer.start()
+        with pytest.raises(SigintError) as caught:
+            plan_moves(world, *HARD)
+    finally:
+        armed[0] = False
+        timer.cancel()
+        timer.join()
+        signal.signal(signal.SIGINT, old)
+    # raised from the search's poll, not after the search returned
+    assert traceback.extract_tb(caught.value.__traceback__)[-2].name == "_poll"
 
 
 def test_statuses_and_bad_frame(world):
@@ -262,7 +320,7 @@ def _degrees_square() -> skyroute.World:
 
 @pytest.mark.parametrize("kw", [{"step": 0}, {"step": "x"}, {"step": math.nan},
                                 {"step": -STEP}, {"max_expansions": "5"},
-                                {"max_expansions": None}, {"max_expansions": 5.5},
+                                {"max_expansions": 5.5},
                                 {"max_expansions": -1}, {"merge": "x"}])
 def test_plan_moves_names_a_bad_option(kw):
     # step=0 was a ZeroDivisionError, "5" a numba TypingError, NaN and -STEP "no_path"

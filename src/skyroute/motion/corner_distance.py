@@ -22,6 +22,7 @@ and 5 m safety, 1,128 corners, took 68 s through shapely's test pair by pair and
 
 from __future__ import annotations
 
+import functools
 import math
 import weakref
 from dataclasses import dataclass
@@ -29,8 +30,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from skyroute.motion import edge_grid
 from skyroute.motion.move_search import _sight
-from skyroute.motion.zone_kernels import zone_arrays
+from skyroute.motion.zone_kernels import sight, zone_arrays
 from skyroute.world.world import World
 
 MAX_CORNERS = 5_000  # the FCND city has 3,347
@@ -46,11 +48,16 @@ class CornerGraph:
     adjacency: np.ndarray
     edges: np.ndarray
 
+    @functools.cached_property
+    def grid(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The edges' bucket grid (:mod:`skyroute.motion.edge_grid`), built on first use."""
+        return edge_grid.build(self.edges)
+
     def to(self, target) -> np.ndarray:
         """(N,) shortest distance from each corner to ``target`` (inf: unreachable)."""
         t = np.asarray(target, dtype=float).reshape(2)
         return target_distances(float(t[0]), float(t[1]), self.corners, self.adjacency,
-                                self.edges)
+                                self.edges, *self.grid)
 
 
 def corner_graph(world: World) -> CornerGraph:
@@ -88,13 +95,14 @@ def _build(world: World) -> CornerGraph:
 
 
 @njit(cache=True)
-def target_distances(tx, ty, corners, adj, edges):
-    """Dense Dijkstra from the target over the corners (O(N^2), no heap)."""
+def target_distances(tx, ty, corners, adj, edges, meta, start, ids):
+    """Dense Dijkstra from the target over the corners (O(N^2), no heap); which corners
+    the target sees through the edges' bucket grid (meta, start, ids)."""
     n = corners.shape[0]
     dist = np.full(n, np.inf)
     done = np.zeros(n, np.bool_)
     for c in range(n):
-        if _sight(tx, ty, corners[c, 0], corners[c, 1], edges):
+        if sight(tx, ty, corners[c, 0], corners[c, 1], edges, meta, start, ids):
             dist[c] = math.hypot(tx - corners[c, 0], ty - corners[c, 1])
     for _ in range(n):
         u = -1

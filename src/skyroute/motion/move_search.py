@@ -13,15 +13,21 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, types
+from numba import njit, objmode, types
 from numba.typed import Dict
 
-from skyroute.motion.zone_kernels import crosses, expand
+from skyroute.motion.zone_kernels import crosses, expand, sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
 
 _TIE = (1 << 20) - 1
 _HALF = 1 << 31
+_POLL = 4096  # expansions between two returns to the interpreter (for Ctrl-C)
+
+
+def _poll() -> None:
+    """Called from the compiled search now and then: the interpreter runs a pending
+    signal's handler here (Ctrl-C raises KeyboardInterrupt out of the search)."""
 
 
 @njit(cache=True)
@@ -34,28 +40,54 @@ def _sight(qx, qy, vx, vy, edges):
 
 
 @njit(cache=True)
-def distance(qx, qy, sees, tx, ty, corners, cdist, edges):
-    """A lower bound on the obstacle-avoiding distance from q to the target.
+def distance(qx, qy, sees, tx, ty, corners, cdist, edges, meta, start, ids):
+    """A lower bound on the obstacle-avoiding distance from q to the target; (meta, start,
+    ids) the edges' bucket grid (:mod:`skyroute.motion.edge_grid`).
 
     The straight distance when q sees the target, else min over the corners q sees of
     |q - v| + D(v), D the corner's shortest distance to the target: every path from q
-    bends first at a corner in sight. Corners are tried cheapest first, so usually the
-    first sight test settles it.
+    bends first at a corner in sight. Corners are tried cheapest first (a binary heap of
+    their values: a city's point may test hundreds of its thousands of corners before one
+    is in sight), so usually the first sight test settles it.
     """
     d = math.hypot(qx - tx, qy - ty)
     if not sees and corners.shape[0]:
         vals = np.empty(corners.shape[0])
+        order = np.empty(corners.shape[0], np.int64)
+        n = 0
         for c in range(corners.shape[0]):
-            vals[c] = math.hypot(qx - corners[c, 0], qy - corners[c, 1]) + cdist[c]
-        for _ in range(corners.shape[0]):
-            c = np.argmin(vals)
-            if not vals[c] < np.inf:
+            v = math.hypot(qx - corners[c, 0], qy - corners[c, 1]) + cdist[c]
+            if v < np.inf:
+                vals[n], order[n] = v, c
+                n += 1
+        for i in range(n // 2 - 1, -1, -1):
+            _sift_down(vals, order, i, n)
+        while n > 0:
+            v, c = vals[0], order[0]
+            if sight(qx, qy, corners[c, 0], corners[c, 1], edges, meta, start, ids):
+                d = max(d, v)
                 break
-            if _sight(qx, qy, corners[c, 0], corners[c, 1], edges):
-                d = max(d, vals[c])
-                break
-            vals[c] = np.inf
+            n -= 1
+            vals[0], order[0] = vals[n], order[n]
+            _sift_down(vals, order, 0, n)
     return d
+
+
+@njit(cache=True, inline="always")
+def _sift_down(vals, order, i, n):
+    """Restore the min-heap on vals[:n] (order alongside) below slot i."""
+    v, c = vals[i], order[i]
+    while True:
+        k = 2 * i + 1
+        if k >= n:
+            break
+        if k + 1 < n and vals[k + 1] < vals[k]:
+            k += 1
+        if not vals[k] < v:
+            break
+        vals[i], order[i] = vals[k], order[k]
+        i = k
+    vals[i], order[i] = v, c
 
 
 @njit(cache=True)
@@ -67,14 +99,15 @@ def moves_left(d, step):
 
 
 @njit(cache=True)
-def bound(qx, qy, sees, tx, ty, corners, cdist, edges, step):
+def bound(qx, qy, sees, tx, ty, corners, cdist, edges, meta, start, ids, step):
     """:func:`moves_left` of :func:`distance`: A*'s heuristic."""
-    return moves_left(distance(qx, qy, sees, tx, ty, corners, cdist, edges), step)
+    return moves_left(distance(qx, qy, sees, tx, ty, corners, cdist, edges, meta, start, ids),
+                      step)
 
 
 @njit(cache=True)
-def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners, cdist,
-           step, merge, max_expansions, eps):
+def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, meta, start, ids,
+           corners, cdist, step, merge, max_expansions, eps):
     """A* from (sx, sy) to closer than ``step`` to (tx, ty).
 
     The heuristic is evaluated lazily: a new state gets the cheap bound max(|q - t|,
@@ -98,7 +131,7 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
     hn = np.empty(cap, np.int64)
     seen = Dict.empty(key_type=types.int64, value_type=types.int64)
     x[0], y[0], parent[0], move[0], g[0] = sx, sy, -1, -1, 0
-    dist[0] = distance(sx, sy, sees0, tx, ty, corners, cdist, edges)
+    dist[0] = distance(sx, sy, sees0, tx, ty, corners, cdist, edges, meta, start, ids)
     exact[0] = True
     n = 1
     seen[np.int64(_HALF) * (1 << 32) + _HALF] = 0
@@ -116,8 +149,9 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
             return FOUND, i, expanded, x[:n], y[:n], parent[:n], move[:n]
         if not exact[i]:
             exact[i] = True
-            sees = _sight(x[i], y[i], tx, ty, edges)
-            dist[i] = max(dist[i], distance(x[i], y[i], sees, tx, ty, corners, cdist, edges))
+            sees = sight(x[i], y[i], tx, ty, edges, meta, start, ids)
+            dist[i] = max(dist[i], distance(x[i], y[i], sees, tx, ty, corners, cdist, edges,
+                                            meta, start, ids))
             f = g[i] + moves_left(dist[i], step)
             if f > (top >> 20):
                 if size + 1 > hk.shape[0]:
@@ -126,10 +160,14 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, corners,
                 size += 1
                 continue
         closed[i] = True
+        if expanded % _POLL == _POLL - 1:
+            with objmode():
+                _poll()
         if expanded >= max_expansions:
             return BUDGET_EXHAUSTED, -1, expanded, x[:n], y[:n], parent[:n], move[:n]
         expanded += 1
-        ok, _ = expand(x[i], y[i], deltas, tx, ty, edges, owner, nzones, bedges, eps, False)
+        ok, _ = expand(x[i], y[i], deltas, tx, ty, edges, owner, nzones, bedges, meta, start,
+                       ids, eps, False)
         gi = g[i] + 1
         for k in range(deltas.shape[0]):
             if not ok[k]:

@@ -29,7 +29,7 @@ import shapely
 
 from skyroute.caches import register
 from skyroute.errors import OptionError, QueryError, check_instance, real, renamed, whole
-from skyroute.motion import move_search
+from skyroute.motion import edge_grid, move_search
 from skyroute.motion.zone_kernels import zone_arrays
 from skyroute.result import FOUND, STATUS_OF_CODE, Status
 from skyroute.world.geometry import convex_corners
@@ -40,6 +40,8 @@ HOVER = -999
 ANGLES = np.arange(0, 360, 10)
 MAX_PAIRS = 50_000  # vertex pairs up to which corners are tested pair by pair
 MERGE = 5e-6  # positions in one lattice cell this wide (1/30 step) are one state
+UNBOUNDED_BUDGET = 200_000  # plan_moves' default expansions in a world without a boundary
+MAX_BUDGET = 2_000_000  # and at most this many in one with a boundary
 _CORNER_GRAPHS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _ZONES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _BOUNDS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -196,11 +198,12 @@ def _bound(world: World, t: np.ndarray) -> DistanceBound:
 
 
 def _zones(world: World) -> tuple:
-    """The compiled kernels' view of the zones (cached per world)."""
+    """The compiled kernels' view of the zones (cached per world): edges, owner, zone
+    count, boundary edges, and the edges' bucket grid (meta, start, ids)."""
     z = _ZONES.get(world)
     if z is None:
         edges, owner, bedges = zone_arrays(world)
-        z = _ZONES[world] = (edges, owner, len(world.obstacles), bedges)
+        z = _ZONES[world] = (edges, owner, len(world.obstacles), bedges, *edge_grid.build(edges))
     return z
 
 
@@ -210,8 +213,22 @@ def _coarse(p: np.ndarray, step: float) -> tuple[int, int]:
     return round(p[0] / (step / 3)), round(p[1] / (step / 3))
 
 
+def default_budget(world: World, merge: float = MERGE) -> int:
+    """plan_moves' expansion budget when none is given: in a world with a boundary, every
+    state its search can hold (the ``merge``-wide lattice cells of the boundary's box:
+    a state is expanded once, so the search ends found or no_path), at most
+    :data:`MAX_BUDGET`; without a boundary :data:`UNBOUNDED_BUDGET`. The ILP area at the
+    default merge: 1,183,200 (1,632 x 725 cells)."""
+    if world.boundary is None:
+        return UNBOUNDED_BUDGET
+    x0, y0, x1, y1 = shapely.Polygon(world.boundary).bounds
+    cells = (math.floor((x1 - x0) / merge) + 2) * (math.floor((y1 - y0) / merge) + 2)
+    return int(min(cells, MAX_BUDGET))
+
+
 def plan_moves(world: World, start, goal=None, *, step: float = STEP,
-               max_expansions: int = 200_000, merge: float = MERGE, target=None) -> Flight:
+               max_expansions: int | None = None, merge: float = MERGE,
+               target=None) -> Flight:
     """The fewest moves from ``start`` to a position strictly closer than ``step`` to
     ``goal`` (A* over positions reachable by steps; positions in one ``merge``-wide
     lattice cell are one state, which on the ILP map gives the same move counts as
@@ -220,16 +237,20 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     h = max(0, ceil(d / step - 1)) where d is a lower bound on the obstacle-avoiding
     distance to the goal (:class:`DistanceBound`): admissible, since each move covers
     at most ``step`` and the flight may stop within ``step`` of the goal. Ties go to
-    the deeper node. No path is a status, not an exception. The whole search is one
-    compiled call (:mod:`skyroute.motion.move_search`).
+    the deeper node. No path is a status, not an exception, and so is running out of
+    ``max_expansions`` (None: :func:`default_budget`, which in a bounded world such as
+    the ILP area lets the search run until it ends; a fixed 200,000 ran out on a legal
+    pair there that needs 215,220). The whole search is one compiled call
+    (:mod:`skyroute.motion.move_search`), which Ctrl-C interrupts.
     """
     _check_world(world)
     goal = renamed("goal", goal, "target", target)
     if goal is None:
         raise OptionError("plan_moves needs a goal", param="goal")
     step = real("step", step, low=0.0, strict=True)
-    max_expansions = whole("max_expansions", max_expansions, low=0)
     merge = real("merge", merge, low=0.0, strict=True)
+    max_expansions = default_budget(world, merge) if max_expansions is None else \
+        whole("max_expansions", max_expansions, low=0)
     t0 = time.perf_counter()
     s = world.check_point(start, "start")
     t = world.to_plane(goal, "goal")
