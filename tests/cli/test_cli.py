@@ -147,6 +147,12 @@ def test_a_walls_cell_within_the_margin_is_named_so(monkeypatch, capsys, tmp_pat
 @pytest.mark.parametrize("args, words", [
     (["plan", "den312d", "--start", "0,0", "--goal", "60,13"], "start (0, 0) is on a blocked"),
     (["plan", "den312d", "--start", "50,76", "--goal", "99,9"], "goal (99, 9) lies outside"),
+    # a cell typed (row, column), numpy's order: the swapped cell is on the map, and the
+    # error says so (a lon/lat world says it of (lat, lon)); a cell off the map either
+    # way gets no hint (above)
+    (["plan", "den312d", "--start", "76,50", "--goal", "60,13"], "error: start (76, 50) lies "
+     "outside the 65x81 grid (x in 0..64, y in 0..80); (50, 76) is inside: cells are "
+     "(x, y) = (column, row)\n"),
     (["plan", "nope.map", "--start", "0,0", "--goal", "1,1"], "nope.map: no such file"),
     # a cell the map has free, blocked by the margin alone: it read "is on a blocked cell"
     (["plan", *QUERY, "--safety", "3"], "error: start (50, 76) is free in den312d.map but "

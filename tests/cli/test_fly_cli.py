@@ -445,3 +445,39 @@ def test_lattice_default_speed_in_the_degrees_frame_is_1_m_per_s(monkeypatch, ca
     assert code == 0, err
     m = _strict(text)["metrics"]
     assert m["time"] >= m["length"] * 111_000  # degrees over 1/111,341 degrees a second
+
+
+WALL = ("lat0 55.9, lon0 -3.1\nposX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n"
+        "0,0,10,1,500,10\n")  # a wall 2 m thick across the whole boundary box below
+WALLED = ["--frame", "ned", "--start", "5,0", "--boundary=-3.1010,55.8995,-3.0990,55.9005"]
+
+
+@pytest.mark.parametrize("args, status", [
+    (["--vehicle", "dubins", "--goal=-5,0"], "no_path"),
+    (["--vehicle", "dubins", "--planner", "waypoints", "--goal=-5,0"], "no_path"),
+    (["--vehicle", "dubins", "--targets", "TARGETS"], "no_path"),
+    (["--vehicle", "lattice", "--goal=-5,0"], "no_path"),
+])
+def test_a_flight_not_found_says_its_status_and_prints_no_infinity(monkeypatch, capsys,
+                                                                   tmp_path, args, status):
+    """A goal behind a wall that closes the boundary: the table read "length inf m"
+    (and a tour's "greedy bound inf m", "bound inf m" and an empty "order"), and the
+    lattice and the waypoints planner gave no status at all, only a why ("no lattice
+    route: no_path"). Each now reports its status, in the table and in --json, and the
+    table leaves out what a flight not found has no value for (--json: null)."""
+    world = tmp_path / "wall.csv"
+    world.write_text(WALL)
+    targets = tmp_path / "targets.csv"
+    targets.write_text("north,east\n20,0\n-20,0\n")  # the second behind the wall
+    args = [str(targets) if a == "TARGETS" else a for a in args]
+    code, text, err = run(monkeypatch, capsys, "fly", str(world), *WALLED, *args)
+    assert code == 1, err
+    rows = {line.split("│")[1].strip(): line.split("│")[2].strip()
+            for line in text.splitlines() if line.count("│") == 3}
+    assert rows["status"] == status and rows["reached"] == "False"
+    assert not any(v == "" or "inf" in v.split() for v in rows.values()), rows
+    code, text, err = run(monkeypatch, capsys, "fly", str(world), *WALLED, *args, "--json")
+    assert code == 1, err
+    doc = json.loads(text)
+    assert doc["reached"] is False and doc["metrics"]["status"] == status
+    assert "length" not in doc["metrics"] or doc["metrics"]["length"] is None

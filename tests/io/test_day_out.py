@@ -127,3 +127,28 @@ def test_an_invalid_order_is_not_a_customer(site, orders):
     day = a_day(site, only, delivered=[], invalid=only)
     assert day_out.customer_places(site, day) == {"served": {}, "partly served": {},
                                                  "not served": {}}
+
+
+def test_the_title_says_a_day_without_orders_or_valid_orders_and_moves_as_the_table(
+        site, orders, figures, tmp_path):
+    """An empty day's picture read "0/0 orders, no orders, 0 moves"; one whose orders
+    were all invalid "0/N orders, no orders"; and a day of 1,442 moves "1442 moves"
+    under a table that prints "1,442"."""
+    every = [o for os in orders.values() for o in os]
+    empty = np.empty((0, 2))
+    still = DayFlight(Flight(empty, np.empty(0, int), empty.copy()), ())
+    n = 1200
+    lon = np.linspace(-3.169, -3.163, n + 1)
+    path = np.c_[lon, np.full(n + 1, 55.971)]
+    flown = DayFlight(Flight(path[:-1], np.zeros(n, int), path[1:]), ())
+    days = [DayResult(DAY, [], [], [], still, money_placed=0),
+            DayResult(DAY, every, [(o, "made up") for o in every], [], still, money_placed=0),
+            DayResult(DAY, every, [], [price(site, o) for o in every], flown,
+                      money_placed=sum(price(site, o).cost for o in every))]
+    for i, result in enumerate(days):
+        day_out.plot_day(site, result, tmp_path / f"d{i}.png")
+    titles = [fig.axes[0].get_title().replace("\n", ", ") for fig in figures]
+    assert titles == ["Delivery day 03 Jan 2024: no orders stored, nothing flown",
+                      f"Delivery day 03 Jan 2024: 0/{len(every)} orders, none valid, 0 moves",
+                      f"Delivery day 03 Jan 2024: {len(every)}/{len(every)} orders, 100.0% "
+                      "of the money, 1,200 moves"]

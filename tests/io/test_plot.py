@@ -88,6 +88,23 @@ def test_the_grid_title_gives_the_cost_s_unit(figures, tmp_path, resolution, cos
         f"row: astar, {cost}, {result.expanded:,} expanded"
 
 
+@pytest.mark.parametrize("shape", [(12, 22), (4, 12), (81, 65)])
+def test_grid_ticks_are_whole_cells(figures, tmp_path, shape):
+    """A cell is a whole (x, y): the ticks of a small map read 2.5, 7.5, 12.5, ... (the
+    22x12 raster of two 10 m walls at 0.5 m, `plan walls.csv --resolution 0.5 --plot`),
+    places no cell is. Every tick is a whole number, on the map's axes."""
+    grid = Grid(np.zeros(shape, dtype=bool), name="small")
+    h, w = shape
+    result = skyroute.plan(grid, (0, 0), (w - 1, h - 1))
+    plot_grid_path(grid, result, (0, 0), (w - 1, h - 1), tmp_path / "p.png")
+    ax = figures[0].axes[0]
+    drawn(figures[0])
+    for ticks, (lo, hi) in ((ax.get_xticks(), ax.get_xlim()),
+                            (ax.get_yticks(), sorted(ax.get_ylim()))):
+        shown = [t for t in ticks if lo <= t <= hi]
+        assert len(shown) >= 2 and all(float(t).is_integer() for t in shown), ticks
+
+
 def test_grid_picture_pixels_follow_the_map_size(tmp_path):
     """A 512x512 map gets about 4 pixels a cell (it was a 1,000-pixel thumbnail, 2 a
     cell, the maze's corridors lost under the path); a 32x32 map stays small."""

@@ -478,3 +478,21 @@ def test_a_grids_cells_cannot_be_made_writeable_again():
     b = g.blocked.copy()
     b[:4, 2] = True
     assert skyroute.plan(Grid(b), (0, 0), (4, 4)).cost == pytest.approx(6 + np.sqrt(2))
+
+
+@pytest.mark.parametrize("start, hint", [
+    ((4, 1), "; (1, 4) is inside: cells are (x, y) = (column, row)"),  # (row, column)
+    ((4, 4), ""),  # off the grid either way: nothing to suggest
+    ((1, 7), ""),
+    ((-1, 2), ""),
+])
+def test_a_cell_off_the_grid_says_when_it_is_on_it_swapped(start, hint):
+    """A cell typed (row, column), numpy's order, lies off a grid that is not square
+    where (column, row) lies on it; the error says so, as a lon/lat World says it of
+    (lat, lon). A cell off the grid either way gets no hint."""
+    grid = Grid(np.zeros((6, 3), bool))  # 3 wide, 6 high
+    with pytest.raises(skyroute.QueryError) as err:
+        skyroute.plan(grid, start, (0, 0))
+    x, y = start
+    assert str(err.value) == (f"start ({x}, {y}) lies outside the 3x6 grid (x in 0..2, "
+                              f"y in 0..5){hint}")

@@ -255,10 +255,13 @@ def metric_label(name: str) -> str:
 
 def metrics_table(title: str, doc: dict, plane_unit: str) -> Table:
     """The table ``fly`` prints: each metric by its label (:func:`metric_label`) and
-    value (:func:`_shown`), then whether the goal was reached."""
+    value (:func:`_shown`), then whether the goal was reached. A metric a flight not
+    found has no value for (its length and bounds are infinite, ``null`` in ``--json``;
+    a tour's order is empty) is left out, as ``plan-world`` leaves out a cost it did not
+    find: the table read "length inf m" and an empty "order" row."""
     table = Table(title=title, show_header=False)
     for k, v in doc["metrics"].items():
-        if k != "reached":
+        if k != "reached" and not _no_value(v):
             table.add_row(metric_label(k), _shown(k, v, plane_unit))
     table.add_row("reached", str(doc["reached"]))
     return table
@@ -271,6 +274,11 @@ METRIC_UNITS = {"length": "plane", "bound": "plane", "greedy_bound": "plane",
 # Decimals by unit, as the other tables have them: lengths as plan-world's cost (6),
 # seconds to the millisecond, smoothness to 1e-4 rad
 DECIMALS = {"m": 6, "deg": 6, "s": 3, "rad/move": 4}
+
+
+def _no_value(value) -> bool:
+    """True for a metric with nothing to show: a float that is not finite, or ''."""
+    return value == "" or (isinstance(value, float) and not math.isfinite(value))
 
 
 def _shown(name: str, value, plane_unit: str) -> str:
@@ -470,8 +478,8 @@ def _fly_dubins(world, s, t, radius, h0, h1, step):
     from skyroute.motion.dubins import through
 
     route = plan(world, s, t)
-    if not route.found:
-        return _not_reached("no route between start and goal"), [], np.array([s])
+    if not route.found:  # the exact route's status, as the other vehicles report theirs
+        return _not_reached(route.status), [], np.array([s])
     corners = world.to_plane(route.path)
     if len(corners) == 1:  # start == goal: still one Dubins path, between the two headings
         corners = np.repeat(corners, 2, axis=0)
@@ -496,7 +504,7 @@ def _fly_lattice(world, s, t, headings, speed, rate, h0, resolution):
     res = plan_turns_world(world, s, t, resolution=resolution, headings=headings,
                            speed=speed, turn_rate=rate, start_heading=h0)
     if not res.found:
-        return _not_reached(f"no lattice route: {res.status.value}"), [], np.array([s])
+        return _not_reached(res.status, expanded=res.expanded), [], np.array([s])
     plane_h = world.heading_to_plane(res.headings)
     metrics = {"time": res.time, "length": res.distance, "moves": len(res.path) - 1,
                "smoothness": _smoothness(plane_h), "expanded": res.expanded,
@@ -517,8 +525,11 @@ def _fly_field(world, s, t, step, escape, sensor_range, sensor_rays, mode, max_t
              "columns": list(AXES[world.frame])}, rows, xy)
 
 
-def _not_reached(why: str) -> dict:
-    return {"reached": False, "metrics": {"why": why}, "columns": []}
+def _not_reached(status: Status, **metrics) -> dict:
+    """A flight not found: its ``status`` (no_path, budget_exhausted) among the metrics,
+    as every vehicle reports it. It was a ``why`` alone ("no lattice route: no_path"),
+    with no ``status`` in ``--json`` or the table."""
+    return {"reached": False, "metrics": {"status": status.value, **metrics}, "columns": []}
 
 
 def _render(path: Path, rows, columns, lonlat) -> str:

@@ -52,17 +52,28 @@ def plot_day(site, result: DayResult, path: Path) -> Path:
             ax.plot(a[:, 0], a[:, 1], linestyle="none", zorder=5, label=_place_label(kind, counts),
                     **_PLACE_STYLE[kind])
     ax.plot(*site.home, "*", color="black", ms=13, zorder=6, label="home")
-    pct = result.money_pct
-    set_title(ax, [f"Delivery day {result.date:%d %b %Y}: {len(result.delivered)}/"
-                   f"{len(result.orders)} orders",
-                   "no orders" if pct is None else f"{pct:.1f}% of the money",
-                   f"{f.moves} moves"])
+    set_title(ax, day_title(result))
     finish_axes(ax, site.world)
     # shop names last, on the final axes, each where it covers no other name or marker
     # (shops a few metres apart had their names piled on one another's squares)
     place_labels(ax, shops, [s.name for s in site.shops], fontsize=7,
                  avoid=[p for counts in places.values() for p in counts] + [site.home])
     return save_figure(fig, path)
+
+
+def day_title(result: DayResult) -> list[str]:
+    """The parts of a day picture's title: the orders delivered of those placed, the
+    share of the money and the moves, with thousands separators as the table has them
+    (it read "1442 moves" under a table of "1,442"). A day without orders says so
+    ("0/0 orders, no orders, 0 moves" before), and a day whose orders are all invalid
+    that none was valid (it read "0/5 orders, no orders")."""
+    day = f"Delivery day {result.date:%d %b %Y}"
+    if not result.orders:
+        return [f"{day}: no orders stored", "nothing flown"]
+    pct = result.money_pct
+    return [f"{day}: {len(result.delivered)}/{len(result.orders)} orders",
+            "none valid" if pct is None else f"{pct:.1f}% of the money",
+            f"{result.flight.flight.moves:,} moves"]
 
 
 SERVED, PARTLY, NOT_SERVED = "served", "partly served", "not served"

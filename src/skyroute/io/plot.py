@@ -121,6 +121,12 @@ def draw_grid_path(ax, grid: Grid, result: PlanResult | None = None,
     set_title(ax, parts)
     ax.set_xlabel("x (column)")
     ax.set_ylabel("y (row)")
+    # cells are whole numbers: a small map's ticks read 2.5, 7.5, ... (a 22x12 walls
+    # raster), places no cell is
+    from matplotlib.ticker import MaxNLocator
+
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     return ax
 
 

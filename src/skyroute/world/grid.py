@@ -228,8 +228,13 @@ def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
     ``what``."""
     x, y = cell_xy(cell, what)
     if not (0 <= x < grid.width and 0 <= y < grid.height):
+        # (row, column), numpy's order, is the likely slip when the swapped cell lies
+        # inside: said so, as a World says it of (lat, lon)
+        swapped = (f"; ({y}, {x}) is inside: cells are (x, y) = (column, row)"
+                   if 0 <= y < grid.width and 0 <= x < grid.height else "")
         raise QueryError(f"{what} ({x}, {y}) lies outside the {grid.width}x{grid.height} grid "
-                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})", param=what)
+                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1}){swapped}",
+                         param=what)
     if grid.blocked[y, x]:
         raise QueryError(f"{what} ({x}, {y}) is on a blocked cell", param=what)
     return x, y
