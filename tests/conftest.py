@@ -34,6 +34,27 @@ def movingai_pairs() -> list[tuple[Path, Path]]:
     return find_pairs(MOVINGAI)
 
 
+_TERMINAL = ("COLUMNS", "LINES")
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    """pytest-xdist (controller): send each worker the terminal size variables as the run
+    was started with. A library loaded here has by then set COLUMNS=80 and LINES=24 in
+    the C environment, which the workers inherit into their ``os.environ``; the CLI's
+    tables would then be cut to 80 columns in every worker and every process it starts."""
+    node.workerinput["skyroute_terminal"] = {k: os.environ.get(k) for k in _TERMINAL}
+
+
+def pytest_configure(config):
+    sent = getattr(config, "workerinput", {}).get("skyroute_terminal")
+    for k, v in (sent or {}).items():  # an xdist worker: the run's own values
+        if v is None:
+            os.environ.pop(k, None)
+        else:
+            os.environ[k] = v
+
+
 def pytest_collection_modifyitems(config, items):
     if SHARED.is_dir():
         return
