@@ -1571,3 +1571,36 @@ def test_a_failed_choice_leaves_the_list_on_what_is_shown(open_page, server, pag
         p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{other}')",
                             timeout=15_000)
         assert p.input_value(key) == other
+
+
+# -- bad networks, empty maps, the focus order --------------------------------------------
+
+@pytest.mark.parametrize("page", ["day", "fleet"])
+def test_the_focus_follows_the_panels_on_a_wide_screen(open_page, server, page):
+    """On a wide screen the job form sits under the first panel, beside the map; it came
+    after the tables in the page, so Tab went from the first panel to the map, down to
+    the tables at the foot, and back up to the form. The focus now visits the panels in
+    the order they are seen: by rows, left to right."""
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    path = f"/day.html#date={DAY}" if page == "day" else f"/fleet.html#run={server[1]}"
+    pg = open_page(path, "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    panel = ("(() => { const a = document.activeElement;"
+             " const kids = [...document.querySelector('.layout').children];"
+             " return kids.findIndex((k) => k.contains(a)); })()")
+    visited = []
+    for _ in range(80):
+        p.keyboard.press("Tab")
+        at = p.evaluate(panel)
+        if at < 0 and visited:
+            break  # out of the panels (past the last one)
+        if at >= 0 and (not visited or visited[-1] != at):
+            visited.append(at)
+    seen = p.evaluate("""() => [...document.querySelector('.layout').children].map((k, i) => {
+        const r = k.getBoundingClientRect();
+        return [Math.round(r.top), Math.round(r.left), i]; })""")
+    by_rows = [i for _, _, i in sorted(seen) if i in visited]
+    assert visited == by_rows, (visited, seen)
+    assert len(visited) == 4  # the first panel, the map's player, the job form, the tables
