@@ -901,6 +901,7 @@ def test_a_link_to_what_is_not_stored_says_so(open_page, server, path, named):
     text = p.inner_text("#status")
     assert f"The link names {'run ' if 'fleet' in path else ''}{named}, which is not" in text, text
     assert "Press Play" in text, text
+    assert _key_inked(p) > 0  # a map drawn: its scale bar and north arrow
     pg.done("link-not-stored")
 
 
@@ -1497,6 +1498,7 @@ def test_an_empty_store_says_so_and_how_to_fill_it(open_page, page):
         key, words = "#run", "no stored runs"
     assert p.locator(f"{key} option").all_inner_texts() == [words]
     assert p.is_disabled(key)
+    assert _key_inked(p) == 0  # no scale bar or north arrow on the empty map
     pg.done(f"{page}-empty-store")
 
 
@@ -1574,6 +1576,35 @@ def test_a_failed_choice_leaves_the_list_on_what_is_shown(open_page, server, pag
 
 
 # -- bad networks, empty maps, the focus order --------------------------------------------
+
+KEY_PX = 30  # view.js KEY: the strip under a map that holds its scale bar and north arrow
+INKED = """(key) => {
+  const c = document.querySelector('#map');
+  const h = Math.round(key * c.height / c.clientHeight);
+  const d = c.getContext('2d').getImageData(0, c.height - h, c.width, h).data;
+  let n = 0;
+  for (let i = 0; i < d.length; i += 4) if (d[i] < 128 && d[i + 3] > 0) n++;
+  return n;
+}"""
+
+
+def _key_inked(p) -> int:
+    """Dark pixels in the key strip of the map canvas (the scale bar and north arrow are
+    dark ink on the map's near-white)."""
+    return p.evaluate(INKED, KEY_PX)
+
+
+def test_an_empty_map_draws_no_scale_bar(open_page):
+    """A map with nothing on it (no world loaded; an empty store's day and fleet pages,
+    see test_an_empty_store_says_so_and_how_to_fill_it) had a scale bar and a north
+    arrow, scaling and orienting nothing; they come with the first thing drawn."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('Choose')")
+    assert _key_inked(p) == 0
+    _load_city(pg)
+    assert _key_inked(p) > 0
+
 
 @pytest.mark.parametrize("page", ["day", "fleet"])
 def test_the_focus_follows_the_panels_on_a_wide_screen(open_page, server, page):

@@ -24,7 +24,10 @@ let proj = null;
 let t = 0;
 let loading = 0; // counts the days asked for: only the last one asked is shown
 
-const view = new MapView($("map"), { draw: drawMap });
+// blank: no day, or one with nothing to place (no flight, no customer, no site)
+const view = new MapView($("map"), {
+  draw: drawMap, blank: () => !day || (!day.coords.length && !site && !day.orders.some((o) => o.lonlat)),
+});
 const player = new Player({
   play: $("play"), speed: $("speed"), slider: $("time"), output: $("time-text"),
   describe: (x) => (day ? `move ${Math.floor(x)} of ${day.moves}` : "move 0 of 0"),

@@ -34,7 +34,7 @@ let lastTables = 0;
 let loading = 0; // counts the runs asked for: only the last one asked is shown
 let missing = null; // a run the page's link (#run=) names that the store does not hold
 
-const view = new MapView($("map"), { draw: drawMap });
+const view = new MapView($("map"), { draw: drawMap, blank: () => !run });
 const player = new Player({
   play: $("play"), speed: $("speed"), slider: $("time"), output: $("time-text"),
   describe: (x) => (run ? `${clock(x)} of ${clock(run.horizon)}` : "0:00"),

@@ -17,7 +17,7 @@ let world = null; // {format, frame, text, name, shapes: [{ring (plane), floor, 
 let answer = null;
 let round = 0;
 
-const view = new MapView($("map"), { draw: drawMap });
+const view = new MapView($("map"), { draw: drawMap, blank: () => !world });
 bindToken($("token"));
 
 // -- reading a world file in the page (for drawing and for checking clicks) ----------
