@@ -1594,6 +1594,82 @@ def _key_inked(p) -> int:
     return p.evaluate(INKED, KEY_PX)
 
 
+@pytest.mark.parametrize("page", ["day", "planner", "fleet"])
+def test_a_server_that_never_answers_is_said_with_a_way_to_retry(open_page, server, page):
+    """A server (or a proxy) that took the connection and never answered left the page
+    on "Loading…" for ever: no request had a time limit, and nothing offered to ask
+    again. Past the limit (45 s: the page's clock is run forward here) the status line
+    names what did not load, and its Try again button asks again."""
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    held_url, path, what = {
+        "day": (f"**/days/{DAY}", f"/day.html#date={DAY}", f"Reading {DAY}"),
+        "planner": ("**/maps", "/planner.html", "Reading the bundled maps"),
+        "fleet": (f"**/fleet/runs/{server[1]}/tracks.csv", f"/fleet.html#run={server[1]}",
+                  "Reading the run"),
+    }[page]
+    pg = open_page(path, "desktop")
+    p = pg.page
+    # (the first load done: none of its requests is held, the reload's is)
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'",
+                        timeout=15_000)
+    held = []
+    p.route(held_url, lambda r: held.append(r))  # taken, never answered
+    p.clock.install()
+    p.reload()
+    for _ in range(200):
+        if held:
+            break
+        p.wait_for_timeout(50)
+    assert held
+    p.clock.fast_forward(46_000)  # past api.js's WAIT_MS
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'error'",
+                        timeout=5_000)
+    said = p.inner_text("#status")
+    assert said == f"{what} failed: the server did not answer within 45 s. Try again", said
+    p.unroute(held_url)  # the server answers again
+    p.click("#status .retry")
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'",
+                        timeout=15_000)
+    assert p.locator("#status .retry").count() == 0
+    assert not pg.errors, pg.errors
+
+
+EVENT = '{"t": 0.0, "kind": "spawn", "package": 0, "airport": "A"}'
+
+
+@pytest.mark.parametrize(("page", "url", "answer", "said"), [
+    # a proxy's sign-in page where the JSON should be: the parser's words were shown
+    ("day", f"**/days/{DAY}",
+     {"status": 200, "content_type": "text/html", "body": "<html><body>Sign in</body></html>"},
+     f'Reading {DAY} failed: the server\'s answer is not JSON (it begins "<html><body>Sign '
+     'in</body></html>"). Try again'),
+    # a 500 without a problem document: its status was said twice
+    ("day", f"**/days/{DAY}",
+     {"status": 500, "content_type": "text/html", "body": "<h1>Internal Server Error</h1>"},
+     f"Reading {DAY} failed (500): Internal Server Error Try again"),
+    # events.jsonl cut short: an exception in the console, the page left on "Loading"
+    ("fleet", "**/events.jsonl",
+     {"status": 200, "content_type": "application/x-ndjson", "body": f'{EVENT}\n{{"t": 1.0, "ki'},
+     "Reading the run failed: events.jsonl line 2 is not an event (a JSON object with a "
+     "time t)."),
+], ids=["proxy-page", "500-without-problem", "events-cut-short"])
+def test_an_answer_that_is_not_what_was_asked_for_is_said_in_one_line(
+        open_page, server, page, url, answer, said):
+    """A 500 or an answer that is no JSON: one line naming what failed, no exception."""
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    path = f"/day.html#date={DAY}" if page == "day" else f"/fleet.html#run={server[1]}"
+    pg = open_page(path, "desktop")
+    p = pg.page
+    p.route(url, lambda r: r.fulfill(**answer))
+    p.reload()
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'error'",
+                        timeout=15_000)
+    assert p.inner_text("#status") == said
+    assert [e for e in pg.errors if "Failed to load resource" not in e] == []
+
+
 def test_an_empty_map_draws_no_scale_bar(open_page):
     """A map with nothing on it (no world loaded; an empty store's day and fleet pages,
     see test_an_empty_store_says_so_and_how_to_fill_it) had a scale bar and a north
