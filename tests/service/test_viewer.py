@@ -180,6 +180,9 @@ def test_home_page_links_every_page(open_page, size):
     urls = pg.page.locator("nav a").evaluate_all("a => a.map(x => x.href)")
     root = pg.page.url.rstrip("/")
     assert urls == [f"{root}/{x}" for x in links]
+    # the endpoints table fits (at 360 px its answers were cut at the edge, to be scrolled to)
+    assert pg.page.evaluate("(t => t.scrollWidth - t.clientWidth)"
+                            "(document.querySelector('.table-wrap'))") <= 0
     pg.done("home")
 
 
