@@ -180,6 +180,9 @@ def test_home_page_links_every_page(open_page, size):
     urls = pg.page.locator("nav a").evaluate_all("a => a.map(x => x.href)")
     root = pg.page.url.rstrip("/")
     assert urls == [f"{root}/{x}" for x in links]
+    # the endpoints table fits (at 360 px its answers were cut at the edge, to be scrolled to)
+    assert pg.page.evaluate("(t => t.scrollWidth - t.clientWidth)"
+                            "(document.querySelector('.table-wrap'))") <= 0
     pg.done("home")
 
 
@@ -901,6 +904,7 @@ def test_a_link_to_what_is_not_stored_says_so(open_page, server, path, named):
     text = p.inner_text("#status")
     assert f"The link names {'run ' if 'fleet' in path else ''}{named}, which is not" in text, text
     assert "Press Play" in text, text
+    assert _key_inked(p) > 0  # a map drawn: its scale bar and north arrow
     pg.done("link-not-stored")
 
 
@@ -1497,6 +1501,7 @@ def test_an_empty_store_says_so_and_how_to_fill_it(open_page, page):
         key, words = "#run", "no stored runs"
     assert p.locator(f"{key} option").all_inner_texts() == [words]
     assert p.is_disabled(key)
+    assert _key_inked(p) == 0  # no scale bar or north arrow on the empty map
     pg.done(f"{page}-empty-store")
 
 
@@ -1571,3 +1576,141 @@ def test_a_failed_choice_leaves_the_list_on_what_is_shown(open_page, server, pag
         p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{other}')",
                             timeout=15_000)
         assert p.input_value(key) == other
+
+
+# -- bad networks, empty maps, the focus order --------------------------------------------
+
+KEY_PX = 30  # view.js KEY: the strip under a map that holds its scale bar and north arrow
+INKED = """(key) => {
+  const c = document.querySelector('#map');
+  const h = Math.round(key * c.height / c.clientHeight);
+  const d = c.getContext('2d').getImageData(0, c.height - h, c.width, h).data;
+  let n = 0;
+  for (let i = 0; i < d.length; i += 4) if (d[i] < 128 && d[i + 3] > 0) n++;
+  return n;
+}"""
+
+
+def _key_inked(p) -> int:
+    """Dark pixels in the key strip of the map canvas (the scale bar and north arrow are
+    dark ink on the map's near-white)."""
+    return p.evaluate(INKED, KEY_PX)
+
+
+@pytest.mark.parametrize("page", ["day", "planner", "fleet"])
+def test_a_server_that_never_answers_is_said_with_a_way_to_retry(open_page, server, page):
+    """A server (or a proxy) that took the connection and never answered left the page
+    on "Loading…" for ever: no request had a time limit, and nothing offered to ask
+    again. Past the limit (45 s: the page's clock is run forward here) the status line
+    names what did not load, and its Try again button asks again."""
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    held_url, path, what = {
+        "day": (f"**/days/{DAY}", f"/day.html#date={DAY}", f"Reading {DAY}"),
+        "planner": ("**/maps", "/planner.html", "Reading the bundled maps"),
+        "fleet": (f"**/fleet/runs/{server[1]}/tracks.csv", f"/fleet.html#run={server[1]}",
+                  "Reading the run"),
+    }[page]
+    pg = open_page(path, "desktop")
+    p = pg.page
+    # (the first load done: none of its requests is held, the reload's is)
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'",
+                        timeout=15_000)
+    held = []
+    p.route(held_url, lambda r: held.append(r))  # taken, never answered
+    p.clock.install()
+    p.reload()
+    for _ in range(200):
+        if held:
+            break
+        p.wait_for_timeout(50)
+    assert held
+    p.clock.fast_forward(46_000)  # past api.js's WAIT_MS
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'error'",
+                        timeout=5_000)
+    said = p.inner_text("#status")
+    assert said == f"{what} failed: the server did not answer within 45 s. Try again", said
+    p.unroute(held_url)  # the server answers again
+    p.click("#status .retry")
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'",
+                        timeout=15_000)
+    assert p.locator("#status .retry").count() == 0
+    assert not pg.errors, pg.errors
+
+
+EVENT = '{"t": 0.0, "kind": "spawn", "package": 0, "airport": "A"}'
+
+
+@pytest.mark.parametrize(("page", "url", "answer", "said"), [
+    # a proxy's sign-in page where the JSON should be: the parser's words were shown
+    ("day", f"**/days/{DAY}",
+     {"status": 200, "content_type": "text/html", "body": "<html><body>Sign in</body></html>"},
+     f'Reading {DAY} failed: the server\'s answer is not JSON (it begins "<html><body>Sign '
+     'in</body></html>"). Try again'),
+    # a 500 without a problem document: its status was said twice
+    ("day", f"**/days/{DAY}",
+     {"status": 500, "content_type": "text/html", "body": "<h1>Internal Server Error</h1>"},
+     f"Reading {DAY} failed (500): Internal Server Error Try again"),
+    # events.jsonl cut short: an exception in the console, the page left on "Loading"
+    ("fleet", "**/events.jsonl",
+     {"status": 200, "content_type": "application/x-ndjson", "body": f'{EVENT}\n{{"t": 1.0, "ki'},
+     "Reading the run failed: events.jsonl line 2 is not an event (a JSON object with a "
+     "time t)."),
+], ids=["proxy-page", "500-without-problem", "events-cut-short"])
+def test_an_answer_that_is_not_what_was_asked_for_is_said_in_one_line(
+        open_page, server, page, url, answer, said):
+    """A 500 or an answer that is no JSON: one line naming what failed, no exception."""
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    path = f"/day.html#date={DAY}" if page == "day" else f"/fleet.html#run={server[1]}"
+    pg = open_page(path, "desktop")
+    p = pg.page
+    p.route(url, lambda r: r.fulfill(**answer))
+    p.reload()
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'error'",
+                        timeout=15_000)
+    assert p.inner_text("#status") == said
+    assert [e for e in pg.errors if "Failed to load resource" not in e] == []
+
+
+def test_an_empty_map_draws_no_scale_bar(open_page):
+    """A map with nothing on it (no world loaded; an empty store's day and fleet pages,
+    see test_an_empty_store_says_so_and_how_to_fill_it) had a scale bar and a north
+    arrow, scaling and orienting nothing; they come with the first thing drawn."""
+    pg = open_page("/world.html", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#status').textContent.startsWith('Choose')")
+    assert _key_inked(p) == 0
+    _load_city(pg)
+    assert _key_inked(p) > 0
+
+
+@pytest.mark.parametrize("page", ["day", "fleet"])
+def test_the_focus_follows_the_panels_on_a_wide_screen(open_page, server, page):
+    """On a wide screen the job form sits under the first panel, beside the map; it came
+    after the tables in the page, so Tab went from the first panel to the map, down to
+    the tables at the foot, and back up to the form. The focus now visits the panels in
+    the order they are seen: by rows, left to right."""
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    path = f"/day.html#date={DAY}" if page == "day" else f"/fleet.html#run={server[1]}"
+    pg = open_page(path, "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    panel = ("(() => { const a = document.activeElement;"
+             " const kids = [...document.querySelector('.layout').children];"
+             " return kids.findIndex((k) => k.contains(a)); })()")
+    visited = []
+    for _ in range(80):
+        p.keyboard.press("Tab")
+        at = p.evaluate(panel)
+        if at < 0 and visited:
+            break  # out of the panels (past the last one)
+        if at >= 0 and (not visited or visited[-1] != at):
+            visited.append(at)
+    seen = p.evaluate("""() => [...document.querySelector('.layout').children].map((k, i) => {
+        const r = k.getBoundingClientRect();
+        return [Math.round(r.top), Math.round(r.left), i]; })""")
+    by_rows = [i for _, _, i in sorted(seen) if i in visited]
+    assert visited == by_rows, (visited, seen)
+    assert len(visited) == 4  # the first panel, the map's player, the job form, the tables

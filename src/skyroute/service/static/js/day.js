@@ -6,7 +6,7 @@
 // that a day of invalid orders would otherwise keep) and follows GET /jobs/{id}; deletes
 // a day without a flight (a mistyped date) with DELETE /days/{date}.
 
-import { ApiError, bindToken, choices, explain, focusFault, getJSON, postJSON, remove } from "./api.js";
+import { ApiError, bindToken, choices, explain, focusFault, getJSON, mayPass, postJSON, remove } from "./api.js";
 import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
 import { fmt, h, isBusy, pounds, say, setBusy } from "./ui.js";
@@ -24,7 +24,10 @@ let proj = null;
 let t = 0;
 let loading = 0; // counts the days asked for: only the last one asked is shown
 
-const view = new MapView($("map"), { draw: drawMap });
+// blank: no day, or one with nothing to place (no flight, no customer, no site)
+const view = new MapView($("map"), {
+  draw: drawMap, blank: () => !day || (!day.coords.length && !site && !day.orders.some((o) => o.lonlat)),
+});
 const player = new Player({
   play: $("play"), speed: $("speed"), slider: $("time"), output: $("time-text"),
   describe: (x) => (day ? `move ${Math.floor(x)} of ${day.moves}` : "move 0 of 0"),
@@ -65,13 +68,15 @@ function siteFrom(doc) {
   return s;
 }
 
-/** Fill the day list (``wanted`` chosen when stored); false when there is none to show. */
-async function listDays(wanted = null) {
+/** Fill the day list (``wanted`` chosen when stored); false when there is none to show.
+ * A failure says so with a way to ask again (``retry``: the list and a day shown). */
+async function listDays(wanted = null, retry = () => showDays(wanted)) {
   let days;
   try {
     days = await getJSON("/days");
+    if (!Array.isArray(days)) throw new Error("the server's answer is not a list of days");
   } catch (err) {
-    say(status, explain(err, "Reading the stored days"), "error");
+    say(status, explain(err, "Reading the stored days"), "error", { retry: mayPass(err) ? retry : null });
     return false;
   }
   if (!days.length) {
@@ -99,14 +104,18 @@ async function start() {
     setBusy($("start"), true);
     say(jobStatus, "Following the day being flown since before this page was loaded…", "busy");
   }
-  const wanted = new URLSearchParams(location.hash.slice(1)).get("date");
-  if (await listDays(wanted)) {
-    await loadSite();
-    // a link to a day the store does not hold says so, not just shows another day
-    await load(select.value, wanted && select.value !== wanted ? `The link names ${wanted}, which is ` +
-      `not a stored day; this is ${select.value}. ` : "");
-  }
+  await showDays(new URLSearchParams(location.hash.slice(1)).get("date"), { linked: true });
   if (job) await jobs.follow(job);
+}
+
+/** The day list, the site and a day: ``wanted`` when stored, else the newest (and, when
+ * ``linked`` (the page's address named it), a note that it is not stored). */
+async function showDays(wanted = null, { linked = false } = {}) {
+  if (!(await listDays(wanted, () => showDays(wanted, { linked })))) return;
+  await loadSite();
+  // a link to a day the store does not hold says so, not just shows another day
+  await load(select.value, linked && wanted && select.value !== wanted ? `The link names ${wanted}, ` +
+    `which is not a stored day; this is ${select.value}. ` : "");
 }
 
 async function loadSite() {
@@ -189,7 +198,7 @@ async function load(date, note = "") {
     ]);
   } catch (err) {
     if (mine !== loading) return;
-    say(status, explain(err, `Reading ${date}`), "error");
+    say(status, explain(err, `Reading ${date}`), "error", { retry: mayPass(err) ? () => load(date, note) : null });
     // a day deleted since the list was read goes from it; the list shows the day shown
     // again (left on the failed one, choosing that one again asked nothing)
     if (err instanceof ApiError && err.status === 404) [...select.options].find((o) => o.value === date)?.remove();
@@ -197,7 +206,19 @@ async function load(date, note = "") {
     return;
   }
   if (mine !== loading) return; // another day was chosen while this one was read
-  history.replaceState(null, "", `#date=${date}`);
+  try {
+    show(date, detail, flight, note);
+  } catch (err) {
+    // an answer of another shape (another server, a proxy's JSON): said, not a page
+    // left on "Loading…" with an exception in the console
+    showNoDay();
+    say(status, `Reading ${date} failed: the server's answer is not a stored day as this page ` +
+      `reads one (${err.message}).`, "error");
+  }
+}
+
+/** Show the day ``date`` from its GET /days/{date} and flightpath.geojson answers. */
+function show(date, detail, flight, note) {
   const feature = flight.features[0];
   const coords = feature.geometry ? feature.geometry.coordinates : [];
   const props = feature.properties || {};
@@ -211,6 +232,8 @@ async function load(date, note = "") {
   const battery = detail.report.settings && detail.report.settings.battery
     ? detail.report.settings.battery : detail.report.moves + detail.report.moves_left;
   day = { date, report: detail.report, orders: detail.orders || [], deliveries, coords, moves, battery, cost, doneAt };
+  history.replaceState(null, "", `#date=${date}`);
+  if ([...select.options].some((o) => o.value === date)) select.value = date; // (asked again)
 
   // the plane: metres around the middle of everything drawn
   const ll = [...coords];
@@ -436,7 +459,7 @@ function drawMap(ctx, v) {
   }
 }
 
-start();
+start().catch((err) => say(status, explain(err, "Loading the page"), "error"));
 
 /** The day's orders grouped by their customer's place: [{lonlat, orders}], in order of
  * first appearance (orders without a place left out). */

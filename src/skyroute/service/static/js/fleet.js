@@ -6,7 +6,7 @@
 // to the next), /fleet/runs/{id}, its tracks.csv, events.jsonl, fleet.geojson and
 // packages.csv; starts runs with POST /jobs/fleet and follows GET /jobs/{id}.
 
-import { ApiError, bindToken, choices, explain, focusFault, getJSON, getPage, getText, postJSON } from "./api.js";
+import { ApiError, bindToken, choices, explain, focusFault, getJSON, getPage, getText, mayPass, postJSON } from "./api.js";
 import { EventFold, dronesAt, parseEvents, parseRoutes, parseTracks, runEnd, trail } from "./fleetstate.js";
 import { JobFollower } from "./jobs.js";
 import { Player } from "./player.js";
@@ -34,7 +34,7 @@ let lastTables = 0;
 let loading = 0; // counts the runs asked for: only the last one asked is shown
 let missing = null; // a run the page's link (#run=) names that the store does not hold
 
-const view = new MapView($("map"), { draw: drawMap });
+const view = new MapView($("map"), { draw: drawMap, blank: () => !run });
 const player = new Player({
   play: $("play"), speed: $("speed"), slider: $("time"), output: $("time-text"),
   describe: (x) => (run ? `${clock(x)} of ${clock(run.horizon)}` : "0:00"),
@@ -95,17 +95,27 @@ function showRuns() {
     : n === 1 ? "" : `All ${n} stored runs are listed, newest first.`;
 }
 
+/** List the runs (``select`` chosen when listed) and show one; a failure says so with a
+ * way to ask again. */
+async function showRunList(select = null) {
+  if (await listRuns(select)) await load(runSelect.value);
+}
+
 async function listRuns(select = null) {
   const mine = ++listing;
   let page;
   try {
     page = await getPage(`/fleet/runs?limit=${RUNS_PAGE}`);
+    if (!Array.isArray(page.items)) throw new Error("the server's answer is not a list of runs");
   } catch (err) {
+    if (mine !== listing) return false;
     runSelect.replaceChildren(h("option", {}, "no runs"));
     moreRuns.hidden = true;
-    const why = err instanceof ApiError && err.status === 503 ? "fleet runs are not available on this server"
-      : explain(err, "Reading the fleet runs");
-    say(status, why.charAt(0).toUpperCase() + why.slice(1), "error");
+    // the server's own words: a 503 is an installation without fleet runs (for good) or
+    // a store busy or out of reach (for now; it says which)
+    const gone = err instanceof ApiError && err.status === 503 && /not available/.test(err.detail);
+    say(status, explain(err, "Reading the fleet runs"), "error",
+      { retry: mayPass(err) && !gone ? () => showRunList(select) : null });
     return false;
   }
   runs = page.items;
@@ -185,7 +195,7 @@ async function load(id) {
     ]);
   } catch (err) {
     if (mine !== loading) return;
-    say(status, explain(err, "Reading the run"), "error");
+    say(status, explain(err, "Reading the run"), "error", { retry: mayPass(err) ? () => load(id) : null });
     // a run deleted since the list was read goes from it; the list shows the run shown
     // again (left on the failed one, choosing that one again asked nothing)
     if (err instanceof ApiError && err.status === 404) {
@@ -196,19 +206,24 @@ async function load(id) {
     return;
   }
   if (mine !== loading) return; // another run was chosen while this one was read
+  try {
+    show(id, entry, detail, tracksText, eventsText, geo, routesText);
+  } catch (err) {
+    // a file of another shape (cut short, another server's): said, not a page left on
+    // "Loading run…" with an exception in the console
+    say(status, `Reading the run failed: ${err.message}.`, "error");
+  }
+}
+
+/** Show run ``id`` from its files' texts and answers. */
+function show(id, entry, detail, tracksText, eventsText, geo, routesText) {
   const scenario = [detail.scenario, (detail.params || {}).scenario, (entry.params || {}).scenario]
     .find((s) => s && typeof s === "object" && s.home_lon !== undefined);
   if (!scenario) {
     say(status, "This run does not give its scenario's home (home_lon, home_lat): its tracks cannot be placed.", "error");
     return;
   }
-  let tracks;
-  try {
-    tracks = parseTracks(tracksText);
-  } catch (err) {
-    say(status, `tracks.csv: ${err.message}`, "error");
-    return;
-  }
+  const tracks = parseTracks(tracksText);
   const events = parseEvents(eventsText);
   const proj = localProjection(scenario.home_lon, scenario.home_lat);
   const ground = { airports: [], gates: [], runways: [], zones: [] };
@@ -240,6 +255,7 @@ async function load(id) {
     fold: new EventFold(events, routesText ? parseRoutes(routesText) : null),
   };
   history.replaceState(null, "", `#run=${encodeURIComponent(id)}`);
+  if (runs.some((r) => String(r.id) === String(id))) runSelect.value = id; // (asked again)
   $("s-scenario").textContent = `${scenario.name || entry.scenario || "–"}, ${params.scheduler || (rep.settings || {}).scheduler || "seed"} dispatch`;
   $("s-size").textContent = `${ground.airports.length} airports, ${drones} drones`;
   $("s-delivered").textContent = rep.delivered === undefined ? "–" : `${rep.delivered} of ${rep.offered} packages`;
@@ -350,7 +366,7 @@ const jobs = new JobFollower({
   what: "the run", done: "The run is done and stored.",
   onDone: async (r) => {
     const runId = r.fleet_run ?? r.run_id ?? r.id;
-    if (runId !== undefined && (await listRuns(String(runId)))) await load(runSelect.value);
+    if (runId !== undefined) await showRunList(String(runId));
   },
 });
 
@@ -391,8 +407,8 @@ async function start() {
     setBusy($("start"), true);
     say(jobStatus, "Following the run started before this page was loaded…", "busy");
   }
-  if (await listRuns()) await load(runSelect.value);
+  await showRunList();
   if (job) await jobs.follow(job);
 }
 
-start();
+start().catch((err) => say(status, explain(err, "Loading the page"), "error"));

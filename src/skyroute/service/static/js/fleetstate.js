@@ -69,9 +69,24 @@ export function parseTracks(text) {
   return { n, t, drone, north, east, alt, phase, phases, byDrone, step: Number.isFinite(step) ? step : 1 };
 }
 
-/** events.jsonl -> events (already in time order). */
+/** events.jsonl -> events (already in time order); a line that is no JSON object is an
+ * Error naming it. */
 export function parseEvents(text) {
-  return text.split("\n").filter((line) => line.trim()).map((line) => JSON.parse(line));
+  const events = [];
+  text.split("\n").forEach((line, i) => {
+    if (!line.trim()) return;
+    let e;
+    try {
+      e = JSON.parse(line);
+    } catch {
+      e = null;
+    }
+    if (!e || typeof e !== "object" || typeof e.t !== "number") {
+      throw new Error(`events.jsonl line ${i + 1} is not an event (a JSON object with a time t)`);
+    }
+    events.push(e);
+  });
+  return events;
 }
 
 /** packages.csv -> Map id -> {from, to}. */

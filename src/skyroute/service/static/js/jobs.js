@@ -4,7 +4,7 @@
 // line. The job is kept in this tab's sessionStorage, so a reload (or a visit to another
 // page and back) goes on following it; a server that does not answer is asked again.
 
-import { explain, getJSON } from "./api.js";
+import { explain, getJSON, mayPass } from "./api.js";
 import { clock, fmt, say, setBusy } from "./ui.js";
 
 const POLL_MS = 500;
@@ -64,7 +64,7 @@ export class JobFollower {
           // with the token that submitted it: a failed job's error is shown in full
           job = await getJSON(`/jobs/${encodeURIComponent(id)}`, { token: true });
         } catch (err) {
-          if (err.status === 0 || err.status >= 500) {
+          if (mayPass(err)) { // no answer (or none in time), a 5xx, a proxy's page: for now
             say(line, `${explain(err, following)} Asking again every ${RETRY_MS / 1000} s…`, "error");
             await pause(RETRY_MS);
             continue;

@@ -3,7 +3,7 @@
 //
 // Reads GET /maps and /maps/{name}; plans with POST /plan (one request per algorithm).
 
-import { bindToken, choices, explain, focusFault, getJSON, postJSON } from "./api.js";
+import { PLAN_WAIT_MS, bindToken, choices, explain, focusFault, getJSON, mayPass, postJSON } from "./api.js";
 import { PALETTE, fmt, h, isBusy, say, setBusy } from "./ui.js";
 import { KEY, drawScaleBar } from "./view.js";
 
@@ -38,15 +38,20 @@ async function loadMap(name) {
   let doc;
   try {
     doc = await getJSON(`/maps/${encodeURIComponent(name)}`);
+    const { width, height, rows } = doc || {};
+    if (!(Number.isInteger(width) && width > 0 && Number.isInteger(height) && height > 0 && Array.isArray(rows))) {
+      throw new Error("the server's answer is not a map (width, height and rows)");
+    }
   } catch (err) {
     if (mine !== loading) return;
-    say(status, explain(err, `Reading map ${name}`), "error");
+    say(status, explain(err, `Reading map ${name}`), "error", { retry: mayPass(err) ? () => loadMap(name) : null });
     if (grid) mapSelect.value = grid.name; // the map shown: choosing the failed one asks again
     return;
   }
   if (mine !== loading) return; // another map was chosen while this one was read
   round++; // a query on the old map still under way: its answers are dropped
   setBusy($("run"), false);
+  mapSelect.value = name; // (asked again after a failure, the list is on the map shown)
   const { width, height, rows } = doc;
   const passable = doc.passable || ".G";
   const free = new Uint8Array(width * height);
@@ -232,7 +237,8 @@ async function plan() {
   try {
     for (const r of results) {
       try {
-        r.answer = await postJSON("/plan", { map: grid.name, start, goal, algorithm: r.algorithm, ...options });
+        r.answer = await postJSON("/plan", { map: grid.name, start, goal, algorithm: r.algorithm, ...options },
+          { wait: PLAN_WAIT_MS });
       } catch (err) {
         r.error = err;
         if (err.status === 401 || err.status === 403) {
@@ -297,11 +303,18 @@ async function start() {
   const all = await choices("PlanRequest", "algorithm", ["astar", "dijkstra", "bfs", "jps", "theta", "lazy_theta"]);
   box.replaceChildren(...all.filter((a) => !WORLD_ONLY.has(a)).map((a) =>
     h("label", { class: "check" }, h("input", { type: "checkbox", value: a, checked: DEFAULT_ON.has(a) }), a)));
+  await listMaps();
+}
+
+/** The map list, and its first map shown; a failure says so with a way to ask again. */
+async function listMaps() {
+  say(status, "Loading the bundled maps…", "busy");
   let maps;
   try {
     maps = await getJSON("/maps");
+    if (!Array.isArray(maps)) throw new Error("the server's answer is not a list of maps");
   } catch (err) {
-    say(status, explain(err, "Reading the bundled maps"), "error");
+    say(status, explain(err, "Reading the bundled maps"), "error", { retry: mayPass(err) ? listMaps : null });
     return;
   }
   if (!maps.length) {
@@ -310,8 +323,8 @@ async function start() {
   }
   mapSelect.replaceChildren(...maps.map((m) => h("option", { value: m.name }, `${m.name} (${m.width} × ${m.height})`)));
   mapSelect.disabled = false;
-  mapSelect.addEventListener("change", () => loadMap(mapSelect.value));
   await loadMap(mapSelect.value);
 }
 
-start();
+mapSelect.addEventListener("change", () => loadMap(mapSelect.value));
+start().catch((err) => say(status, explain(err, "Loading the page"), "error"));

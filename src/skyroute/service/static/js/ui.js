@@ -33,10 +33,22 @@ export function isBusy(button) {
   return button.getAttribute("aria-disabled") === "true";
 }
 
-/** Set the status line ``el`` (an aria-live region): kind info, ok, busy or error. */
-export function say(el, text, kind = "info") {
+/** Set the status line ``el`` (an aria-live region): kind info, ok, busy or error.
+ * With ``retry``, a "Try again" button after the text calls it (what failed to load is
+ * asked for again); the next message takes the button away. */
+export function say(el, text, kind = "info", { retry = null } = {}) {
   el.dataset.kind = kind;
   el.textContent = text;
+  if (!retry) return;
+  el.append(" ", h("button", {
+    type: "button", class: "retry secondary",
+    onclick: () => {
+      // the button goes with the next message: the focus stays on the line, not the body
+      el.tabIndex = -1;
+      el.focus();
+      retry();
+    },
+  }, "Try again"));
 }
 
 export function fmt(x, digits = 0) {

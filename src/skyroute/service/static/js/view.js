@@ -47,12 +47,15 @@ export const KEY = 30; // (the planner's canvas has the same strip)
 
 /** A canvas showing the plane region ``bounds`` (x east, y north) at the largest scale
  * that fits above the key strip, redrawn by ``draw(ctx, view)`` on ``render()`` and
- * whenever its width changes. */
+ * whenever its width changes. While ``blank()`` is true (nothing loaded yet, or nothing
+ * to load) the key strip is left empty: a scale bar and a north arrow over an empty map
+ * measure and orient nothing, and read as a map that failed to draw. */
 export class MapView {
-  constructor(canvas, { draw, maxShare = 0.72, minHeight = 240, unit = "m", north = true } = {}) {
+  constructor(canvas, { draw, blank = () => false, maxShare = 0.72, minHeight = 240, unit = "m", north = true } = {}) {
     this.canvas = canvas;
     this.ctx = canvas.getContext("2d");
     this.draw = draw;
+    this.blank = blank;
     this.maxShare = maxShare;
     this.minHeight = minHeight;
     this.unit = unit;
@@ -113,6 +116,7 @@ export class MapView {
     ctx.fillStyle = "#fbfcfd";
     ctx.fillRect(0, 0, this.width, this.height);
     if (this.draw) this.draw(ctx, this);
+    if (this.blank()) return;
     drawScaleBar(ctx, this.scale, this.unit, 12, this.height - 8);
     if (this.north) drawNorthArrow(ctx, this.width - 14, this.height - KEY + 4);
   }

@@ -5,7 +5,7 @@
 // A colliders world is planned in the "ned" frame (points are north, east metres from the
 // file's lat0, lon0); GeoJSON zones in "lonlat" (points are lon, lat).
 
-import { bindToken, choices, explain, focusFault, postJSON } from "./api.js";
+import { PLAN_WAIT_MS, bindToken, choices, explain, focusFault, postJSON } from "./api.js";
 import { download, fmt, h, isBusy, say, setBusy } from "./ui.js";
 import { MapView, bbox, grow, localProjection } from "./view.js";
 
@@ -17,7 +17,7 @@ let world = null; // {format, frame, text, name, shapes: [{ring (plane), floor, 
 let answer = null;
 let round = 0;
 
-const view = new MapView($("map"), { draw: drawMap });
+const view = new MapView($("map"), { draw: drawMap, blank: () => !world });
 bindToken($("token"));
 
 // -- reading a world file in the page (for drawing and for checking clicks) ----------
@@ -321,7 +321,7 @@ async function plan() {
   setBusy($("run"), true);
   say(status, `Planning with ${body.algorithm}…`, "busy");
   try {
-    const a = await postJSON("/plan", body);
+    const a = await postJSON("/plan", body, { wait: PLAN_WAIT_MS });
     if (mine !== round) return;
     answer = a;
     showResult();
@@ -384,4 +384,4 @@ async function start() {
   say(status, "Choose a world file (or paste one), then click the start and the goal.", "info");
 }
 
-start();
+start().catch((err) => say(status, explain(err, "Loading the page"), "error"));
