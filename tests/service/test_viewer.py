@@ -28,6 +28,9 @@ if not CHROMIUM.exists():
 sync_api = pytest.importorskip("playwright.sync_api",
                                reason="browser tests: playwright is not installed (dev extra)")
 
+# how long a page may take to show what a test waits for: a bound for a loaded machine
+# (a first plan compiles its kernels while the other test process runs), not a measurement
+WAIT = 120_000
 SHOTS = ROOT / "artefacts" / "screenshots"
 VIEWPORTS = {"desktop": {"width": 1280, "height": 800}, "phone": {"width": 360, "height": 740}}
 SIZES = {**VIEWPORTS, "phone-640": {"width": 360, "height": 640},  # (Page's other sizes)
@@ -107,7 +110,7 @@ class Page:
                                            bypass_csp=not csp)
         # a page's waits get 60 s, not Playwright's 30: a job the page follows (a day
         # flown by the server's workers) took longer on a machine loaded by other runs
-        self.context.set_default_timeout(60_000)
+        self.context.set_default_timeout(WAIT)
         self.page = self.context.new_page()
         if init_script:
             self.page.add_init_script(init_script)
@@ -198,7 +201,7 @@ def test_day_animates_to_its_end(open_page, api, size):
     p.click("#play")
     p.wait_for_function("(t => t.value === t.max)(document.querySelector('#time'))"
                         " && document.querySelector('#play').textContent === 'Play'",
-                        timeout=15_000)
+                        timeout=WAIT)
     moves = report["moves"]
     assert p.inner_text("#time-text") == f"move {moves} of {moves}"
     assert p.inner_text("#s-pct") == f"{report['money_pct']:.1f} %"
@@ -240,7 +243,7 @@ def test_planner_click_pair_matches_post_plan(open_page, api, size):
         click_cell(p, doc["width"], x + 0.5, y + 0.5)
     p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'"
                         " && document.querySelector('#status').textContent.startsWith('Planned')",
-                        timeout=30_000)
+                        timeout=WAIT)
     cells = [int(p.input_value(f"#{k}")) for k in ("sx", "sy", "gx", "gy")]
     assert max(abs(a - b) for a, b in zip(cells, [*start, *goal], strict=True)) <= 1, cells
     rows = p.locator("#results tbody tr")
@@ -288,7 +291,7 @@ def test_world_draws_a_path_and_offers_waypoints(open_page, api, size):
     click_canvas(p, 0.05, 0.05)
     click_canvas(p, 0.95, 0.95)
     p.wait_for_function("document.querySelector('#status').textContent.startsWith('Found')",
-                        timeout=30_000)
+                        timeout=WAIT)
     start = [float(p.input_value("#s0")), float(p.input_value("#s1"))]
     goal = [float(p.input_value("#g0")), float(p.input_value("#g1"))]
     want = api.post("/plan", json={"world_text": (ROOT / "examples" / "city.csv").read_text(),
@@ -311,7 +314,7 @@ def test_fleet_replay_moves_drones_with_the_slider(open_page, server, size):
         pytest.skip("skyroute.jobs is not in this tree (jobs branch not merged): no fleet run")
     pg = open_page(f"/fleet.html#run={server[1]}", size)
     p = pg.page
-    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
     assert p.input_value("#run") == server[1]
     assert p.locator("#drones tbody tr").count() == 3
 
@@ -364,7 +367,7 @@ def test_the_pages_load_under_their_csp(open_page, path, ready):
     page fills itself from the API without a refusal (Chromium logs each as a console
     error, which ``done`` checks)."""
     pg = open_page(path, "desktop", csp=True)
-    pg.page.locator(ready).first.wait_for(state="attached", timeout=30_000)
+    pg.page.locator(ready).first.wait_for(state="attached", timeout=WAIT)
     pg.done(f"csp-{path.strip('/').split('.')[0] or 'home'}")
 
 
@@ -381,7 +384,7 @@ def test_the_planner_plans_under_its_csp(open_page, api):
     p.locator("#status", has_text="den312d").wait_for()
     _type_cells(p, free[0], free[-1])
     p.click("#run")
-    p.locator("#results tbody tr").nth(2).wait_for(timeout=30_000)
+    p.locator("#results tbody tr").nth(2).wait_for(timeout=WAIT)
     assert p.locator("#results tbody tr .swatch[style]").count() == 3
     pg.done("csp-planner")
 
@@ -482,7 +485,7 @@ def test_world_error_leaves_no_old_path(open_page):
     click_canvas(p, 0.05, 0.05)
     click_canvas(p, 0.95, 0.95)
     p.wait_for_function("document.querySelector('#status').textContent.startsWith('Found')",
-                        timeout=30_000)
+                        timeout=WAIT)
     assert p.inner_text("#r-status") == "found"
     # the centre of the city's first box (north, east), inside it at any altitude
     first = (ROOT / "examples" / "city.csv").read_text().splitlines()[2].split(",")
@@ -585,7 +588,7 @@ def test_api_reference_renders_offline(browser, server):
     page.on("pageerror", lambda e: errors.append(str(e)))
     try:
         page.goto(server[0] + "/docs")
-        page.wait_for_selector(".opblock", timeout=20_000)
+        page.wait_for_selector(".opblock", timeout=WAIT)
         paths = page.locator(".opblock-summary-path").all_inner_texts()
         assert any("/plan" in p for p in paths), paths
         assert not outside and not errors, (outside, errors)
@@ -636,7 +639,7 @@ def _start_fleet_job(open_page, server, job: dict):
     pg = open_page(f"/fleet.html#run={server[1]}", "desktop")
     p = pg.page
     _job_routes(p, job)
-    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
     p.fill("#token", TOKEN)
     p.click("#start")
     return pg
@@ -656,7 +659,7 @@ def test_fleet_job_shows_it_runs_and_survives_a_reload(open_page, server):
     assert p.is_disabled("#start")
     p.reload()
     p.wait_for_function("document.querySelector('#job-status').textContent"
-                        ".startsWith('Job running')", timeout=15_000)
+                        ".startsWith('Job running')", timeout=WAIT)
     assert p.is_disabled("#start")
     job.update(state="running", progress=0.4)
     p.wait_for_function("document.querySelector('#job-status').textContent"
@@ -664,10 +667,10 @@ def test_fleet_job_shows_it_runs_and_survives_a_reload(open_page, server):
     assert p.evaluate("document.querySelector('#progress').value") == pytest.approx(0.4)
     job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
-                        " && !document.querySelector('#start').ariaDisabled", timeout=15_000)
+                        " && !document.querySelector('#start').ariaDisabled", timeout=WAIT)
     assert p.inner_text("#job-status") == "The run is done and stored."
     p.reload()  # the job is over: nothing to follow after another reload
-    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
     assert p.inner_text("#job-status") == "" and not p.is_disabled("#start")
     pg.done("fleet-job")
 
@@ -683,7 +686,7 @@ def test_a_failed_job_shows_its_error_read_with_the_token(open_page, server):
                         ".startsWith('Job running')")
     job.update(state="failed", error="scenario.airports: too few (see the docs)")
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'error'",
-                        timeout=15_000)
+                        timeout=WAIT)
     assert p.inner_text("#job-status").startswith(
         "The job failed: scenario.airports: too few (see the docs)"), \
         p.inner_text("#job-status")
@@ -702,7 +705,7 @@ def test_fleet_job_outlives_a_server_that_does_not_answer(open_page, server):
     assert p.is_disabled("#start")
     job.update(state="done", progress=1.0, result={"fleet_run": server[1]})
     p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
-                        " && !document.querySelector('#start').ariaDisabled", timeout=15_000)
+                        " && !document.querySelector('#start').ariaDisabled", timeout=WAIT)
 
 
 @contextlib.contextmanager
@@ -737,7 +740,7 @@ def test_a_run_stored_without_packages_csv_opens_without_a_console_error(open_pa
         assert "packages.csv" not in httpx.get(f"{server[0]}/fleet/runs/{copy}").json()["files"]
         pg = open_page(f"/fleet.html#run={copy}", "desktop")
         p = pg.page
-        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
         assert p.input_value("#run") == copy
         set_slider(p, "#time", p.eval_on_selector("#time", "e => e.max"))
         p.wait_for_function("document.querySelector('#packages tbody tr')")
@@ -753,7 +756,7 @@ def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
     with _copied_run(server) as copy:
         pg = open_page("/fleet.html", "desktop")
         p = pg.page
-        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
         labels = p.locator("#run option").all_inner_texts()
         assert len(labels) == 2 and labels[0] != labels[1], labels
         assert p.input_value("#run") == copy  # the newest first
@@ -809,7 +812,7 @@ def test_the_fleet_page_lists_runs_past_the_first_page(open_page, server, size):
     with _newer_runs(server, 100) as newer:
         pg = open_page("/fleet.html", size)
         p = pg.page
-        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
         assert _options(p) == newer and p.input_value("#run") == newer[0]
         assert p.is_visible("#more-runs")
         assert p.inner_text("#run-count") == \
@@ -829,7 +832,7 @@ def test_the_fleet_page_lists_runs_past_the_first_page(open_page, server, size):
         p.keyboard.press("End")  # the oldest, chosen from the list by keyboard
         p.wait_for_function(f"location.hash === '#run={oldest}'"
                             " && document.querySelector('#status').dataset.kind === 'ok'",
-                            timeout=15_000)
+                            timeout=WAIT)
         assert p.input_value("#run") == oldest
         pg.done("fleet-older-runs")
 
@@ -838,7 +841,7 @@ def test_the_fleet_page_lists_runs_past_the_first_page(open_page, server, size):
         pg = open_page(f"/fleet.html#run={oldest}", size)
         p = pg.page
         p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'"
-                            " && document.querySelector('#time').max > 0", timeout=15_000)
+                            " && document.querySelector('#time').max > 0", timeout=WAIT)
         assert p.input_value("#run") == oldest and "not stored" not in p.inner_text("#status")
         assert _options(p) == [*newer, oldest] and p.is_visible("#more-runs")
         p.click("#more-runs")
@@ -870,7 +873,7 @@ def test_the_last_choice_is_shown_when_an_earlier_one_answers_late(open_page, se
             pg = open_page(f"/{page}.html#{key}={last}", "desktop")
         p = pg.page
         p.wait_for_function("document.querySelector('#status').dataset.kind !== 'busy'"
-                            " && document.querySelector('#status').textContent", timeout=15_000)
+                            " && document.querySelector('#status').textContent", timeout=WAIT)
         held = []
         p.route(held_url, lambda r: held.append(r))  # the first choice's answer waits
         p.select_option(f"#{key}", first)
@@ -900,7 +903,7 @@ def test_a_link_to_what_is_not_stored_says_so(open_page, server, path, named):
         pytest.skip("skyroute.jobs is not in this tree: no fleet run")
     pg = open_page(path, "desktop")
     p = pg.page
-    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
     text = p.inner_text("#status")
     assert f"The link names {'run ' if 'fleet' in path else ''}{named}, which is not" in text, text
     assert "Press Play" in text, text
@@ -1100,7 +1103,7 @@ def test_a_pressed_button_keeps_the_focus(open_page, server, page):
                        "desktop")
         p = pg.page
         _job_routes(p, job, "deliver" if page == "day" else "fleet", posts=sent)
-        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
         p.fill("#token", TOKEN)
         if page == "day":
             p.fill("#job-date", DAY)
@@ -1124,7 +1127,7 @@ def test_a_pressed_button_keeps_the_focus(open_page, server, page):
         job.update(state="done", progress=1.0,
                    result={"from": DAY, "to": DAY} if page == "day" else {"fleet_run": server[1]})
         p.wait_for_function("document.querySelector('#job-status').dataset.kind === 'ok'"
-                            " && !document.querySelector('#start').ariaDisabled", timeout=15_000)
+                            " && !document.querySelector('#start').ariaDisabled", timeout=WAIT)
     assert p.evaluate("document.activeElement.id") == button  # after the answer
     assert not pg.errors, pg.errors
 
@@ -1467,7 +1470,7 @@ def test_fleet_replay_ends_where_the_run_ends(open_page, server):
         assert end == horizon_seconds(hours) == 100.001 != hours * 3600
         pg = open_page(f"/fleet.html#run={run_id}", "desktop")
         p = pg.page
-        p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+        p.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
         assert p.input_value("#run") == run_id
         assert float(p.get_attribute("#time", "max")) == end
         pg.close()
@@ -1554,7 +1557,7 @@ def test_a_failed_choice_leaves_the_list_on_what_is_shown(open_page, server, pag
 
             key, shown, other = "#run", server[1], stack.enter_context(_copied_run(server))
             pg = open_page(f"/fleet.html#run={shown}", "desktop")
-            pg.page.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+            pg.page.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
             eng = sa.create_engine(server[2])
             with eng.begin() as c:  # deleted after the page listed it
                 for table, column in (("fleet_run_files", "run_id"), ("fleet_runs", "id")):
@@ -1574,7 +1577,7 @@ def test_a_failed_choice_leaves_the_list_on_what_is_shown(open_page, server, pag
         p.unroute(gone)  # the server is back: the same choice again is read
         p.select_option(key, other)
         p.wait_for_function(f"document.querySelector('#status').textContent.startsWith('{other}')",
-                            timeout=15_000)
+                            timeout=WAIT)
         assert p.input_value(key) == other
 
 
@@ -1615,7 +1618,7 @@ def test_a_server_that_never_answers_is_said_with_a_way_to_retry(open_page, serv
     p = pg.page
     # (the first load done: none of its requests is held, the reload's is)
     p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'",
-                        timeout=15_000)
+                        timeout=WAIT)
     held = []
     p.route(held_url, lambda r: held.append(r))  # taken, never answered
     p.clock.install()
@@ -1633,7 +1636,7 @@ def test_a_server_that_never_answers_is_said_with_a_way_to_retry(open_page, serv
     p.unroute(held_url)  # the server answers again
     p.click("#status .retry")
     p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'",
-                        timeout=15_000)
+                        timeout=WAIT)
     assert p.locator("#status .retry").count() == 0
     assert not pg.errors, pg.errors
 
@@ -1668,7 +1671,7 @@ def test_an_answer_that_is_not_what_was_asked_for_is_said_in_one_line(
     p.route(url, lambda r: r.fulfill(**answer))
     p.reload()
     p.wait_for_function("document.querySelector('#status').dataset.kind === 'error'",
-                        timeout=15_000)
+                        timeout=WAIT)
     assert p.inner_text("#status") == said
     assert [e for e in pg.errors if "Failed to load resource" not in e] == []
 
@@ -1696,7 +1699,7 @@ def test_the_focus_follows_the_panels_on_a_wide_screen(open_page, server, page):
     path = f"/day.html#date={DAY}" if page == "day" else f"/fleet.html#run={server[1]}"
     pg = open_page(path, "desktop")
     p = pg.page
-    p.wait_for_function("document.querySelector('#time').max > 0", timeout=15_000)
+    p.wait_for_function("document.querySelector('#time').max > 0", timeout=WAIT)
     panel = ("(() => { const a = document.activeElement;"
              " const kids = [...document.querySelector('.layout').children];"
              " return kids.findIndex((k) => k.contains(a)); })()")
