@@ -39,7 +39,7 @@ from skyroute.motion.dubins_kernel import (
     tangent_heading,
     words,
 )
-from skyroute.motion.move_search import _sight
+from skyroute.motion.zone_kernels import sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
 
@@ -123,8 +123,8 @@ def _analytic(x, y, th, g, scale, best, gx, gy, gth, has_heading, r, ref, dth, H
 @njit(cache=True)
 def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth, H, cell,
            region, ed, st, it, x0, y0, bcell, nx, ny, eps, clear, corners, cdist,
-           sight_edges, sight_tests, weight, max_expansions, every, max_words, reverse,
-           back_cost, switch_cost):
+           sight_edges, smeta, sstart, sids, sight_tests, weight, max_expansions, every,
+           max_words, reverse, back_cost, switch_cost):
     """Hybrid A* from the poses ``seeds`` (S, 3) to the goal.
 
     ``region`` (xmin, ymin, xmax, ymax): nodes outside it are dropped (states are keyed
@@ -153,6 +153,8 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
     stamp = np.zeros(ed.shape[0], np.int64)
     tick = np.zeros(1, np.int64)
     scratch = np.empty(corners.shape[0])
+    picks = np.empty(corners.shape[0], np.int64)
+    cols = np.ascontiguousarray(corners.T)  # (2, N): the bound's first pass vectorised
     ny_cells = np.int64(math.floor((region[3] - region[1]) / cell)) + 1
     n = 0
     size = 0
@@ -188,9 +190,10 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
         sees = False
         if not exact[i]:
             exact[i] = True
-            sees = _sight(x[i], y[i], gx, gy, sight_edges)
-            d2[i] = max(d2[i], lower_bound(x[i], y[i], gx, gy, sees, corners, cdist,
-                                           sight_edges, scratch, sight_tests))
+            sees = sight(x[i], y[i], gx, gy, sight_edges, smeta, sstart, sids)
+            d2[i] = max(d2[i], lower_bound(x[i], y[i], gx, gy, sees, cols, cdist,
+                                           sight_edges, smeta, sstart, sids, scratch,
+                                           picks, sight_tests))
             f2 = g[i] + weight * max(hd[i], d2[i])
             if f2 > f:
                 if size + 1 > hf.shape[0]:
@@ -200,7 +203,7 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
                 size += 1
                 continue
         else:
-            sees = _sight(x[i], y[i], gx, gy, sight_edges)
+            sees = sight(x[i], y[i], gx, gy, sight_edges, smeta, sstart, sids)
         if expanded >= max_expansions:
             stopped = True
             break
