@@ -9,10 +9,11 @@ Heuristic: h = max(Dubins length to the goal ignoring obstacles (to the goal pos
 to the goal point with any heading), the obstacle-avoiding 2D distance). Both are lower
 bounds of the remaining length; ``weight`` > 1 turns the search into weighted A*
 (default 1). The 2D term (:func:`corner_distance.lower_bound`, from a per-goal corner
-table) costs sight tests, so a new node first gets the cheap bound
-max(|q - goal|, d2(parent) - |u|) (the 2D distance is 1-Lipschitz and a primitive moves
-at most |u|) and the exact one when it reaches the top of the heap; if that raises its
-f it goes back in.
+table) costs a scan of the corners and sight tests (through the edge grid of
+:mod:`skyroute.motion.edge_grid`, as the goal sight test), so a new node first gets
+the cheap bound max(|q - goal|, d2(parent) - |u|) (the 2D distance is 1-Lipschitz and
+a primitive moves at most |u|) and the exact one when it reaches the top of the heap;
+if that raises its f it goes back in.
 
 Analytic expansion: the popped node tries a Dubins path to the goal (the shortest words
 first; for a free goal heading, the two turn-then-tangent paths, and every heading bin
@@ -43,9 +44,10 @@ from skyroute.motion.zone_kernels import sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
 
-# numba caches these kernels with dubins_kernel's code compiled in, keyed by this
-# file's date alone: edit this file when dubins_kernel changes (as for ZERO, its
-# rounding rule), or a checkout keeps running the old words from the cache.
+# numba caches these kernels with dubins_kernel's code compiled in (and
+# corner_distance's bound, zone_kernels' sight and edge_grid's bucket walk), keyed by
+# this file's date alone: edit this file when one of those changes (as for ZERO, the
+# words' rounding rule), or a checkout keeps running the old code from the cache.
 
 TWO_PI = 2 * math.pi
 
