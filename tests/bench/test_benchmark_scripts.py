@@ -38,7 +38,7 @@ def one_line_error(proc, name: str, words: str) -> None:
 
 
 @pytest.mark.parametrize("name", ["plan_ab.py", "plan_overhead.py", "prepare_memory.py",
-                                  "prepare_time.py", "world_queries.py"])
+                                  "prepare_time.py", "world_queries.py", "hybrid_cpu.py"])
 def test_each_script_has_a_help(name):
     proc = script(name, "--help")
     assert proc.returncode == 0 and proc.stdout.startswith(f"usage: {name}"), proc.stderr
@@ -228,3 +228,27 @@ def test_world_queries_counts_segments_through_shared_faces(tmp_path):
 ])
 def test_world_queries_refuses_wrong_input(args, words):
     one_line_error(script("world_queries.py", *args), "world_queries.py", words)
+
+
+def test_hybrid_cpu_reports_each_query(tmp_path):
+    # one box between start and goal: a path round it, longer than the straight 60 m
+    city = tmp_path / "one.csv"
+    city.write_text("lat0 37.792480, lon0 -122.397450\n"
+                    "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n30,0,10,5,5,10\n")
+    proc = script("hybrid_cpu.py", str(city), "0,0,0;60,0", "--radius", "5", "--reps", "2")
+    assert proc.returncode == 0, proc.stderr
+    (line,) = proc.stdout.splitlines()
+    row = json.loads(line)
+    assert row["query"] == "0,0,0;60,0" and row["status"] == "found"
+    assert row["expanded"] > 0 and 60 < row["length"] < 80 and len(row["sha1"]) == 10
+    assert len(row["cpu"]) == 2 and all(c >= 0 for c in row["cpu"])
+
+
+@pytest.mark.parametrize("args, words", [
+    (["no-such.csv", "0,0;1,1"], "no-such.csv: no such file"),
+    ([__file__, "0,0"], "query '0,0': expected START;GOAL"),
+    ([__file__, "0,0;a,1"], "query '0,0;a,1': 'a,1' is not N,E or N,E,HEADING"),
+    ([__file__, "0,0;1,1", "--reps", "0"], "--reps 0: expected 1 to 100"),
+])
+def test_hybrid_cpu_refuses_wrong_input(args, words):
+    one_line_error(script("hybrid_cpu.py", *args), "hybrid_cpu.py", words)

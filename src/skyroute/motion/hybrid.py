@@ -393,7 +393,7 @@ class _Lattice:
                 seeds, float(gxy[0]), float(gxy[1]), 0.0 if gth is None else float(gth),
                 gth is not None, r, self.k, self.u, self.c, float(ref), dth, H,
                 step / math.sqrt(2), self.region, *self.index.args(), g.corners,
-                g.to(gxy), g.edges, _SIGHT_TESTS, _WEIGHT, budget, _EVERY, _WORDS,
+                g.to(gxy), g.edges, *g.grid, _SIGHT_TESTS, _WEIGHT, budget, _EVERY, _WORDS,
                 self.reverse, _BACK_COST, _SWITCH * r)
         if code != FOUND:
             return _Found(int(code), int(expanded), int(tries))

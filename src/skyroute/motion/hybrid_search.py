@@ -9,10 +9,11 @@ Heuristic: h = max(Dubins length to the goal ignoring obstacles (to the goal pos
 to the goal point with any heading), the obstacle-avoiding 2D distance). Both are lower
 bounds of the remaining length; ``weight`` > 1 turns the search into weighted A*
 (default 1). The 2D term (:func:`corner_distance.lower_bound`, from a per-goal corner
-table) costs sight tests, so a new node first gets the cheap bound
-max(|q - goal|, d2(parent) - |u|) (the 2D distance is 1-Lipschitz and a primitive moves
-at most |u|) and the exact one when it reaches the top of the heap; if that raises its
-f it goes back in.
+table) costs a scan of the corners and sight tests (through the edge grid of
+:mod:`skyroute.motion.edge_grid`, as the goal sight test), so a new node first gets
+the cheap bound max(|q - goal|, d2(parent) - |u|) (the 2D distance is 1-Lipschitz and
+a primitive moves at most |u|) and the exact one when it reaches the top of the heap;
+if that raises its f it goes back in.
 
 Analytic expansion: the popped node tries a Dubins path to the goal (the shortest words
 first; for a free goal heading, the two turn-then-tangent paths, and every heading bin
@@ -39,13 +40,14 @@ from skyroute.motion.dubins_kernel import (
     tangent_heading,
     words,
 )
-from skyroute.motion.move_search import _sight
+from skyroute.motion.zone_kernels import sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
 
-# numba caches these kernels with dubins_kernel's code compiled in, keyed by this
-# file's date alone: edit this file when dubins_kernel changes (as for ZERO, its
-# rounding rule), or a checkout keeps running the old words from the cache.
+# numba caches these kernels with dubins_kernel's code compiled in (and
+# corner_distance's bound, zone_kernels' sight and edge_grid's bucket walk), keyed by
+# this file's date alone: edit this file when one of those changes (as for ZERO, the
+# words' rounding rule), or a checkout keeps running the old code from the cache.
 
 TWO_PI = 2 * math.pi
 
@@ -123,8 +125,8 @@ def _analytic(x, y, th, g, scale, best, gx, gy, gth, has_heading, r, ref, dth, H
 @njit(cache=True)
 def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth, H, cell,
            region, ed, st, it, x0, y0, bcell, nx, ny, eps, clear, corners, cdist,
-           sight_edges, sight_tests, weight, max_expansions, every, max_words, reverse,
-           back_cost, switch_cost):
+           sight_edges, smeta, sstart, sids, sight_tests, weight, max_expansions, every,
+           max_words, reverse, back_cost, switch_cost):
     """Hybrid A* from the poses ``seeds`` (S, 3) to the goal.
 
     ``region`` (xmin, ymin, xmax, ymax): nodes outside it are dropped (states are keyed
@@ -153,6 +155,8 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
     stamp = np.zeros(ed.shape[0], np.int64)
     tick = np.zeros(1, np.int64)
     scratch = np.empty(corners.shape[0])
+    picks = np.empty(corners.shape[0], np.int64)
+    cols = np.ascontiguousarray(corners.T)  # (2, N): the bound's first pass vectorised
     ny_cells = np.int64(math.floor((region[3] - region[1]) / cell)) + 1
     n = 0
     size = 0
@@ -188,9 +192,10 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
         sees = False
         if not exact[i]:
             exact[i] = True
-            sees = _sight(x[i], y[i], gx, gy, sight_edges)
-            d2[i] = max(d2[i], lower_bound(x[i], y[i], gx, gy, sees, corners, cdist,
-                                           sight_edges, scratch, sight_tests))
+            sees = sight(x[i], y[i], gx, gy, sight_edges, smeta, sstart, sids)
+            d2[i] = max(d2[i], lower_bound(x[i], y[i], gx, gy, sees, cols, cdist,
+                                           sight_edges, smeta, sstart, sids, scratch,
+                                           picks, sight_tests))
             f2 = g[i] + weight * max(hd[i], d2[i])
             if f2 > f:
                 if size + 1 > hf.shape[0]:
@@ -200,7 +205,7 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
                 size += 1
                 continue
         else:
-            sees = _sight(x[i], y[i], gx, gy, sight_edges)
+            sees = sight(x[i], y[i], gx, gy, sight_edges, smeta, sstart, sids)
         if expanded >= max_expansions:
             stopped = True
             break

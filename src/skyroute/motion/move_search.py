@@ -16,7 +16,7 @@ import numpy as np
 from numba import njit, objmode, types
 from numba.typed import Dict
 
-from skyroute.motion.zone_kernels import crosses, expand, sight
+from skyroute.motion.zone_kernels import expand, sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
 
@@ -28,15 +28,6 @@ _POLL = 4096  # expansions between two returns to the interpreter (for Ctrl-C)
 def _poll() -> None:
     """Called from the compiled search now and then: the interpreter runs a pending
     signal's handler here (Ctrl-C raises KeyboardInterrupt out of the search)."""
-
-
-@njit(cache=True)
-def _sight(qx, qy, vx, vy, edges):
-    """No zone edge properly crosses segment qv (touching counts as sight: a superset)."""
-    for i in range(edges.shape[0]):
-        if crosses(qx, qy, vx, vy, edges[i, 0], edges[i, 1], edges[i, 2], edges[i, 3]):
-            return False
-    return True
 
 
 @njit(cache=True)
