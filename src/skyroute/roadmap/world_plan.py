@@ -12,6 +12,7 @@ import numpy as np
 
 from skyroute.caches import register
 from skyroute.errors import OptionError, check_choice
+from skyroute.keywords import unknown_keywords
 from skyroute.result import PlanResult
 from skyroute.roadmap.prm import PRM, prm_options
 from skyroute.roadmap.raster import plan_on_raster
@@ -64,12 +65,17 @@ def plan_world(world: World, start, goal, *, algorithm: str = "visibility",
     """See :func:`skyroute.plan`: ``start`` and ``goal`` in the world's frame, the path
     in it too (and in lon/lat as ``path_lonlat`` where the world has a home).
     ``options``: PRM's (:data:`PRM_OPTIONS`) or the grid algorithms'
-    (:data:`GRID_OPTIONS`); one the algorithm does not read is an OptionError."""
+    (:data:`GRID_OPTIONS`); one the algorithm does not read is an OptionError, one that
+    no planner reads (a misspelt option) a KeywordError naming the closest."""
+    unknown = [name for name in options if name not in (*PRM_OPTIONS, *GRID_OPTIONS)]
+    if unknown:
+        raise unknown_keywords(plan_world, unknown, ("world", "start", "goal", "algorithm",
+                                                     "max_expansions", *PRM_OPTIONS,
+                                                     *GRID_OPTIONS))
     check_choice("algorithm", algorithm, WORLD_ALGORITHMS)
     for name, value in options.items():
         if name not in options_for(algorithm, **{name: value}):
-            reads = "PRM" if name in PRM_OPTIONS else "the grid algorithms" \
-                if name in GRID_OPTIONS else "no planner"
+            reads = "PRM" if name in PRM_OPTIONS else "the grid algorithms"
             raise OptionError(f"{name}={value!r} does not apply to algorithm={algorithm!r} "
                               f"(it is read by {reads})", param=name)
     s = world.check_point(start, "start")  # errors speak the caller's frame
