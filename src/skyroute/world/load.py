@@ -14,7 +14,7 @@ from skyroute.errors import (
     real,
     renamed,
 )
-from skyroute.files import as_path
+from skyroute.files import as_path, cannot_read
 from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.world.grid import Grid
 
@@ -45,7 +45,7 @@ def resolve_map_path(path: str | Path) -> Path:
         if p.exists() and not p.is_dir():
             return p
     except OSError as exc:  # e.g. a name longer than the file system allows
-        raise InputFormatError(p, f"cannot read: {exc.strerror}") from None
+        raise cannot_read(p, exc) from None
     maps = bundled_maps()
     key = p.name[:-4] if p.name.endswith(".map") else p.name
     if str(path) == p.name and key in maps:
