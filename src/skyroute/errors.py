@@ -90,6 +90,13 @@ class OptionError(SkyrouteError, ValueError):
     """An unknown or out-of-range option; the message lists the valid ones."""
 
 
+class KeywordError(OptionError, TypeError):
+    """A keyword argument the function does not take (a misspelt option): the message
+    names it, the closest valid keyword and the valid ones (see
+    :mod:`skyroute.keywords`). A TypeError too, as Python's own error for an unexpected
+    keyword is, so a caller's ``except TypeError`` still catches it."""
+
+
 class WorldNotGridError(InputFormatError):
     """A continuous world's file (GeoJSON zones) read as a grid map: plan in it as a world
     (:func:`skyroute.load_world`). It read "unknown map type '.geojson'", which named no

@@ -34,10 +34,36 @@ def read_text(path: str | Path, *, max_bytes: int | None = None,
                                    f"for {kind}")
         return Path(path).read_text(encoding="utf-8-sig")
     except OSError as exc:
-        raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
+        raise cannot_read(path, exc) from None
     except UnicodeDecodeError as exc:
         raise InputFormatError(path, f"cannot read: not UTF-8 text ({exc.reason} at "
                                f"byte {exc.start})") from None
+
+
+def cannot_read(path: str | Path, exc: OSError) -> InputFormatError:
+    """The error for a file that could not be opened, in the words every reader uses:
+    ``PATH: no such file``, ``PATH: a folder, not a file``, else ``PATH: cannot read:
+    <the system's reason>`` (its strerror: the path is named once, not twice). One
+    wording for every command: ``fleet simulate`` said "cannot read: No such file or
+    directory" where ``plan`` said "no such file"."""
+    if isinstance(exc, FileNotFoundError):
+        return InputFormatError(path, "no such file")
+    if isinstance(exc, IsADirectoryError):
+        return InputFormatError(path, "a folder, not a file")
+    return InputFormatError(path, f"cannot read: {exc.strerror or exc}")
+
+
+def need_folder(path: str | Path, what: str = "") -> Path:
+    """``path`` as a Path when it is a folder, else ``PATH: no such folder`` (or ``PATH:
+    not a folder``, ``what`` after it: ``not a folder of .map and .scen files``) as an
+    :class:`InputFormatError`. Checked before any file inside is looked for, so a
+    mistyped folder is named as the user typed it, not as ``DIR/database/orders.csv``."""
+    path = Path(path)
+    if not path.exists():
+        raise InputFormatError(path, "no such folder")
+    if not path.is_dir():
+        raise InputFormatError(path, "not a folder" + (f" {what}" if what else ""))
+    return path
 
 
 def open_text(path: str | Path) -> TextIO:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from skyroute.errors import OptionError
+from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.result import PlanResult
 from skyroute.search.grid_plan import _grid_options, grid_options, plan_grid
 from skyroute.world.grid import Grid
@@ -13,12 +14,13 @@ if TYPE_CHECKING:
     from skyroute.world.world import World
 
 
+@strict_keywords
 def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
          connectivity: int | None = None, corner_cutting: bool = False,
          heuristic: str | None = None, weight: float | None = None, prune: str | None = None,
          max_expansions: int | None = None, resolution: float | None = None,
          samples: int | None = None, neighbours: int | None = None,
-         prm_star: bool | None = None, seed: int | None = None) -> PlanResult:
+         prm_star: bool | None = None, seed: int | None = None, **misspelt) -> PlanResult:
     """Plan a path on a Grid from cell ``start`` to cell ``goal``, both (x, y) = (column,
     row), or on a World between two points given in the world's frame.
 
@@ -72,7 +74,8 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
         inside an obstacle), or not two numbers (two integers on a Grid).
     OptionError
         an unknown, out-of-range or inapplicable option (the message lists the valid
-        ones), or ``grid`` not a Grid or World.
+        ones), or ``grid`` not a Grid or World; a misspelt keyword (``algoritm=``) is
+        its child KeywordError (a TypeError too), naming the closest valid one.
 
     Examples
     --------
@@ -84,6 +87,8 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
     >>> skyroute.plan(grid, (50, 76), (60, 13), algorithm="theta").cost < r.cost
     True
     """
+    if misspelt:
+        raise unknown_keywords(plan, misspelt)
     if not isinstance(grid, Grid):
         # shapely and the roadmaps are imported only here: a grid plan never loads them
         from skyroute.roadmap.world_plan import plan_world

@@ -119,7 +119,7 @@ def test_db_init_and_import(monkeypatch, capsys, tmp_path):
     (["deliver", "2024-01-01", "--data", EXAMPLE, "--db", "postgresql+psycopg3://u@h/db"],
      "--db 'postgresql+psycopg3://u@h/db': SQLAlchemy has no driver 'psycopg3' for "
      "postgresql (e.g. "),
-    (["data", "serve", "/nonexistent"], "not a data folder"),
+    (["data", "serve", "/nonexistent"], "/nonexistent: no such folder"),
     (["data", "serve", EXAMPLE, "--port", "99999"], "is not in the range 0<=x<=65535"),
     (["data", "serve", EXAMPLE, "--port", "-1"], "is not in the range 0<=x<=65535"),
 ])

@@ -22,7 +22,8 @@ def test_fcnd_json_waypoints_geojson_plot(monkeypatch, capsys, tmp_path):
     assert code == 0, err
     doc = json.loads(out)
     assert list(doc) == ["status", "cost", "frame", "path", "path_local", "path_lonlat",
-                         "expanded", "seconds", "algorithm"]
+                         "expanded", "seconds", "setup_seconds", "algorithm"]
+    assert doc["setup_seconds"] > 0  # the graph, apart from the search (a new world)
     assert doc["frame"] == "lonlat" and doc["path"] == doc["path_lonlat"]
     assert doc["status"] == "found" and doc["path_local"][0] == pytest.approx([0, 0], abs=1e-6)
     assert doc["path_lonlat"][-1] == pytest.approx([-122.396428, 37.795232], abs=1e-9)

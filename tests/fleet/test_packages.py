@@ -136,13 +136,13 @@ def test_csv_errors_name_the_file_the_line_and_the_field(tmp_path, nine, text, l
 
 
 def test_csv_that_cannot_be_read(tmp_path, nine):
-    # named once, as every other reader names a file: it was "missing.csv: cannot read:
+    # named once, in the words every reader uses: it was "missing.csv: cannot read:
     # [Errno 2] No such file or directory: 'missing.csv'" and "bin.csv: not text:
     # 'utf-8' codec can't decode byte 0xff in position 0: invalid start byte"
     missing = tmp_path / "missing.csv"
     with pytest.raises(InputFormatError) as err:
         packages.read_csv(missing, nine)
-    assert str(err.value) == f"{missing}: cannot read: No such file or directory"
+    assert str(err.value) == f"{missing}: no such file"
     p = tmp_path / "bin.csv"
     p.write_bytes(b"\xff\xfe\x00t,from")
     with pytest.raises(InputFormatError) as err:

@@ -173,11 +173,11 @@ def test_a_log_level_not_uvicorns_is_one_line(monkeypatch, capsys, tmp_path):
 
 @pytest.mark.parametrize("args, words", [
     (["--data", "/nonexistent", "--source", "http://x"], "at most one of --data"),
-    (["--data", "/nonexistent"], "not a data folder"),
+    (["--data", "/nonexistent"], "/nonexistent: no such folder"),
     (["--source", "ftp://x"], "expected an http:// or https:// URL"),
     (["--port", "0"], "--port 0 must be"),
     (["--db", "nonsense"], "not a database URL"),
-    (["--token-file", "/nonexistent/token"], "--token-file /nonexistent/token: cannot read"),
+    (["--token-file", "/nonexistent/token"], "--token-file /nonexistent/token: no such file"),
     (["--job-queue", "0"], "--job-queue: Input should be greater than or equal to 1"),
 ])
 def test_bad_flags_are_one_line(monkeypatch, capsys, tmp_path, args, words):

@@ -29,6 +29,7 @@ from skyroute.bench.path_check import Checker, legal_length, path_length
 from skyroute.bench.peers import PEERS, available, skip_reason
 from skyroute.bench.random_maps import far_queries, parse_random, random_grid
 from skyroute.errors import InputFormatError, OptionError, check_choice
+from skyroute.files import need_folder
 from skyroute.planner import plan
 from skyroute.search.grid_plan import ANY_ANGLE, GRID_ALGORITHMS
 from skyroute.search.prepared import prepare
@@ -48,9 +49,7 @@ MAX_RANDOM_CELL_QUERIES = 1 << 29
 
 def find_pairs(folder: str | Path, names: Sequence[str] = ()) -> list[tuple[Path, Path]]:
     """(map, scen) pairs in ``folder``: ``X.map`` with ``X.map.scen`` or ``X-*.scen``."""
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise InputFormatError(folder, "not a folder of .map and .scen files")
+    folder = need_folder(folder, "of .map and .scen files")
     pairs = {}
     for m in sorted(folder.glob("*.map")):
         scen = m.with_name(m.name + ".scen")

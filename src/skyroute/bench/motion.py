@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError
+from skyroute.files import cannot_read
 
 
 def dubins_speed(*, sizes=(100_000, 1_000_000), threads=(1, 2), repeats: int = 7,
@@ -136,7 +137,9 @@ def ilp_places(path: Path) -> dict:
         doc = json.loads(path.read_text(encoding="utf-8"))
         places = {f["properties"]["name"]: f["geometry"]["coordinates"]
                   for f in doc["features"] if f["geometry"]["type"] == "Point"}
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
+    except OSError as exc:
+        raise cannot_read(path, exc) from None
+    except (UnicodeDecodeError, ValueError) as exc:
         raise InputFormatError(path, f"cannot read: {exc}") from None
     except (KeyError, TypeError, AttributeError):
         raise InputFormatError(path, "expected a FeatureCollection of Point features with "

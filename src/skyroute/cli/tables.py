@@ -19,13 +19,15 @@ if TYPE_CHECKING:  # Rich is imported on use: `skyroute plan --json` prints with
 
 def result_table(title: str, result: PlanResult, *, unit: str,
                  metres_per_unit: float | None = None,
-                 files: tuple[tuple[str, object], ...] = ()) -> Table:
+                 files: tuple[tuple[str, object], ...] = (),
+                 set_up: str = "masks, tables, compiled kernels") -> Table:
     """Status, cost, waypoints, statistics and written files of one result.
 
     ``unit`` names the cost's unit ("cells" on a grid map, "m" or "deg" in a world);
     ``metres_per_unit``, when given and not 1, adds the cost in metres (a grid of
     0.5 m cells: "6.000000 cells (3.000000 m)"). Numbers have thousands separators, and
-    as many decimals wherever they appear: costs 6, milliseconds 3."""
+    as many decimals wherever they appear: costs 6, milliseconds 3. ``set_up`` says
+    what a first query's set-up time (``extra["setup_seconds"]``) holds."""
     from rich.table import Table
 
     table = Table(title=title, show_header=False)
@@ -44,7 +46,7 @@ def result_table(title: str, result: PlanResult, *, unit: str,
     table.add_row("search time", f"{result.seconds * 1e3:,.3f} ms")
     if "setup_seconds" in result.extra:
         table.add_row("set-up time", f"{result.extra['setup_seconds'] * 1e3:,.3f} ms "
-                      "(first query: masks, tables, compiled kernels)")
+                      f"(first query: {set_up})")
     for label, path in files:
         if path:
             table.add_row(label, str(path))

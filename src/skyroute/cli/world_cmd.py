@@ -29,6 +29,10 @@ from skyroute.result import Status
 from skyroute.roadmap.world_plan import WORLD_ALGORITHMS, options_for, roadmap_edges
 
 EXIT_NOT_FOUND = 1
+# what a first query's set-up time holds, by algorithm (the grid ones: on the raster)
+SET_UP = {"visibility": "the visibility graph, compiled kernels",
+          "prm": "the roadmap, compiled kernels",
+          "raster": "the raster, masks, tables, compiled kernels"}
 
 
 def plan_world_command(
@@ -100,7 +104,8 @@ def plan_world_command(
         files = (("waypoints file", waypoints_out), ("geojson", geojson), ("plot", plot)) \
             if result.found else ()
         table = result_table(f"{world.name}: {result.algorithm}", result,
-                             unit="deg" if world.plane == "degrees" else "m", files=files)
+                             unit="deg" if world.plane == "degrees" else "m", files=files,
+                             set_up=SET_UP.get(algorithm, SET_UP["raster"]))
         if result.status == Status.NO_PATH and algorithm == "prm":
             table.add_row("why", prm_no_path_why(given.get("samples", 1000),
                                                  given.get("seed", 0)))
@@ -120,7 +125,9 @@ def prm_no_path_why(samples: int, seed: int) -> str:
 
 def world_result_doc(world, result) -> dict:
     """The --json object of a world plan: the path in the frame (``path``), as north/east
-    metres (``path_local``; lon/lat in the degrees frame, as before) and as lon/lat."""
+    metres (``path_local``; lon/lat in the degrees frame, as before) and as lon/lat;
+    ``seconds`` the search alone, ``setup_seconds`` what its first query set up (the
+    roadmap or raster, compiled kernels; in a command's one query, always a number)."""
     local = result.path if world.frame == "degrees" else path_north_east(world, result.path)
     lonlat = result.path_lonlat if result.path_lonlat is not None else np.empty((0, 2))
     return {"status": result.status.value,
@@ -130,7 +137,9 @@ def world_result_doc(world, result) -> dict:
             "path_local": np.asarray(local).tolist(),
             "path_lonlat": np.asarray(lonlat).tolist(),
             "expanded": int(result.expanded),
-            "seconds": result.seconds, "algorithm": result.algorithm}
+            "seconds": result.seconds,
+            "setup_seconds": result.extra.get("setup_seconds"),
+            "algorithm": result.algorithm}
 
 
 def synth_city_command(

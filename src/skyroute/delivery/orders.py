@@ -18,7 +18,7 @@ from pathlib import Path
 
 from skyroute.delivery.site import check_place
 from skyroute.errors import InputFormatError
-from skyroute.files import read_text
+from skyroute.files import need_folder, read_text
 
 CHARGE = 50
 MAX_ITEMS = 4
@@ -109,7 +109,7 @@ def _rows(path: Path, header: list[str]):
 
 def read_csv_orders(root: Path) -> list[Order]:
     """Every order of ``root/database`` with its items (in file order)."""
-    opath = root / "database" / "orders.csv"
+    opath = need_folder(root) / "database" / "orders.csv"
     dpath = root / "database" / "orderDetails.csv"
     heads = []
     seen: set[str] = set()

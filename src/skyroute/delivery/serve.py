@@ -8,6 +8,7 @@ from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 
 from skyroute.errors import InputFormatError, SkyrouteError
+from skyroute.files import need_folder
 
 
 class _Quiet(SimpleHTTPRequestHandler):
@@ -17,7 +18,7 @@ class _Quiet(SimpleHTTPRequestHandler):
 
 def make_server(data: Path, port: int, host: str = "127.0.0.1") -> ThreadingHTTPServer:
     """A server for ``data/website`` on ``host:port`` (port 0 picks a free one)."""
-    site = data / "website"
+    site = need_folder(data) / "website"
     if not site.is_dir():
         raise InputFormatError(data, "not a data folder: no website/ inside")
     handler = functools.partial(_Quiet, directory=str(site))

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from skyroute.errors import InputFormatError, OptionError, SkyrouteError
-from skyroute.files import read_text, strip_bom
+from skyroute.files import need_folder, read_text, strip_bom
 
 TIMEOUT = 5.0  # seconds per request
 
@@ -79,6 +79,6 @@ def open_source(data: Path | None, source: str | None) -> DirSource | HttpSource
             raise OptionError(f"source={source!r}: expected an http:// or https:// URL",
                               param="source")
         return HttpSource(source)
-    if not (data / "website").is_dir():
+    if not (need_folder(data) / "website").is_dir():
         raise InputFormatError(data, "not a data folder: no website/ inside (the ILP layout)")
     return DirSource(data)

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError, check_seed, real
-from skyroute.files import open_text
+from skyroute.files import cannot_read, open_text
 from skyroute.fleet.limits import MAX_PACKAGES, expected_packages
 from skyroute.fleet.scenario import Scenario
 
@@ -129,7 +129,7 @@ def read_csv(path: str | Path, scenario: Scenario) -> Stream:
                                            "limit of one run; split the file", line=line)
                 rows.append(_row(p, line, rec, ids))
     except OSError as exc:  # strerror: the file is named once, not twice
-        raise InputFormatError(p, f"cannot read: {exc.strerror or exc}") from None
+        raise cannot_read(p, exc) from None
     except UnicodeDecodeError as exc:  # as files.read_text words it for every other file
         raise InputFormatError(p, f"cannot read: not UTF-8 text ({exc.reason} at byte "
                                f"{exc.start})") from None

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from skyroute.errors import OptionError, QueryError, flag, real, whole
+from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.motion import dubins_kernel
 from skyroute.motion.dubins_batch import lengths_kernel
 from skyroute.motion.dubins_kernel import WORDS, ZERO
@@ -109,11 +110,14 @@ def _words(starts: np.ndarray, goals: np.ndarray, radius: float) -> np.ndarray:
     return out
 
 
-def lengths(starts, goals, radius: float) -> np.ndarray:
+@strict_keywords
+def lengths(starts, goals, radius: float, **misspelt) -> np.ndarray:
     """Shortest Dubins lengths for (N, 3) arrays of start and goal poses (compiled).
 
     Raises QueryError for poses that are not (N, 3) finite numbers or not as many,
     OptionError for a radius that is not a number > 0."""
+    if misspelt:
+        raise unknown_keywords(lengths, misspelt)
     r = _check_radius(radius)
     s = _poses(starts, "starts") if np.size(starts) else np.empty((0, 3))
     g = _poses(goals, "goals") if np.size(goals) else np.empty((0, 3))
@@ -200,10 +204,13 @@ def _advance(pose: np.ndarray, kind: str, s: np.ndarray, r: float) -> np.ndarray
     return np.c_[nx, ny, th + turn]
 
 
-def shortest_path(start, goal, radius: float) -> DubinsPath:
+@strict_keywords
+def shortest_path(start, goal, radius: float, **misspelt) -> DubinsPath:
     """The shortest Dubins path from pose ``start`` to pose ``goal`` (x, y, heading) with
     turning ``radius`` > 0. Raises QueryError for a pose that is not three finite
     numbers, OptionError for a bad radius."""
+    if misspelt:
+        raise unknown_keywords(shortest_path, misspelt)
     r = _check_radius(radius)
     s, g = (_one_pose(p, what) for p, what in ((start, "start"), (goal, "goal")))
     seg, total = dubins_kernel.words(*s, *g, r)  # compiled: one query

@@ -77,6 +77,7 @@ from skyroute.errors import (
     real,
     whole,
 )
+from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.motion import hybrid_search
 from skyroute.motion.arc_kernels import chain_free, edge_index
 from skyroute.motion.corner_distance import corner_graph
@@ -176,10 +177,11 @@ def runway_goal(threshold, runway_heading: float, approach_length: float) -> tup
     return gate, Piece("S", gate, a, math.inf)
 
 
+@strict_keywords
 def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
          step: float | None = None, reverse: bool = False,
          max_expansions: int | None = None, approach: float | None = None,
-         smooth: bool = True, seed: int = 0) -> HybridResult:
+         smooth: bool = True, seed: int = 0, **misspelt) -> HybridResult:
     """A short path of arcs (radius ``radius``) and straights from ``start`` to ``goal``
     that meets no obstacle interior and stays strictly inside the boundary.
 
@@ -238,6 +240,8 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
     OptionError
         an out-of-range option.
     """
+    if misspelt:
+        raise unknown_keywords(plan, misspelt)
     check_instance("world", world, World, "a skyroute World")
     r, H, step, limit = _options(radius, heading_bins, step, reverse, max_expansions, seed,
                                  smooth)

@@ -32,6 +32,7 @@ import shapely
 
 from skyroute.caches import register
 from skyroute.errors import OptionError, check_choice, check_instance, flag, real, whole
+from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.result import Status
 from skyroute.world.world import World
 
@@ -250,12 +251,13 @@ def _navigation(world: World, goal: np.ndarray, resolution: float, points: np.nd
     return grid, dist
 
 
+@strict_keywords
 def run_field(world: World, start, goal, *, step: float | None = None,
               attract: float = 1.0, repulse: float | None = None,
               sensor_range: float | None = None, sensor_rays: int = 36,
               tolerance: float | None = None, max_moves: int = 2000, escape: bool = True,
               window: int = 40, mode: str = "step", max_turn: float = math.pi / 4,
-              heading: float | None = None) -> FieldRun:
+              heading: float | None = None, **misspelt) -> FieldRun:
     """Descend the field from ``start``; with ``escape``, follow the navigation function
     instead whenever the field cannot move on: when the last ``window`` moves made less
     than two steps of net progress (a local minimum, or circling), when the force
@@ -278,6 +280,8 @@ def run_field(world: World, start, goal, *, step: float | None = None,
     step and tolerance were half a degree (55 km), and every goal of a city was
     "reached" at the start, in 0 moves.
     """
+    if misspelt:
+        raise unknown_keywords(run_field, misspelt)
     check_instance("world", world, World, "a skyroute World")
     check_choice("mode", mode, MODES)
     p = world.check_point(start, "start")

@@ -29,6 +29,7 @@ import shapely
 
 from skyroute.caches import register
 from skyroute.errors import OptionError, QueryError, check_instance, real, renamed, whole
+from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.motion import edge_grid, move_search
 from skyroute.motion.zone_kernels import zone_arrays
 from skyroute.result import FOUND, STATUS_OF_CODE, Status
@@ -226,9 +227,10 @@ def default_budget(world: World, merge: float = MERGE) -> int:
     return int(min(cells, MAX_BUDGET))
 
 
+@strict_keywords
 def plan_moves(world: World, start, goal=None, *, step: float = STEP,
                max_expansions: int | None = None, merge: float = MERGE,
-               target=None) -> Flight:
+               target=None, **misspelt) -> Flight:
     """The fewest moves from ``start`` to a position strictly closer than ``step`` to
     ``goal`` (A* over positions reachable by steps; positions in one ``merge``-wide
     lattice cell are one state, which on the ILP map gives the same move counts as
@@ -243,6 +245,8 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     pair there that needs 215,220). The whole search is one compiled call
     (:mod:`skyroute.motion.move_search`), which Ctrl-C interrupts.
     """
+    if misspelt:
+        raise unknown_keywords(plan_moves, misspelt)
     _check_world(world)
     goal = renamed("goal", goal, "target", target)
     if goal is None:

@@ -27,6 +27,7 @@ import numpy as np
 from numba import njit
 
 from skyroute.errors import QueryError, check_instance, check_seed, real, whole
+from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.motion import hybrid
 from skyroute.motion.dubins_kernel import TURNS, shortest_length, words
 from skyroute.motion.pieces import chain, check_samples, sample
@@ -110,9 +111,10 @@ def _dubins_table(starts, pts, cand, r):
     return c0, C
 
 
+@strict_keywords
 def tour(start_pose, targets, radius: float, *, world: World | None = None,
          headings: int = 16, exact_limit: int = 12, max_expansions: int | None = None,
-         seed: int = 0) -> TourResult:
+         seed: int = 0, **misspelt) -> TourResult:
     """The shortest tour from ``start_pose`` (x, y, heading) through every target (x, y).
 
     The start heading is given, not chosen (``fly --targets`` without one starts on 0);
@@ -128,6 +130,8 @@ def tour(start_pose, targets, radius: float, *, world: World | None = None,
     budget makes the tour's status. ``no_path`` with no legs: no order has a finite cost
     (a target walled off).
     """
+    if misspelt:
+        raise unknown_keywords(tour, misspelt)
     t0 = time.perf_counter()
     radius = real("radius", radius, low=0.0, strict=True)  # numpy numbers too
     headings = whole("headings", headings, low=1, high=72)

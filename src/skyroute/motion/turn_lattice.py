@@ -19,6 +19,7 @@ import numpy as np
 from numba import njit
 
 from skyroute.errors import OptionError, budget, check_choice, check_instance, real
+from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH, STATUS_OF_CODE, Status
 from skyroute.roadmap.raster import entry_cell, world_raster
 from skyroute.search import heap
@@ -137,15 +138,18 @@ def _lattice_kernel(blk, Wp, start, start_h, goal, H, dirs, offs, lens, turn, sp
     return NO_PATH, -1, g, parent, expanded
 
 
+@strict_keywords
 def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
                headings: int = 8, speed: float = 1.0, turn_rate: float = math.pi / 2,
                start_heading: float | None = None,
-               max_expansions: int | None = None) -> LatticeResult:
+               max_expansions: int | None = None, **misspelt) -> LatticeResult:
     """Fastest route from cell ``start`` to cell ``goal`` (any final heading).
 
     ``speed`` in cells per second, ``turn_rate`` in radians per second; ``start_heading``
     (radians, from the x axis towards +y) snaps to the nearest lattice heading, or any.
     """
+    if misspelt:
+        raise unknown_keywords(plan_turns, misspelt)
     check_instance("grid", grid, Grid, "a skyroute Grid")
     check_choice("headings", headings, (8, 16))
     speed, turn_rate = _rates(speed, turn_rate)

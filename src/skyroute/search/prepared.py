@@ -17,6 +17,7 @@ import numpy as np
 
 from skyroute.errors import InputFormatError, OptionError, check_choice
 from skyroute.files import as_path
+from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.result import STATUS_OF_CODE, PlanResult
 from skyroute.search import subgoal_table
 from skyroute.search.cache_lines import line_aligned
@@ -133,13 +134,16 @@ class PreparedGrid:
         """Bytes of the index arrays, the padded grid and the query workspace."""
         return int(sum(a.nbytes for a in self._args if isinstance(a, np.ndarray)))
 
-    def plan(self, start, goal) -> PlanResult:
+    @strict_keywords
+    def plan(self, start, goal, **misspelt) -> PlanResult:
         """The exact octile path from cell ``start`` to ``goal``, both (x, y).
 
         Same contract as ``skyroute.plan(grid, start, goal)``: ``status`` found or
         no_path (at once, from component labels, when they lie in different free
         regions), ``path`` every cell, ``cost``; ``expanded`` counts graph nodes.
         """
+        if misspelt:
+            raise unknown_keywords(self.plan, misspelt)
         s, t = self._space.flat_pair(start, goal)
         t0 = time.perf_counter()
         code, path, cost, expanded, frontier = self._call(*self._args, s, t)
@@ -255,7 +259,8 @@ def _require_grid(grid) -> None:
                           param="grid")
 
 
-def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
+@strict_keywords
+def prepare(grid: Grid, *, method: str = "auto", **misspelt) -> PreparedGrid:
     """Build a reusable index of ``grid`` for repeated exact queries.
 
     ``method`` "subgoal": a simple subgoal graph (Uras, Koenig & Hernandez 2013) with
@@ -277,6 +282,8 @@ def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
     >>> r.status.value, round(r.cost, 8), len(r.path)
     ('found', 112.55634919, 109)
     """
+    if misspelt:
+        raise unknown_keywords(prepare, misspelt)
     check_choice("method", method, METHODS)
     _require_grid(grid)
     t0 = time.perf_counter()
@@ -301,11 +308,14 @@ def prepare(grid: Grid, *, method: str = "auto") -> PreparedGrid:
     return index
 
 
-def load_index(path: str | Path, grid: Grid) -> PreparedGrid:
+@strict_keywords
+def load_index(path: str | Path, grid: Grid, **misspelt) -> PreparedGrid:
     """Read an index written by :meth:`PreparedGrid.save` for ``grid``; an unreadable,
     outdated, malformed or foreign index is an InputFormatError naming the file.
     Distances are trusted as written: load only indexes skyroute wrote (see
     :mod:`skyroute.search.index_file`)."""
+    if misspelt:
+        raise unknown_keywords(load_index, misspelt)
     _require_grid(grid)
     blocked = np.asarray(grid.blocked, dtype=bool)
     method, arrays = read_index(as_path(path, "path"), blocked, grid.name)

@@ -14,7 +14,8 @@ from skyroute.errors import (
     real,
     renamed,
 )
-from skyroute.files import as_path
+from skyroute.files import as_path, cannot_read
+from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.world.grid import Grid
 
 if TYPE_CHECKING:
@@ -44,7 +45,7 @@ def resolve_map_path(path: str | Path) -> Path:
         if p.exists() and not p.is_dir():
             return p
     except OSError as exc:  # e.g. a name longer than the file system allows
-        raise InputFormatError(p, f"cannot read: {exc.strerror}") from None
+        raise cannot_read(p, exc) from None
     maps = bundled_maps()
     key = p.name[:-4] if p.name.endswith(".map") else p.name
     if str(path) == p.name and key in maps:
@@ -54,8 +55,9 @@ def resolve_map_path(path: str | Path) -> Path:
     raise InputFormatError(p, "no such file (bundled maps: " + ", ".join(maps) + ")")
 
 
+@strict_keywords
 def load_map(path: str | Path, *, resolution: float | None = None, safety: float | None = None,
-             cell_size: float | None = None, clearance: float | None = None) -> Grid:
+             cell_size: float | None = None, clearance: float | None = None, **misspelt) -> Grid:
     """Read a map into a :class:`Grid`, chosen by the file's suffix.
 
     - ``.map``: a MovingAI map (1 m cells; ``resolution`` rescales it);
@@ -73,6 +75,8 @@ def load_map(path: str | Path, *, resolution: float | None = None, safety: float
     >>> grid.width, grid.height
     (65, 81)
     """
+    if misspelt:
+        raise unknown_keywords(load_map, misspelt)
     resolution = renamed("resolution", resolution, "cell_size", cell_size)
     resolution = 1.0 if resolution is None else real("resolution", resolution)
     safety = renamed("safety", safety, "clearance", clearance)
@@ -113,9 +117,10 @@ ALTITUDE = f"a finite number >= {MIN_ALTITUDE:g}"  # what an altitude must be
 MAX_SAFETY_DEGREES = 180.0  # a safety margin in the degrees frame; in metres, MAX_METRES
 
 
+@strict_keywords
 def load_world(path: str | Path, *, altitude: float | None = None, safety: float = 0.0,
                boundary: str | Path | None = None, frame: str = "lonlat",
-               text: str | None = None) -> World:
+               text: str | None = None, **misspelt) -> World:
     """Read a continuous world: a ``colliders.csv`` city or a GeoJSON file of zones.
 
     ``frame`` is how points are given to and returned by everything that takes this
@@ -129,6 +134,8 @@ def load_world(path: str | Path, *, altitude: float | None = None, safety: float
     frame). ``text``: the file's content, already in hand (an upload); ``path`` then only
     names it and its suffix tells the format.
     """
+    if misspelt:
+        raise unknown_keywords(load_world, misspelt)
     from skyroute.geo import FRAME_ALIASES, FRAMES
     from skyroute.world.colliders import read_colliders
     from skyroute.world.geojson_world import parse_boundary, read_geojson_world

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from skyroute.errors import InputFormatError
-from skyroute.files import strip_bom
+from skyroute.files import cannot_read, strip_bom
 from skyroute.world.grid import MAX_CELLS, Grid, check_file_cells
 
 PASSABLE = ".GS"
@@ -35,7 +35,7 @@ def _lines(path: Path, raw: bytes | None = None, kind: str = "a map file") -> li
                                        f"{MAX_BYTES:,} for {kind}")
             raw = path.read_bytes()
         except OSError as exc:
-            raise InputFormatError(path, f"cannot read: {exc.strerror or exc}") from None
+            raise cannot_read(path, exc) from None
     raw = strip_bom(raw)
     if not raw.strip():
         raise InputFormatError(path, "the file is empty", line=1)
