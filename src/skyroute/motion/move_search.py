@@ -52,33 +52,15 @@ def distance(qx, qy, sees, tx, ty, corners, cdist, edges, meta, start, ids):
                 vals[n], order[n] = v, c
                 n += 1
         for i in range(n // 2 - 1, -1, -1):
-            _sift_down(vals, order, i, n)
+            heap.sift_down(vals, order, i, n)
         while n > 0:
             v, c = vals[0], order[0]
             if sight(qx, qy, corners[c, 0], corners[c, 1], edges, meta, start, ids):
                 d = max(d, v)
                 break
+            heap.pop_plain(vals, order, n)
             n -= 1
-            vals[0], order[0] = vals[n], order[n]
-            _sift_down(vals, order, 0, n)
     return d
-
-
-@njit(cache=True, inline="always")
-def _sift_down(vals, order, i, n):
-    """Restore the min-heap on vals[:n] (order alongside) below slot i."""
-    v, c = vals[i], order[i]
-    while True:
-        k = 2 * i + 1
-        if k >= n:
-            break
-        if k + 1 < n and vals[k + 1] < vals[k]:
-            k += 1
-        if not vals[k] < v:
-            break
-        vals[i], order[i] = vals[k], order[k]
-        i = k
-    vals[i], order[i] = v, c
 
 
 @njit(cache=True)

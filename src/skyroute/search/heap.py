@@ -154,24 +154,30 @@ def pop_plain(hk, hn, size):
     """Remove the minimum of a plain heap of ``size`` entries; return its node."""
     top = hn[0]
     size -= 1
-    lk, ln = hk[size], hn[size]
-    i = 0
+    if size > 0:
+        hk[0], hn[0] = hk[size], hn[size]
+        sift_down(hk, hn, 0, size)
+    return top
+
+
+@njit(cache=True, inline="always")
+def sift_down(hk, hn, i, size):
+    """Restore the min-heap on ``hk[:size]`` (``hn`` alongside) below slot ``i``: a pop's
+    second half, and with ``i`` from ``size // 2 - 1`` down to 0 a heapify."""
+    k, node = hk[i], hn[i]
     while True:
         b = 2 * i + 1
         if b >= size:
             break
         if b + 1 < size and hk[b + 1] < hk[b]:
             b += 1
-        if hk[b] < lk:
-            hk[i] = hk[b]
-            hn[i] = hn[b]
-            i = b
-        else:
+        if not hk[b] < k:
             break
-    if size > 0:
-        hk[i] = lk
-        hn[i] = ln
-    return top
+        hk[i] = hk[b]
+        hn[i] = hn[b]
+        i = b
+    hk[i] = k
+    hn[i] = node
 
 
 @njit(cache=True)
