@@ -15,7 +15,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "skyroute"
 
 # Bottom first. A module may import its own layer (without cycles) and the ones below.
 LAYERS = [
-    {"errors", "result", "geo", "caches", "files", "lazy", "blas_probe", "version"},
+    {"errors", "keywords", "result", "geo", "caches", "files", "lazy", "blas_probe", "version"},
     {"world"},
     {"search"},
     {"roadmap", "planner", "world_plan"},
