@@ -244,3 +244,18 @@ def test_an_empty_world_path_is_named_as_such():
                        r"city or a GeoJSON file$") as info:
         skyroute.load_world("")
     assert info.value.param == "path"
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_a_world_built_with_a_vertex_not_finite_is_refused_naming_it(bad):
+    """The loaders refuse NaN and infinity in a file, but a World built in code took them:
+    the step drone's plan_moves then raised numpy's "cannot convert float NaN to integer"
+    for a NaN (its edge grid; before the grid it flew 30 moves round whatever the kernels
+    made of the ring) and GEOS's "encountered NaN/Inf numbers" for an infinity."""
+    ring = [(0, 0), (1e-3, 0), (1e-3, bad), (0, 1e-3)]
+    with pytest.raises(OptionError, match=r"^obstacle 1 \('tower'\) has a vertex that is "
+                       r"not finite \(0\.001, -?(nan|inf)\)"):
+        skyroute.World([shapely.box(5, 5, 6, 6), shapely.Polygon(ring)], 0, 1,
+                       ("hall", "tower"), frame="degrees")
+    with pytest.raises(OptionError, match=r"^the boundary has a vertex that is not finite"):
+        skyroute.World([], 0, 1, (), boundary=shapely.Polygon([(-1, -1), (1, -1), (bad, 1)]))

@@ -22,7 +22,9 @@ from skyroute.files import write_atomic
 from skyroute.motion.step_drone import MERGE, STEP, plan_moves
 from skyroute.world.world import World
 
-VERSION = 1  # bump when plan_moves' results may change
+# bump when plan_moves' results may change (2: its default budget became every state of
+# a bounded world; a pair past the old 200,000 expansions was kept as -1, no flight)
+VERSION = 2
 
 
 def _world_key(world: World) -> str:

@@ -64,6 +64,27 @@ def _flat(geoms):
     return shapely.force_2d(geoms) if has_z else geoms
 
 
+def _check_finite(obstacles, names, boundary) -> None:
+    """An OptionError naming the first obstacle (or the boundary) with a coordinate that
+    is not finite. The loaders refuse one in a file; a World built in code reached the
+    planners with it (the step drone's edge grid raised numpy's "cannot convert float NaN
+    to integer"). Anything not a geometry is left for the planners to refuse."""
+    for what, geoms in (("obstacle", obstacles), ("boundary", boundary)):
+        if geoms is None:
+            continue
+        try:
+            xy, index = shapely.get_coordinates(geoms, return_index=True)
+        except (TypeError, shapely.errors.GEOSException):
+            continue
+        bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))
+        if len(bad):
+            k = int(index[bad[0]])
+            who = "the boundary" if what == "boundary" else f"obstacle {k} ({names[k]!r})"
+            x, y = map(float, xy[bad[0]])
+            raise OptionError(f"{who} has a vertex that is not finite ({x!r}, {y!r}): "
+                              "every coordinate must be a finite number")
+
+
 @dataclass(frozen=True, eq=False)
 class World:
     """Polygon obstacles (with floors and ceilings), a boundary, a frame and a home.
@@ -109,6 +130,7 @@ class World:
         object.__setattr__(self, "obstacles", _flat(obs))
         if self.boundary is not None:
             object.__setattr__(self, "boundary", _flat(self.boundary))
+        _check_finite(self.obstacles, names, self.boundary)
         object.__setattr__(self, "floors", floors)
         object.__setattr__(self, "ceilings", ceilings)
         object.__setattr__(self, "names", names)
