@@ -84,19 +84,15 @@ def _early_processes(request, tmp_path_factory, leg_cache):
             cwd = tmp_path_factory.mktemp("process")
             started[item.nodeid] = cwd, _start(mark.args, cwd)
     yield started
-    _stop(started)
+    for _, proc in started.values():  # a test that never ran (-x, Ctrl-C): stop its process
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
 
 
 def _start(args, cwd: Path) -> subprocess.Popen:
     return subprocess.Popen([sys.executable, *args], cwd=cwd, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, env=dict(os.environ))
-
-
-def _stop(started: dict) -> None:
-    for _, proc in started.values():  # a test that never ran (-x, Ctrl-C): stop its process
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
 
 
 @pytest.fixture
