@@ -68,3 +68,27 @@ def test_order_costs_pick_the_better_shop_order():
     assert best[0][0] == (2, 1) and cost[0, 0] == 2 + 9 + 1 + 3
     # from the customer: A (1), B (9), back (4) beats B (20), A (9), back (1)
     assert best[1][0] == (1, 2) and cost[1, 0] == 1 + 9 + 4 + 3
+
+
+def test_a_timed_out_solve_is_never_worse_than_the_greedy_tour(monkeypatch):
+    """HiGHS out of time may hand back its trivial incumbent, no order at all (a CI under
+    load flew an empty day with 60 moves of battery where one order fits): then the
+    greedy tour is flown, not nothing, and the answer is not called proven."""
+    import scipy.optimize
+
+    value = np.array([500.0, 300.0])
+    cost = np.array([[20.0, 40.0], [30.0, 30.0]])
+    back = np.array([0.0, 11.0])
+    cust = np.array([1, 1])
+    real = scipy.optimize.milp
+
+    def out_of_time(c, **kw):
+        res = real(c, **kw)
+        res.x, res.status = np.zeros_like(res.x), 1  # time limit reached, incumbent 0
+        return res
+
+    monkeypatch.setattr(scipy.optimize, "milp", out_of_time)
+    chosen, proven = mission.solve(value, cost, back, cust, 60)
+    assert not proven
+    assert chosen == [(0, 0)] == [(i, 0) for i in mission.greedy(value, cost, back, cust, 60)]
+    assert tour_cost([0], cost, back, cust) <= 60

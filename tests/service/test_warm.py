@@ -119,3 +119,26 @@ def test_the_warm_up_queries_are_found_paths():
     for body in queries():
         out = _plan(PlanRequest.model_validate(body), res)
         assert out["status"] == "found" and len(out["path"]) >= 2, body
+
+
+def test_the_warm_up_builds_its_graphs_past_the_disk_cache(tmp_path, monkeypatch):
+    """A warm-up world's graph kept in the disk cache (its first build took longer than
+    ``SAVE_AFTER``, as on a loaded machine) is built again all the same: read back, it
+    loaded no build kernel, and the first real world's query loaded them (found by the
+    test above, under load)."""
+    from skyroute.roadmap import visibility
+    from skyroute.service.resources import Resources
+    from skyroute.service.settings import Settings
+    from skyroute.service.warm import warm
+
+    monkeypatch.setenv("SKYROUTE_CACHE", str(tmp_path))
+    monkeypatch.setattr(visibility, "SAVE_AFTER", -1.0)  # every graph is kept
+    res = Resources(Settings(token="warm-test-token-0001"))
+    assert warm(res)["failed"] == 0
+    kept = sorted(p.name for p in tmp_path.glob("visibility-*.npz"))
+    assert len(kept) == 2, kept  # one for each world format, read back from now on
+    built = []
+    real = visibility._build
+    monkeypatch.setattr(visibility, "_build", lambda w: built.append(w) or real(w))
+    assert warm(res)["failed"] == 0
+    assert len(built) == 2, built

@@ -128,15 +128,25 @@ def solve(value: np.ndarray, cost: np.ndarray, back: np.ndarray, cust: np.ndarra
         chosen = [arcs[k] for k in range(len(arcs)) if x[k]]
         parts = _disconnected(chosen, cust)
         if not parts:
+            if not proven:  # HiGHS's best when its time ran out: at times no order at
+                # all (seen under load), where the greedy tour flies some
+                fallback = _greedy_arcs(value, cost, back, cust, budget)
+                if value[[i for i, _ in fallback]].sum() > value[[i for i, _ in chosen]].sum():
+                    return fallback, False
             return chosen, proven
         for part in parts:
             rows += _cut(arcs, cust, part)
     # out of time with the tour still in pieces: the greedy tour (connected by making)
-    tour, at, arcs_ = greedy(value, cost, back, cust, budget), 0, []
-    for i in tour:
-        arcs_.append((i, at))
+    return _greedy_arcs(value, cost, back, cust, budget), False
+
+
+def _greedy_arcs(value, cost, back, cust, budget) -> list[tuple[int, int]]:
+    """:func:`greedy`'s tour as :func:`solve`'s arcs (order, origin index)."""
+    arcs, at = [], 0
+    for i in greedy(value, cost, back, cust, budget):
+        arcs.append((i, at))
         at = int(cust[i])
-    return arcs_, False
+    return arcs
 
 
 def _flow_rows(arcs, cust, n: int, n_org: int, flow: int) -> list[tuple[dict, float, float]]:

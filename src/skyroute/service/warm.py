@@ -87,9 +87,27 @@ def warm(res: Resources) -> dict:
             log.warning("warming the planners: %s on %s failed: %s",
                         body.get("algorithm"), "map_text" if "map_text" in body
                         else body["world_format"], " ".join(str(exc).split()))
+    for body in bodies:  # a graph read from the disk cache loaded no build kernel
+        if body.get("algorithm") == "visibility":
+            _build_graph(body)
     for name in bundled_maps():
         res.grid(name)
     seconds = time.perf_counter() - t0
     log.info("warmed the planners in %.1f s (%d queries%s)", seconds, len(bodies),
              f", {failed} failed" if failed else "")
     return {"queries": len(bodies), "failed": failed, "seconds": seconds}
+
+
+def _build_graph(body: dict) -> None:
+    """Build the visibility graph of a warm-up world again, past the disk cache: a tiny
+    world's graph built once (slowly, on a loaded machine or a cold numba cache) is kept
+    there, and a warm-up that read it back left the build's kernels to the first real
+    world's query. Logged and skipped on failure, as the queries are."""
+    from skyroute.roadmap.visibility import VisibilityGraph
+    from skyroute.service.routers.plan import PlanRequest, _world
+
+    try:
+        VisibilityGraph(_world(PlanRequest.model_validate(body)), cache=False)
+    except Exception as exc:  # a cold worker is slower, not broken
+        log.warning("warming the planners: the %s graph build failed: %s",
+                    body["world_format"], " ".join(str(exc).split()))
