@@ -10,6 +10,7 @@ import jsonschema_rs
 import pytest
 from pydantic import ValidationError
 
+from skyroute.fleet.scenario import preset
 from skyroute.service import alternatives
 from skyroute.service.routers.jobs import DeliverJob, FleetJob
 from skyroute.service.routers.plan import PlanRequest
@@ -25,7 +26,9 @@ RULES = {
     "DeliverJob": (DeliverJob, "/jobs/deliver", [["date"], ["from", "to"]],
                    {"date": "2024-01-03", "from": "2024-01-01", "to": "2024-01-02"}, {}),
     "FleetJob": (FleetJob, "/jobs/fleet", [["preset"], ["scenario"]],
-                 {"preset": "seed-3x3", "scenario": {"name": "x"}}, {"hours": 0.5}),
+                 # a scenario is the fleet's model now, in the schema as in the validator
+                 {"preset": "seed-3x3", "scenario": preset("seed-3x3").model_dump(
+                     mode="json")}, {"hours": 0.5}),
 }
 ABSENT = object()
 

@@ -281,8 +281,8 @@ RINGED = ringed()
     ("/jobs/fleet", {"preset": "seed-3x3", "seed": -1}, "seed", "greater than or equal"),
     ("/jobs/fleet", {"preset": "seed-3x3", "scheduler": "fifo"}, "scheduler", "'seed'"),
     ("/jobs/fleet", {"scenario": {"drones": 2}}, "scenario.airports", "Field required"),
-    ("/jobs/fleet", {"scenario": {"airports": [], "drones": 2, "packages": {
-        "csv": "/etc/passwd"}}}, "scenario.packages.csv", "cannot name a file"),
+    ("/jobs/fleet", {"scenario": {**SEED3, "packages": {"csv": "/etc/passwd"}}},
+     "scenario.packages.csv", "cannot name a file"),
     ("/jobs/fleet", {"preset": "seed-3x3", "hours": 23.5}, "hours", "refused by the runner"),
     ("/jobs/fleet", {"scenario": {**SEED3, "packages": {"rate_per_hour": 1e9}}},
      "scenario.packages.rate_per_hour", "1e+09 packages per hour is over the limit of 100,000"),
@@ -309,12 +309,12 @@ RINGED = ringed()
      "1000 drones for 24 h would store up to 8.6e+07 track rows"),
     ("/jobs/fleet", {"preset": "seed-3x3", "rate": 1e9, "hours": 0.01}, "rate",
      "less than or equal"),
-    ("/jobs/fleet", {"scenario": {"packages": "x"}}, "scenario.packages",
+    ("/jobs/fleet", {"scenario": {**SEED3, "packages": "x"}}, "scenario.packages",
      "expected a mapping"),
     # a ring of no-fly zones round an airport: refused now, not when it is first flown
     ("/jobs/fleet", {"scenario": RINGED}, "scenario.no_fly_zones",
      "no cruise can join airports C and A: zones 'west', 'east' close a ring round C"),
-    ("/jobs/fleet", {"scenario": {"packages": [1]}}, "scenario.packages",
+    ("/jobs/fleet", {"scenario": {**SEED3, "packages": [1]}}, "scenario.packages",
      "expected a mapping"),
     # ran on SQLite; on PostgreSQL the run was flown, then not stored: a raw SQL error
     ("/jobs/fleet", {"scenario": {**SEED3, "name": "Zoë\x00"}}, "scenario.name",

@@ -20,10 +20,12 @@ from skyroute.roadmap import world_plan
 from skyroute.roadmap.prm import prm_options
 from skyroute.service.app import create_app
 from skyroute.service.settings import Settings
+from skyroute.world.points import MAX_METRES
 from tests.service.conftest import AUTH, TOKEN, make_client
 from tests.service.test_app import assert_problem
 from tests.service.test_plan import CITY, CITY_LONLAT
 
+FRAMES = ("lonlat", "degrees", "ned", "local", "enu")
 # the fields whose bounds the schema came to declare (each of its bounds is checked)
 FIELDS = ("altitude", "safety", "samples", "boundary", "map")
 # what it must declare of them (field, keyword, the frame it holds in)
@@ -31,13 +33,21 @@ DECLARED = {("altitude", "minimum", None), ("safety", "minimum", None),
             ("safety", "maximum", None), ("safety", "maximum", "degrees"),
             ("samples", "minimum", None), ("samples", "maximum", None),
             ("map", "enum", None),
-            *((f"boundary[{i}]", k, None) for i in range(4) for k in ("minimum", "maximum"))}
-SPEC = create_app(Settings(token=TOKEN, warm=False, db_url="sqlite://")).openapi()
+            *((f"boundary[{i}]", k, None) for i in range(4) for k in ("minimum", "maximum")),
+            # start and goal: cells on a map, points in the frame on a world
+            *((f"{p}[{i}]", k, case) for p in ("start", "goal") for i in (0, 1)
+              for case in ("map", *FRAMES) for k in ("minimum", "maximum")
+              if (case, k) != ("map", "maximum"))}
+# a server whose own limit on samples is past the planner's: the schema declares the
+# planner's (test_samples_are_declared_up_to_this_servers_limit: a lower one)
+SPEC = create_app(Settings(token=TOKEN, warm=False, db_url="sqlite://",
+                           max_samples=10**9)).openapi()
 
 
 def bounds(spec: dict) -> list[tuple[str, str, object, str, str | None]]:
-    """(field as a 422 names it, keyword, bound, JSON type, frame) of every bound the
-    PlanRequest schema puts on :data:`FIELDS`, its ``if frame ... then`` ones too."""
+    """(field as a 422 names it, keyword, bound, JSON type, case) of every bound the
+    PlanRequest schema puts on :data:`FIELDS`, and of its ``if ... then`` ones (the case:
+    the frame they hold in, or "map")."""
     plan = spec["components"]["schemas"]["PlanRequest"]
     out = []
 
@@ -52,11 +62,20 @@ def bounds(spec: dict) -> list[tuple[str, str, object, str, str | None]]:
 
     for name in FIELDS:
         walk(name, plan["properties"][name], None, None)
-    if "if" in plan:
-        frame = plan["if"]["properties"]["frame"]["const"]
-        for name, sub in plan["then"]["properties"].items():
-            walk(name, sub, plan["properties"][name].get("type"), frame)
+    for rule in plan.get("allOf", ()):
+        for case in cases(rule["if"]):
+            for name, sub in rule["then"]["properties"].items():
+                walk(name, sub, plan["properties"][name].get("type"), case)
     return out
+
+
+def cases(rule: dict) -> list[str]:
+    """The frames an ``if`` holds for, or ["map"] (no world_text)."""
+    frame = rule.get("properties", {}).get("frame")
+    if frame is None:
+        assert rule["properties"]["world_text"] == {"type": "null"}, rule
+        return ["map"]
+    return [frame["const"]] if "const" in frame else list(frame["enum"])
 
 
 BOUNDS = bounds(SPEC)
@@ -72,11 +91,16 @@ def _step(bound, kind: str, down: bool):
     return math.nextafter(float(bound), -math.inf if down else math.inf)
 
 
-def at_and_past(key: str, bound, kind: str) -> tuple[list, list]:
-    """The values at the bound (accepted) and one step past it (refused)."""
+def at_and_past(key: str, bound, kind: str, *, edge: bool = False) -> tuple[list, list]:
+    """The values at the bound (accepted) and one step past it (refused). ``edge``: a
+    point of a world at the bound lies on the world's edge, which is outside it, and a
+    lon/lat's way through the local plane moves its last bits: the accepted value is
+    1e-9 of the bound inside it."""
     if key == "enum":
         return list(bound), [bound[0] + ".map"]
     exact = int(bound) if kind == "integer" else float(bound)
+    if edge:
+        return [exact * (1 - 1e-9)], [_step(bound, kind, down=key == "minimum")]
     if key == "minimum":
         return [exact], [_step(bound, kind, down=True)]
     if key == "maximum":
@@ -105,8 +129,46 @@ def zones(box: list[float]) -> dict:
             "goal": [x0 + 0.9 * (x1 - x0), y0 + 0.9 * (y1 - y0)]}
 
 
+MAP_TEXT = "type octile\nheight 3\nwidth 4\nmap\n....\n....\n....\n"  # all free
+
+
+def _point(field: str, value, frame: str) -> dict:
+    """A request whose ``start[i]`` or ``goal[i]`` is ``value``: a cell of a free map, or
+    a point of a world in ``frame`` round a small zone near it (lon/lat, or metres from
+    home: a world may lie anywhere within MAX_METRES of home, reaching 1,000 km)."""
+    name, i = field[:-3], int(field[-2])
+    if frame == "map":
+        b = {"map_text": MAP_TEXT, "start": [0, 0], "goal": [3, 2]}
+    else:
+        top, size = ((180.0, 90.0)[i], 0.01) if frame in ("lonlat", "degrees") \
+            else (MAX_METRES, 100.0)
+        edge = math.copysign(top, value)  # a box inside that edge
+        box = [0.0, 0.0, size, size]
+        box[i], box[i + 2] = sorted((edge, edge - math.copysign(size, value)))
+        b = zones(box) if top != MAX_METRES else colliders(box, frame)
+        if frame != "lonlat":  # lonlat: the default, not given
+            b["frame"] = frame
+    b[name][i] = value
+    return b
+
+
+def colliders(box: list[float], frame: str) -> dict:
+    """A colliders.csv world (metres, north and east of its home) of one building in the
+    middle of ``box`` (in ``frame``: ned, local or enu), start and goal either side."""
+    x0, y0, x1, y1 = box
+    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+    north, east = (cy, cx) if frame == "enu" else (cx, cy)
+    text = (f"lat0 55.944494, lon0 -3.186874\nposX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n"
+            f"{north},{east},10,5,5,10\n")
+    return {"world_format": "colliders", "world_text": text,
+            "start": [x0 + 0.1 * (x1 - x0), y0 + 0.1 * (y1 - y0)],
+            "goal": [x0 + 0.9 * (x1 - x0), y0 + 0.9 * (y1 - y0)]}
+
+
 def body(field: str, value, frame: str | None) -> dict:
     """A request valid but for ``field`` = ``value``, where that field is read."""
+    if field.startswith(("start", "goal")):
+        return _point(field, value, frame)
     if field == "map":
         return {"map": value, "start": [1, 1], "goal": [2, 2]}
     if field.startswith("boundary["):
@@ -153,16 +215,72 @@ VALIDATOR = jsonschema_rs.Draft202012Validator(
                               for f, k, _, _, fr in BOUNDS])
 def test_a_declared_bound_is_where_the_server_refuses(client, field, key, bound, kind,
                                                       frame):
-    ok, bad = at_and_past(key, bound, kind)
+    edge = field.startswith(("start", "goal")) and frame != "map"
+    ok, bad = at_and_past(key, bound, kind, edge=edge)
+    # a 422 names start or goal for either of its numbers
+    names = {field, field[:-3]} if field.startswith(("start", "goal")) else {field}
     for value in ok:
         b = body(field, value, frame)
         assert VALIDATOR.is_valid(b), (field, value)
         r = client.post("/plan", json=b, headers=AUTH)
         named = {e["field"] for e in r.json().get("errors", ())} \
             if r.status_code == 422 else set()
-        assert r.status_code in (200, 422) and field not in named, (value, r.text)
+        assert r.status_code in (200, 422) and not names & named, (value, r.text)
+        if field.startswith(("start", "goal")):  # planned
+            assert r.status_code == 200, (value, r.text)
     for value in bad:
         b = body(field, value, frame)
         assert not VALIDATOR.is_valid(b), (field, value)
         doc = assert_problem(client.post("/plan", json=b, headers=AUTH), 422)
-        assert field in {e["field"] for e in doc["errors"]}, (value, doc)
+        assert names & {e["field"] for e in doc["errors"]}, (value, doc)
+        assert len(doc["detail"].splitlines()) == 1
+
+
+def test_a_cell_on_a_map_is_declared_as_integers(client):
+    """On a map start and goal are cells: the schema says integers (a whole float counts,
+    in JSON Schema as on the server); on a world they are any numbers of the frame."""
+    for name in ("start", "goal"):
+        ok = {"map_text": MAP_TEXT, "start": [0, 0], "goal": [3, 2], name: [1.0, 2]}
+        assert VALIDATOR.is_valid(ok)
+        assert client.post("/plan", json=ok, headers=AUTH).status_code == 200
+        bad = {**ok, name: [1.5, 2]}
+        assert not VALIDATOR.is_valid(bad)
+        assert_problem(client.post("/plan", json=bad, headers=AUTH), 422, name,
+                       "a cell on a map is two integers")
+    world = {**zones([0.0, 0.0, 0.01, 0.01]), "start": [0.0015, 0.0025]}
+    assert VALIDATOR.is_valid(world)
+    assert client.post("/plan", json=world, headers=AUTH).status_code == 200
+
+
+def test_samples_are_declared_up_to_this_servers_limit(monkeypatch):
+    """The schema's ``samples`` maximum was the planner's (1e7) on every server, whose
+    own limit (``max_samples``, ``serve --max-samples``) is lower: 20,000 by default.
+    It is the server's now, and so is the default when the limit is below the
+    planner's 1000 (a PRM request without samples was refused for samples=1000)."""
+    asked = []
+    real = world_plan.prm_roadmap
+
+    def roadmap(world, *, samples=1000, **kw):
+        asked.append(samples)
+        return real(world, samples=min(samples, 50), **kw)
+
+    monkeypatch.setattr(world_plan, "prm_roadmap", roadmap)
+    default = create_app(Settings(token=TOKEN, warm=False)).openapi()
+    assert default["components"]["schemas"]["PlanRequest"]["properties"]["samples"][
+        "maximum"] == Settings().max_samples == 20_000
+    with make_client(db_url="sqlite://", max_samples=500) as c:
+        spec = c.get("/openapi.json").json()
+        samples = spec["components"]["schemas"]["PlanRequest"]["properties"]["samples"]
+        assert (samples["maximum"], samples["default"]) == (500, 500)
+        check = jsonschema_rs.Draft202012Validator(
+            {"$ref": "#/components/schemas/PlanRequest", "components": spec["components"]})
+        prm = {**CITY_BODY, "algorithm": "prm"}
+        for n in (500, 499):
+            assert check.is_valid({**prm, "samples": n})
+            assert c.post("/plan", json={**prm, "samples": n}, headers=AUTH).status_code == 200
+        assert not check.is_valid({**prm, "samples": 501})
+        assert_problem(c.post("/plan", json={**prm, "samples": 501}, headers=AUTH), 422,
+                       "samples", "samples=501 is over this server's limit of 500")
+        assert check.is_valid(prm)
+        assert c.post("/plan", json=prm, headers=AUTH).status_code == 200
+    assert asked == [500, 499, 500]

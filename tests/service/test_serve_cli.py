@@ -179,6 +179,7 @@ def test_a_log_level_not_uvicorns_is_one_line(monkeypatch, capsys, tmp_path):
     (["--db", "nonsense"], "not a database URL"),
     (["--token-file", "/nonexistent/token"], "--token-file /nonexistent/token: no such file"),
     (["--job-queue", "0"], "--job-queue: Input should be greater than or equal to 1"),
+    (["--max-samples", "1"], "--max-samples: Input should be greater than or equal to 2"),
 ])
 def test_bad_flags_are_one_line(monkeypatch, capsys, tmp_path, args, words):
     monkeypatch.chdir(tmp_path)
@@ -431,3 +432,16 @@ def test_bad_allowed_hosts_are_one_line(monkeypatch, capsys, tmp_path, given, wo
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
     assert "skyroute service on" not in err + out and not (tmp_path / "s.db").exists()
 
+
+
+def test_max_samples_is_the_limit_the_schema_declares(monkeypatch, capsys, tmp_path):
+    """``--max-samples``: the server's limit on a PRM request's samples, which
+    ``/openapi.json`` declares (the flag did not exist: every server held 20,000)."""
+    from fastapi.testclient import TestClient
+
+    app, _ = _served(monkeypatch, capsys, tmp_path, "--max-samples", "500")
+    with TestClient(app, base_url="http://127.0.0.1:8000") as c:
+        spec = c.get("/openapi.json").json()
+        assert spec["components"]["schemas"]["PlanRequest"]["properties"]["samples"][
+            "maximum"] == 500
+    assert app.state.settings.max_samples == 500  # what POST /plan holds samples to

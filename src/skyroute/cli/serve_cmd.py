@@ -61,6 +61,9 @@ def serve_command(
     max_body_mb: Annotated[float, typer.Option(help="Largest request body, MB.")] = 10.0,
     max_expansions: Annotated[int, typer.Option(
         help="Search budget of one POST /plan.")] = 2_000_000,
+    max_samples: Annotated[int, typer.Option(
+        help="Largest PRM roadmap of one POST /plan (its samples; /openapi.json declares "
+             "the limit).")] = 20_000,
     job_queue: Annotated[int, typer.Option(help="Jobs queued or running at once.")] = 8,
     log_level: Annotated[str, typer.Option(
         help="The lowest level logged on stderr, by uvicorn and skyroute alike: critical, "
@@ -105,13 +108,15 @@ def serve_command(
     try:
         settings = Settings(db_url=db, data_dir=data, source_url=source, dask_address=dask,
                             max_body_bytes=int(max_body_mb * MB),
-                            max_expansions=max_expansions, job_queue=job_queue, warm=warm,
+                            max_expansions=max_expansions, max_samples=max_samples,
+                            job_queue=job_queue, warm=warm,
                             allowed_hosts=hosts, **({"token": token} if token else {}))
     except ValidationError as exc:  # a limit out of range, or the token: before the store
         err = exc.errors()[0]
         field = str(err["loc"][0]) if err["loc"] else ""
         flag = {"max_body_bytes": "--max-body-mb", "job_queue": "--job-queue",
-                "max_expansions": "--max-expansions", "allowed_hosts": "--allowed-hosts"
+                "max_expansions": "--max-expansions", "max_samples": "--max-samples",
+                "allowed_hosts": "--allowed-hosts"
                 }.get(field, TOKEN_ENV if where == TOKEN_ENV else f"--token-file {where}")
         raise OptionError(f"{flag}: {err['msg'].removeprefix('Value error, ')}") from None
     if dask is not None:  # a wrong address (or skyroute on the cluster): one line now;

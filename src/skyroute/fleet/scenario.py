@@ -29,6 +29,7 @@ from pydantic import (
     field_validator,
     model_validator,
 )
+from pydantic.fields import FieldInfo
 
 from skyroute.errors import InputFormatError, OptionError, check_seed, real, whole
 from skyroute.files import lone_surrogate, read_text
@@ -54,15 +55,28 @@ def _near_home(v: float) -> float:
     return v
 
 
-def _at_most(limit: float, what: str):
+def _declared(**keywords) -> FieldInfo:
+    """JSON Schema keywords for a bound a validator of this module checks with its own
+    message: the service publishes the scenario's schema (``POST /jobs/fleet``), and a
+    client made from it should know every bound the server holds a value to."""
+    return Field(json_schema_extra=keywords)
+
+
+def _at_most(kind: type, limit: float, what: str):
+    """``kind`` at most ``limit`` ("1e+07 drones is over the limit of 1,000"), declared
+    as the schema's ``maximum``."""
     def check(v):
         if v > limit:
             raise ValueError(f"{v:g} {what} is over the limit of {limit:,g}")
         return v
-    return AfterValidator(check)
+    return Annotated[kind, AfterValidator(check), _declared(maximum=limit)]
 
 
-Metres = Annotated[float, AfterValidator(_near_home)]
+Metres = Annotated[float, AfterValidator(_near_home),
+                   _declared(minimum=-MAX_DISTANCE, maximum=MAX_DISTANCE)]
+Rate = _at_most(float, MAX_RATE, "packages per hour")
+Drones = _at_most(int, MAX_DRONES, "drones")
+Levels = _at_most(int, MAX_LEVELS, "levels")
 
 
 class _Strict(BaseModel):
@@ -127,14 +141,16 @@ class Airport(_Strict):
     own, at least ``gate_width`` apart and within :data:`MAX_GATE_DISTANCE` of it.
     """
 
-    id: str = Field(min_length=1)
-    north: Metres
-    east: Metres
-    landing: Runway
-    takeoff: Runway
+    id: str = Field(min_length=1, description="unique among the scenario's airports")
+    north: Metres = Field(description="metres north of home")
+    east: Metres = Field(description="metres east of home")
+    landing: Runway = Field(description="the runway drones land on")
+    takeoff: Runway = Field(description="the runway drones take off from")
     gate_width: float = Field(default=30.0, gt=0, description="metres between gate centres")
-    gates: tuple[tuple[FiniteFloat, FiniteFloat], ...] | None = Field(
-        default=None, description="[[north, east], [north, east]] of gates 0 and 1, metres")
+    gates: Annotated[tuple[tuple[FiniteFloat, FiniteFloat], ...],
+                     _declared(minItems=2, maxItems=2)] | None = Field(
+        default=None, description="[[north, east], [north, east]] of gates 0 and 1, metres: "
+        f"at least gate_width apart, each within {MAX_GATE_DISTANCE:g} m of the airport")
 
     @field_validator("gates")
     @classmethod
@@ -164,11 +180,14 @@ class Drone(_Strict):
 
     cruise_speed: float = Field(default=50.0, gt=0, description="m/s")
     turn_radius: float = Field(default=250.0, gt=0, description="m")
-    climb_angle_deg: float = Field(default=20.0, gt=0, lt=90)
-    landing_speed: float = Field(default=40.0, gt=0, description="m/s at touchdown")
+    climb_angle_deg: float = Field(default=20.0, gt=0, lt=90, description="degrees above "
+                                   "the horizon after the take-off roll")
+    landing_speed: float = Field(default=40.0, gt=0, description="m/s at touchdown, at "
+                                 "most cruise_speed")
     rollout: float = Field(default=192.0, gt=0, description="m from touchdown to a stop")
-    glide_angle_deg: float = Field(default=6.0, gt=0, lt=45)
-    taxi_speed: float = Field(default=10.0, gt=0)
+    glide_angle_deg: float = Field(default=6.0, gt=0, lt=45, description="degrees below "
+                                   "the horizon on the final approach")
+    taxi_speed: float = Field(default=10.0, gt=0, description="m/s on the ground")
     taxi_near_speed: float = Field(default=3.0, gt=0, description="within one gate width")
     taxi_gate_speed: float = Field(default=1.0, gt=0, description="within half a gate width")
 
@@ -182,8 +201,8 @@ class Drone(_Strict):
 class Packages(_Strict):
     """Where packages come from: a seeded Poisson stream or an explicit CSV."""
 
-    rate_per_hour: Annotated[float, _at_most(MAX_RATE, "packages per hour")] = Field(
-        default=60.0, ge=0)
+    rate_per_hour: Rate = Field(default=60.0, ge=0, description="packages per hour, a "
+                                "seeded Poisson stream")
     csv: str | None = Field(default=None, description="t,from_airport,from_gate,"
                                                       "to_airport,to_gate")
 
@@ -192,19 +211,24 @@ class Airspace(_Strict):
     """Cruise levels and separation minima."""
 
     mode: Literal["layers", "shared"] = "layers"
-    sep_horizontal: float = Field(default=50.0, gt=0)
-    sep_vertical: float = Field(default=10.0, gt=0)
-    base_altitude: float = Field(default=50.0, ge=50.0, description="lowest cruise level")
-    layer_step: float = Field(default=10.0, gt=0)
-    shared_levels: Annotated[int, _at_most(MAX_LEVELS, "levels")] = Field(
-        default=4, ge=1, description="levels by direction")
+    mode: Literal["layers", "shared"] = Field("layers", description="layers: a cruise "
+                                              "level per drone; shared: levels by bearing")
+    sep_horizontal: float = Field(default=50.0, gt=0, description="metres")
+    sep_vertical: float = Field(default=10.0, gt=0, description="metres")
+    base_altitude: float = Field(default=50.0, ge=50.0, description="lowest cruise level, "
+                                 "metres")
+    layer_step: float = Field(default=10.0, gt=0, description="metres between levels")
+    shared_levels: Levels = Field(default=4, ge=1, description="levels by direction")
 
 
 class NoFlyZone(_Strict):
     """A polygon no drone may fly into: (north, east) metres, at least three corners."""
 
     name: str = Field(default="zone", min_length=1)
-    points: list[tuple[Metres, Metres]] = Field(min_length=3)
+    points: list[tuple[Metres, Metres]] = Field(
+        min_length=3, description="[north, east] corners, metres from home: a simple "
+        f"polygon with an area (the scenario's zones hold at most {MAX_ZONE_CORNERS:,} "
+        "corners in all)")
 
     @model_validator(mode="after")
     def _valid(self) -> NoFlyZone:
@@ -220,22 +244,35 @@ class Scenario(_Strict):
     """Everything a fleet simulation needs besides the hours, seed and dispatcher."""
 
     name: str = "scenario"
-    home_lat: float = Field(default=50.8798, ge=-90, le=90)  # Leuven
-    home_lon: float = Field(default=4.7005, ge=-180, le=180)
-    airports: list[Airport] = Field(min_length=2)
-    drones: Annotated[int, _at_most(MAX_DRONES, "drones")] = Field(default=3, ge=1)
+    home_lat: float = Field(default=50.8798, ge=-90, le=90,  # Leuven
+                            description="latitude of home, degrees")
+    home_lon: float = Field(default=4.7005, ge=-180, le=180,
+                            description="longitude of home, degrees")
+    airports: list[Airport] = Field(
+        min_length=2, json_schema_extra={"maxItems": MAX_AIRPORTS},
+        description="farther apart than the longest runway")
+    drones: Drones = Field(default=3, ge=1, description="the fleet's size")
     handover_seconds: float = Field(default=15.0, ge=0, description="at a gate: unload, "
                                     "load")
     drone: Drone = Drone()
     packages: Packages = Packages()
     airspace: Airspace = Airspace()
-    no_fly_zones: list[NoFlyZone] = Field(default_factory=list)
+    no_fly_zones: list[NoFlyZone] = Field(
+        default_factory=list, json_schema_extra={"maxItems": MAX_ZONES},
+        description="none may cover a runway or close a ring round some airports")
+
+    @field_validator("airports", mode="before")
+    @classmethod
+    def _airport_count(cls, airports):
+        # counted on the input, before an airport is read (and before the distance
+        # matrix of every pair): the service took the same count before parsing
+        if isinstance(airports, list | tuple) and len(airports) > MAX_AIRPORTS:
+            raise ValueError(f"{len(airports)} airports is over the limit of {MAX_AIRPORTS}")
+        return airports
 
     @field_validator("airports")
     @classmethod
     def _layout(cls, airports: list[Airport]) -> list[Airport]:
-        if len(airports) > MAX_AIRPORTS:  # before the distance matrix of every pair
-            raise ValueError(f"{len(airports)} airports is over the limit of {MAX_AIRPORTS}")
         ids = [a.id for a in airports]
         if len(set(ids)) != len(ids):
             raise ValueError(f"ids must be unique, got {ids}")
@@ -439,31 +476,38 @@ def _parse(data, where, locate=None) -> Scenario:
     try:
         s = Scenario.model_validate(data)
     except ValidationError as exc:
-        errors = exc.errors()
-        # a misspelt key first: "Airports:" was reported as "airports: Field required",
-        # which hid the typo that caused it
-        err = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
-        field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err["loc"])
-        msg = err["msg"].removeprefix("Value error, ")
-        if err["type"] == "extra_forbidden":  # a typo: say what the section takes
-            msg = _unknown_key(err["loc"])
-        # a check of several fields (at the model level) names its own field first
+        loc, msg = first_error(exc)
+        field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc)
         text = f"{field.lstrip('.')}: {msg}" if field else msg
-        line = None
-        if locate is not None:
-            named = _FIELD.match(text)
-            line = locate(_loc(named.group(1)) if named else ())
-        raise InputFormatError(where, text, line=line) from None
+        raise InputFormatError(where, text, line=None if locate is None
+                               else locate(loc)) from None
     return s
 
 
-def _unknown_key(loc: tuple) -> str:
-    """"unknown key; valid: ..." for the key at ``loc`` (a validation error's path),
-    with the closest valid key first when one is close ("cruise_sped")."""
+def first_error(exc: ValidationError, model: type[BaseModel] = Scenario) -> tuple[tuple, str]:
+    """(field, message) of the error a scenario's reader reports of ``exc`` (``model``'s
+    validation error): a misspelt key first, as "unknown key; valid: ..."; a check of
+    several fields names its own field, which becomes the field (``airports[1]...``).
+    The field is a path of keys and list indices; () for the scenario itself."""
+    errors = exc.errors()
+    # a misspelt key first: "Airports:" was reported as "airports: Field required",
+    # which hid the typo that caused it
+    err = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
+    loc, msg = tuple(err["loc"]), err["msg"].removeprefix("Value error, ")
+    if err["type"] == "extra_forbidden":  # a typo: say what the section takes
+        msg = _unknown_key(loc, model)
+    named = None if loc else _FIELD.match(msg)
+    if named:  # a check of several fields (at the model level) names its own field
+        loc, msg = _loc(named.group(1)), msg[named.end():]
+    return loc, msg
+
+
+def _unknown_key(loc: tuple, model: type[BaseModel]) -> str:
+    """"unknown key; valid: ..." for the key at ``loc`` (a validation error's path in
+    ``model``), with the closest valid key first when one is close ("cruise_sped")."""
     import difflib
     import typing
 
-    model: type[BaseModel] = Scenario
     for part in loc[:-1]:
         if isinstance(part, int):
             continue

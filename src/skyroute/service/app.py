@@ -80,6 +80,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.resources = Resources(settings)
     problems.install(app)
     problems.document(app)
+    _declare_limits(app, settings)
     app.include_router(_post_only(POST_ONLY))  # first: /jobs/fleet is not /jobs/{job_id}
     modules = (health, maps, days, orders, site, plan, jobs, fleet, fleet_packages)
     for module in modules:
@@ -97,6 +98,19 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.api_heads = problems.api_heads(routes)
     app.state.api_methods = problems.api_methods(routes)  # a 405's Allow
     return app
+
+
+def _declare_limits(app: FastAPI, settings: Settings) -> None:
+    """``app``'s OpenAPI with this server's own limits where its settings lower the
+    library's (:func:`plan.declare_limits`): the document is made once, then kept."""
+    made = app.openapi
+
+    def openapi() -> dict:
+        if not app.openapi_schema:
+            plan.declare_limits(made(), settings)
+        return app.openapi_schema
+
+    app.openapi = openapi
 
 
 def _post_only(paths: tuple[str, ...]) -> APIRouter:

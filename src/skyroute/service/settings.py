@@ -14,6 +14,7 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from skyroute.delivery.store import DEFAULT_DB
+from skyroute.roadmap.limits import MIN_SAMPLES
 
 MB = 1024 * 1024
 # a token's fewest characters: the write endpoints answer anyone who can reach the
@@ -40,7 +41,9 @@ class Settings(BaseModel):
     max_raster_cells: int = Field(4_000_000, gt=0, description="Largest raster a grid "
                                   "algorithm on a world may build: its resolution (given "
                                   "or default) over the world, start and goal.")
-    max_samples: int = Field(20_000, gt=0, description="Largest PRM roadmap per request.")
+    max_samples: int = Field(20_000, ge=MIN_SAMPLES, description="Largest PRM roadmap per "
+                             "request (POST /plan's samples; /openapi.json declares it, or "
+                             "the planner's own where that is lower, as their maximum).")
     fresh_seconds: float = Field(1.0, ge=0, description="How long a file made from a "
                                  "stored day is served before the store is asked again "
                                  "whether the day changed.")

@@ -16,21 +16,22 @@ import threading
 from typing import Annotated, Any, Literal
 
 from fastapi import APIRouter, Depends, Path, Request
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from skyroute.delivery.limits import MAX_DAYS
 from skyroute.errors import SEED_MAX, SkyrouteError, StoreBusyError, StoreSchemaError
 from skyroute.fleet.limits import (
-    MAX_AIRPORTS,
     MAX_PACKAGES,
     MAX_RATE,
     MAX_TRACK_ROWS,
     expected_packages,
     track_rows,
 )
+from skyroute.service import fleet_scenario
 from skyroute.service.alternatives import exactly_one
 from skyroute.service.auth import has_token, require_token
 from skyroute.service.dates import IsoDate
+from skyroute.service.fleet_scenario import PostedScenario
 from skyroute.service.json_response import FiniteJSONResponse
 from skyroute.service.paths import url_path
 from skyroute.service.problems import Problem, responses
@@ -59,8 +60,8 @@ class DeliverJob(BaseModel):
                                  "and to.")
     from_: IsoDate | None = Field(None, alias="from", description="The range's first day "
                                   "(with to, without date).")
-    to: IsoDate | None = Field(None, description="The range's last day, not before from "
-                               "(with from, without date).")
+    to: IsoDate | None = Field(None, description="The range's last day, not before from, "
+                               f"at most {MAX_DAYS} days in all (with from, without date).")
     method: Literal["milp", "greedy"] = "milp"
     # strict, as the plan route's switches: true or false, never "yes" or 1
     replace: bool = Field(False, strict=True, description="Store a day whose every order "
@@ -89,14 +90,23 @@ class FleetJob(BaseModel):
                               json_schema_extra=exactly_one("preset", "scenario"))
 
     preset: Literal["seed-3x3", "seed-9x9", "seed-18x9"] | None = None
-    scenario: dict[str, Any] | None = Field(None, description="A scenario (the fields of "
-                                            "`skyroute fleet scenario`'s YAML).")
-    hours: float = Field(1.0, gt=0, le=MAX_HOURS)
+    scenario: PostedScenario | None = Field(None, description="A scenario: the fields of "
+                                           "`skyroute fleet scenario`'s YAML, checked as "
+                                           "`skyroute fleet simulate` checks a file.")
+    hours: float = Field(1.0, gt=0, le=MAX_HOURS, description="Simulated hours; with the "
+                         f"rate at most {MAX_PACKAGES:,g} packages in all, and with the "
+                         f"drones at most {MAX_TRACK_ROWS:,.0f} track rows (one a second).")
     seed: int = Field(0, ge=0, le=SEED_MAX)
     scheduler: Literal["seed", "optimal"] = "seed"
     airspace: Literal["layers", "shared"] | None = None
     rate: float | None = Field(None, gt=0, le=MAX_RATE, description="Packages per hour "
-                               "(default: the scenario's).")
+                               "(default: the scenario's); rate x hours at most "
+                               f"{MAX_PACKAGES:,g}.")
+
+    @field_validator("scenario", mode="wrap")
+    @classmethod
+    def _scenario(cls, value, handler):
+        return fleet_scenario.validate(value, handler)
 
     @model_validator(mode="after")
     def _one(self) -> FleetJob:
@@ -220,23 +230,11 @@ def post_deliver(body: DeliverJob, res: ResourcesDep, request: Request):
              summary="Run a fleet simulation as a job")
 def post_fleet(body: FleetJob, res: ResourcesDep, request: Request):
     from skyroute.fleet.airborne import check_flights
-    from skyroute.fleet.scenario import Scenario, parse_scenario, preset
+    from skyroute.fleet.scenario import Scenario, preset
 
     if body.scenario is not None:
-        packages = body.scenario.get("packages")
-        if packages is not None and not isinstance(packages, dict):
-            raise Problem(422, "scenario.packages: expected a mapping of package fields "
-                          "(rate_per_hour)", field="scenario.packages")
-        if (packages or {}).get("csv") is not None:
-            raise Problem(422, "scenario.packages.csv: a posted scenario cannot name a "
-                          "file on the server; give packages.rate_per_hour",
-                          field="scenario.packages.csv")
-        airports = body.scenario.get("airports")
-        if isinstance(airports, list) and len(airports) > MAX_AIRPORTS:  # before parsing
-            raise Problem(422, f"scenario.airports: {len(airports)} airports is over the "
-                          f"limit of {MAX_AIRPORTS}", field="scenario.airports")
+        scenario: Scenario = body.scenario  # read and checked as the request was read
         try:
-            scenario: Scenario = parse_scenario(body.scenario, "scenario")
             check_flights(scenario, "scenario")
         except SkyrouteError as exc:
             text = str(exc).removeprefix("scenario: ")

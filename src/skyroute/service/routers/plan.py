@@ -43,13 +43,42 @@ Point = tuple[Number, Number]
 Lon = Annotated[Number, Field(ge=-MAX_LON, le=MAX_LON)]
 Lat = Annotated[Number, Field(ge=-MAX_LAT, le=MAX_LAT)]
 MapName = Literal[tuple(bundled_maps())]  # the bundled maps, as GET /maps lists them
-# a margin in the degrees frame is at most MAX_SAFETY_DEGREES (load_world refuses more,
-# a 422 naming safety): a bound that depends on frame, stated as JSON Schema's if/then
-DEGREES_SAFETY = {"if": {"properties": {"frame": {"const": "degrees"}},
-                         "required": ["frame"]},
-                  "then": {"properties": {"safety": {"maximum": MAX_SAFETY_DEGREES}}}}
+# Bounds that depend on another field, stated as JSON Schema's if/then (each a 422
+# naming its field): a margin in the degrees frame is at most MAX_SAFETY_DEGREES
+# (load_world refuses more); start and goal on a map are cells, two integers from 0
+# (_cell, the grid's bounds); on a world they are points in the frame: lon/lat in
+# lonlat (the default) and degrees (check_places), metres within MAX_METRES of home in
+# ned, local and enu (check_metres).
+WORLD = {"required": ["world_text"], "properties": {"world_text": {"type": "string"}}}
+
+
+def _when(rule: dict, then: dict) -> dict:
+    return {"if": rule, "then": {"properties": then}}
+
+
+def _points(*item: dict) -> dict:
+    return {k: {"prefixItems": list(item)} for k in ("start", "goal")}
+
+
+def _within(limit: float) -> dict:
+    return {"minimum": -limit, "maximum": limit}
+
+
+CONDITIONS = [
+    _when({"properties": {"frame": {"const": "degrees"}}, "required": ["frame"]},
+          {"safety": {"maximum": MAX_SAFETY_DEGREES}}),
+    _when({"properties": {"world_text": {"type": "null"}}},  # absent or null: a map
+          _points(*[{"type": "integer", "minimum": 0}] * 2)),
+    _when({**WORLD, "properties": {**WORLD["properties"],
+                                   "frame": {"enum": ["lonlat", "degrees"]}}},
+          _points(_within(MAX_LON), _within(MAX_LAT))),
+    _when({"required": [*WORLD["required"], "frame"],
+           "properties": {**WORLD["properties"], "frame": {"enum": ["ned", "local", "enu"]}}},
+          _points(*[_within(MAX_METRES)] * 2)),
+]
 Pair = Annotated[list[float], Field(min_length=2, max_length=2)]
 SOURCES = ("map", "map_text", "world_text")  # exactly one of them
+DEFAULT_SAMPLES = 1000  # skyroute.plan's, unless this server's limit is lower
 
 
 class PlanRequest(BaseModel):
@@ -65,7 +94,7 @@ class PlanRequest(BaseModel):
         "examples": [{"map": "den312d", "start": [50, 76], "goal": [60, 13],
                       "algorithm": "astar"}],
         **exactly_one("map", "map_text", ("world_text", "world_format"),
-                      among=SOURCES), **DEGREES_SAFETY})
+                      among=SOURCES), "allOf": CONDITIONS})
 
     map: MapName | None = Field(None, description="A bundled map's name (GET /maps). "
                                 "Exactly one of map, map_text and world_text.")
@@ -104,9 +133,9 @@ class PlanRequest(BaseModel):
                                       "grid algorithms: cell size in world units (at most "
                                       "a local plane's 1e7 m; the raster, 8 cells round "
                                       "the obstacles and points, must lie within it).")
-    samples: int = Field(1000, strict=True, ge=MIN_SAMPLES, le=MAX_SAMPLES,
-                         description="PRM samples (the server may hold them to a lower "
-                         "limit: a 422 naming its limit).")
+    samples: int = Field(DEFAULT_SAMPLES, strict=True, ge=MIN_SAMPLES, le=MAX_SAMPLES,
+                         description="PRM samples, at most this server's limit (the "
+                         "schema's maximum; the default is held to it too).")
     neighbours: int = Field(10, strict=True, ge=1, le=1000, description="PRM neighbours.")
     prm_star: StrictBool = False
     seed: int = Field(0, strict=True, ge=0, le=SEED_MAX, description="PRM seed.")
@@ -219,10 +248,12 @@ def _plan_checked(body: PlanRequest, res: Resources) -> dict:
         world = _world(body)
         _check_world_limits(body, world, res)
         algorithm = body.algorithm or "visibility"
+        options = _options(body)
         if algorithm == "prm":
             budget = None  # scipy's Dijkstra has no budget; samples bound the work
+            options.setdefault("samples", _samples_default(res.settings))
         r = plan(world, tuple(body.start), tuple(body.goal), algorithm=algorithm,
-                 max_expansions=None if algorithm == "prm" else budget, **_options(body))
+                 max_expansions=budget, **options)
         out = r.to_dict()
         out["frame"] = world.frame
         if r.found:
@@ -291,7 +322,8 @@ def _world(body: PlanRequest):
 def _check_world_limits(body: PlanRequest, world, res: Resources) -> None:
     s = res.settings
     algorithm = body.algorithm or "visibility"
-    if algorithm == "prm" and body.samples > s.max_samples:
+    if algorithm == "prm" and "samples" in body.model_fields_set \
+            and body.samples > s.max_samples:
         raise Problem(422, f"samples={body.samples} is over this server's limit of "
                       f"{s.max_samples:,}", field="samples")
     if algorithm not in ("prm", "visibility"):
@@ -312,3 +344,19 @@ def _raster_cells(body: PlanRequest, world) -> tuple[int, float]:
     r = default_resolution(world, [s, t]) if body.resolution is None else body.resolution
     x0, y0, x1, y1 = raster_box(world, s, t, r)
     return max(1, math.ceil((x1 - x0) / r)) * max(1, math.ceil((y1 - y0) / r)), r
+
+
+def _samples_default(settings) -> int:
+    """PRM's samples when a request gives none: skyroute.plan's default, held to this
+    server's limit (a request that gave none was refused when the limit was lower)."""
+    return min(DEFAULT_SAMPLES, settings.max_samples)
+
+
+def declare_limits(spec: dict, settings) -> None:
+    """Put this server's own limits into ``spec`` (the app's OpenAPI document), where
+    the request model holds the library's: ``samples`` at most ``max_samples``, and its
+    default held to it. A client made from ``/openapi.json`` then refuses what this
+    server would (a 422 naming ``samples``)."""
+    samples = spec["components"]["schemas"]["PlanRequest"]["properties"]["samples"]
+    samples["maximum"] = min(samples["maximum"], settings.max_samples)
+    samples["default"] = _samples_default(settings)
