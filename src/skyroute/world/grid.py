@@ -225,19 +225,28 @@ def cell_xy(cell: object, what: str) -> tuple[int, int]:
 
 def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
     """(x, y) as ints (:func:`cell_xy`), on the grid and free; else QueryError naming
-    ``what``."""
+    ``what``, with :func:`swap_hint`."""
     x, y = cell_xy(cell, what)
     if not (0 <= x < grid.width and 0 <= y < grid.height):
-        # (row, column), numpy's order, is the likely slip when the swapped cell lies
-        # inside: said so, as a World says it of (lat, lon)
-        swapped = (f"; ({y}, {x}) is inside: cells are (x, y) = (column, row)"
-                   if 0 <= y < grid.width and 0 <= x < grid.height else "")
         raise QueryError(f"{what} ({x}, {y}) lies outside the {grid.width}x{grid.height} grid "
-                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1}){swapped}",
-                         param=what)
+                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})"
+                         f"{swap_hint(grid, x, y)}", param=what)
     if grid.blocked[y, x]:
-        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell", param=what)
+        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell{swap_hint(grid, x, y)}",
+                         param=what)
     return x, y
+
+
+def swap_hint(grid: Grid, x: int, y: int) -> str:
+    """'; (y, x) is free: cells are (x, y) = (column, row)' when cell (x, y), refused as
+    off the grid or blocked, is a free cell of the grid with its numbers swapped, else ''.
+    (row, column), numpy's order, is the likely slip, as (lat, lon) is in a World; on a
+    square map it never falls off the grid, so a blocked cell is where it shows. A swapped
+    cell that is blocked too gets no hint: it would point to a cell as bad as the first
+    (it did, for a cell off the grid)."""
+    if x == y or not (0 <= y < grid.width and 0 <= x < grid.height) or grid.blocked[x, y]:
+        return ""
+    return f"; ({y}, {x}) is free: cells are (x, y) = (column, row)"
 
 
 MAX_CELLS = 1 << 26  # 8192 x 8192: a search keeps about 50 bytes a cell (3.4 GB here)
