@@ -211,16 +211,23 @@ def _frozen(arr: np.ndarray) -> np.ndarray:
 def cell_xy(cell: object, what: str) -> tuple[int, int]:
     """(x, y) as ints, else QueryError naming ``what``. A mapping or a set is refused
     (unpacking it gives its keys or members, in no (x, y) order), and bytes
-    (b"\\x01\\x02" unpacks to two ints)."""
+    (b"\\x01\\x02" unpacks to two ints); so is a bool, which Python counts as an int
+    (``(True, 76)`` planned from (1, 76)), as numpy's bool is (no ``__index__``) and every
+    option reader refuses one for a number."""
     if isinstance(cell, Mapping | Set | bytes | bytearray):
         raise QueryError(f"{what} {cell!r} must be two integers (x, y), not a "
                          f"{type(cell).__name__}", param=what)
+    note = ""
     try:
         x, y = cell  # type: ignore[misc]
+        if isinstance(x, bool | np.bool_) or isinstance(y, bool | np.bool_):
+            note = ", not booleans"
+            raise TypeError(note)
         return operator.index(x), operator.index(y)
     except (TypeError, ValueError):
         shown = " ".join(repr(cell).split())  # one line: a 2-D array's repr has several
-        raise QueryError(f"{what} {shown} must be two integers (x, y)", param=what) from None
+        raise QueryError(f"{what} {shown} must be two integers (x, y){note}",
+                         param=what) from None
 
 
 def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
