@@ -180,6 +180,10 @@ def test_a_bool_is_not_a_cell_of_a_prepared_grid_nor_a_grid_method():
     for method in (grid.is_free, grid.in_bounds):
         with pytest.raises(QueryError, match=r"^cell \(True, 0\) .* not booleans$"):
             method((True, 0))
+    from skyroute.motion.turn_lattice import plan_turns
+
+    with pytest.raises(QueryError, match=r"^goal \(4, False\) .* not booleans$"):
+        plan_turns(grid, (0, 0), (4, False))
     # whole numbers of every other kind still plan, on the inline path and off it
     for cell in ((1, 3), [1, 3], (np.int64(1), np.int32(3)), np.array([1, 3])):
         assert skyroute.plan(grid, cell, (4, 4)).path[0].tolist() == [1, 3]
