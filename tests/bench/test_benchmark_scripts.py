@@ -38,7 +38,8 @@ def one_line_error(proc, name: str, words: str) -> None:
 
 
 @pytest.mark.parametrize("name", ["plan_ab.py", "plan_overhead.py", "prepare_memory.py",
-                                  "prepare_time.py", "world_queries.py", "hybrid_cpu.py"])
+                                  "prepare_time.py", "world_queries.py", "hybrid_cpu.py",
+                                  "flat_pair_ab.py"])
 def test_each_script_has_a_help(name):
     proc = script(name, "--help")
     assert proc.returncode == 0 and proc.stdout.startswith(f"usage: {name}"), proc.stderr
@@ -118,6 +119,33 @@ def test_a_tree_given_as_a_commit_is_its_archived_src():
     from skyroute.bench.random_maps import random_grid
 
     assert (common.random_blocked(40, 0.3, 5) == random_grid(40, 0.3, 5).blocked).all()
+
+
+def test_flat_pair_ab_times_both_trees_in_one_process(tmp_path):
+    (tmp_path / "tiny.map").write_text("type octile\nheight 3\nwidth 4\nmap\n@...\n....\n"
+                                       "..@.\n")
+    proc = script("flat_pair_ab.py", str(SRC), str(SRC.parent), "--map",
+                  str(tmp_path / "tiny.map"), "--number", "20", "--rounds", "2")
+    assert proc.returncode == 0, proc.stderr
+    assert "tiny.map, (1, 0) -> (2, 0)" in proc.stdout
+    rows = [line.split(" | ") for line in proc.stdout.splitlines() if line.startswith("| ")]
+    assert [r[0] for r in rows[1:]] == ["| plan() astar (us)", "| plan() jps (us)",
+                                        "| flat_pair alone (ns)"]
+    for r in rows[1:]:
+        assert all(positive(float(x)) for cell in r[1:3] for x in cell.split(" / ")), r
+        assert r[4].endswith(" of 2 |")
+
+
+@pytest.mark.parametrize("args, words", [
+    (["no/such/tree", ".", "--map", "README.md"], "tree 'no/such/tree': neither a folder "
+                                                  "nor a commit of "),
+    (["docs", ".", "--map", "README.md"], "tree 'docs': the folder holds no skyroute"),
+    ([".", ".", "--map", "no/such.map"], "--map no/such.map: no such file"),
+    ([".", ".", "--map", "README.md", "--rounds", "0"], "--rounds 0: expected 1 to 1000"),
+])
+def test_flat_pair_ab_refuses_a_wrong_tree_or_map(monkeypatch, args, words):
+    monkeypatch.chdir(ROOT)
+    one_line_error(script("flat_pair_ab.py", *args), "flat_pair_ab.py", words)
 
 
 @pytest.mark.slow

@@ -147,12 +147,18 @@ def test_a_walls_cell_within_the_margin_is_named_so(monkeypatch, capsys, tmp_pat
 @pytest.mark.parametrize("args, words", [
     (["plan", "den312d", "--start", "0,0", "--goal", "60,13"], "start (0, 0) is on a blocked"),
     (["plan", "den312d", "--start", "50,76", "--goal", "99,9"], "goal (99, 9) lies outside"),
-    # a cell typed (row, column), numpy's order: the swapped cell is on the map, and the
+    # a cell typed (row, column), numpy's order: the swapped cell is free, and the
     # error says so (a lon/lat world says it of (lat, lon)); a cell off the map either
     # way gets no hint (above)
     (["plan", "den312d", "--start", "76,50", "--goal", "60,13"], "error: start (76, 50) lies "
-     "outside the 65x81 grid (x in 0..64, y in 0..80); (50, 76) is inside: cells are "
+     "outside the 65x81 grid (x in 0..64, y in 0..80); (50, 76) is free: cells are "
      "(x, y) = (column, row)\n"),
+    # ... but not when the swapped cell is blocked too: it pointed to (0, 65), a wall
+    (["plan", "den312d", "--start", "65,0", "--goal", "60,13"], "error: start (65, 0) lies "
+     "outside the 65x81 grid (x in 0..64, y in 0..80)\n"),
+    # on a blocked cell, the slip a square map shows: (60, 13) is free
+    (["plan", "den312d", "--start", "50,76", "--goal", "13,60"], "error: goal (13, 60) is "
+     "on a blocked cell; (60, 13) is free: cells are (x, y) = (column, row)\n"),
     (["plan", "nope.map", "--start", "0,0", "--goal", "1,1"], "nope.map: no such file"),
     # a cell the map has free, blocked by the margin alone: it read "is on a blocked cell"
     (["plan", *QUERY, "--safety", "3"], "error: start (50, 76) is free in den312d.map but "

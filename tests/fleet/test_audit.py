@@ -106,9 +106,8 @@ def rules(draw):
     slice of its own and only the reservations keep drones apart), several shared
     levels, no hand-over time (a drone leaves by the other gate the instant it
     arrived), an airport's gates placed farther apart, and small no-fly zones. (Gates
-    placed on a take-off runway's line are left out: ground movements are not
-    deconflicted beyond the bookings, docs/fleet.md says, and the audit flags a drone
-    taxiing from such a gate while another uses the runway.)"""
+    placed on a take-off runway's line are left out: a scenario refuses them, since the
+    audit flagged a drone taxiing from such a gate while another used the runway.)"""
     airports = draw(st.integers(2, 4))
     s = generate(airports, draw(st.integers(1, 6)), area_km=draw(st.floats(2.5, 5.0)),
                  seed=draw(st.integers(0, 10_000)))

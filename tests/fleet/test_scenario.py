@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import re
 
+import numpy as np
 import pytest
 import yaml
 
@@ -179,6 +180,41 @@ def _near(data: dict, k: int, north: float, east: float) -> list[float]:
     return [a["north"] + north, a["east"] + east]
 
 
+def _along(data: dict, k: int, along: float, left: float = 0.0) -> list[float]:
+    """A point ``along`` metres from airport ``k`` of a scenario's data along its take-off
+    heading and ``left`` metres to the left of that line."""
+    h = math.radians(data["airports"][k]["takeoff"]["heading_deg"])
+    return _near(data, k, along * math.cos(h) + left * math.sin(h),
+                 along * math.sin(h) - left * math.cos(h))
+
+
+@pytest.mark.parametrize("gates", [
+    [(0, 15), (0, -15)],  # where the defaults stand, half a gate width beside the runway
+    [(-300, 16), (200, -15.5)],
+    [(-316, 0), (0, 40)],  # on the line, behind the threshold: no drone goes there
+])
+def test_gates_beside_the_take_off_runway_are_allowed(gates):
+    data = sc.preset("seed-3x3").model_dump()
+    data["airports"][0]["gates"] = [_along(data, 0, *g) for g in gates]
+    placed = np.array(sc.parse_scenario(data).airports[0].gates)
+    assert placed == pytest.approx(np.array([_along(data, 0, *g) for g in gates]))
+
+
+def test_the_default_gates_are_what_an_explicit_check_allows():
+    """The default gates stand exactly half a gate width from the take-off runway's centre
+    line and a gate width apart; given explicitly, with their rounding, they are allowed
+    (they were refused as overlapping: 29.999999999999996 m apart)."""
+    from skyroute.fleet.flightplan import gate_position
+
+    data = sc.preset("seed-9x9").model_dump()
+    s = sc.parse_scenario(data)
+    default = [[gate_position(a, g).tolist() for g in (0, 1)] for a in s.airports]
+    for k, gates in enumerate(default):
+        data["airports"][k]["gates"] = gates
+    placed = [a.gates for a in sc.parse_scenario(data).airports]
+    assert np.array(placed) == pytest.approx(np.array(default), abs=0)
+
+
 def _other_beside_first(d: dict) -> None:
     d["airports"][1]["north"], d["airports"][1]["east"] = _near(d, 0, 0, 100)
 
@@ -206,6 +242,17 @@ def _other_beside_first(d: dict) -> None:
      "airports[2].gates: gate 1 is 566 m from the airport, farther than 500 m"),
     (lambda d: d["airports"][1].update(gates=[[0.0, 0.0, 5.0], _near(d, 1, 0, 50)]),
      "airports[1].gates[0]: Tuple should have at most 2 items"),
+    # a gate on the take-off runway: a drone rolled through it while another stood there
+    (lambda d: d["airports"][0].update(gates=[_along(d, 0, -100), _along(d, 0, 0, 40)]),
+     "airports[0].gates: gate 0 stands on the take-off runway (0.0 m from its centre line, "
+     "200 m from the threshold; less than half gate_width, 15 m): a drone taking off would "
+     "roll through a drone at the gate"),
+    (lambda d: d["airports"][2].update(gates=[_along(d, 2, 0, 40), _along(d, 2, 250, -5)]),
+     "airports[2].gates: gate 1 stands on the take-off runway (5.0 m from its centre line, "
+     "550 m from the threshold;"),
+    (lambda d: d["airports"][1].update(gates=[_along(d, 1, 0, 40), _along(d, 1, 310, 0)]),
+     "airports[1].gates: gate 1 stands on the take-off runway (10.0 m from its centre line, "
+     "600 m from the threshold;"),  # past the far end, within half a gate of it
     # negative speeds
     (lambda d: d["drone"].update(cruise_speed=-50.0),
      "drone.cruise_speed: Input should be greater than 0"),
@@ -259,6 +306,8 @@ def _refused(tmp_path, edit) -> tuple:
      "airports[0].gates: gates overlapping"),
     (lambda d: d["drone"].update(cruise_speed=-50.0), "drone.cruise_speed: Input should be"),
     (_other_beside_first, "airports: A and B are 100 m apart, closer than a runway"),
+    (lambda d: d["airports"][0].update(gates=[_along(d, 0, -100), _along(d, 0, 0, 40)]),
+     "airports[0].gates: gate 0 stands on the take-off runway"),
 ])
 def test_the_command_line_prints_one_line_and_exits_2(tmp_path, monkeypatch, capsys, edit,
                                                       words):
@@ -284,7 +333,8 @@ def test_the_command_line_prints_one_line_and_exits_2(tmp_path, monkeypatch, cap
 
 def test_a_gate_just_within_500_m_is_allowed():
     data = sc.preset("seed-3x3").model_dump()
-    data["airports"][2]["gates"] = [_near(data, 2, 0, 20), _near(data, 2, 300, -399.9)]
+    # gate 0 off the take-off runway (it was 6.8 m from its centre line, now refused)
+    data["airports"][2]["gates"] = [_along(data, 2, 0, 20), _near(data, 2, 300, -399.9)]
     assert sc.parse_scenario(data).airports[2].gates[1] == tuple(_near(data, 2, 300, -399.9))
 
 

@@ -2,6 +2,7 @@
 
 import collections
 import decimal
+import re
 import types
 
 import numpy as np
@@ -153,6 +154,42 @@ def test_a_mapping_or_set_is_not_a_cell(algorithm, cell, kind):
         skyroute.plan(grid, [4, 4], cell, algorithm=algorithm)
 
 
+# bools: Python counts True as the int 1, and (True, 3) planned from (1, 3); numpy's bool
+# was refused already (no __index__), so a cell read from a mask and one typed differed
+BOOL_CELLS = [((True, 3), (4, 4), "start (True, 3)"), ((0, 0), (4, False), "goal (4, False)"),
+              ([np.True_, 3], (4, 4), "start [np.True_, 3]"),
+              ((0, 0), (np.int64(4), True), "goal (np.int64(4), True)")]
+
+
+@pytest.mark.parametrize("algorithm", ALGS)
+@pytest.mark.parametrize("start, goal, words", BOOL_CELLS)
+def test_a_bool_is_not_a_cell_coordinate(algorithm, start, goal, words):
+    grid = skyroute.Grid(np.zeros((5, 5), bool))
+    with pytest.raises(QueryError) as err:
+        skyroute.plan(grid, start, goal, algorithm=algorithm)
+    assert str(err.value) == f"{words} must be two integers (x, y), not booleans"
+    assert err.value.param == words.split()[0]
+
+
+def test_a_bool_is_not_a_cell_of_a_prepared_grid_nor_a_grid_method():
+    grid = skyroute.Grid(np.zeros((5, 5), bool))
+    index = skyroute.prepare(grid)
+    for start, goal, words in BOOL_CELLS:
+        with pytest.raises(QueryError, match=rf"^{re.escape(words)} .* not booleans$"):
+            index.plan(start, goal)
+    for method in (grid.is_free, grid.in_bounds):
+        with pytest.raises(QueryError, match=r"^cell \(True, 0\) .* not booleans$"):
+            method((True, 0))
+    from skyroute.motion.turn_lattice import plan_turns
+
+    with pytest.raises(QueryError, match=r"^goal \(4, False\) .* not booleans$"):
+        plan_turns(grid, (0, 0), (4, False))
+    # whole numbers of every other kind still plan, on the inline path and off it
+    for cell in ((1, 3), [1, 3], (np.int64(1), np.int32(3)), np.array([1, 3])):
+        assert skyroute.plan(grid, cell, (4, 4)).path[0].tolist() == [1, 3]
+        assert index.plan(cell, (4, 4)).path[0].tolist() == [1, 3]
+
+
 def test_a_mapping_or_set_is_not_a_cell_of_a_prepared_grid():
     index = skyroute.prepare(skyroute.Grid(np.zeros((5, 5), bool)))
     for cell, kind in NOT_CELLS:
@@ -171,8 +208,8 @@ def test_cells_as_numpy_ints_or_lists_plan_as_tuples(algorithm):
     want = skyroute.plan(grid, (0, 0), (5, 5), algorithm=algorithm)
     cell = collections.namedtuple("Cell", "x y")
     for s, t in (([0, 0], [5, 5]), (np.array([0, 0]), np.array([5, 5])),
-                 ((np.int32(0), np.int64(0)), (5, 5)), ((False, False), (5, 5)),
-                 (cell(0, 0), cell(5, 5))):
+                 ((np.int32(0), np.int64(0)), (5, 5)), (cell(0, 0), cell(5, 5))):
+        # (False, False) planned as (0, 0) here: bools are refused now (BOOL_CELLS)
         got = skyroute.plan(grid, s, t, algorithm=algorithm)
         assert got.cost == want.cost and np.array_equal(got.path, want.path)
 

@@ -137,3 +137,57 @@ def test_the_first_fcnd_layout_names_its_own_lines(tmp_path, text, line, words):
     with pytest.raises(InputFormatError) as err:
         read_colliders(path)
     assert err.value.line == line and words in str(err.value)
+
+
+# -- how far from home a box may reach ----------------------------------------------------
+
+@pytest.mark.parametrize("row, km", [
+    ("4182912.5,553400.2,5,2,3,5", "4,219.4"),  # UTM northing, easting: not from home
+    ("49995,0,5,6,3,5", "50.0"),  # 50,001 m north: just past
+    ("-30000,-40000,5,1,1,5", "50.0"),  # 50,001.4 m as the crow flies (a corner)
+])
+def test_a_box_far_from_home_is_refused_naming_its_line(tmp_path, row, km):
+    """Past MAX_CITY_REACH the tangent plane at home is over a metre off: a box there was
+    read and planned round silently (UTM coordinates for metres from home, 4,219 km
+    away, gave a path 'found' around a box on another continent)."""
+    for home, line in ((HOME, 4), ("lat0,lon0\n37.792480,-122.397450", 5)):
+        path = tmp_path / "far.csv"
+        path.write_text(f"{home}\n{HEADER}\n10,0,5,2,3,5\n{row}\n")
+        with pytest.raises(InputFormatError) as err:
+            skyroute.load_world(path)
+        assert str(err.value) == (
+            f"{path}:{line}: the box reaches {km} km from home, over the 50 km limit: "
+            "posX, posY are metres north and east of lat0, lon0, not UTM or another origin "
+            "(beyond 50 km the tangent plane at home is over a metre off)")
+
+
+def test_a_box_within_the_reach_is_read(tmp_path):
+    from skyroute.world.colliders import MAX_CITY_REACH
+
+    path = tmp_path / "wide.csv"
+    path.write_text(f"{HOME}\n{HEADER}\n29998,-39998,5,1,1,5\n0,49990,5,2,9.9,5\n")
+    world = skyroute.load_world(path, frame="ned")
+    # 49,999.0 and 49,999.9 m from home at their farthest corners
+    assert world.bounds == pytest.approx((-39999, -2, 49999.9, 29999))
+    assert MAX_CITY_REACH == 50_000
+
+
+def test_the_reach_holds_the_plane_to_a_metre_of_its_lon_lat():
+    """The limit's reason, measured: a plane point 50 km from home, to (lon, lat) and back,
+    lands within 1.6 m of itself (and its ground distance within 1.1 m of its plane
+    distance); at 100 km both are over 8 m, more than FCND's 5 m margin."""
+    import numpy as np
+    from pyproj import Geod
+
+    from skyroute.geo import Home, enu_to_lonlat, lonlat_to_enu
+
+    home = Home(-122.39745, 37.79248, 0.0)
+    for d, most in ((50e3, 1.6), (100e3, None)):
+        lonlat = enu_to_lonlat([d], [0.0], 0.0, home)
+        back = lonlat_to_enu(lonlat[:, 0], lonlat[:, 1], 0.0, home)[0]
+        off = float(np.hypot(back[0] - d, back[1]))
+        ground = Geod(ellps="WGS84").inv(home.lon, home.lat, *lonlat[0, :2])[2]
+        if most is None:
+            assert off > 8 and d - ground > 8
+        else:
+            assert off < most and d - ground < 1.1

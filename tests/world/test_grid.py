@@ -481,18 +481,38 @@ def test_a_grids_cells_cannot_be_made_writeable_again():
 
 
 @pytest.mark.parametrize("start, hint", [
-    ((4, 1), "; (1, 4) is inside: cells are (x, y) = (column, row)"),  # (row, column)
+    ((4, 1), "; (1, 4) is free: cells are (x, y) = (column, row)"),  # (row, column)
+    ((4, 0), ""),  # (0, 4), swapped, is on the grid but blocked: no hint to a bad cell
     ((4, 4), ""),  # off the grid either way: nothing to suggest
     ((1, 7), ""),
     ((-1, 2), ""),
 ])
-def test_a_cell_off_the_grid_says_when_it_is_on_it_swapped(start, hint):
+def test_a_cell_off_the_grid_says_when_it_is_free_swapped(start, hint):
     """A cell typed (row, column), numpy's order, lies off a grid that is not square
-    where (column, row) lies on it; the error says so, as a lon/lat World says it of
-    (lat, lon). A cell off the grid either way gets no hint."""
-    grid = Grid(np.zeros((6, 3), bool))  # 3 wide, 6 high
+    where (column, row) is a free cell of it; the error says so, as a lon/lat World says
+    it of (lat, lon). A cell off the grid either way, or whose swapped cell is blocked,
+    gets no hint (it pointed to a blocked cell)."""
+    blocked = np.zeros((6, 3), bool)  # 3 wide, 6 high
+    blocked[4, 0] = True  # cell (0, 4)
     with pytest.raises(skyroute.QueryError) as err:
-        skyroute.plan(grid, start, (0, 0))
+        skyroute.plan(Grid(blocked), start, (1, 1))
     x, y = start
     assert str(err.value) == (f"start ({x}, {y}) lies outside the 3x6 grid (x in 0..2, "
                               f"y in 0..5){hint}")
+
+
+@pytest.mark.parametrize("goal, hint", [
+    ((2, 1), "; (1, 2) is free: cells are (x, y) = (column, row)"),  # (row, column)
+    ((3, 0), ""),  # (0, 3), swapped, is blocked too
+    ((2, 2), ""),  # the same cell swapped
+    ((0, 5), ""),  # (5, 0), swapped, is off the grid
+])
+def test_a_blocked_cell_says_when_it_is_free_swapped(goal, hint):
+    """On a square map a cell typed (row, column) never falls off the grid: a blocked
+    cell is where the slip shows, and the error names the swapped cell when it is free."""
+    blocked = np.zeros((6, 4), bool)  # 4 wide, 6 high
+    blocked[1, 2] = blocked[0, 3] = blocked[3, 0] = blocked[2, 2] = blocked[5, 0] = True
+    with pytest.raises(skyroute.QueryError) as err:
+        skyroute.plan(Grid(blocked), (1, 1), goal)
+    assert str(err.value) == f"goal {goal} is on a blocked cell{hint}"
+    assert err.value.param == "goal"

@@ -51,7 +51,7 @@ def test_a_point_within_the_plane_still_plans(tmp_path):
 @pytest.mark.parametrize("row", ["1e308,10,5,1e308,2,5", "0,9999999,5,2,2,5",
                                  "0,0,5,1,1,1e8"])
 def test_a_box_reaching_beyond_the_plane_names_its_line(tmp_path, row):
-    with pytest.raises(InputFormatError, match="reaches more than") as err:
+    with pytest.raises(InputFormatError, match="the box reaches more than") as err:
         skyroute.load_world(_city(tmp_path, f"10,10,5,1,1,5\n{row}\n"))
     assert err.value.line == 4
 

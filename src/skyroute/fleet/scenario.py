@@ -46,6 +46,7 @@ from skyroute.fleet.limits import (
 from skyroute.fleet.vehicle import takeoff_phases
 
 MAX_GATE_DISTANCE = 500.0  # metres from an airport's position to a gate it places
+ROUNDING = 1e-6  # metres a gate may lie inside a limit that the default gates sit on
 
 
 def _near_home(v: float) -> float:
@@ -138,7 +139,8 @@ class Airport(_Strict):
     The gates stand ``gate_width`` apart beside the airport's position (see
     :func:`skyroute.fleet.flightplan.gate_position`) unless ``gates`` places them: two
     ``[north, east]`` positions in metres, in the scenario's frame like the airport's
-    own, at least ``gate_width`` apart and within :data:`MAX_GATE_DISTANCE` of it.
+    own, at least ``gate_width`` apart, within :data:`MAX_GATE_DISTANCE` of it and not
+    on the take-off runway (:func:`_off_takeoff_runway`).
     """
 
     id: str = Field(min_length=1, description="unique among the scenario's airports")
@@ -169,10 +171,36 @@ class Airport(_Strict):
                                      f"{MAX_GATE_DISTANCE:g} m")
         gap = math.hypot(gates[0][0] - gates[1][0], gates[0][1] - gates[1][1])
         width = known.get("gate_width")
-        if width is not None and gap < width:
+        # a micrometre's slack: the default gates, written out (to_yaml of gate_position),
+        # are gate_width apart give or take a rounding, and were refused as overlapping
+        if width is not None and gap < width - ROUNDING:
             raise ValueError(f"gates overlapping: {gap:g} m apart, closer than gate_width "
                              f"({width:g} m)")
+        if width is not None and {"north", "east", "takeoff"} <= known.keys():
+            _off_takeoff_runway(gates, known["north"], known["east"], known["takeoff"], width)
         return gates
+
+
+def _off_takeoff_runway(gates, north: float, east: float, takeoff: Runway,
+                        width: float) -> None:
+    """A ValueError naming the first gate that stands on the take-off runway: its centre
+    closer than ``width / 2`` (a gate's half width: two gates closer than ``width``
+    overlap) to the runway's centre line between its ends. The runway is held by one
+    drone at a time, taxiing out, rolling, lifting off (docs/fleet.md's airport manager),
+    and nothing books the gates against it, so a drone at such a gate stood where another
+    rolled at take-off speed. The default gates stand exactly half a gate width beside
+    the runway, the least allowed (:data:`ROUNDING` let through)."""
+    thr, end = _ends(north, east, takeoff)
+    u = (end - thr) / takeoff.length
+    for k, g in enumerate(gates):
+        r = np.asarray(g, dtype=float) - thr
+        along = float(np.clip(r @ u, 0.0, takeoff.length))
+        d = float(np.hypot(*(r - along * u)))
+        if d < width / 2 - ROUNDING:
+            raise ValueError(f"gate {k} stands on the take-off runway ({d:.1f} m from its "
+                             f"centre line, {along:.0f} m from the threshold; less than "
+                             f"half gate_width, {width / 2:g} m): a drone taking off would "
+                             "roll through a drone at the gate")
 
 
 class Drone(_Strict):
@@ -603,7 +631,12 @@ def _name(k: int) -> str:
 
 def runway_ends(a: Airport, runway: Runway) -> tuple[np.ndarray, np.ndarray]:
     """(threshold, far end) of a runway through the airport, (north, east) metres."""
+    return _ends(a.north, a.east, runway)
+
+
+def _ends(north: float, east: float, runway: Runway) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`runway_ends` of a runway centred on (``north``, ``east``)."""
     h = math.radians(runway.heading_deg)
     d = np.array([math.cos(h), math.sin(h)]) * runway.length / 2
-    c = np.array([a.north, a.east])
+    c = np.array([north, east])
     return c - d, c + d

@@ -57,23 +57,24 @@ class SearchSpace:
         small map each microsecond is a tenth of a query. Anything else goes through
         :func:`~skyroute.world.grid.check_cell` for its message. Only sequences match
         the patterns: a mapping or a set, unpacked, gave its keys or members as (x, y) in
-        no order. The type test is on the two flat indices, not the four coordinates:
-        they come out ints only from ints (bools too, which check_cell takes), and
-        coordinates that are no numbers fail the comparisons; together, no slower than
-        the four tests were."""
+        no order. Each coordinate's class must be ``int`` itself, so a bool (an int to
+        Python: ``(True, 76)`` planned from (1, 76)) goes to check_cell, which refuses
+        it, as every option reader refuses a bool for a number. ``__class__`` is read
+        rather than ``type()`` called: the four tests cost at most about 40 ns more than
+        the two on the flat indices they replaced, no difference a whole ``plan()`` call
+        shows
+        (docs/benchmarks.md, section 11)."""
         w, h, Wp, blk = self.width, self.height, self.Wp, self._blocked_bytes
         match start:
             case (x, y):
                 match goal:
                     case (u, v):
-                        try:
-                            if 0 <= x < w and 0 <= y < h and 0 <= u < w and 0 <= v < h:
-                                s, t = (y + 1) * Wp + x + 1, (v + 1) * Wp + u + 1
-                                if type(s) is int and type(t) is int and not blk[s] \
-                                        and not blk[t]:
-                                    return s, t
-                        except Exception:  # an array, a NaN Decimal, ...: check_cell
-                            pass           # names it
+                        if x.__class__ is int and y.__class__ is int and u.__class__ is int \
+                                and v.__class__ is int and 0 <= x < w and 0 <= y < h \
+                                and 0 <= u < w and 0 <= v < h:
+                            s, t = (y + 1) * Wp + x + 1, (v + 1) * Wp + u + 1
+                            if not blk[s] and not blk[t]:
+                                return s, t
         grid = self._grid()
         return self.index(check_cell(grid, start, "start")), \
             self.index(check_cell(grid, goal, "goal"))

@@ -7,7 +7,8 @@ course's first file (Udacity's FCND-Motion-Planning, 2018, still in many student
 gives the home on two lines, ``lat0,lon0`` over ``37.792480,-122.397450``, the header on
 line 3 and boxes from line 4; it is read as well. Each
 box grows by ``safety`` on every side and at its top; it counts at an altitude below
-its top + safety.
+its top + safety. A box may reach :data:`MAX_CITY_REACH` (50 km) from home, where the
+tangent plane the World plans in is still within a metre or so of the ground.
 
 A file is refused before it is read past :data:`MAX_BYTES`, and after its lines are
 split, before any is parsed, past :data:`MAX_BOXES` boxes: the FCND city has 3,845 boxes
@@ -17,6 +18,7 @@ grid planners take in seconds; 140,000 boxes took them about a minute (docs/cli.
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
@@ -30,6 +32,16 @@ from skyroute.world.points import MAX_METRES
 from skyroute.world.world import World
 
 HEADER = "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ"
+# How far (metres, horizontally) a box may reach from home. The World's plane is PROJ's
+# tangent plane at home: a (lon, lat) goes to it at R sin(s/R) for a ground distance s, a
+# plane point back at R atan(d/R), so a path planned in the plane and returned in lon/lat
+# lies d**3 / (2 R**2) from where the plane had it, and the plane's distances fall
+# d**3 / (3 R**2) short of the ground's (what a local frame such as PX4's keeps). At
+# 50 km that is 1.5 m and 1.0 m (WGS84, measured through geo.py), under a third of the
+# 5 m margin FCND plans with; at 100 km 12.4 m and 8.2 m, more than it. The FCND city
+# reaches 0.73 km from home and ``synth-city``'s largest 4.2 km; a box thousands of km
+# away is a position in another frame (UTM northings, another home).
+MAX_CITY_REACH = 50_000.0
 MAX_BOXES = 50_000  # 13 times the FCND city's
 MAX_BYTES = 10_000_000  # 200 bytes a box line (FCND's are 35); a file is read whole
 # any float Python reads (a sign, an exponent) and any case: float() and the range
@@ -79,6 +91,14 @@ def read_colliders(path: str | Path, *, safety: float = 0.0, frame: str = "lonla
         if max(abs(vals[i]) + vals[i + 3] for i in range(3)) > MAX_METRES:
             raise InputFormatError(path, f"the box reaches more than {MAX_METRES:.0e} m from "
                                    "home", line=n)
+        reach = math.hypot(abs(vals[0]) + vals[3], abs(vals[1]) + vals[4])
+        if reach > MAX_CITY_REACH:
+            km = f"{MAX_CITY_REACH / 1000:g} km"
+            raise InputFormatError(path, f"the box reaches {reach / 1000:,.1f} km from home, "
+                                   f"over the {km} limit: posX, posY are metres north and "
+                                   "east of lat0, lon0, not UTM or another origin (beyond "
+                                   f"{km} the tangent plane at home is over a metre off)",
+                                   line=n)
         rows.append(vals)
         numbers.append(n)
     if not rows:

@@ -211,33 +211,49 @@ def _frozen(arr: np.ndarray) -> np.ndarray:
 def cell_xy(cell: object, what: str) -> tuple[int, int]:
     """(x, y) as ints, else QueryError naming ``what``. A mapping or a set is refused
     (unpacking it gives its keys or members, in no (x, y) order), and bytes
-    (b"\\x01\\x02" unpacks to two ints)."""
+    (b"\\x01\\x02" unpacks to two ints); so is a bool, which Python counts as an int
+    (``(True, 76)`` planned from (1, 76)), as numpy's bool is (no ``__index__``) and every
+    option reader refuses one for a number."""
     if isinstance(cell, Mapping | Set | bytes | bytearray):
         raise QueryError(f"{what} {cell!r} must be two integers (x, y), not a "
                          f"{type(cell).__name__}", param=what)
+    note = ""
     try:
         x, y = cell  # type: ignore[misc]
+        if isinstance(x, bool | np.bool_) or isinstance(y, bool | np.bool_):
+            note = ", not booleans"
+            raise TypeError(note)
         return operator.index(x), operator.index(y)
     except (TypeError, ValueError):
         shown = " ".join(repr(cell).split())  # one line: a 2-D array's repr has several
-        raise QueryError(f"{what} {shown} must be two integers (x, y)", param=what) from None
+        raise QueryError(f"{what} {shown} must be two integers (x, y){note}",
+                         param=what) from None
 
 
 def check_cell(grid: Grid, cell: object, what: str) -> tuple[int, int]:
     """(x, y) as ints (:func:`cell_xy`), on the grid and free; else QueryError naming
-    ``what``."""
+    ``what``, with :func:`swap_hint`."""
     x, y = cell_xy(cell, what)
     if not (0 <= x < grid.width and 0 <= y < grid.height):
-        # (row, column), numpy's order, is the likely slip when the swapped cell lies
-        # inside: said so, as a World says it of (lat, lon)
-        swapped = (f"; ({y}, {x}) is inside: cells are (x, y) = (column, row)"
-                   if 0 <= y < grid.width and 0 <= x < grid.height else "")
         raise QueryError(f"{what} ({x}, {y}) lies outside the {grid.width}x{grid.height} grid "
-                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1}){swapped}",
-                         param=what)
+                         f"(x in 0..{grid.width - 1}, y in 0..{grid.height - 1})"
+                         f"{swap_hint(grid, x, y)}", param=what)
     if grid.blocked[y, x]:
-        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell", param=what)
+        raise QueryError(f"{what} ({x}, {y}) is on a blocked cell{swap_hint(grid, x, y)}",
+                         param=what)
     return x, y
+
+
+def swap_hint(grid: Grid, x: int, y: int) -> str:
+    """'; (y, x) is free: cells are (x, y) = (column, row)' when cell (x, y), refused as
+    off the grid or blocked, is a free cell of the grid with its numbers swapped, else ''.
+    (row, column), numpy's order, is the likely slip, as (lat, lon) is in a World; on a
+    square map it never falls off the grid, so a blocked cell is where it shows. A swapped
+    cell that is blocked too gets no hint: it would point to a cell as bad as the first
+    (it did, for a cell off the grid)."""
+    if x == y or not (0 <= y < grid.width and 0 <= x < grid.height) or grid.blocked[x, y]:
+        return ""
+    return f"; ({y}, {x}) is free: cells are (x, y) = (column, row)"
 
 
 MAX_CELLS = 1 << 26  # 8192 x 8192: a search keeps about 50 bytes a cell (3.4 GB here)
