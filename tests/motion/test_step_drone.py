@@ -181,7 +181,7 @@ def test_heuristic_never_exceeds_the_moves_left(world, places, u, v, k):
     table = DistanceBound(world, t)
     sees = bool(world.segments_free([q], [t])[0])
     z = _zones(world)
-    h = move_search.bound(q[0], q[1], sees, t[0], t[1], table.corners, table.dist,
+    h = move_search.bound(q[0], q[1], sees, t[0], t[1], table.cols, table.dist,
                           z[0], *z[4:], STEP)
     d = shortest_distance(q, t)
     assert h <= max(0, math.ceil(d / STEP - 1 + 1e-9))

@@ -135,13 +135,11 @@ class DistanceBound:
 
     Built once per world (visibility among the corners) and once per target (Dijkstra).
     The compiled search bounds a point q's distance by |q - t| when q sees t, else by
-    min over the corners v that q sees of |q - v| + D(v) (:func:`move_search.bound`).
+    min over the corners v that q sees of |q - v| + D(v) (:func:`move_search.bound`),
+    reading the corners as ``cols``, (2, N) rows of x and y.
     """
 
     def __init__(self, world: World, target: np.ndarray) -> None:
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import dijkstra
-
         self.world = world
         self.target = np.asarray(target, dtype=float)
         if world not in _CORNER_GRAPHS:
@@ -150,17 +148,26 @@ class DistanceBound:
         if not isinstance(table, tuple):  # a city's: the visibility graph's corner table
             self.corners = table.corners
             self.dist = table.to(self.target) if len(self.corners) else np.zeros(0)
-            return
-        self.corners, i, j = table
-        n = len(self.corners)
-        sees = world.segments_free(np.broadcast_to(self.target, (n, 2)), self.corners) \
+        else:
+            self.corners = table[0]
+            self.dist = self._dijkstra(*table)
+        self.cols = np.ascontiguousarray(self.corners.T)
+
+    def _dijkstra(self, corners: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """D(v) through the free corner pairs (i, j) and the corners the target sees."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import dijkstra
+
+        world = self.world
+        n = len(corners)
+        sees = world.segments_free(np.broadcast_to(self.target, (n, 2)), corners) \
             if n else np.zeros(0, bool)
         rows = np.concatenate([i, np.full(int(sees.sum()), n)])
         cols = np.concatenate([j, np.flatnonzero(sees)])
-        w = np.hypot(*(np.vstack([self.corners, self.target])[rows] -
-                       np.vstack([self.corners, self.target])[cols]).T) + 1e-300
+        w = np.hypot(*(np.vstack([corners, self.target])[rows] -
+                       np.vstack([corners, self.target])[cols]).T) + 1e-300
         graph = coo_matrix((w, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
-        self.dist = dijkstra(graph, directed=False, indices=n)[:n] if n else np.zeros(0)
+        return dijkstra(graph, directed=False, indices=n)[:n] if n else np.zeros(0)
 
 
 def _corner_pairs(world: World):
@@ -269,7 +276,7 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     while status == move_search.INTERRUPTED:  # again when SIGINT's handler did not raise
         with move_search.interruptible():
             status, end, expanded, x, y, parent, move = move_search.search(
-                s[0], s[1], t[0], t[1], sees0, deltas, *_zones(world), bound.corners,
+                s[0], s[1], t[0], t[1], sees0, deltas, *_zones(world), bound.cols,
                 bound.dist, step, merge, max_expansions, 1e-12)
     seconds = time.perf_counter() - t0
     if status != FOUND:
