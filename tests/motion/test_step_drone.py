@@ -247,6 +247,18 @@ def test_default_budget_is_every_state_of_a_bounded_world(world):
     assert tiny.found
 
 
+def test_a_budget_beyond_an_int64_is_no_budget():
+    # as errors.budget reads it for every planner; plan_moves passed it to its compiled
+    # search as given, which raised numba's OverflowError ("int too big to convert")
+    w = _degrees_square()
+    s, t = (-3.19, 55.943), (-3.186, 55.9448)
+    ref = plan_moves(w, s, t)
+    assert ref.found and ref.moves > 20
+    for huge in (2**63, 10**30):
+        f = plan_moves(w, s, t, max_expansions=huge)
+        assert f.found and f.expanded == ref.expanded and f.rows() == ref.rows()
+
+
 def _interrupted(world, monkeypatch, handler):
     """plan_moves on the HARD pair with ``handler`` as SIGINT's and a SIGINT sent 0.3 s
     in (a few seconds before its end): (the flight or the exception it raised, the

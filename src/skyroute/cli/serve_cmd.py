@@ -60,7 +60,8 @@ def serve_command(
     workers: Annotated[int, typer.Option(help="Server processes.")] = 1,
     max_body_mb: Annotated[float, typer.Option(help="Largest request body, MB.")] = 10.0,
     max_expansions: Annotated[int, typer.Option(
-        help="Search budget of one POST /plan.")] = 2_000_000,
+        help="The cap on one POST /plan's search budget (a request without "
+             "max_expansions, enough to finish the search, is capped to it).")] = 2_000_000,
     job_queue: Annotated[int, typer.Option(help="Jobs queued or running at once.")] = 8,
     log_level: Annotated[str, typer.Option(
         help="The lowest level logged on stderr, by uvicorn and skyroute alike: critical, "

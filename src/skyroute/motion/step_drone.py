@@ -28,7 +28,15 @@ import numpy as np
 import shapely
 
 from skyroute.caches import register
-from skyroute.errors import OptionError, QueryError, check_instance, real, renamed, whole
+from skyroute.errors import (
+    OptionError,
+    QueryError,
+    budget,
+    check_instance,
+    real,
+    renamed,
+    whole,
+)
 from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.motion import edge_grid, move_search
 from skyroute.motion.zone_kernels import zone_arrays
@@ -41,8 +49,10 @@ HOVER = -999
 ANGLES = np.arange(0, 360, 10)
 MAX_PAIRS = 50_000  # vertex pairs up to which corners are tested pair by pair
 MERGE = 5e-6  # positions in one lattice cell this wide (1/30 step) are one state
-UNBOUNDED_BUDGET = 200_000  # plan_moves' default expansions in a world without a boundary
-MAX_BUDGET = 2_000_000  # and at most this many in one with a boundary
+#: max_expansions=None (:func:`default_budget`): the cap in a world without a boundary,
+#: whose states are unbounded, and the cap in one with a boundary (memory and time)
+UNBOUNDED_BUDGET = 200_000
+MAX_BUDGET = 2_000_000
 _CORNER_GRAPHS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _ZONES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _BOUNDS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -222,11 +232,12 @@ def _coarse(p: np.ndarray, step: float) -> tuple[int, int]:
 
 
 def default_budget(world: World, merge: float = MERGE) -> int:
-    """plan_moves' expansion budget when none is given: in a world with a boundary, every
-    state its search can hold (the ``merge``-wide lattice cells of the boundary's box:
-    a state is expanded once, so the search ends found or no_path), at most
-    :data:`MAX_BUDGET`; without a boundary :data:`UNBOUNDED_BUDGET`. The ILP area at the
-    default merge: 1,183,200 (1,632 x 725 cells)."""
+    """plan_moves' budget for ``max_expansions=None``: enough to finish the search, capped
+    to protect memory. In a world with a boundary, every state its search can hold (the
+    ``merge``-wide lattice cells of the boundary's box: a state is expanded once, so the
+    search ends found or no_path), capped at :data:`MAX_BUDGET` (2,000,000); without a
+    boundary the states are unbounded and the cap is :data:`UNBOUNDED_BUDGET` (200,000).
+    The ILP area at the default merge: 1,183,200 (1,632 x 725 cells)."""
     if world.boundary is None:
         return UNBOUNDED_BUDGET
     x0, y0, x1, y1 = shapely.Polygon(world.boundary).bounds
@@ -247,10 +258,12 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     distance to the goal (:class:`DistanceBound`): admissible, since each move covers
     at most ``step`` and the flight may stop within ``step`` of the goal. Ties go to
     the deeper node. No path is a status, not an exception, and so is running out of
-    ``max_expansions`` (None: :func:`default_budget`, which in a bounded world such as
-    the ILP area lets the search run until it ends; a fixed 200,000 ran out on a legal
-    pair there that needs 215,220). The whole search is one compiled call
-    (:mod:`skyroute.motion.move_search`), which Ctrl-C interrupts.
+    ``max_expansions`` (None: enough to finish the search, capped to protect memory:
+    :func:`default_budget`, every state of a bounded world such as the ILP area, where
+    a fixed 200,000 ran out on a legal pair that needs 215,220, capped at
+    :data:`MAX_BUDGET`, 2,000,000; without a boundary :data:`UNBOUNDED_BUDGET`, 200,000;
+    a number beyond an int64 is no budget, as for every planner). The whole search is
+    one compiled call (:mod:`skyroute.motion.move_search`), which Ctrl-C interrupts.
     """
     if misspelt:
         raise unknown_keywords(plan_moves, misspelt)
@@ -261,7 +274,7 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     step = real("step", step, low=0.0, strict=True)
     merge = real("merge", merge, low=0.0, strict=True)
     max_expansions = default_budget(world, merge) if max_expansions is None else \
-        whole("max_expansions", max_expansions, low=0)
+        budget(max_expansions)
     t0 = time.perf_counter()
     s = world.check_point(start, "start")
     t = world.to_plane(goal, "goal")
