@@ -74,6 +74,8 @@ def ilp_queries(args: argparse.Namespace) -> tuple:
     if args.queries or args.altitude is not None or args.safety:
         raise Fail("--ilp: the queries are the ILP places' pairs; give no queries, "
                    "--altitude or --safety")
+    if not args.ilp.is_dir():
+        raise Fail(f"--ilp {args.ilp}: no such folder")
     world, places = load_ilp(args.ilp)
     return world, [(f"{a} -> {b}", places[a], places[b])
                    for a, b in itertools.permutations(places, 2)]
