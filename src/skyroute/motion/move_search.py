@@ -25,6 +25,10 @@ from skyroute.motion.zone_kernels import expand, sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
 
+# numba caches these kernels with corner_distance's first pass (approximate, beyond,
+# exact), zone_kernels' tests and the heap compiled in, keyed by this file's date alone:
+# edit this file when one of those changes, or a checkout keeps running the old code.
+
 _TIE = (1 << 20) - 1
 _HALF = 1 << 31
 _POLL = 4096  # expansions between two returns to the interpreter (for Ctrl-C)
