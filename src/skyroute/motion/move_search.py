@@ -25,10 +25,6 @@ from skyroute.motion.zone_kernels import expand, sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
 
-# numba caches these kernels with corner_distance's first pass (approximate, beyond,
-# exact), zone_kernels' tests and the heap compiled in, keyed by this file's date alone:
-# edit this file when one of those changes, or a checkout keeps running the old code.
-
 _TIE = (1 << 20) - 1
 _HALF = 1 << 31
 _POLL = 4096  # expansions between two returns to the interpreter (for Ctrl-C)
@@ -71,6 +67,11 @@ def interruptible():
         noted, _noted[0] = _noted[0], False
     if noted:
         old(signal.SIGINT, sys._getframe(2))  # the frame of the block's caller
+
+
+# numba caches the kernels below with corner_distance's first pass (approximate, beyond,
+# exact), zone_kernels' tests and the heap compiled in, keyed by this file's date alone:
+# edit this file when one of those changes, or a checkout keeps running the old code.
 
 
 @njit(cache=True)
