@@ -7,7 +7,10 @@ compares (:func:`resolve_tree`).
 
 from __future__ import annotations
 
+import argparse
+import math
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -20,6 +23,42 @@ REPO = Path(__file__).resolve().parent.parent
 
 class Fail(Exception):  # noqa: N818 (the scripts raise it as `raise Fail(...)`)
     """Bad input: the script prints ``NAME: error: MESSAGE`` and exits 2."""
+
+
+def parser(prog: str, description: str) -> argparse.ArgumentParser:
+    """An argument parser that takes an argument starting with ``-`` and a digit or a
+    point as a value: a query whose first coordinate is negative (``'-300,250;0,0'``),
+    typed as is. argparse reads as a value only a plain negative number (``-5``) and
+    refused such a query as an unknown option, unless ``--`` came before it. (Its
+    pattern for negative numbers is an attribute without a public setter; no option of
+    these scripts looks like a negative number.)"""
+    p = argparse.ArgumentParser(prog=prog, description=description)
+    p._negative_number_matcher = re.compile(r"^-\.?\d")
+    return p
+
+
+def ned_queries(texts: list[str], *, headings: bool = True) -> list[tuple]:
+    """``(text, start, goal)`` of each ``'N,E[,HEADING];N,E[,HEADING]'`` in ``texts``:
+    metres in the NED frame, headings (with ``headings``) degrees clockwise from north,
+    returned in radians; a :class:`Fail` naming the query that is not one."""
+    form = "N,E or N,E,HEADING" if headings else "N,E"
+    out = []
+    for q in texts:
+        parts = q.split(";")
+        if len(parts) != 2:
+            raise Fail(f"query {q!r}: expected START;GOAL")
+        poses = []
+        for text in parts:
+            try:
+                v = [float(x) for x in text.split(",")]
+            except ValueError:
+                v = []
+            if len(v) not in ((2, 3) if headings else (2,)) or \
+                    not all(math.isfinite(x) for x in v):
+                raise Fail(f"query {q!r}: {text!r} is not {form}")
+            poses.append((v[0], v[1]) + ((math.radians(v[2]),) if len(v) == 3 else ()))
+        out.append((q, *poses))
+    return out
 
 
 def check_counts(args, names: tuple[str, ...], low: int = 1, high: int = 100) -> None:

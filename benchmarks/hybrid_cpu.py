@@ -21,17 +21,16 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import math
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import Fail, check_counts, run_main
+from _common import Fail, check_counts, ned_queries, parser, run_main
 
 
 def parse(argv=None) -> argparse.Namespace:
-    p = argparse.ArgumentParser(prog="hybrid_cpu.py", description=__doc__.split("\n\n")[0])
+    p = parser("hybrid_cpu.py", __doc__.split("\n\n")[0])
     p.add_argument("city", type=Path, help="a colliders.csv file")
     p.add_argument("queries", nargs="+", metavar="S;G",
                    help="start and goal, 'N,E[,HEADING];N,E[,HEADING]' in metres (NED)")
@@ -42,25 +41,10 @@ def parse(argv=None) -> argparse.Namespace:
     return p.parse_args(argv)
 
 
-def pose(text: str, query: str) -> tuple[float, ...]:
-    try:
-        v = [float(x) for x in text.split(",")]
-    except ValueError:
-        v = []
-    if len(v) not in (2, 3) or not all(math.isfinite(x) for x in v):
-        raise Fail(f"query {query!r}: {text!r} is not N,E or N,E,HEADING")
-    return (v[0], v[1]) + ((math.radians(v[2]),) if len(v) == 3 else ())
-
-
 def main() -> None:
     args = parse()
     check_counts(args, ("reps",))
-    queries = []
-    for q in args.queries:
-        parts = q.split(";")
-        if len(parts) != 2:
-            raise Fail(f"query {q!r}: expected START;GOAL")
-        queries.append((q, pose(parts[0], q), pose(parts[1], q)))
+    queries = ned_queries(args.queries)
     if not args.city.is_file():
         raise Fail(f"{args.city}: no such file")
     from skyroute.cli.world_args import load_world_file

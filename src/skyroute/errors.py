@@ -211,12 +211,16 @@ def check_seed(value: object, name: str = "seed") -> int:
     return whole(name, value, low=0, high=SEED_MAX)
 
 
-NO_BUDGET = 2**63 - 1  # max_expansions=None: no budget (an int64 for the kernels)
+NO_BUDGET = 2**63 - 1  # max_expansions=None with no cap (an int64 for the kernels)
 
 
 def budget(value: object, name: str = "max_expansions") -> int:
-    """An expansion budget: None is none (:data:`NO_BUDGET`), else an integer >= 0 (one
-    above an int64 is no budget either)."""
+    """An expansion budget: an integer >= 0 (one above an int64 is no budget), or None,
+    which for every planner means enough to finish the search. A search whose states are
+    finite and bounded by its input (a grid's cells, a turn lattice's states, a roadmap's
+    nodes) needs no cap: None is :data:`NO_BUDGET`, as here. A planner whose states could
+    fill the memory caps it and names the cap (the step drone's
+    ``step_drone.default_budget``, Hybrid A*'s ``hybrid.MAX_NODES``)."""
     if value is None:
         return NO_BUDGET
     return min(whole(name, value, low=0), NO_BUDGET)

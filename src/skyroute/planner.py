@@ -53,7 +53,8 @@ def plan(grid: Grid | World, start, goal, *, algorithm: str | None = None,
     prune : {"none", "collinear", "los"}, optional
         Drop straight-on points, or also shortcut by line of sight. Never illegal or longer.
     max_expansions : int, optional
-        Stop with status ``budget_exhausted`` after this many expansions.
+        Stop with status ``budget_exhausted`` after this many expansions. None: enough to
+        finish the search, with no cap (the grid's cells or the roadmap's nodes bound it).
     resolution : float, optional
         A World planned by a grid algorithm: the cell size in plane units.
     samples, neighbours, prm_star, seed : optional

@@ -39,7 +39,7 @@ def one_line_error(proc, name: str, words: str) -> None:
 
 @pytest.mark.parametrize("name", ["plan_ab.py", "plan_overhead.py", "prepare_memory.py",
                                   "prepare_time.py", "world_queries.py", "hybrid_cpu.py",
-                                  "flat_pair_ab.py"])
+                                  "flat_pair_ab.py", "step_cpu.py"])
 def test_each_script_has_a_help(name):
     proc = script(name, "--help")
     assert proc.returncode == 0 and proc.stdout.startswith(f"usage: {name}"), proc.stderr
@@ -258,16 +258,23 @@ def test_world_queries_refuses_wrong_input(args, words):
     one_line_error(script("world_queries.py", *args), "world_queries.py", words)
 
 
-def test_hybrid_cpu_reports_each_query(tmp_path):
-    # one box between start and goal: a path round it, longer than the straight 60 m
+def one_box(tmp_path) -> Path:
+    """A colliders.csv city of one box, 10 m square round (30, 0) north, east."""
     city = tmp_path / "one.csv"
     city.write_text("lat0 37.792480, lon0 -122.397450\n"
                     "posX,posY,posZ,halfSizeX,halfSizeY,halfSizeZ\n30,0,10,5,5,10\n")
-    proc = script("hybrid_cpu.py", str(city), "0,0,0;60,0", "--radius", "5", "--reps", "2")
+    return city
+
+
+def test_hybrid_cpu_reports_each_query(tmp_path):
+    # the box between start and goal: a path round it, longer than the straight 60 m; the
+    # start's north is negative, typed as is (argparse took it for an unknown option)
+    proc = script("hybrid_cpu.py", str(one_box(tmp_path)), "-10,0,0;50,0", "--radius", "5",
+                  "--reps", "2")
     assert proc.returncode == 0, proc.stderr
     (line,) = proc.stdout.splitlines()
     row = json.loads(line)
-    assert row["query"] == "0,0,0;60,0" and row["status"] == "found"
+    assert row["query"] == "-10,0,0;50,0" and row["status"] == "found"
     assert row["expanded"] > 0 and 60 < row["length"] < 80 and len(row["sha1"]) == 10
     assert len(row["cpu"]) == 2 and all(c >= 0 for c in row["cpu"])
 
@@ -276,7 +283,37 @@ def test_hybrid_cpu_reports_each_query(tmp_path):
     (["no-such.csv", "0,0;1,1"], "no-such.csv: no such file"),
     ([__file__, "0,0"], "query '0,0': expected START;GOAL"),
     ([__file__, "0,0;a,1"], "query '0,0;a,1': 'a,1' is not N,E or N,E,HEADING"),
-    ([__file__, "0,0;1,1", "--reps", "0"], "--reps 0: expected 1 to 100"),
+    ([__file__, "-1.5,0;a,1"], "query '-1.5,0;a,1': 'a,1' is not N,E or N,E,HEADING"),
+    ([__file__, "-.5,0;1,1", "--reps", "0"], "--reps 0: expected 1 to 100"),
 ])
 def test_hybrid_cpu_refuses_wrong_input(args, words):
     one_line_error(script("hybrid_cpu.py", *args), "hybrid_cpu.py", words)
+
+
+def test_step_cpu_reports_each_query_and_the_totals(tmp_path):
+    # round the box from south of it to north of it (the step is 0.00015 degrees, about
+    # 17 m north), a start with a negative north
+    proc = script("step_cpu.py", "--city", str(one_box(tmp_path)), "-10,0;70,0", "0,20;0,-20",
+                  "--reps", "2")
+    assert proc.returncode == 0, proc.stderr
+    *rows, total = [json.loads(line) for line in proc.stdout.splitlines()]
+    assert [r["query"] for r in rows] == ["-10,0;70,0", "0,20;0,-20"]
+    for r in rows:
+        assert r["status"] == "found" and r["moves"] >= 2 and r["expanded"] >= r["moves"]
+        assert len(r["sha1"]) == 10 and len(r["cpu"]) == 2 and all(c >= 0 for c in r["cpu"])
+    assert rows[0]["moves"] >= 4  # 80 m north, ending within a step: ceil(80 / 16.7 - 1)
+    assert total["total"] == 2 and len(total["sha1"]) == 10
+    assert total["cpu"] == pytest.approx([sum(r["cpu"][k] for r in rows) for k in (0, 1)],
+                                         abs=1e-3)
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--city", "no-such.csv", "0,0;1,1"], "no-such.csv: no such file"),
+    (["--city", __file__], "--city: give one or more queries 'N,E;N,E'"),
+    (["--city", __file__, "-3,0;1,1,90"], "query '-3,0;1,1,90': '1,1,90' is not N,E"),
+    (["--ilp", "no/such"], "--ilp no/such: no such folder"),
+    (["--ilp", ".", "0,0;1,1"], "--ilp: the queries are the ILP places' pairs"),
+    (["--city", __file__, "0,0;1,1", "--reps", "0"], "--reps 0: expected 1 to 100"),
+])
+def test_step_cpu_refuses_wrong_input(args, words):
+    one_line_error(script("step_cpu.py", *args), "step_cpu.py", words)

@@ -1,8 +1,11 @@
-"""Hybrid A*'s 2D bound (:func:`corner_distance.lower_bound`): its sight tests read the
-edge grid and its corner scan computes ``hypot`` only for the few candidates, and it
-answers what the plain rule answers, a scan of every corner in order of value (ties: the
-lower index) with shapely's proper crossings for sight. Half-integer coordinates put
-corners, edge ends and query points on bucket sides and make many values tie."""
+"""The 2D bounds through the corner table, Hybrid A*'s (:func:`corner_distance.
+lower_bound`, which gives up after a few blocked corners) and the step drone's
+(:func:`move_search.distance`, which tries corners until one is in sight): their sight
+tests read the edge grid and their corner scans compute ``hypot`` only for the few
+candidates, and they answer what the plain rule answers, a scan of every corner in order
+of value (ties: the lower index) with shapely's proper crossings for sight. Half-integer
+coordinates put corners, edge ends and query points on bucket sides and make many values
+tie."""
 
 import math
 
@@ -11,7 +14,7 @@ import shapely
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from skyroute.motion import edge_grid
+from skyroute.motion import edge_grid, move_search
 from skyroute.motion.corner_distance import lower_bound
 from skyroute.motion.zone_kernels import crosses
 
@@ -44,10 +47,12 @@ def hypot(x, y) -> float:
 
 def plain_bound(q, t, sees, corners, cdist, edges, tests, sight=shapely_sight):
     """The rule as written: every corner's hypot value, the cheapest first, sight over
-    every edge."""
+    every edge; after ``tests`` blocked corners the next one's value (None: no limit)."""
     d = hypot(q[0] - t[0], q[1] - t[1])
     if sees or len(corners) == 0:
         return d
+    if tests is None:
+        tests = len(corners)
     vals = [hypot(q[0] - c[0], q[1] - c[1]) + D
             for c, D in zip(corners, cdist, strict=True)]
     order = sorted(range(len(vals)), key=lambda c: (vals[c], c))
@@ -57,6 +62,21 @@ def plain_bound(q, t, sees, corners, cdist, edges, tests, sight=shapely_sight):
         if k == tests or sight(q, corners[c], edges):
             return max(d, vals[c])
     return d
+
+
+def kernel(q, t, sees, corners, cdist, edges, grid, tests):
+    """Hybrid A*'s bound giving up after ``tests`` blocked corners, or with ``tests``
+    None the step drone's."""
+    n = len(corners)
+    cols = np.ascontiguousarray(corners.T)
+    if tests is None:
+        return move_search.distance(*q, sees, *t, cols, cdist, edges, *grid, np.empty(n),
+                                    np.empty(n, np.int64))
+    return lower_bound(*q, *t, sees, cols, cdist, edges, *grid, np.empty(n),
+                       np.empty(n, np.int64), tests)
+
+
+tests_or_none = st.one_of(st.none(), st.integers(0, 4))
 
 
 @st.composite
@@ -69,12 +89,10 @@ def cases(draw):
 
 
 @settings(max_examples=400, deadline=None)
-@given(cases(), point, point, st.booleans(), st.integers(0, 4))
+@given(cases(), point, point, st.booleans(), tests_or_none)
 def test_the_bound_is_the_plain_scan_of_every_corner(case, q, t, sees, tests):
     edges, corners, cdist, grid = case
-    n = len(corners)
-    got = lower_bound(*q, *t, sees, np.ascontiguousarray(corners.T), cdist, edges, *grid,
-                      np.empty(n), np.empty(n, np.int64), tests)
+    got = kernel(q, t, sees, corners, cdist, edges, grid, tests)
     assert got == plain_bound(q, t, sees, corners, cdist, edges, tests)
 
 
@@ -103,16 +121,19 @@ def _case(edges, corners, cdist):
 
 
 @settings(max_examples=400, deadline=None)
-@given(float_cases(), st.tuples(real, real), st.tuples(real, real), st.integers(0, 4))
+@given(float_cases(), st.tuples(real, real), st.tuples(real, real), tests_or_none)
 # pairs where Python's math.hypot and the C library's differ in the last bit (found by
 # hypothesis): the distance to the target, and the value of the candidate returned
 @example(case=_case([[500, 500, 501, 500]], [[0, 0]], [0]), q=(1.5387996, -24.5420822),
          t=(43.8791853, 22.4127685), tests=0)
 @example(case=_case([[-1, 75, 2, 1]], [[0, 51], [0, -23], [52.2922444, 0], [0, 0]],
                     [0, 0, 0, math.inf]), q=(0.0, 50.1695025), t=(0.0, 0.0), tests=1)
+# two corners in sight whose values and approximations are in opposite orders: the
+# step drone's heap of approximations takes the second first, and must go on to the first
+@example(case=_case([[500, 500, 501, 500]], [[-65.5405188, 18.1601727],
+                                             [-8.2453711, 44.6217592]],
+                    [0, 22.63276680954487]), q=(0.0, 0.0), t=(1.0, 0.0), tests=None)
 def test_the_bound_is_the_plain_scan_on_inexact_coordinates(case, q, t, tests):
     edges, corners, cdist, grid = case
-    n = len(corners)
-    got = lower_bound(*q, *t, False, np.ascontiguousarray(corners.T), cdist, edges, *grid,
-                      np.empty(n), np.empty(n, np.int64), tests)
+    got = kernel(q, t, False, corners, cdist, edges, grid, tests)
     assert got == plain_bound(q, t, False, corners, cdist, edges, tests, scan_sight)

@@ -181,7 +181,7 @@ def test_heuristic_never_exceeds_the_moves_left(world, places, u, v, k):
     table = DistanceBound(world, t)
     sees = bool(world.segments_free([q], [t])[0])
     z = _zones(world)
-    h = move_search.bound(q[0], q[1], sees, t[0], t[1], table.corners, table.dist,
+    h = move_search.bound(q[0], q[1], sees, t[0], t[1], table.cols, table.dist,
                           z[0], *z[4:], STEP)
     d = shortest_distance(q, t)
     assert h <= max(0, math.ceil(d / STEP - 1 + 1e-9))
@@ -245,6 +245,18 @@ def test_default_budget_is_every_state_of_a_bounded_world(world):
     assert default_budget(_grid_city(2)) == UNBOUNDED_BUDGET  # no boundary: no such count
     tiny = plan_moves(world, AT, (-3.1913, 55.9455), max_expansions=None)
     assert tiny.found
+
+
+def test_a_budget_beyond_an_int64_is_no_budget():
+    # as errors.budget reads it for every planner; plan_moves passed it to its compiled
+    # search as given, which raised numba's OverflowError ("int too big to convert")
+    w = _degrees_square()
+    s, t = (-3.19, 55.943), (-3.186, 55.9448)
+    ref = plan_moves(w, s, t)
+    assert ref.found and ref.moves > 20
+    for huge in (2**63, 10**30):
+        f = plan_moves(w, s, t, max_expansions=huge)
+        assert f.found and f.expanded == ref.expanded and f.rows() == ref.rows()
 
 
 def _interrupted(world, monkeypatch, handler):

@@ -114,8 +114,9 @@ def fly_command(
         "--reverse", help=_for("reverse", "the vehicle may also drive backwards (a "
                                           "car)."))] = False,
     max_expansions: Annotated[int | None, typer.Option(help=_for(
-        "max_expansions", "Hybrid A*'s expansion budget (status budget_exhausted); default "
-        "10,000,000 (5,000,000 with --reverse)."))] = None,
+        "max_expansions", "Hybrid A*'s expansion budget (status budget_exhausted); default: "
+        "enough to finish the search, capped at 10,000,000 (5,000,000 with --reverse) to "
+        "protect memory."))] = None,
     targets: Annotated[Path | None, typer.Option(help=_for(
         "targets", "visit these targets (a .csv or .json of A,B points in --frame) in the "
                    "shortest order from START; GOAL is not used."))] = None,

@@ -46,7 +46,8 @@ def plan_command(
         help="Metres per cell: the rasterising resolution for .csv walls (--cell-size: old "
              "name).")] = 1.0,
     max_expansions: Annotated[int | None, typer.Option(
-        help="Give up after this many expansions (status budget_exhausted).")] = None,
+        help="Give up after this many expansions (status budget_exhausted); default: "
+             "enough to finish the search, with no cap (the map's cells bound it).")] = None,
     index: Annotated[Path | None, typer.Option(
         help="Answer from this prepared index ('skyroute prepare MAP -o MAP.idx'): the exact "
              "octile path; only with the default search options.")] = None,

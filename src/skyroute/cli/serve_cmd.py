@@ -60,7 +60,8 @@ def serve_command(
     workers: Annotated[int, typer.Option(help="Server processes.")] = 1,
     max_body_mb: Annotated[float, typer.Option(help="Largest request body, MB.")] = 10.0,
     max_expansions: Annotated[int, typer.Option(
-        help="Search budget of one POST /plan.")] = 2_000_000,
+        help="The cap on one POST /plan's search budget (a request without "
+             "max_expansions, enough to finish the search, is capped to it).")] = 2_000_000,
     max_samples: Annotated[int, typer.Option(
         help="Largest PRM roadmap of one POST /plan (its samples; /openapi.json declares "
              "the limit).")] = 20_000,

@@ -121,6 +121,34 @@ def target_distances(tx, ty, corners, adj, edges, meta, start, ids):
 
 
 @njit(cache=True)
+def approximate(qx, qy, cols, cdist, out):
+    """``out[c] = sqrt(dx**2 + dy**2) + D(c)`` for every corner c, (dx, dy) = q - c: a
+    first pass over the corners (``cols``: (2, N) rows of x and y, C order, which LLVM
+    vectorises) that glibc's ``hypot`` made most of a search's time. It is within a few
+    ulps of the exact value (:func:`exact`), so a corner whose approximation exceeds
+    :func:`beyond` of an exact value v has an exact value above v."""
+    for c in range(cols.shape[1]):
+        dx = qx - cols[0, c]
+        dy = qy - cols[1, c]
+        out[c] = math.sqrt(dx * dx + dy * dy) + cdist[c]
+
+
+@njit(cache=True)
+def beyond(v):
+    """The approximation (:func:`approximate`) above which a corner's exact value exceeds
+    ``v``, and the exact value of every corner whose approximation is ``v`` or less (an
+    approximation and its exact value differ by a few ulps, far below 1e-12 of it; the
+    1e-150 covers squares that underflow); inf when ``v`` is."""
+    return v * (1.0 + 1e-12) + 1e-150
+
+
+@njit(cache=True)
+def exact(qx, qy, cols, cdist, c):
+    """Corner c's value ``hypot(q - c) + D(c)``: what the bounds return."""
+    return math.hypot(qx - cols[0, c], qy - cols[1, c]) + cdist[c]
+
+
+@njit(cache=True)
 def lower_bound(qx, qy, tx, ty, sees, cols, cdist, edges, meta, start, ids, scratch, picks,
                 tests):
     """A lower bound on the obstacle-avoiding distance from q to target t: |q - t| when q
@@ -130,23 +158,18 @@ def lower_bound(qx, qy, tx, ty, sees, cols, cdist, edges, meta, start, ids, scra
     corner q sees costs at least that, so the bound stays a bound, and the loop stays
     short among many corners. The sight tests read the edges through their bucket grid
     (meta, start, ids: :attr:`CornerGraph.grid`). ``cols``: the corners as (2, N) rows of
-    x and y (C order: the first pass reads them contiguously and is vectorised).
-    ``scratch`` (N,) float and ``picks`` (N,) int64: workspace.
+    x and y. ``scratch`` (N,) float and ``picks`` (N,) int64: workspace.
 
-    The candidates' values are ``hypot(q - c) + D(c)``; glibc's ``hypot`` over every
-    corner was most of a search's time, so a first pass takes ``sqrt(dx**2 + dy**2)``
-    (within a few ulps of it, and vectorised) and only the corners within 1e-12 of the
-    (tests + 1)-th smallest of those get the exact value: they hold every corner the
-    exact order could try, so the answer is the one a scan of every corner gives.
+    The candidates are found from the corners' approximations (:func:`approximate`): only
+    those within :func:`beyond` of the (tests + 1)-th smallest get the exact value. They
+    hold every corner the exact order could try, so the answer is the one a scan of every
+    corner's exact value gives.
     """
     d = math.hypot(qx - tx, qy - ty)
     n = cols.shape[1]
     if sees or n == 0:
         return d
-    for c in range(n):
-        dx = qx - cols[0, c]
-        dy = qy - cols[1, c]
-        scratch[c] = math.sqrt(dx * dx + dy * dy) + cdist[c]
+    approximate(qx, qy, cols, cdist, scratch)
     top = np.full(tests + 1, np.inf)  # the smallest approximations, ascending
     for c in range(n):
         v = scratch[c]
@@ -156,12 +179,12 @@ def lower_bound(qx, qy, tx, ty, sees, cols, cdist, edges, meta, start, ids, scra
                 top[k] = top[k - 1]
                 k -= 1
             top[k] = v
-    cut = top[tests] * (1.0 + 1e-12) + 1e-150  # inf when fewer values are finite
+    cut = beyond(top[tests])  # inf when fewer values are finite
     m = 0
     for c in range(n):
         if scratch[c] <= cut:
             picks[m] = c
-            scratch[m] = math.hypot(qx - cols[0, c], qy - cols[1, c]) + cdist[c]
+            scratch[m] = exact(qx, qy, cols, cdist, c)
             m += 1
     for k in range(tests + 1):
         j = np.argmin(scratch[:m])

@@ -102,8 +102,9 @@ _WEIGHT = 1.0  # f = g + weight h; 1 keeps the search best-first on the true bou
 _REVERSE_BUDGET = 500  # expansions of the reversed search that comes first
 _BACK_COST = 1.0  # reverse=True: a metre driven backwards costs as much as one forwards
 _SWITCH = 1.0  # reverse=True: each change of direction costs this many turning radii
-#: max_expansions=None: the search stores at most this many nodes (each expansion adds at
-#: most one per primitive; about 2 GB), 10,000,000 expansions (5,000,000 with reverse).
+#: max_expansions=None: enough to finish the search, capped so that it stores at most this
+#: many nodes (each expansion adds at most one per primitive; about 2 GB): 10,000,000
+#: expansions (5,000,000 with reverse).
 #: The largest searches measured that find a path used 3,000,000 (radius 5 m across the
 #: 930 m FCND city, docs/architecture.md); without a cap a radius tiny beside the world
 #: (0.01 m in 100 m) filled 10 GB in 5 minutes.
@@ -211,12 +212,13 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         r times the heading change), which stays a bound with reversing.
     max_expansions : int, optional
         Stop with ``budget_exhausted`` (or with the best path found so far) after this
-        many expansions. None: :data:`MAX_NODES` divided by the primitives per expansion,
-        10,000,000 (5,000,000 with ``reverse``): about 2 GB and a few minutes at most, far
-        above the searches that find a path in city-sized worlds at radii of metres, and
-        the guard against a radius tiny beside the world, whose lattice has billions of
-        states. Running out says so in ``extra["hint"]``, with the world's size in
-        turning radii.
+        many expansions. None: enough to finish the search (every lattice state of the
+        search region), capped to protect memory at :data:`MAX_NODES` divided by the
+        primitives per expansion, 10,000,000 (5,000,000 with ``reverse``): about 2 GB and
+        a few minutes at most, far above the searches that find a path in city-sized
+        worlds at radii of metres, and the guard against a radius tiny beside the world,
+        whose lattice has billions of states. Running out says so in ``extra["hint"]``,
+        with the world's size in turning radii.
     approach : float, optional
         ``goal`` is a runway threshold (x, y, runway heading) and the path ends with a
         straight final approach this long along the runway (:func:`runway_goal`).

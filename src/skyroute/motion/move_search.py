@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit, objmode, types
 from numba.typed import Dict
 
+from skyroute.motion.corner_distance import approximate, beyond, exact
 from skyroute.motion.zone_kernels import expand, sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
 from skyroute.search import heap
@@ -68,8 +69,13 @@ def interruptible():
         old(signal.SIGINT, sys._getframe(2))  # the frame of the block's caller
 
 
+# numba caches the kernels below with corner_distance's first pass (approximate, beyond,
+# exact), zone_kernels' tests and the heap compiled in, keyed by this file's date alone:
+# edit this file when one of those changes, or a checkout keeps running the old code.
+
+
 @njit(cache=True)
-def distance(qx, qy, sees, tx, ty, corners, cdist, edges, meta, start, ids):
+def distance(qx, qy, sees, tx, ty, cols, cdist, edges, meta, start, ids, vals, order):
     """A lower bound on the obstacle-avoiding distance from q to the target; (meta, start,
     ids) the edges' bucket grid (:mod:`skyroute.motion.edge_grid`).
 
@@ -77,28 +83,34 @@ def distance(qx, qy, sees, tx, ty, corners, cdist, edges, meta, start, ids):
     |q - v| + D(v), D the corner's shortest distance to the target: every path from q
     bends first at a corner in sight. Corners are tried cheapest first (a binary heap of
     their values: a city's point may test hundreds of its thousands of corners before one
-    is in sight), so usually the first sight test settles it.
+    is in sight), so usually the first sight test settles it. The heap holds the values'
+    approximations (:func:`corner_distance.approximate`, ``sqrt`` and vectorised, where
+    ``hypot`` for every corner was a tenth of a city's ``skyroute fly``); a corner taken
+    from it gets its exact value, and once the approximations left are beyond the least
+    exact value in sight (:func:`corner_distance.beyond`) none can be less: the answer is
+    the exact values' minimum, as a heap of them gives. ``cols``: the corners as (2, N)
+    rows of x and y; ``vals`` (N,) float and ``order`` (N,) int64: workspace.
     """
     d = math.hypot(qx - tx, qy - ty)
-    if not sees and corners.shape[0]:
-        vals = np.empty(corners.shape[0])
-        order = np.empty(corners.shape[0], np.int64)
-        n = 0
-        for c in range(corners.shape[0]):
-            v = math.hypot(qx - corners[c, 0], qy - corners[c, 1]) + cdist[c]
-            if v < np.inf:
-                vals[n], order[n] = v, c
-                n += 1
-        for i in range(n // 2 - 1, -1, -1):
-            heap.sift_down(vals, order, i, n)
-        while n > 0:
-            v, c = vals[0], order[0]
-            if sight(qx, qy, corners[c, 0], corners[c, 1], edges, meta, start, ids):
-                d = max(d, v)
-                break
-            heap.pop_plain(vals, order, n)
-            n -= 1
-    return d
+    n = cols.shape[1]
+    if sees or n == 0:
+        return d
+    approximate(qx, qy, cols, cdist, vals)
+    m = 0
+    for c in range(n):
+        if vals[c] < np.inf:
+            vals[m], order[m] = vals[c], c
+            m += 1
+    for i in range(m // 2 - 1, -1, -1):
+        heap.sift_down(vals, order, i, m)
+    best = np.inf
+    while m > 0 and vals[0] <= beyond(best):
+        c = heap.pop_plain(vals, order, m)
+        m -= 1
+        v = exact(qx, qy, cols, cdist, c)
+        if v < best and sight(qx, qy, cols[0, c], cols[1, c], edges, meta, start, ids):
+            best = v
+    return max(d, best) if best < np.inf else d
 
 
 @njit(cache=True)
@@ -110,15 +122,16 @@ def moves_left(d, step):
 
 
 @njit(cache=True)
-def bound(qx, qy, sees, tx, ty, corners, cdist, edges, meta, start, ids, step):
+def bound(qx, qy, sees, tx, ty, cols, cdist, edges, meta, start, ids, step):
     """:func:`moves_left` of :func:`distance`: A*'s heuristic."""
-    return moves_left(distance(qx, qy, sees, tx, ty, corners, cdist, edges, meta, start, ids),
-                      step)
+    n = cols.shape[1]
+    return moves_left(distance(qx, qy, sees, tx, ty, cols, cdist, edges, meta, start, ids,
+                               np.empty(n), np.empty(n, np.int64)), step)
 
 
 @njit(cache=True)
 def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, meta, start, ids,
-           corners, cdist, step, merge, max_expansions, eps):
+           cols, cdist, step, merge, max_expansions, eps):
     """A* from (sx, sy) to closer than ``step`` to (tx, ty).
 
     The heuristic is evaluated lazily: a new state gets the cheap bound max(|q - t|,
@@ -142,8 +155,11 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, meta, st
     hk = np.empty(cap, np.int64)
     hn = np.empty(cap, np.int64)
     seen = Dict.empty(key_type=types.int64, value_type=types.int64)
+    vals = np.empty(cols.shape[1])  # the bound's workspace
+    order = np.empty(cols.shape[1], np.int64)
     x[0], y[0], parent[0], move[0], g[0] = sx, sy, -1, -1, 0
-    dist[0] = distance(sx, sy, sees0, tx, ty, corners, cdist, edges, meta, start, ids)
+    dist[0] = distance(sx, sy, sees0, tx, ty, cols, cdist, edges, meta, start, ids, vals,
+                       order)
     exact[0] = True
     n = 1
     seen[np.int64(_HALF) * (1 << 32) + _HALF] = 0
@@ -162,8 +178,8 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, meta, st
         if not exact[i]:
             exact[i] = True
             sees = sight(x[i], y[i], tx, ty, edges, meta, start, ids)
-            dist[i] = max(dist[i], distance(x[i], y[i], sees, tx, ty, corners, cdist, edges,
-                                            meta, start, ids))
+            dist[i] = max(dist[i], distance(x[i], y[i], sees, tx, ty, cols, cdist, edges,
+                                            meta, start, ids, vals, order))
             f = g[i] + moves_left(dist[i], step)
             if f > (top >> 20):
                 if size + 1 > hk.shape[0]:

@@ -28,7 +28,15 @@ import numpy as np
 import shapely
 
 from skyroute.caches import register
-from skyroute.errors import OptionError, QueryError, check_instance, real, renamed, whole
+from skyroute.errors import (
+    OptionError,
+    QueryError,
+    budget,
+    check_instance,
+    real,
+    renamed,
+    whole,
+)
 from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.motion import edge_grid, move_search
 from skyroute.motion.zone_kernels import zone_arrays
@@ -41,8 +49,10 @@ HOVER = -999
 ANGLES = np.arange(0, 360, 10)
 MAX_PAIRS = 50_000  # vertex pairs up to which corners are tested pair by pair
 MERGE = 5e-6  # positions in one lattice cell this wide (1/30 step) are one state
-UNBOUNDED_BUDGET = 200_000  # plan_moves' default expansions in a world without a boundary
-MAX_BUDGET = 2_000_000  # and at most this many in one with a boundary
+#: max_expansions=None (:func:`default_budget`): the cap in a world without a boundary,
+#: whose states are unbounded, and the cap in one with a boundary (memory and time)
+UNBOUNDED_BUDGET = 200_000
+MAX_BUDGET = 2_000_000
 _CORNER_GRAPHS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _ZONES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _BOUNDS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -135,13 +145,11 @@ class DistanceBound:
 
     Built once per world (visibility among the corners) and once per target (Dijkstra).
     The compiled search bounds a point q's distance by |q - t| when q sees t, else by
-    min over the corners v that q sees of |q - v| + D(v) (:func:`move_search.bound`).
+    min over the corners v that q sees of |q - v| + D(v) (:func:`move_search.bound`),
+    reading the corners as ``cols``, (2, N) rows of x and y.
     """
 
     def __init__(self, world: World, target: np.ndarray) -> None:
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import dijkstra
-
         self.world = world
         self.target = np.asarray(target, dtype=float)
         if world not in _CORNER_GRAPHS:
@@ -150,17 +158,26 @@ class DistanceBound:
         if not isinstance(table, tuple):  # a city's: the visibility graph's corner table
             self.corners = table.corners
             self.dist = table.to(self.target) if len(self.corners) else np.zeros(0)
-            return
-        self.corners, i, j = table
-        n = len(self.corners)
-        sees = world.segments_free(np.broadcast_to(self.target, (n, 2)), self.corners) \
+        else:
+            self.corners = table[0]
+            self.dist = self._dijkstra(*table)
+        self.cols = np.ascontiguousarray(self.corners.T)
+
+    def _dijkstra(self, corners: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """D(v) through the free corner pairs (i, j) and the corners the target sees."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import dijkstra
+
+        world = self.world
+        n = len(corners)
+        sees = world.segments_free(np.broadcast_to(self.target, (n, 2)), corners) \
             if n else np.zeros(0, bool)
         rows = np.concatenate([i, np.full(int(sees.sum()), n)])
         cols = np.concatenate([j, np.flatnonzero(sees)])
-        w = np.hypot(*(np.vstack([self.corners, self.target])[rows] -
-                       np.vstack([self.corners, self.target])[cols]).T) + 1e-300
+        w = np.hypot(*(np.vstack([corners, self.target])[rows] -
+                       np.vstack([corners, self.target])[cols]).T) + 1e-300
         graph = coo_matrix((w, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
-        self.dist = dijkstra(graph, directed=False, indices=n)[:n] if n else np.zeros(0)
+        return dijkstra(graph, directed=False, indices=n)[:n] if n else np.zeros(0)
 
 
 def _corner_pairs(world: World):
@@ -215,11 +232,12 @@ def _coarse(p: np.ndarray, step: float) -> tuple[int, int]:
 
 
 def default_budget(world: World, merge: float = MERGE) -> int:
-    """plan_moves' expansion budget when none is given: in a world with a boundary, every
-    state its search can hold (the ``merge``-wide lattice cells of the boundary's box:
-    a state is expanded once, so the search ends found or no_path), at most
-    :data:`MAX_BUDGET`; without a boundary :data:`UNBOUNDED_BUDGET`. The ILP area at the
-    default merge: 1,183,200 (1,632 x 725 cells)."""
+    """plan_moves' budget for ``max_expansions=None``: enough to finish the search, capped
+    to protect memory. In a world with a boundary, every state its search can hold (the
+    ``merge``-wide lattice cells of the boundary's box: a state is expanded once, so the
+    search ends found or no_path), capped at :data:`MAX_BUDGET` (2,000,000); without a
+    boundary the states are unbounded and the cap is :data:`UNBOUNDED_BUDGET` (200,000).
+    The ILP area at the default merge: 1,183,200 (1,632 x 725 cells)."""
     if world.boundary is None:
         return UNBOUNDED_BUDGET
     x0, y0, x1, y1 = shapely.Polygon(world.boundary).bounds
@@ -240,10 +258,12 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     distance to the goal (:class:`DistanceBound`): admissible, since each move covers
     at most ``step`` and the flight may stop within ``step`` of the goal. Ties go to
     the deeper node. No path is a status, not an exception, and so is running out of
-    ``max_expansions`` (None: :func:`default_budget`, which in a bounded world such as
-    the ILP area lets the search run until it ends; a fixed 200,000 ran out on a legal
-    pair there that needs 215,220). The whole search is one compiled call
-    (:mod:`skyroute.motion.move_search`), which Ctrl-C interrupts.
+    ``max_expansions`` (None: enough to finish the search, capped to protect memory:
+    :func:`default_budget`, every state of a bounded world such as the ILP area, where
+    a fixed 200,000 ran out on a legal pair that needs 215,220, capped at
+    :data:`MAX_BUDGET`, 2,000,000; without a boundary :data:`UNBOUNDED_BUDGET`, 200,000;
+    a number beyond an int64 is no budget, as for every planner). The whole search is
+    one compiled call (:mod:`skyroute.motion.move_search`), which Ctrl-C interrupts.
     """
     if misspelt:
         raise unknown_keywords(plan_moves, misspelt)
@@ -254,7 +274,7 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     step = real("step", step, low=0.0, strict=True)
     merge = real("merge", merge, low=0.0, strict=True)
     max_expansions = default_budget(world, merge) if max_expansions is None else \
-        whole("max_expansions", max_expansions, low=0)
+        budget(max_expansions)
     t0 = time.perf_counter()
     s = world.check_point(start, "start")
     t = world.to_plane(goal, "goal")
@@ -269,7 +289,7 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     while status == move_search.INTERRUPTED:  # again when SIGINT's handler did not raise
         with move_search.interruptible():
             status, end, expanded, x, y, parent, move = move_search.search(
-                s[0], s[1], t[0], t[1], sees0, deltas, *_zones(world), bound.corners,
+                s[0], s[1], t[0], t[1], sees0, deltas, *_zones(world), bound.cols,
                 bound.dist, step, merge, max_expansions, 1e-12)
     seconds = time.perf_counter() - t0
     if status != FOUND:

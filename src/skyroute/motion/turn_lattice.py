@@ -147,6 +147,8 @@ def plan_turns(grid: Grid, start: tuple[int, int], goal: tuple[int, int], *,
 
     ``speed`` in cells per second, ``turn_rate`` in radians per second; ``start_heading``
     (radians, from the x axis towards +y) snaps to the nearest lattice heading, or any.
+    ``max_expansions``: stop with ``budget_exhausted`` after this many; None: enough to
+    finish the search, with no cap (the grid's cells times the headings bound it).
     """
     if misspelt:
         raise unknown_keywords(plan_turns, misspelt)

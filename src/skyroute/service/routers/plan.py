@@ -128,7 +128,8 @@ class PlanRequest(BaseModel):
     prune: Literal["none", "collinear", "los"] | None = None
     max_expansions: int | None = Field(None, strict=True, ge=1, le=2**62,
                                        description="Stop after this many expansions; "
-                                       "capped by the server's budget.")
+                                       "null: enough to finish the search; capped by the "
+                                       "server's budget.")
     resolution: Number | None = Field(None, gt=0, le=MAX_METRES, description="Worlds, "
                                       "grid algorithms: cell size in world units (at most "
                                       "a local plane's 1e7 m; the raster, 8 cells round "
