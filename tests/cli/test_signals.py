@@ -141,6 +141,36 @@ def test_an_interrupt_swallowed_by_a_ctypes_callback_still_interrupts():
     assert "finished" not in out
 
 
+# Ctrl-C while code made from source text runs, as dataclasses make their methods by
+# exec (numba's imports make hundreds, the first seconds of 'fly --vehicle dubins' and
+# 'plan-world'). CPython notes a KeyboardInterrupt that leaves such an exec, even one
+# caught later, and 'python -m' ended the process by SIGINT after its teardown: exit
+# status -2 after "skyroute: interrupted", about one Ctrl-C in eight there.
+IN_EXEC = """
+import typer
+from skyroute.cli.errors import run_cli
+
+app = typer.Typer(add_completion=False)
+
+@app.command()
+def define() -> None:
+    exec("import os, signal, time\\nos.kill(os.getpid(), signal.SIGINT)\\ntime.sleep(20)")
+    print("finished")
+
+run_cli(app)
+"""
+
+
+def test_ctrl_c_inside_an_exec_of_source_exits_130_under_python_m(tmp_path):
+    (tmp_path / "exec_command.py").write_text(IN_EXEC)
+    p = _start(["-m", "exec_command"], env={"PYTHONPATH": f"{SRC}{os.pathsep}{tmp_path}"})
+    try:
+        out, err = p.communicate(timeout=30)
+    finally:
+        p.kill()
+    assert (p.returncode, err, out) == (130, "skyroute: interrupted\n", "")
+
+
 def test_ctrl_c_while_numba_compiles_is_one_line(tmp_path):
     # a first run, the kernels compiled into an empty cache; SIGINT a moment after the
     # first one is saved, while the others compile (where it lands varies: in LLVM's
