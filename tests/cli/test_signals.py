@@ -13,6 +13,7 @@ import typer
 
 import skyroute
 from skyroute.cli.errors import run_cli
+from tests.conftest import ROOT
 
 SRC = Path(skyroute.__file__).resolve().parents[1]
 
@@ -187,6 +188,49 @@ def test_ctrl_c_while_numba_compiles_is_one_line(tmp_path):
     finally:
         p.kill()
     assert (p.returncode, err) == (130, "skyroute: interrupted\n")
+
+
+# 'fly --vehicle dubins' with Hybrid A*'s search (one compiled call) spied on: each call
+# says when it starts and what it returned. A radius of 1 m in the bundled city: its
+# 300,000 expansions take seconds (the default budget, minutes).
+FLY_DUBINS = """
+import sys
+from skyroute.motion import hybrid_search
+from skyroute.cli.app import console
+
+search = hybrid_search.search
+
+def spy(*args):
+    print("searching", flush=True)
+    out = search(*args)
+    print("status", int(out[0]), flush=True)
+    return out
+
+hybrid_search.search = spy
+sys.argv = ["skyroute", "fly", sys.argv[1], "--vehicle", "dubins", "--frame", "ned",
+            "--altitude", "10", "--safety", "2", "--start", "104,104", "--goal", "-74,5",
+            "--radius", "1", "--max-expansions", "300000", "--json"]
+console()
+"""
+
+
+def test_ctrl_c_stops_hybrid_a_star_inside_its_search():
+    # Ctrl-C waited for the compiled search's end (the default budget: minutes); it now
+    # returns at its next poll (4,096 expansions) and the command ends in one line, 130
+    from skyroute.search.interrupt import INTERRUPTED
+
+    p = _start(["-c", FLY_DUBINS, str(ROOT / "examples/city.csv")])
+    try:
+        lines = []
+        while lines.count("searching\n") < 2:  # the forward search, after the reversed one
+            lines.append(p.stdout.readline())
+            assert lines[-1], lines
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=120)
+    finally:
+        p.kill()
+    assert (p.returncode, err) == (130, "skyroute: interrupted\n")
+    assert out == f"status {INTERRUPTED}\n"  # no JSON: the flight was not planned
 
 
 def test_ctrl_c_while_a_fleet_run_is_written_leaves_the_earlier_run(tmp_path):
