@@ -1,6 +1,7 @@
 """SIGINT and SIGTERM end a command with one line and 130 / 143, after its work has
 unwound: no traceback, no temporary file left beside an output being written."""
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -259,6 +260,44 @@ def test_ctrl_c_while_a_fleet_run_is_written_leaves_the_earlier_run(tmp_path):
     assert (p.returncode, err) == (130, "skyroute: interrupted\n")
     assert sorted(out.iterdir()) == before  # no temporary file left either
     assert all((out / n).read_text() == f"earlier {n}\n" for n in RUN_FILES)
+
+
+def _starting_workers(pid: int) -> int:
+    """The processes under ``pid`` that multiprocessing's spawn started whose Python has
+    set its SIGINT handler and not yet been told to ignore SIGINT (/proc's masks): a
+    Dask worker importing distributed, before its preload."""
+    import psutil
+
+    n = 0
+    for child in psutil.Process(pid).children(recursive=True):
+        with contextlib.suppress(psutil.Error, OSError):  # (one that ended meanwhile)
+            status = dict(line.split(":\t", 1)
+                          for line in Path(f"/proc/{child.pid}/status").read_text().splitlines()
+                          if line.startswith(("SigCgt", "SigIgn")))
+            bit = 1 << (signal.SIGINT - 1)
+            n += "spawn_main" in " ".join(child.cmdline()) and \
+                bool(int(status["SigCgt"], 16) & bit) and not int(status["SigIgn"], 16) & bit
+    return n
+
+
+def test_ctrl_c_as_the_dask_workers_start_is_one_line():
+    # a terminal's Ctrl-C reaches the whole group: in the seconds the in-process
+    # cluster's workers took to import distributed, each printed a KeyboardInterrupt
+    # traceback, then "Nanny failed to start" and, at exit, distributed's close_clusters
+    # AssertionError (Status.init), some 80 lines under "skyroute: interrupted"
+    p = _start(["-m", "skyroute", "fleet", "sweep", "--preset", "seed-3x3", "--seeds", "0-3",
+                "--hours", "1", "--executor", "dask", "--jobs", "2"],
+               start_new_session=True)
+    try:
+        end = time.monotonic() + 120
+        while p.poll() is None and time.monotonic() < end and _starting_workers(p.pid) < 2:
+            time.sleep(0.005)  # both workers started, importing distributed
+        os.killpg(p.pid, signal.SIGINT)
+        _, err = p.communicate(timeout=120)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(p.pid, signal.SIGKILL)
+    assert (p.returncode, err) == (130, "skyroute: interrupted\n")
 
 
 # A command whose clean-up after a Ctrl-C takes a while (workers ending, a transaction
