@@ -217,7 +217,8 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         above the searches that find a path in city-sized worlds at radii of metres, and
         the guard against a radius tiny beside the world, whose lattice has billions of
         states. Running out says so in ``extra["hint"]``, with the world's size in
-        turning radii.
+        turning radii. Ctrl-C stops the search within 4,096 expansions
+        (:mod:`skyroute.search.interrupt`).
     approach : float, optional
         ``goal`` is a runway threshold (x, y, runway heading) and the path ends with a
         straight final approach this long along the runway (:func:`runway_goal`).
