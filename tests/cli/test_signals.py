@@ -1,6 +1,7 @@
 """SIGINT and SIGTERM end a command with one line and 130 / 143, after its work has
 unwound: no traceback, no temporary file left beside an output being written."""
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -13,6 +14,7 @@ import typer
 
 import skyroute
 from skyroute.cli.errors import run_cli
+from tests.conftest import ROOT
 
 SRC = Path(skyroute.__file__).resolve().parents[1]
 
@@ -141,6 +143,36 @@ def test_an_interrupt_swallowed_by_a_ctypes_callback_still_interrupts():
     assert "finished" not in out
 
 
+# Ctrl-C while code made from source text runs, as dataclasses make their methods by
+# exec (numba's imports make hundreds, the first seconds of 'fly --vehicle dubins' and
+# 'plan-world'). CPython notes a KeyboardInterrupt that leaves such an exec, even one
+# caught later, and 'python -m' ended the process by SIGINT after its teardown: exit
+# status -2 after "skyroute: interrupted", about one Ctrl-C in eight there.
+IN_EXEC = """
+import typer
+from skyroute.cli.errors import run_cli
+
+app = typer.Typer(add_completion=False)
+
+@app.command()
+def define() -> None:
+    exec("import os, signal, time\\nos.kill(os.getpid(), signal.SIGINT)\\ntime.sleep(20)")
+    print("finished")
+
+run_cli(app)
+"""
+
+
+def test_ctrl_c_inside_an_exec_of_source_exits_130_under_python_m(tmp_path):
+    (tmp_path / "exec_command.py").write_text(IN_EXEC)
+    p = _start(["-m", "exec_command"], env={"PYTHONPATH": f"{SRC}{os.pathsep}{tmp_path}"})
+    try:
+        out, err = p.communicate(timeout=30)
+    finally:
+        p.kill()
+    assert (p.returncode, err, out) == (130, "skyroute: interrupted\n", "")
+
+
 def test_ctrl_c_while_numba_compiles_is_one_line(tmp_path):
     # a first run, the kernels compiled into an empty cache; SIGINT a moment after the
     # first one is saved, while the others compile (where it lands varies: in LLVM's
@@ -157,6 +189,49 @@ def test_ctrl_c_while_numba_compiles_is_one_line(tmp_path):
     finally:
         p.kill()
     assert (p.returncode, err) == (130, "skyroute: interrupted\n")
+
+
+# 'fly --vehicle dubins' with Hybrid A*'s search (one compiled call) spied on: each call
+# says when it starts and what it returned. A radius of 1 m in the bundled city: its
+# 300,000 expansions take seconds (the default budget, minutes).
+FLY_DUBINS = """
+import sys
+from skyroute.motion import hybrid_search
+from skyroute.cli.app import console
+
+search = hybrid_search.search
+
+def spy(*args):
+    print("searching", flush=True)
+    out = search(*args)
+    print("status", int(out[0]), flush=True)
+    return out
+
+hybrid_search.search = spy
+sys.argv = ["skyroute", "fly", sys.argv[1], "--vehicle", "dubins", "--frame", "ned",
+            "--altitude", "10", "--safety", "2", "--start", "104,104", "--goal", "-74,5",
+            "--radius", "1", "--max-expansions", "300000", "--json"]
+console()
+"""
+
+
+def test_ctrl_c_stops_hybrid_a_star_inside_its_search():
+    # Ctrl-C waited for the compiled search's end (the default budget: minutes); it now
+    # returns at its next poll (4,096 expansions) and the command ends in one line, 130
+    from skyroute.search.interrupt import INTERRUPTED
+
+    p = _start(["-c", FLY_DUBINS, str(ROOT / "examples/city.csv")])
+    try:
+        lines = []
+        while lines.count("searching\n") < 2:  # the forward search, after the reversed one
+            lines.append(p.stdout.readline())
+            assert lines[-1], lines
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=120)
+    finally:
+        p.kill()
+    assert (p.returncode, err) == (130, "skyroute: interrupted\n")
+    assert out == f"status {INTERRUPTED}\n"  # no JSON: the flight was not planned
 
 
 def test_ctrl_c_while_a_fleet_run_is_written_leaves_the_earlier_run(tmp_path):
@@ -185,6 +260,44 @@ def test_ctrl_c_while_a_fleet_run_is_written_leaves_the_earlier_run(tmp_path):
     assert (p.returncode, err) == (130, "skyroute: interrupted\n")
     assert sorted(out.iterdir()) == before  # no temporary file left either
     assert all((out / n).read_text() == f"earlier {n}\n" for n in RUN_FILES)
+
+
+def _starting_workers(pid: int) -> int:
+    """The processes under ``pid`` that multiprocessing's spawn started whose Python has
+    set its SIGINT handler and not yet been told to ignore SIGINT (/proc's masks): a
+    Dask worker importing distributed, before its preload."""
+    import psutil
+
+    n = 0
+    for child in psutil.Process(pid).children(recursive=True):
+        with contextlib.suppress(psutil.Error, OSError):  # (one that ended meanwhile)
+            status = dict(line.split(":\t", 1)
+                          for line in Path(f"/proc/{child.pid}/status").read_text().splitlines()
+                          if line.startswith(("SigCgt", "SigIgn")))
+            bit = 1 << (signal.SIGINT - 1)
+            n += "spawn_main" in " ".join(child.cmdline()) and \
+                bool(int(status["SigCgt"], 16) & bit) and not int(status["SigIgn"], 16) & bit
+    return n
+
+
+def test_ctrl_c_as_the_dask_workers_start_is_one_line():
+    # a terminal's Ctrl-C reaches the whole group: in the seconds the in-process
+    # cluster's workers took to import distributed, each printed a KeyboardInterrupt
+    # traceback, then "Nanny failed to start" and, at exit, distributed's close_clusters
+    # AssertionError (Status.init), some 80 lines under "skyroute: interrupted"
+    p = _start(["-m", "skyroute", "fleet", "sweep", "--preset", "seed-3x3", "--seeds", "0-3",
+                "--hours", "1", "--executor", "dask", "--jobs", "2"],
+               start_new_session=True)
+    try:
+        end = time.monotonic() + 120
+        while p.poll() is None and time.monotonic() < end and _starting_workers(p.pid) < 2:
+            time.sleep(0.005)  # both workers started, importing distributed
+        os.killpg(p.pid, signal.SIGINT)
+        _, err = p.communicate(timeout=120)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(p.pid, signal.SIGKILL)
+    assert (p.returncode, err) == (130, "skyroute: interrupted\n")
 
 
 # A command whose clean-up after a Ctrl-C takes a while (workers ending, a transaction

@@ -611,6 +611,18 @@ def test_local_workers_start_deaf_to_ctrl_c():
     assert signal.pthread_sigmask(signal.SIG_BLOCK, []) == before
 
 
+
+def test_dask_workers_start_deaf_to_ctrl_c(dask_executor):
+    """As the local pool's: a Ctrl-C in the seconds the in-process cluster's workers took
+    to import distributed (before the preload that ignores SIGINT) printed a
+    KeyboardInterrupt traceback from each, "Nanny failed to start" and distributed's
+    close_clusters AssertionError at exit. The cluster is started with SIGINT blocked;
+    its workers inherit the mask, the caller's is as it was."""
+    import signal
+
+    assert list(dask_executor.client.run(_sigint_blocked_here, None).values()) == [True] * 2
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+
 # A local Dask cluster takes no fixed port: two at once (two commands, or a command beside
 # a notebook's cluster) printed distributed's "Port 8787 is already in use" warning to the
 # second one's user.

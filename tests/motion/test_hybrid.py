@@ -638,3 +638,52 @@ def test_a_start_or_goal_on_an_edge_is_refused_naming_it():
     # a hair off it, the way out is found (and the same flight a hair further off)
     res = plan(block, (60.01, 50, 0.0), (90, 90), R)
     check_path(block, res, (60.01, 50, 0.0), (90, 90), R)
+
+
+# -- Ctrl-C -------------------------------------------------------------------------------
+
+def _interrupted(monkeypatch, handler):
+    """The 0.5 m query of the default budget's test (about 55,000 expansions) with
+    ``handler`` as SIGINT's and a SIGINT as its forward search starts (the second, after
+    the 500 expansions the other way): tests/search/sigint.py."""
+    from skyroute.motion import hybrid_search
+    from tests.search.sigint import interrupted
+
+    world = make_world([(45, 0, 55, 60)])
+    query = (world, (20, 20, 0.0), (80, 20, 0.0), 0.5)
+    plan(*query, max_expansions=5000)  # compiled, and the same tables built
+    out = interrupted(monkeypatch, hybrid_search, lambda: plan(*query), handler, at=2)
+    return out, query
+
+
+def test_ctrl_c_stops_a_long_search_inside_the_compiled_loop_and_frees_it(monkeypatch):
+    """Hybrid A*'s default budget is 10,000,000 expansions (minutes), in one compiled
+    call that Ctrl-C could not stop: the signal's handler ran when it returned. It polls
+    every 4,096 expansions and returns; the handler runs after, from Python, so nothing
+    of the search stays allocated (skyroute.search.interrupt)."""
+    from skyroute.result import BUDGET_EXHAUSTED
+    from skyroute.search.interrupt import INTERRUPTED
+
+    class SigintError(Exception):
+        pass
+
+    def handler(signum, frame):
+        raise SigintError
+
+    (out, statuses, (allocs, frees)), _ = _interrupted(monkeypatch, handler)
+    assert isinstance(out, SigintError)
+    assert statuses == [BUDGET_EXHAUSTED, INTERRUPTED]  # stopped inside, not at its end
+    assert allocs > 0 and frees == allocs
+
+
+def test_a_sigint_handler_that_does_not_raise_lets_the_search_end(monkeypatch):
+    from skyroute.result import BUDGET_EXHAUSTED, FOUND
+    from skyroute.search.interrupt import INTERRUPTED
+
+    calls = []
+    (out, statuses, _), query = _interrupted(monkeypatch, lambda signum, frame: calls.append(1))
+    assert calls == [1]
+    assert statuses == [BUDGET_EXHAUSTED, INTERRUPTED, FOUND]
+    alone = plan(*query)
+    assert out.found and (out.length, out.expanded) == (alone.length, alone.expanded)
+    assert out.segments == alone.segments

@@ -3,7 +3,6 @@
 import functools
 import json
 import math
-import os
 from collections import deque
 
 import numpy as np
@@ -14,6 +13,7 @@ from hypothesis import strategies as st
 
 import skyroute
 from skyroute.motion.step_drone import HOVER, STEP, Flight, follow, plan_moves
+from skyroute.search import interrupt
 from tests.conftest import SHARED
 
 ILP = SHARED / "ilp2021"
@@ -260,57 +260,21 @@ def test_a_budget_beyond_an_int64_is_no_budget():
 
 
 def _interrupted(world, monkeypatch, handler):
-    """plan_moves on the HARD pair with ``handler`` as SIGINT's and a SIGINT sent 0.3 s
-    in (a few seconds before its end): (the flight or the exception it raised, the
-    statuses its compiled searches returned, the numba runtime's allocations and frees
-    during the call)."""
-    import gc
-    import signal
-    import threading
-
-    from numba.core.runtime import _nrt_python, rtsys
-
+    """plan_moves on the HARD pair with ``handler`` as SIGINT's and a SIGINT as its
+    search starts (tests/search/sigint.py)."""
     from skyroute.motion import move_search
+    from tests.search.sigint import interrupted
 
     plan_moves(world, AT, (-3.1913, 55.9455))  # compiled and the corner table built
-    statuses = []
-    search = move_search.search
-
-    def spy(*args):
-        out = search(*args)
-        statuses.append(out[0])
-        return out
-
-    monkeypatch.setattr(move_search, "search", spy)
-    old = signal.signal(signal.SIGINT, handler)
-    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
-    _nrt_python.memsys_enable_stats()
-    try:
-        before = rtsys.get_allocation_stats()
-        timer.start()
-        try:
-            out = plan_moves(world, *HARD)
-        except Exception as exc:  # returned for the test to check
-            out = exc
-            out.__traceback__ = None  # (its frames hold what the search returned)
-        gc.collect()
-        after = rtsys.get_allocation_stats()
-    finally:
-        _nrt_python.memsys_disable_stats()
-        timer.cancel()
-        timer.join()
-        signal.signal(signal.SIGINT, old)
-    return out, statuses, (after.alloc - before.alloc, after.free - before.free)
+    return interrupted(monkeypatch, move_search, lambda: plan_moves(world, *HARD), handler)
 
 
 def test_ctrl_c_stops_a_long_search_inside_the_compiled_loop_and_frees_it(world,
                                                                           monkeypatch):
     """The compiled search polls every 4,096 expansions; SIGINT's handler runs once the
-    search has returned (:data:`move_search.INTERRUPTED`), so its exception is raised
+    search has returned (:data:`interrupt.INTERRUPTED`), so its exception is raised
     from Python, not through the compiled frames: raised there (the handler ran in the
     poll) it left the search's arrays allocated, about 25 MB a Ctrl-C a few seconds in."""
-    from skyroute.motion import move_search
-
     class SigintError(Exception):
         pass
 
@@ -320,19 +284,17 @@ def test_ctrl_c_stops_a_long_search_inside_the_compiled_loop_and_frees_it(world,
     out, statuses, (allocs, frees) = _interrupted(world, monkeypatch, handler)
     assert isinstance(out, SigintError)
     assert allocs > 0 and frees == allocs
-    assert statuses == [move_search.INTERRUPTED]  # stopped inside, not run to its end
+    assert statuses == [interrupt.INTERRUPTED]  # stopped inside, not run to its end
 
 
 def test_a_sigint_handler_that_does_not_raise_lets_the_search_end(world, monkeypatch):
     """A handler that returns (as the CLI's does for a second Ctrl-C while the first one
     unwinds) did not stop the search when it ran in the poll; the search cut short for it
     is run again, and the flight found."""
-    from skyroute.motion import move_search
-
     calls = []
     out, statuses, _ = _interrupted(world, monkeypatch, lambda signum, frame: calls.append(1))
     assert calls == [1]
-    assert statuses == [move_search.INTERRUPTED, skyroute.result.FOUND]
+    assert statuses == [interrupt.INTERRUPTED, skyroute.result.FOUND]
     assert out.found and out.moves == 36
 
 

@@ -212,3 +212,45 @@ def test_property_a_world_route_is_free_and_drives_along_its_headings(
     steps = gap(np.roll(ang, -1), ang)
     assert all(np.isclose(steps, t, rtol=0, atol=1e-9).any() for t in turns)
     assert res.distance == pytest.approx(float(np.hypot(*d.T).sum()), abs=1e-9)
+
+
+def _boxed_goal_grid():
+    """A 200 x 200 grid whose goal cell (196, 197) is walled in (12 wall cells round 3):
+    the search expands the other 39,985 cells' 8 states each, then ends in no_path."""
+    from skyroute.world.grid import Grid
+
+    b = np.zeros((200, 200), bool)
+    b[195, 195:198] = b[199, 195:198] = True
+    b[195:200, 195] = b[195:200, 197] = True
+    return Grid(b), (0, 0), (196, 197)
+
+
+@pytest.mark.parametrize("raises", [True, False])
+def test_ctrl_c_stops_the_compiled_search_and_frees_it(monkeypatch, raises):
+    """The lattice's search is one compiled call (a fine raster's: seconds and more); it
+    polls every 4,096 expansions (skyroute.search.interrupt): a SIGINT handler that raises
+    does so after the search has returned, so nothing of it stays allocated, and one that
+    does not lets it run again to the end."""
+    from skyroute.motion import turn_lattice
+    from skyroute.result import NO_PATH
+    from skyroute.search.interrupt import INTERRUPTED
+    from tests.search.sigint import interrupted
+
+    class SigintError(Exception):
+        pass
+
+    def handler(signum, frame):
+        if raises:
+            raise SigintError
+
+    grid, s, t = _boxed_goal_grid()
+    alone = plan_turns(grid, s, t)
+    assert alone.status is skyroute.Status.NO_PATH and alone.expanded == 8 * (200 * 200 - 15)
+    out, statuses, (allocs, frees) = interrupted(
+        monkeypatch, turn_lattice, lambda: plan_turns(grid, s, t), handler,
+        kernel="_lattice_kernel")
+    if raises:
+        assert isinstance(out, SigintError) and statuses == [INTERRUPTED]
+        assert allocs > 0 and frees == allocs
+    else:
+        assert statuses == [INTERRUPTED, NO_PATH] and out.expanded == alone.expanded

@@ -172,6 +172,20 @@ def run_cli(app: typer.Typer) -> None:
         sys.unraisablehook = hook
         for sig, handler in before.items():
             signal.signal(sig, handler)
+        _forget_interrupts_in_exec()
+
+
+def _forget_interrupts_in_exec() -> None:
+    """Clear CPython's note that a KeyboardInterrupt left an ``exec`` of source text.
+
+    CPython notes it whenever one does (``run_eval_code_obj``), even when a caller
+    catches it, and ``python -m`` then ends the process by SIGINT after the teardown,
+    whatever the exit code: ``python -m skyroute`` exited -2 (a shell shows 130 either
+    way) after ``skyroute: interrupted`` about one Ctrl-C in eight in the first seconds
+    of ``fly`` or ``plan-world``, which import numba: dataclasses make their methods by
+    ``exec`` of source, and the Ctrl-C landed in one. Each such ``exec`` clears the note
+    first, so an empty one clears it; the command's exit code stands."""
+    exec("")
 
 
 def _signal_exit(signum, signals: _Signals | None) -> None:

@@ -415,7 +415,16 @@ def _sigint_blocked():
     second or so a spawned worker took to start Python and reach that initializer
     printed a KeyboardInterrupt traceback from multiprocessing's ``spawn_main`` (each
     worker one) over ``skyroute: interrupted``. This process still gets the signal:
-    another thread takes it for the main one, or this thread once it is unblocked."""
+    another thread takes it for the main one, or this thread once it is unblocked.
+
+    multiprocessing's resource tracker is started first: the first spawn or semaphore
+    of a process starts it, and that unblocks SIGINT in the thread that does
+    (``resource_tracker.ensure_running`` blocks it around the tracker's spawn, then
+    unblocks it whatever it was): the in-process Dask cluster's event loop, inheriting
+    this block, started its workers deaf to nothing."""
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
     old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
@@ -536,18 +545,29 @@ class DaskExecutor(_Executor):
         # deadlocks the process (seen in the test suite). Finalise such leftovers now.
         gc.collect()
         if address is None:
-            self._cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
-                                         threads_per_worker=1, processes=True,
-                                         dashboard_address=None,
-                                         # its HTTP routes (no dashboard) on a free
-                                         # port: at distributed's default (8787), a
-                                         # second cluster or any server there made a
-                                         # "Port 8787 is already in use" warning
-                                         scheduler_kwargs={
-                                             "dashboard_address": "127.0.0.1:0"},
-                                         silence_logs=logging.ERROR,
-                                         preload=["skyroute.jobs.local_worker"])
-            self.client = Client(self._cluster)
+            # SIGINT blocked while the cluster starts: its event loop's thread, and the
+            # threads that thread starts, inherit the mask, and so do the worker
+            # processes they spawn (as the local pool's, _sigint_blocked). A Ctrl-C in
+            # the seconds a worker took to import distributed, before its preload
+            # (local_worker) ignores SIGINT, printed its KeyboardInterrupt traceback,
+            # "Nanny failed to start" and, at exit, distributed's close_clusters
+            # AssertionError (Status.init). The Ctrl-C is taken once the cluster is up,
+            # and closes it.
+            try:
+                with _sigint_blocked():
+                    self._cluster = LocalCluster(
+                        n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
+                        processes=True, dashboard_address=None,
+                        # its HTTP routes (no dashboard) on a free port: at distributed's
+                        # default (8787), a second cluster or any server there made a
+                        # "Port 8787 is already in use" warning
+                        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                        silence_logs=logging.ERROR, preload=["skyroute.jobs.local_worker"])
+                    self.client = Client(self._cluster)
+            except BaseException:
+                if hasattr(self, "client"):  # up, when a signal held meanwhile was taken
+                    self.close()
+                raise
         else:
             if not isinstance(address, str):
                 raise OptionError(f"address={address!r} must be a scheduler address like "

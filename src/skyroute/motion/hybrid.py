@@ -93,6 +93,7 @@ from skyroute.motion.pieces import (
 )
 from skyroute.motion.smooth import length, shortcut
 from skyroute.result import FOUND, NO_PATH, STATUS_OF_CODE, Status
+from skyroute.search import interrupt
 from skyroute.world.world import World
 
 Pose = tuple[float, float, float]
@@ -218,7 +219,8 @@ def plan(world: World, start, goal, radius: float, *, heading_bins: int = 72,
         a few minutes at most, far above the searches that find a path in city-sized
         worlds at radii of metres, and the guard against a radius tiny beside the world,
         whose lattice has billions of states. Running out says so in ``extra["hint"]``,
-        with the world's size in turning radii.
+        with the world's size in turning radii. Ctrl-C stops the search within 4,096
+        expansions (:mod:`skyroute.search.interrupt`).
     approach : float, optional
         ``goal`` is a runway threshold (x, y, runway heading) and the path ends with a
         straight final approach this long along the runway (:func:`runway_goal`).
@@ -395,12 +397,12 @@ class _Lattice:
             seeds = np.c_[np.tile(sxy, (len(heads), 1)), heads]
         g = self.graph
         code, end, end_head, end_word, end_back, _, expanded, tries, x, y, th, parent, prim = \
-            hybrid_search.search(
-                seeds, float(gxy[0]), float(gxy[1]), 0.0 if gth is None else float(gth),
-                gth is not None, r, self.k, self.u, self.c, float(ref), dth, H,
-                step / math.sqrt(2), self.region, *self.index.args(), g.corners,
-                g.to(gxy), g.edges, *g.grid, _SIGHT_TESTS, _WEIGHT, budget, _EVERY, _WORDS,
-                self.reverse, _BACK_COST, _SWITCH * r)
+            interrupt.run(
+                hybrid_search.search, seeds, float(gxy[0]), float(gxy[1]),
+                0.0 if gth is None else float(gth), gth is not None, r, self.k, self.u,
+                self.c, float(ref), dth, H, step / math.sqrt(2), self.region,
+                *self.index.args(), g.corners, g.to(gxy), g.edges, *g.grid, _SIGHT_TESTS,
+                _WEIGHT, budget, _EVERY, _WORDS, self.reverse, _BACK_COST, _SWITCH * r)
         if code != FOUND:
             return _Found(int(code), int(expanded), int(tries))
         nodes = [end]

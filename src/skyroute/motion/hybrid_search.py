@@ -42,12 +42,13 @@ from skyroute.motion.dubins_kernel import (
 )
 from skyroute.motion.zone_kernels import sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
-from skyroute.search import heap
+from skyroute.search import heap, interrupt
 
 # numba caches these kernels with dubins_kernel's code compiled in (and
-# corner_distance's bound, zone_kernels' sight and edge_grid's bucket walk), keyed by
-# this file's date alone: edit this file when one of those changes (as for ZERO, the
-# words' rounding rule), or a checkout keeps running the old code from the cache.
+# corner_distance's bound, zone_kernels' sight, edge_grid's bucket walk and interrupt's
+# poll), keyed by this file's date alone: edit this file when one of those changes (as
+# for ZERO, the words' rounding rule), or a checkout keeps running the old code from
+# the cache.
 
 TWO_PI = 2 * math.pi
 
@@ -135,7 +136,8 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
     analytic expansion also tries Dubins paths driven wholly in reverse (length times
     ``back_cost``): the forward Dubins path of the vehicle turned round. Returns (status,
     end node, goal heading, word, analytic path driven backwards, best cost, expanded,
-    analytic tries, x, y, th, parent, primitive).
+    analytic tries, x, y, th, parent, primitive); status
+    :data:`skyroute.search.interrupt.INTERRUPTED` when its poll saw a SIGINT (Ctrl-C).
     """
     cap = 4096
     x = np.empty(cap)
@@ -206,6 +208,10 @@ def search(seeds, gx, gy, gth, has_heading, r, prim_k, prim_u, prim_c, ref, dth,
                 continue
         else:
             sees = sight(x[i], y[i], gx, gy, sight_edges, smeta, sstart, sids)
+        if interrupt.stop(expanded):  # nothing of the tree kept (see interrupt)
+            e, none = np.empty(0), np.empty(0, np.int64)
+            return (interrupt.INTERRUPTED, -1, 0.0, -1, False, math.inf, expanded, tries, e,
+                    e, e, none, none)
         if expanded >= max_expansions:
             stopped = True
             break

@@ -10,63 +10,19 @@ first") with lazy deletion; a state not yet expanded takes a shorter route found
 
 from __future__ import annotations
 
-import contextlib
 import math
-import signal
-import sys
-import threading
 
 import numpy as np
-from numba import njit, objmode, types
+from numba import njit, types
 from numba.typed import Dict
 
 from skyroute.motion.corner_distance import approximate, beyond, exact
 from skyroute.motion.zone_kernels import expand, sight
 from skyroute.result import BUDGET_EXHAUSTED, FOUND, NO_PATH
-from skyroute.search import heap
+from skyroute.search import heap, interrupt
 
 _TIE = (1 << 20) - 1
 _HALF = 1 << 31
-_POLL = 4096  # expansions between two returns to the interpreter (for Ctrl-C)
-INTERRUPTED = -1  # search's status when its poll saw a SIGINT noted (interruptible)
-_noted = [False]  # a SIGINT came while interruptible() held the main thread's handler
-
-
-def _note(signum, frame) -> None:
-    _noted[0] = True
-
-
-def _poll() -> int:
-    """Called from the compiled search now and then: the interpreter runs a pending
-    signal's handler here; 1 when a SIGINT was noted (:func:`interruptible`) and this is
-    the main thread's search, which then returns :data:`INTERRUPTED` (a search in
-    another thread goes on)."""
-    return 1 if _noted[0] and threading.current_thread() is threading.main_thread() else 0
-
-
-@contextlib.contextmanager
-def interruptible():
-    """Hold SIGINT while the block runs the compiled search: in the main thread, with a
-    handler set from Python, the signal is only noted (the search's poll sees it and
-    returns, freeing its arrays), and the handler that was in place runs as the block
-    ends: Ctrl-C raises its KeyboardInterrupt from there. Run in the poll, the handler
-    raised through the compiled frames, which left the search's arrays allocated for as
-    long as the process lived (about 25 MB a Ctrl-C a few seconds into an ILP search).
-    Elsewhere nothing changes (no handler runs in another thread's poll). A handler that
-    returns without raising lets the caller search again (:data:`INTERRUPTED`)."""
-    old = signal.getsignal(signal.SIGINT)
-    if threading.current_thread() is not threading.main_thread() or not callable(old):
-        yield
-        return
-    _noted[0] = False
-    signal.signal(signal.SIGINT, _note)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, old)
-        noted, _noted[0] = _noted[0], False
-    if noted:
-        old(signal.SIGINT, sys._getframe(2))  # the frame of the block's caller
 
 
 # numba caches the kernels below with corner_distance's first pass (approximate, beyond,
@@ -141,7 +97,7 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, meta, st
     sight tests are never made.
 
     Returns (status, goal node, expanded, x, y, parent, move index); parent -1 at the start;
-    status :data:`INTERRUPTED` when its poll saw a SIGINT (:func:`interruptible`).
+    status :data:`skyroute.search.interrupt.INTERRUPTED` when its poll saw a SIGINT.
     """
     cap = 4096
     x = np.empty(cap)
@@ -188,12 +144,9 @@ def search(sx, sy, tx, ty, sees0, deltas, edges, owner, nzones, bedges, meta, st
                 size += 1
                 continue
         closed[i] = True
-        if expanded % _POLL == _POLL - 1:
-            with objmode(stop="int64"):
-                stop = _poll()
-            if stop:  # nothing of the tree kept: a traceback may hold what is returned
-                none = np.empty(0, np.int64)
-                return INTERRUPTED, -1, expanded, np.empty(0), np.empty(0), none, none
+        if interrupt.stop(expanded):  # nothing of the tree kept (see interrupt)
+            none = np.empty(0, np.int64)
+            return interrupt.INTERRUPTED, -1, expanded, np.empty(0), np.empty(0), none, none
         if expanded >= max_expansions:
             return BUDGET_EXHAUSTED, -1, expanded, x[:n], y[:n], parent[:n], move[:n]
         expanded += 1

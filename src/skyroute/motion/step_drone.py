@@ -41,6 +41,7 @@ from skyroute.keywords import strict_keywords, unknown_keywords
 from skyroute.motion import edge_grid, move_search
 from skyroute.motion.zone_kernels import zone_arrays
 from skyroute.result import FOUND, STATUS_OF_CODE, Status
+from skyroute.search import interrupt
 from skyroute.world.geometry import convex_corners
 from skyroute.world.world import World
 
@@ -285,12 +286,9 @@ def plan_moves(world: World, start, goal=None, *, step: float = STEP,
     deltas = step * np.c_[np.cos(rad), np.sin(rad)]
     bound = _bound(world, t)
     sees0 = bool(world.segments_free([s], [t])[0])
-    status = move_search.INTERRUPTED
-    while status == move_search.INTERRUPTED:  # again when SIGINT's handler did not raise
-        with move_search.interruptible():
-            status, end, expanded, x, y, parent, move = move_search.search(
-                s[0], s[1], t[0], t[1], sees0, deltas, *_zones(world), bound.cols,
-                bound.dist, step, merge, max_expansions, 1e-12)
+    status, end, expanded, x, y, parent, move = interrupt.run(
+        move_search.search, s[0], s[1], t[0], t[1], sees0, deltas, *_zones(world),
+        bound.cols, bound.dist, step, merge, max_expansions, 1e-12)
     seconds = time.perf_counter() - t0
     if status != FOUND:
         return _empty(s, STATUS_OF_CODE[status], expanded, seconds)
