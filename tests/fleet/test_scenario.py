@@ -89,6 +89,9 @@ def test_a_scenario_saved_with_a_byte_order_mark_and_crlf_loads(tmp_path, suffix
      "airports[0].landing.heading_deg: Input should be less than 360"),
     (lambda y: y.replace("mode: layers", "mode: stacked"),
      "airspace.mode: Input should be 'layers' or 'shared'"),
+    # pydantic's own message named the Python class ("instance of Drone")
+    (lambda y: re.sub(r"drone:\n(  .*\n)+", "drone: 3\n", y),
+     "bad.yaml:40: drone: expected a mapping of fields, not 3"),
     (lambda y: y + "  : [\n", "not YAML"),
     (lambda y: y.replace("cruise_speed: 50.0", "cruise_speed: .inf"),
      "drone.cruise_speed: Input should be a finite number"),

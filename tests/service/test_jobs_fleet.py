@@ -316,6 +316,10 @@ RINGED = ringed()
      "no cruise can join airports C and A: zones 'west', 'east' close a ring round C"),
     ("/jobs/fleet", {"scenario": {**SEED3, "packages": [1]}}, "scenario.packages",
      "expected a mapping"),
+    # pydantic's own message named the Python class ("instance of PostedScenario")
+    ("/jobs/fleet", {"scenario": 5}, "scenario", "expected a mapping of scenario fields, not 5"),
+    ("/jobs/fleet", {"scenario": {**SEED3, "drone": [1]}}, "scenario.drone",
+     "expected a mapping of fields, not [1]"),
     # ran on SQLite; on PostgreSQL the run was flown, then not stored: a raw SQL error
     ("/jobs/fleet", {"scenario": {**SEED3, "name": "Zoë\x00"}}, "scenario.name",
      "'Zoë\\x00' holds a NUL character, which a PostgreSQL store cannot keep"),

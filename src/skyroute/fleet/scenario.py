@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import re
+import reprlib
 import tomllib
 from pathlib import Path
 from typing import Annotated, Literal
@@ -238,7 +239,6 @@ class Packages(_Strict):
 class Airspace(_Strict):
     """Cruise levels and separation minima."""
 
-    mode: Literal["layers", "shared"] = "layers"
     mode: Literal["layers", "shared"] = Field("layers", description="layers: a cruise "
                                               "level per drone; shared: levels by bearing")
     sep_horizontal: float = Field(default=50.0, gt=0, description="metres")
@@ -524,6 +524,10 @@ def first_error(exc: ValidationError, model: type[BaseModel] = Scenario) -> tupl
     loc, msg = tuple(err["loc"]), err["msg"].removeprefix("Value error, ")
     if err["type"] == "extra_forbidden":  # a typo: say what the section takes
         msg = _unknown_key(loc, model)
+    elif err["type"] in ("model_type", "model_attributes_type"):  # pydantic's named the
+        # Python class ("instance of Drone", "object to extract fields from")
+        msg = (f"expected a mapping of {'fields' if loc else 'scenario fields'}, not "
+               f"{reprlib.repr(err['input'])}")
     named = None if loc else _FIELD.match(msg)
     if named:  # a check of several fields (at the model level) names its own field
         loc, msg = _loc(named.group(1)), msg[named.end():]

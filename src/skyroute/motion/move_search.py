@@ -26,8 +26,9 @@ _HALF = 1 << 31
 
 
 # numba caches the kernels below with corner_distance's first pass (approximate, beyond,
-# exact), zone_kernels' tests and the heap compiled in, keyed by this file's date alone:
-# edit this file when one of those changes, or a checkout keeps running the old code.
+# exact), zone_kernels' tests, the heap and interrupt's poll compiled in, keyed by this
+# file's date alone: edit this file when one of those changes, or a checkout keeps
+# running the old code.
 
 
 @njit(cache=True)
