@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import copy
 import itertools
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -161,6 +163,26 @@ def test_optimal_sends_only_ready_drones_and_handles_nothing_to_do():
                             drones=[(1, 0, 0.0), (2, 1, 10.0)], travel=travel) == []
     assert dispatch.optimal(now=0.0, packages=[(5, 1, 0.0)],
                             drones=[(1, 0, 0.0), (2, 1, 500.0)], travel=travel) == [(1, 5)]
+
+
+LAZY = """
+import sys
+import numpy as np
+import skyroute.fleet.simulate, skyroute.jobs.fleet
+from skyroute.fleet import dispatch
+print("scipy.optimize" in sys.modules)
+print(dispatch.optimal(now=0.0, packages=[(5, 1, 0.0)], drones=[(1, 0, 0.0)],
+                       travel=np.array([[0.0, 100.0], [100.0, 0.0]])))
+"""
+
+
+def test_the_simulation_and_the_jobs_import_the_optimal_rules_solver_when_it_runs():
+    """scipy.optimize (about 0.7 s of CPU to import) is not loaded by a process that
+    runs the seed rule (the default) or only names the schedulers."""
+    done = subprocess.run([sys.executable, "-c", LAZY], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[:2] == ["False", "[(1, 5)]"]
 
 
 # ------------------------------------------------------------------ timetables

@@ -53,8 +53,12 @@ def config_id(c) -> str:
     return "-".join(map(str, c))
 
 
-@pytest.fixture(params=CONFIGS, ids=config_id)
+@pytest.fixture(scope="module", params=CONFIGS, ids=config_id)
 def config(request) -> tuple[Simulation, dict]:
+    """Module scope: pytest runs each configuration's tests one after another, so
+    pytest-xdist hands them to one process in one batch; with a function scope it ran
+    them test by test over all 60 configurations, and both processes simulated most of
+    them (about 30 s of CPU twice)."""
     return simulated(*request.param)
 
 

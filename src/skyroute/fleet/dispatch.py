@@ -33,7 +33,6 @@ answer (a package spawns, a drone becomes ready) and releases the pairs it retur
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 SCHEDULERS = ("seed", "optimal")
 AGE_WEIGHT = 0.1
@@ -76,6 +75,11 @@ def optimal(*, now: float, packages, drones, travel,
     sorted by drone."""
     if not packages or not drones:
         return []
+    # here, not at the top: scipy.optimize takes about 0.7 s CPU to import, and a run
+    # with the seed rule (the default), a worker or a server that only names the
+    # schedulers never calls it
+    from scipy.optimize import linear_sum_assignment
+
     pa = np.array([a for _, a, _ in packages], dtype=np.int64)
     age = now - np.array([t for _, _, t in packages])
     da = np.array([a for _, a, _ in drones], dtype=np.int64)
