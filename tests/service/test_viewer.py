@@ -750,7 +750,8 @@ def test_a_run_stored_without_packages_csv_opens_without_a_console_error(open_pa
 
 def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
     """Runs of one preset, hours and seed were the same line in the run list (31 of them
-    could not be told apart); each line now starts with when the run was stored."""
+    could not be told apart); each line now starts with when the run was stored (to the
+    minute, or the second where two share a minute; whole in its tooltip)."""
     if server[1] is None:
         pytest.skip("skyroute.jobs is not in this tree: no fleet run")
     with _copied_run(server) as copy:
@@ -760,8 +761,11 @@ def test_fleet_runs_of_the_same_settings_are_told_apart(open_page, server):
         labels = p.locator("#run option").all_inner_texts()
         assert len(labels) == 2 and labels[0] != labels[1], labels
         assert p.input_value("#run") == copy  # the newest first
-        when = r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d · seed-3x3"
+        when = r"\d\d? [A-Z][a-z]{2}( \d{4})? \d\d:\d\d(:\d\d)? · seed-3x3"
         assert all(re.match(when, x) for x in labels), labels
+        titles = p.eval_on_selector_all("#run option", "os => os.map((o) => o.title)")
+        when = r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d · seed-3x3"
+        assert all(re.match(when, x) for x in titles), titles
         pg.done("fleet-runs")
 
 
@@ -1717,3 +1721,277 @@ def test_the_focus_follows_the_panels_on_a_wide_screen(open_page, server, page):
     by_rows = [i for _, _, i in sorted(seen) if i in visited]
     assert visited == by_rows, (visited, seen)
     assert len(visited) == 4  # the first panel, the map's player, the job form, the tables
+
+
+# -- empty maps, long run labels, answers of another shape, the site's failures -----------
+
+NOTE_OVER_MAP = """() => {
+  const note = document.querySelector('.map-empty');
+  if (!note || note.hidden) return null;
+  const n = note.getBoundingClientRect();
+  const c = document.querySelector('#map').getBoundingClientRect();
+  return { text: note.innerText, inside: n.left >= c.left - 1 && n.right <= c.right + 1
+    && n.top >= c.top - 1 && n.bottom <= c.bottom + 1 && n.height > 20 };
+}"""
+
+
+@pytest.mark.parametrize("size", ["desktop", "phone"])
+@pytest.mark.parametrize("page", ["day", "fleet", "planner", "world", "day-of-nothing"])
+def test_an_empty_map_says_why(open_page, server, page, size):
+    """A map with nothing on it (an empty store's day and fleet pages, the planner whose
+    maps did not load, a day with no flight, no customer's place and no site) was a
+    blank box with no word: it reads as a page that failed to draw. It says there is
+    nothing to draw, and why, over the map; the note goes with the first thing drawn."""
+    pg = open_page({"day": "/day.html", "fleet": "/fleet.html", "planner": "/planner.html",
+                    "world": "/world.html", "day-of-nothing": f"/day.html#date={DAY}"}[page],
+                   size)
+    p = pg.page
+    if page == "day":
+        p.route("**/days", lambda r: r.fulfill(json=[]))
+        why = "Nothing to draw: the store holds no delivery day yet."
+    elif page == "fleet":
+        p.route(re.compile(r"/fleet/runs\?limit="), lambda r: r.fulfill(json=[]))
+        why = "Nothing to draw: no fleet run is stored yet."
+    elif page == "planner":
+        p.route("**/maps", lambda r: r.fulfill(status=500, body="x"))
+        why = "Nothing to draw: the bundled maps could not be read."
+    elif page == "world":
+        why = "Nothing to draw yet: choose or paste a world file."
+    else:  # a day whose orders have no place, without a flight or a site
+        def nowhere(route):
+            d = route.fetch().json()
+            route.fulfill(json={**d, "orders": [{**o, "lonlat": None} for o in d["orders"]]})
+
+        p.route(f"**/days/{DAY}", nowhere)
+        p.route("**/flightpath.geojson", lambda r: r.fulfill(json={
+            "type": "FeatureCollection", "features": [
+                {"type": "Feature", "geometry": None, "properties": {"moves": 0}}]}))
+        p.route("**/site.geojson", lambda r: r.fulfill(
+            status=404, content_type="application/problem+json",
+            body='{"detail": "no site"}'))
+        why = (f"Nothing to draw: {DAY} has no flight and no customer's place, and no site "
+               "is loaded.")
+    p.reload()
+    p.wait_for_function("(() => { const s = document.querySelector('#status');"
+                        " return s.dataset.kind && s.dataset.kind !== 'busy'; })()",
+                        timeout=WAIT)
+    assert p.evaluate(NOTE_OVER_MAP) == {"text": why, "inside": True}
+    if page != "planner":
+        assert _key_inked(p) == 0  # (no scale bar under the note)
+    pg.errors[:] = [e for e in pg.errors if "Failed to load resource" not in e]
+    pg.done(f"empty-map-{page}")
+    if page not in ("planner", "world") or size != "desktop":
+        return
+    # the first thing drawn takes the note away
+    pg = open_page(f"/{page}.html", size)
+    p = pg.page
+    if page == "planner":
+        p.route("**/maps", lambda r: r.fulfill(status=500, body="x"))
+        p.reload()
+        p.wait_for_selector("#status .retry")
+        p.unroute("**/maps")
+        p.click("#status .retry")
+        p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'",
+                            timeout=WAIT)
+    else:
+        _load_city(pg)
+    assert p.evaluate(NOTE_OVER_MAP) is None
+    assert p.is_hidden(".map-empty")
+
+
+LONG_NAME = "Hamburg-Altona harbour feeder network with nine airports (winter timetable)"
+FITS_THE_LIST = """() => {
+  const s = document.querySelector('#run');
+  const cs = getComputedStyle(s);
+  const room = s.clientWidth - parseFloat(cs.paddingLeft) - parseFloat(cs.paddingRight) - 20;
+  const span = document.createElement('span');
+  span.style.font = cs.font;
+  span.style.whiteSpace = 'pre';
+  span.style.position = 'absolute';
+  document.body.append(span);
+  const out = [...s.options].map((o) => {
+    span.textContent = o.text;
+    return span.offsetWidth <= room;
+  });
+  span.remove();
+  return out;
+}"""
+
+
+@pytest.mark.parametrize("size", ["desktop", "phone"])
+def test_long_run_labels_fit_the_list(open_page, server, size):
+    """A run's label (when stored, scenario, hours, seed, packages delivered) is wider
+    than the run list on every screen: the list showed its first 30 letters or so, and
+    a long scenario name hid which run was which. Each option is the longest form of
+    its label that fits the list's width, its whole label its tooltip (the list's too,
+    for the run chosen), and the panel's numbers give every part of it, wrapped."""
+    if server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+
+    def long_runs(route):
+        r = route.fetch()
+        route.fulfill(response=r, json=[{**x, "scenario": LONG_NAME} for x in r.json()])
+
+    def long_detail(route):
+        r = route.fetch()
+        d = r.json()
+        route.fulfill(response=r, json={**d, "scenario": {**d["scenario"], "name": LONG_NAME}})
+
+    with _copied_run(server, params={"hours": 0.25, "seed": 7}) as copy:
+        pg = open_page(f"/fleet.html#run={copy}", size)
+        p = pg.page
+        p.route(re.compile(r"/fleet/runs\?limit="), long_runs)
+        p.route(re.compile(r"/fleet/runs/[^/?]+\?limit=1$"), long_detail)
+        p.reload()
+        p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'"
+                            " && document.querySelector('#time').max > 0", timeout=WAIT)
+        assert p.evaluate(FITS_THE_LIST) == [True, True]
+        texts = p.locator("#run option").all_inner_texts()
+        titles = p.eval_on_selector_all("#run option", "os => os.map((o) => o.title)")
+        assert len(set(texts)) == 2, texts
+        whole = r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d · " + re.escape(LONG_NAME) + \
+            r" · 0\.25 h · seed \d+ · \d+/\d+ delivered"
+        assert all(re.fullmatch(whole, t) for t in titles), titles
+        assert " · seed 7" in titles[0] and " · seed 7" in texts[0]  # the copy: newest
+        assert p.get_attribute("#run", "title") == titles[0]
+        assert LONG_NAME in p.inner_text("#s-scenario")
+        assert re.fullmatch(r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d", p.inner_text("#s-stored"))
+        assert p.inner_text("#s-hours") == "0.25 h, seed 7"
+        p.select_option("#run", server[1])  # the list's tooltip follows the run chosen
+        p.wait_for_function(f"location.hash === '#run={server[1]}'"
+                            " && document.querySelector('#status').dataset.kind === 'ok'",
+                            timeout=WAIT)
+        assert p.get_attribute("#run", "title") == titles[1]
+        pg.done("fleet-long-labels")
+
+
+DAY_GONE_WRONG = f'Reading {DAY} failed: the server\'s answer to /days/{DAY}'
+
+
+@pytest.mark.parametrize(("page", "url", "body", "said"), [
+    # each was the browser's TypeError ("Cannot read properties of undefined (reading
+    # 'map')"), or an exception in the console and a page left on "Loading"
+    ("day", f"**/days/{DAY}", {"orders": []},
+     f'{DAY_GONE_WRONG} is not a stored day: "report" is not an object. Try again'),
+    ("day", "**/flightpath.geojson", {"type": "FeatureCollection", "features": {}},
+     f"{DAY_GONE_WRONG}/flightpath.geojson is not a day's flight (GeoJSON): \"features\" "
+     "is not a list. Try again"),
+    ("day", "**/days", [{"day": DAY}],
+     "Reading the stored days failed: the server's answer to /days is not a list of days: "
+     "\"[0].date\" is not a string. Try again"),
+    ("fleet", "**/fleet.geojson", {"features": 3},
+     "Reading the run failed: the server's answer to /fleet/runs/{run}/fleet.geojson is not "
+     "a fleet's ground (GeoJSON): \"features\" is not a list. Try again"),
+    ("fleet", re.compile(r"/fleet/runs\?limit="), [None],
+     "Reading the fleet runs failed: the server's answer to /fleet/runs is not a list of "
+     "runs: \"[0]\" is not an object. Try again"),
+], ids=["day", "flight", "day-list", "fleet-ground", "run-list"])
+def test_json_of_another_shape_is_said_in_skyroutes_words(open_page, server, page, url,
+                                                          body, said):
+    """JSON of another shape than the page reads (another server's, a proxy's, an older
+    skyroute's) was said in the browser's words, or not at all: one line now names the
+    endpoint and the field, as the other failures are said, with Try again."""
+    if page == "fleet" and server[1] is None:
+        pytest.skip("skyroute.jobs is not in this tree: no fleet run")
+    path = f"/day.html#date={DAY}" if page == "day" else f"/fleet.html#run={server[1]}"
+    pg = open_page(path, "desktop")
+    p = pg.page
+    p.route(url, lambda r: r.fulfill(json=body))
+    p.reload()
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'error'",
+                        timeout=WAIT)
+    assert p.inner_text("#status") == said.replace("{run}", str(server[1]))
+    assert pg.errors == []
+
+
+def test_a_plan_of_another_shape_is_said_in_skyroutes_words(open_page, api):
+    """POST /plan answered with JSON of another shape: the planner threw in the console
+    (``a.status`` of undefined) and left its rows "planning…"."""
+    doc = api.get("/maps/den312d").json()
+    free = _free_cells(doc["rows"], doc["passable"])
+    pg = open_page("/planner.html", "desktop")
+    p = pg.page
+    _open_map(pg, "den312d")
+    p.route("**/plan", lambda r: r.fulfill(json={"path": []}))
+    _type_cells(p, free[0], free[-1])
+    p.click("#run")
+    said = _wait_status(p, "error")
+    assert said == ("Planning failed: the server's answer to /plan is not a plan: "
+                    "\"status\" is not a string."), said
+    assert p.locator("#results tbody tr .tag.bad").count() == 3
+    assert pg.errors == []
+
+
+SHOP_INKED = """() => {
+  const c = document.querySelector('#map');
+  const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+  let n = 0;  // the shops' fill, #e69f00
+  for (let i = 0; i < d.length; i += 4) {
+    if (Math.abs(d[i] - 230) < 8 && Math.abs(d[i + 1] - 159) < 8 && d[i + 2] < 20) n++;
+  }
+  return n;
+}"""
+
+
+READ = """(ends) => ends.every((end) => performance.getEntriesByType('resource')
+  .some((e) => e.name.endsWith(end) && e.responseEnd > 0))"""
+
+
+@pytest.mark.parametrize("how", ["busy", "never-answers", "absent"])
+def test_a_site_that_fails_is_said_with_a_way_to_retry(open_page, how):
+    """GET /site.geojson failing was said on the day's status line, which the day's own
+    line replaced at once: nobody saw it, and nothing asked for the site again. The
+    site has a line of its own under the day's, with Try again (the same time limit as
+    every request: 45 s); the day is drawn without it meanwhile, and with it after."""
+    pg = open_page(f"/day.html#date={DAY}", "desktop")
+    p = pg.page
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'",
+                        timeout=WAIT)
+    assert p.evaluate(SHOP_INKED) > 0 and p.inner_text("#site-status") == ""
+    held = []
+    if how == "busy":
+        p.route("**/site.geojson", lambda r: r.fulfill(
+            status=503, content_type="application/problem+json",
+            body='{"detail": "the store is busy; try again shortly"}'))
+    elif how == "absent":
+        p.route("**/site.geojson", lambda r: r.fulfill(
+            status=404, content_type="application/problem+json",
+            body='{"detail": "this server has no delivery site"}'))
+    else:
+        p.route("**/site.geojson", lambda r: held.append(r))  # taken, never answered
+        p.clock.install()
+    p.reload()
+    if how == "never-answers":
+        # the day is asked beside the site: its answers in before the clock runs on (else
+        # they run out of time too)
+        for _ in range(400):
+            if held and p.evaluate(READ, [f"/days/{DAY}", "/flightpath.geojson"]):
+                break
+            p.wait_for_timeout(50)
+        assert held
+        p.wait_for_timeout(500)  # (their bodies read by the page)
+        p.clock.fast_forward(46_000)  # past api.js's WAIT_MS
+    p.wait_for_function("document.querySelector('#status').dataset.kind === 'ok'",
+                        timeout=WAIT)
+    assert p.inner_text("#status").startswith(f"{DAY}: ")  # the day, drawn without the site
+    assert p.evaluate(SHOP_INKED) == 0
+    said = p.inner_text("#site-status")
+    if how == "absent":
+        assert said == ("No site to draw (the server was started without --data or "
+                        "--source): the flight is shown alone.")
+        assert p.locator("#site-status .retry").count() == 0
+        pg.errors[:] = [e for e in pg.errors if "Failed to load resource" not in e]
+        pg.done("day-without-site")
+        return
+    why = (" (503): the store is busy; try again shortly." if how == "busy"
+           else ": the server did not answer within 45 s.")
+    assert said == f"Reading the site failed{why} The day is drawn without it. Try again", said
+    assert p.evaluate("document.querySelector('#site-status').dataset.kind") == "error"
+    p.unroute("**/site.geojson")  # the server answers again
+    p.click("#site-status .retry")
+    p.wait_for_function("document.querySelector('#site-status').textContent === ''",
+                        timeout=WAIT)
+    assert p.evaluate(SHOP_INKED) > 0  # the day drawn again, over its site
+    assert p.inner_text("#status").startswith(f"{DAY}: ")
+    pg.errors[:] = [e for e in pg.errors if "Failed to load resource" not in e]
+    pg.done(f"day-site-{how}")

@@ -180,20 +180,25 @@ export function bindToken(input) {
 }
 
 /** ``text`` ended as a sentence. */
-function stop(text) {
+export function sentence(text) {
   return /[.!?]$/.test(text) ? text : `${text}.`;
 }
 
-/** One sentence for the user about ``err`` (an ApiError or anything thrown). */
+/** One sentence for the user about ``err`` (an ApiError or anything thrown). Anything
+ * else thrown (a TypeError: the page's own fault, or an answer whose shape no check
+ * caught) is said in skyroute's words, the browser's kept to the console. */
 export function explain(err, what = "the request") {
-  if (!(err instanceof ApiError)) return stop(`${what} failed: ${err && err.message ? err.message : err}`);
+  if (!(err instanceof ApiError)) {
+    console.warn(err);
+    return `${what} failed: the page could not read the server's answer.`;
+  }
   if (err.status === 401) {
     return `${what} needs the server's token: paste it into the Token field ` +
       "(skyroute serve prints it when it starts, or reads SKYROUTE_TOKEN).";
   }
   if (err.status === 403) return `the server refused the token (403): check the Token field.`;
   // no answer, or a 2xx that is not JSON: no status worth saying
-  if (err.status === 0 || err.status < 300) return stop(`${what} failed: ${err.detail}`);
+  if (err.status === 0 || err.status < 300) return sentence(`${what} failed: ${err.detail}`);
   return `${what} failed (${err.status}): ${err.detail}`;
 }
 

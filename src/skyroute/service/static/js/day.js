@@ -6,28 +6,30 @@
 // that a day of invalid orders would otherwise keep) and follows GET /jobs/{id}; deletes
 // a day without a flight (a mistyped date) with DELETE /days/{date}.
 
-import { ApiError, bindToken, choices, explain, focusFault, getJSON, mayPass, postJSON, remove } from "./api.js";
-import { JobFollower } from "./jobs.js";
+import { ApiError, bindToken, choices, explain, focusFault, getJSON, mayPass, postJSON, remove, sentence } from "./api.js";
+import { JobFollower, jobId } from "./jobs.js";
 import { Player } from "./player.js";
+import { Answer, readable } from "./shape.js";
 import { fmt, h, isBusy, pounds, say, setBusy } from "./ui.js";
 import { MapView, bbox, dot, grow, label, localProjection } from "./view.js";
 
 const $ = (id) => document.getElementById(id);
 const status = $("status");
+const siteStatus = $("site-status");
 const jobStatus = $("job-status");
 const select = $("date");
 const tbody = document.querySelector("#orders tbody");
 
 let site = null; // {zones: [[ring, ...]], confinement: ring|null, home, shops, customers} in lon/lat
+let siteRead = null; // the site's read under way
+let siteGone = false; // the server has no site (404): not asked again
 let day = null; // the loaded day, see load()
+let noDay = "Nothing to draw yet: reading the stored days…"; // why no day is shown
 let proj = null;
 let t = 0;
 let loading = 0; // counts the days asked for: only the last one asked is shown
 
-// blank: no day, or one with nothing to place (no flight, no customer, no site)
-const view = new MapView($("map"), {
-  draw: drawMap, blank: () => !day || (!day.coords.length && !site && !day.orders.some((o) => o.lonlat)),
-});
+const view = new MapView($("map"), { draw: drawMap, empty: emptyWhy });
 const player = new Player({
   play: $("play"), speed: $("speed"), slider: $("time"), output: $("time-text"),
   describe: (x) => (day ? `move ${Math.floor(x)} of ${day.moves}` : "move 0 of 0"),
@@ -46,26 +48,81 @@ const player = new Player({
   },
 });
 
+/** Why the map has nothing on it ("" when it has): no day, or a day with nothing to
+ * place (no flight, no customer's place, no site). */
+function emptyWhy() {
+  if (!day) return noDay;
+  if (day.coords.length || site || day.orders.some((o) => o.lonlat)) return "";
+  return `Nothing to draw: ${day.date} has no flight and no customer's place, and no site is loaded.`;
+}
+
+/** GET /site.geojson's features as the map draws them (a point feature of another
+ * geometry, or a kind the page does not know, is left out). */
 function siteFrom(doc) {
   const s = { zones: [], confinement: null, home: null, shops: [], customers: [] };
-  for (const f of doc.features || []) {
+  for (const f of new Answer("/site.geojson", "a delivery site (GeoJSON)").features(doc)) {
     const p = f.properties || {};
     const g = f.geometry;
     if (!g) continue;
+    const point = g.type === "Point";
     if (p.kind === "no_fly_zone") {
       const polys = g.type === "Polygon" ? [g.coordinates] : g.type === "MultiPolygon" ? g.coordinates : [];
       for (const poly of polys) s.zones.push({ rings: poly, name: p.name || "" });
     } else if (p.kind === "confinement" && g.type === "Polygon") {
       s.confinement = g.coordinates[0];
-    } else if (p.kind === "home") {
+    } else if (p.kind === "home" && point) {
       s.home = g.coordinates;
-    } else if (p.kind === "shop") {
-      s.shops.push({ at: g.coordinates, name: p.name || "shop" });
-    } else if (p.kind === "customer") {
+    } else if (p.kind === "shop" && point) {
+      s.shops.push({ at: g.coordinates, name: String(p.name || "shop") });
+    } else if (p.kind === "customer" && point) {
       s.customers.push({ at: g.coordinates, words: p.words || "" });
     }
   }
   return s;
+}
+
+/** GET /days as the list shows it: each with its date. */
+function checkDays(days) {
+  const a = new Answer("/days", "a list of days");
+  return a.list(days, "", (d, f) => {
+    a.object(d, f);
+    a.string(d.date, `${f}.date`);
+    a.maybe(d.money_pct, `${f}.money_pct`, a.number);
+  });
+}
+
+/** GET /days/{date} (at ``where``) and its flightpath.geojson as show() reads them. */
+function checkDay(detail, flight, where) {
+  const a = new Answer(where, "a stored day");
+  a.object(detail);
+  const r = a.object(detail.report, "report");
+  for (const k of ["orders_placed", "orders_delivered", "orders_invalid", "money_placed", "moves", "moves_left"]) {
+    a.number(r[k], `report.${k}`);
+  }
+  a.maybe(r.money_pct, "report.money_pct", a.number);
+  a.maybe(r.settings, "report.settings", a.object);
+  a.list(detail.deliveries, "deliveries", (d, f) => {
+    a.object(d, f);
+    a.string(d.order_no, `${f}.order_no`);
+    a.number(d.cost_in_pence, `${f}.cost_in_pence`);
+  });
+  a.list(detail.orders, "orders", (o, f) => {
+    a.object(o, f);
+    a.string(o.order_no, `${f}.order_no`);
+    a.string(o.status, `${f}.status`);
+    a.list(o.items, `${f}.items`);
+    a.maybe(o.value, `${f}.value`, a.number);
+    a.maybe(o.lonlat, `${f}.lonlat`, a.position);
+  });
+  const g = new Answer(`${where}/flightpath.geojson`, "a day's flight (GeoJSON)");
+  const features = g.features(flight);
+  if (!features.length) g.fail("features", "a list of one flight");
+  g.maybe(features[0].geometry, "features[0].geometry", (geo, f) => {
+    if (geo.type !== "LineString") g.fail(`${f}.type`, "LineString");
+  });
+  const props = features[0].properties || {};
+  g.maybe(props.orders, "features[0].properties.orders", g.list);
+  g.maybe(props.moves, "features[0].properties.moves", g.number);
 }
 
 /** Fill the day list (``wanted`` chosen when stored); false when there is none to show.
@@ -73,16 +130,16 @@ function siteFrom(doc) {
 async function listDays(wanted = null, retry = () => showDays(wanted)) {
   let days;
   try {
-    days = await getJSON("/days");
-    if (!Array.isArray(days)) throw new Error("the server's answer is not a list of days");
+    days = checkDays(await getJSON("/days"));
   } catch (err) {
     say(status, explain(err, "Reading the stored days"), "error", { retry: mayPass(err) ? retry : null });
+    if (!day) sayNoDay("Nothing to draw: the stored days could not be read.");
     return false;
   }
   if (!days.length) {
     select.replaceChildren(h("option", {}, "no stored days"));
     select.disabled = true;
-    showNoDay();
+    showNoDay("Nothing to draw: the store holds no delivery day yet.");
     // a day is flown from the store's orders: a fresh store has none to fly
     say(status, "The store holds no delivery day yet. Import a day's orders (skyroute db import " +
       "DIR --db URL) and fly it below, or fly it with skyroute deliver DATE --data DIR --db URL.", "info");
@@ -108,26 +165,48 @@ async function start() {
   if (job) await jobs.follow(job);
 }
 
-/** The day list, the site and a day: ``wanted`` when stored, else the newest (and, when
- * ``linked`` (the page's address named it), a note that it is not stored). */
+/** The day list and a day (with the site): ``wanted`` when stored, else the newest
+ * (and, when ``linked`` (the page's address named it), a note that it is not stored). */
 async function showDays(wanted = null, { linked = false } = {}) {
   if (!(await listDays(wanted, () => showDays(wanted, { linked })))) return;
-  await loadSite();
   // a link to a day the store does not hold says so, not just shows another day
   await load(select.value, linked && wanted && select.value !== wanted ? `The link names ${wanted}, ` +
     `which is not a stored day; this is ${select.value}. ` : "");
 }
 
-async function loadSite() {
-  if (site) return;
+/** The site read, if it is not yet (again after a failure that may pass: by the next
+ * day shown, or the site line's Try again). It never fails: a failure is said on the
+ * site's own line (the day's line, said after it, took its place), and the day is drawn
+ * without it. */
+function siteReady() {
+  if (site || siteGone) return Promise.resolve();
+  siteRead = siteRead || readSite().finally(() => {
+    siteRead = null;
+  });
+  return siteRead;
+}
+
+async function readSite() {
   try {
     site = siteFrom(await getJSON("/site.geojson"));
+    say(siteStatus, "");
   } catch (err) {
     site = null;
-    const why = err instanceof ApiError && err.status === 404 ? "the server was started without --data or --source"
-      : explain(err, "reading the site");
-    say(status, `No site to draw (${why}): the flight is shown alone.`, "info");
+    if (err instanceof ApiError && err.status === 404) {
+      siteGone = true;
+      say(siteStatus, "No site to draw (the server was started without --data or --source): " +
+        "the flight is shown alone.", "info");
+    } else {
+      say(siteStatus, `${sentence(explain(err, "Reading the site"))} The day is drawn without it.`, "error",
+        { retry: mayPass(err) ? retrySite : null });
+    }
   }
+}
+
+async function retrySite() {
+  say(siteStatus, "Reading the site…", "busy");
+  await siteReady();
+  if (site && day) place(); // the day shown, now over its site
 }
 
 // -- flying a day as a job -------------------------------------------------------
@@ -145,7 +224,6 @@ const jobs = new JobFollower({
         "flight can be deleted above.", "error");
     }
     if (!(await listDays(r.from))) return;
-    await loadSite();
     await load(select.value);
   },
 });
@@ -175,7 +253,7 @@ $("job").addEventListener("submit", async (ev) => {
   say(jobStatus, `Submitting ${date}…`, "busy");
   let id;
   try {
-    ({ id } = await postJSON("/jobs/deliver", { date, method: $("method").value, replace }));
+    id = jobId(await postJSON("/jobs/deliver", { date, method: $("method").value, replace }), "/jobs/deliver");
   } catch (err) {
     say(jobStatus, explain(err, `Flying ${date}`), "error");
     focusFault(err, { date: "job-date", method: "method", replace: "replace" });
@@ -190,15 +268,16 @@ async function load(date, note = "") {
   player.pause();
   const mine = ++loading;
   say(status, `Loading ${date}…`, "busy");
+  const where = `/days/${encodeURIComponent(date)}`;
   let detail, flight;
   try {
-    [detail, flight] = await Promise.all([
-      getJSON(`/days/${encodeURIComponent(date)}`),
-      getJSON(`/days/${encodeURIComponent(date)}/flightpath.geojson`),
-    ]);
+    // the site (when not yet read) asked beside the day: the day is drawn over it
+    [detail, flight] = await Promise.all([getJSON(where), getJSON(`${where}/flightpath.geojson`), siteReady()]);
+    checkDay(detail, flight, where);
   } catch (err) {
     if (mine !== loading) return;
     say(status, explain(err, `Reading ${date}`), "error", { retry: mayPass(err) ? () => load(date, note) : null });
+    if (!day) sayNoDay(`Nothing to draw: ${date} could not be read.`);
     // a day deleted since the list was read goes from it; the list shows the day shown
     // again (left on the failed one, choosing that one again asked nothing)
     if (err instanceof ApiError && err.status === 404) [...select.options].find((o) => o.value === date)?.remove();
@@ -209,11 +288,10 @@ async function load(date, note = "") {
   try {
     show(date, detail, flight, note);
   } catch (err) {
-    // an answer of another shape (another server, a proxy's JSON): said, not a page
-    // left on "Loading…" with an exception in the console
-    showNoDay();
-    say(status, `Reading ${date} failed: the server's answer is not a stored day as this page ` +
-      `reads one (${err.message}).`, "error");
+    // a shape checkDay let pass: said in skyroute's words, not a page left on
+    // "Loading…" with an exception in the console
+    showNoDay(`Nothing to draw: ${date} could not be read.`);
+    say(status, explain(readable(err, where, "a stored day"), `Reading ${date}`), "error");
   }
 }
 
@@ -231,24 +309,10 @@ function show(date, detail, flight, note) {
   const deliveries = detail.deliveries.map((d) => ({ ...d, at: doneAt.get(d.order_no) ?? moves }));
   const battery = detail.report.settings && detail.report.settings.battery
     ? detail.report.settings.battery : detail.report.moves + detail.report.moves_left;
-  day = { date, report: detail.report, orders: detail.orders || [], deliveries, coords, moves, battery, cost, doneAt };
+  day = { date, report: detail.report, orders: detail.orders, deliveries, coords, moves, battery, cost, doneAt };
   history.replaceState(null, "", `#date=${date}`);
   if ([...select.options].some((o) => o.value === date)) select.value = date; // (asked again)
-
-  // the plane: metres around the middle of everything drawn
-  const ll = [...coords];
-  if (site) {
-    if (site.confinement) ll.push(...site.confinement);
-    for (const z of site.zones) ll.push(...z.rings[0]);
-    for (const s of site.shops) ll.push(s.at);
-  }
-  for (const o of day.orders) if (o.lonlat) ll.push(o.lonlat);
-  if (!ll.length) ll.push([0, 0]);
-  const b = bbox(ll);
-  proj = localProjection((b[0] + b[2]) / 2, (b[1] + b[3]) / 2);
-  day.xy = coords.map(proj.fwd);
-  view.setBounds(grow(bbox(ll.map(proj.fwd)), 0.03, 5));
-
+  place();
   fillOrders();
   player.load(moves, 1);
   // a day without a flight (a mistyped date, no orders to fly) may be deleted
@@ -265,8 +329,33 @@ function show(date, detail, flight, note) {
     `${detail.report.moves_left} moves of battery left at the end.`;
 }
 
-/** The page without a day (the store holds none): an empty map, table and numbers. */
-function showNoDay() {
+/** Say ``why`` on the empty map (no day is shown; the address keeps the day linked). */
+function sayNoDay(why) {
+  noDay = why;
+  view.render();
+}
+
+/** The plane of the day shown: metres around the middle of everything drawn (its
+ * flight and customers, the site), fitted to the map; drawn again. */
+function place() {
+  const ll = [...day.coords];
+  if (site) {
+    if (site.confinement) ll.push(...site.confinement);
+    for (const z of site.zones) ll.push(...z.rings[0]);
+    for (const s of site.shops) ll.push(s.at);
+  }
+  for (const o of day.orders) if (o.lonlat) ll.push(o.lonlat);
+  if (!ll.length) ll.push([0, 0]);
+  const b = bbox(ll);
+  proj = localProjection((b[0] + b[2]) / 2, (b[1] + b[3]) / 2);
+  day.xy = day.coords.map(proj.fwd);
+  view.setBounds(grow(bbox(ll.map(proj.fwd)), 0.03, 5));
+}
+
+/** The page without a day (``why``: the store holds none, it could not be read): an
+ * empty map saying so, an empty table and numbers. */
+function showNoDay(why) {
+  noDay = why;
   day = null;
   player.load(0, 1);
   tbody.replaceChildren();

@@ -8,8 +8,10 @@
 
 import { ApiError, bindToken, choices, explain, focusFault, getJSON, getPage, getText, mayPass, postJSON } from "./api.js";
 import { EventFold, dronesAt, parseEvents, parseRoutes, parseTracks, runEnd, trail } from "./fleetstate.js";
-import { JobFollower } from "./jobs.js";
+import { JobFollower, jobId } from "./jobs.js";
 import { Player } from "./player.js";
+import { fitsIn, runLabel, runLabels, runParts } from "./runlabels.js";
+import { Answer, readable } from "./shape.js";
 import { PALETTE, clock, fmt, h, isBusy, say, setBusy } from "./ui.js";
 import { MapView, bbox, dot, grow, label, localProjection } from "./view.js";
 
@@ -33,8 +35,9 @@ let t = 0;
 let lastTables = 0;
 let loading = 0; // counts the runs asked for: only the last one asked is shown
 let missing = null; // a run the page's link (#run=) names that the store does not hold
+let noRun = "Nothing to draw yet: reading the stored runs…"; // why no run is shown
 
-const view = new MapView($("map"), { draw: drawMap, blank: () => !run });
+const view = new MapView($("map"), { draw: drawMap, empty: emptyWhy });
 const player = new Player({
   play: $("play"), speed: $("speed"), slider: $("time"), output: $("time-text"),
   describe: (x) => (run ? `${clock(x)} of ${clock(run.horizon)}` : "0:00"),
@@ -54,46 +57,82 @@ const player = new Player({
 });
 bindToken($("token"));
 
+/** Why the map has nothing on it ("" when it has): no run, or one with nothing to place. */
+function emptyWhy() {
+  if (!run) return noRun;
+  const g = run.ground;
+  return run.tracks.n || g.airports.length || g.gates.length || g.runways.length || g.zones.length ? ""
+    : "Nothing to draw: this run has no airports, no no-fly zones and no tracks.";
+}
+
 function colour(d, count) {
   if (count <= PALETTE.length) return PALETTE[d % PALETTE.length];
   return `hsl(${(d * 137.508) % 360}, 65%, 42%)`;
 }
 
-function stored(iso) {
-  const d = new Date(iso);
-  if (!iso || Number.isNaN(d.getTime())) return null;
-  const two = (n) => String(n).padStart(2, "0");
-  return `${d.getFullYear()}-${two(d.getMonth() + 1)}-${two(d.getDate())} ` +
-    `${two(d.getHours())}:${two(d.getMinutes())}:${two(d.getSeconds())}`;
+/** GET /fleet/runs's page (at ``where``) as the list reads it: runs with their ids. */
+function checkRuns(items, where) {
+  const a = new Answer(where, "a list of runs");
+  return a.list(items, "", (r, f) => {
+    a.object(r, f);
+    if (typeof r.id !== "number") a.string(r.id, `${f}.id`);
+    for (const k of ["params", "report"]) a.maybe(r[k], `${f}.${k}`, a.object);
+    for (const k of ["scenario", "created"]) a.maybe(r[k], `${f}.${k}`, a.string);
+  });
 }
 
-function runLabel(r, { when = true } = {}) {
-  const p = r.params || {};
-  const rep = r.report || {};
-  const hours = p.hours ?? rep.simulated_hours;
-  const seed = p.seed ?? (rep.settings || {}).seed;
-  const parts = [r.scenario || "scenario"];
-  if (hours !== undefined) parts.push(`${fmt(hours, 2)} h`);
-  if (seed !== undefined) parts.push(`seed ${seed}`);
-  if (rep.delivered !== undefined) parts.push(`${rep.delivered}/${rep.offered} delivered`);
-  const at = when ? stored(r.created) : null; // runs of the same settings differ by it
-  return (at ? [at, ...parts] : parts).join(" · ");
+/** A run's GET /fleet/runs/{id} and fleet.geojson (at ``where``) as show() reads them. */
+function checkRun(detail, geo, where) {
+  const a = new Answer(where, "a fleet run");
+  a.object(detail);
+  for (const k of ["scenario", "params", "report", "files"]) a.maybe(detail[k], k, a.object);
+  new Answer(`${where}/fleet.geojson`, "a fleet's ground (GeoJSON)").features(geo);
 }
 
 function showRuns() {
-  // a label twice (runs stored in one second, or by a server without their time) gets
-  // the run's id, so that every run in the list can be told apart
   const keep = runSelect.value;
-  const labels = runs.map((r) => runLabel(r));
-  const twice = new Set(labels.filter((x, i) => labels.indexOf(x) !== i));
-  runSelect.replaceChildren(...runs.map((r, i) => h("option", { value: r.id },
-    twice.has(labels[i]) ? `${labels[i]} · run ${String(r.id).slice(0, 8)}` : labels[i])));
+  runSelect.replaceChildren(...runs.map((r) => h("option", { value: r.id })));
+  labelRuns();
   if (runs.some((r) => String(r.id) === keep)) runSelect.value = keep;
+  chosenTitle();
   moreRuns.hidden = !nextRuns;
   const n = runs.length;
   runCount.textContent = !n ? "" : nextRuns ? `The newest ${n} runs are listed; older ones follow.`
     : n === 1 ? "" : `All ${n} stored runs are listed, newest first.`;
 }
+
+/** Label the listed runs to fit the list's width (runlabels.js): each the longest form
+ * of its label that fits, its whole label its tooltip. Labels alike (runs stored in one
+ * minute, or in one second, or by a server without their time) say more (the seconds,
+ * then the run's id), so that every run in the list can be told apart. */
+function labelRuns() {
+  const options = [...runSelect.options];
+  if (options.length !== runs.length || options.some((o, i) => o.value !== String(runs[i].id))) return;
+  const fits = fitsIn(runSelect);
+  let labels = runs.map((r) => runLabels(r, fits));
+  for (let alike = 1; alike <= 2; alike++) {
+    const shorts = labels.map((l) => l.short);
+    const twice = new Set(shorts.filter((x, i) => shorts.indexOf(x) !== i));
+    if (!twice.size) break;
+    labels = labels.map((l, i) => (twice.has(l.short) ? runLabels(runs[i], fits, alike) : l));
+  }
+  options.forEach((o, i) => {
+    o.textContent = labels[i].short;
+    o.title = labels[i].whole;
+  });
+}
+
+/** The list's tooltip: the whole label of the run chosen. */
+function chosenTitle() {
+  runSelect.title = runSelect.selectedOptions[0] ? runSelect.selectedOptions[0].title : "";
+}
+
+let listWidth = 0;
+new ResizeObserver(() => {
+  if (runSelect.clientWidth === listWidth) return;
+  listWidth = runSelect.clientWidth;
+  labelRuns();
+}).observe(runSelect);
 
 /** List the runs (``select`` chosen when listed) and show one; a failure says so with a
  * way to ask again. */
@@ -106,11 +145,13 @@ async function listRuns(select = null) {
   let page;
   try {
     page = await getPage(`/fleet/runs?limit=${RUNS_PAGE}`);
-    if (!Array.isArray(page.items)) throw new Error("the server's answer is not a list of runs");
+    checkRuns(page.items, "/fleet/runs");
   } catch (err) {
     if (mine !== listing) return false;
     runSelect.replaceChildren(h("option", {}, "no runs"));
     moreRuns.hidden = true;
+    if (!run) noRun = "Nothing to draw: the stored runs could not be read.";
+    view.render();
     // the server's own words: a 503 is an installation without fleet runs (for good) or
     // a store busy or out of reach (for now; it says which)
     const gone = err instanceof ApiError && err.status === 503 && /not available/.test(err.detail);
@@ -125,6 +166,8 @@ async function listRuns(select = null) {
     showRuns(); // (an empty list) before the line that says so, which it replaced
     runSelect.replaceChildren(h("option", {}, "no stored runs"));
     runSelect.disabled = true;
+    noRun = "Nothing to draw: no fleet run is stored yet.";
+    view.render();
     say(status, "No fleet run is stored yet: start one below.", "info");
     return false;
   }
@@ -133,8 +176,10 @@ async function listRuns(select = null) {
   if (wanted && nextRuns && !runs.some((r) => String(r.id) === wanted)) {
     // a run older than the first page (a link to run 101): listed last until its page is
     try {
-      const d = await getJSON(`/fleet/runs/${encodeURIComponent(wanted)}?limit=1`);
+      const where = `/fleet/runs/${encodeURIComponent(wanted)}`;
+      const d = await getJSON(`${where}?limit=1`);
       if (mine !== listing) return false;
+      checkRun(d, { features: [] }, where);
       runs.push({ id: String(d.id), scenario: (d.scenario || {}).name, params: d.params, report: d.report });
       outOfPage = String(d.id);
     } catch {
@@ -156,6 +201,7 @@ async function listOlderRuns() {
   let page;
   try {
     page = await getPage(nextRuns);
+    checkRuns(page.items, "/fleet/runs");
   } catch (err) {
     setBusy(moreRuns, false);
     showRuns();
@@ -190,12 +236,15 @@ async function load(id) {
       getJSON(`${base}/fleet.geojson`),
       // routes known from the start (else from events); asked for only where the run's
       // files name it: a run stored without it is a 404, a console error in the browser
-      asked.then((d) => ((d.files || {})["packages.csv"] ? getText(`${base}/packages.csv`) : null))
+      asked.then((d) => (((d && d.files) || {})["packages.csv"] ? getText(`${base}/packages.csv`) : null))
         .catch(() => null),
     ]);
+    checkRun(detail, geo, base);
   } catch (err) {
     if (mine !== loading) return;
     say(status, explain(err, "Reading the run"), "error", { retry: mayPass(err) ? () => load(id) : null });
+    if (!run) noRun = "Nothing to draw: the run could not be read.";
+    view.render();
     // a run deleted since the list was read goes from it; the list shows the run shown
     // again (left on the failed one, choosing that one again asked nothing)
     if (err instanceof ApiError && err.status === 404) {
@@ -211,7 +260,7 @@ async function load(id) {
   } catch (err) {
     // a file of another shape (cut short, another server's): said, not a page left on
     // "Loading run…" with an exception in the console
-    say(status, `Reading the run failed: ${err.message}.`, "error");
+    say(status, explain(readable(err, base, "a fleet run"), "Reading the run"), "error");
   }
 }
 
@@ -231,12 +280,13 @@ function show(id, entry, detail, tracksText, eventsText, geo, routesText) {
     const p = f.properties || {};
     const g = f.geometry;
     if (!g) continue;
-    if (p.kind === "airport") ground.airports.push({ id: p.id, at: proj.fwd(g.coordinates) });
-    else if (p.kind === "gate") ground.gates.push({ airport: p.airport, gate: p.gate, at: proj.fwd(g.coordinates) });
-    else if (p.kind === "landing" || p.kind === "takeoff") {
+    const point = g.type === "Point";
+    if (p.kind === "airport" && point) ground.airports.push({ id: String(p.id), at: proj.fwd(g.coordinates) });
+    else if (p.kind === "gate" && point) ground.gates.push({ airport: p.airport, gate: p.gate, at: proj.fwd(g.coordinates) });
+    else if ((p.kind === "landing" || p.kind === "takeoff") && g.type === "LineString") {
       ground.runways.push({ kind: p.kind, airport: p.airport, line: g.coordinates.map((c) => proj.fwd(c)) });
     } else if (p.kind === "no_fly_zone" && g.type === "Polygon") {
-      ground.zones.push({ name: p.name, ring: g.coordinates[0].map((c) => proj.fwd(c)) });
+      ground.zones.push({ name: String(p.name || ""), ring: g.coordinates[0].map((c) => proj.fwd(c)) });
     }
   }
   const rep = detail.report || entry.report || {};
@@ -250,12 +300,17 @@ function show(id, entry, detail, tracksText, eventsText, geo, routesText) {
     ...ground.zones.flatMap((z) => z.ring)];
   let b = bbox(pts);
   for (let i = 0; i < tracks.n; i++) b = bbox([[tracks.east[i], tracks.north[i]]], b);
+  if (!Number.isFinite(b[0])) b = [0, 0, 1000, 600]; // nothing to place: the map says so
   run = {
     id, name: runLabel(entry, { when: false }), tracks, drones, horizon, ground,
     fold: new EventFold(events, routesText ? parseRoutes(routesText) : null),
   };
   history.replaceState(null, "", `#run=${encodeURIComponent(id)}`);
   if (runs.some((r) => String(r.id) === String(id))) runSelect.value = id; // (asked again)
+  chosenTitle();
+  const parts = runParts({ ...entry, params, report: rep });
+  $("s-stored").textContent = parts.at ? parts.at.whole : "–";
+  $("s-hours").textContent = [parts.hours, parts.seed].filter(Boolean).join(", ") || "–";
   $("s-scenario").textContent = `${scenario.name || entry.scenario || "–"}, ${params.scheduler || (rep.settings || {}).scheduler || "seed"} dispatch`;
   $("s-size").textContent = `${ground.airports.length} airports, ${drones} drones`;
   $("s-delivered").textContent = rep.delivered === undefined ? "–" : `${rep.delivered} of ${rep.offered} packages`;
@@ -382,7 +437,7 @@ $("job").addEventListener("submit", async (ev) => {
   say(jobStatus, "Submitting the run…", "busy");
   let id;
   try {
-    ({ id } = await postJSON("/jobs/fleet", body));
+    id = jobId(await postJSON("/jobs/fleet", body), "/jobs/fleet");
   } catch (err) {
     say(jobStatus, explain(err, "Starting the run"), "error");
     focusFault(err, { hours: "hours", seed: "seed", preset: "preset", scheduler: "scheduler" });

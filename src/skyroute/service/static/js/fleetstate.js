@@ -2,6 +2,8 @@
 // sorted by time then drone; a drone at its gate has no rows) in typed arrays, and the
 // state of every drone and package at a time t, folded from the events (events.jsonl).
 
+import { ShapeError } from "./shape.js";
+
 export const PARKED = "at gate";
 
 /**
@@ -23,7 +25,7 @@ export function parseTracks(text) {
   const header = (lines[0] || "").trim().split(",");
   const col = Object.fromEntries(header.map((name, i) => [name, i]));
   for (const name of ["t", "drone", "north", "east", "alt", "phase"]) {
-    if (!(name in col)) throw new Error(`tracks.csv has no column ${name}`);
+    if (!(name in col)) throw new ShapeError(`tracks.csv has no column ${name}`);
   }
   let n = 0;
   for (let i = 1; i < lines.length; i++) if (lines[i]) n++;
@@ -40,6 +42,9 @@ export function parseTracks(text) {
     const line = lines[i];
     if (!line) continue;
     const f = line.split(",");
+    if (f.length < header.length) {
+      throw new ShapeError(`tracks.csv line ${i + 1} has ${f.length} fields, not ${header.length}`);
+    }
     t[k] = +f[col.t];
     drone[k] = +f[col.drone];
     north[k] = +f[col.north];
@@ -82,7 +87,7 @@ export function parseEvents(text) {
       e = null;
     }
     if (!e || typeof e !== "object" || typeof e.t !== "number") {
-      throw new Error(`events.jsonl line ${i + 1} is not an event (a JSON object with a time t)`);
+      throw new ShapeError(`events.jsonl line ${i + 1} is not an event (a JSON object with a time t)`);
     }
     events.push(e);
   });
@@ -92,6 +97,7 @@ export function parseEvents(text) {
 /** packages.csv -> Map id -> {from, to}. */
 export function parseRoutes(text) {
   const lines = text.split("\n").filter((line) => line.trim());
+  if (!lines.length) throw new ShapeError("packages.csv is empty (it has no header line)");
   const header = lines[0].split(",");
   const at = (name) => header.indexOf(name);
   const [id, from, to] = [at("id"), at("from_airport"), at("to_airport")];

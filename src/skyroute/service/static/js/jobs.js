@@ -5,12 +5,29 @@
 // page and back) goes on following it; a server that does not answer is asked again.
 
 import { explain, getJSON, mayPass } from "./api.js";
+import { Answer } from "./shape.js";
 import { clock, fmt, say, setBusy } from "./ui.js";
 
 const POLL_MS = 500;
 export const RETRY_MS = 3000; // between polls while the server does not answer
 
 const pause = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+/** The id in the answer to a job's POST at ``where`` (``/jobs/fleet``). */
+export function jobId(answer, where) {
+  const a = new Answer(where, "a job");
+  return a.string(a.object(answer).id, "id");
+}
+
+/** GET /jobs/{id}'s answer (at ``where``) as it is followed. */
+function checkJob(job, where) {
+  const a = new Answer(where, "a job");
+  a.object(job);
+  a.string(job.state, "state");
+  a.maybe(job.progress, "progress", a.number);
+  a.maybe(job.error, "error", a.string);
+  return job;
+}
 
 export class JobFollower {
   /**
@@ -62,7 +79,8 @@ export class JobFollower {
         let job;
         try {
           // with the token that submitted it: a failed job's error is shown in full
-          job = await getJSON(`/jobs/${encodeURIComponent(id)}`, { token: true });
+          const where = `/jobs/${encodeURIComponent(id)}`;
+          job = checkJob(await getJSON(where, { token: true }), where);
         } catch (err) {
           if (mayPass(err)) { // no answer (or none in time), a 5xx, a proxy's page: for now
             say(line, `${explain(err, following)} Asking again every ${RETRY_MS / 1000} s…`, "error");

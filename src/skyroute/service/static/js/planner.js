@@ -4,8 +4,9 @@
 // Reads GET /maps and /maps/{name}; plans with POST /plan (one request per algorithm).
 
 import { PLAN_WAIT_MS, bindToken, choices, explain, focusFault, getJSON, mayPass, postJSON } from "./api.js";
+import { Answer, checkPlan } from "./shape.js";
 import { PALETTE, fmt, h, isBusy, say, setBusy } from "./ui.js";
-import { KEY, drawScaleBar } from "./view.js";
+import { EmptyNote, KEY, drawScaleBar } from "./view.js";
 
 const $ = (id) => document.getElementById(id);
 const status = $("status");
@@ -22,8 +23,32 @@ let cell = 1; // CSS pixels per cell; the map fills the canvas's top, the key st
 let results = []; // [{algorithm, colour, answer|null, error|null}]
 let round = 0; // discards answers of an older query
 let loading = 0; // counts the maps asked for: only the last one asked is shown
+const note = new EmptyNote(canvas); // why no map is drawn
 
 bindToken($("token"));
+
+/** GET /maps as the list shows it: each map's name and size. */
+function checkMaps(maps) {
+  const a = new Answer("/maps", "a list of maps");
+  return a.list(maps, "", (m, f) => {
+    a.object(m, f);
+    a.string(m.name, `${f}.name`);
+    for (const k of ["width", "height"]) a.number(m[k], `${f}.${k}`);
+  });
+}
+
+/** GET /maps/{name} (at ``where``) as the canvas draws it: a width and a height of
+ * whole cells, a row of text a line, the passable letters. */
+function checkMap(doc, where) {
+  const a = new Answer(where, "a map");
+  a.object(doc);
+  for (const k of ["width", "height"]) {
+    if (!(Number.isInteger(doc[k]) && doc[k] > 0)) a.fail(k, "a whole number of cells");
+  }
+  a.list(doc.rows, "rows", a.string);
+  a.maybe(doc.passable, "passable", a.string);
+  return doc;
+}
 
 function terrain(ch, passable) {
   if (passable.includes(ch)) return ch === "S" ? [223, 233, 216] : [255, 255, 255];
@@ -37,15 +62,13 @@ async function loadMap(name) {
   say(status, `Loading ${name}…`, "busy");
   let doc;
   try {
-    doc = await getJSON(`/maps/${encodeURIComponent(name)}`);
-    const { width, height, rows } = doc || {};
-    if (!(Number.isInteger(width) && width > 0 && Number.isInteger(height) && height > 0 && Array.isArray(rows))) {
-      throw new Error("the server's answer is not a map (width, height and rows)");
-    }
+    const where = `/maps/${encodeURIComponent(name)}`;
+    doc = checkMap(await getJSON(where), where);
   } catch (err) {
     if (mine !== loading) return;
     say(status, explain(err, `Reading map ${name}`), "error", { retry: mayPass(err) ? () => loadMap(name) : null });
     if (grid) mapSelect.value = grid.name; // the map shown: choosing the failed one asks again
+    else note.show(`Nothing to draw: map ${name} could not be read.`);
     return;
   }
   if (mine !== loading) return; // another map was chosen while this one was read
@@ -72,6 +95,7 @@ async function loadMap(name) {
   }
   ictx.putImageData(data, 0, 0);
   grid = { name, width, height, free, image };
+  note.show("");
   for (const id of ["sx", "gx"]) $(id).max = String(width - 1);
   for (const id of ["sy", "gy"]) $(id).max = String(height - 1);
   for (const id of ["sx", "sy", "gx", "gy"]) $(id).value = "";
@@ -84,7 +108,10 @@ async function loadMap(name) {
 }
 
 function resize() {
-  if (!grid) return;
+  if (!grid) {
+    note.show(); // (placed over the canvas's new size)
+    return;
+  }
   const wrap = canvas.parentElement;
   const most = wrap.clientWidth - 18; // the figure's padding
   const tallest = Math.max(240, window.innerHeight * 0.72) - KEY;
@@ -237,8 +264,8 @@ async function plan() {
   try {
     for (const r of results) {
       try {
-        r.answer = await postJSON("/plan", { map: grid.name, start, goal, algorithm: r.algorithm, ...options },
-          { wait: PLAN_WAIT_MS });
+        r.answer = checkPlan(await postJSON("/plan", { map: grid.name, start, goal, algorithm: r.algorithm, ...options },
+          { wait: PLAN_WAIT_MS }));
       } catch (err) {
         r.error = err;
         if (err.status === 401 || err.status === 403) {
@@ -309,16 +336,18 @@ async function start() {
 /** The map list, and its first map shown; a failure says so with a way to ask again. */
 async function listMaps() {
   say(status, "Loading the bundled maps…", "busy");
+  if (!grid) note.show("Nothing to draw yet: reading the bundled maps…");
   let maps;
   try {
-    maps = await getJSON("/maps");
-    if (!Array.isArray(maps)) throw new Error("the server's answer is not a list of maps");
+    maps = checkMaps(await getJSON("/maps"));
   } catch (err) {
     say(status, explain(err, "Reading the bundled maps"), "error", { retry: mayPass(err) ? listMaps : null });
+    if (!grid) note.show("Nothing to draw: the bundled maps could not be read.");
     return;
   }
   if (!maps.length) {
     say(status, "This server has no bundled maps.", "error");
+    note.show("Nothing to draw: this server has no bundled maps.");
     return;
   }
   mapSelect.replaceChildren(...maps.map((m) => h("option", { value: m.name }, `${m.name} (${m.width} × ${m.height})`)));

@@ -45,17 +45,52 @@ const PAD = 14; // CSS pixels round the plotted region
 // runway.
 export const KEY = 30; // (the planner's canvas has the same strip)
 
+/** A line over a map's plotted region (``canvas`` above its key strip of ``key`` px)
+ * saying why there is nothing on it: an empty canvas read as a page that failed to
+ * draw. A paragraph after the canvas (read after the map's label by a screen reader),
+ * placed over it; the canvas's figure is its positioned parent (viewer.css). */
+export class EmptyNote {
+  constructor(canvas, key = KEY) {
+    this.canvas = canvas;
+    this.key = key;
+    this.text = "";
+    this.el = document.createElement("p");
+    this.el.className = "map-empty";
+    this.el.hidden = true;
+    canvas.after(this.el);
+  }
+
+  /** Show ``text`` over the canvas (the one shown: placed again), or nothing (null, ""). */
+  show(text = this.text) {
+    const el = this.el;
+    this.text = text || "";
+    if (!text) {
+      el.hidden = true;
+      return;
+    }
+    if (el.textContent !== text) el.textContent = text;
+    el.hidden = false;
+    const c = this.canvas;
+    Object.assign(el.style, {
+      left: `${c.offsetLeft}px`, top: `${c.offsetTop}px`, width: `${c.offsetWidth}px`,
+      height: `${Math.max(c.offsetHeight - this.key, 0)}px`,
+    });
+  }
+}
+
 /** A canvas showing the plane region ``bounds`` (x east, y north) at the largest scale
  * that fits above the key strip, redrawn by ``draw(ctx, view)`` on ``render()`` and
- * whenever its width changes. While ``blank()`` is true (nothing loaded yet, or nothing
- * to load) the key strip is left empty: a scale bar and a north arrow over an empty map
- * measure and orient nothing, and read as a map that failed to draw. */
+ * whenever its width changes. While ``empty()`` gives a reason (nothing loaded yet, or
+ * nothing to load: a sentence, "" or null when there is something to draw) the map says
+ * it (``EmptyNote``) and its key strip is left empty: a scale bar and a north arrow over
+ * an empty map measure and orient nothing, and read as a map that failed to draw. */
 export class MapView {
-  constructor(canvas, { draw, blank = () => false, maxShare = 0.72, minHeight = 240, unit = "m", north = true } = {}) {
+  constructor(canvas, { draw, empty = () => "", maxShare = 0.72, minHeight = 240, unit = "m", north = true } = {}) {
     this.canvas = canvas;
     this.ctx = canvas.getContext("2d");
     this.draw = draw;
-    this.blank = blank;
+    this.empty = empty;
+    this.note = new EmptyNote(canvas);
     this.maxShare = maxShare;
     this.minHeight = minHeight;
     this.unit = unit;
@@ -116,7 +151,9 @@ export class MapView {
     ctx.fillStyle = "#fbfcfd";
     ctx.fillRect(0, 0, this.width, this.height);
     if (this.draw) this.draw(ctx, this);
-    if (this.blank()) return;
+    const why = this.empty();
+    this.note.show(why);
+    if (why) return;
     drawScaleBar(ctx, this.scale, this.unit, 12, this.height - 8);
     if (this.north) drawNorthArrow(ctx, this.width - 14, this.height - KEY + 4);
   }

@@ -6,6 +6,7 @@
 // file's lat0, lon0); GeoJSON zones in "lonlat" (points are lon, lat).
 
 import { PLAN_WAIT_MS, bindToken, choices, explain, focusFault, postJSON } from "./api.js";
+import { checkPlan } from "./shape.js";
 import { download, fmt, h, isBusy, say, setBusy } from "./ui.js";
 import { MapView, bbox, grow, localProjection } from "./view.js";
 
@@ -17,7 +18,9 @@ let world = null; // {format, frame, text, name, shapes: [{ring (plane), floor, 
 let answer = null;
 let round = 0;
 
-const view = new MapView($("map"), { draw: drawMap, blank: () => !world });
+let noWorld = "Nothing to draw yet: choose or paste a world file."; // why no world is drawn
+
+const view = new MapView($("map"), { draw: drawMap, empty: () => (world ? "" : noWorld) });
 bindToken($("token"));
 
 // -- reading a world file in the page (for drawing and for checking clicks) ----------
@@ -73,6 +76,7 @@ function loadText(text, name) {
   clearResult();
   if (!text.trim()) {
     world = null;
+    noWorld = "Nothing to draw yet: choose or paste a world file.";
     view.render();
     return;
   }
@@ -81,6 +85,7 @@ function loadText(text, name) {
     world = format === "geojson" ? parseGeojson(text) : parseColliders(text);
   } catch (err) {
     world = null;
+    noWorld = `Nothing to draw: ${name} could not be read as a world (the line below says why).`;
     say(status, `${name}: ${err.message} (as ${format === "geojson" ? "GeoJSON" : "a colliders CSV"}).`, "error");
     view.render();
     return;
@@ -150,12 +155,7 @@ function point(prefix) {
 }
 
 function drawMap(ctx, v) {
-  if (!world) {
-    ctx.fillStyle = "#5b6475";
-    ctx.font = "14px system-ui, sans-serif";
-    ctx.fillText("Choose or paste a world file.", 16, 28);
-    return;
-  }
+  if (!world) return;
   if (world.boundary) {
     v.path(world.boundary, true);
     ctx.setLineDash([6, 4]);
@@ -321,7 +321,7 @@ async function plan() {
   setBusy($("run"), true);
   say(status, `Planning with ${body.algorithm}…`, "busy");
   try {
-    const a = await postJSON("/plan", body, { wait: PLAN_WAIT_MS });
+    const a = checkPlan(await postJSON("/plan", body, { wait: PLAN_WAIT_MS }));
     if (mine !== round) return;
     answer = a;
     showResult();
