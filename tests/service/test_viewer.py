@@ -381,7 +381,9 @@ def test_the_planner_plans_under_its_csp(open_page, api):
     p.locator("#map-name option").nth(1).wait_for(state="attached")
     p.fill("#token", TOKEN)
     p.select_option("#map-name", "den312d")
-    p.locator("#status", has_text="den312d").wait_for()
+    # the map drawn ("den312d: W x H cells..."), not "Loading den312d...": Plan pressed
+    # before the map is in does nothing, and no result row ever came (a loaded CI)
+    p.locator("#status", has_text="den312d: ").wait_for(timeout=WAIT)
     _type_cells(p, free[0], free[-1])
     p.click("#run")
     p.locator("#results tbody tr").nth(2).wait_for(timeout=WAIT)
